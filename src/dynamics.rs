@@ -1,0 +1,356 @@
+//! Equations of motion of the viscoelastic-legged rimless wheel (MODEL.md sections 1-2, paper Eq. (1)).
+//!
+//! The wheel is described by `q = [x, z, theta, L1, L2]` in the slope frame (`x` down the slope, `z` normal to
+//! it). `(x, z)` is the tip of Leg 1, `theta` the angle of Leg 1 from the slope normal, `L1`, `L2` the lengths of
+//! Leg 1 and Leg 2. Every body is a point mass (the hub, and one sliding mass per leg at distance `a` from the
+//! tip) plus the hub's rotational inertia, so the equations are assembled from point kinematics:
+//!
+//! ```text
+//! M(q)    = sum_i m_i J_i^T J_i + IH e_theta e_theta^T
+//! h(q,q') = sum_i m_i J_i^T (dJ_i/dt q' + g_n) + dV_spring/dq + damping
+//! ```
+//!
+//! with `J_i = dp_i/dq` and `g_n = g (-sin phi, cos phi)` (minus the gravity vector). This is exactly Lagrange's
+//! equations for the energies of MODEL.md section 2 (the tests check it against finite differences of `T` and
+//! `V`).
+
+use nalgebra::{SMatrix, SVector, Vector2};
+
+use crate::params::{ConfigError, Params};
+
+/// Number of generalized coordinates.
+pub const NQ: usize = 5;
+/// Generalized coordinates or velocities `[x, z, theta, L1, L2]`.
+pub type Coords = SVector<f64, NQ>;
+/// A 5x5 matrix over the generalized coordinates.
+pub type Mat5 = SMatrix<f64, NQ, NQ>;
+/// Jacobian of a planar point with respect to `q`.
+pub type PointJacobian = SMatrix<f64, 2, NQ>;
+
+/// Index of `x` in `q`.
+pub const X: usize = 0;
+/// Index of `z` in `q`.
+pub const Z: usize = 1;
+/// Index of `theta` in `q`.
+pub const THETA: usize = 2;
+/// Index of `L1` (length of Leg 1) in `q`.
+pub const L1: usize = 3;
+/// Index of `L2` (length of Leg 2) in `q`.
+pub const L2: usize = 4;
+
+/// Position, Jacobian and velocity-product acceleration of one point of the wheel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointKinematics {
+    /// Position in the slope frame [m].
+    pub position: Vector2<f64>,
+    /// `J = dp/dq`.
+    pub jacobian: PointJacobian,
+    /// `dJ/dt q'`: the acceleration of the point when `q'' = 0` [m/s^2].
+    pub velocity_product: Vector2<f64>,
+}
+
+impl PointKinematics {
+    /// Velocity `J q'` of the point [m/s].
+    pub fn velocity(&self, qd: &Coords) -> Vector2<f64> {
+        self.jacobian * qd
+    }
+}
+
+/// Which leg of the wheel, counted from Leg 1 (`j = 0`) in the direction of Leg 2 (`j = 1`); the next leg to
+/// touch down is `j = N - 1` (MODEL.md section 1: `psi_j = theta + j alpha`).
+pub type LegIndex = usize;
+
+/// The validated model: parameters plus precomputed leg-angle offsets.
+#[derive(Debug, Clone)]
+pub struct Model {
+    params: Params,
+    alpha: f64,
+    /// `(sin j alpha, cos j alpha)` for `j = 0..N`.
+    offsets: Vec<(f64, f64)>,
+    /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame [m/s^2].
+    up: Vector2<f64>,
+}
+
+impl Model {
+    /// Validate the parameters and build the model.
+    pub fn new(params: &Params) -> Result<Model, ConfigError> {
+        params.validate()?;
+        let alpha = params.alpha();
+        let offsets = (0..params.legs)
+            .map(|j| {
+                let a = j as f64 * alpha;
+                (a.sin(), a.cos())
+            })
+            .collect();
+        let up = params.gravity * Vector2::new(-params.slope.sin(), params.slope.cos());
+        Ok(Model {
+            params: params.clone(),
+            alpha,
+            offsets,
+            up,
+        })
+    }
+
+    /// The parameters this model was built from.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Inter-leg angle `alpha = 2 pi / N` [rad].
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// Number of legs `N`.
+    pub fn legs(&self) -> usize {
+        self.offsets.len()
+    }
+
+    /// Index of the next leg to touch down (`j = -1`, i.e. `N - 1`).
+    pub fn front_leg(&self) -> LegIndex {
+        self.legs() - 1
+    }
+
+    /// Total mass `mH + N m` [kg].
+    pub fn total_mass(&self) -> f64 {
+        self.params.hub_mass + self.legs() as f64 * self.params.leg_mass
+    }
+
+    /// Length of leg `j`: `L1`, `L2` from `q`, the stopper length `L0` for the locked legs (MODEL.md section 2).
+    pub fn leg_length(&self, q: &Coords, j: LegIndex) -> (f64, Option<usize>) {
+        match j {
+            0 => (q[L1], Some(L1)),
+            1 => (q[L2], Some(L2)),
+            _ => (self.params.stopper_length, None),
+        }
+    }
+
+    /// Hub kinematics: `p_H = (x + L1 sin theta, z + L1 cos theta)` (MODEL.md section 1).
+    pub fn hub(&self, q: &Coords, qd: &Coords) -> PointKinematics {
+        let (s, c) = q[THETA].sin_cos();
+        let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
+        let mut jac = PointJacobian::zeros();
+        jac[(0, X)] = 1.0;
+        jac[(1, Z)] = 1.0;
+        jac[(0, THETA)] = l1 * c;
+        jac[(1, THETA)] = -l1 * s;
+        jac[(0, L1)] = s;
+        jac[(1, L1)] = c;
+        PointKinematics {
+            position: Vector2::new(q[X] + l1 * s, q[Z] + l1 * c),
+            jacobian: jac,
+            velocity_product: Vector2::new(
+                2.0 * dl1 * c * w - l1 * s * w * w,
+                -2.0 * dl1 * s * w - l1 * c * w * w,
+            ),
+        }
+    }
+
+    /// A point on leg `j` at distance `from_tip` from its tip, `p = p_H + (L_j - from_tip) e(psi_j)` with
+    /// `e(psi) = (-sin psi, -cos psi)`, given the hub kinematics `hub`.
+    pub fn leg_point_from_hub(
+        &self,
+        hub: &PointKinematics,
+        q: &Coords,
+        qd: &Coords,
+        j: LegIndex,
+        from_tip: f64,
+    ) -> PointKinematics {
+        let (sj, cj) = self.offsets[j];
+        let (st, ct) = q[THETA].sin_cos();
+        // psi = theta + j alpha
+        let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
+        let e = Vector2::new(-sp, -cp);
+        let e_psi = Vector2::new(-cp, sp);
+        let (length, length_index) = self.leg_length(q, j);
+        let d = length - from_tip;
+        let dd = length_index.map_or(0.0, |i| qd[i]);
+        let w = qd[THETA];
+        let mut jac = hub.jacobian;
+        if let Some(i) = length_index {
+            jac[(0, i)] += e.x;
+            jac[(1, i)] += e.y;
+        }
+        jac[(0, THETA)] += d * e_psi.x;
+        jac[(1, THETA)] += d * e_psi.y;
+        PointKinematics {
+            position: hub.position + d * e,
+            jacobian: jac,
+            velocity_product: hub.velocity_product + 2.0 * dd * w * e_psi - d * w * w * e,
+        }
+    }
+
+    /// The tip of leg `j`.
+    pub fn tip(&self, q: &Coords, qd: &Coords, j: LegIndex) -> PointKinematics {
+        let hub = self.hub(q, qd);
+        self.leg_point_from_hub(&hub, q, qd, j, 0.0)
+    }
+
+    /// Height of the tip of leg `j` above the slope [m] (no Jacobian; cheap, for event functions).
+    pub fn tip_height(&self, q: &Coords, j: LegIndex) -> f64 {
+        let (sj, cj) = self.offsets[j];
+        let (st, ct) = q[THETA].sin_cos();
+        let cp = ct * cj - st * sj;
+        let (length, _) = self.leg_length(q, j);
+        q[Z] + q[L1] * ct - length * cp
+    }
+
+    /// Mass matrix `M(q)` and bias vector `h(q, q')` of Eq. (1): Coriolis/centrifugal terms, gravity, the leg
+    /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (MODEL.md section 2).
+    pub fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+        let p = &self.params;
+        let hub = self.hub(q, qd);
+        let mut m = p.hub_mass * hub.jacobian.transpose() * hub.jacobian;
+        let mut h = p.hub_mass * hub.jacobian.transpose() * (hub.velocity_product + self.up);
+        m[(THETA, THETA)] += p.hub_inertia;
+        for j in 0..self.legs() {
+            let leg = self.leg_point_from_hub(&hub, q, qd, j, p.leg_mass_offset);
+            let jt = leg.jacobian.transpose();
+            m += p.leg_mass * jt * leg.jacobian;
+            h += p.leg_mass * jt * (leg.velocity_product + self.up);
+        }
+        h[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
+        h[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
+        (m, h)
+    }
+
+    /// Mass matrix `M(q)` alone.
+    pub fn mass_matrix(&self, q: &Coords) -> Mat5 {
+        self.mass_and_bias(q, &Coords::zeros()).0
+    }
+
+    /// Kinetic energy `T = 1/2 q'^T M q'` [J].
+    pub fn kinetic_energy(&self, q: &Coords, qd: &Coords) -> f64 {
+        0.5 * qd.dot(&(self.mass_matrix(q) * qd))
+    }
+
+    /// Potential energy `V`: gravity of every body, `mass g (-p_x sin phi + p_z cos phi)`, plus the springs of
+    /// Legs 1 and 2, `1/2 k (Lstar - L)^2` [J] (MODEL.md section 2).
+    pub fn potential_energy(&self, q: &Coords) -> f64 {
+        let p = &self.params;
+        let zero = Coords::zeros();
+        let hub = self.hub(q, &zero);
+        let mut v = p.hub_mass * hub.position.dot(&self.up);
+        for j in 0..self.legs() {
+            let leg = self.leg_point_from_hub(&hub, q, &zero, j, p.leg_mass_offset);
+            v += p.leg_mass * leg.position.dot(&self.up);
+        }
+        let spring = |l: f64| 0.5 * p.stiffness * (p.spring_natural_length - l).powi(2);
+        v + spring(q[L1]) + spring(q[L2])
+    }
+
+    /// Total mechanical energy `T + V` [J].
+    pub fn energy(&self, q: &Coords, qd: &Coords) -> f64 {
+        self.kinetic_energy(q, qd) + self.potential_energy(q)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// Relative tolerance of central finite differences with step `FD_STEP`.
+    const FD_TOL: f64 = 1e-6;
+    const FD_STEP: f64 = 1e-5;
+
+    fn model() -> Model {
+        let params = Params {
+            hub_inertia: 0.3,
+            ..Params::default()
+        };
+        Model::new(&params).unwrap()
+    }
+
+    fn sample_state() -> (Coords, Coords) {
+        (
+            Coords::new(0.1, 0.02, -0.2, 0.93, 0.81),
+            Coords::new(0.4, -0.3, 1.1, -0.25, 0.6),
+        )
+    }
+
+    fn unit(i: usize) -> Coords {
+        let mut e = Coords::zeros();
+        e[i] = 1.0;
+        e
+    }
+
+    #[test]
+    fn mass_matrix_is_symmetric_positive_definite() {
+        let m = model().mass_matrix(&sample_state().0);
+        assert_relative_eq!(m, m.transpose(), epsilon = 1e-14);
+        assert!(m.cholesky().is_some());
+    }
+
+    #[test]
+    fn mass_matrix_is_the_hessian_of_kinetic_energy() {
+        let model = model();
+        let (q, _) = sample_state();
+        let m = model.mass_matrix(&q);
+        for i in 0..NQ {
+            for j in 0..NQ {
+                // T is quadratic in q', so the second difference is exact up to rounding.
+                let t = |a: f64, b: f64| model.kinetic_energy(&q, &(a * unit(i) + b * unit(j)));
+                let fd = (t(1.0, 1.0) - t(1.0, -1.0) - t(-1.0, 1.0) + t(-1.0, -1.0)) / 4.0;
+                assert_relative_eq!(m[(i, j)], fd, epsilon = 1e-10, max_relative = 1e-10);
+            }
+        }
+    }
+
+    /// `h = dM/dt q' - dT/dq + dV/dq + damping`, Lagrange's equations built from the energies only.
+    #[test]
+    fn bias_matches_lagrange_equations_from_energies() {
+        let model = model();
+        let p = model.params().clone();
+        let (q, qd) = sample_state();
+        let (_, h) = model.mass_and_bias(&q, &qd);
+        // dM/dt q' = sum_k dM/dq_k qd_k q', by central differences along q'
+        let m_at = |s: f64| model.mass_matrix(&(q + s * qd));
+        let dm_dt = (m_at(FD_STEP) - m_at(-FD_STEP)) / (2.0 * FD_STEP);
+        let mut expected = dm_dt * qd;
+        for k in 0..NQ {
+            let e = unit(k) * FD_STEP;
+            let dt_dq = (model.kinetic_energy(&(q + e), &qd) - model.kinetic_energy(&(q - e), &qd))
+                / (2.0 * FD_STEP);
+            let dv_dq = (model.potential_energy(&(q + e)) - model.potential_energy(&(q - e)))
+                / (2.0 * FD_STEP);
+            expected[k] += -dt_dq + dv_dq;
+        }
+        expected[L1] += p.viscosity * qd[L1];
+        expected[L2] += p.viscosity * qd[L2];
+        assert_relative_eq!(h, expected, epsilon = 1e-6, max_relative = FD_TOL);
+    }
+
+    #[test]
+    fn point_jacobians_and_velocity_products_match_finite_differences() {
+        let model = model();
+        let (q, qd) = sample_state();
+        for j in 0..model.legs() {
+            let tip = model.tip(&q, &qd, j);
+            let pos = |q: &Coords| model.tip(q, &qd, j).position;
+            for k in 0..NQ {
+                let e = unit(k) * FD_STEP;
+                let fd = (pos(&(q + e)) - pos(&(q - e))) / (2.0 * FD_STEP);
+                assert_relative_eq!(tip.jacobian.column(k).into_owned(), fd, epsilon = 1e-8);
+            }
+            // dJ/dt q' = d/ds [J(q + s q') q'] at s = 0
+            let jq = |s: f64| model.tip(&(q + s * qd), &qd, j).jacobian * qd;
+            let fd = (jq(FD_STEP) - jq(-FD_STEP)) / (2.0 * FD_STEP);
+            assert_relative_eq!(tip.velocity_product, fd, epsilon = 1e-7);
+        }
+    }
+
+    #[test]
+    fn leg_one_tip_is_the_origin_of_q_with_constant_jacobian() {
+        let model = model();
+        let (q, qd) = sample_state();
+        let tip = model.tip(&q, &qd, 0);
+        assert_relative_eq!(tip.position, Vector2::new(q[X], q[Z]), epsilon = 1e-14);
+        let mut expected = PointJacobian::zeros();
+        expected[(0, X)] = 1.0;
+        expected[(1, Z)] = 1.0;
+        assert_relative_eq!(tip.jacobian, expected, epsilon = 1e-14);
+        assert_relative_eq!(tip.velocity_product.norm(), 0.0, epsilon = 1e-13);
+        assert_relative_eq!(model.tip_height(&q, 3), model.tip(&q, &qd, 3).position.y, epsilon = 1e-14);
+    }
+}

@@ -1,0 +1,921 @@
+//! Fig. 2 of the paper: the DLS indicators of the walking gait against a swept
+//! parameter (the leg viscosity `c`), written as SVG and PNG.
+//!
+//! Panel (a) plots `lambda_I4` (the impulse indicator, [N s]); panel (b) plots
+//! `lambda_2+` and `lambda_4+` (the normal forces just after impact, [N]); see
+//! `MODEL.md` sections 5 and 6 and section 3 of the paper. Points where
+//! scuffing of Leg 2 arises are drawn with hollow markers, the others with
+//! filled ones. Thresholds (where an indicator crosses zero, where the gait is
+//! lost) are drawn as labelled vertical dashed lines through both panels,
+//! which share the x axis.
+//!
+//! Text is rendered with DejaVu Sans, bundled under `assets/fonts/` (license
+//! next to it) and registered with plotters' `ab_glyph` font table, so no system
+//! font or font library is needed at run time. The PNG is rasterised with that
+//! font; the SVG keeps its text as `<text>` elements with
+//! `font-family="DejaVu Sans, sans-serif"`, so a viewer draws it with DejaVu
+//! Sans if installed and its own sans-serif face otherwise.
+
+use std::ops::Range;
+use std::path::Path;
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use plotters::style::{register_font, FontStyle, FontTransform};
+
+/// One gait on the sweep: the parameter value and its DLS indicators (MODEL.md section 5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IndicatorPoint {
+    /// Swept parameter value, e.g. the leg viscosity `c` [N s/m].
+    pub param: f64,
+    /// Impulse indicator `lambda_I4` [N s]; NaN when there is no gait.
+    pub lambda_i4: f64,
+    /// Normal force of Leg 1 just after impact, `lambda_2+` [N]; NaN when there is no gait.
+    pub lambda_2_plus: f64,
+    /// Normal force of Leg 2 just after impact, `lambda_4+` [N]; NaN when there is no gait.
+    pub lambda_4_plus: f64,
+    /// Whether scuffing of Leg 2 arises on this gait (drawn with hollow markers).
+    pub scuffing: bool,
+}
+
+/// A vertical annotated marker.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThresholdMark {
+    /// Text drawn verbatim beside the line, e.g. `"λ₄⁺ = 0 at c = 220.1"` or `"c = 220.1"`.
+    pub label: String,
+    /// Parameter value where the line is drawn (same unit as [`IndicatorPoint::param`]).
+    /// Non-finite values are skipped.
+    pub value: f64,
+}
+
+/// What to draw in Fig. 2.
+pub struct Fig2Spec<'a> {
+    /// The sweep; may contain NaN indicators for points without a gait: those are skipped.
+    pub points: &'a [IndicatorPoint],
+    /// Vertical dashed lines with labels (thresholds, loss of the gait).
+    pub thresholds: &'a [ThresholdMark],
+    /// Label of the x axis with unit, e.g. `"c [N s/m]"`.
+    pub param_label: &'a str,
+    /// Figure title (may be empty: no title is drawn).
+    pub title: &'a str,
+}
+
+/// Why a figure could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The backend failed to draw or to write the file at `path`.
+    #[error("cannot draw {path}: {message}")]
+    Draw { path: String, message: String },
+    /// Nothing finite to plot.
+    #[error("no data to plot: {0}")]
+    Empty(String),
+}
+
+/// Size of both the SVG and the PNG, in pixels.
+pub const FIG2_SIZE: (u32, u32) = (1600, 1200);
+
+/// A run of text on the baseline, as a subscript, or as a stacked
+/// subscript/superscript pair (plotters has no rich text).
+#[derive(Clone, Copy)]
+enum Seg {
+    Text(&'static str),
+    Sub(&'static str),
+    SubSup(&'static str, &'static str),
+}
+
+const NAME_I4: &[Seg] = &[Seg::Text("λ"), Seg::Sub("I4")];
+const NAME_2: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("2", "+")];
+const NAME_4: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("4", "+")];
+const LABEL_I4: &[Seg] = &[Seg::Text("λ"), Seg::Sub("I4"), Seg::Text(" [N s]")];
+const LABEL_PLUS: &[Seg] = &[Seg::Text("λ [N]")];
+
+/// Font family name under which the bundled font is registered; it is also the
+/// CSS `font-family` list written into the SVG.
+const FAMILY: &str = "DejaVu Sans, sans-serif";
+static FONT_BYTES: &[u8] = include_bytes!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/assets/fonts/DejaVuSans.ttf"
+));
+static FONT_REGISTERED: OnceLock<bool> = OnceLock::new();
+
+/// Registers the bundled DejaVu Sans once per process, under [`FAMILY`] and
+/// under plotters' default `"sans-serif"`. Returns whether it succeeded.
+fn ensure_font() -> bool {
+    *FONT_REGISTERED.get_or_init(|| {
+        register_font(FAMILY, FontStyle::Normal, FONT_BYTES).is_ok()
+            && register_font("sans-serif", FontStyle::Normal, FONT_BYTES).is_ok()
+    })
+}
+
+// Layout, in pixels of the 1600 x 1200 canvas.
+const MARGIN: i32 = 24;
+const TITLE_H: i32 = 64;
+const ROW_H: i32 = 36;
+const LEGEND_W: i32 = 320;
+const Y_LABEL_AREA: i32 = 140;
+const X_LABEL_AREA: i32 = 100;
+const TOP_TICK_AREA: i32 = 14;
+const PANEL_GAP: i32 = 18;
+const TITLE_FONT: f64 = 40.0;
+const AXIS_FONT: f64 = 34.0;
+const TICK_FONT: f64 = 28.0;
+const NOTE_FONT: f64 = 27.0;
+
+const COLOR_I4: RGBColor = RGBColor(0, 0, 0);
+const COLOR_2: RGBColor = RGBColor(0, 114, 178);
+const COLOR_4: RGBColor = RGBColor(213, 94, 0);
+const COLOR_MARK: RGBColor = RGBColor(90, 90, 90);
+const COLOR_GRID: RGBColor = RGBColor(225, 225, 225);
+
+#[derive(Clone, Copy, PartialEq)]
+enum Shape {
+    Circle,
+    Triangle,
+}
+
+/// One plotted indicator: its finite samples sorted by parameter, split into
+/// runs that are not interrupted by points without a gait.
+struct Series {
+    name: &'static [Seg],
+    color: RGBColor,
+    shape: Shape,
+    runs: Vec<Vec<(f64, f64, bool)>>,
+}
+
+impl Series {
+    fn new(
+        name: &'static [Seg],
+        color: RGBColor,
+        shape: Shape,
+        sorted: &[&IndicatorPoint],
+        value: fn(&IndicatorPoint) -> f64,
+    ) -> Self {
+        let mut runs: Vec<Vec<(f64, f64, bool)>> = vec![Vec::new()];
+        for p in sorted {
+            let v = value(p);
+            if v.is_finite() {
+                runs.last_mut().unwrap().push((p.param, v, p.scuffing));
+            } else if !runs.last().unwrap().is_empty() {
+                runs.push(Vec::new());
+            }
+        }
+        runs.retain(|r| !r.is_empty());
+        Series {
+            name,
+            color,
+            shape,
+            runs,
+        }
+    }
+
+    fn samples(&self) -> impl Iterator<Item = &(f64, f64, bool)> {
+        self.runs.iter().flatten()
+    }
+
+    fn any_scuffing(&self) -> bool {
+        self.samples().any(|s| s.2)
+    }
+}
+
+/// Validated data and axis ranges.
+struct Prepared {
+    x: Range<f64>,
+    y_a: Range<f64>,
+    y_b: Range<f64>,
+    panel_a: Vec<Series>,
+    panel_b: Vec<Series>,
+    marks: Vec<ThresholdMark>,
+    marker: i32,
+}
+
+fn padded(lo: f64, hi: f64, frac: f64) -> Range<f64> {
+    let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
+    (lo - frac * span)..(hi + frac * span)
+}
+
+/// Range of the y values of `series`, always including 0 (the zero line).
+fn y_range(series: &[Series]) -> Range<f64> {
+    let (lo, hi) = series
+        .iter()
+        .flat_map(|s| s.samples())
+        .fold((0.0_f64, 0.0_f64), |(lo, hi), s| (lo.min(s.1), hi.max(s.1)));
+    let (lo, hi) = if hi > lo { (lo, hi) } else { (-1.0, 1.0) };
+    let r = padded(lo, hi, 0.07);
+    // Keep the zero line on the frame only when no data lies below it.
+    let start = if lo >= 0.0 { 0.0 } else { r.start };
+    start..r.end
+}
+
+impl Prepared {
+    fn new(spec: &Fig2Spec) -> Result<Self, PlotError> {
+        if spec.points.is_empty() {
+            return Err(PlotError::Empty("the sweep has no points".into()));
+        }
+        let mut sorted: Vec<&IndicatorPoint> =
+            spec.points.iter().filter(|p| p.param.is_finite()).collect();
+        sorted.sort_by(|a, b| a.param.total_cmp(&b.param));
+        let panel_a = vec![Series::new(
+            NAME_I4,
+            COLOR_I4,
+            Shape::Circle,
+            &sorted,
+            |p| p.lambda_i4,
+        )];
+        let panel_b = vec![
+            Series::new(NAME_2, COLOR_2, Shape::Circle, &sorted, |p| p.lambda_2_plus),
+            Series::new(NAME_4, COLOR_4, Shape::Triangle, &sorted, |p| {
+                p.lambda_4_plus
+            }),
+        ];
+        let xs: Vec<f64> = panel_a
+            .iter()
+            .chain(&panel_b)
+            .flat_map(|s| s.samples().map(|s| s.0))
+            .collect();
+        if xs.is_empty() {
+            return Err(PlotError::Empty(format!(
+                "none of the {} points has a finite parameter and indicator (no gait found)",
+                spec.points.len()
+            )));
+        }
+        let marks: Vec<ThresholdMark> = spec
+            .thresholds
+            .iter()
+            .filter(|m| m.value.is_finite())
+            .cloned()
+            .collect();
+        let (lo, hi) = xs
+            .iter()
+            .copied()
+            .chain(marks.iter().map(|m| m.value))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        let mut x = padded(lo, hi, 0.03);
+        if lo >= 0.0 && x.start < 0.0 {
+            x.start = 0.0;
+        }
+        let n = panel_b
+            .iter()
+            .chain(&panel_a)
+            .map(|s| s.samples().count())
+            .max()
+            .unwrap_or(1)
+            .max(1) as i32;
+        let marker = (1100 / n / 2).clamp(4, 7);
+        Ok(Prepared {
+            x,
+            y_a: y_range(&panel_a),
+            y_b: y_range(&panel_b),
+            panel_a,
+            panel_b,
+            marks,
+            marker,
+        })
+    }
+}
+
+/// Writes Fig. 2 (DLS indicators against the swept parameter) to `svg_path`
+/// and `png_path`, both [`FIG2_SIZE`] pixels.
+///
+/// Panel (a): `lambda_I4`, y label "λ_I4 [N s]" (with a real subscript);
+/// panel (b): `lambda_2+` and `lambda_4+`, y label "λ [N]"; shared x axis labelled
+/// `spec.param_label`. Points with a NaN indicator are skipped (and break the
+/// connecting line); scuffing points get hollow markers; each threshold is a
+/// dashed vertical line labelled with its text.
+///
+/// # Errors
+/// [`PlotError::Empty`] if there are no points or no point has a finite
+/// parameter and indicator (nothing is written then); [`PlotError::Draw`] if a
+/// file cannot be drawn or written.
+pub fn write_fig2(spec: &Fig2Spec, svg_path: &Path, png_path: &Path) -> Result<(), PlotError> {
+    let data = Prepared::new(spec)?;
+    let fail = |path: &Path, message: String| PlotError::Draw {
+        path: path.display().to_string(),
+        message,
+    };
+    if !ensure_font() {
+        return Err(fail(
+            svg_path,
+            "the bundled DejaVu Sans font is invalid".into(),
+        ));
+    }
+    {
+        let root = SVGBackend::new(svg_path, FIG2_SIZE).into_drawing_area();
+        draw_fig2(&root, spec, &data).map_err(|e| fail(svg_path, e.to_string()))?;
+        root.present().map_err(|e| fail(svg_path, e.to_string()))?;
+    }
+    {
+        let root = BitMapBackend::new(png_path, FIG2_SIZE).into_drawing_area();
+        draw_fig2(&root, spec, &data).map_err(|e| fail(png_path, e.to_string()))?;
+        root.present().map_err(|e| fail(png_path, e.to_string()))?;
+    }
+    Ok(())
+}
+
+const SCUFF_NOTE: &str = "scuffing of Leg 2";
+
+/// Pixel ranges (x, y) of a plotting area on the canvas.
+type PixelRect = (Range<i32>, Range<i32>);
+
+type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+fn font(size: f64) -> TextStyle<'static> {
+    (FontFamily::Name(FAMILY), size).into_font().color(&BLACK)
+}
+
+/// Tick label of `v` on an axis spanning `range`: as many decimals as the
+/// tick step needs (plotters' default prints "100.0"), and a true minus sign.
+fn tick_label(v: f64, range: &Range<f64>) -> String {
+    let span = (range.end - range.start).abs().max(f64::MIN_POSITIVE);
+    // Smallest 1-2-5 step giving at most 10 ticks (plotters asks for <= 10).
+    let mut step = 10f64.powf((span / 10.0).log10().floor());
+    for m in [1.0, 2.0, 5.0, 10.0] {
+        if span / (m * step) <= 10.0 {
+            step *= m;
+            break;
+        }
+    }
+    let mut decimals = (-step.log10().floor()).max(0.0) as usize;
+    let mut s = format!("{v:.decimals$}");
+    while decimals < 8 && (s.parse::<f64>().unwrap_or(v) - v).abs() > 1e-6 * step {
+        decimals += 1;
+        s = format!("{v:.decimals$}");
+    }
+    if s.parse::<f64>() == Ok(0.0) {
+        return format!("{:.decimals$}", 0.0);
+    }
+    s.replace('-', "\u{2212}")
+}
+
+/// Sizes of a subscript relative to its base text, and the baseline shifts.
+const SUB_SCALE: f64 = 0.68;
+const SUB_DROP: f64 = 0.16;
+const SUP_RISE: f64 = 0.36;
+
+/// Width in pixels of rich text at font size `size`.
+fn rich_width<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    segs: &[Seg],
+    size: f64,
+) -> Result<i32, DrawingAreaErrorKind<DB::ErrorType>> {
+    let w = |t: &str, sz: f64| root.estimate_text_size(t, &font(sz)).map(|s| s.0 as i32);
+    let mut total = 0;
+    for seg in segs {
+        total += match *seg {
+            Seg::Text(t) => w(t, size)?,
+            Seg::Sub(t) => w(t, size * SUB_SCALE)? + 2,
+            Seg::SubSup(a, b) => w(a, size * SUB_SCALE)?.max(w(b, size * SUB_SCALE)?) + 2,
+        };
+    }
+    Ok(total)
+}
+
+/// Draws rich text whose first line box has its top-left corner at `at`
+/// (with `rotated`, the text runs upwards from `at`, its top facing left).
+/// Baselines follow plotters' ab_glyph rasteriser: `size / 2` below the top.
+fn draw_rich<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    segs: &[Seg],
+    at: (i32, i32),
+    size: f64,
+    rotated: bool,
+) -> DrawResult<DB> {
+    let small = size * SUB_SCALE;
+    let base = size / 2.0;
+    let mut advance = 0;
+    let put = |t: &str, sz: f64, baseline: f64, advance: i32| {
+        let down = (baseline - sz / 2.0).round() as i32;
+        let (pos, style) = if rotated {
+            (
+                (at.0 + down, at.1 - advance),
+                font(sz).transform(FontTransform::Rotate270),
+            )
+        } else {
+            ((at.0 + advance, at.1 + down), font(sz))
+        };
+        root.draw(&Text::new(t.to_string(), pos, style))
+    };
+    for seg in segs {
+        match *seg {
+            Seg::Text(t) => {
+                // SVG drops leading blanks of a <text>: advance past them instead.
+                let body = t.trim_start();
+                let lead = rich_width(root, &[Seg::Text(t)], size)?
+                    - rich_width(root, &[Seg::Text(body)], size)?;
+                put(body, size, base, advance + lead)?
+            }
+            Seg::Sub(t) => put(t, small, base + SUB_DROP * size, advance + 1)?,
+            Seg::SubSup(a, b) => {
+                put(a, small, base + SUB_DROP * size, advance + 1)?;
+                put(b, small, base - SUP_RISE * size, advance + 1)?;
+            }
+        }
+        advance += rich_width(root, &[*seg], size)?;
+    }
+    Ok(())
+}
+
+/// Assigns each threshold label a row of the label strip (row 0 is next to
+/// the plot). `labels` holds each line's x and its text's x interval. A label
+/// must not overlap another label in its row, its text must not be crossed by
+/// the line of a label further up, and its own line must not cross a label
+/// below it. Greedy, from the rightmost line leftwards, lowest free row first.
+fn label_rows(labels: &[(i32, Range<i32>)]) -> Vec<usize> {
+    const GAP: i32 = 16;
+    let mut order: Vec<usize> = (0..labels.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(labels[i].0));
+    let mut rows = vec![0usize; labels.len()];
+    let covers = |r: &Range<i32>, x: i32| r.start - GAP / 2 <= x && x <= r.end + GAP / 2;
+    for (k, &i) in order.iter().enumerate() {
+        let (xi, ref ti) = labels[i];
+        let placed = &order[..k];
+        let free = |row: usize| {
+            placed.iter().all(|&j| {
+                let (xj, ref tj) = labels[j];
+                match row.cmp(&rows[j]) {
+                    std::cmp::Ordering::Equal => {
+                        ti.end + GAP <= tj.start || tj.end + GAP <= ti.start
+                    }
+                    std::cmp::Ordering::Less => !covers(ti, xj),
+                    std::cmp::Ordering::Greater => !covers(tj, xi),
+                }
+            })
+        };
+        let top = placed.iter().map(|&j| rows[j] + 1).max().unwrap_or(0);
+        rows[i] = (0..=top).find(|&r| free(r)).unwrap_or(top);
+    }
+    rows
+}
+
+fn dashed_vline<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    x: i32,
+    y0: i32,
+    y1: i32,
+) -> DrawResult<DB> {
+    let style = COLOR_MARK.stroke_width(2);
+    let mut y = y0;
+    while y < y1 {
+        let e = (y + 10).min(y1);
+        root.draw(&PathElement::new(vec![(x, y), (x, e)], style))?;
+        y += 17;
+    }
+    Ok(())
+}
+
+fn draw_marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+    shape: Shape,
+    color: RGBColor,
+    hollow: bool,
+    r: i32,
+) -> DrawResult<DB> {
+    match shape {
+        Shape::Circle => {
+            if hollow {
+                area.draw(&Circle::new(at, r, WHITE.filled()))?;
+                area.draw(&Circle::new(at, r, color.stroke_width(2)))?;
+            } else {
+                area.draw(&Circle::new(at, r, color.filled()))?;
+            }
+        }
+        Shape::Triangle => {
+            let s = r + 2;
+            let h = (s as f64 * 0.87).round() as i32;
+            let pts = vec![
+                (at.0, at.1 - s),
+                (at.0 - h, at.1 + s / 2),
+                (at.0 + h, at.1 + s / 2),
+            ];
+            if hollow {
+                area.draw(&Polygon::new(pts.clone(), WHITE.filled()))?;
+                let mut closed = pts.clone();
+                closed.push(pts[0]);
+                area.draw(&PathElement::new(closed, color.stroke_width(2)))?;
+            } else {
+                area.draw(&Polygon::new(pts, color.filled()))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+struct Panel {
+    tag: &'static str,
+    y_label: &'static [Seg],
+    top: i32,
+    height: i32,
+    bottom_axis: bool,
+}
+
+/// Draws one panel; returns the pixel rectangle of its plotting area.
+fn draw_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    series: &[Series],
+    x: &Range<f64>,
+    y: &Range<f64>,
+    data: &Prepared,
+    param_label: &str,
+) -> Result<PixelRect, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (w, _) = root.dim_in_pixel();
+    let area = root
+        .clone()
+        .shrink((MARGIN, panel.top), (w as i32 - 2 * MARGIN, panel.height));
+    let mut chart = ChartBuilder::on(&area)
+        .margin_right(LEGEND_W)
+        .x_label_area_size(if panel.bottom_axis {
+            X_LABEL_AREA
+        } else {
+            TOP_TICK_AREA
+        })
+        .y_label_area_size(Y_LABEL_AREA)
+        .build_cartesian_2d(x.clone(), y.clone())?;
+    let y_fmt = |v: &f64| tick_label(*v, y);
+    let x_fmt = |v: &f64| tick_label(*v, x);
+    let no_fmt = |_: &f64| String::new();
+    {
+        let mut mesh = chart.configure_mesh();
+        mesh.label_style(font(TICK_FONT))
+            .axis_desc_style(font(AXIS_FONT))
+            .y_label_formatter(&y_fmt)
+            .x_labels(10)
+            .y_labels(7)
+            .bold_line_style(COLOR_GRID.stroke_width(1))
+            .light_line_style(TRANSPARENT)
+            .axis_style(BLACK.stroke_width(2))
+            .set_all_tick_mark_size(8);
+        if panel.bottom_axis {
+            mesh.x_desc(param_label).x_label_formatter(&x_fmt);
+        } else {
+            mesh.x_label_formatter(&no_fmt);
+        }
+        mesh.draw()?;
+    }
+    let plot = chart.plotting_area().strip_coord_spec();
+    let to_px = |p: (f64, f64)| chart.backend_coord(&p);
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    // Coordinates relative to `plot` (what `plot.draw` expects).
+    let rel = |p: (f64, f64)| {
+        let (a, b) = to_px(p);
+        (a - px.start, b - py.start)
+    };
+    // Zero line.
+    plot.draw(&PathElement::new(
+        vec![rel((x.start, 0.0)), rel((x.end, 0.0))],
+        BLACK.stroke_width(2),
+    ))?;
+    // Thresholds inside the plot.
+    for m in &data.marks {
+        dashed_vline(root, to_px((m.value, 0.0)).0, py.start, py.end)?;
+    }
+    // Lines, then markers on top.
+    for s in series {
+        for run in &s.runs {
+            plot.draw(&PathElement::new(
+                run.iter().map(|&(a, b, _)| rel((a, b))).collect::<Vec<_>>(),
+                s.color.stroke_width(2),
+            ))?;
+        }
+    }
+    for s in series {
+        for &(a, b, scuff) in s.samples() {
+            draw_marker(&plot, rel((a, b)), s.shape, s.color, scuff, data.marker)?;
+        }
+    }
+    // Frame on the top and right sides.
+    plot.draw(&Rectangle::new(
+        [(0, 0), (px.end - px.start - 1, py.end - py.start - 1)],
+        BLACK.stroke_width(2),
+    ))?;
+    // Axis label, rotated and centred on the plot's height.
+    let label_w = rich_width(root, panel.y_label, AXIS_FONT)?;
+    draw_rich(
+        root,
+        panel.y_label,
+        (MARGIN + 6, (py.start + py.end + label_w) / 2),
+        AXIS_FONT,
+        true,
+    )?;
+    // Panel tag, top left of the figure beside the plot.
+    root.draw(&Text::new(
+        panel.tag,
+        (MARGIN, py.start - 4),
+        font(AXIS_FONT),
+    ))?;
+    // Legend, to the right of the plot.
+    draw_legend(root, series, (px.end + 28, py.start + 6))?;
+    Ok((px, py))
+}
+
+fn draw_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    series: &[Series],
+    (x0, y0): (i32, i32),
+) -> DrawResult<DB> {
+    const LINE: i32 = 40;
+    const SAMPLE_W: i32 = 56;
+    let scuff: Vec<&Series> = series.iter().filter(|s| s.any_scuffing()).collect();
+    let entries = series.len() + usize::from(!scuff.is_empty());
+    let mut text_w = 0;
+    for s in series {
+        text_w = text_w.max(rich_width(root, s.name, NOTE_FONT)?);
+    }
+    if !scuff.is_empty() {
+        text_w = text_w.max(rich_width(root, &[Seg::Text(SCUFF_NOTE)], NOTE_FONT)?);
+    }
+    let box_w = 16 + SAMPLE_W + 12 + text_w + 16;
+    let box_h = entries as i32 * LINE + 12;
+    root.draw(&Rectangle::new(
+        [(x0, y0), (x0 + box_w, y0 + box_h)],
+        WHITE.filled(),
+    ))?;
+    root.draw(&Rectangle::new(
+        [(x0, y0), (x0 + box_w, y0 + box_h)],
+        RGBColor(150, 150, 150).stroke_width(1),
+    ))?;
+    let sx = x0 + 16;
+    let tx = sx + SAMPLE_W + 12;
+    let mut y = y0 + 6 + LINE / 2;
+    for s in series {
+        root.draw(&PathElement::new(
+            vec![(sx, y), (sx + SAMPLE_W, y)],
+            s.color.stroke_width(2),
+        ))?;
+        draw_marker(root, (sx + SAMPLE_W / 2, y), s.shape, s.color, false, 7)?;
+        draw_rich(
+            root,
+            s.name,
+            (tx, y - NOTE_FONT as i32 / 2),
+            NOTE_FONT,
+            false,
+        )?;
+        y += LINE;
+    }
+    if !scuff.is_empty() {
+        let step = SAMPLE_W / (scuff.len() as i32 + 1);
+        for (k, s) in scuff.iter().enumerate() {
+            draw_marker(
+                root,
+                (sx + step * (k as i32 + 1), y),
+                s.shape,
+                s.color,
+                true,
+                7,
+            )?;
+        }
+        root.draw(&Text::new(
+            SCUFF_NOTE,
+            (tx, y),
+            font(NOTE_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+    }
+    Ok(())
+}
+
+fn draw_fig2<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    spec: &Fig2Spec,
+    data: &Prepared,
+) -> DrawResult<DB> {
+    root.fill(&WHITE)?;
+    let (w, h) = root.dim_in_pixel();
+    let (w, h) = (w as i32, h as i32);
+    let mut top = MARGIN;
+    if !spec.title.is_empty() {
+        // Shrink a long title to fit the width.
+        let (tw, _) = root.estimate_text_size(spec.title, &font(TITLE_FONT))?;
+        let fit = f64::from(w - 2 * MARGIN) / f64::from(tw.max(1));
+        let size = TITLE_FONT * fit.min(1.0);
+        root.draw(&Text::new(
+            spec.title,
+            (w / 2, top + ((TITLE_FONT - size) / 2.0) as i32),
+            font(size).pos(Pos::new(HPos::Center, VPos::Top)),
+        ))?;
+        top += TITLE_H;
+    }
+    // Threshold label strip: the x positions are known before drawing, since
+    // both panels share the same horizontal layout.
+    let plot_x0 = MARGIN + Y_LABEL_AREA;
+    let plot_x1 = w - MARGIN - LEGEND_W;
+    let span = data.x.end - data.x.start;
+    let px_of = |v: f64| {
+        plot_x0 + ((v - data.x.start) / span * f64::from(plot_x1 - plot_x0 - 1)).round() as i32
+    };
+    // Each label starts right of its line, or ends left of it where it would
+    // leave the canvas.
+    let mut xw = Vec::with_capacity(data.marks.len());
+    for m in &data.marks {
+        let (tw, _) = root.estimate_text_size(&m.label, &font(NOTE_FONT))?;
+        let x = px_of(m.value);
+        let tw = tw as i32;
+        let text = if x + 8 + tw <= w - MARGIN / 2 {
+            (x + 8)..(x + 8 + tw)
+        } else {
+            (x - 8 - tw)..(x - 8)
+        };
+        xw.push((x, text));
+    }
+    let rows = label_rows(&xw);
+    let n_rows = rows.iter().map(|r| r + 1).max().unwrap_or(0) as i32;
+    let strip = if n_rows > 0 { n_rows * ROW_H + 10 } else { 16 };
+    let label_top = top;
+    top += strip;
+
+    let avail = h - MARGIN - top - X_LABEL_AREA - TOP_TICK_AREA - PANEL_GAP;
+    let h_a = avail * 45 / 100;
+    let panel_a = Panel {
+        tag: "(a)",
+        y_label: LABEL_I4,
+        top,
+        height: h_a + TOP_TICK_AREA,
+        bottom_axis: false,
+    };
+    let top_b = top + h_a + TOP_TICK_AREA + PANEL_GAP;
+    let panel_b = Panel {
+        tag: "(b)",
+        y_label: LABEL_PLUS,
+        top: top_b,
+        height: h - MARGIN - top_b,
+        bottom_axis: true,
+    };
+    let (_, py_a) = draw_panel(
+        root,
+        &panel_a,
+        &data.panel_a,
+        &data.x,
+        &data.y_a,
+        data,
+        spec.param_label,
+    )?;
+    draw_panel(
+        root,
+        &panel_b,
+        &data.panel_b,
+        &data.x,
+        &data.y_b,
+        data,
+        spec.param_label,
+    )?;
+    // Threshold labels and the dashed lines up to them.
+    for ((m, (x, text)), &row) in data.marks.iter().zip(&xw).zip(&rows) {
+        let y_text = label_top + strip - 10 - (row as i32) * ROW_H - ROW_H / 2;
+        dashed_vline(root, *x, y_text, py_a.start)?;
+        root.draw(&Text::new(
+            m.label.as_str(),
+            (text.start, y_text),
+            font(NOTE_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Synthetic sweep shaped like the paper's Fig. 2.
+    fn synthetic() -> Vec<IndicatorPoint> {
+        (0..60)
+            .map(|k| {
+                let c = 1.0 + 299.0 * k as f64 / 59.0;
+                IndicatorPoint {
+                    param: c,
+                    lambda_i4: 2.0 + 3.0 * (-c / 80.0).exp(),
+                    lambda_2_plus: -5.0 + 105.0 * (1.0 - (-(c - 1.0) / 60.0).exp()) / 0.993,
+                    lambda_4_plus: 60.0 - 60.0 * c / 220.1,
+                    scuffing: c < 30.0,
+                }
+            })
+            .collect()
+    }
+
+    fn marks() -> Vec<ThresholdMark> {
+        vec![
+            ThresholdMark {
+                label: "λ₂⁺ = 0: c = 4.0".into(),
+                value: 4.0,
+            },
+            ThresholdMark {
+                label: "λ₄⁺ = 0: c = 220.1".into(),
+                value: 220.1,
+            },
+        ]
+    }
+
+    fn png_size(bytes: &[u8]) -> (u32, u32) {
+        assert!(bytes.len() > 24);
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG magic");
+        assert_eq!(&bytes[12..16], b"IHDR");
+        let be = |s: &[u8]| u32::from_be_bytes([s[0], s[1], s[2], s[3]]);
+        (be(&bytes[16..20]), be(&bytes[20..24]))
+    }
+
+    #[test]
+    fn writes_svg_and_png_for_synthetic_sweep() {
+        let dir = tempfile::tempdir().unwrap();
+        let (svg, png) = (dir.path().join("fig2.svg"), dir.path().join("fig2.png"));
+        let mut points = synthetic();
+        points[10].lambda_i4 = f64::NAN;
+        points[11].lambda_2_plus = f64::NAN;
+        let marks = marks();
+        let spec = Fig2Spec {
+            points: &points,
+            thresholds: &marks,
+            param_label: "c [N s/m]",
+            title: "DLS indicators vs leg viscosity",
+        };
+        write_fig2(&spec, &svg, &png).unwrap();
+        let png_bytes = std::fs::read(&png).unwrap();
+        assert_eq!(png_size(&png_bytes), FIG2_SIZE);
+        let svg_text = std::fs::read_to_string(&svg).unwrap();
+        assert!(svg_text.starts_with("<svg"));
+        for label in [
+            "c [N s/m]",
+            "\nI4\n",
+            "[N s]",
+            "λ [N]",
+            "λ₄⁺ = 0: c = 220.1",
+            "(b)",
+        ] {
+            assert!(svg_text.contains(label), "SVG lacks {label:?}");
+        }
+        assert!(svg_text.contains(&format!("font-family=\"{FAMILY}\"")));
+    }
+
+    #[test]
+    fn empty_sweep_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let spec = Fig2Spec {
+            points: &[],
+            thresholds: &[],
+            param_label: "c [N s/m]",
+            title: "",
+        };
+        let (svg, png) = (dir.path().join("a.svg"), dir.path().join("a.png"));
+        let err = write_fig2(&spec, &svg, &png).unwrap_err();
+        assert!(matches!(err, PlotError::Empty(_)), "{err}");
+        assert!(!svg.exists() && !png.exists());
+    }
+
+    #[test]
+    fn all_nan_sweep_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let points: Vec<IndicatorPoint> = synthetic()
+            .into_iter()
+            .map(|p| IndicatorPoint {
+                lambda_i4: f64::NAN,
+                lambda_2_plus: f64::NAN,
+                lambda_4_plus: f64::NAN,
+                ..p
+            })
+            .collect();
+        let marks = marks();
+        let spec = Fig2Spec {
+            points: &points,
+            thresholds: &marks,
+            param_label: "c [N s/m]",
+            title: "",
+        };
+        let err =
+            write_fig2(&spec, &dir.path().join("a.svg"), &dir.path().join("a.png")).unwrap_err();
+        assert!(matches!(err, PlotError::Empty(_)), "{err}");
+    }
+
+    #[test]
+    fn unwritable_path_is_a_draw_error() {
+        let points = synthetic();
+        let spec = Fig2Spec {
+            points: &points,
+            thresholds: &[],
+            param_label: "c [N s/m]",
+            title: "",
+        };
+        let bad = Path::new("/nonexistent-dir/for/sure/fig2.svg");
+        let err = write_fig2(&spec, bad, &bad.with_extension("png")).unwrap_err();
+        assert!(matches!(err, PlotError::Draw { .. }), "{err}");
+    }
+
+    #[test]
+    fn close_threshold_labels_stack_without_covering_lines() {
+        // Two lines 10 px apart with 100 px labels, one far away.
+        let right = |x: i32| (x, (x + 8)..(x + 108));
+        let rows = label_rows(&[right(100), right(110), right(600)]);
+        assert_eq!(rows, vec![1, 0, 0]);
+        // A label turned to the left of its line (at the right edge) and an
+        // overlapping label to its left: different rows, and the upper label's
+        // line must miss the lower label's text.
+        let all = [right(1250), (1420, 1312..1412)];
+        let rows = label_rows(&all);
+        assert_ne!(rows[0], rows[1]);
+        let (lo, hi) = if rows[0] < rows[1] { (0, 1) } else { (1, 0) };
+        // The upper label's line passes the lower row: it must miss that text.
+        let (x_hi, _) = &all[hi];
+        let (_, t_lo) = &all[lo];
+        assert!(!t_lo.contains(x_hi));
+    }
+}

@@ -1,0 +1,146 @@
+//! Reference problems with known closed-form answers, shared by tests and benchmarks.
+//!
+//! Like diffsol's and russell's test models, each problem is an [`OdeSystem`] together with its
+//! exact solution and exact event times, so the integrator and the event location can be
+//! checked against numbers that do not come from the integrator itself.
+
+use nalgebra::SVector;
+
+use crate::integrate::OdeSystem;
+
+/// Point mass falling from height h0 with upward velocity v0 under gravity g: y=[z, vz], exact impact time
+/// of z = 0.
+///
+/// Dynamics z' = vz, vz' = -g, so z(t) = h0 + v0 t - g t²/2 and vz(t) = v0 - g t.
+/// Requires `h0 > 0` and `g > 0` for an impact to exist.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FallingPoint {
+    /// Initial height z(0) \[m\].
+    pub h0: f64,
+    /// Initial upward velocity vz(0) \[m/s\].
+    pub v0: f64,
+    /// Gravitational acceleration, positive downward \[m/s²\].
+    pub g: f64,
+}
+
+impl FallingPoint {
+    /// The positive root of h0 + v0 t - g t²/2 = 0, `t = (v0 + s)/g = 2 h0/(s - v0)` with
+    /// `s = sqrt(v0² + 2 g h0)`; the form without cancellation is used for the sign of v0.
+    pub fn exact_impact_time(&self) -> f64 {
+        let s = (self.v0 * self.v0 + 2.0 * self.g * self.h0).sqrt();
+        if self.v0 >= 0.0 {
+            (self.v0 + s) / self.g
+        } else {
+            2.0 * self.h0 / (s - self.v0)
+        }
+    }
+
+    /// Exact state [z, vz] at time t.
+    pub fn exact(&self, t: f64) -> SVector<f64, 2> {
+        SVector::<f64, 2>::new(
+            self.h0 + self.v0 * t - 0.5 * self.g * t * t,
+            self.v0 - self.g * t,
+        )
+    }
+}
+
+impl OdeSystem<2> for FallingPoint {
+    fn rhs(&self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
+        SVector::<f64, 2>::new(y[1], -self.g)
+    }
+}
+
+/// Harmonic oscillator x'' = -w^2 x, exact zero crossings t_k = (k*pi + pi/2 - phase)/w of
+/// x(t) = A cos(w t + phase).
+///
+/// State y = [x, v] with v = x'. For `-pi/2 < phase < pi/2`, `t_0` is the first crossing after
+/// t = 0. The energy `(v² + w² x²)/2 = w² A²/2` is conserved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HarmonicOscillator {
+    /// Angular frequency w \[rad/s\].
+    pub omega: f64,
+    /// Amplitude A of x \[m\].
+    pub amplitude: f64,
+    /// Phase of x(t) = A cos(w t + phase) at t = 0 \[rad\].
+    pub phase: f64,
+}
+
+impl HarmonicOscillator {
+    /// Exact state [x, v] = [A cos(w t + phase), -A w sin(w t + phase)] at time t.
+    pub fn exact(&self, t: f64) -> SVector<f64, 2> {
+        let (s, c) = (self.omega * t + self.phase).sin_cos();
+        SVector::<f64, 2>::new(self.amplitude * c, -self.amplitude * self.omega * s)
+    }
+
+    /// Time of the k-th zero of x (k = 0, 1, ...): t_k = (k pi + pi/2 - phase)/w.
+    pub fn zero_crossing(&self, k: usize) -> f64 {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        (k as f64 * PI + FRAC_PI_2 - self.phase) / self.omega
+    }
+}
+
+impl OdeSystem<2> for HarmonicOscillator {
+    fn rhs(&self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
+        SVector::<f64, 2>::new(y[1], -self.omega * self.omega * y[0])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_abs_diff_eq;
+
+    /// Central-difference step for checking exact solutions against the right-hand side \[s\].
+    const FD_STEP: f64 = 1e-5;
+    /// Tolerance of the central-difference derivative check (O(FD_STEP²) plus roundoff).
+    const FD_TOL: f64 = 1e-8;
+    /// Roundoff tolerance on closed-form identities.
+    const ROUNDOFF_TOL: f64 = 1e-14;
+
+    fn check_exact_solves_ode(
+        sys: &impl OdeSystem<2>,
+        exact: impl Fn(f64) -> SVector<f64, 2>,
+        t: f64,
+    ) {
+        let fd = (exact(t + FD_STEP) - exact(t - FD_STEP)) / (2.0 * FD_STEP);
+        let f = sys.rhs(t, &exact(t));
+        assert_abs_diff_eq!(fd, f, epsilon = FD_TOL);
+    }
+
+    #[test]
+    fn falling_point_exact_solution_and_impact_time() {
+        for v0 in [0.5, 0.0, -0.3] {
+            let p = FallingPoint {
+                h0: 1.0,
+                v0,
+                g: 9.81,
+            };
+            for t in [0.0, 0.2, 0.4] {
+                check_exact_solves_ode(&p, |t| p.exact(t), t);
+            }
+            let t_impact = p.exact_impact_time();
+            assert!(t_impact > 0.0);
+            assert_abs_diff_eq!(p.exact(t_impact)[0], 0.0, epsilon = ROUNDOFF_TOL);
+        }
+    }
+
+    #[test]
+    fn harmonic_oscillator_exact_solution_and_crossings() {
+        let osc = HarmonicOscillator {
+            omega: 3.0,
+            amplitude: 0.7,
+            phase: 0.3,
+        };
+        for t in [0.0, 0.5, 2.0] {
+            check_exact_solves_ode(&osc, |t| osc.exact(t), t);
+        }
+        assert!(osc.zero_crossing(0) > 0.0);
+        for k in 0..10 {
+            assert_abs_diff_eq!(
+                osc.exact(osc.zero_crossing(k))[0],
+                0.0,
+                epsilon = ROUNDOFF_TOL
+            );
+        }
+    }
+}
