@@ -80,6 +80,10 @@ pub struct ActiveSet {
     pub lock1: bool,
     /// Leg 2 is held at `L0` by its stopper.
     pub lock2: bool,
+    /// The contact of Leg 1 slides: only its normal row is active (`lambda_1 = 0`).
+    pub slide1: bool,
+    /// The contact of Leg 2 slides: only its normal row is active (`lambda_3 = 0`).
+    pub slide2: bool,
 }
 
 impl ActiveSet {
@@ -99,11 +103,27 @@ impl ActiveSet {
         }
     }
 
-    /// Set the ground contact of `leg`.
+    /// Does the contact of `leg` slide (normal constraint only)?
+    pub fn slide(&self, leg: Leg) -> bool {
+        match leg {
+            Leg::One => self.slide1,
+            Leg::Two => self.slide2,
+        }
+    }
+
+    /// Set the ground contact of `leg` as a no-slip contact (`on`) or open it.
     pub fn set_contact(&mut self, leg: Leg, on: bool) {
         match leg {
-            Leg::One => self.contact1 = on,
-            Leg::Two => self.contact2 = on,
+            Leg::One => (self.contact1, self.slide1) = (on, false),
+            Leg::Two => (self.contact2, self.slide2) = (on, false),
+        }
+    }
+
+    /// Make the contact of `leg` a sliding one (normal row only).
+    pub fn set_sliding(&mut self, leg: Leg) {
+        match leg {
+            Leg::One => (self.contact1, self.slide1) = (true, true),
+            Leg::Two => (self.contact2, self.slide2) = (true, true),
         }
     }
 
@@ -118,9 +138,9 @@ impl ActiveSet {
     /// Which rows of the fixed stacking are active.
     pub fn row_mask(&self) -> [bool; NROWS] {
         [
+            self.contact1 && !self.slide1,
             self.contact1,
-            self.contact1,
-            self.contact2,
+            self.contact2 && !self.slide2,
             self.contact2,
             self.lock1,
             self.lock2,
@@ -228,6 +248,10 @@ fn constraint_rows(model: &Model, q: &Coords, qd: &Coords, active: &ActiveSet) -
             let r = 2 * leg.index();
             rows.fixed_view_mut::<2, NQ>(r, 0).copy_from(&tip.jacobian);
             jdq.fixed_rows_mut::<2>(r).copy_from(&tip.velocity_product);
+            if active.slide(leg) {
+                rows.row_mut(r).fill(0.0);
+                jdq[r] = 0.0;
+            }
         }
         if active.lock(leg) {
             rows[(leg.stopper_row(), leg.length_coordinate())] = 1.0;
@@ -327,8 +351,7 @@ mod tests {
         let active = ActiveSet {
             contact1: true,
             contact2: true,
-            lock1: false,
-            lock2: false,
+            ..Default::default()
         };
         let sol = constrained_dynamics(&model, &q, &qd, &active).unwrap();
         let (m, h) = model.mass_and_bias(&q, &qd);
@@ -381,6 +404,7 @@ mod tests {
             contact2: true,
             lock1: true,
             lock2: true,
+            ..Default::default()
         };
         let err = constrained_dynamics(&model, &q, &Coords::zeros(), &all).unwrap_err();
         assert_eq!(err, ContactError::RedundantConstraints(all));

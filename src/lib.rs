@@ -1,5 +1,8 @@
 pub mod contact;
 pub mod dynamics;
+pub mod error;
 pub mod integrate;
 pub mod params;
 pub mod reference;
+pub mod walk;
+pub mod output;

@@ -11,6 +11,7 @@
 //! viscosity = 50          # integers are accepted for real-valued keys
 //! impact = "traditional"
 //! rigid_legs = false
+//! inconsistent_contact = "slide"
 //! rtol = 1e-11
 //! ```
 //!
@@ -62,6 +63,51 @@ impl fmt::Display for ImpactModel {
     }
 }
 
+/// What happens when no no-slip contact state is consistent (`MODEL.md` sections 3-4).
+///
+/// At a lift-off where the tangential force of the no-slip contact is not zero (the paper's "scuffing" /
+/// open case), holding the tip needs a pulling normal force and releasing it drives the tip into the ground.
+///
+/// In TOML and on the command line the values are the strings `"slide"` (default) and `"rebound"`;
+/// [`Display`](fmt::Display) gives the same strings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactInconsistency {
+    /// The tip slides frictionlessly along the ground (normal constraint only) until its normal force
+    /// vanishes: the limit of any friction cone as the normal force goes to zero. Default.
+    Slide,
+    /// `MODEL.md` section 4 literally: the tip is released, re-contacts at once (plastic impact), and the
+    /// force check (B1)-(B3) releases it again; the resulting chatter is bounded by `max_events_per_step`.
+    Rebound,
+}
+
+impl ContactInconsistency {
+    /// Every treatment of an inconsistent contact.
+    const ALL: [ContactInconsistency; 2] =
+        [ContactInconsistency::Slide, ContactInconsistency::Rebound];
+
+    /// The name of this treatment (`"slide"` or `"rebound"`).
+    fn name(self) -> &'static str {
+        match self {
+            ContactInconsistency::Slide => "slide",
+            ContactInconsistency::Rebound => "rebound",
+        }
+    }
+
+    /// The treatment called `name`, if there is one.
+    fn from_name(name: &str) -> Option<ContactInconsistency> {
+        Self::ALL
+            .into_iter()
+            .find(|treatment| treatment.name() == name)
+    }
+}
+
+impl fmt::Display for ContactInconsistency {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Physical parameters of the wheel and the slope (`MODEL.md` sections 1, 2 and 7).
 ///
 /// Defaults are the paper's Table 1; the viscosity `c` is the parameter the paper sweeps. Check a value
@@ -106,10 +152,14 @@ pub struct Params {
     /// ways, through impacts too) and the exchange is the traditional one, which makes the model the
     /// classical rigid rimless wheel with a closed-form step map. Default `false`. `MODEL.md` section 7.
     pub rigid_legs: bool,
+    /// What happens when no no-slip contact state is consistent (a lift-off with a non-zero tangential
+    /// contact force). Default [`ContactInconsistency::Slide`]. `MODEL.md` sections 3-4.
+    pub inconsistent_contact: ContactInconsistency,
 }
 
 impl Default for Params {
-    /// The paper's Table 1, with `c = 50 N s/m`, `g = 9.81 m/s^2`, `IH = 0` and the DLS-indicator impact.
+    /// The paper's Table 1, with `c = 50 N s/m`, `g = 9.81 m/s^2`, `IH = 0`, the DLS-indicator impact and
+    /// frictionless sliding at an inconsistent contact.
     fn default() -> Self {
         Params {
             legs: 8,
@@ -125,6 +175,7 @@ impl Default for Params {
             gravity: 9.81,
             impact: ImpactModel::Dlsi,
             rigid_legs: false,
+            inconsistent_contact: ContactInconsistency::Slide,
         }
     }
 }
@@ -254,7 +305,8 @@ impl SolverOptions {
 /// Everything a run needs: physics ([`Params`]) and numerics ([`SolverOptions`]).
 ///
 /// It reads from, and serializes to, a flat TOML table whose keys are the field names of both structs
-/// (e.g. `viscosity = 50.0`, `impact = "traditional"`, `rigid_legs = true`, `rtol = 1e-11`).
+/// (e.g. `viscosity = 50.0`, `impact = "traditional"`, `rigid_legs = true`,
+/// `inconsistent_contact = "rebound"`, `rtol = 1e-11`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Config {
     /// Physical parameters (`MODEL.md` sections 1, 2 and 7). Default: the paper's Table 1.
@@ -267,7 +319,7 @@ pub struct Config {
 
 /// Every key of a configuration, in declaration order: the fields of [`Params`], then of
 /// [`SolverOptions`].
-const ALL_KEYS: [&str; 22] = [
+const ALL_KEYS: [&str; 23] = [
     "legs",
     "hub_mass",
     "hub_inertia",
@@ -281,6 +333,7 @@ const ALL_KEYS: [&str; 22] = [
     "gravity",
     "impact",
     "rigid_legs",
+    "inconsistent_contact",
     "rtol",
     "atol",
     "max_step",
@@ -377,7 +430,8 @@ impl Config {
 
     /// Sets `key` from its textual `value`, parsed by the key's type: a real number for `f64` keys
     /// (`"50"`, `"5e1"`, `"0.1"`), a non-negative integer for `legs` and `max_events_per_step`, `true` or
-    /// `false` for `rigid_legs`, `dlsi` or `traditional` for `impact`.
+    /// `false` for `rigid_legs`, `dlsi` or `traditional` for `impact`, `slide` or `rebound` for
+    /// `inconsistent_contact`.
     ///
     /// Does not validate, because the rules couple keys: call [`Config::validate`] after the last change.
     pub fn set(&mut self, key: &str, value: &str) -> Result<(), ConfigError> {
@@ -446,6 +500,9 @@ impl Config {
             "max_events_per_step" => self.solver.max_events_per_step = value.count(key)?,
             "rigid_legs" => self.params.rigid_legs = value.flag(key)?,
             "impact" => self.params.impact = value.impact(key)?,
+            "inconsistent_contact" => {
+                self.params.inconsistent_contact = value.inconsistency(key)?
+            }
             _ => {
                 return Err(ConfigError::UnknownKey {
                     key: key.to_string(),
@@ -523,6 +580,8 @@ trait RawValue {
     fn flag(&self, key: &str) -> Result<bool, ConfigError>;
     /// An impact law, by its name.
     fn impact(&self, key: &str) -> Result<ImpactModel, ConfigError>;
+    /// A treatment of an inconsistent contact, by its name.
+    fn inconsistency(&self, key: &str) -> Result<ContactInconsistency, ConfigError>;
 }
 
 /// Text of a `--set` override.
@@ -554,6 +613,10 @@ impl RawValue for str {
 
     fn impact(&self, key: &str) -> Result<ImpactModel, ConfigError> {
         impact_from_name(key, self)
+    }
+
+    fn inconsistency(&self, key: &str) -> Result<ContactInconsistency, ConfigError> {
+        inconsistency_from_name(key, self)
     }
 }
 
@@ -587,6 +650,13 @@ impl RawValue for toml::Value {
             other => Err(wrong_type(key, EXPECTED_IMPACT, describe(other))),
         }
     }
+
+    fn inconsistency(&self, key: &str) -> Result<ContactInconsistency, ConfigError> {
+        match self {
+            toml::Value::String(name) => inconsistency_from_name(key, name),
+            other => Err(wrong_type(key, EXPECTED_INCONSISTENCY, describe(other))),
+        }
+    }
 }
 
 /// Expected type of a real-valued key, as shown in [`ConfigError::WrongType`].
@@ -597,6 +667,8 @@ const EXPECTED_COUNT: &str = "a non-negative integer";
 const EXPECTED_FLAG: &str = "true or false";
 /// Expected type of the `impact` key, as shown in [`ConfigError::WrongType`].
 const EXPECTED_IMPACT: &str = "the string \"dlsi\" or \"traditional\"";
+/// Expected type of the `inconsistent_contact` key, as shown in [`ConfigError::WrongType`].
+const EXPECTED_INCONSISTENCY: &str = "the string \"slide\" or \"rebound\"";
 
 /// A TOML value's type and value, for [`ConfigError::WrongType`].
 fn describe(value: &toml::Value) -> String {
@@ -623,6 +695,18 @@ fn impact_from_name(key: &str, name: &str) -> Result<ImpactModel, ConfigError> {
             key,
             format!("{name:?}"),
             format!("must be {EXPECTED_IMPACT}"),
+        )
+    })
+}
+
+/// The treatment of an inconsistent contact called `name`, or an [`ConfigError::InvalidValue`] listing
+/// the known names.
+fn inconsistency_from_name(key: &str, name: &str) -> Result<ContactInconsistency, ConfigError> {
+    ContactInconsistency::from_name(name).ok_or_else(|| {
+        invalid(
+            key,
+            format!("{name:?}"),
+            format!("must be {EXPECTED_INCONSISTENCY}"),
         )
     })
 }
@@ -731,6 +815,7 @@ mod tests {
         assert_eq!(p.gravity, 9.81);
         assert_eq!(p.impact, ImpactModel::Dlsi);
         assert!(!p.rigid_legs);
+        assert_eq!(p.inconsistent_contact, ContactInconsistency::Slide);
         // The preload k (Lstar - L0) = 10 N exceeds the leg weight m g (MODEL.md section 2).
         let preload = p.stiffness * (p.spring_natural_length - p.stopper_length);
         assert!(preload > p.leg_mass * p.gravity);
@@ -763,6 +848,77 @@ mod tests {
     }
 
     #[test]
+    fn inconsistency_names_match_serde_and_display() {
+        for treatment in ContactInconsistency::ALL {
+            let via_serde = toml::Value::try_from(treatment).unwrap();
+            assert_eq!(via_serde.as_str(), Some(treatment.to_string().as_str()));
+            let back: ContactInconsistency = via_serde.try_into().unwrap();
+            assert_eq!(back, treatment);
+        }
+        assert_eq!(ContactInconsistency::Slide.to_string(), "slide");
+        assert_eq!(ContactInconsistency::Rebound.to_string(), "rebound");
+    }
+
+    #[test]
+    fn inconsistent_contact_parses_both_values() {
+        for treatment in ContactInconsistency::ALL {
+            let name = treatment.name();
+            let config =
+                Config::from_toml_str(&format!("inconsistent_contact = \"{name}\"")).unwrap();
+            assert_eq!(config.params.inconsistent_contact, treatment, "TOML {name}");
+
+            let mut config = Config::default();
+            config
+                .apply_override(&format!("inconsistent_contact={name}"))
+                .unwrap();
+            assert_eq!(
+                config.params.inconsistent_contact, treatment,
+                "--set {name}"
+            );
+            config.validate().unwrap();
+        }
+        // The default comes back after a change.
+        let mut config = Config::from_toml_str("inconsistent_contact = \"rebound\"").unwrap();
+        config
+            .apply_override("inconsistent_contact = slide")
+            .unwrap();
+        assert_eq!(config, Config::default());
+    }
+
+    #[test]
+    fn inconsistent_contact_rejects_unknown_names() {
+        let error = Config::from_toml_str("inconsistent_contact = \"stick\"").unwrap_err();
+        assert!(matches!(error, ConfigError::InvalidValue { .. }), "{error}");
+        assert_eq!(key_of(&error), Some("inconsistent_contact"));
+        let message = error.to_string();
+        assert!(
+            message.contains("slide") && message.contains("rebound") && message.contains("stick"),
+            "{message}"
+        );
+
+        let mut config = Config::default();
+        let error = config
+            .apply_override("inconsistent_contact=Slide")
+            .unwrap_err();
+        assert!(matches!(error, ConfigError::InvalidValue { .. }), "{error}");
+        assert_eq!(key_of(&error), Some("inconsistent_contact"));
+        assert!(error.to_string().contains("rebound"), "{error}");
+        assert_eq!(
+            config,
+            Config::default(),
+            "a failed override changes nothing"
+        );
+
+        let error = Config::from_toml_str("inconsistent_contact = true").unwrap_err();
+        assert!(matches!(error, ConfigError::WrongType { .. }), "{error}");
+        assert_eq!(key_of(&error), Some("inconsistent_contact"));
+        assert!(
+            error.to_string().contains("\"slide\" or \"rebound\""),
+            "{error}"
+        );
+    }
+
+    #[test]
     fn toml_file_round_trip() {
         let mut config = Config::default();
         config.params.legs = 6;
@@ -770,6 +926,7 @@ mod tests {
         config.params.slope = -0.05;
         config.params.impact = ImpactModel::Traditional;
         config.params.rigid_legs = true;
+        config.params.inconsistent_contact = ContactInconsistency::Rebound;
         config.solver.rtol = 3e-11;
         config.solver.max_events_per_step = 17;
 
@@ -780,7 +937,9 @@ mod tests {
         let mut expected = ALL_KEYS.to_vec();
         written.sort_unstable();
         expected.sort_unstable();
+        assert_eq!(written.len(), 23);
         assert_eq!(written, expected);
+        assert_eq!(table["inconsistent_contact"].as_str(), Some("rebound"));
 
         let path = temp_path("round-trip.toml");
         std::fs::write(&path, &text).unwrap();
@@ -904,6 +1063,7 @@ mod tests {
             ("viscosity = \"50\"", "viscosity"),
             ("rigid_legs = 1", "rigid_legs"),
             ("impact = 3", "impact"),
+            ("inconsistent_contact = 0", "inconsistent_contact"),
             ("slope = [0.1]", "slope"),
             ("gravity = 1979-05-27", "gravity"),
         ];
@@ -1007,6 +1167,7 @@ mod tests {
             "max_events_per_step=+50",
             "rigid_legs=true",
             "impact=traditional",
+            "inconsistent_contact=rebound",
         ] {
             config.apply_override(assignment).unwrap();
         }
@@ -1017,6 +1178,10 @@ mod tests {
         assert_eq!(config.solver.max_events_per_step, 50);
         assert!(config.params.rigid_legs);
         assert_eq!(config.params.impact, ImpactModel::Traditional);
+        assert_eq!(
+            config.params.inconsistent_contact,
+            ContactInconsistency::Rebound
+        );
         config.validate().unwrap();
 
         let cases = [
@@ -1037,6 +1202,7 @@ mod tests {
             ("legs=-1", "legs"),
             ("legs=99999999999999999999999", "legs"),
             ("impact=rigid", "impact"),
+            ("inconsistent_contact=stick", "inconsistent_contact"),
         ] {
             let error = Config::default().apply_override(assignment).unwrap_err();
             assert!(
@@ -1076,7 +1242,13 @@ mod tests {
         let keys = Config::numeric_keys();
         assert_eq!(keys.len(), 18);
         assert!(keys.iter().all(|key| ALL_KEYS.contains(key)));
-        for key in ["legs", "max_events_per_step", "impact", "rigid_legs"] {
+        for key in [
+            "legs",
+            "max_events_per_step",
+            "impact",
+            "rigid_legs",
+            "inconsistent_contact",
+        ] {
             assert!(!keys.contains(&key), "{key} is not real-valued");
         }
 

@@ -1,0 +1,118 @@
+//! Why a walk, a step or a gait search stopped (STYLE.md point 6): every variant carries the time and the
+//! phase where it happened, so a failed run is a result the user can read.
+
+use crate::contact::{ContactError, Phase};
+use crate::integrate::IntegrationError;
+
+/// A walk that cannot continue.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WalkError {
+    /// The hub dropped below `fall_hub_height`.
+    #[error("fell: hub height {hub_height:.4} m below the threshold at t = {time:.6} s in {phase}")]
+    Fell {
+        /// Time [s].
+        time: f64,
+        /// Phase at the fall.
+        phase: Phase,
+        /// Hub height [m].
+        hub_height: f64,
+    },
+    /// The wheel stopped and started rolling backward (`dtheta/dt` reached 0).
+    #[error("rolled back: dtheta/dt reached 0 at t = {time:.6} s in {phase}")]
+    RolledBack {
+        /// Time [s].
+        time: f64,
+        /// Phase.
+        phase: Phase,
+    },
+    /// No touchdown within `max_step_time`.
+    #[error("stalled: no touchdown within {limit} s (t = {time:.6} s, in {phase})")]
+    Stalled {
+        /// Time [s].
+        time: f64,
+        /// Phase.
+        phase: Phase,
+        /// The time limit of one step [s].
+        limit: f64,
+    },
+    /// More than `max_events_per_step` events in one step (Zeno chatter).
+    #[error("chatter: {events} events in one step by t = {time:.6} s in {phase}")]
+    Chatter {
+        /// Time [s].
+        time: f64,
+        /// Phase.
+        phase: Phase,
+        /// Number of events in the step.
+        events: usize,
+    },
+    /// At touchdown the old Leg 2, which leaves `q`, was not locked at `L0` (MODEL.md section 5).
+    #[error("old rear leg not relocked at touchdown (t = {time:.6} s, length {length:.6} m, rate {rate:.4} m/s)")]
+    RearLegNotLocked {
+        /// Time [s].
+        time: f64,
+        /// Its length [m].
+        length: f64,
+        /// Its rate of extension [m/s].
+        rate: f64,
+    },
+    /// At touchdown the old Leg 2 was still on the ground: three legs would support the wheel.
+    #[error("old rear leg still on the ground at touchdown (t = {time:.6} s)")]
+    RearLegInContact {
+        /// Time [s].
+        time: f64,
+    },
+    /// No set of active contacts and stoppers satisfies the unilateral conditions.
+    #[error("no consistent contact state at t = {time:.6} s in {phase}")]
+    InconsistentContacts {
+        /// Time [s].
+        time: f64,
+        /// Phase before the search.
+        phase: Phase,
+    },
+    /// The constraint equations could not be solved.
+    #[error("constraint solve failed at t = {time:.6} s in {phase}: {source}")]
+    Contact {
+        /// Time [s].
+        time: f64,
+        /// Phase.
+        phase: Phase,
+        /// What failed.
+        source: ContactError,
+    },
+    /// The integrator failed.
+    #[error("integration failed in {phase}: {source}")]
+    Integration {
+        /// Phase.
+        phase: Phase,
+        /// What failed.
+        source: IntegrationError,
+    },
+    /// A Poincare-section state the wheel cannot be in.
+    #[error("invalid section state: {field} = {value}: {reason}")]
+    InvalidSection {
+        /// Which component (`L2`, `thetadot`, `L2dot`).
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// Why it is rejected.
+        reason: &'static str,
+    },
+}
+
+impl WalkError {
+    /// A short machine-readable name of the failure (`fell`, `stalled`, ...), used in CSV and JSON output.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            WalkError::Fell { .. } => "fell",
+            WalkError::RolledBack { .. } => "rolled_back",
+            WalkError::Stalled { .. } => "stalled",
+            WalkError::Chatter { .. } => "chatter",
+            WalkError::RearLegNotLocked { .. } => "rear_leg_not_locked",
+            WalkError::RearLegInContact { .. } => "rear_leg_in_contact",
+            WalkError::InconsistentContacts { .. } => "inconsistent_contacts",
+            WalkError::Contact { .. } => "constraint_failure",
+            WalkError::Integration { .. } => "solver_failure",
+            WalkError::InvalidSection { .. } => "invalid_section",
+        }
+    }
+}

@@ -1,0 +1,411 @@
+//! Touchdown: re-indexing and the DLS-indicator impact procedure (MODEL.md section 5, paper Sec. 2.2,
+//! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event.
+//!
+//! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward) are resolved by
+//! enumerating the few possible active sets (at most four optional units, so at most 16 sets) and keeping a
+//! set that satisfies complementarity: included units push the right way, excluded units do not penetrate.
+//! Where several sets qualify, the one that best matches the stated preference (keep what was active, add no
+//! stopper that is not needed, follow the paper's branch) wins, so in the regular case the result is exactly
+//! the paper's procedure.
+
+use serde::Serialize;
+
+use crate::contact::{
+    constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg,
+};
+use crate::dynamics::{Coords, Model};
+use crate::params::{ContactInconsistency, ImpactModel};
+
+/// Tolerance of the complementarity checks (forces [N], impulses [N s], velocities [m/s], accelerations
+/// [m/s^2]): a value within this of zero counts as zero, so that an event located at a force or velocity
+/// zero is not undone by rounding.
+pub const COMPLEMENTARITY_TOL: f64 = 1e-9;
+
+/// The three DLS indicators of the paper (Sec. 2.2): `lambda_I4` from (A1), `lambda_2+`, `lambda_4+` from (B1).
+/// `NaN` where the procedure does not define them (`lambda_2+`, `lambda_4+` after (A3), all three when the
+/// rear leg was not on the ground at touchdown or the legs are rigid).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DlsIndicators {
+    /// Normal impulse on Leg 2 of the DLS collision (A1) [N s].
+    pub lambda_i4: f64,
+    /// Normal force on Leg 1 just after impact, Eqs. (6)-(7) [N].
+    pub lambda_2_plus: f64,
+    /// Normal force on Leg 2 just after impact, Eqs. (6)-(7) [N].
+    pub lambda_4_plus: f64,
+}
+
+impl DlsIndicators {
+    /// All three undefined.
+    pub const UNDEFINED: DlsIndicators = DlsIndicators {
+        lambda_i4: f64::NAN,
+        lambda_2_plus: f64::NAN,
+        lambda_4_plus: f64::NAN,
+    };
+}
+
+/// Which branch of the procedure a touchdown took.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "SCREAMING_SNAKE_CASE")]
+pub enum Branch {
+    /// (B2): `lambda_I4 >= 0`, `lambda_2+ >= 0`, `lambda_4+ >= 0`: a DLS phase follows.
+    Dls,
+    /// (A3), or the traditional impact: the rear leg leaves at once (`J_SLS` collision).
+    Sls,
+    /// (B3): `lambda_I4 >= 0` but `lambda_4+ < 0`: SLS from the DLS post-impact velocity (the paper's open case).
+    SlsB3,
+    /// `lambda_I4 >= 0` but `lambda_2+ < 0`: Leg 1 bounces at once.
+    Bounce,
+    /// The rear leg was in the air at touchdown (after a bounce): a plain plastic landing of Leg 1.
+    RearAirborne,
+}
+
+impl std::fmt::Display for Branch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Branch::Dls => "DLS",
+            Branch::Sls => "SLS",
+            Branch::SlsB3 => "SLS_B3",
+            Branch::Bounce => "BOUNCE",
+            Branch::RearAirborne => "REAR_AIRBORNE",
+        })
+    }
+}
+
+/// A unilateral unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// Ground contact of a leg tip.
+    Contact(Leg),
+    /// Stopper of a leg.
+    Stopper(Leg),
+}
+
+/// State of a unit in an active set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// Inactive: the tip is free / the leg is free of its stopper.
+    Off,
+    /// Active: a no-slip contact, or a locked stopper.
+    On,
+    /// A contact that slides without friction (normal row only); used only when neither `On` nor `Off` is
+    /// consistent and [`ContactInconsistency::Slide`] is selected.
+    Slide,
+}
+
+impl Unit {
+    /// Put the unit in `mode` in `active`.
+    pub fn apply(self, active: &mut ActiveSet, mode: Mode) {
+        match (self, mode) {
+            (Unit::Contact(leg), Mode::Slide) => active.set_sliding(leg),
+            (Unit::Contact(leg), m) => active.set_contact(leg, m == Mode::On),
+            (Unit::Stopper(leg), m) => active.set_lock(leg, m != Mode::Off),
+        }
+    }
+
+    /// The unit's mode in `active`.
+    pub fn mode(self, active: &ActiveSet) -> Mode {
+        match self {
+            Unit::Contact(leg) if active.slide(leg) => Mode::Slide,
+            Unit::Contact(leg) if active.contact(leg) => Mode::On,
+            Unit::Stopper(leg) if active.lock(leg) => Mode::On,
+            _ => Mode::Off,
+        }
+    }
+}
+
+/// An optional unit and the mode the caller prefers for it when several are consistent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Candidate {
+    /// The unit.
+    pub unit: Unit,
+    /// Preferred mode.
+    pub preferred: Mode,
+}
+
+impl Candidate {
+    /// The candidate `unit` preferring the mode it has in `active`.
+    pub fn keep(unit: Unit, active: &ActiveSet) -> Candidate {
+        Candidate {
+            unit,
+            preferred: unit.mode(active),
+        }
+    }
+
+    fn modes(&self, allow_slide: bool) -> &'static [Mode] {
+        match (self.unit, allow_slide) {
+            (Unit::Contact(_), true) => &[Mode::Off, Mode::On, Mode::Slide],
+            _ => &[Mode::Off, Mode::On],
+        }
+    }
+
+    /// Preference score: the preferred mode 2, another regular mode 1, sliding (the last resort) 0.
+    fn score(&self, mode: Mode) -> usize {
+        if mode == self.preferred {
+            2
+        } else if mode == Mode::Slide {
+            0
+        } else {
+            1
+        }
+    }
+}
+
+/// Among `forced` plus every combination of modes of the `candidates`, the consistent set with the best
+/// preference score. With `allow_slide` false and no consistent set, the all-preferred set is returned (the
+/// paper's rule, MODEL.md section 4 taken literally).
+fn best_subset<T>(
+    forced: ActiveSet,
+    candidates: &[Candidate],
+    allow_slide: bool,
+    mut solve: impl FnMut(&ActiveSet) -> Result<T, ContactError>,
+    mut consistent: impl FnMut(&ActiveSet, &T) -> bool,
+) -> Result<Option<(ActiveSet, T)>, ContactError> {
+    let radix: Vec<usize> = candidates.iter().map(|c| c.modes(allow_slide).len()).collect();
+    let combinations: usize = radix.iter().product();
+    let mut best: Option<(usize, ActiveSet, T)> = None;
+    for mut code in 0..combinations {
+        let mut set = forced;
+        let mut score = 0;
+        for (c, r) in candidates.iter().zip(&radix) {
+            let mode = c.modes(allow_slide)[code % r];
+            code /= r;
+            c.unit.apply(&mut set, mode);
+            score += c.score(mode);
+        }
+        if best.as_ref().is_some_and(|(s, _, _)| *s >= score) {
+            continue;
+        }
+        match solve(&set) {
+            Ok(value) if consistent(&set, &value) => best = Some((score, set, value)),
+            Ok(_) => {}
+            // A redundant set is simply not a candidate; other failures are real.
+            Err(ContactError::RedundantConstraints(_)) => {}
+            Err(e) => return Err(e),
+        }
+    }
+    if best.is_none() && !allow_slide {
+        let mut set = forced;
+        for c in candidates {
+            c.unit.apply(&mut set, c.preferred);
+        }
+        return Ok(Some((set, solve(&set)?)));
+    }
+    Ok(best.map(|(_, set, value)| (set, value)))
+}
+
+/// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
+/// must (impulses push, excluded units separate): paper Eq. (5) with the active set resolved. Impacts are
+/// no-slip (no sliding mode); if no combination is consistent the preferred one is used.
+pub fn plastic_impact(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    forced: ActiveSet,
+    candidates: &[Candidate],
+) -> Result<Option<(ActiveSet, ImpulseSolution)>, ContactError> {
+    best_subset(
+        forced,
+        candidates,
+        false,
+        |set| impulse(model, q, qd, set),
+        |set, sol| {
+            candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+                (Unit::Contact(leg), Mode::Off) => {
+                    model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
+                }
+                (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
+                (Unit::Stopper(leg), Mode::Off) => {
+                    sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+                }
+                (Unit::Stopper(leg), _) => sol.stopper_impulse(leg) >= -COMPLEMENTARITY_TOL,
+            })
+        },
+    )
+}
+
+/// The active set for continuous motion (the force-level complementarity problem): `forced` units plus the
+/// `candidates` that must push (positive normal force, inward stopper reaction) so that no excluded unit
+/// penetrates (tip accelerating into the ground, leg accelerating past its stopper). Sliding contacts are
+/// tried only under [`ContactInconsistency::Slide`].
+pub fn consistent_active_set(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    forced: ActiveSet,
+    candidates: &[Candidate],
+) -> Result<Option<(ActiveSet, ConstrainedDynamics)>, ContactError> {
+    let allow_slide = model.params().inconsistent_contact == ContactInconsistency::Slide;
+    best_subset(
+        forced,
+        candidates,
+        allow_slide,
+        |set| constrained_dynamics(model, q, qd, set),
+        |set, dynamics| {
+            candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+                (Unit::Contact(leg), Mode::Off) => {
+                    let tip = model.tip(q, qd, leg.index());
+                    (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
+                }
+                (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
+                (Unit::Stopper(leg), Mode::Off) => {
+                    dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+                }
+                (Unit::Stopper(leg), _) => dynamics.stopper_reaction(leg) >= -COMPLEMENTARITY_TOL,
+            })
+        },
+    )
+}
+
+/// What the touchdown impact produced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TouchdownImpact {
+    /// `q'+`.
+    pub qd_plus: Coords,
+    /// DLS indicators of this touchdown.
+    pub indicators: DlsIndicators,
+    /// Branch of the procedure.
+    pub branch: Branch,
+    /// Units that took the impulse (all at zero relative velocity after it).
+    pub impulse_set: ActiveSet,
+    /// Contacts the procedure asks to keep for the motion that follows (its preferred phase).
+    pub preferred: ActiveSet,
+    /// Kinetic energy lost in the impact [J].
+    pub loss: f64,
+}
+
+/// Stoppers a touchdown impulse may need: Leg 1 (at `L0`, locked before touchdown) and Leg 2 if locked.
+fn stopper_candidates(before: &ActiveSet) -> Vec<Candidate> {
+    Leg::BOTH
+        .into_iter()
+        .filter(|leg| before.lock(*leg))
+        .map(|leg| Candidate {
+            unit: Unit::Stopper(leg),
+            preferred: Mode::Off,
+        })
+        .collect()
+}
+
+/// The touchdown impact at `(q_dagger, q'_dagger)` after re-indexing (MODEL.md section 5).
+///
+/// `before` is the active set just before impact in the new indexing: `contact2` = the old Leg 1 was on the
+/// ground, `lock1` = true (the new leg arrives locked), `lock2` = the old Leg 1's stopper.
+///
+/// 1. (A1) solve Eq. (5) with `J_DLS`: DLS indicator 1 is `lambda_I4`.
+/// 2. (A3) if `lambda_I4 < 0`, the collision is recomputed with `J_SLS`.
+/// 3. (A4)/(B1) otherwise keep `q'+` of (A1) and solve Eqs. (6)-(7) for `lambda+`: `lambda_2+`, `lambda_4+`.
+/// 4. (B2) both non-negative: DLS; (B3) `lambda_4+ < 0`: SLS from the same `q'+`; `lambda_2+ < 0`: bounce.
+///
+/// With [`ImpactModel::Traditional`] the indicators are still computed and reported, but the collision is
+/// always the `J_SLS` one. With `rigid_legs` the stoppers act both ways and the exchange is the traditional
+/// one; the indicators are undefined (a DLS collision of two locked legs is statically indeterminate).
+pub fn touchdown_impact(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    before: ActiveSet,
+) -> Result<Option<TouchdownImpact>, ContactError> {
+    let kinetic = |v: &Coords| model.kinetic_energy(q, v);
+    let finish = |impulse_set: ActiveSet,
+                  sol: ImpulseSolution,
+                  indicators: DlsIndicators,
+                  branch: Branch,
+                  preferred: ActiveSet| TouchdownImpact {
+        qd_plus: sol.qd_plus,
+        indicators,
+        branch,
+        impulse_set,
+        preferred,
+        loss: kinetic(qd) - kinetic(&sol.qd_plus),
+    };
+    let sls = ActiveSet {
+        contact1: true,
+        ..Default::default()
+    };
+    let stoppers = stopper_candidates(&before);
+
+    if model.params().rigid_legs {
+        let set = ActiveSet {
+            contact1: true,
+            lock1: true,
+            lock2: true,
+            ..Default::default()
+        };
+        let sol = impulse(model, q, qd, &set)?;
+        return Ok(Some(finish(set, sol, DlsIndicators::UNDEFINED, Branch::Sls, set)));
+    }
+    if !before.contact2 {
+        let Some((set, sol)) = plastic_impact(model, q, qd, sls, &stoppers)? else {
+            return Ok(None);
+        };
+        return Ok(Some(finish(set, sol, DlsIndicators::UNDEFINED, Branch::RearAirborne, sls)));
+    }
+
+    // (A1) the DLS collision.
+    let dls = ActiveSet {
+        contact2: true,
+        ..sls
+    };
+    let Some((dls_set, dls_sol)) = plastic_impact(model, q, qd, dls, &stoppers)? else {
+        return Ok(None);
+    };
+    let lambda_i4 = dls_sol.normal_impulse(Leg::Two);
+    // (B1) forces just after the DLS collision, Eqs. (6)-(7).
+    let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
+        let after = constrained_dynamics(model, q, &dls_sol.qd_plus, &dls_set)?;
+        (after.normal_force(Leg::One), after.normal_force(Leg::Two))
+    } else {
+        (f64::NAN, f64::NAN)
+    };
+    let indicators = DlsIndicators {
+        lambda_i4,
+        lambda_2_plus,
+        lambda_4_plus,
+    };
+
+    if model.params().impact == ImpactModel::Traditional || lambda_i4 < 0.0 {
+        // (A3), or the traditional exchange: the rear leg leaves at once.
+        let Some((set, sol)) = plastic_impact(model, q, qd, sls, &stoppers)? else {
+            return Ok(None);
+        };
+        return Ok(Some(finish(set, sol, indicators, Branch::Sls, sls)));
+    }
+    let (branch, preferred) = match (lambda_2_plus >= 0.0, lambda_4_plus >= 0.0) {
+        (true, true) => (Branch::Dls, dls),
+        (true, false) => (Branch::SlsB3, sls),
+        (false, rear) => (
+            Branch::Bounce,
+            ActiveSet {
+                contact2: rear,
+                ..Default::default()
+            },
+        ),
+    };
+    Ok(Some(finish(dls_set, dls_sol, indicators, branch, preferred)))
+}
+
+/// Candidates for the motion right after an impact whose impulse acted on `impulse_set`: every unit that took
+/// the impulse is closed (zero relative velocity) and may stay active; `preferred` gives the contact modes the
+/// procedure wants (the paper's branch at a touchdown). With `rigid_legs` the stoppers are bilateral and forced.
+pub fn post_impact_candidates(
+    model: &Model,
+    impulse_set: &ActiveSet,
+    preferred: &ActiveSet,
+) -> (ActiveSet, Vec<Candidate>) {
+    let rigid = model.params().rigid_legs;
+    let mut forced = ActiveSet::default();
+    let mut candidates = Vec::new();
+    for leg in Leg::BOTH {
+        if impulse_set.contact(leg) {
+            candidates.push(Candidate::keep(Unit::Contact(leg), preferred));
+        }
+        if rigid {
+            forced.set_lock(leg, true);
+        } else if impulse_set.lock(leg) {
+            candidates.push(Candidate {
+                unit: Unit::Stopper(leg),
+                preferred: Mode::On,
+            });
+        }
+    }
+    (forced, candidates)
+}

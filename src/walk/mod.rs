@@ -1,0 +1,744 @@
+//! The hybrid walk (MODEL.md sections 4-5): continuous phases separated by located events.
+//!
+//! A [`Walker`] holds the wheel at the Poincare section (just before a touchdown, after re-indexing) and
+//! [`Walker::step`] advances it to the next one: the touchdown impact of [`impact`], then phases of constrained
+//! motion, each integrated by [`Dopri5`] until the earliest event, located on the dense output:
+//!
+//! | event | function crossing zero from above |
+//! |---|---|
+//! | touchdown | height of the next leg's tip (length `L0`) |
+//! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (+ [`COMPLEMENTARITY_TOL`]) |
+//! | landing / rear re-contact of an airborne tip | its height (armed once above `recontact_gap`, see below) |
+//! | stopper unlock | the stopper's inward reaction (+ [`COMPLEMENTARITY_TOL`]) |
+//! | stopper hit of a free leg | `L0 - L` (armed once below `L0 - stopper_gap`) |
+//! | fall | hub height minus `fall_hub_height` |
+//! | rolling back | `dtheta/dt` |
+//!
+//! **Grazing guard.** Right after a lift-off at `lambda_4 = 0` the tip leaves the ground with zero velocity and
+//! acceleration, so the height function starts at zero. Such an event is *disarmed*: its function is
+//! `height + recontact_gap`, which fires only if the tip sinks `recontact_gap` below the ground without having
+//! risen; once the height exceeds `recontact_gap` at an accepted step the event is armed and its function is the
+//! height itself. Stoppers use `stopper_gap` the same way. Both are options of [`SolverOptions`].
+
+pub mod impact;
+pub mod report;
+pub mod section;
+
+use nalgebra::SVector;
+
+use crate::contact::{constrained_dynamics, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase};
+use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X, Z};
+use crate::error::WalkError;
+use crate::integrate::{locate_root, DenseStep, Dopri5, OdeSystem, Tolerances};
+use crate::params::SolverOptions;
+
+use impact::{
+    consistent_active_set, plastic_impact, post_impact_candidates, touchdown_impact, Candidate, Mode, Unit,
+    COMPLEMENTARITY_TOL,
+};
+pub use impact::{Branch, DlsIndicators};
+pub use report::{EnergyAudit, StepReport};
+pub use section::SectionState;
+
+/// Size of the integrated state `[q, q', E_damper]`.
+pub const NY: usize = 2 * NQ + 1;
+/// The integrated state: coordinates, velocities and the energy dissipated by the dampers so far in the step.
+pub type WalkVector = SVector<f64, NY>;
+
+fn pack(q: &Coords, qd: &Coords, dissipated: f64) -> WalkVector {
+    let mut y = WalkVector::zeros();
+    y.fixed_rows_mut::<NQ>(0).copy_from(q);
+    y.fixed_rows_mut::<NQ>(NQ).copy_from(qd);
+    y[2 * NQ] = dissipated;
+    y
+}
+
+fn unpack(y: &WalkVector) -> (Coords, Coords) {
+    (y.fixed_rows::<NQ>(0).into_owned(), y.fixed_rows::<NQ>(NQ).into_owned())
+}
+
+/// The vector field of one phase: Eq. (1) with the constraints of `active`, plus the damper power
+/// `c (dL1^2 + dL2^2)` as a quadrature.
+#[derive(Debug, Clone, Copy)]
+pub struct PhaseSystem<'a> {
+    /// The model.
+    pub model: &'a Model,
+    /// Active contacts and stoppers.
+    pub active: ActiveSet,
+}
+
+impl OdeSystem<NY> for PhaseSystem<'_> {
+    fn rhs(&self, _t: f64, y: &WalkVector) -> WalkVector {
+        let (q, qd) = unpack(y);
+        match constrained_dynamics(self.model, &q, &qd, &self.active) {
+            Ok(d) => {
+                let c = self.model.params().viscosity;
+                pack(&qd, &d.qdd, c * (qd[L1] * qd[L1] + qd[L2] * qd[L2]))
+            }
+            // The integrator reports a non-finite derivative as an error with its time.
+            Err(_) => WalkVector::repeat(f64::NAN),
+        }
+    }
+}
+
+/// The wheel between events, in the frame of its current Leg 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkState {
+    /// Time [s].
+    pub time: f64,
+    /// `q` (with `x` relative to `x_origin`).
+    pub q: Coords,
+    /// `q'`.
+    pub qd: Coords,
+    /// Active contacts and stoppers (before the touchdown impact, when at the section).
+    pub active: ActiveSet,
+    /// Position along the slope of this frame's origin (the touchdown point of Leg 1) [m].
+    pub x_origin: f64,
+    /// Which physical leg (0..N) is Leg 1.
+    pub leg1: usize,
+}
+
+/// One sample of the trajectory, taken from the dense output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    /// Time [s].
+    pub time: f64,
+    /// `q` with `x` measured from the start of the walk.
+    pub q: Coords,
+    /// `q'`.
+    pub qd: Coords,
+    /// Active contacts and stoppers.
+    pub active: ActiveSet,
+    /// `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]`.
+    pub multipliers: Multipliers,
+    /// Which physical leg is Leg 1.
+    pub leg1: usize,
+}
+
+/// Samples of the trajectory every `dt` seconds, plus one right after every event.
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    dt: f64,
+    next: usize,
+    /// The samples, in time order.
+    pub samples: Vec<Sample>,
+}
+
+impl Trajectory {
+    /// Sample every `dt` seconds of simulated time.
+    pub fn new(dt: f64) -> Trajectory {
+        Trajectory {
+            dt,
+            next: 0,
+            samples: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, model: &Model, time: f64, y: &WalkVector, active: ActiveSet, frame: &WalkState) {
+        let (mut q, qd) = unpack(y);
+        let multipliers = constrained_dynamics(model, &q, &qd, &active)
+            .map_or(Multipliers::repeat(f64::NAN), |d| d.multipliers);
+        q[X] += frame.x_origin;
+        self.samples.push(Sample {
+            time,
+            q,
+            qd,
+            active,
+            multipliers,
+            leg1: frame.leg1,
+        });
+    }
+
+    fn record(&mut self, model: &Model, step: &DenseStep<NY>, until: f64, active: ActiveSet, frame: &WalkState) {
+        loop {
+            let t = self.next as f64 * self.dt;
+            if t > until {
+                break;
+            }
+            if t >= step.t0() {
+                self.push(model, t, &step.eval(t), active, frame);
+            }
+            self.next += 1;
+        }
+    }
+}
+
+/// Kinds of events (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum EventKind {
+    Touchdown,
+    Fall,
+    RollBack,
+    LiftOff(Leg),
+    Unlock(Leg),
+    Landing(Leg),
+    StopperHit(Leg),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Event {
+    kind: EventKind,
+    armed: bool,
+}
+
+/// Event functions of one phase.
+struct EventSet<'a> {
+    model: &'a Model,
+    opts: &'a SolverOptions,
+    active: ActiveSet,
+    events: Vec<Event>,
+}
+
+impl<'a> EventSet<'a> {
+    fn new(model: &'a Model, opts: &'a SolverOptions, active: ActiveSet, q: &Coords) -> EventSet<'a> {
+        let mut set = EventSet {
+            model,
+            opts,
+            active,
+            events: vec![],
+        };
+        for kind in [EventKind::Touchdown, EventKind::Fall, EventKind::RollBack] {
+            set.events.push(Event { kind, armed: true });
+        }
+        for leg in Leg::BOTH {
+            let kind = if active.contact(leg) {
+                EventKind::LiftOff(leg)
+            } else {
+                EventKind::Landing(leg)
+            };
+            set.events.push(Event { kind, armed: true });
+            if !model.params().rigid_legs {
+                let kind = if active.lock(leg) {
+                    EventKind::Unlock(leg)
+                } else {
+                    EventKind::StopperHit(leg)
+                };
+                set.events.push(Event { kind, armed: true });
+            }
+        }
+        let zero = Coords::zeros();
+        let dynamics = None;
+        for k in 0..set.events.len() {
+            let (raw, gap) = set.raw(k, q, &zero, &dynamics);
+            if let Some(gap) = gap {
+                set.events[k].armed = raw > gap;
+            }
+        }
+        set
+    }
+
+    /// The unshifted function of event `k` and, for guarded events, their gap.
+    fn raw(&self, k: usize, q: &Coords, qd: &Coords, dynamics: &Option<ConstrainedDynamics>) -> (f64, Option<f64>) {
+        let p = self.model.params();
+        let force = |f: &dyn Fn(&ConstrainedDynamics) -> f64| dynamics.as_ref().map_or(f64::NAN, f);
+        match self.events[k].kind {
+            EventKind::Touchdown => (self.model.tip_height(q, self.model.front_leg()), None),
+            EventKind::Fall => (q[Z] + q[L1] * q[THETA].cos() - self.opts.fall_hub_height, None),
+            EventKind::RollBack => (qd[THETA], None),
+            EventKind::LiftOff(leg) => (force(&|d| d.normal_force(leg)) + COMPLEMENTARITY_TOL, None),
+            EventKind::Unlock(leg) => (force(&|d| d.stopper_reaction(leg)) + COMPLEMENTARITY_TOL, None),
+            EventKind::Landing(leg) => (self.model.tip_height(q, leg.index()), Some(self.opts.recontact_gap)),
+            EventKind::StopperHit(leg) => (
+                p.stopper_length - q[leg.length_coordinate()],
+                Some(self.opts.stopper_gap),
+            ),
+        }
+    }
+
+    fn needs_forces(&self) -> bool {
+        self.events
+            .iter()
+            .any(|e| matches!(e.kind, EventKind::LiftOff(_) | EventKind::Unlock(_)))
+    }
+
+    /// Values of all event functions at `y` (guarded events shifted by their gap while disarmed).
+    fn values(&self, y: &WalkVector) -> Vec<f64> {
+        let (q, qd) = unpack(y);
+        let dynamics = if self.needs_forces() {
+            constrained_dynamics(self.model, &q, &qd, &self.active).ok()
+        } else {
+            None
+        };
+        (0..self.events.len())
+            .map(|k| {
+                let (raw, gap) = self.raw(k, &q, &qd, &dynamics);
+                match gap {
+                    Some(gap) if !self.events[k].armed => raw + gap,
+                    _ => raw,
+                }
+            })
+            .collect()
+    }
+
+    fn value(&self, k: usize, y: &WalkVector) -> f64 {
+        let (q, qd) = unpack(y);
+        let dynamics = match self.events[k].kind {
+            EventKind::LiftOff(_) | EventKind::Unlock(_) => {
+                constrained_dynamics(self.model, &q, &qd, &self.active).ok()
+            }
+            _ => None,
+        };
+        let (raw, gap) = self.raw(k, &q, &qd, &dynamics);
+        match gap {
+            Some(gap) if !self.events[k].armed => raw + gap,
+            _ => raw,
+        }
+    }
+
+    /// Arm guarded events whose function has cleared its gap; returns the values in the new definitions.
+    fn arm(&mut self, values: &mut [f64]) {
+        for (k, e) in self.events.iter_mut().enumerate() {
+            if !e.armed {
+                let gap = match e.kind {
+                    EventKind::Landing(_) => self.opts.recontact_gap,
+                    EventKind::StopperHit(_) => self.opts.stopper_gap,
+                    _ => continue,
+                };
+                // values[k] = raw + gap
+                if values[k] - gap > gap {
+                    e.armed = true;
+                    values[k] -= gap;
+                }
+            }
+        }
+    }
+}
+
+/// Bookkeeping of the step in progress.
+#[derive(Debug, Default, Clone, Copy)]
+struct StepTally {
+    dls_duration: f64,
+    scuffing: bool,
+    bounce: bool,
+    impact_loss: f64,
+    stopper_loss: f64,
+    events: usize,
+}
+
+/// Walks the wheel from touchdown to touchdown.
+#[derive(Debug, Clone)]
+pub struct Walker<'m> {
+    model: &'m Model,
+    opts: SolverOptions,
+    /// At the section: just before the touchdown impact, after re-indexing.
+    state: WalkState,
+    steps_done: usize,
+    /// Why the next step cannot start (the re-indexing at the last touchdown failed).
+    blocked: Option<WalkError>,
+}
+
+impl<'m> Walker<'m> {
+    /// Start at a Poincare-section state (MODEL.md section 6), at time 0 and position 0.
+    pub fn new(model: &'m Model, opts: &SolverOptions, section: &SectionState) -> Result<Walker<'m>, WalkError> {
+        section.validate(model)?;
+        let (q, qd) = section.to_coords(model);
+        let state = WalkState {
+            time: 0.0,
+            q,
+            qd,
+            active: ActiveSet {
+                contact1: false,
+                contact2: true,
+                lock1: true,
+                lock2: model.params().rigid_legs,
+                ..Default::default()
+            },
+            x_origin: 0.0,
+            leg1: 0,
+        };
+        Ok(Walker {
+            model,
+            opts: opts.clone(),
+            state,
+            steps_done: 0,
+            blocked: None,
+        })
+    }
+
+    /// The current state (at the section).
+    pub fn state(&self) -> &WalkState {
+        &self.state
+    }
+
+    /// The current Poincare-section state, or why the walk cannot continue.
+    pub fn section(&self) -> Result<SectionState, WalkError> {
+        match &self.blocked {
+            Some(e) => Err(e.clone()),
+            None => Ok(SectionState::from_coords(&self.state.q, &self.state.qd)),
+        }
+    }
+
+    fn tolerances(&self) -> Tolerances {
+        Tolerances {
+            rtol: self.opts.rtol,
+            atol: self.opts.atol,
+            h_max: self.opts.max_step,
+            ..Tolerances::default()
+        }
+    }
+
+    /// Advance from this touchdown to the next one: the impact procedure, then the continuous phases and their
+    /// events. Returns the step's report; the walker is then at the next section. Samples go to `trajectory`.
+    pub fn step(&mut self, mut trajectory: Option<&mut Trajectory>) -> Result<StepReport, WalkError> {
+        if let Some(e) = &self.blocked {
+            return Err(e.clone());
+        }
+        let model = self.model;
+        let opts = self.opts.clone();
+        let start = self.state.clone();
+        let t_start = start.time;
+        let contact_error = |time: f64, phase: Phase| move |source| WalkError::Contact { time, phase, source };
+
+        let e_start = model.energy(&start.q, &start.qd);
+        let td = touchdown_impact(model, &start.q, &start.qd, start.active)
+            .map_err(contact_error(t_start, Phase::SingleSupport))?
+            .ok_or(WalkError::InconsistentContacts {
+                time: t_start,
+                phase: Phase::SingleSupport,
+            })?;
+        let mut tally = StepTally {
+            impact_loss: td.loss,
+            bounce: td.branch == Branch::Bounce,
+            ..StepTally::default()
+        };
+        let (forced, candidates) = post_impact_candidates(model, &td.impulse_set, &td.preferred);
+        let (mut active, _) = consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
+            .map_err(contact_error(t_start, td.preferred.phase()))?
+            .ok_or(WalkError::InconsistentContacts {
+                time: t_start,
+                phase: td.preferred.phase(),
+            })?;
+        tally.scuffing |= active.slide2;
+
+        let mut t = t_start;
+        let mut y = pack(&start.q, &td.qd_plus, 0.0);
+        if let Some(tr) = trajectory.as_deref_mut() {
+            tr.push(model, t, &y, active, &start);
+        }
+        let t_limit = t_start + opts.max_step_time;
+        let mut solver = Dopri5::new(&PhaseSystem { model, active }, t, y, self.tolerances());
+        let (q0, _) = unpack(&y);
+        let mut events = EventSet::new(model, &opts, active, &q0);
+        let mut g_prev = events.values(&y);
+
+        loop {
+            let phase = active.phase();
+            if t >= t_limit {
+                return Err(WalkError::Stalled {
+                    time: t,
+                    phase,
+                    limit: opts.max_step_time,
+                });
+            }
+            let sys = PhaseSystem { model, active };
+            let step = solver
+                .step(&sys, t_limit)
+                .map_err(|source| WalkError::Integration { phase, source })?;
+            let mut g_next = events.values(step.y1());
+            let mut hit: Option<(f64, usize)> = None;
+            for k in 0..g_next.len() {
+                if g_prev[k] > 0.0 && g_next[k] <= 0.0 {
+                    let tk = locate_root(
+                        &step,
+                        |_, y| events.value(k, y),
+                        step.t0(),
+                        g_prev[k],
+                        step.t1(),
+                        g_next[k],
+                        opts.event_time_tol,
+                    );
+                    if hit.is_none_or(|(t_hit, _)| tk < t_hit) {
+                        hit = Some((tk, k));
+                    }
+                }
+            }
+            let t_end = hit.map_or(step.t1(), |(t_hit, _)| t_hit);
+            if active.contact1 && active.contact2 {
+                tally.dls_duration += t_end - step.t0();
+            }
+            if let Some(tr) = trajectory.as_deref_mut() {
+                tr.record(model, &step, t_end, active, &start);
+            }
+            let Some((t_hit, k)) = hit else {
+                events.arm(&mut g_next);
+                g_prev = g_next;
+                t = step.t1();
+                continue;
+            };
+
+            // An event at t_hit.
+            t = t_hit;
+            y = step.eval(t_hit);
+            let (q, qd) = unpack(&y);
+            let kind = events.events[k].kind;
+            match kind {
+                EventKind::Touchdown => {
+                    let report = self.finish_step(&start, &td, tally, e_start, t, &y, active);
+                    return Ok(report);
+                }
+                EventKind::Fall => {
+                    return Err(WalkError::Fell {
+                        time: t,
+                        phase,
+                        hub_height: q[Z] + q[L1] * q[THETA].cos(),
+                    })
+                }
+                EventKind::RollBack => return Err(WalkError::RolledBack { time: t, phase }),
+                EventKind::LiftOff(leg) => {
+                    active = self.release_contact(t, &q, &qd, active, leg)?;
+                    tally.bounce |= leg == Leg::One && !active.contact(Leg::One);
+                    tally.scuffing |= active.slide2;
+                }
+                EventKind::Unlock(leg) => active.set_lock(leg, false),
+                EventKind::Landing(leg) | EventKind::StopperHit(leg) => {
+                    let unit = match kind {
+                        EventKind::Landing(_) => Unit::Contact(leg),
+                        _ => Unit::Stopper(leg),
+                    };
+                    let (new_active, qd_plus, loss) = self.close_unit(t, &q, &qd, active, unit)?;
+                    match unit {
+                        Unit::Contact(_) => tally.impact_loss += loss,
+                        Unit::Stopper(_) => tally.stopper_loss += loss,
+                    }
+                    tally.scuffing |= (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || new_active.slide2;
+                    active = new_active;
+                    y = pack(&q, &qd_plus, y[2 * NQ]);
+                }
+            }
+            tally.events += 1;
+            if tally.events > opts.max_events_per_step {
+                return Err(WalkError::Chatter {
+                    time: t,
+                    phase: active.phase(),
+                    events: tally.events,
+                });
+            }
+            let sys = PhaseSystem { model, active };
+            solver.restart(&sys, t, y);
+            let (q, _) = unpack(&y);
+            events = EventSet::new(model, &opts, active, &q);
+            g_prev = events.values(&y);
+            if let Some(tr) = trajectory.as_deref_mut() {
+                tr.push(model, t, &y, active, &start);
+            }
+        }
+    }
+
+    /// A plastic impact closing `unit` (a tip landing or a leg hitting its stopper), then the active set of the
+    /// motion that follows. Returns the new active set, `q'+` and the kinetic energy lost.
+    fn close_unit(
+        &self,
+        time: f64,
+        q: &Coords,
+        qd: &Coords,
+        active: ActiveSet,
+        unit: Unit,
+    ) -> Result<(ActiveSet, Coords, f64), WalkError> {
+        let model = self.model;
+        let phase = active.phase();
+        let rigid = model.params().rigid_legs;
+        let mut forced = ActiveSet {
+            lock1: rigid,
+            lock2: rigid,
+            ..ActiveSet::default()
+        };
+        match unit {
+            Unit::Contact(leg) => forced.set_contact(leg, true),
+            Unit::Stopper(leg) => forced.set_lock(leg, true),
+        }
+        // Contacts already closed stay closed through the impact (the force check below may open them);
+        // stoppers take an impulse only if they must.
+        let mut candidates = Vec::new();
+        for leg in Leg::BOTH {
+            if active.contact(leg) {
+                Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(&active));
+            }
+            if !rigid && active.lock(leg) && unit != Unit::Stopper(leg) {
+                candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
+            }
+        }
+        let err = |source| WalkError::Contact { time, phase, source };
+        let inconsistent = WalkError::InconsistentContacts { time, phase };
+        let (impulse_set, sol) = plastic_impact(model, q, qd, forced, &candidates)
+            .map_err(err)?
+            .ok_or(inconsistent.clone())?;
+        let loss = model.kinetic_energy(q, qd) - model.kinetic_energy(q, &sol.qd_plus);
+        let (forced, candidates) = post_impact_candidates(model, &impulse_set, &impulse_set);
+        let (new_active, _) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)
+            .map_err(err)?
+            .ok_or(inconsistent)?;
+        Ok((new_active, sol.qd_plus, loss))
+    }
+
+    /// A contact's normal force reached zero: the active set of the motion that follows, preferring the tip to
+    /// leave the ground (it slides instead if leaving would drive it into the ground, see
+    /// [`crate::params::ContactInconsistency`]).
+    fn release_contact(
+        &self,
+        time: f64,
+        q: &Coords,
+        qd: &Coords,
+        active: ActiveSet,
+        leaving: Leg,
+    ) -> Result<ActiveSet, WalkError> {
+        let model = self.model;
+        let phase = active.phase();
+        let rigid = model.params().rigid_legs;
+        let forced = ActiveSet {
+            lock1: rigid,
+            lock2: rigid,
+            ..ActiveSet::default()
+        };
+        let mut candidates = Vec::new();
+        for leg in Leg::BOTH {
+            if active.contact(leg) {
+                let mut c = Candidate::keep(Unit::Contact(leg), &active);
+                if leg == leaving {
+                    c.preferred = Mode::Off;
+                }
+                candidates.push(c);
+            }
+            if !rigid && active.lock(leg) {
+                candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
+            }
+        }
+        let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
+            .map_err(|source| WalkError::Contact { time, phase, source })?
+            .ok_or(WalkError::InconsistentContacts { time, phase })?;
+        Ok(new_active)
+    }
+
+    /// Close the step at the touchdown event `(t, y)`: the report, then re-indexing for the next step.
+    #[allow(clippy::too_many_arguments)]
+    fn finish_step(
+        &mut self,
+        start: &WalkState,
+        td: &impact::TouchdownImpact,
+        tally: StepTally,
+        e_start: f64,
+        t: f64,
+        y: &WalkVector,
+        active: ActiveSet,
+    ) -> StepReport {
+        let model = self.model;
+        let (q, qd) = unpack(y);
+        let e_end = model.energy(&q, &qd);
+        let damper = y[2 * NQ];
+        let loss = e_start - e_end;
+        let front = model.tip(&q, &qd, model.front_leg());
+        let step_length = front.position.x - start.q[X];
+        let period = t - start.time;
+        self.steps_done += 1;
+        let report = StepReport {
+            step: self.steps_done,
+            time: start.time,
+            section: SectionState::from_coords(&start.q, &start.qd),
+            theta: start.q[THETA],
+            indicators: td.indicators,
+            branch: td.branch,
+            dls_duration: tally.dls_duration,
+            period,
+            step_length,
+            speed: step_length / period,
+            scuffing: tally.scuffing,
+            bounce: tally.bounce,
+            events: tally.events,
+            energy: EnergyAudit {
+                start: e_start,
+                end: e_end,
+                loss,
+                damper,
+                impact: tally.impact_loss,
+                stopper: tally.stopper_loss,
+                residual: loss - (damper + tally.impact_loss + tally.stopper_loss),
+            },
+        };
+        match reindex(model, t, &q, &qd, active) {
+            Ok((q_new, qd_new, before)) => {
+                self.state = WalkState {
+                    time: t,
+                    q: q_new,
+                    qd: qd_new,
+                    active: before,
+                    x_origin: start.x_origin + front.position.x,
+                    leg1: (start.leg1 + model.legs() - 1) % model.legs(),
+                };
+            }
+            Err(e) => self.blocked = Some(e),
+        }
+        report
+    }
+}
+
+/// Re-indexing at touchdown (paper Sec. 2.2, MODEL.md section 5): the touching leg becomes Leg 1, the old Leg 1
+/// becomes Leg 2, the old Leg 2 (which must be locked at `L0` and in the air) leaves `q`. The origin moves to
+/// the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
+fn reindex(
+    model: &Model,
+    time: f64,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+) -> Result<(Coords, Coords, ActiveSet), WalkError> {
+    if active.contact2 {
+        return Err(WalkError::RearLegInContact { time });
+    }
+    if !active.lock2 {
+        return Err(WalkError::RearLegNotLocked {
+            time,
+            length: q[L2],
+            rate: qd[L2],
+        });
+    }
+    let front = model.tip(q, qd, model.front_leg());
+    let v = front.velocity(qd);
+    let l0 = model.params().stopper_length;
+    let q_new = Coords::new(0.0, front.position.y, q[THETA] - model.alpha(), l0, q[L1]);
+    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, qd[L1]);
+    let before = ActiveSet {
+        contact1: false,
+        contact2: active.contact1,
+        lock1: true,
+        lock2: active.lock1,
+        ..Default::default()
+    };
+    Ok((q_new, qd_new, before))
+}
+
+/// The result of [`simulate`]: every completed step, and how the run ended.
+#[derive(Debug, Clone)]
+pub struct WalkRun {
+    /// Reports of the completed steps.
+    pub steps: Vec<StepReport>,
+    /// `None` if all requested steps were walked, else why the walk stopped.
+    pub failure: Option<WalkError>,
+    /// Time reached [s].
+    pub time: f64,
+}
+
+/// Walk `steps` steps from `initial`, keeping every completed step when the walk stops early.
+pub fn simulate(
+    model: &Model,
+    opts: &SolverOptions,
+    initial: &SectionState,
+    steps: usize,
+    mut trajectory: Option<&mut Trajectory>,
+) -> Result<WalkRun, WalkError> {
+    let mut walker = Walker::new(model, opts, initial)?;
+    let mut run = WalkRun {
+        steps: Vec::with_capacity(steps),
+        failure: None,
+        time: 0.0,
+    };
+    for _ in 0..steps {
+        match walker.step(trajectory.as_deref_mut()) {
+            Ok(report) => run.steps.push(report),
+            Err(e) => {
+                run.failure = Some(e);
+                break;
+            }
+        }
+        run.time = walker.state().time;
+    }
+    Ok(run)
+}

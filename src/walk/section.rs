@@ -1,0 +1,103 @@
+//! The Poincare section of MODEL.md section 6: just before touchdown, after re-indexing.
+//!
+//! There `x = z = 0` (the new Leg 1's tip is the origin), `L1 = L0`, `dL1/dt = 0`, and Leg 2's tip is on the
+//! ground and at rest, so the state reduces to `s = (L2, dtheta/dt, dL2/dt)`: `theta` follows from Leg 2's tip
+//! touching the ground and `(dx, dz)` from Leg 2's tip being at rest.
+
+use serde::Serialize;
+
+use crate::contact::Leg;
+use crate::dynamics::{Coords, Model, L2, THETA, X, Z};
+use crate::error::WalkError;
+
+/// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SectionState {
+    /// Length of Leg 2 (the stance leg about to become the rear leg) [m].
+    pub l2: f64,
+    /// Angular velocity of the wheel [rad/s].
+    pub theta_dot: f64,
+    /// Rate of change of the length of Leg 2 [m/s].
+    pub l2_dot: f64,
+}
+
+impl SectionState {
+    /// The section state as a vector `[L2, dtheta/dt, dL2/dt]`.
+    pub fn to_array(&self) -> [f64; 3] {
+        [self.l2, self.theta_dot, self.l2_dot]
+    }
+
+    /// The section state from a vector `[L2, dtheta/dt, dL2/dt]`.
+    pub fn from_array(s: [f64; 3]) -> SectionState {
+        SectionState {
+            l2: s[0],
+            theta_dot: s[1],
+            l2_dot: s[2],
+        }
+    }
+
+    /// `theta` at which Leg 1 (length `L0`, tip at the origin) and Leg 2 (length `L2`) both touch the ground:
+    /// `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2 sin(alpha))`.
+    pub fn theta(&self, model: &Model) -> f64 {
+        let alpha = model.alpha();
+        let l0 = model.params().stopper_length;
+        ((self.l2 * alpha.cos() - l0) / (self.l2 * alpha.sin())).atan()
+    }
+
+    /// Check that this is a state the wheel can be in at touchdown.
+    pub fn validate(&self, model: &Model) -> Result<(), WalkError> {
+        let l0 = model.params().stopper_length;
+        let bad = |field: &'static str, value: f64, reason: &'static str| {
+            Err(WalkError::InvalidSection {
+                field,
+                value,
+                reason,
+            })
+        };
+        for (field, value) in [
+            ("L2", self.l2),
+            ("thetadot", self.theta_dot),
+            ("L2dot", self.l2_dot),
+        ] {
+            if !value.is_finite() {
+                return bad(field, value, "must be a finite number");
+            }
+        }
+        if !(self.l2 > 0.0 && self.l2 <= l0) {
+            return bad("L2", self.l2, "must lie in (0, stopper_length]");
+        }
+        if self.theta_dot <= 0.0 {
+            return bad("thetadot", self.theta_dot, "must be positive (the wheel rolls forward)");
+        }
+        if model.params().rigid_legs && (self.l2 != l0 || self.l2_dot != 0.0) {
+            return bad(
+                "L2",
+                self.l2,
+                "rigid_legs needs L2 = stopper_length and L2dot = 0",
+            );
+        }
+        Ok(())
+    }
+
+    /// Generalized coordinates and velocities `(q_dagger, q'_dagger)` of this section state.
+    pub fn to_coords(&self, model: &Model) -> (Coords, Coords) {
+        let l0 = model.params().stopper_length;
+        let q = Coords::new(0.0, 0.0, self.theta(model), l0, self.l2);
+        let mut qd = Coords::new(0.0, 0.0, self.theta_dot, 0.0, self.l2_dot);
+        // Leg 2's tip at rest: J_C2 q' = 0, and its x/z columns are the identity.
+        let tip = model.tip(&q, &qd, Leg::Two.index());
+        let v = tip.velocity(&qd);
+        qd[X] = -v.x;
+        qd[Z] = -v.y;
+        (q, qd)
+    }
+
+    /// The section state of generalized coordinates at the section.
+    pub fn from_coords(q: &Coords, qd: &Coords) -> SectionState {
+        SectionState {
+            l2: q[L2],
+            theta_dot: qd[THETA],
+            l2_dot: qd[L2],
+        }
+    }
+}
