@@ -6,3 +6,4 @@ pub mod params;
 pub mod reference;
 pub mod walk;
 pub mod output;
+pub mod app;

@@ -42,6 +42,19 @@ pub enum OutputError {
     },
 }
 
+/// A number as written in CSV: the shortest text that reads back to the same `f64`, in scientific notation
+/// when very small or very large; `NaN` for undefined values.
+pub fn num(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".to_string()
+    } else if (1e-4..1e15).contains(&a) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Create `dir` (and its parents) if needed.
 pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
@@ -130,29 +143,29 @@ pub fn write_steps_csv(path: &Path, steps: &[StepReport]) -> Result<(), OutputEr
         let e = &s.energy;
         let row = [
             s.step.to_string(),
-            s.time.to_string(),
-            s.section.l2.to_string(),
-            s.section.theta_dot.to_string(),
-            s.section.l2_dot.to_string(),
-            s.theta.to_string(),
-            s.indicators.lambda_i4.to_string(),
-            s.indicators.lambda_2_plus.to_string(),
-            s.indicators.lambda_4_plus.to_string(),
+            num(s.time),
+            num(s.section.l2),
+            num(s.section.theta_dot),
+            num(s.section.l2_dot),
+            num(s.theta),
+            num(s.indicators.lambda_i4),
+            num(s.indicators.lambda_2_plus),
+            num(s.indicators.lambda_4_plus),
             s.branch.to_string(),
-            s.dls_duration.to_string(),
-            s.period.to_string(),
-            s.step_length.to_string(),
-            s.speed.to_string(),
+            num(s.dls_duration),
+            num(s.period),
+            num(s.step_length),
+            num(s.speed),
             s.scuffing.to_string(),
             s.bounce.to_string(),
             s.events.to_string(),
-            e.start.to_string(),
-            e.end.to_string(),
-            e.loss.to_string(),
-            e.damper.to_string(),
-            e.impact.to_string(),
-            e.stopper.to_string(),
-            e.residual.to_string(),
+            num(e.start),
+            num(e.end),
+            num(e.loss),
+            num(e.damper),
+            num(e.impact),
+            num(e.stopper),
+            num(e.residual),
         ];
         write_record(&mut w, path, row)?;
     }
@@ -196,12 +209,12 @@ pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), Outpu
     let flag = |b: bool| if b { "1" } else { "0" }.to_string();
     for s in samples {
         let mut row: Vec<String> = Vec::with_capacity(TRAJECTORY_HEADER.len());
-        row.push(s.time.to_string());
-        row.extend(s.q.iter().chain(s.qd.iter()).map(|v| v.to_string()));
+        row.push(num(s.time));
+        row.extend(s.q.iter().chain(s.qd.iter()).map(|v| num(*v)));
         let a = &s.active;
         row.extend([a.contact1, a.contact2, a.slide1, a.slide2, a.lock1, a.lock2].map(flag));
         let m = &s.multipliers;
-        row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(|v| v.to_string()));
+        row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(num));
         row.push(s.leg1.to_string());
         write_record(&mut w, path, row)?;
     }

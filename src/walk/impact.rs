@@ -151,8 +151,7 @@ impl Candidate {
 }
 
 /// Among `forced` plus every combination of modes of the `candidates`, the consistent set with the best
-/// preference score. With `allow_slide` false and no consistent set, the all-preferred set is returned (the
-/// paper's rule, MODEL.md section 4 taken literally).
+/// preference score, or `None` if no combination is consistent.
 fn best_subset<T>(
     forced: ActiveSet,
     candidates: &[Candidate],
@@ -183,14 +182,16 @@ fn best_subset<T>(
             Err(e) => return Err(e),
         }
     }
-    if best.is_none() && !allow_slide {
-        let mut set = forced;
-        for c in candidates {
-            c.unit.apply(&mut set, c.preferred);
-        }
-        return Ok(Some((set, solve(&set)?)));
-    }
     Ok(best.map(|(_, set, value)| (set, value)))
+}
+
+/// `forced` plus every candidate in its preferred mode.
+fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
+    let mut set = forced;
+    for c in candidates {
+        c.unit.apply(&mut set, c.preferred);
+    }
+    set
 }
 
 /// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
@@ -203,11 +204,12 @@ pub fn plastic_impact(
     forced: ActiveSet,
     candidates: &[Candidate],
 ) -> Result<Option<(ActiveSet, ImpulseSolution)>, ContactError> {
-    best_subset(
+    let solve = |set: &ActiveSet| impulse(model, q, qd, set);
+    let found = best_subset(
         forced,
         candidates,
         false,
-        |set| impulse(model, q, qd, set),
+        solve,
         |set, sol| {
             candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
                 (Unit::Contact(leg), Mode::Off) => {
@@ -220,13 +222,21 @@ pub fn plastic_impact(
                 (Unit::Stopper(leg), _) => sol.stopper_impulse(leg) >= -COMPLEMENTARITY_TOL,
             })
         },
-    )
+    )?;
+    match found {
+        Some(found) => Ok(Some(found)),
+        None => {
+            let set = preferred_set(forced, candidates);
+            Ok(Some((set, solve(&set)?)))
+        }
+    }
 }
 
 /// The active set for continuous motion (the force-level complementarity problem): `forced` units plus the
 /// `candidates` that must push (positive normal force, inward stopper reaction) so that no excluded unit
 /// penetrates (tip accelerating into the ground, leg accelerating past its stopper). Sliding contacts are
-/// tried only under [`ContactInconsistency::Slide`].
+/// tried only under [`ContactInconsistency::Slide`]; under [`ContactInconsistency::Rebound`], when no set is
+/// consistent, the paper's (B2)/(B3) rule decides: contacts with a pulling normal force are released.
 pub fn consistent_active_set(
     model: &Model,
     q: &Coords,
@@ -235,11 +245,12 @@ pub fn consistent_active_set(
     candidates: &[Candidate],
 ) -> Result<Option<(ActiveSet, ConstrainedDynamics)>, ContactError> {
     let allow_slide = model.params().inconsistent_contact == ContactInconsistency::Slide;
-    best_subset(
+    let solve = |set: &ActiveSet| constrained_dynamics(model, q, qd, set);
+    let found = best_subset(
         forced,
         candidates,
         allow_slide,
-        |set| constrained_dynamics(model, q, qd, set),
+        solve,
         |set, dynamics| {
             candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
                 (Unit::Contact(leg), Mode::Off) => {
@@ -253,7 +264,22 @@ pub fn consistent_active_set(
                 (Unit::Stopper(leg), _) => dynamics.stopper_reaction(leg) >= -COMPLEMENTARITY_TOL,
             })
         },
-    )
+    )?;
+    if found.is_some() || allow_slide {
+        return Ok(found);
+    }
+    // ContactInconsistency::Rebound: the paper's rule (B2)/(B3) applied literally. Start from the preferred set
+    // and release every contact whose normal force pulls, even if the released tip then falls back at once.
+    let mut set = preferred_set(forced, candidates);
+    let dynamics = solve(&set)?;
+    for c in candidates {
+        if let Unit::Contact(leg) = c.unit {
+            if set.contact(leg) && dynamics.normal_force(leg) < 0.0 {
+                set.set_contact(leg, false);
+            }
+        }
+    }
+    Ok(Some((set, solve(&set)?)))
 }
 
 /// What the touchdown impact produced.

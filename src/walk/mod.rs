@@ -155,7 +155,7 @@ impl Trajectory {
             if t > until {
                 break;
             }
-            if t >= step.t0() {
+            if t >= step.t0() && self.samples.last().is_none_or(|s| s.time < t) {
                 self.push(model, t, &step.eval(t), active, frame);
             }
             self.next += 1;

@@ -101,3 +101,35 @@ impl SectionState {
         }
     }
 }
+
+/// A section state written as `L2,thetadot,L2dot` could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("invalid initial state {text:?}: {reason} (expected three numbers L2,thetadot,L2dot, e.g. 0.72,1.0,0.0)")]
+pub struct ParseSectionError {
+    /// The text given.
+    pub text: String,
+    /// What is wrong with it.
+    pub reason: String,
+}
+
+impl std::str::FromStr for SectionState {
+    type Err = ParseSectionError;
+
+    fn from_str(text: &str) -> Result<SectionState, ParseSectionError> {
+        let err = |reason: String| ParseSectionError {
+            text: text.to_string(),
+            reason,
+        };
+        let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+        if parts.len() != 3 {
+            return Err(err(format!("{} values given", parts.len())));
+        }
+        let mut values = [0.0; 3];
+        for (value, (part, name)) in values.iter_mut().zip(parts.iter().zip(["L2", "thetadot", "L2dot"])) {
+            *value = part
+                .parse::<f64>()
+                .map_err(|_| err(format!("{name} = {part:?} is not a number")))?;
+        }
+        Ok(SectionState::from_array(values))
+    }
+}

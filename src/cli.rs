@@ -1,0 +1,122 @@
+//! Command-line options (clap derive) and the human summaries printed after each job.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand};
+
+use vrw::app::{run_simulate, SimulateJob};
+use vrw::params::Config;
+use vrw::walk::SectionState;
+
+/// Passive dynamic walking of a viscoelastic-legged rimless wheel, with the DLS indicators.
+#[derive(Debug, Parser)]
+#[command(name = "vrw", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Walk N steps from a Poincare-section state and report every touchdown.
+    Simulate(SimulateArgs),
+}
+
+/// Model parameters: a TOML file and `key=value` overrides.
+#[derive(Debug, Args)]
+struct ModelArgs {
+    /// TOML file with parameters (flat keys, e.g. `viscosity = 50`); defaults are the paper's Table 1.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Override one parameter, e.g. `--set viscosity=120` (repeatable, applied after --config).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+impl ModelArgs {
+    fn load(&self) -> Result<Config> {
+        let mut config = match &self.config {
+            Some(path) => Config::from_file(path)?,
+            None => Config::default(),
+        };
+        for assignment in &self.set {
+            config.apply_override(assignment)?;
+        }
+        config.validate()?;
+        Ok(config)
+    }
+}
+
+#[derive(Debug, Args)]
+struct SimulateArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Number of steps (touchdowns) to walk.
+    #[arg(long, default_value_t = 20)]
+    steps: usize,
+    /// Initial Poincare-section state `L2,thetadot,L2dot` [m, rad/s, m/s]; default 0.72,1.0,0.0
+    /// (L0,1.0,0.0 with rigid_legs).
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Output directory for steps.csv, trajectory.csv and summary.json.
+    #[arg(long, default_value = "out/simulate")]
+    out: PathBuf,
+    /// Sampling interval of trajectory.csv [s].
+    #[arg(long, default_value_t = 0.005)]
+    sample_dt: f64,
+}
+
+/// Run the parsed command.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Simulate(args) => simulate(args),
+    }
+}
+
+fn simulate(args: SimulateArgs) -> Result<()> {
+    let job = SimulateJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        steps: args.steps,
+        sample_dt: args.sample_dt,
+        out_dir: args.out.clone(),
+    };
+    let summary = run_simulate(&job).context("simulate")?;
+    println!(
+        "vrw simulate: c = {} N s/m, slope = {} rad, impact = {}; start (L2, thetadot, L2dot) = ({}, {}, {})",
+        job.config.params.viscosity,
+        job.config.params.slope,
+        job.config.params.impact,
+        summary.initial.l2,
+        summary.initial.theta_dot,
+        summary.initial.l2_dot
+    );
+    println!(
+        "{} of {} steps in {:.4} s; max |energy residual| = {:.2e} J",
+        summary.steps_completed, summary.steps_requested, summary.end_time, summary.max_abs_energy_residual
+    );
+    if let Some(last) = summary.steps.last() {
+        let i = &last.indicators;
+        println!(
+            "step {}: lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, lambda_4+ = {:.6} N, branch {}, DLS {:.4} s, \
+             period {:.4} s, step {:.4} m, speed {:.4} m/s{}{}",
+            last.step,
+            i.lambda_i4,
+            i.lambda_2_plus,
+            i.lambda_4_plus,
+            last.branch,
+            last.dls_duration,
+            last.period,
+            last.step_length,
+            last.speed,
+            if last.scuffing { ", scuffing" } else { "" },
+            if last.bounce { ", bounce" } else { "" },
+        );
+    }
+    println!("wrote {}/{{steps.csv, trajectory.csv, summary.json}}", args.out.display());
+    if let Some(message) = &summary.message {
+        bail!("walk stopped after {} steps: {message}", summary.steps_completed);
+    }
+    Ok(())
+}
