@@ -7,6 +7,7 @@
 use nalgebra::SVector;
 
 use crate::integrate::OdeSystem;
+use crate::params::Params;
 
 /// Point mass falling from height h0 with upward velocity v0 under gravity g: y=[z, vz], exact impact time
 /// of z = 0.
@@ -82,6 +83,60 @@ impl HarmonicOscillator {
 impl OdeSystem<2> for HarmonicOscillator {
     fn rhs(&self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
         SVector::<f64, 2>::new(y[1], -self.omega * self.omega * y[0])
+    }
+}
+
+/// The classical rigid rimless wheel (MODEL.md section 7): the VRW with `rigid_legs`, whose step map is known
+/// in closed form. Angular momentum about the new contact point is conserved through the impact, so
+/// `omega+ = eta omega-` with `eta = 1 - M L0^2 (1 - cos alpha) / I_P`; between impacts the wheel rotates
+/// rigidly about its stance tip from `theta = -alpha/2` to `alpha/2`, gaining
+/// `Delta E = 2 M g L0 sin(phi) sin(alpha/2)`. `M` is the total mass and `I_P = IH + N m (L0 - a)^2 + M L0^2`
+/// the inertia about a tip (the centre of mass is at the hub by symmetry).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidRimlessWheel {
+    /// The parameters (only `rigid_legs`-relevant ones are used).
+    pub params: Params,
+}
+
+impl RigidRimlessWheel {
+    fn total_mass(&self) -> f64 {
+        self.params.hub_mass + self.params.legs as f64 * self.params.leg_mass
+    }
+
+    /// Inertia about a leg tip, `I_P` [kg m^2].
+    pub fn inertia_about_tip(&self) -> f64 {
+        let p = &self.params;
+        let r = p.stopper_length - p.leg_mass_offset;
+        p.hub_inertia + p.legs as f64 * p.leg_mass * r * r + self.total_mass() * p.stopper_length.powi(2)
+    }
+
+    /// Velocity ratio of the impact, `eta = omega+ / omega-`.
+    pub fn eta(&self) -> f64 {
+        let p = &self.params;
+        1.0 - self.total_mass() * p.stopper_length.powi(2) * (1.0 - p.alpha().cos()) / self.inertia_about_tip()
+    }
+
+    /// `omega^2` gained between impacts: `2 Delta E / I_P`.
+    fn omega_sq_gain(&self) -> f64 {
+        let p = &self.params;
+        4.0 * self.total_mass() * p.gravity * p.stopper_length * p.slope.sin() * (p.alpha() / 2.0).sin()
+            / self.inertia_about_tip()
+    }
+
+    /// The step map on `omega = dtheta/dt` just before touchdown: `sqrt(eta^2 omega^2 + 2 Delta E / I_P)`, valid
+    /// when the wheel passes over its top, which the walk checks for itself.
+    pub fn step_map(&self, omega: f64) -> f64 {
+        (self.eta().powi(2) * omega * omega + self.omega_sq_gain()).sqrt()
+    }
+
+    /// Its derivative, the Floquet multiplier of the gait at the fixed point: `eta^2 omega / P(omega)`.
+    pub fn step_map_derivative(&self, omega: f64) -> f64 {
+        self.eta().powi(2) * omega / self.step_map(omega)
+    }
+
+    /// The fixed point `omega* = sqrt(2 Delta E / (I_P (1 - eta^2)))`.
+    pub fn fixed_point(&self) -> f64 {
+        (self.omega_sq_gain() / (1.0 - self.eta().powi(2))).sqrt()
     }
 }
 
