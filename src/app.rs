@@ -95,7 +95,11 @@ impl SimulateSummary {
             initial,
             steps_requested: job.steps,
             steps_completed: run.steps.len(),
-            status: run.failure.as_ref().map_or("completed", WalkError::kind).to_string(),
+            status: run
+                .failure
+                .as_ref()
+                .map_or("completed", WalkError::kind)
+                .to_string(),
             message: run.failure.as_ref().map(ToString::to_string),
             end_time: run.time,
             max_abs_energy_residual: run
@@ -126,13 +130,23 @@ pub fn run_simulate(job: &SimulateJob) -> Result<SimulateSummary, AppError> {
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
     let mut trajectory = Trajectory::new(job.sample_dt);
-    let run = simulate(&model, &job.config.solver, &initial, job.steps, Some(&mut trajectory))?;
+    let run = simulate(
+        &model,
+        &job.config.solver,
+        &initial,
+        job.steps,
+        Some(&mut trajectory),
+    )?;
     let summary = SimulateSummary::new(job, initial, &run);
     write_simulation(&job.out_dir, &summary, &trajectory)?;
     Ok(summary)
 }
 
-fn write_simulation(dir: &Path, summary: &SimulateSummary, trajectory: &Trajectory) -> Result<(), OutputError> {
+fn write_simulation(
+    dir: &Path,
+    summary: &SimulateSummary,
+    trajectory: &Trajectory,
+) -> Result<(), OutputError> {
     output::ensure_dir(dir)?;
     output::write_steps_csv(&dir.join("steps.csv"), &summary.steps)?;
     output::write_trajectory_csv(&dir.join("trajectory.csv"), &trajectory.samples)?;

@@ -94,7 +94,10 @@ fn simulate(args: SimulateArgs) -> Result<()> {
     );
     println!(
         "{} of {} steps in {:.4} s; max |energy residual| = {:.2e} J",
-        summary.steps_completed, summary.steps_requested, summary.end_time, summary.max_abs_energy_residual
+        summary.steps_completed,
+        summary.steps_requested,
+        summary.end_time,
+        summary.max_abs_energy_residual
     );
     if let Some(last) = summary.steps.last() {
         let i = &last.indicators;
@@ -114,9 +117,15 @@ fn simulate(args: SimulateArgs) -> Result<()> {
             if last.bounce { ", bounce" } else { "" },
         );
     }
-    println!("wrote {}/{{steps.csv, trajectory.csv, summary.json}}", args.out.display());
+    println!(
+        "wrote {}/{{steps.csv, trajectory.csv, summary.json}}",
+        args.out.display()
+    );
     if let Some(message) = &summary.message {
-        bail!("walk stopped after {} steps: {message}", summary.steps_completed);
+        bail!(
+            "walk stopped after {} steps: {message}",
+            summary.steps_completed
+        );
     }
     Ok(())
 }

@@ -238,7 +238,12 @@ impl ImpulseSolution {
 }
 
 /// Rows `J` of the active constraints and `dJ/dt q'`, zero where inactive.
-fn constraint_rows(model: &Model, q: &Coords, qd: &Coords, active: &ActiveSet) -> (Rows, Multipliers) {
+fn constraint_rows(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: &ActiveSet,
+) -> (Rows, Multipliers) {
     let mut rows = Rows::zeros();
     let mut jdq = Multipliers::zeros();
     let hub = model.hub(q, qd);
@@ -356,7 +361,11 @@ mod tests {
         let sol = constrained_dynamics(&model, &q, &qd, &active).unwrap();
         let (m, h) = model.mass_and_bias(&q, &qd);
         let (rows, jdq) = constraint_rows(&model, &q, &qd, &active);
-        assert_relative_eq!(m * sol.qdd + h, rows.transpose() * sol.multipliers, epsilon = 1e-8);
+        assert_relative_eq!(
+            m * sol.qdd + h,
+            rows.transpose() * sol.multipliers,
+            epsilon = 1e-8
+        );
         assert_relative_eq!(rows * sol.qdd, -jdq, epsilon = SOLVE_TOL);
         // Leg 1 tip fixed means x'' = z'' = 0.
         assert_relative_eq!(sol.qdd[X], 0.0, epsilon = SOLVE_TOL);
@@ -373,16 +382,31 @@ mod tests {
         qd[X] = 0.3;
         qd[Z] = -0.5;
         for active in [
-            ActiveSet { contact1: true, ..Default::default() },
-            ActiveSet { contact1: true, contact2: true, ..Default::default() },
-            ActiveSet { contact1: true, lock1: true, lock2: true, ..Default::default() },
+            ActiveSet {
+                contact1: true,
+                ..Default::default()
+            },
+            ActiveSet {
+                contact1: true,
+                contact2: true,
+                ..Default::default()
+            },
+            ActiveSet {
+                contact1: true,
+                lock1: true,
+                lock2: true,
+                ..Default::default()
+            },
         ] {
             let sol = impulse(&model, &q, &qd, &active).unwrap();
             let (rows, _) = constraint_rows(&model, &q, &qd, &active);
             assert_relative_eq!((rows * sol.qd_plus).norm(), 0.0, epsilon = SOLVE_TOL);
             let t_minus = model.kinetic_energy(&q, &qd);
             let t_plus = model.kinetic_energy(&q, &sol.qd_plus);
-            assert!(t_plus <= t_minus + 1e-12, "{active:?}: {t_plus} > {t_minus}");
+            assert!(
+                t_plus <= t_minus + 1e-12,
+                "{active:?}: {t_plus} > {t_minus}"
+            );
             // momentum is conserved in every constraint-free direction: M (q'+ - q'-) lies in range(J^T)
             let m = model.mass_matrix(&q);
             assert_relative_eq!(

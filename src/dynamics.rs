@@ -197,7 +197,92 @@ impl Model {
 
     /// Mass matrix `M(q)` and bias vector `h(q, q')` of Eq. (1): Coriolis/centrifugal terms, gravity, the leg
     /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (MODEL.md section 2).
+    ///
+    /// Every point Jacobian has the form `J_i = [I_2 | b_theta | b_L1 | b_L2]` (the `x`, `z` columns are the
+    /// identity), so `M = sum m_i J_i^T J_i` and `h = sum m_i J_i^T f_i` are accumulated from the three
+    /// columns `b` only; [`Model::mass_and_bias_reference`] is the plain formula the tests compare against.
     pub fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+        let p = &self.params;
+        let (st, ct) = q[THETA].sin_cos();
+        let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
+        // Hub: b_theta = (L1 c, -L1 s), b_L1 = (s, c), b_L2 = 0; dJ/dt q' as in `hub`.
+        let hub_b = [
+            Vector2::new(l1 * ct, -l1 * st),
+            Vector2::new(st, ct),
+            Vector2::zeros(),
+        ];
+        let hub_vp = Vector2::new(
+            2.0 * dl1 * ct * w - l1 * st * w * w,
+            -2.0 * dl1 * st * w - l1 * ct * w * w,
+        );
+        // Accumulators: total mass, sum m b_k, sum m b_k . b_l, sum f, sum b_k . f.
+        let mut mass_total = 0.0;
+        let mut sum_b = [Vector2::zeros(); 3];
+        let mut bb = [[0.0; 3]; 3];
+        let mut sum_f = Vector2::zeros();
+        let mut bf = [0.0; 3];
+        let mut add = |m: f64, b: &[Vector2<f64>; 3], vp: Vector2<f64>| {
+            let f = m * (vp + self.up);
+            mass_total += m;
+            sum_f += f;
+            for k in 0..3 {
+                sum_b[k] += m * b[k];
+                bf[k] += b[k].dot(&f);
+                for l in k..3 {
+                    bb[k][l] += m * b[k].dot(&b[l]);
+                }
+            }
+        };
+        add(p.hub_mass, &hub_b, hub_vp);
+        for (j, &(sj, cj)) in self.offsets.iter().enumerate() {
+            // psi = theta + j alpha; e = (-sin psi, -cos psi), e_psi = de/dpsi = (-cos psi, sin psi)
+            let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
+            let e = Vector2::new(-sp, -cp);
+            let e_psi = Vector2::new(-cp, sp);
+            let (length, dlength, slot) = match j {
+                0 => (l1, dl1, Some(1)),
+                1 => (q[L2], qd[L2], Some(2)),
+                _ => (p.stopper_length, 0.0, None),
+            };
+            let d = length - p.leg_mass_offset;
+            let mut b = hub_b;
+            b[0] += d * e_psi;
+            if let Some(k) = slot {
+                b[k] += e;
+            }
+            add(
+                p.leg_mass,
+                &b,
+                hub_vp + 2.0 * dlength * w * e_psi - d * w * w * e,
+            );
+        }
+        let mut m = Mat5::zeros();
+        let mut h = Coords::zeros();
+        m[(X, X)] = mass_total;
+        m[(Z, Z)] = mass_total;
+        h[X] = sum_f.x;
+        h[Z] = sum_f.y;
+        for k in 0..3 {
+            let c = THETA + k;
+            m[(X, c)] = sum_b[k].x;
+            m[(c, X)] = sum_b[k].x;
+            m[(Z, c)] = sum_b[k].y;
+            m[(c, Z)] = sum_b[k].y;
+            h[c] = bf[k];
+            for l in k..3 {
+                m[(c, THETA + l)] = bb[k][l];
+                m[(THETA + l, c)] = bb[k][l];
+            }
+        }
+        m[(THETA, THETA)] += p.hub_inertia;
+        h[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
+        h[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
+        (m, h)
+    }
+
+    /// `M` and `h` by the plain point-mass formula `sum m_i J_i^T J_i`, `sum m_i J_i^T (dJ_i/dt q' + g_n)`:
+    /// slower than [`Model::mass_and_bias`], kept as its reference.
+    pub fn mass_and_bias_reference(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
         let p = &self.params;
         let hub = self.hub(q, qd);
         let mut m = p.hub_mass * hub.jacobian.transpose() * hub.jacobian;
@@ -276,6 +361,16 @@ mod tests {
     }
 
     #[test]
+    fn structured_assembly_equals_the_point_mass_formula() {
+        let model = model();
+        let (q, qd) = sample_state();
+        let (m, h) = model.mass_and_bias(&q, &qd);
+        let (m_ref, h_ref) = model.mass_and_bias_reference(&q, &qd);
+        assert_relative_eq!(m, m_ref, epsilon = 1e-12, max_relative = 1e-13);
+        assert_relative_eq!(h, h_ref, epsilon = 1e-11, max_relative = 1e-13);
+    }
+
+    #[test]
     fn mass_matrix_is_symmetric_positive_definite() {
         let m = model().mass_matrix(&sample_state().0);
         assert_relative_eq!(m, m.transpose(), epsilon = 1e-14);
@@ -351,6 +446,10 @@ mod tests {
         expected[(1, Z)] = 1.0;
         assert_relative_eq!(tip.jacobian, expected, epsilon = 1e-14);
         assert_relative_eq!(tip.velocity_product.norm(), 0.0, epsilon = 1e-13);
-        assert_relative_eq!(model.tip_height(&q, 3), model.tip(&q, &qd, 3).position.y, epsilon = 1e-14);
+        assert_relative_eq!(
+            model.tip_height(&q, 3),
+            model.tip(&q, &qd, 3).position.y,
+            epsilon = 1e-14
+        );
     }
 }

@@ -8,7 +8,9 @@ use crate::integrate::IntegrationError;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WalkError {
     /// The hub dropped below `fall_hub_height`.
-    #[error("fell: hub height {hub_height:.4} m below the threshold at t = {time:.6} s in {phase}")]
+    #[error(
+        "fell: hub height {hub_height:.4} m below the threshold at t = {time:.6} s in {phase}"
+    )]
     Fell {
         /// Time [s].
         time: f64,

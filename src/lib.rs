@@ -1,9 +1,9 @@
+pub mod app;
 pub mod contact;
 pub mod dynamics;
 pub mod error;
 pub mod integrate;
+pub mod output;
 pub mod params;
 pub mod reference;
 pub mod walk;
-pub mod output;
-pub mod app;

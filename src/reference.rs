@@ -107,19 +107,26 @@ impl RigidRimlessWheel {
     pub fn inertia_about_tip(&self) -> f64 {
         let p = &self.params;
         let r = p.stopper_length - p.leg_mass_offset;
-        p.hub_inertia + p.legs as f64 * p.leg_mass * r * r + self.total_mass() * p.stopper_length.powi(2)
+        p.hub_inertia
+            + p.legs as f64 * p.leg_mass * r * r
+            + self.total_mass() * p.stopper_length.powi(2)
     }
 
     /// Velocity ratio of the impact, `eta = omega+ / omega-`.
     pub fn eta(&self) -> f64 {
         let p = &self.params;
-        1.0 - self.total_mass() * p.stopper_length.powi(2) * (1.0 - p.alpha().cos()) / self.inertia_about_tip()
+        1.0 - self.total_mass() * p.stopper_length.powi(2) * (1.0 - p.alpha().cos())
+            / self.inertia_about_tip()
     }
 
     /// `omega^2` gained between impacts: `2 Delta E / I_P`.
     fn omega_sq_gain(&self) -> f64 {
         let p = &self.params;
-        4.0 * self.total_mass() * p.gravity * p.stopper_length * p.slope.sin() * (p.alpha() / 2.0).sin()
+        4.0 * self.total_mass()
+            * p.gravity
+            * p.stopper_length
+            * p.slope.sin()
+            * (p.alpha() / 2.0).sin()
             / self.inertia_about_tip()
     }
 

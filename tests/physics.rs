@@ -8,7 +8,7 @@ use vrw::dynamics::{Coords, Model, L1, L2, THETA, Z};
 use vrw::integrate::{Dopri5, Tolerances};
 use vrw::params::{Config, ImpactModel, Params, SolverOptions};
 use vrw::reference::RigidRimlessWheel;
-use vrw::walk::{simulate, Branch, PhaseSystem, SectionState, Walker, WalkVector};
+use vrw::walk::{simulate, Branch, PhaseSystem, SectionState, WalkVector, Walker};
 
 /// Relative drift of `T + V` allowed over 2 s without damping (the requirement).
 const ENERGY_DRIFT_TOL: f64 = 1e-9;
@@ -27,7 +27,10 @@ fn default_start() -> SectionState {
 /// `T + V`.
 fn energy_drift(params: &Params, q: Coords, qd: Coords, active: ActiveSet, duration: f64) -> f64 {
     let model = Model::new(params).unwrap();
-    let sys = PhaseSystem { model: &model, active };
+    let sys = PhaseSystem {
+        model: &model,
+        active,
+    };
     let mut y = WalkVector::zeros();
     y.fixed_rows_mut::<5>(0).copy_from(&q);
     y.fixed_rows_mut::<5>(5).copy_from(&qd);
@@ -42,7 +45,10 @@ fn energy_drift(params: &Params, q: Coords, qd: Coords, active: ActiveSet, durat
     while solver.t() < duration {
         solver.step(&sys, duration).unwrap();
         let y = solver.y();
-        let (q, qd) = (y.fixed_rows::<5>(0).into_owned(), y.fixed_rows::<5>(5).into_owned());
+        let (q, qd) = (
+            y.fixed_rows::<5>(0).into_owned(),
+            y.fixed_rows::<5>(5).into_owned(),
+        );
         worst = worst.max(((model.energy(&q, &qd) - e0) / e0).abs());
     }
     worst
@@ -86,7 +92,9 @@ fn energy_is_conserved_without_damping_in_double_support() {
         contact2: true,
         ..Default::default()
     };
-    let qd = vrw::contact::impulse(&model, &q, &qd, &active).unwrap().qd_plus;
+    let qd = vrw::contact::impulse(&model, &q, &qd, &active)
+        .unwrap()
+        .qd_plus;
     let drift = energy_drift(&params, q, qd, active, 2.0);
     assert!(drift < ENERGY_DRIFT_TOL, "relative drift {drift:e}");
 }
@@ -100,9 +108,18 @@ fn energy_audit_closes_over_twenty_steps() {
     assert_eq!(run.steps.len(), 20);
     for s in &run.steps {
         let e = &s.energy;
-        assert!(e.residual.abs() < AUDIT_TOL, "step {}: residual {:e}", s.step, e.residual);
+        assert!(
+            e.residual.abs() < AUDIT_TOL,
+            "step {}: residual {:e}",
+            s.step,
+            e.residual
+        );
         // Dissipation and impact losses are losses: never negative.
-        assert!(e.damper >= 0.0 && e.impact >= 0.0 && e.stopper >= 0.0, "step {}: {e:?}", s.step);
+        assert!(
+            e.damper >= 0.0 && e.impact >= 0.0 && e.stopper >= 0.0,
+            "step {}: {e:?}",
+            s.step
+        );
         assert!(e.loss > 0.0);
     }
 }
@@ -119,7 +136,11 @@ fn touchdown_is_located_on_the_ground_and_the_section_is_consistent() {
         assert!(state.q[Z].abs() < 1e-11, "tip height {:e}", state.q[Z]);
         // Leg 2 (the old stance leg) is on the ground and at rest at the section.
         let tip = model.tip(&state.q, &state.qd, Leg::Two.index());
-        assert!(tip.position.y.abs() < 1e-9, "rear tip height {:e}", tip.position.y);
+        assert!(
+            tip.position.y.abs() < 1e-9,
+            "rear tip height {:e}",
+            tip.position.y
+        );
         assert!(tip.velocity(&state.qd).norm() < 1e-9);
         assert_relative_eq!(state.q[L1], model.params().stopper_length);
     }
@@ -187,11 +208,18 @@ fn rigid_legs_follow_the_closed_form_step_map() {
     for s in &run.steps {
         assert_relative_eq!(s.section.theta_dot, omega, max_relative = 1e-9);
         assert_relative_eq!(s.theta, -model.alpha() / 2.0, epsilon = 1e-10);
-        assert_relative_eq!(s.step_length, 2.0 * (model.alpha() / 2.0).sin(), max_relative = 1e-9);
+        assert_relative_eq!(
+            s.step_length,
+            2.0 * (model.alpha() / 2.0).sin(),
+            max_relative = 1e-9
+        );
         omega = wheel.step_map(omega);
     }
     // and the walk converges towards the closed-form fixed point
-    assert!((run.steps[5].section.theta_dot - wheel.fixed_point()).abs() < (2.0 - wheel.fixed_point()).abs());
+    assert!(
+        (run.steps[5].section.theta_dot - wheel.fixed_point()).abs()
+            < (2.0 - wheel.fixed_point()).abs()
+    );
 }
 
 /// Regression: right after the rear lift-off at lambda_4 = 0 (with a non-zero tangential force) the freed
@@ -214,7 +242,10 @@ fn rebound_option_terminates_with_a_status() {
     let model = Model::new(&config.params).unwrap();
     let run = simulate(&model, &config.solver, &default_start(), 5, None).unwrap();
     if let Some(failure) = &run.failure {
-        assert!(matches!(failure, vrw::error::WalkError::Chatter { .. }), "{failure}");
+        assert!(
+            matches!(failure, vrw::error::WalkError::Chatter { .. }),
+            "{failure}"
+        );
     }
     for s in &run.steps {
         assert!(s.energy.residual.abs() < AUDIT_TOL);

@@ -72,7 +72,11 @@ pub fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
 }
 
 /// Write one CSV record, mapping errors to [`OutputError`].
-pub fn write_record<I, T>(w: &mut csv::Writer<File>, path: &Path, record: I) -> Result<(), OutputError>
+pub fn write_record<I, T>(
+    w: &mut csv::Writer<File>,
+    path: &Path,
+    record: I,
+) -> Result<(), OutputError>
 where
     I: IntoIterator<Item = T>,
     T: AsRef<[u8]>,

@@ -11,7 +11,8 @@
 use serde::Serialize;
 
 use crate::contact::{
-    constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg,
+    constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution,
+    Leg,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::{ContactInconsistency, ImpactModel};
@@ -159,7 +160,10 @@ fn best_subset<T>(
     mut solve: impl FnMut(&ActiveSet) -> Result<T, ContactError>,
     mut consistent: impl FnMut(&ActiveSet, &T) -> bool,
 ) -> Result<Option<(ActiveSet, T)>, ContactError> {
-    let radix: Vec<usize> = candidates.iter().map(|c| c.modes(allow_slide).len()).collect();
+    let radix: Vec<usize> = candidates
+        .iter()
+        .map(|c| c.modes(allow_slide).len())
+        .collect();
     let combinations: usize = radix.iter().product();
     let mut best: Option<(usize, ActiveSet, T)> = None;
     for mut code in 0..combinations {
@@ -205,24 +209,18 @@ pub fn plastic_impact(
     candidates: &[Candidate],
 ) -> Result<Option<(ActiveSet, ImpulseSolution)>, ContactError> {
     let solve = |set: &ActiveSet| impulse(model, q, qd, set);
-    let found = best_subset(
-        forced,
-        candidates,
-        false,
-        solve,
-        |set, sol| {
-            candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
-                (Unit::Contact(leg), Mode::Off) => {
-                    model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
-                }
-                (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
-                (Unit::Stopper(leg), Mode::Off) => {
-                    sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
-                }
-                (Unit::Stopper(leg), _) => sol.stopper_impulse(leg) >= -COMPLEMENTARITY_TOL,
-            })
-        },
-    )?;
+    let found = best_subset(forced, candidates, false, solve, |set, sol| {
+        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+            (Unit::Contact(leg), Mode::Off) => {
+                model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
+            }
+            (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
+            (Unit::Stopper(leg), Mode::Off) => {
+                sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+            }
+            (Unit::Stopper(leg), _) => sol.stopper_impulse(leg) >= -COMPLEMENTARITY_TOL,
+        })
+    })?;
     match found {
         Some(found) => Ok(Some(found)),
         None => {
@@ -246,25 +244,19 @@ pub fn consistent_active_set(
 ) -> Result<Option<(ActiveSet, ConstrainedDynamics)>, ContactError> {
     let allow_slide = model.params().inconsistent_contact == ContactInconsistency::Slide;
     let solve = |set: &ActiveSet| constrained_dynamics(model, q, qd, set);
-    let found = best_subset(
-        forced,
-        candidates,
-        allow_slide,
-        solve,
-        |set, dynamics| {
-            candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
-                (Unit::Contact(leg), Mode::Off) => {
-                    let tip = model.tip(q, qd, leg.index());
-                    (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
-                }
-                (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
-                (Unit::Stopper(leg), Mode::Off) => {
-                    dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
-                }
-                (Unit::Stopper(leg), _) => dynamics.stopper_reaction(leg) >= -COMPLEMENTARITY_TOL,
-            })
-        },
-    )?;
+    let found = best_subset(forced, candidates, allow_slide, solve, |set, dynamics| {
+        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+            (Unit::Contact(leg), Mode::Off) => {
+                let tip = model.tip(q, qd, leg.index());
+                (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
+            }
+            (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
+            (Unit::Stopper(leg), Mode::Off) => {
+                dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+            }
+            (Unit::Stopper(leg), _) => dynamics.stopper_reaction(leg) >= -COMPLEMENTARITY_TOL,
+        })
+    })?;
     if found.is_some() || allow_slide {
         return Ok(found);
     }
@@ -357,13 +349,25 @@ pub fn touchdown_impact(
             ..Default::default()
         };
         let sol = impulse(model, q, qd, &set)?;
-        return Ok(Some(finish(set, sol, DlsIndicators::UNDEFINED, Branch::Sls, set)));
+        return Ok(Some(finish(
+            set,
+            sol,
+            DlsIndicators::UNDEFINED,
+            Branch::Sls,
+            set,
+        )));
     }
     if !before.contact2 {
         let Some((set, sol)) = plastic_impact(model, q, qd, sls, &stoppers)? else {
             return Ok(None);
         };
-        return Ok(Some(finish(set, sol, DlsIndicators::UNDEFINED, Branch::RearAirborne, sls)));
+        return Ok(Some(finish(
+            set,
+            sol,
+            DlsIndicators::UNDEFINED,
+            Branch::RearAirborne,
+            sls,
+        )));
     }
 
     // (A1) the DLS collision.
@@ -406,7 +410,9 @@ pub fn touchdown_impact(
             },
         ),
     };
-    Ok(Some(finish(dls_set, dls_sol, indicators, branch, preferred)))
+    Ok(Some(finish(
+        dls_set, dls_sol, indicators, branch, preferred,
+    )))
 }
 
 /// Candidates for the motion right after an impact whose impulse acted on `impulse_set`: every unit that took

@@ -26,15 +26,17 @@ pub mod section;
 
 use nalgebra::SVector;
 
-use crate::contact::{constrained_dynamics, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase};
+use crate::contact::{
+    constrained_dynamics, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase,
+};
 use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X, Z};
 use crate::error::WalkError;
 use crate::integrate::{locate_root, DenseStep, Dopri5, OdeSystem, Tolerances};
 use crate::params::SolverOptions;
 
 use impact::{
-    consistent_active_set, plastic_impact, post_impact_candidates, touchdown_impact, Candidate, Mode, Unit,
-    COMPLEMENTARITY_TOL,
+    consistent_active_set, plastic_impact, post_impact_candidates, touchdown_impact, Candidate,
+    Mode, Unit, COMPLEMENTARITY_TOL,
 };
 pub use impact::{Branch, DlsIndicators};
 pub use report::{EnergyAudit, StepReport};
@@ -54,7 +56,10 @@ fn pack(q: &Coords, qd: &Coords, dissipated: f64) -> WalkVector {
 }
 
 fn unpack(y: &WalkVector) -> (Coords, Coords) {
-    (y.fixed_rows::<NQ>(0).into_owned(), y.fixed_rows::<NQ>(NQ).into_owned())
+    (
+        y.fixed_rows::<NQ>(0).into_owned(),
+        y.fixed_rows::<NQ>(NQ).into_owned(),
+    )
 }
 
 /// The vector field of one phase: Eq. (1) with the constraints of `active`, plus the damper power
@@ -134,7 +139,14 @@ impl Trajectory {
         }
     }
 
-    fn push(&mut self, model: &Model, time: f64, y: &WalkVector, active: ActiveSet, frame: &WalkState) {
+    fn push(
+        &mut self,
+        model: &Model,
+        time: f64,
+        y: &WalkVector,
+        active: ActiveSet,
+        frame: &WalkState,
+    ) {
         let (mut q, qd) = unpack(y);
         let multipliers = constrained_dynamics(model, &q, &qd, &active)
             .map_or(Multipliers::repeat(f64::NAN), |d| d.multipliers);
@@ -149,7 +161,14 @@ impl Trajectory {
         });
     }
 
-    fn record(&mut self, model: &Model, step: &DenseStep<NY>, until: f64, active: ActiveSet, frame: &WalkState) {
+    fn record(
+        &mut self,
+        model: &Model,
+        step: &DenseStep<NY>,
+        until: f64,
+        active: ActiveSet,
+        frame: &WalkState,
+    ) {
         loop {
             let t = self.next as f64 * self.dt;
             if t > until {
@@ -190,7 +209,12 @@ struct EventSet<'a> {
 }
 
 impl<'a> EventSet<'a> {
-    fn new(model: &'a Model, opts: &'a SolverOptions, active: ActiveSet, q: &Coords) -> EventSet<'a> {
+    fn new(
+        model: &'a Model,
+        opts: &'a SolverOptions,
+        active: ActiveSet,
+        q: &Coords,
+    ) -> EventSet<'a> {
         let mut set = EventSet {
             model,
             opts,
@@ -228,16 +252,33 @@ impl<'a> EventSet<'a> {
     }
 
     /// The unshifted function of event `k` and, for guarded events, their gap.
-    fn raw(&self, k: usize, q: &Coords, qd: &Coords, dynamics: &Option<ConstrainedDynamics>) -> (f64, Option<f64>) {
+    fn raw(
+        &self,
+        k: usize,
+        q: &Coords,
+        qd: &Coords,
+        dynamics: &Option<ConstrainedDynamics>,
+    ) -> (f64, Option<f64>) {
         let p = self.model.params();
         let force = |f: &dyn Fn(&ConstrainedDynamics) -> f64| dynamics.as_ref().map_or(f64::NAN, f);
         match self.events[k].kind {
             EventKind::Touchdown => (self.model.tip_height(q, self.model.front_leg()), None),
-            EventKind::Fall => (q[Z] + q[L1] * q[THETA].cos() - self.opts.fall_hub_height, None),
+            EventKind::Fall => (
+                q[Z] + q[L1] * q[THETA].cos() - self.opts.fall_hub_height,
+                None,
+            ),
             EventKind::RollBack => (qd[THETA], None),
-            EventKind::LiftOff(leg) => (force(&|d| d.normal_force(leg)) + COMPLEMENTARITY_TOL, None),
-            EventKind::Unlock(leg) => (force(&|d| d.stopper_reaction(leg)) + COMPLEMENTARITY_TOL, None),
-            EventKind::Landing(leg) => (self.model.tip_height(q, leg.index()), Some(self.opts.recontact_gap)),
+            EventKind::LiftOff(leg) => {
+                (force(&|d| d.normal_force(leg)) + COMPLEMENTARITY_TOL, None)
+            }
+            EventKind::Unlock(leg) => (
+                force(&|d| d.stopper_reaction(leg)) + COMPLEMENTARITY_TOL,
+                None,
+            ),
+            EventKind::Landing(leg) => (
+                self.model.tip_height(q, leg.index()),
+                Some(self.opts.recontact_gap),
+            ),
             EventKind::StopperHit(leg) => (
                 p.stopper_length - q[leg.length_coordinate()],
                 Some(self.opts.stopper_gap),
@@ -329,7 +370,11 @@ pub struct Walker<'m> {
 
 impl<'m> Walker<'m> {
     /// Start at a Poincare-section state (MODEL.md section 6), at time 0 and position 0.
-    pub fn new(model: &'m Model, opts: &SolverOptions, section: &SectionState) -> Result<Walker<'m>, WalkError> {
+    pub fn new(
+        model: &'m Model,
+        opts: &SolverOptions,
+        section: &SectionState,
+    ) -> Result<Walker<'m>, WalkError> {
         section.validate(model)?;
         let (q, qd) = section.to_coords(model);
         let state = WalkState {
@@ -379,7 +424,10 @@ impl<'m> Walker<'m> {
 
     /// Advance from this touchdown to the next one: the impact procedure, then the continuous phases and their
     /// events. Returns the step's report; the walker is then at the next section. Samples go to `trajectory`.
-    pub fn step(&mut self, mut trajectory: Option<&mut Trajectory>) -> Result<StepReport, WalkError> {
+    pub fn step(
+        &mut self,
+        mut trajectory: Option<&mut Trajectory>,
+    ) -> Result<StepReport, WalkError> {
         if let Some(e) = &self.blocked {
             return Err(e.clone());
         }
@@ -387,7 +435,13 @@ impl<'m> Walker<'m> {
         let opts = self.opts.clone();
         let start = self.state.clone();
         let t_start = start.time;
-        let contact_error = |time: f64, phase: Phase| move |source| WalkError::Contact { time, phase, source };
+        let contact_error = |time: f64, phase: Phase| {
+            move |source| WalkError::Contact {
+                time,
+                phase,
+                source,
+            }
+        };
 
         let e_start = model.energy(&start.q, &start.qd);
         let td = touchdown_impact(model, &start.q, &start.qd, start.active)
@@ -402,12 +456,13 @@ impl<'m> Walker<'m> {
             ..StepTally::default()
         };
         let (forced, candidates) = post_impact_candidates(model, &td.impulse_set, &td.preferred);
-        let (mut active, _) = consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
-            .map_err(contact_error(t_start, td.preferred.phase()))?
-            .ok_or(WalkError::InconsistentContacts {
-                time: t_start,
-                phase: td.preferred.phase(),
-            })?;
+        let (mut active, _) =
+            consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
+                .map_err(contact_error(t_start, td.preferred.phase()))?
+                .ok_or(WalkError::InconsistentContacts {
+                    time: t_start,
+                    phase: td.preferred.phase(),
+                })?;
         tally.scuffing |= active.slide2;
 
         let mut t = t_start;
@@ -500,7 +555,8 @@ impl<'m> Walker<'m> {
                         Unit::Contact(_) => tally.impact_loss += loss,
                         Unit::Stopper(_) => tally.stopper_loss += loss,
                     }
-                    tally.scuffing |= (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || new_active.slide2;
+                    tally.scuffing |=
+                        (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || new_active.slide2;
                     active = new_active;
                     y = pack(&q, &qd_plus, y[2 * NQ]);
                 }
@@ -557,7 +613,11 @@ impl<'m> Walker<'m> {
                 candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
             }
         }
-        let err = |source| WalkError::Contact { time, phase, source };
+        let err = |source| WalkError::Contact {
+            time,
+            phase,
+            source,
+        };
         let inconsistent = WalkError::InconsistentContacts { time, phase };
         let (impulse_set, sol) = plastic_impact(model, q, qd, forced, &candidates)
             .map_err(err)?
@@ -603,7 +663,11 @@ impl<'m> Walker<'m> {
             }
         }
         let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
-            .map_err(|source| WalkError::Contact { time, phase, source })?
+            .map_err(|source| WalkError::Contact {
+                time,
+                phase,
+                source,
+            })?
             .ok_or(WalkError::InconsistentContacts { time, phase })?;
         Ok(new_active)
     }

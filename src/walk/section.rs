@@ -67,7 +67,11 @@ impl SectionState {
             return bad("L2", self.l2, "must lie in (0, stopper_length]");
         }
         if self.theta_dot <= 0.0 {
-            return bad("thetadot", self.theta_dot, "must be positive (the wheel rolls forward)");
+            return bad(
+                "thetadot",
+                self.theta_dot,
+                "must be positive (the wheel rolls forward)",
+            );
         }
         if model.params().rigid_legs && (self.l2 != l0 || self.l2_dot != 0.0) {
             return bad(
@@ -125,7 +129,10 @@ impl std::str::FromStr for SectionState {
             return Err(err(format!("{} values given", parts.len())));
         }
         let mut values = [0.0; 3];
-        for (value, (part, name)) in values.iter_mut().zip(parts.iter().zip(["L2", "thetadot", "L2dot"])) {
+        for (value, (part, name)) in values
+            .iter_mut()
+            .zip(parts.iter().zip(["L2", "thetadot", "L2dot"]))
+        {
             *value = part
                 .parse::<f64>()
                 .map_err(|_| err(format!("{name} = {part:?} is not a number")))?;
