@@ -1,1 +1,80 @@
-fn main() {}
+//! Speed of the walk on the paper's parameters (Table 1, c = 50 N s/m) from the reference start
+//! `(L2, thetadot, L2dot) = (0.72, 1.0, 0.0)`.
+//!
+//! Run with `cargo bench --bench walk` (add `-- --quick` for a fast estimate).
+//!
+//! - `walking_step`: one `Walker::step` (touchdown impact, the DLS/SLS phases and their events, re-indexing)
+//!   from a state on the gait, reached by first walking `SETTLE_STEPS` steps.
+//! - `twenty_steps`: `vrw::walk::simulate` for 20 steps from the reference start, without a trajectory.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+
+use vrw::app::default_initial;
+use vrw::dynamics::Model;
+use vrw::params::Config;
+use vrw::walk::{simulate, Walker};
+
+/// Steps walked from the reference start before timing a single step, so that the step timed is on the
+/// gait rather than in the initial transient.
+const SETTLE_STEPS: usize = 10;
+/// Steps of the `twenty_steps` benchmark.
+const WALK_STEPS: usize = 20;
+
+fn walking_step(c: &mut Criterion) {
+    let config = Config::default();
+    let model = Model::new(&config.params).expect("the paper's parameters are valid");
+    let mut walker = Walker::new(&model, &config.solver, &default_initial(&config))
+        .expect("the reference start is a valid section state");
+    for k in 0..SETTLE_STEPS {
+        walker
+            .step(None)
+            .unwrap_or_else(|e| panic!("step {} of the reference walk failed: {e}", k + 1));
+    }
+
+    let mut group = c.benchmark_group("walk");
+    group.sample_size(20);
+    group.measurement_time(Duration::from_secs(5));
+    group.bench_function("walking_step", |b| {
+        b.iter_batched(
+            || walker.clone(),
+            |mut w| black_box(w.step(None).expect("a step on the gait failed")),
+            BatchSize::SmallInput,
+        )
+    });
+    group.finish();
+}
+
+fn twenty_steps(c: &mut Criterion) {
+    let config = Config::default();
+    let model = Model::new(&config.params).expect("the paper's parameters are valid");
+    let initial = default_initial(&config);
+
+    let mut group = c.benchmark_group("walk");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    group.bench_function("twenty_steps", |b| {
+        b.iter(|| {
+            let run = simulate(
+                black_box(&model),
+                &config.solver,
+                black_box(&initial),
+                WALK_STEPS,
+                None,
+            )
+            .expect("the reference start is a valid section state");
+            assert!(
+                run.failure.is_none(),
+                "the reference walk stopped: {:?}",
+                run.failure
+            );
+            black_box(run)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, walking_step, twenty_steps);
+criterion_main!(benches);

@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::dynamics::Model;
 use crate::error::WalkError;
+use crate::gait::{find_gait, Gait, GaitOptions, StepMap};
 use crate::output::{self, OutputError};
 use crate::params::{Config, ConfigError};
 use crate::walk::{simulate, SectionState, StepReport, Trajectory, WalkRun};
@@ -151,4 +152,59 @@ fn write_simulation(
     output::write_steps_csv(&dir.join("steps.csv"), &summary.steps)?;
     output::write_trajectory_csv(&dir.join("trajectory.csv"), &trajectory.samples)?;
     output::write_json(&dir.join("summary.json"), summary)
+}
+
+/// What `vrw gait` runs.
+#[derive(Debug, Clone)]
+pub struct GaitJob {
+    /// Parameters and solver options.
+    pub config: Config,
+    /// Where the search starts (`None`: [`default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Search settings.
+    pub options: GaitOptions,
+    /// Where `gait.json` goes.
+    pub out_dir: PathBuf,
+}
+
+/// `gait.json`: the parameters, and the gait or why none was found.
+#[derive(Debug, Clone, Serialize)]
+pub struct GaitSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options used.
+    pub config: Config,
+    /// Search settings.
+    pub options: GaitOptions,
+    /// Initial section state of the search.
+    pub initial: SectionState,
+    /// `found`, or the failure kind.
+    pub status: String,
+    /// The failure, in words, if any.
+    pub message: Option<String>,
+    /// The gait, if found (its fields are also flattened into the top level of the JSON).
+    #[serde(flatten)]
+    pub gait: Option<Gait>,
+}
+
+/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason).
+pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
+    job.config.validate()?;
+    let model = Model::new(&job.config.params)?;
+    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
+    initial.validate(&model)?;
+    let map = StepMap::new(&model, &job.config.solver);
+    let result = find_gait(&map, &initial, &job.options, None);
+    let summary = GaitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        options: job.options,
+        initial,
+        status: result.as_ref().map_or_else(|e| e.kind(), |_| "found").to_string(),
+        message: result.as_ref().err().map(ToString::to_string),
+        gait: result.ok(),
+    };
+    output::ensure_dir(&job.out_dir)?;
+    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
+    Ok(summary)
 }

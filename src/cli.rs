@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 
-use vrw::app::{run_simulate, SimulateJob};
+use vrw::app::{run_gait, run_simulate, GaitJob, SimulateJob};
+use vrw::gait::GaitOptions;
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
@@ -21,6 +22,8 @@ pub struct Cli {
 enum Command {
     /// Walk N steps from a Poincare-section state and report every touchdown.
     Simulate(SimulateArgs),
+    /// Find the walking gait (limit cycle), its DLS indicators and Floquet multipliers.
+    Gait(GaitArgs),
 }
 
 /// Model parameters: a TOML file and `key=value` overrides.
@@ -67,10 +70,29 @@ struct SimulateArgs {
     sample_dt: f64,
 }
 
+#[derive(Debug, Args)]
+struct GaitArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot`; default 0.72,1.0,0.0.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Steps walked before Newton's method starts.
+    #[arg(long, default_value_t = GaitOptions::default().transient_steps)]
+    transient: usize,
+    /// Newton tolerance on max |P(s) - s|.
+    #[arg(long, default_value_t = GaitOptions::default().tolerance)]
+    tolerance: f64,
+    /// Output directory for gait.json.
+    #[arg(long, default_value = "out/gait")]
+    out: PathBuf,
+}
+
 /// Run the parsed command.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Simulate(args) => simulate(args),
+        Command::Gait(args) => gait(args),
     }
 }
 
@@ -127,5 +149,62 @@ fn simulate(args: SimulateArgs) -> Result<()> {
             summary.steps_completed
         );
     }
+    Ok(())
+}
+
+fn gait(args: GaitArgs) -> Result<()> {
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        bail!("invalid --tolerance {}: must be a positive number", args.tolerance);
+    }
+    let job = GaitJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        options: GaitOptions {
+            transient_steps: args.transient,
+            tolerance: args.tolerance,
+            ..GaitOptions::default()
+        },
+        out_dir: args.out.clone(),
+    };
+    let summary = run_gait(&job).context("gait")?;
+    let p = &job.config.params;
+    println!(
+        "vrw gait: c = {} N s/m, slope = {} rad, impact = {}",
+        p.viscosity, p.slope, p.impact
+    );
+    let Some(g) = &summary.gait else {
+        println!("wrote {}/gait.json", args.out.display());
+        bail!("no gait found: {}", summary.message.as_deref().unwrap_or("unknown reason"));
+    };
+    let s = &g.section;
+    println!(
+        "gait at (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}), theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
+        s.l2, s.theta_dot, s.l2_dot, g.theta, g.residual, g.iterations
+    );
+    println!(
+        "lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, lambda_4+ = {:.6} N, branch {}{}{}",
+        g.lambda_i4,
+        g.lambda_2_plus,
+        g.lambda_4_plus,
+        g.branch,
+        if g.scuffing { ", scuffing" } else { "" },
+        if g.bounce { ", bounce" } else { "" },
+    );
+    println!(
+        "period {:.6} s, step {:.6} m, speed {:.6} m/s, DLS {:.6} s",
+        g.period, g.step_length, g.speed, g.dls_duration
+    );
+    let multipliers: Vec<String> = g
+        .floquet_multipliers
+        .iter()
+        .map(|[re, im]| if *im == 0.0 { format!("{re:.6}") } else { format!("{re:.6}{im:+.6}i") })
+        .collect();
+    println!(
+        "Floquet multipliers [{}] (Jacobian error ~{:.0e}): {}",
+        multipliers.join(", "),
+        g.jacobian_error,
+        if g.stable { "stable" } else { "UNSTABLE" }
+    );
+    println!("wrote {}/gait.json", args.out.display());
     Ok(())
 }

@@ -2,6 +2,7 @@ pub mod app;
 pub mod contact;
 pub mod dynamics;
 pub mod error;
+pub mod gait;
 pub mod integrate;
 pub mod output;
 pub mod params;

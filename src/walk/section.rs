@@ -10,6 +10,10 @@ use crate::contact::Leg;
 use crate::dynamics::{Coords, Model, L2, THETA, X, Z};
 use crate::error::WalkError;
 
+/// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
+/// by rounding only [m, m/s].
+pub const RIGID_SECTION_TOL: f64 = 1e-9;
+
 /// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SectionState {
@@ -73,7 +77,9 @@ impl SectionState {
                 "must be positive (the wheel rolls forward)",
             );
         }
-        if model.params().rigid_legs && (self.l2 != l0 || self.l2_dot != 0.0) {
+        if model.params().rigid_legs
+            && ((self.l2 - l0).abs() > RIGID_SECTION_TOL || self.l2_dot.abs() > RIGID_SECTION_TOL)
+        {
             return bad(
                 "L2",
                 self.l2,
@@ -83,11 +89,21 @@ impl SectionState {
         Ok(())
     }
 
-    /// Generalized coordinates and velocities `(q_dagger, q'_dagger)` of this section state.
+    /// Generalized coordinates and velocities `(q_dagger, q'_dagger)` of this section state (with
+    /// `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly).
     pub fn to_coords(&self, model: &Model) -> (Coords, Coords) {
         let l0 = model.params().stopper_length;
-        let q = Coords::new(0.0, 0.0, self.theta(model), l0, self.l2);
-        let mut qd = Coords::new(0.0, 0.0, self.theta_dot, 0.0, self.l2_dot);
+        let s = if model.params().rigid_legs {
+            SectionState {
+                l2: l0,
+                l2_dot: 0.0,
+                ..*self
+            }
+        } else {
+            *self
+        };
+        let q = Coords::new(0.0, 0.0, s.theta(model), l0, s.l2);
+        let mut qd = Coords::new(0.0, 0.0, s.theta_dot, 0.0, s.l2_dot);
         // Leg 2's tip at rest: J_C2 q' = 0, and its x/z columns are the identity.
         let tip = model.tip(&q, &qd, Leg::Two.index());
         let v = tip.velocity(&qd);

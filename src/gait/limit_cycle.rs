@@ -1,0 +1,268 @@
+//! The passive gait: a fixed point `s* = P(s*)` of the step map, found by Newton's method, and its stability
+//! from the eigenvalues of `DP(s*)` (the Floquet multipliers) (MODEL.md section 6).
+
+use nalgebra::{Complex, DMatrix, DVector};
+use serde::Serialize;
+
+use super::step_map::{StepMap, StepOutcome};
+use crate::error::WalkError;
+use crate::walk::{Branch, SectionState};
+
+/// How a gait is searched for.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GaitOptions {
+    /// Steps walked from the initial state before Newton's method starts (default 30).
+    pub transient_steps: usize,
+    /// Newton iterations allowed (default 20).
+    pub max_iterations: usize,
+    /// Convergence: `max |P(s) - s| <` this (default 1e-10; units of the section coordinates).
+    pub tolerance: f64,
+    /// Relative finite-difference step of the Jacobian (default 1e-4).
+    pub fd_step: f64,
+    /// Compute the final `DP` with Richardson extrapolation and an error estimate (default true); otherwise
+    /// one central difference (half the cost, used inside sweeps).
+    pub refine_jacobian: bool,
+}
+
+impl Default for GaitOptions {
+    fn default() -> Self {
+        GaitOptions {
+            transient_steps: 30,
+            max_iterations: 20,
+            tolerance: 1e-10,
+            fd_step: 1e-4,
+            refine_jacobian: true,
+        }
+    }
+}
+
+/// Why no gait was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GaitError {
+    /// The walk failed during the transient, at step `step`.
+    #[error("walk failed during the transient at step {step}: {source}")]
+    Transient {
+        /// Transient step number (from 1).
+        step: usize,
+        /// Why.
+        source: WalkError,
+    },
+    /// The step map could not be evaluated during Newton's method.
+    #[error("step map failed in Newton iteration {iteration}: {source}")]
+    Newton {
+        /// Iteration number (from 1).
+        iteration: usize,
+        /// Why.
+        source: WalkError,
+    },
+    /// Newton's method did not reach the tolerance.
+    #[error("no convergence: residual {residual:e} after {iterations} Newton iterations")]
+    NoConvergence {
+        /// Iterations done.
+        iterations: usize,
+        /// Final `max |P(s) - s|`.
+        residual: f64,
+    },
+    /// `DP - I` is singular (a multiplier at 1: a fold of the gait).
+    #[error("DP - I is singular (a Floquet multiplier at 1), residual {residual:e}")]
+    SingularJacobian {
+        /// Residual at that point.
+        residual: f64,
+    },
+}
+
+impl GaitError {
+    /// Short machine-readable name (`fell`, `stalled`, `no_convergence`, ...).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            GaitError::Transient { source, .. } | GaitError::Newton { source, .. } => source.kind(),
+            GaitError::NoConvergence { .. } => "no_convergence",
+            GaitError::SingularJacobian { .. } => "singular_jacobian",
+        }
+    }
+}
+
+/// A walking gait (limit cycle) and what it does.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Gait {
+    /// The fixed point on the section.
+    pub section: SectionState,
+    /// `theta` at the section [rad].
+    pub theta: f64,
+    /// `max |P(s*) - s*|`.
+    pub residual: f64,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// DLS indicator `lambda_I4` [N s].
+    pub lambda_i4: f64,
+    /// DLS indicator `lambda_2+` [N].
+    pub lambda_2_plus: f64,
+    /// DLS indicator `lambda_4+` [N].
+    pub lambda_4_plus: f64,
+    /// Branch of the impact procedure.
+    pub branch: Branch,
+    /// Step period [s].
+    pub period: f64,
+    /// Step length [m].
+    pub step_length: f64,
+    /// Mean speed [m/s].
+    pub speed: f64,
+    /// Time in double support per step [s].
+    pub dls_duration: f64,
+    /// Leg 2 scuffs (re-contacts or slides after its lift-off).
+    pub scuffing: bool,
+    /// Leg 1 bounces.
+    pub bounce: bool,
+    /// Energy-audit residual of the gait's step [J].
+    pub energy_residual: f64,
+    /// `DP(s*)` on the free coordinates, row-major.
+    pub jacobian: Vec<Vec<f64>>,
+    /// Estimated error of the Jacobian entries (Richardson), or `NaN` if not refined.
+    pub jacobian_error: f64,
+    /// Eigenvalues of `DP(s*)` as `[re, im]`, largest modulus first.
+    pub floquet_multipliers: Vec<[f64; 2]>,
+    /// Largest modulus of the multipliers.
+    pub max_floquet: f64,
+    /// All multipliers inside the unit circle.
+    pub stable: bool,
+}
+
+/// Largest entry of `|v|`.
+fn norm(v: &DVector<f64>) -> f64 {
+    v.amax()
+}
+
+/// Find the gait from `initial`: `transient_steps` steps of the map, then Newton's method on `P(s) - s`.
+///
+/// `jacobian_guess`, if given (e.g. the neighbour's `DP` in a continuation), is used as the Newton matrix as
+/// long as the residual falls at least tenfold per iteration; otherwise `DP` is recomputed.
+pub fn find_gait(
+    map: &StepMap,
+    initial: &SectionState,
+    options: &GaitOptions,
+    jacobian_guess: Option<&DMatrix<f64>>,
+) -> Result<Gait, GaitError> {
+    let mut s = *initial;
+    for step in 1..=options.transient_steps {
+        s = map.eval(&s).map_err(|source| GaitError::Transient { step, source })?.next;
+    }
+    let n = map.free_coordinates().len();
+    let eval = |s: &SectionState, iteration: usize| -> Result<(StepOutcome, DVector<f64>), GaitError> {
+        let out = map.eval(s).map_err(|source| GaitError::Newton { iteration, source })?;
+        let r = map.reduce(&out.next) - map.reduce(s);
+        Ok((out, r))
+    };
+    let mut newton_matrix: Option<DMatrix<f64>> = jacobian_guess.map(|j| j - DMatrix::identity(n, n));
+    let (mut outcome, mut r) = eval(&s, 1)?;
+    let mut iterations = 0;
+    while norm(&r) >= options.tolerance {
+        iterations += 1;
+        if iterations > options.max_iterations {
+            return Err(GaitError::NoConvergence {
+                iterations: options.max_iterations,
+                residual: norm(&r),
+            });
+        }
+        let a = match &newton_matrix {
+            Some(a) => a.clone(),
+            None => {
+                let dp = map
+                    .central_jacobian(&s, options.fd_step)
+                    .map_err(|source| GaitError::Newton { iteration: iterations, source })?;
+                let a = dp - DMatrix::identity(n, n);
+                newton_matrix = Some(a.clone());
+                a
+            }
+        };
+        let delta = a
+            .lu()
+            .solve(&(-&r))
+            .ok_or(GaitError::SingularJacobian { residual: norm(&r) })?;
+        // Damped step: halve until the residual decreases (the map may fail far from the gait).
+        let x = map.reduce(&s);
+        let mut lambda = 1.0;
+        let mut accepted = None;
+        for _ in 0..6 {
+            let trial = map.expand(&s, &(&x + lambda * &delta));
+            if let Ok((out, r_trial)) = eval(&trial, iterations) {
+                if norm(&r_trial) < norm(&r) {
+                    accepted = Some((trial, out, r_trial));
+                    break;
+                }
+            }
+            lambda /= 2.0;
+        }
+        let Some((trial, out, r_trial)) = accepted else {
+            if jacobian_guess.is_some() || newton_matrix.is_some() {
+                // A stale matrix: recompute DP here and try again.
+                newton_matrix = None;
+                continue;
+            }
+            return Err(GaitError::NoConvergence {
+                iterations,
+                residual: norm(&r),
+            });
+        };
+        if norm(&r_trial) > 0.1 * norm(&r) {
+            newton_matrix = None;
+        }
+        s = trial;
+        outcome = out;
+        r = r_trial;
+    }
+    let residual = norm(&r);
+    let (dp, jacobian_error) = if options.refine_jacobian {
+        map.jacobian(&s, options.fd_step)
+    } else {
+        map.central_jacobian(&s, options.fd_step).map(|j| (j, f64::NAN))
+    }
+    .map_err(|source| GaitError::Newton {
+        iteration: iterations + 1,
+        source,
+    })?;
+    Ok(gait_at(s, residual, iterations, &outcome, dp, jacobian_error))
+}
+
+fn gait_at(
+    s: SectionState,
+    residual: f64,
+    iterations: usize,
+    outcome: &StepOutcome,
+    dp: DMatrix<f64>,
+    jacobian_error: f64,
+) -> Gait {
+    let mut multipliers: Vec<Complex<f64>> = dp.complex_eigenvalues().iter().copied().collect();
+    multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
+    let max_floquet = multipliers.first().map_or(0.0, |z| z.norm());
+    let report = &outcome.report;
+    Gait {
+        section: s,
+        theta: report.theta,
+        residual,
+        iterations,
+        lambda_i4: report.indicators.lambda_i4,
+        lambda_2_plus: report.indicators.lambda_2_plus,
+        lambda_4_plus: report.indicators.lambda_4_plus,
+        branch: report.branch,
+        period: report.period,
+        step_length: report.step_length,
+        speed: report.speed,
+        dls_duration: report.dls_duration,
+        scuffing: report.scuffing,
+        bounce: report.bounce,
+        energy_residual: report.energy.residual,
+        jacobian: dp.row_iter().map(|row| row.iter().copied().collect()).collect(),
+        jacobian_error,
+        floquet_multipliers: multipliers.iter().map(|z| [z.re, z.im]).collect(),
+        max_floquet,
+        stable: max_floquet < 1.0,
+    }
+}
+
+impl Gait {
+    /// `DP(s*)` as a matrix.
+    pub fn jacobian_matrix(&self) -> DMatrix<f64> {
+        let n = self.jacobian.len();
+        DMatrix::from_fn(n, n, |i, j| self.jacobian[i][j])
+    }
+}

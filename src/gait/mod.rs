@@ -1,0 +1,8 @@
+//! Gait analysis (MODEL.md section 6): the step map, limit cycles and their stability, parameter sweeps with
+//! continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
+
+pub mod limit_cycle;
+pub mod step_map;
+
+pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions};
+pub use step_map::{StepMap, StepOutcome};

@@ -1,0 +1,112 @@
+//! The step map `P` on the Poincare section (MODEL.md section 6) and its Jacobian.
+//!
+//! `P(s)` walks one step from the section state `s = (L2, dtheta/dt, dL2/dt)` to the next touchdown. With
+//! `rigid_legs` only `dtheta/dt` is free (`L2 = L0`, `dL2/dt = 0` always), so the map acts on that coordinate
+//! alone.
+//!
+//! **Jacobian.** `DP` is computed by central differences of the whole map with Richardson extrapolation:
+//! `D(h) = (P(s + h e_i) - P(s - h e_i)) / 2h` has an error `c2 h^2 + c4 h^4 + noise/h`, and
+//! `(4 D(h/2) - D(h)) / 3` removes the `h^2` term. The difference between the extrapolated and the plain
+//! `D(h/2)` estimates the error, which is reported with every gait. Forward sensitivities through the events
+//! (variational equations with saltation matrices) would avoid the `noise/h` term; the finite differences are
+//! checked against the closed-form Floquet multiplier of the rigid rimless wheel instead (tests), where they
+//! agree to about 1e-9.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::dynamics::Model;
+use crate::error::WalkError;
+use crate::params::SolverOptions;
+use crate::walk::{SectionState, StepReport, Walker};
+
+/// One evaluation of the step map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepOutcome {
+    /// `P(s)`.
+    pub next: SectionState,
+    /// The step's report (DLS indicators, period, energy audit, ...).
+    pub report: StepReport,
+}
+
+/// The step map of one parameter set.
+#[derive(Debug, Clone)]
+pub struct StepMap<'m> {
+    model: &'m Model,
+    opts: SolverOptions,
+}
+
+impl<'m> StepMap<'m> {
+    /// The step map of `model` integrated with `opts`.
+    pub fn new(model: &'m Model, opts: &SolverOptions) -> StepMap<'m> {
+        StepMap {
+            model,
+            opts: opts.clone(),
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &'m Model {
+        self.model
+    }
+
+    /// Evaluate `P(s)`. Fails with the reason the step could not be walked (fell, stalled, old rear leg not
+    /// relocked at the next touchdown, ...).
+    pub fn eval(&self, s: &SectionState) -> Result<StepOutcome, WalkError> {
+        let mut walker = Walker::new(self.model, &self.opts, s)?;
+        let report = walker.step(None)?;
+        let next = walker.section()?;
+        Ok(StepOutcome { next, report })
+    }
+
+    /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.
+    pub fn free_coordinates(&self) -> &'static [usize] {
+        if self.model.params().rigid_legs {
+            &[1]
+        } else {
+            &[0, 1, 2]
+        }
+    }
+
+    /// The free coordinates of `s` as a vector.
+    pub fn reduce(&self, s: &SectionState) -> DVector<f64> {
+        let a = s.to_array();
+        DVector::from_iterator(self.free_coordinates().len(), self.free_coordinates().iter().map(|&i| a[i]))
+    }
+
+    /// `base` with its free coordinates replaced by `v`.
+    pub fn expand(&self, base: &SectionState, v: &DVector<f64>) -> SectionState {
+        let mut a = base.to_array();
+        for (k, &i) in self.free_coordinates().iter().enumerate() {
+            a[i] = v[k];
+        }
+        SectionState::from_array(a)
+    }
+
+    /// Central-difference Jacobian `D(h)` of the reduced map at `s`, with relative step `h`.
+    pub fn central_jacobian(&self, s: &SectionState, h: f64) -> Result<DMatrix<f64>, WalkError> {
+        let x = self.reduce(s);
+        let n = x.len();
+        let mut jac = DMatrix::zeros(n, n);
+        for j in 0..n {
+            let step = h * x[j].abs().max(1.0);
+            let mut plus = x.clone();
+            plus[j] += step;
+            let mut minus = x.clone();
+            minus[j] -= step;
+            let p_plus = self.reduce(&self.eval(&self.expand(s, &plus))?.next);
+            let p_minus = self.reduce(&self.eval(&self.expand(s, &minus))?.next);
+            jac.set_column(j, &((p_plus - p_minus) / (2.0 * step)));
+        }
+        Ok(jac)
+    }
+
+    /// Richardson-extrapolated Jacobian `(4 D(h/2) - D(h)) / 3` and an estimate of its error (the largest
+    /// entry of `|extrapolated - D(h/2)|`).
+    pub fn jacobian(&self, s: &SectionState, h: f64) -> Result<(DMatrix<f64>, f64), WalkError> {
+        let coarse = self.central_jacobian(s, h)?;
+        let fine = self.central_jacobian(s, h / 2.0)?;
+        let extrapolated = (4.0 * &fine - coarse) / 3.0;
+        let error = (&extrapolated - fine).abs().max();
+        Ok((extrapolated, error))
+    }
+}

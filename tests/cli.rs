@@ -1,0 +1,333 @@
+//! The `vrw` binary end to end: what `vrw simulate` writes, and how it refuses bad input (exit code 1, an
+//! `Error:` line naming the problem, never a panic).
+
+use std::fs;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use tempfile::TempDir;
+
+/// Columns `steps.csv` must have (the DLS indicators, the step measures, the flags and the energy audit).
+const STEPS_COLUMNS: [&str; 11] = [
+    "lambda_I4",
+    "lambda_2_plus",
+    "lambda_4_plus",
+    "branch",
+    "dls_duration",
+    "period",
+    "step_length",
+    "speed",
+    "scuffing",
+    "bounce",
+    "energy_residual",
+];
+
+/// The exit code of a run that failed (bad input, or a walk that stopped early).
+const EXIT_FAILURE: i32 = 1;
+
+/// What one run of the binary left behind.
+struct Run {
+    output: Output,
+    /// Keeps the temporary directory alive while the test reads `out`.
+    _dir: TempDir,
+    /// The `--out` directory.
+    out: PathBuf,
+}
+
+impl Run {
+    fn stdout(&self) -> String {
+        String::from_utf8_lossy(&self.output.stdout).into_owned()
+    }
+
+    fn stderr(&self) -> String {
+        String::from_utf8_lossy(&self.output.stderr).into_owned()
+    }
+
+    fn code(&self) -> Option<i32> {
+        self.output.status.code()
+    }
+
+    fn read(&self, file: &str) -> String {
+        let path = self.out.join(file);
+        fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+    }
+
+    fn summary(&self) -> Value {
+        serde_json::from_str(&self.read("summary.json")).expect("summary.json is not valid JSON")
+    }
+}
+
+/// A fresh temporary directory, with `files` (name, contents) written into it.
+fn temp_dir_with(files: &[(&str, &str)]) -> TempDir {
+    let dir = tempfile::tempdir().expect("cannot create a temporary directory");
+    for (name, contents) in files {
+        fs::write(dir.path().join(name), contents).expect("cannot write a test input file");
+    }
+    dir
+}
+
+/// Run `vrw simulate <args> --out <dir>/out` in `dir`, where `dir` may hold input files.
+fn simulate_in(dir: TempDir, args: &[&str]) -> Run {
+    let out = dir.path().join("out");
+    let output = Command::new(env!("CARGO_BIN_EXE_vrw"))
+        .arg("simulate")
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .current_dir(dir.path())
+        .output()
+        .expect("cannot run the vrw binary");
+    Run {
+        output,
+        _dir: dir,
+        out,
+    }
+}
+
+fn simulate(args: &[&str]) -> Run {
+    simulate_in(temp_dir_with(&[]), args)
+}
+
+/// The run failed with exit code 1 and an `Error:` line on stderr that contains every one of `needles`;
+/// it did not panic.
+fn assert_error(run: &Run, needles: &[&str]) {
+    let stderr = run.stderr();
+    assert!(
+        !stderr.contains("panicked"),
+        "vrw panicked:\n{stderr}\nstdout:\n{}",
+        run.stdout()
+    );
+    assert_eq!(
+        run.code(),
+        Some(EXIT_FAILURE),
+        "exit code, stderr:\n{stderr}"
+    );
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("Error:"))
+        .unwrap_or_else(|| panic!("no `Error:` line on stderr:\n{stderr}"));
+    for needle in needles {
+        assert!(
+            stderr.contains(needle),
+            "the error does not mention {needle:?}: {line}\nstderr:\n{stderr}"
+        );
+    }
+}
+
+/// Bad input must also not leave results behind.
+fn assert_no_output(run: &Run) {
+    assert!(
+        !run.out.join("summary.json").exists(),
+        "summary.json written for rejected input"
+    );
+}
+
+fn data_rows(csv: &str) -> usize {
+    csv.lines().skip(1).filter(|l| !l.trim().is_empty()).count()
+}
+
+#[test]
+fn simulate_three_steps_writes_all_results() {
+    let run = simulate(&["--steps", "3"]);
+    assert_eq!(
+        run.code(),
+        Some(0),
+        "stdout:\n{}\nstderr:\n{}",
+        run.stdout(),
+        run.stderr()
+    );
+
+    let steps = run.read("steps.csv");
+    let header: Vec<&str> = steps
+        .lines()
+        .next()
+        .expect("empty steps.csv")
+        .split(',')
+        .collect();
+    assert_eq!(&header[..2], ["step", "time"], "header: {header:?}");
+    for column in STEPS_COLUMNS {
+        assert!(
+            header.contains(&column),
+            "steps.csv has no column {column}: {header:?}"
+        );
+    }
+    assert_eq!(header, vrw::output::STEPS_HEADER);
+    assert_eq!(data_rows(&steps), 3, "steps.csv:\n{steps}");
+    for (k, row) in steps.lines().skip(1).enumerate() {
+        let fields: Vec<&str> = row.split(',').collect();
+        assert_eq!(fields.len(), header.len(), "row {}: {row}", k + 1);
+        assert_eq!(fields[0], (k + 1).to_string(), "step number of row {row}");
+    }
+
+    let trajectory = run.read("trajectory.csv");
+    let trajectory_header = trajectory.lines().next().expect("empty trajectory.csv");
+    assert!(
+        trajectory_header.starts_with("time,"),
+        "trajectory.csv header: {trajectory_header}"
+    );
+    assert!(
+        data_rows(&trajectory) > 3,
+        "trajectory.csv has almost no samples"
+    );
+
+    let summary = run.summary();
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(summary["steps_completed"], 3);
+    assert_eq!(summary["steps_requested"], 3);
+    assert_eq!(summary["config"]["viscosity"], 50.0);
+    assert!(summary["message"].is_null());
+    assert_eq!(summary["steps"].as_array().map(Vec::len), Some(3));
+}
+
+#[test]
+fn negative_hub_mass_is_rejected() {
+    let run = simulate(&["--steps", "1", "--set", "hub_mass=-1"]);
+    assert_error(&run, &["hub_mass"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn two_legs_are_rejected() {
+    let run = simulate(&["--steps", "1", "--set", "legs=2"]);
+    assert_error(&run, &["legs"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn spring_shorter_than_stopper_is_rejected() {
+    let run = simulate(&["--steps", "1", "--set", "spring_natural_length=0.9"]);
+    assert_error(&run, &["spring_natural_length", "stopper_length"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn unknown_key_is_rejected() {
+    let run = simulate(&["--steps", "1", "--set", "foo=1"]);
+    assert_error(&run, &["unknown key", "foo"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn non_numeric_value_is_rejected() {
+    let run = simulate(&["--steps", "1", "--set", "viscosity=abc"]);
+    assert_error(&run, &["viscosity", "abc"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn override_without_equals_sign_is_rejected() {
+    let run = simulate(&["--steps", "1", "--set", "viscosity"]);
+    assert_error(&run, &["viscosity", "key=value"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn malformed_config_file_is_rejected_with_its_path() {
+    let dir = temp_dir_with(&[("bad.toml", "viscosity = [\n")]);
+    let path = dir.path().join("bad.toml");
+    let path = path
+        .to_str()
+        .expect("temporary path is not UTF-8")
+        .to_owned();
+    let run = simulate_in(dir, &["--steps", "1", "--config", &path]);
+    assert_error(&run, &[&path, "TOML"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn missing_config_file_is_rejected_with_its_path() {
+    let run = simulate(&["--steps", "1", "--config", "no_such_config.toml"]);
+    assert_error(&run, &["no_such_config.toml"]);
+    assert_no_output(&run);
+}
+
+/// `--initial` with two numbers is refused while the command line is parsed, by clap: a usage error, which
+/// clap reports with exit code 2 and a lowercase `error:` line (not the `Error:` / exit 1 of `main`).
+#[test]
+fn initial_state_with_two_values_is_a_usage_error() {
+    let run = simulate(&["--steps", "1", "--initial", "0.8,1"]);
+    let stderr = run.stderr();
+    assert!(!stderr.contains("panicked"), "vrw panicked:\n{stderr}");
+    assert_eq!(run.code(), Some(2), "stderr:\n{stderr}");
+    assert!(stderr.contains("error:"), "stderr:\n{stderr}");
+    assert!(stderr.contains("--initial"), "stderr:\n{stderr}");
+    assert!(stderr.contains("2 values given"), "stderr:\n{stderr}");
+    assert_no_output(&run);
+}
+
+#[test]
+fn initial_leg_longer_than_stopper_is_rejected() {
+    let run = simulate(&["--steps", "1", "--initial", "1.5,1,0"]);
+    assert_error(&run, &["L2", "1.5", "stopper_length"]);
+    assert_no_output(&run);
+}
+
+#[test]
+fn zero_sample_interval_is_rejected() {
+    let run = simulate(&["--steps", "1", "--sample-dt", "0"]);
+    assert_error(&run, &["--sample-dt"]);
+    assert_no_output(&run);
+}
+
+/// Too slow to pass over the front leg: the walk stops in the first step. The run fails, but every result
+/// file is still written.
+#[test]
+fn walk_that_stops_early_fails_but_keeps_its_results() {
+    let run = simulate(&["--steps", "3", "--initial", "0.72,0.05,0.0"]);
+    assert_error(&run, &["stopped"]);
+
+    let summary = run.summary();
+    let status = summary["status"].as_str().expect("status is not a string");
+    assert_ne!(status, "completed");
+    assert_eq!(summary["steps_requested"], 3);
+    let completed = summary["steps_completed"]
+        .as_u64()
+        .expect("steps_completed is not a count");
+    assert!(completed < 3, "steps_completed = {completed}");
+    assert!(
+        summary["message"].is_string(),
+        "no failure message: {summary}"
+    );
+
+    let steps = run.read("steps.csv");
+    assert!(steps.starts_with("step,time,"), "steps.csv:\n{steps}");
+    assert_eq!(data_rows(&steps) as u64, completed);
+    assert!(run.read("trajectory.csv").starts_with("time,"));
+}
+
+#[test]
+fn set_overrides_config_file() {
+    let dir = temp_dir_with(&[("walk.toml", "viscosity = 80\n")]);
+    let run = simulate_in(
+        dir,
+        &[
+            "--steps",
+            "1",
+            "--config",
+            "walk.toml",
+            "--set",
+            "viscosity=60",
+        ],
+    );
+    let summary = run.summary();
+    assert_eq!(
+        summary["config"]["viscosity"],
+        60.0,
+        "stderr:\n{}",
+        run.stderr()
+    );
+}
+
+#[test]
+fn config_file_sets_parameters() {
+    let dir = temp_dir_with(&[("walk.toml", "viscosity = 80\n")]);
+    let run = simulate_in(dir, &["--steps", "1", "--config", "walk.toml"]);
+    let summary = run.summary();
+    assert_eq!(
+        summary["config"]["viscosity"],
+        80.0,
+        "stderr:\n{}",
+        run.stderr()
+    );
+}
