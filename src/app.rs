@@ -6,7 +6,12 @@ use serde::Serialize;
 
 use crate::dynamics::Model;
 use crate::error::WalkError;
-use crate::gait::{find_gait, Gait, GaitOptions, StepMap};
+use crate::gait::{
+    find_gait, find_thresholds, sweep, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec, Threshold,
+};
+use crate::output::plot::{
+    write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
+};
 use crate::output::{self, OutputError};
 use crate::params::{Config, ConfigError};
 use crate::walk::{simulate, SectionState, StepReport, Trajectory, WalkRun};
@@ -200,11 +205,186 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
         config: job.config.clone(),
         options: job.options,
         initial,
-        status: result.as_ref().map_or_else(|e| e.kind(), |_| "found").to_string(),
+        status: result
+            .as_ref()
+            .map_or_else(|e| e.kind(), |_| "found")
+            .to_string(),
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok(),
     };
     output::ensure_dir(&job.out_dir)?;
     output::write_json(&job.out_dir.join("gait.json"), &summary)?;
     Ok(summary)
+}
+
+/// What `vrw sweep` runs.
+#[derive(Debug, Clone)]
+pub struct SweepJob {
+    /// Parameters and solver options (the swept key is overridden point by point).
+    pub config: Config,
+    /// The parameter and its range.
+    pub spec: SweepSpec,
+    /// Where the search at the first point starts (`None`: [`default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Search settings.
+    pub options: GaitOptions,
+    /// Where `sweep.csv`, `thresholds.json`, `fig2.svg` and `fig2.png` go.
+    pub out_dir: PathBuf,
+}
+
+/// `thresholds.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options (the swept key at its configured value).
+    pub config: Config,
+    /// The sweep.
+    pub spec: SweepSpec,
+    /// Points with a gait / all points.
+    pub gaits_found: usize,
+    /// Number of sweep points.
+    pub points: usize,
+    /// Every located threshold, in parameter order.
+    pub thresholds: Vec<Threshold>,
+    /// Wall-clock seconds spent on the sweep and on the thresholds (printed, not written: files are
+    /// reproducible).
+    #[serde(skip)]
+    pub seconds: [f64; 2],
+}
+
+/// Run `vrw sweep`: the sweep, its thresholds, `sweep.csv`, `thresholds.json` and Fig. 2. `progress` is called
+/// after every sweep point. `sweep.csv` is written before the thresholds are searched, so a later failure loses
+/// nothing already computed.
+pub fn run_sweep(
+    job: &SweepJob,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<SweepSummary, AppError> {
+    job.config.validate()?;
+    job.spec.validate(&job.config)?;
+    let model = Model::new(&job.config.params)?;
+    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
+    initial.validate(&model)?;
+    output::ensure_dir(&job.out_dir)?;
+    let clock = std::time::Instant::now();
+    let points = sweep(&job.config, &job.spec, &initial, &job.options, progress)?;
+    let sweep_seconds = clock.elapsed().as_secs_f64();
+    output::write_sweep_csv(&job.out_dir.join("sweep.csv"), &job.spec.param, &points)?;
+    let clock = std::time::Instant::now();
+    let mut thresholds = find_thresholds(&job.config, &job.spec, &points, &job.options);
+    let threshold_seconds = clock.elapsed().as_secs_f64();
+    thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let summary = SweepSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec: job.spec.clone(),
+        gaits_found: points.iter().filter(|p| p.gait.is_some()).count(),
+        points: points.len(),
+        thresholds,
+        seconds: [sweep_seconds, threshold_seconds],
+    };
+    output::write_json(&job.out_dir.join("thresholds.json"), &summary)?;
+    if summary.gaits_found > 0 {
+        write_fig2(job, &points, &summary.thresholds)?;
+    }
+    Ok(summary)
+}
+
+fn write_fig2(
+    job: &SweepJob,
+    points: &[SweepPoint],
+    thresholds: &[Threshold],
+) -> Result<(), AppError> {
+    // Points without a gait are NaN, so the curves break there instead of bridging the gap.
+    let indicator_points: Vec<IndicatorPoint> = points
+        .iter()
+        .map(|p| match &p.gait {
+            Some(g) => IndicatorPoint {
+                param: p.value,
+                lambda_i4: g.lambda_i4,
+                lambda_2_plus: g.lambda_2_plus,
+                lambda_4_plus: g.lambda_4_plus,
+                scuffing: g.scuffing,
+            },
+            None => IndicatorPoint {
+                param: p.value,
+                lambda_i4: f64::NAN,
+                lambda_2_plus: f64::NAN,
+                lambda_4_plus: f64::NAN,
+                scuffing: false,
+            },
+        })
+        .collect();
+    let symbol = |name: &str| match name {
+        "lambda_4_plus = 0" => "λ₄⁺ = 0",
+        "lambda_2_plus = 0" => "λ₂⁺ = 0",
+        "lambda_I4 = 0" => "λI4 = 0",
+        "stability_lost" => "unstable",
+        _ => "gait lost",
+    };
+    let marks: Vec<ThresholdMark> = thresholds
+        .iter()
+        .filter(|t| t.value.is_finite())
+        .map(|t| ThresholdMark {
+            label: format!(
+                "{}: {} = {:.2}",
+                symbol(&t.name),
+                short_name(&job.spec.param),
+                t.value
+            ),
+            value: t.value,
+        })
+        .collect();
+    let p = &job.config.params;
+    let title = format!(
+        "DLS indicators of the gait, slope φ = {} rad, impact {} (hollow: scuffing of Leg 2)",
+        p.slope, p.impact
+    );
+    let label = axis_label(&job.spec.param);
+    let spec = Fig2Spec {
+        points: &indicator_points,
+        thresholds: &marks,
+        param_label: &label,
+        title: &title,
+    };
+    write_fig2_files(
+        &spec,
+        &job.out_dir.join("fig2.svg"),
+        &job.out_dir.join("fig2.png"),
+    )
+    .map_err(|e| AppError::InvalidOption {
+        option: "figure",
+        reason: e.to_string(),
+    })
+}
+
+/// Short symbol of a parameter for labels (`c` for viscosity, ...).
+fn short_name(param: &str) -> &str {
+    match param {
+        "viscosity" => "c",
+        "stiffness" => "k",
+        "slope" => "φ",
+        "hub_mass" => "mH",
+        "leg_mass" => "m",
+        other => other,
+    }
+}
+
+/// Axis label with unit.
+fn axis_label(param: &str) -> String {
+    let unit = match param {
+        "viscosity" => "N s/m",
+        "stiffness" => "N/m",
+        "slope" => "rad",
+        "hub_mass" | "leg_mass" => "kg",
+        "hub_inertia" => "kg m²",
+        "gravity" => "m/s²",
+        "leg_mass_offset" | "stopper_length" | "spring_natural_length" => "m",
+        _ => "",
+    };
+    if unit.is_empty() {
+        short_name(param).to_string()
+    } else {
+        format!("{} [{unit}]", short_name(param))
+    }
 }

@@ -2,11 +2,15 @@
 
 use std::path::PathBuf;
 
+use std::io::IsTerminal;
+
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
 
-use vrw::app::{run_gait, run_simulate, GaitJob, SimulateJob};
+use vrw::app::{run_gait, run_simulate, run_sweep, GaitJob, SimulateJob, SweepJob};
 use vrw::gait::GaitOptions;
+use vrw::gait::SweepSpec;
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
@@ -24,6 +28,8 @@ enum Command {
     Simulate(SimulateArgs),
     /// Find the walking gait (limit cycle), its DLS indicators and Floquet multipliers.
     Gait(GaitArgs),
+    /// Sweep a parameter with continuation, locate the thresholds and draw Fig. 2.
+    Sweep(SweepArgs),
 }
 
 /// Model parameters: a TOML file and `key=value` overrides.
@@ -88,11 +94,36 @@ struct GaitArgs {
     out: PathBuf,
 }
 
+#[derive(Debug, Args)]
+struct SweepArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter to sweep (any numeric key, e.g. viscosity, slope, stiffness).
+    #[arg(long, default_value = "viscosity")]
+    param: String,
+    /// First value.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    from: f64,
+    /// Last value.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    to: f64,
+    /// Number of values (ends included).
+    #[arg(long, default_value_t = 300)]
+    points: usize,
+    /// Where the search at the first point starts, `L2,thetadot,L2dot`; default 0.72,1.0,0.0.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Output directory for sweep.csv, thresholds.json, fig2.svg and fig2.png.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+}
+
 /// Run the parsed command.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Simulate(args) => simulate(args),
         Command::Gait(args) => gait(args),
+        Command::Sweep(args) => sweep(args),
     }
 }
 
@@ -154,7 +185,10 @@ fn simulate(args: SimulateArgs) -> Result<()> {
 
 fn gait(args: GaitArgs) -> Result<()> {
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        bail!("invalid --tolerance {}: must be a positive number", args.tolerance);
+        bail!(
+            "invalid --tolerance {}: must be a positive number",
+            args.tolerance
+        );
     }
     let job = GaitJob {
         config: args.model.load()?,
@@ -174,7 +208,10 @@ fn gait(args: GaitArgs) -> Result<()> {
     );
     let Some(g) = &summary.gait else {
         println!("wrote {}/gait.json", args.out.display());
-        bail!("no gait found: {}", summary.message.as_deref().unwrap_or("unknown reason"));
+        bail!(
+            "no gait found: {}",
+            summary.message.as_deref().unwrap_or("unknown reason")
+        );
     };
     let s = &g.section;
     println!(
@@ -197,7 +234,13 @@ fn gait(args: GaitArgs) -> Result<()> {
     let multipliers: Vec<String> = g
         .floquet_multipliers
         .iter()
-        .map(|[re, im]| if *im == 0.0 { format!("{re:.6}") } else { format!("{re:.6}{im:+.6}i") })
+        .map(|[re, im]| {
+            if *im == 0.0 {
+                format!("{re:.6}")
+            } else {
+                format!("{re:.6}{im:+.6}i")
+            }
+        })
         .collect();
     println!(
         "Floquet multipliers [{}] (Jacobian error ~{:.0e}): {}",
@@ -206,5 +249,73 @@ fn gait(args: GaitArgs) -> Result<()> {
         if g.stable { "stable" } else { "UNSTABLE" }
     );
     println!("wrote {}/gait.json", args.out.display());
+    Ok(())
+}
+
+fn sweep(args: SweepArgs) -> Result<()> {
+    let job = SweepJob {
+        config: args.model.load()?,
+        spec: SweepSpec {
+            param: args.param.clone(),
+            from: args.from,
+            to: args.to,
+            points: args.points,
+        },
+        initial: args.initial,
+        options: GaitOptions {
+            refine_jacobian: false,
+            ..GaitOptions::default()
+        },
+        out_dir: args.out.clone(),
+    };
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::new(args.points as u64)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed_precise}]")
+            .expect("the template is valid"),
+    );
+    let started = std::time::Instant::now();
+    let summary = run_sweep(&job, &|p| {
+        bar.set_message(format!("{} = {:.4}: {}", args.param, p.value, p.status));
+        bar.inc(1);
+    })
+    .context("sweep")?;
+    bar.finish_and_clear();
+    println!(
+        "vrw sweep: {} from {} to {} ({} points): gait found at {} points; {:.2} s (sweep {:.2} s, thresholds {:.2} s)",
+        args.param,
+        args.from,
+        args.to,
+        args.points,
+        summary.gaits_found,
+        started.elapsed().as_secs_f64(),
+        summary.seconds[0],
+        summary.seconds[1]
+    );
+    for t in &summary.thresholds {
+        println!(
+            "  {:<18} {} = {:.6}  (bracket [{:.7}, {:.7}], residual {:.1e}){}",
+            t.name,
+            args.param,
+            t.value,
+            t.bracket[0],
+            t.bracket[1],
+            t.residual,
+            t.detail
+                .as_deref()
+                .map(|d| format!(": {d}"))
+                .unwrap_or_default()
+        );
+    }
+    println!(
+        "wrote {}/{{sweep.csv, thresholds.json, fig2.svg, fig2.png}}",
+        args.out.display()
+    );
+    if summary.gaits_found == 0 {
+        bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");
+    }
     Ok(())
 }

@@ -251,7 +251,8 @@ pub struct SolverOptions {
     /// Default 0.3. In `[0, stopper_length)`. `MODEL.md` section 4 (fall / stall).
     pub fall_hub_height: f64,
     /// The run ends with the status `Stalled` when no touchdown happens within this time of the previous
-    /// one \[s\]. Default 5. Positive. `MODEL.md` section 4 (fall / stall).
+    /// one \[s\]. Default 60 (heavily damped gaits creep through long double support). Positive.
+    /// `MODEL.md` section 4 (fall / stall).
     pub max_step_time: f64,
     /// More events than this within one step ends the run with the status `Chatter` (a Zeno sequence of
     /// contacts) \[-\]. Default 200. At least 1. `MODEL.md` section 4.
@@ -269,7 +270,7 @@ impl Default for SolverOptions {
             recontact_gap: 1e-9,
             stopper_gap: 1e-9,
             fall_hub_height: 0.3,
-            max_step_time: 5.0,
+            max_step_time: 60.0,
             max_events_per_step: 200,
         }
     }
@@ -828,7 +829,7 @@ mod tests {
         assert_eq!(s.recontact_gap, 1e-9);
         assert_eq!(s.stopper_gap, 1e-9);
         assert_eq!(s.fall_hub_height, 0.3);
-        assert_eq!(s.max_step_time, 5.0);
+        assert_eq!(s.max_step_time, 60.0);
         assert_eq!(s.max_events_per_step, 200);
 
         Config::default().validate().unwrap();

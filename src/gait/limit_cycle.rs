@@ -127,12 +127,30 @@ pub struct Gait {
     pub stable: bool,
 }
 
+/// Newton stops after this many consecutive iterations with a freshly computed `DP` that fail to halve the
+/// residual.
+pub const MAX_POOR_ITERATIONS: usize = 3;
+
 /// Largest entry of `|v|`.
 fn norm(v: &DVector<f64>) -> f64 {
     v.amax()
 }
 
-/// Find the gait from `initial`: `transient_steps` steps of the map, then Newton's method on `P(s) - s`.
+/// A fixed point of the step map, without its stability.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FixedPoint {
+    /// `s*`.
+    pub section: SectionState,
+    /// The step from `s*` (its report carries the DLS indicators).
+    pub outcome: StepOutcome,
+    /// `max |P(s*) - s*|`.
+    pub residual: f64,
+    /// Newton iterations used.
+    pub iterations: usize,
+}
+
+/// Find the gait from `initial`: `transient_steps` steps of the map, then Newton's method on `P(s) - s`,
+/// then `DP(s*)` and its eigenvalues.
 ///
 /// `jacobian_guess`, if given (e.g. the neighbour's `DP` in a continuation), is used as the Newton matrix as
 /// long as the residual falls at least tenfold per iteration; otherwise `DP` is recomputed.
@@ -142,19 +160,52 @@ pub fn find_gait(
     options: &GaitOptions,
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<Gait, GaitError> {
+    let fp = solve_fixed_point(map, initial, options, jacobian_guess)?;
+    let (dp, jacobian_error) = if options.refine_jacobian {
+        map.jacobian(&fp.section, options.fd_step)
+    } else {
+        map.central_jacobian(&fp.section, options.fd_step)
+            .map(|j| (j, f64::NAN))
+    }
+    .map_err(|source| GaitError::Newton {
+        iteration: fp.iterations + 1,
+        source,
+    })?;
+    Ok(gait_at(&fp, dp, jacobian_error))
+}
+
+/// The fixed point alone (no Jacobian at the end): what threshold searches need.
+pub fn solve_fixed_point(
+    map: &StepMap,
+    initial: &SectionState,
+    options: &GaitOptions,
+    jacobian_guess: Option<&DMatrix<f64>>,
+) -> Result<FixedPoint, GaitError> {
     let mut s = *initial;
     for step in 1..=options.transient_steps {
-        s = map.eval(&s).map_err(|source| GaitError::Transient { step, source })?.next;
+        s = map
+            .eval(&s)
+            .map_err(|source| GaitError::Transient { step, source })?
+            .next;
     }
     let n = map.free_coordinates().len();
-    let eval = |s: &SectionState, iteration: usize| -> Result<(StepOutcome, DVector<f64>), GaitError> {
-        let out = map.eval(s).map_err(|source| GaitError::Newton { iteration, source })?;
-        let r = map.reduce(&out.next) - map.reduce(s);
-        Ok((out, r))
-    };
-    let mut newton_matrix: Option<DMatrix<f64>> = jacobian_guess.map(|j| j - DMatrix::identity(n, n));
+    let eval =
+        |s: &SectionState, iteration: usize| -> Result<(StepOutcome, DVector<f64>), GaitError> {
+            let out = map
+                .eval(s)
+                .map_err(|source| GaitError::Newton { iteration, source })?;
+            let r = map.reduce(&out.next) - map.reduce(s);
+            Ok((out, r))
+        };
+    let mut newton_matrix: Option<DMatrix<f64>> =
+        jacobian_guess.map(|j| j - DMatrix::identity(n, n));
     let (mut outcome, mut r) = eval(&s, 1)?;
     let mut iterations = 0;
+    // Was the current Newton matrix computed at the current iterate (so recomputing it cannot help)?
+    let mut fresh = false;
+    // Consecutive iterations with a fresh DP that did not even halve the residual: Newton is not converging
+    // (e.g. the iterate hops across a discontinuity of the map), so stop early.
+    let mut poor = 0;
     while norm(&r) >= options.tolerance {
         iterations += 1;
         if iterations > options.max_iterations {
@@ -168,9 +219,13 @@ pub fn find_gait(
             None => {
                 let dp = map
                     .central_jacobian(&s, options.fd_step)
-                    .map_err(|source| GaitError::Newton { iteration: iterations, source })?;
+                    .map_err(|source| GaitError::Newton {
+                        iteration: iterations,
+                        source,
+                    })?;
                 let a = dp - DMatrix::identity(n, n);
                 newton_matrix = Some(a.clone());
+                fresh = true;
                 a
             }
         };
@@ -193,8 +248,8 @@ pub fn find_gait(
             lambda /= 2.0;
         }
         let Some((trial, out, r_trial)) = accepted else {
-            if jacobian_guess.is_some() || newton_matrix.is_some() {
-                // A stale matrix: recompute DP here and try again.
+            if !fresh {
+                // A stale matrix (the guess, or DP from an earlier iterate): recompute DP here and retry.
                 newton_matrix = None;
                 continue;
             }
@@ -203,6 +258,18 @@ pub fn find_gait(
                 residual: norm(&r),
             });
         };
+        if fresh && norm(&r_trial) > 0.5 * norm(&r) {
+            poor += 1;
+            if poor >= MAX_POOR_ITERATIONS {
+                return Err(GaitError::NoConvergence {
+                    iterations,
+                    residual: norm(&r_trial),
+                });
+            }
+        } else {
+            poor = 0;
+        }
+        fresh = false;
         if norm(&r_trial) > 0.1 * norm(&r) {
             newton_matrix = None;
         }
@@ -210,27 +277,16 @@ pub fn find_gait(
         outcome = out;
         r = r_trial;
     }
-    let residual = norm(&r);
-    let (dp, jacobian_error) = if options.refine_jacobian {
-        map.jacobian(&s, options.fd_step)
-    } else {
-        map.central_jacobian(&s, options.fd_step).map(|j| (j, f64::NAN))
-    }
-    .map_err(|source| GaitError::Newton {
-        iteration: iterations + 1,
-        source,
-    })?;
-    Ok(gait_at(s, residual, iterations, &outcome, dp, jacobian_error))
+    Ok(FixedPoint {
+        section: s,
+        outcome,
+        residual: norm(&r),
+        iterations,
+    })
 }
 
-fn gait_at(
-    s: SectionState,
-    residual: f64,
-    iterations: usize,
-    outcome: &StepOutcome,
-    dp: DMatrix<f64>,
-    jacobian_error: f64,
-) -> Gait {
+fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
+    let (s, residual, iterations, outcome) = (fp.section, fp.residual, fp.iterations, &fp.outcome);
     let mut multipliers: Vec<Complex<f64>> = dp.complex_eigenvalues().iter().copied().collect();
     multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
     let max_floquet = multipliers.first().map_or(0.0, |z| z.norm());
@@ -251,7 +307,10 @@ fn gait_at(
         scuffing: report.scuffing,
         bounce: report.bounce,
         energy_residual: report.energy.residual,
-        jacobian: dp.row_iter().map(|row| row.iter().copied().collect()).collect(),
+        jacobian: dp
+            .row_iter()
+            .map(|row| row.iter().copied().collect())
+            .collect(),
         jacobian_error,
         floquet_multipliers: multipliers.iter().map(|z| [z.re, z.im]).collect(),
         max_floquet,

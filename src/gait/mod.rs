@@ -3,6 +3,10 @@
 
 pub mod limit_cycle;
 pub mod step_map;
+pub mod sweep;
+pub mod thresholds;
 
-pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions};
+pub use limit_cycle::{find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions};
 pub use step_map::{StepMap, StepOutcome};
+pub use sweep::{sweep, SweepPoint, SweepSpec};
+pub use thresholds::{find_thresholds, Threshold};

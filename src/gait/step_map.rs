@@ -13,6 +13,7 @@
 //! agree to about 1e-9.
 
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 use crate::dynamics::Model;
 use crate::error::WalkError;
@@ -70,7 +71,10 @@ impl<'m> StepMap<'m> {
     /// The free coordinates of `s` as a vector.
     pub fn reduce(&self, s: &SectionState) -> DVector<f64> {
         let a = s.to_array();
-        DVector::from_iterator(self.free_coordinates().len(), self.free_coordinates().iter().map(|&i| a[i]))
+        DVector::from_iterator(
+            self.free_coordinates().len(),
+            self.free_coordinates().iter().map(|&i| a[i]),
+        )
     }
 
     /// `base` with its free coordinates replaced by `v`.
@@ -86,16 +90,24 @@ impl<'m> StepMap<'m> {
     pub fn central_jacobian(&self, s: &SectionState, h: f64) -> Result<DMatrix<f64>, WalkError> {
         let x = self.reduce(s);
         let n = x.len();
+        let steps: Vec<f64> = x.iter().map(|v| h * v.abs().max(1.0)).collect();
+        // The 2n evaluations are independent: run them in parallel (the result does not depend on the
+        // number of threads, since each evaluation is the same computation wherever it runs).
+        let images: Vec<DVector<f64>> = (0..2 * n)
+            .into_par_iter()
+            .map(|k| {
+                let (j, sign) = (k / 2, if k % 2 == 0 { 1.0 } else { -1.0 });
+                let mut shifted = x.clone();
+                shifted[j] += sign * steps[j];
+                Ok(self.reduce(&self.eval(&self.expand(s, &shifted))?.next))
+            })
+            .collect::<Result<_, WalkError>>()?;
         let mut jac = DMatrix::zeros(n, n);
         for j in 0..n {
-            let step = h * x[j].abs().max(1.0);
-            let mut plus = x.clone();
-            plus[j] += step;
-            let mut minus = x.clone();
-            minus[j] -= step;
-            let p_plus = self.reduce(&self.eval(&self.expand(s, &plus))?.next);
-            let p_minus = self.reduce(&self.eval(&self.expand(s, &minus))?.next);
-            jac.set_column(j, &((p_plus - p_minus) / (2.0 * step)));
+            jac.set_column(
+                j,
+                &((&images[2 * j] - &images[2 * j + 1]) / (2.0 * steps[j])),
+            );
         }
         Ok(jac)
     }

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use crate::gait::SweepPoint;
 use crate::walk::{Sample, StepReport};
 
 /// Writing a result file failed.
@@ -221,6 +222,69 @@ pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), Outpu
         row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(num));
         row.push(s.leg1.to_string());
         write_record(&mut w, path, row)?;
+    }
+    finish_csv(w, path)
+}
+
+/// Columns of `sweep.csv` after the parameter column.
+pub const SWEEP_COLUMNS: [&str; 20] = [
+    "status",
+    "L2",
+    "thetadot",
+    "L2dot",
+    "theta",
+    "lambda_I4",
+    "lambda_2_plus",
+    "lambda_4_plus",
+    "branch",
+    "period",
+    "step_length",
+    "speed",
+    "dls_duration",
+    "scuffing",
+    "bounce",
+    "stable",
+    "max_floquet",
+    "residual",
+    "iterations",
+    "message",
+];
+
+/// Write `sweep.csv`: one row per sweep point (the parameter value, the status and the gait's scalars; empty
+/// gait fields where no gait was found).
+pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
+    let mut w = csv_writer(path)?;
+    let header: Vec<&str> = std::iter::once(param).chain(SWEEP_COLUMNS).collect();
+    write_record(&mut w, path, &header)?;
+    for p in points {
+        let mut row = vec![num(p.value), p.status.clone()];
+        match &p.gait {
+            Some(g) => {
+                row.extend(
+                    [
+                        g.section.l2,
+                        g.section.theta_dot,
+                        g.section.l2_dot,
+                        g.theta,
+                        g.lambda_i4,
+                        g.lambda_2_plus,
+                        g.lambda_4_plus,
+                    ]
+                    .map(num),
+                );
+                row.push(g.branch.to_string());
+                row.extend([g.period, g.step_length, g.speed, g.dls_duration].map(num));
+                row.extend([g.scuffing, g.bounce, g.stable].map(|b| b.to_string()));
+                row.extend([
+                    num(g.max_floquet),
+                    num(g.residual),
+                    g.iterations.to_string(),
+                ]);
+            }
+            None => row.extend(std::iter::repeat_n(String::new(), SWEEP_COLUMNS.len() - 2)),
+        }
+        row.push(p.message.clone().unwrap_or_default());
+        write_record(&mut w, path, &row)?;
     }
     finish_csv(w, path)
 }
