@@ -6,6 +6,13 @@
 //! - `walking_step`: one `Walker::step` (touchdown impact, the DLS/SLS phases and their events, re-indexing)
 //!   from a state on the gait, reached by first walking `SETTLE_STEPS` steps.
 //! - `twenty_steps`: `vrw::walk::simulate` for 20 steps from the reference start, without a trajectory.
+//! - `gait_after_transient`: the gait search once its transient is done: Newton's method from the state
+//!   reached after `SETTLE_STEPS` steps, to a residual below 1e-10, plus the Floquet multipliers
+//!   (`central`: one central-difference Jacobian, as in sweeps; `refined`: with the Richardson error estimate,
+//!   as `vrw gait` does).
+//!
+//! The default sweep (300 viscosities with thresholds and Fig. 2) is timed by the command itself, which
+//! prints its wall time split into sweep and thresholds: `cargo run --release -- sweep`.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -14,6 +21,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 use vrw::app::default_initial;
 use vrw::dynamics::Model;
+use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::walk::{simulate, Walker};
 
@@ -76,5 +84,33 @@ fn twenty_steps(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, walking_step, twenty_steps);
+fn gait_after_transient(c: &mut Criterion) {
+    let config = Config::default();
+    let model = Model::new(&config.params).expect("the paper's parameters are valid");
+    let map = StepMap::new(&model, &config.solver);
+    let mut start = default_initial(&config);
+    for _ in 0..SETTLE_STEPS {
+        start = map.eval(&start).expect("the reference walk").next;
+    }
+    let mut group = c.benchmark_group("gait");
+    group.sample_size(20);
+    group.measurement_time(Duration::from_secs(5));
+    for (name, refine_jacobian) in [("central", false), ("refined", true)] {
+        let options = GaitOptions {
+            transient_steps: 0,
+            refine_jacobian,
+            ..GaitOptions::default()
+        };
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let gait = find_gait(&map, black_box(&start), &options, None).expect("the gait");
+                assert!(gait.residual < 1e-10);
+                black_box(gait)
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, walking_step, twenty_steps, gait_after_transient);
 criterion_main!(benches);

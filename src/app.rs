@@ -62,7 +62,7 @@ pub struct SimulateJob {
     pub initial: Option<SectionState>,
     /// Number of steps to walk.
     pub steps: usize,
-    /// Trajectory sampling interval [s].
+    /// Trajectory sampling interval \[s\].
     pub sample_dt: f64,
     /// Where `steps.csv`, `trajectory.csv` and `summary.json` go.
     pub out_dir: PathBuf,
@@ -85,9 +85,9 @@ pub struct SimulateSummary {
     pub status: String,
     /// The failure, in words, if any.
     pub message: Option<String>,
-    /// Simulated time reached [s].
+    /// Simulated time reached \[s\].
     pub end_time: f64,
-    /// Largest `|energy_residual|` over the steps [J].
+    /// Largest `|energy_residual|` over the steps \[J\].
     pub max_abs_energy_residual: f64,
     /// Per-step records.
     pub steps: Vec<StepReport>,

@@ -64,14 +64,14 @@ struct SimulateArgs {
     /// Number of steps (touchdowns) to walk.
     #[arg(long, default_value_t = 20)]
     steps: usize,
-    /// Initial Poincare-section state `L2,thetadot,L2dot` [m, rad/s, m/s]; default 0.72,1.0,0.0
+    /// Initial Poincare-section state `L2,thetadot,L2dot` \[m, rad/s, m/s\]; default 0.72,1.0,0.0
     /// (L0,1.0,0.0 with rigid_legs).
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
     /// Output directory for steps.csv, trajectory.csv and summary.json.
     #[arg(long, default_value = "out/simulate")]
     out: PathBuf,
-    /// Sampling interval of trajectory.csv [s].
+    /// Sampling interval of trajectory.csv \[s\].
     #[arg(long, default_value_t = 0.005)]
     sample_dt: f64,
 }

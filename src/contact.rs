@@ -205,12 +205,12 @@ pub struct ConstrainedDynamics {
 }
 
 impl ConstrainedDynamics {
-    /// Normal ground force on `leg` [N] (positive pushes up).
+    /// Normal ground force on `leg` \[N\] (positive pushes up).
     pub fn normal_force(&self, leg: Leg) -> f64 {
         self.multipliers[leg.normal_row()]
     }
 
-    /// Stopper reaction on `leg` [N], positive when it pushes the leg inward (its only admissible direction).
+    /// Stopper reaction on `leg` \[N\], positive when it pushes the leg inward (its only admissible direction).
     pub fn stopper_reaction(&self, leg: Leg) -> f64 {
         -self.multipliers[leg.stopper_row()]
     }
@@ -226,12 +226,12 @@ pub struct ImpulseSolution {
 }
 
 impl ImpulseSolution {
-    /// Normal impulse on `leg` [N s].
+    /// Normal impulse on `leg` \[N s\].
     pub fn normal_impulse(&self, leg: Leg) -> f64 {
         self.impulses[leg.normal_row()]
     }
 
-    /// Stopper impulse on `leg` [N s], positive when inward.
+    /// Stopper impulse on `leg` \[N s\], positive when inward.
     pub fn stopper_impulse(&self, leg: Leg) -> f64 {
         -self.impulses[leg.stopper_row()]
     }

@@ -41,16 +41,16 @@ pub const L2: usize = 4;
 /// Position, Jacobian and velocity-product acceleration of one point of the wheel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointKinematics {
-    /// Position in the slope frame [m].
+    /// Position in the slope frame \[m\].
     pub position: Vector2<f64>,
     /// `J = dp/dq`.
     pub jacobian: PointJacobian,
-    /// `dJ/dt q'`: the acceleration of the point when `q'' = 0` [m/s^2].
+    /// `dJ/dt q'`: the acceleration of the point when `q'' = 0` \[m/s^2\].
     pub velocity_product: Vector2<f64>,
 }
 
 impl PointKinematics {
-    /// Velocity `J q'` of the point [m/s].
+    /// Velocity `J q'` of the point \[m/s\].
     pub fn velocity(&self, qd: &Coords) -> Vector2<f64> {
         self.jacobian * qd
     }
@@ -67,7 +67,7 @@ pub struct Model {
     alpha: f64,
     /// `(sin j alpha, cos j alpha)` for `j = 0..N`.
     offsets: Vec<(f64, f64)>,
-    /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame [m/s^2].
+    /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame \[m/s^2\].
     up: Vector2<f64>,
 }
 
@@ -96,7 +96,7 @@ impl Model {
         &self.params
     }
 
-    /// Inter-leg angle `alpha = 2 pi / N` [rad].
+    /// Inter-leg angle `alpha = 2 pi / N` \[rad\].
     pub fn alpha(&self) -> f64 {
         self.alpha
     }
@@ -111,7 +111,7 @@ impl Model {
         self.legs() - 1
     }
 
-    /// Total mass `mH + N m` [kg].
+    /// Total mass `mH + N m` \[kg\].
     pub fn total_mass(&self) -> f64 {
         self.params.hub_mass + self.legs() as f64 * self.params.leg_mass
     }
@@ -186,7 +186,7 @@ impl Model {
         self.leg_point_from_hub(&hub, q, qd, j, 0.0)
     }
 
-    /// Height of the tip of leg `j` above the slope [m] (no Jacobian; cheap, for event functions).
+    /// Height of the tip of leg `j` above the slope \[m\] (no Jacobian; cheap, for event functions).
     pub fn tip_height(&self, q: &Coords, j: LegIndex) -> f64 {
         let (sj, cj) = self.offsets[j];
         let (st, ct) = q[THETA].sin_cos();
@@ -304,13 +304,13 @@ impl Model {
         self.mass_and_bias(q, &Coords::zeros()).0
     }
 
-    /// Kinetic energy `T = 1/2 q'^T M q'` [J].
+    /// Kinetic energy `T = 1/2 q'^T M q'` \[J\].
     pub fn kinetic_energy(&self, q: &Coords, qd: &Coords) -> f64 {
         0.5 * qd.dot(&(self.mass_matrix(q) * qd))
     }
 
     /// Potential energy `V`: gravity of every body, `mass g (-p_x sin phi + p_z cos phi)`, plus the springs of
-    /// Legs 1 and 2, `1/2 k (Lstar - L)^2` [J] (MODEL.md section 2).
+    /// Legs 1 and 2, `1/2 k (Lstar - L)^2` \[J\] (MODEL.md section 2).
     pub fn potential_energy(&self, q: &Coords) -> f64 {
         let p = &self.params;
         let zero = Coords::zeros();
@@ -324,7 +324,7 @@ impl Model {
         v + spring(q[L1]) + spring(q[L2])
     }
 
-    /// Total mechanical energy `T + V` [J].
+    /// Total mechanical energy `T + V` \[J\].
     pub fn energy(&self, q: &Coords, qd: &Coords) -> f64 {
         self.kinetic_energy(q, qd) + self.potential_energy(q)
     }

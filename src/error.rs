@@ -12,17 +12,17 @@ pub enum WalkError {
         "fell: hub height {hub_height:.4} m below the threshold at t = {time:.6} s in {phase}"
     )]
     Fell {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
         /// Phase at the fall.
         phase: Phase,
-        /// Hub height [m].
+        /// Hub height \[m\].
         hub_height: f64,
     },
     /// The wheel stopped and started rolling backward (`dtheta/dt` reached 0).
     #[error("rolled back: dtheta/dt reached 0 at t = {time:.6} s in {phase}")]
     RolledBack {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
         /// Phase.
         phase: Phase,
@@ -30,17 +30,17 @@ pub enum WalkError {
     /// No touchdown within `max_step_time`.
     #[error("stalled: no touchdown within {limit} s (t = {time:.6} s, in {phase})")]
     Stalled {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
         /// Phase.
         phase: Phase,
-        /// The time limit of one step [s].
+        /// The time limit of one step \[s\].
         limit: f64,
     },
     /// More than `max_events_per_step` events in one step (Zeno chatter).
     #[error("chatter: {events} events in one step by t = {time:.6} s in {phase}")]
     Chatter {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
         /// Phase.
         phase: Phase,
@@ -50,23 +50,23 @@ pub enum WalkError {
     /// At touchdown the old Leg 2, which leaves `q`, was not locked at `L0` (MODEL.md section 5).
     #[error("old rear leg not relocked at touchdown (t = {time:.6} s, length {length:.6} m, rate {rate:.4} m/s)")]
     RearLegNotLocked {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
-        /// Its length [m].
+        /// Its length \[m\].
         length: f64,
-        /// Its rate of extension [m/s].
+        /// Its rate of extension \[m/s\].
         rate: f64,
     },
     /// At touchdown the old Leg 2 was still on the ground: three legs would support the wheel.
     #[error("old rear leg still on the ground at touchdown (t = {time:.6} s)")]
     RearLegInContact {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
     },
     /// No set of active contacts and stoppers satisfies the unilateral conditions.
     #[error("no consistent contact state at t = {time:.6} s in {phase}")]
     InconsistentContacts {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
         /// Phase before the search.
         phase: Phase,
@@ -74,7 +74,7 @@ pub enum WalkError {
     /// The constraint equations could not be solved.
     #[error("constraint solve failed at t = {time:.6} s in {phase}: {source}")]
     Contact {
-        /// Time [s].
+        /// Time \[s\].
         time: f64,
         /// Phase.
         phase: Phase,

@@ -577,7 +577,7 @@ mod tests {
     const IMPACT_TIME_TOL: f64 = 1e-12;
     /// Required accuracy of the oscillator's zero crossings at rtol 1e-10, atol 1e-12 \[s\].
     const CROSSING_TIME_TOL: f64 = 1e-9;
-    /// Required accuracy of the oscillator state after 10 periods [m, m/s].
+    /// Required accuracy of the oscillator state after 10 periods \[m, m/s\].
     const FINAL_STATE_TOL: f64 = 1e-8;
     /// Allowed relative energy drift of the oscillator over 10 periods (~2000 steps at
     /// rtol 1e-10; same size as the state tolerance).

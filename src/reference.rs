@@ -103,7 +103,7 @@ impl RigidRimlessWheel {
         self.params.hub_mass + self.params.legs as f64 * self.params.leg_mass
     }
 
-    /// Inertia about a leg tip, `I_P` [kg m^2].
+    /// Inertia about a leg tip, `I_P` \[kg m^2\].
     pub fn inertia_about_tip(&self) -> f64 {
         let p = &self.params;
         let r = p.stopper_length - p.leg_mass_offset;

@@ -87,33 +87,33 @@ impl GaitError {
 pub struct Gait {
     /// The fixed point on the section.
     pub section: SectionState,
-    /// `theta` at the section [rad].
+    /// `theta` at the section \[rad\].
     pub theta: f64,
     /// `max |P(s*) - s*|`.
     pub residual: f64,
     /// Newton iterations used.
     pub iterations: usize,
-    /// DLS indicator `lambda_I4` [N s].
+    /// DLS indicator `lambda_I4` \[N s\].
     pub lambda_i4: f64,
-    /// DLS indicator `lambda_2+` [N].
+    /// DLS indicator `lambda_2+` \[N\].
     pub lambda_2_plus: f64,
-    /// DLS indicator `lambda_4+` [N].
+    /// DLS indicator `lambda_4+` \[N\].
     pub lambda_4_plus: f64,
     /// Branch of the impact procedure.
     pub branch: Branch,
-    /// Step period [s].
+    /// Step period \[s\].
     pub period: f64,
-    /// Step length [m].
+    /// Step length \[m\].
     pub step_length: f64,
-    /// Mean speed [m/s].
+    /// Mean speed \[m/s\].
     pub speed: f64,
-    /// Time in double support per step [s].
+    /// Time in double support per step \[s\].
     pub dls_duration: f64,
     /// Leg 2 scuffs (re-contacts or slides after its lift-off).
     pub scuffing: bool,
     /// Leg 1 bounces.
     pub bounce: bool,
-    /// Energy-audit residual of the gait's step [J].
+    /// Energy-audit residual of the gait's step \[J\].
     pub energy_residual: f64,
     /// `DP(s*)` on the free coordinates, row-major.
     pub jacobian: Vec<Vec<f64>>,

@@ -33,13 +33,13 @@ pub struct Threshold {
     /// What crosses: `lambda_4_plus = 0`, `lambda_2_plus = 0`, `lambda_I4 = 0`, `stability_lost` (largest
     /// Floquet multiplier modulus = 1) or `gait_lost`.
     pub name: String,
-    /// The parameter value [unit of the parameter]; `NaN` if the search failed.
+    /// The parameter value \[unit of the parameter\]; `NaN` if the search failed.
     pub value: f64,
     /// Final bracket `[a, b]` (for the grid bracket it was started from, see `grid_bracket`).
     pub bracket: [f64; 2],
     /// The sweep points it was started between.
     pub grid_bracket: [f64; 2],
-    /// The function at `value` (the indicator [N s or N], or `max |multiplier| - 1`); `NaN` for `gait_lost`.
+    /// The function at `value` (the indicator \[N s or N\], or `max |multiplier| - 1`); `NaN` for `gait_lost`.
     pub residual: f64,
     /// How the gait is lost (failure kind beyond the boundary) or why the search failed.
     pub detail: Option<String>,
@@ -124,13 +124,49 @@ pub fn find_thresholds(
             (None, None) => {}
         }
     }
-    tasks
+    let mut found: Vec<Threshold> = tasks
         .par_iter()
         .map(|task| match task {
             Task::Root(q, a, b) => refine_root(config, spec, *q, a, b, options),
             Task::Boundary(a, b) => refine_boundary(config, spec, a, b, options),
         })
-        .collect()
+        .collect();
+    found.extend(sign_changes_across_gaps(points));
+    found
+}
+
+/// Sign changes of a quantity between two gaits separated by points without a gait: the crossing cannot be
+/// refined (the gait does not exist continuously across it), so it is reported with its grid bracket and no
+/// value. This happens where the crossing switches the impact branch and the step map jumps.
+fn sign_changes_across_gaps(points: &[SweepPoint]) -> Vec<Threshold> {
+    let with_gait: Vec<(usize, &SweepPoint, &Gait)> = points
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.gait.as_ref().map(|g| (i, p, g)))
+        .collect();
+    let mut out = Vec::new();
+    for pair in with_gait.windows(2) {
+        let ((ia, a, ga), (ib, b, gb)) = (pair[0], pair[1]);
+        if ib == ia + 1 {
+            continue;
+        }
+        for q in Quantity::ALL {
+            let (fa, fb) = (q.of(ga), q.of(gb));
+            if fa.is_finite() && fb.is_finite() && (fa < 0.0) != (fb < 0.0) {
+                out.push(Threshold {
+                    name: q.name().to_string(),
+                    value: f64::NAN,
+                    bracket: [a.value, b.value],
+                    grid_bracket: [a.value, b.value],
+                    residual: f64::NAN,
+                    detail: Some(format!(
+                        "sign change from {fa} to {fb} across points without a gait: not refinable"
+                    )),
+                });
+            }
+        }
+    }
+    out
 }
 
 /// Brent on `q(gait(v))` between the sweep points `a` and `b`, continuing from `a`'s gait.
@@ -155,6 +191,12 @@ fn refine_root(
     let (lo, hi) = (Cell::new(a.value), Cell::new(b.value));
     let f_a = q.of(start);
     let f = |v: f64| -> f64 {
+        // After a failure the search is abandoned: keep the first reason, evaluate nothing more.
+        let failed = failure.take();
+        if failed.is_some() {
+            failure.set(failed);
+            return f64::NAN;
+        }
         let value = (|| {
             let (c, model) = configured(config, &spec.param, v).map_err(|e| e.to_string())?;
             let map = StepMap::new(&model, &c.solver);

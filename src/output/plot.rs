@@ -1,8 +1,8 @@
 //! Fig. 2 of the paper: the DLS indicators of the walking gait against a swept
 //! parameter (the leg viscosity `c`), written as SVG and PNG.
 //!
-//! Panel (a) plots `lambda_I4` (the impulse indicator, [N s]); panel (b) plots
-//! `lambda_2+` and `lambda_4+` (the normal forces just after impact, [N]); see
+//! Panel (a) plots `lambda_I4` (the impulse indicator, \[N s\]); panel (b) plots
+//! `lambda_2+` and `lambda_4+` (the normal forces just after impact, \[N\]); see
 //! `MODEL.md` sections 5 and 6 and section 3 of the paper. Points where
 //! scuffing of Leg 2 arises are drawn with hollow markers, the others with
 //! filled ones. Thresholds (where an indicator crosses zero, where the gait is
@@ -28,13 +28,13 @@ use plotters::style::{register_font, FontStyle, FontTransform};
 /// One gait on the sweep: the parameter value and its DLS indicators (MODEL.md section 5).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IndicatorPoint {
-    /// Swept parameter value, e.g. the leg viscosity `c` [N s/m].
+    /// Swept parameter value, e.g. the leg viscosity `c` \[N s/m\].
     pub param: f64,
-    /// Impulse indicator `lambda_I4` [N s]; NaN when there is no gait.
+    /// Impulse indicator `lambda_I4` \[N s\]; NaN when there is no gait.
     pub lambda_i4: f64,
-    /// Normal force of Leg 1 just after impact, `lambda_2+` [N]; NaN when there is no gait.
+    /// Normal force of Leg 1 just after impact, `lambda_2+` \[N\]; NaN when there is no gait.
     pub lambda_2_plus: f64,
-    /// Normal force of Leg 2 just after impact, `lambda_4+` [N]; NaN when there is no gait.
+    /// Normal force of Leg 2 just after impact, `lambda_4+` \[N\]; NaN when there is no gait.
     pub lambda_4_plus: f64,
     /// Whether scuffing of Leg 2 arises on this gait (drawn with hollow markers).
     pub scuffing: bool,
@@ -56,7 +56,7 @@ pub struct Fig2Spec<'a> {
     pub points: &'a [IndicatorPoint],
     /// Vertical dashed lines with labels (thresholds, loss of the gait).
     pub thresholds: &'a [ThresholdMark],
-    /// Label of the x axis with unit, e.g. `"c [N s/m]"`.
+    /// Label of the x axis with unit, e.g. `"c \[N s/m\]"`.
     pub param_label: &'a str,
     /// Figure title (may be empty: no title is drawn).
     pub title: &'a str,
@@ -67,7 +67,12 @@ pub struct Fig2Spec<'a> {
 pub enum PlotError {
     /// The backend failed to draw or to write the file at `path`.
     #[error("cannot draw {path}: {message}")]
-    Draw { path: String, message: String },
+    Draw {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
     /// Nothing finite to plot.
     #[error("no data to plot: {0}")]
     Empty(String),
@@ -280,8 +285,8 @@ impl Prepared {
 /// Writes Fig. 2 (DLS indicators against the swept parameter) to `svg_path`
 /// and `png_path`, both [`FIG2_SIZE`] pixels.
 ///
-/// Panel (a): `lambda_I4`, y label "λ_I4 [N s]" (with a real subscript);
-/// panel (b): `lambda_2+` and `lambda_4+`, y label "λ [N]"; shared x axis labelled
+/// Panel (a): `lambda_I4`, y label "λ_I4 \[N s\]" (with a real subscript);
+/// panel (b): `lambda_2+` and `lambda_4+`, y label "λ \[N\]"; shared x axis labelled
 /// `spec.param_label`. Points with a NaN indicator are skipped (and break the
 /// connecting line); scuffing points get hollow markers; each threshold is a
 /// dashed vertical line labelled with its text.

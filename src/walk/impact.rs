@@ -17,8 +17,8 @@ use crate::contact::{
 use crate::dynamics::{Coords, Model};
 use crate::params::{ContactInconsistency, ImpactModel};
 
-/// Tolerance of the complementarity checks (forces [N], impulses [N s], velocities [m/s], accelerations
-/// [m/s^2]): a value within this of zero counts as zero, so that an event located at a force or velocity
+/// Tolerance of the complementarity checks (forces \[N\], impulses \[N s\], velocities \[m/s\], accelerations
+/// \[m/s^2\]): a value within this of zero counts as zero, so that an event located at a force or velocity
 /// zero is not undone by rounding.
 pub const COMPLEMENTARITY_TOL: f64 = 1e-9;
 
@@ -27,11 +27,11 @@ pub const COMPLEMENTARITY_TOL: f64 = 1e-9;
 /// rear leg was not on the ground at touchdown or the legs are rigid).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct DlsIndicators {
-    /// Normal impulse on Leg 2 of the DLS collision (A1) [N s].
+    /// Normal impulse on Leg 2 of the DLS collision (A1) \[N s\].
     pub lambda_i4: f64,
-    /// Normal force on Leg 1 just after impact, Eqs. (6)-(7) [N].
+    /// Normal force on Leg 1 just after impact, Eqs. (6)-(7) \[N\].
     pub lambda_2_plus: f64,
-    /// Normal force on Leg 2 just after impact, Eqs. (6)-(7) [N].
+    /// Normal force on Leg 2 just after impact, Eqs. (6)-(7) \[N\].
     pub lambda_4_plus: f64,
 }
 
@@ -287,7 +287,7 @@ pub struct TouchdownImpact {
     pub impulse_set: ActiveSet,
     /// Contacts the procedure asks to keep for the motion that follows (its preferred phase).
     pub preferred: ActiveSet,
-    /// Kinetic energy lost in the impact [J].
+    /// Kinetic energy lost in the impact \[J\].
     pub loss: f64,
 }
 

@@ -89,7 +89,7 @@ impl OdeSystem<NY> for PhaseSystem<'_> {
 /// The wheel between events, in the frame of its current Leg 1.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WalkState {
-    /// Time [s].
+    /// Time \[s\].
     pub time: f64,
     /// `q` (with `x` relative to `x_origin`).
     pub q: Coords,
@@ -97,7 +97,7 @@ pub struct WalkState {
     pub qd: Coords,
     /// Active contacts and stoppers (before the touchdown impact, when at the section).
     pub active: ActiveSet,
-    /// Position along the slope of this frame's origin (the touchdown point of Leg 1) [m].
+    /// Position along the slope of this frame's origin (the touchdown point of Leg 1) \[m\].
     pub x_origin: f64,
     /// Which physical leg (0..N) is Leg 1.
     pub leg1: usize,
@@ -106,7 +106,7 @@ pub struct WalkState {
 /// One sample of the trajectory, taken from the dense output.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Sample {
-    /// Time [s].
+    /// Time \[s\].
     pub time: f64,
     /// `q` with `x` measured from the start of the walk.
     pub q: Coords,
@@ -776,7 +776,7 @@ pub struct WalkRun {
     pub steps: Vec<StepReport>,
     /// `None` if all requested steps were walked, else why the walk stopped.
     pub failure: Option<WalkError>,
-    /// Time reached [s].
+    /// Time reached \[s\].
     pub time: f64,
 }
 

@@ -10,19 +10,19 @@ use super::section::SectionState;
 /// losses.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EnergyAudit {
-    /// `T + V` just before the touchdown that starts the step [J] (in the step's frame).
+    /// `T + V` just before the touchdown that starts the step \[J\] (in the step's frame).
     pub start: f64,
-    /// `T + V` just before the next touchdown [J] (same frame).
+    /// `T + V` just before the next touchdown \[J\] (same frame).
     pub end: f64,
-    /// `start - end` [J].
+    /// `start - end` \[J\].
     pub loss: f64,
-    /// `integral of c (dL1^2 + dL2^2) dt` over the step [J].
+    /// `integral of c (dL1^2 + dL2^2) dt` over the step \[J\].
     pub damper: f64,
-    /// Kinetic energy lost in the touchdown collision and in ground re-contacts [J].
+    /// Kinetic energy lost in the touchdown collision and in ground re-contacts \[J\].
     pub impact: f64,
-    /// Kinetic energy lost when a sliding leg hits its stopper [J].
+    /// Kinetic energy lost when a sliding leg hits its stopper \[J\].
     pub stopper: f64,
-    /// `loss - (damper + impact + stopper)` [J]: zero up to the integration error.
+    /// `loss - (damper + impact + stopper)` \[J\]: zero up to the integration error.
     pub residual: f64,
 }
 
@@ -31,23 +31,23 @@ pub struct EnergyAudit {
 pub struct StepReport {
     /// Step number, from 1.
     pub step: usize,
-    /// Time of the touchdown that starts the step [s].
+    /// Time of the touchdown that starts the step \[s\].
     pub time: f64,
     /// The Poincare-section state just before that touchdown.
     pub section: SectionState,
-    /// `theta` at that touchdown, after re-indexing [rad].
+    /// `theta` at that touchdown, after re-indexing \[rad\].
     pub theta: f64,
     /// The three DLS indicators of the touchdown (MODEL.md section 5).
     pub indicators: DlsIndicators,
     /// Branch of the impact procedure taken.
     pub branch: Branch,
-    /// Time spent with both legs on the ground during the step [s].
+    /// Time spent with both legs on the ground during the step \[s\].
     pub dls_duration: f64,
-    /// Time to the next touchdown [s].
+    /// Time to the next touchdown \[s\].
     pub period: f64,
-    /// Distance along the slope between this touchdown's tip and the next one's [m].
+    /// Distance along the slope between this touchdown's tip and the next one's \[m\].
     pub step_length: f64,
-    /// `step_length / period` [m/s].
+    /// `step_length / period` \[m/s\].
     pub speed: f64,
     /// Leg 2's tip came back to the ground during the step.
     pub scuffing: bool,

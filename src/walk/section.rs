@@ -11,17 +11,17 @@ use crate::dynamics::{Coords, Model, L2, THETA, X, Z};
 use crate::error::WalkError;
 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
-/// by rounding only [m, m/s].
+/// by rounding only \[m, m/s\].
 pub const RIGID_SECTION_TOL: f64 = 1e-9;
 
 /// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SectionState {
-    /// Length of Leg 2 (the stance leg about to become the rear leg) [m].
+    /// Length of Leg 2 (the stance leg about to become the rear leg) \[m\].
     pub l2: f64,
-    /// Angular velocity of the wheel [rad/s].
+    /// Angular velocity of the wheel \[rad/s\].
     pub theta_dot: f64,
-    /// Rate of change of the length of Leg 2 [m/s].
+    /// Rate of change of the length of Leg 2 \[m/s\].
     pub l2_dot: f64,
 }
 
