@@ -297,3 +297,48 @@ fn section_coordinates_put_both_tips_on_the_ground() {
     assert_eq!(SectionState::from_coords(&q, &qd), s);
     assert!(q[THETA] < 0.0);
 }
+
+/// No airborne tip sinks below the ground and no free leg passes its stopper by more than the grazing guards
+/// allow (regression: a re-contact located at `-recontact_gap` left a guard that could never fire, and the rear
+/// tip sank by millimetres).
+#[test]
+fn airborne_tips_never_penetrate_and_free_legs_never_pass_their_stoppers() {
+    for mode in [
+        vrw::params::ContactInconsistency::Slide,
+        vrw::params::ContactInconsistency::Rebound,
+    ] {
+        let mut config = Config::default();
+        config.params.inconsistent_contact = mode;
+        let model = Model::new(&config.params).unwrap();
+        let mut trajectory = vrw::walk::Trajectory::new(2e-4);
+        let run = simulate(
+            &model,
+            &config.solver,
+            &default_start(),
+            4,
+            Some(&mut trajectory),
+        )
+        .unwrap();
+        assert!(!run.steps.is_empty() || run.failure.is_some());
+        let gap = config.solver.recontact_gap;
+        let l0 = config.params.stopper_length;
+        let events = run.steps.iter().map(|s| s.events).sum::<usize>() + 200;
+        for s in &trajectory.samples {
+            for leg in Leg::BOTH {
+                if !s.active.contact(leg) {
+                    let h = model.tip_height(&s.q, leg.index());
+                    // each disarmed re-contact may start a further gap lower: bounded by the event count
+                    assert!(
+                        h > -(events as f64) * gap,
+                        "{mode:?} t = {}: {leg:?} tip at {h:e}",
+                        s.time
+                    );
+                }
+                if !s.active.lock(leg) {
+                    let l = s.q[leg.length_coordinate()];
+                    assert!(l < l0 + 1e-7, "{mode:?} t = {}: {leg:?} length {l}", s.time);
+                }
+            }
+        }
+    }
+}

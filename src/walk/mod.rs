@@ -16,9 +16,12 @@
 //!
 //! **Grazing guard.** Right after a lift-off at `lambda_4 = 0` the tip leaves the ground with zero velocity and
 //! acceleration, so the height function starts at zero. Such an event is *disarmed*: its function is
-//! `height + recontact_gap`, which fires only if the tip sinks `recontact_gap` below the ground without having
-//! risen; once the height exceeds `recontact_gap` at an accepted step the event is armed and its function is the
-//! height itself. Stoppers use `stopper_gap` the same way. Both are options of [`SolverOptions`].
+//! `height - (min(h0, 0) - recontact_gap)` with `h0` the height at the start of the phase, which fires only if
+//! the tip sinks `recontact_gap` below where it started (or below the ground) without having risen; once the
+//! height exceeds `recontact_gap` at an accepted step the event is armed and its function is the height itself.
+//! Stoppers use `stopper_gap` the same way. Both are options of [`SolverOptions`]. (Measuring from `h0` matters
+//! after a re-contact located at `-recontact_gap`: a guard measured from the ground would start at zero and
+//! never fire, letting the tip sink.)
 
 pub mod impact;
 pub mod report;
@@ -198,6 +201,8 @@ enum EventKind {
 struct Event {
     kind: EventKind,
     armed: bool,
+    /// While disarmed, the event fires when its unshifted function falls to this level.
+    floor: f64,
 }
 
 /// Event functions of one phase.
@@ -222,7 +227,11 @@ impl<'a> EventSet<'a> {
             events: vec![],
         };
         for kind in [EventKind::Touchdown, EventKind::Fall, EventKind::RollBack] {
-            set.events.push(Event { kind, armed: true });
+            set.events.push(Event {
+                kind,
+                armed: true,
+                floor: 0.0,
+            });
         }
         for leg in Leg::BOTH {
             let kind = if active.contact(leg) {
@@ -230,14 +239,22 @@ impl<'a> EventSet<'a> {
             } else {
                 EventKind::Landing(leg)
             };
-            set.events.push(Event { kind, armed: true });
+            set.events.push(Event {
+                kind,
+                armed: true,
+                floor: 0.0,
+            });
             if !model.params().rigid_legs {
                 let kind = if active.lock(leg) {
                     EventKind::Unlock(leg)
                 } else {
                     EventKind::StopperHit(leg)
                 };
-                set.events.push(Event { kind, armed: true });
+                set.events.push(Event {
+                    kind,
+                    armed: true,
+                    floor: 0.0,
+                });
             }
         }
         let zero = Coords::zeros();
@@ -246,6 +263,7 @@ impl<'a> EventSet<'a> {
             let (raw, gap) = set.raw(k, q, &zero, &dynamics);
             if let Some(gap) = gap {
                 set.events[k].armed = raw > gap;
+                set.events[k].floor = raw.min(0.0) - gap;
             }
         }
         set
@@ -304,7 +322,7 @@ impl<'a> EventSet<'a> {
             .map(|k| {
                 let (raw, gap) = self.raw(k, &q, &qd, &dynamics);
                 match gap {
-                    Some(gap) if !self.events[k].armed => raw + gap,
+                    Some(_) if !self.events[k].armed => raw - self.events[k].floor,
                     _ => raw,
                 }
             })
@@ -321,7 +339,7 @@ impl<'a> EventSet<'a> {
         };
         let (raw, gap) = self.raw(k, &q, &qd, &dynamics);
         match gap {
-            Some(gap) if !self.events[k].armed => raw + gap,
+            Some(_) if !self.events[k].armed => raw - self.events[k].floor,
             _ => raw,
         }
     }
@@ -335,10 +353,11 @@ impl<'a> EventSet<'a> {
                     EventKind::StopperHit(_) => self.opts.stopper_gap,
                     _ => continue,
                 };
-                // values[k] = raw + gap
-                if values[k] - gap > gap {
+                // values[k] = raw - floor
+                let raw = values[k] + e.floor;
+                if raw > gap {
                     e.armed = true;
-                    values[k] -= gap;
+                    values[k] = raw;
                 }
             }
         }
