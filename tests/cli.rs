@@ -69,9 +69,14 @@ fn temp_dir_with(files: &[(&str, &str)]) -> TempDir {
 
 /// Run `vrw simulate <args> --out <dir>/out` in `dir`, where `dir` may hold input files.
 fn simulate_in(dir: TempDir, args: &[&str]) -> Run {
+    command_in(dir, "simulate", args)
+}
+
+/// Run `vrw <command> <args> --out <dir>/out` in `dir`.
+fn command_in(dir: TempDir, command: &str, args: &[&str]) -> Run {
     let out = dir.path().join("out");
     let output = Command::new(env!("CARGO_BIN_EXE_vrw"))
-        .arg("simulate")
+        .arg(command)
         .args(args)
         .arg("--out")
         .arg(&out)
@@ -330,4 +335,87 @@ fn config_file_sets_parameters() {
         "stderr:\n{}",
         run.stderr()
     );
+}
+
+#[test]
+fn gait_writes_the_fixed_point_and_its_multipliers() {
+    let run = command_in(temp_dir_with(&[]), "gait", &[]);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let gait: Value = serde_json::from_str(&run.read("gait.json")).unwrap();
+    assert_eq!(gait["status"], "found");
+    for key in ["L2", "thetadot", "L2dot", "theta"] {
+        assert!(gait["section"][key].is_f64(), "section.{key}");
+    }
+    for key in [
+        "lambda_i4",
+        "lambda_2_plus",
+        "lambda_4_plus",
+        "period",
+        "step_length",
+        "speed",
+        "dls_duration",
+    ] {
+        assert!(gait[key].is_f64(), "{key}");
+    }
+    assert_eq!(gait["branch"], "DLS");
+    assert_eq!(gait["stable"], true);
+    let multipliers = gait["floquet_multipliers"].as_array().unwrap();
+    assert_eq!(multipliers.len(), 3);
+    assert!(multipliers.iter().all(|z| z.as_array().unwrap().len() == 2));
+    assert!(run.stdout().contains("stable"));
+}
+
+#[test]
+fn gait_search_that_fails_says_why_and_keeps_the_file() {
+    let run = command_in(temp_dir_with(&[]), "gait", &["--set", "viscosity=250"]);
+    assert_eq!(run.code(), Some(EXIT_FAILURE));
+    assert!(
+        run.stderr().contains("no gait found") && run.stderr().contains("rolled back"),
+        "{}",
+        run.stderr()
+    );
+    let gait: Value = serde_json::from_str(&run.read("gait.json")).unwrap();
+    assert_eq!(gait["status"], "rolled_back");
+}
+
+#[test]
+fn sweep_writes_table_thresholds_and_figure() {
+    let args = ["--from", "130", "--to", "140", "--points", "6"];
+    let run = command_in(temp_dir_with(&[]), "sweep", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let table = run.read("sweep.csv");
+    assert!(table.starts_with("viscosity,status,"));
+    assert!(table.contains("max_floquet"));
+    assert_eq!(data_rows(&table), 6);
+    let thresholds: Value = serde_json::from_str(&run.read("thresholds.json")).unwrap();
+    let list = thresholds["thresholds"].as_array().unwrap();
+    // The gait is lost between 134 and 136: located by bisection to 1e-6.
+    let lost = list
+        .iter()
+        .find(|t| t["name"] == "gait_lost")
+        .expect("a gait_lost threshold");
+    let [a, b] = [
+        lost["bracket"][0].as_f64().unwrap(),
+        lost["bracket"][1].as_f64().unwrap(),
+    ];
+    assert!(b - a <= 1e-6 && a > 134.0 && b < 136.0, "{lost}");
+    let png = fs::read(run.out.join("fig2.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(run.read("fig2.svg").contains("<svg"));
+}
+
+#[test]
+fn sweep_of_an_unknown_parameter_is_rejected() {
+    let run = command_in(
+        temp_dir_with(&[]),
+        "sweep",
+        &["--param", "colour", "--points", "3"],
+    );
+    assert_error(&run, &["colour"]);
+}
+
+#[test]
+fn sweep_with_an_empty_range_is_rejected() {
+    let run = command_in(temp_dir_with(&[]), "sweep", &["--from", "5", "--to", "5"]);
+    assert_error(&run, &["range"]);
 }

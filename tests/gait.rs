@@ -210,3 +210,38 @@ fn sweep_rejects_bad_specifications() {
     assert_eq!(points[0].status, "invalid_parameter");
     assert!(points[2].gait.is_some());
 }
+
+/// Locks the numerics (STYLE.md point 10): the paper-parameter gait as computed when this test was written.
+/// An intended change of the numerics (tolerances, event handling, the model) updates these values and says
+/// why in its commit message; an unintended one fails here.
+#[test]
+fn paper_gait_snapshot() {
+    /// Relative agreement required: far above rounding differences between machines, far below any change
+    /// of the model or of the event handling.
+    const SNAPSHOT_TOL: f64 = 1e-7;
+    let config = Config::default();
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let g = find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None,
+    )
+    .unwrap();
+    let expected = [
+        (g.section.l2, 0.709843787336971),
+        (g.section.theta_dot, 0.8954383386443644),
+        (g.section.l2_dot, -0.4797624014976493),
+        (g.theta, -0.781527471509902),
+        (g.lambda_i4, 0.07137566453544389),
+        (g.lambda_2_plus, 18.009031491329296),
+        (g.lambda_4_plus, 155.0875802019337),
+        (g.period, 2.691666212526113),
+        (g.step_length, 0.7071120782469035),
+    ];
+    for (got, want) in expected {
+        assert_relative_eq!(got, want, max_relative = SNAPSHOT_TOL, epsilon = 1e-12);
+    }
+    assert_relative_eq!(g.max_floquet, 0.016147, max_relative = 1e-4);
+}

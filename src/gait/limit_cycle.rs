@@ -82,8 +82,10 @@ impl GaitError {
     }
 }
 
-/// A walking gait (limit cycle) and what it does.
+/// A walking gait (limit cycle) and what it does. Serialized with `theta` inside `section`
+/// (`{"section": {"L2", "thetadot", "L2dot", "theta"}, ...}`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(into = "GaitRecord")]
 pub struct Gait {
     /// The fixed point on the section.
     pub section: SectionState,
@@ -315,6 +317,67 @@ fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
         floquet_multipliers: multipliers.iter().map(|z| [z.re, z.im]).collect(),
         max_floquet,
         stable: max_floquet < 1.0,
+    }
+}
+
+/// The section state with its `theta`, as written in `gait.json`.
+#[derive(Debug, Clone, Serialize)]
+struct SectionRecord {
+    #[serde(flatten)]
+    state: SectionState,
+    theta: f64,
+}
+
+/// The serialized shape of a [`Gait`].
+#[derive(Debug, Clone, Serialize)]
+struct GaitRecord {
+    section: SectionRecord,
+    residual: f64,
+    iterations: usize,
+    lambda_i4: f64,
+    lambda_2_plus: f64,
+    lambda_4_plus: f64,
+    branch: Branch,
+    period: f64,
+    step_length: f64,
+    speed: f64,
+    dls_duration: f64,
+    scuffing: bool,
+    bounce: bool,
+    energy_residual: f64,
+    jacobian: Vec<Vec<f64>>,
+    jacobian_error: f64,
+    floquet_multipliers: Vec<[f64; 2]>,
+    max_floquet: f64,
+    stable: bool,
+}
+
+impl From<Gait> for GaitRecord {
+    fn from(g: Gait) -> GaitRecord {
+        GaitRecord {
+            section: SectionRecord {
+                state: g.section,
+                theta: g.theta,
+            },
+            residual: g.residual,
+            iterations: g.iterations,
+            lambda_i4: g.lambda_i4,
+            lambda_2_plus: g.lambda_2_plus,
+            lambda_4_plus: g.lambda_4_plus,
+            branch: g.branch,
+            period: g.period,
+            step_length: g.step_length,
+            speed: g.speed,
+            dls_duration: g.dls_duration,
+            scuffing: g.scuffing,
+            bounce: g.bounce,
+            energy_residual: g.energy_residual,
+            jacobian: g.jacobian,
+            jacobian_error: g.jacobian_error,
+            floquet_multipliers: g.floquet_multipliers,
+            max_floquet: g.max_floquet,
+            stable: g.stable,
+        }
     }
 }
 

@@ -18,10 +18,13 @@ pub const RIGID_SECTION_TOL: f64 = 1e-9;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SectionState {
     /// Length of Leg 2 (the stance leg about to become the rear leg) \[m\].
+    #[serde(rename = "L2")]
     pub l2: f64,
     /// Angular velocity of the wheel \[rad/s\].
+    #[serde(rename = "thetadot")]
     pub theta_dot: f64,
     /// Rate of change of the length of Leg 2 \[m/s\].
+    #[serde(rename = "L2dot")]
     pub l2_dot: f64,
 }
 
