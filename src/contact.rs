@@ -276,9 +276,24 @@ fn solve_saddle(
     let chol = m.cholesky().ok_or(ContactError::SingularMass)?;
     let x_free = chol.solve(f);
     let minv_jt = chol.solve(&rows.transpose());
-    let mut schur = rows * minv_jt;
-    let mut rhs = b - rows * x_free;
-    for (i, on) in active.row_mask().iter().enumerate() {
+    let lam = solve_schur(
+        rows * minv_jt,
+        b - rows * x_free,
+        &active.row_mask(),
+        active,
+    )?;
+    Ok((x_free + minv_jt * lam, lam))
+}
+
+/// Solve `S lam = rhs` for the Schur complement `S = J M^-1 J^T` of `K` stacked rows of which `mask` says
+/// which are active: inactive rows become identity rows with zero right-hand side (so their `lam` is 0).
+fn solve_schur<const K: usize>(
+    mut schur: SMatrix<f64, K, K>,
+    mut rhs: SVector<f64, K>,
+    mask: &[bool],
+    active: &ActiveSet,
+) -> Result<SVector<f64, K>, ContactError> {
+    for (i, on) in mask.iter().enumerate() {
         if !on {
             schur[(i, i)] = 1.0;
             rhs[i] = 0.0;
@@ -292,8 +307,7 @@ fn solve_saddle(
     if min_pivot < REDUNDANCY_TOL * scale {
         return Err(redundant);
     }
-    let lam = chol_s.solve(&rhs);
-    Ok((x_free + minv_jt * lam, lam))
+    Ok(chol_s.solve(&rhs))
 }
 
 /// Accelerations and multipliers of Eq. (1) with the constraints of `active` (MODEL.md section 3).
@@ -337,22 +351,8 @@ fn solve_with_fixed_leg_one(
     }
     let x_free = chol.solve(&(-h_r));
     let minv_jt = chol.solve(&rows_r.transpose());
-    let mut schur = rows_r * minv_jt;
-    let mut rhs = -jdq.fixed_rows::<4>(2) - rows_r * x_free;
-    for i in 0..4 {
-        if !mask[i + 2] {
-            schur[(i, i)] = 1.0;
-            rhs[i] = 0.0;
-        }
-    }
-    let scale = schur.diagonal().max();
-    let redundant = ContactError::RedundantConstraints(*active);
-    let chol_s = schur.cholesky().ok_or(redundant)?;
-    let min_pivot = chol_s.l_dirty().diagonal().map(|d| d * d).min();
-    if min_pivot < REDUNDANCY_TOL * scale {
-        return Err(redundant);
-    }
-    let lam_rest = chol_s.solve(&rhs);
+    let rhs = -jdq.fixed_rows::<4>(2) - rows_r * x_free;
+    let lam_rest = solve_schur(rows_r * minv_jt, rhs, &mask[2..], active)?;
     let qdd_r = x_free + minv_jt * lam_rest;
     let mut qdd = Coords::zeros();
     qdd.fixed_rows_mut::<R>(2).copy_from(&qdd_r);

@@ -12,6 +12,11 @@ use vrw::walk::SectionState;
 /// Agreement of the finite-difference Floquet multiplier with the closed form of the rigid wheel.
 const RIGID_MULTIPLIER_TOL: f64 = 1e-8;
 
+/// The gait of the paper's parameters, searched from the default start.
+fn paper_gait(map: &StepMap, config: &Config) -> vrw::gait::Gait {
+    find_gait(map, &default_initial(config), &GaitOptions::default(), None).unwrap()
+}
+
 fn rigid_config() -> Config {
     let mut config = Config::default();
     config.params.rigid_legs = true;
@@ -60,13 +65,7 @@ fn gait_jacobian_matches_finite_differences_of_the_step_map() {
     let config = Config::default();
     let model = Model::new(&config.params).unwrap();
     let map = StepMap::new(&model, &config.solver);
-    let gait = find_gait(
-        &map,
-        &default_initial(&config),
-        &GaitOptions::default(),
-        None,
-    )
-    .unwrap();
+    let gait = paper_gait(&map, &config);
     let dp = gait.jacobian_matrix();
     // Forward differences with a different step: first-order accurate, so a looser tolerance.
     let h = 1e-5;
@@ -100,13 +99,7 @@ fn paper_parameters_have_a_stable_gait_with_dls() {
     let config = Config::default();
     let model = Model::new(&config.params).unwrap();
     let map = StepMap::new(&model, &config.solver);
-    let gait = find_gait(
-        &map,
-        &default_initial(&config),
-        &GaitOptions::default(),
-        None,
-    )
-    .unwrap();
+    let gait = paper_gait(&map, &config);
     assert!(gait.residual < 1e-10);
     assert!(gait.stable && gait.max_floquet < 1.0);
     assert!(gait.lambda_i4 > 0.0 && gait.lambda_2_plus > 0.0 && gait.lambda_4_plus > 0.0);
