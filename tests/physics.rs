@@ -253,20 +253,24 @@ fn rebound_option_terminates_with_a_status() {
 }
 
 #[test]
-fn a_fall_is_a_status_and_the_steps_before_it_are_kept() {
-    let config = Config::default();
+fn a_walk_that_stops_is_a_status_and_the_steps_before_it_are_kept() {
+    let mut config = Config::default();
+    // Just below the slope where the gait exists (0.0906 rad): two steps, then the wheel rolls back.
+    config.params.slope = 0.09;
     let model = Model::new(&config.params).unwrap();
-    // Too slow to pass over the top: the wheel rolls back.
-    let slow = SectionState {
-        theta_dot: 0.05,
-        ..default_start()
-    };
-    let run = simulate(&model, &config.solver, &slow, 5, None).unwrap();
-    let failure = run.failure.expect("a slow wheel cannot walk");
-    assert!(
-        matches!(failure.kind(), "rolled_back" | "stalled" | "fell"),
-        "{failure}"
-    );
+    let run = simulate(&model, &config.solver, &default_start(), 20, None).unwrap();
+    let failure = run.failure.expect("the wheel cannot keep walking");
+    assert_eq!(failure.kind(), "rolled_back", "{failure}");
+    assert_eq!(run.steps.len(), 2);
+    assert!(run.steps.iter().all(|s| s.energy.residual.abs() < AUDIT_TOL));
+    match failure {
+        vrw::error::WalkError::RolledBack { time, phase } => {
+            let last = run.steps.last().unwrap();
+            assert!(time > last.time + last.period, "the failure comes after the kept steps");
+            assert_eq!(phase, vrw::contact::Phase::DoubleSupport);
+        }
+        other => panic!("{other}"),
+    }
 }
 
 #[test]
