@@ -262,11 +262,17 @@ fn a_walk_that_stops_is_a_status_and_the_steps_before_it_are_kept() {
     let failure = run.failure.expect("the wheel cannot keep walking");
     assert_eq!(failure.kind(), "rolled_back", "{failure}");
     assert_eq!(run.steps.len(), 2);
-    assert!(run.steps.iter().all(|s| s.energy.residual.abs() < AUDIT_TOL));
+    assert!(run
+        .steps
+        .iter()
+        .all(|s| s.energy.residual.abs() < AUDIT_TOL));
     match failure {
         vrw::error::WalkError::RolledBack { time, phase } => {
             let last = run.steps.last().unwrap();
-            assert!(time > last.time + last.period, "the failure comes after the kept steps");
+            assert!(
+                time > last.time + last.period,
+                "the failure comes after the kept steps"
+            );
             assert_eq!(phase, vrw::contact::Phase::DoubleSupport);
         }
         other => panic!("{other}"),
