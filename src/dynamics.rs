@@ -186,6 +186,11 @@ impl Model {
         self.leg_point_from_hub(&hub, q, qd, j, 0.0)
     }
 
+    /// Height of the hub above the slope, `z + L1 cos(theta)` \[m\].
+    pub fn hub_height(&self, q: &Coords) -> f64 {
+        q[Z] + q[L1] * q[THETA].cos()
+    }
+
     /// Height of the tip of leg `j` above the slope \[m\] (no Jacobian; cheap, for event functions).
     pub fn tip_height(&self, q: &Coords, j: LegIndex) -> f64 {
         let (sj, cj) = self.offsets[j];

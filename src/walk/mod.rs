@@ -32,7 +32,7 @@ use nalgebra::SVector;
 use crate::contact::{
     constrained_dynamics, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase,
 };
-use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X, Z};
+use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X};
 use crate::error::WalkError;
 use crate::integrate::{locate_root, DenseStep, Dopri5, OdeSystem, Tolerances};
 use crate::params::SolverOptions;
@@ -200,8 +200,8 @@ enum EventKind {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Event {
     kind: EventKind,
-    armed: bool,
-    /// While disarmed, the event fires when its unshifted function falls to this level.
+    /// The event fires when its unshifted function falls to this level: 0 once armed, and
+    /// `min(h0, 0) - gap` while a guarded event is disarmed (see the module documentation).
     floor: f64,
 }
 
@@ -220,145 +220,129 @@ impl<'a> EventSet<'a> {
         active: ActiveSet,
         q: &Coords,
     ) -> EventSet<'a> {
+        let mut kinds = vec![EventKind::Touchdown, EventKind::Fall, EventKind::RollBack];
+        for leg in Leg::BOTH {
+            kinds.push(if active.contact(leg) {
+                EventKind::LiftOff(leg)
+            } else {
+                EventKind::Landing(leg)
+            });
+            if !model.params().rigid_legs {
+                kinds.push(if active.lock(leg) {
+                    EventKind::Unlock(leg)
+                } else {
+                    EventKind::StopperHit(leg)
+                });
+            }
+        }
         let mut set = EventSet {
             model,
             opts,
             active,
-            events: vec![],
+            events: Vec::with_capacity(kinds.len()),
         };
-        for kind in [EventKind::Touchdown, EventKind::Fall, EventKind::RollBack] {
-            set.events.push(Event {
-                kind,
-                armed: true,
-                floor: 0.0,
-            });
-        }
-        for leg in Leg::BOTH {
-            let kind = if active.contact(leg) {
-                EventKind::LiftOff(leg)
-            } else {
-                EventKind::Landing(leg)
-            };
-            set.events.push(Event {
-                kind,
-                armed: true,
-                floor: 0.0,
-            });
-            if !model.params().rigid_legs {
-                let kind = if active.lock(leg) {
-                    EventKind::Unlock(leg)
-                } else {
-                    EventKind::StopperHit(leg)
-                };
-                set.events.push(Event {
-                    kind,
-                    armed: true,
-                    floor: 0.0,
-                });
-            }
-        }
         let zero = Coords::zeros();
-        let dynamics = None;
-        for k in 0..set.events.len() {
-            let (raw, gap) = set.raw(k, q, &zero, &dynamics);
-            if let Some(gap) = gap {
-                set.events[k].armed = raw > gap;
-                set.events[k].floor = raw.min(0.0) - gap;
-            }
+        for kind in kinds {
+            // Guarded events start disarmed unless their function already clears the gap.
+            let floor = match Self::guard(opts, kind) {
+                Some(gap) => {
+                    let h0 = set.raw(kind, q, &zero, &None);
+                    if h0 > gap {
+                        0.0
+                    } else {
+                        h0.min(0.0) - gap
+                    }
+                }
+                None => 0.0,
+            };
+            set.events.push(Event { kind, floor });
         }
         set
     }
 
-    /// The unshifted function of event `k` and, for guarded events, their gap.
+    /// The grazing guard of an event kind, if it has one.
+    fn guard(opts: &SolverOptions, kind: EventKind) -> Option<f64> {
+        match kind {
+            EventKind::Landing(_) => Some(opts.recontact_gap),
+            EventKind::StopperHit(_) => Some(opts.stopper_gap),
+            _ => None,
+        }
+    }
+
+    /// The unshifted function of an event.
     fn raw(
         &self,
-        k: usize,
+        kind: EventKind,
         q: &Coords,
         qd: &Coords,
         dynamics: &Option<ConstrainedDynamics>,
-    ) -> (f64, Option<f64>) {
-        let p = self.model.params();
+    ) -> f64 {
         let force = |f: &dyn Fn(&ConstrainedDynamics) -> f64| dynamics.as_ref().map_or(f64::NAN, f);
-        match self.events[k].kind {
-            EventKind::Touchdown => (self.model.tip_height(q, self.model.front_leg()), None),
-            EventKind::Fall => (
-                q[Z] + q[L1] * q[THETA].cos() - self.opts.fall_hub_height,
-                None,
-            ),
-            EventKind::RollBack => (qd[THETA], None),
-            EventKind::LiftOff(leg) => {
-                (force(&|d| d.normal_force(leg)) + COMPLEMENTARITY_TOL, None)
+        match kind {
+            EventKind::Touchdown => self.model.tip_height(q, self.model.front_leg()),
+            EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
+            EventKind::RollBack => qd[THETA],
+            EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)) + COMPLEMENTARITY_TOL,
+            EventKind::Unlock(leg) => force(&|d| d.stopper_reaction(leg)) + COMPLEMENTARITY_TOL,
+            EventKind::Landing(leg) => self.model.tip_height(q, leg.index()),
+            EventKind::StopperHit(leg) => {
+                self.model.params().stopper_length - q[leg.length_coordinate()]
             }
-            EventKind::Unlock(leg) => (
-                force(&|d| d.stopper_reaction(leg)) + COMPLEMENTARITY_TOL,
-                None,
-            ),
-            EventKind::Landing(leg) => (
-                self.model.tip_height(q, leg.index()),
-                Some(self.opts.recontact_gap),
-            ),
-            EventKind::StopperHit(leg) => (
-                p.stopper_length - q[leg.length_coordinate()],
-                Some(self.opts.stopper_gap),
-            ),
         }
     }
 
-    fn needs_forces(&self) -> bool {
-        self.events
-            .iter()
-            .any(|e| matches!(e.kind, EventKind::LiftOff(_) | EventKind::Unlock(_)))
+    /// The value of event `e` at `(q, q')`: its function measured from its floor.
+    fn shifted(
+        &self,
+        e: &Event,
+        q: &Coords,
+        qd: &Coords,
+        dynamics: &Option<ConstrainedDynamics>,
+    ) -> f64 {
+        self.raw(e.kind, q, qd, dynamics) - e.floor
     }
 
-    /// Values of all event functions at `y` (guarded events shifted by their gap while disarmed).
+    fn needs_forces(kind: EventKind) -> bool {
+        matches!(kind, EventKind::LiftOff(_) | EventKind::Unlock(_))
+    }
+
+    fn dynamics_if(&self, needed: bool, q: &Coords, qd: &Coords) -> Option<ConstrainedDynamics> {
+        needed
+            .then(|| constrained_dynamics(self.model, q, qd, &self.active).ok())
+            .flatten()
+    }
+
+    /// Values of all event functions at `y`.
     fn values(&self, y: &WalkVector) -> Vec<f64> {
         let (q, qd) = unpack(y);
-        let dynamics = if self.needs_forces() {
-            constrained_dynamics(self.model, &q, &qd, &self.active).ok()
-        } else {
-            None
-        };
-        (0..self.events.len())
-            .map(|k| {
-                let (raw, gap) = self.raw(k, &q, &qd, &dynamics);
-                match gap {
-                    Some(_) if !self.events[k].armed => raw - self.events[k].floor,
-                    _ => raw,
-                }
-            })
+        let needed = self.events.iter().any(|e| Self::needs_forces(e.kind));
+        let dynamics = self.dynamics_if(needed, &q, &qd);
+        self.events
+            .iter()
+            .map(|e| self.shifted(e, &q, &qd, &dynamics))
             .collect()
     }
 
+    /// Value of event `k` at `y`.
     fn value(&self, k: usize, y: &WalkVector) -> f64 {
         let (q, qd) = unpack(y);
-        let dynamics = match self.events[k].kind {
-            EventKind::LiftOff(_) | EventKind::Unlock(_) => {
-                constrained_dynamics(self.model, &q, &qd, &self.active).ok()
-            }
-            _ => None,
-        };
-        let (raw, gap) = self.raw(k, &q, &qd, &dynamics);
-        match gap {
-            Some(_) if !self.events[k].armed => raw - self.events[k].floor,
-            _ => raw,
-        }
+        let e = &self.events[k];
+        let dynamics = self.dynamics_if(Self::needs_forces(e.kind), &q, &qd);
+        self.shifted(e, &q, &qd, &dynamics)
     }
 
-    /// Arm guarded events whose function has cleared its gap; returns the values in the new definitions.
+    /// Arm guarded events whose function has cleared its gap; `values` are updated to the new definitions.
     fn arm(&mut self, values: &mut [f64]) {
-        for (k, e) in self.events.iter_mut().enumerate() {
-            if !e.armed {
-                let gap = match e.kind {
-                    EventKind::Landing(_) => self.opts.recontact_gap,
-                    EventKind::StopperHit(_) => self.opts.stopper_gap,
-                    _ => continue,
-                };
-                // values[k] = raw - floor
-                let raw = values[k] + e.floor;
-                if raw > gap {
-                    e.armed = true;
-                    values[k] = raw;
-                }
+        let opts = self.opts;
+        for (e, value) in self.events.iter_mut().zip(values.iter_mut()) {
+            if e.floor == 0.0 {
+                continue;
+            }
+            let gap = Self::guard(opts, e.kind).expect("only guarded events have a floor");
+            let raw = *value + e.floor;
+            if raw > gap {
+                e.floor = 0.0;
+                *value = raw;
             }
         }
     }
@@ -554,7 +538,7 @@ impl<'m> Walker<'m> {
                     return Err(WalkError::Fell {
                         time: t,
                         phase,
-                        hub_height: q[Z] + q[L1] * q[THETA].cos(),
+                        hub_height: model.hub_height(&q),
                     })
                 }
                 EventKind::RollBack => return Err(WalkError::RolledBack { time: t, phase }),
