@@ -102,6 +102,15 @@ pub enum WalkError {
 }
 
 impl WalkError {
+    /// Wraps a failed constraint solve at `time` in `phase` (for `map_err`).
+    pub fn contact_at(time: f64, phase: Phase) -> impl Fn(ContactError) -> WalkError + Copy {
+        move |source| WalkError::Contact {
+            time,
+            phase,
+            source,
+        }
+    }
+
     /// A short machine-readable name of the failure (`fell`, `stalled`, ...), used in CSV and JSON output.
     pub fn kind(&self) -> &'static str {
         match self {

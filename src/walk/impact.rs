@@ -207,7 +207,7 @@ pub fn plastic_impact(
     qd: &Coords,
     forced: ActiveSet,
     candidates: &[Candidate],
-) -> Result<Option<(ActiveSet, ImpulseSolution)>, ContactError> {
+) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
     let solve = |set: &ActiveSet| impulse(model, q, qd, set);
     let found = best_subset(forced, candidates, false, solve, |set, sol| {
         candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
@@ -222,10 +222,10 @@ pub fn plastic_impact(
         })
     })?;
     match found {
-        Some(found) => Ok(Some(found)),
+        Some(found) => Ok(found),
         None => {
             let set = preferred_set(forced, candidates);
-            Ok(Some((set, solve(&set)?)))
+            Ok((set, solve(&set)?))
         }
     }
 }
@@ -321,7 +321,7 @@ pub fn touchdown_impact(
     q: &Coords,
     qd: &Coords,
     before: ActiveSet,
-) -> Result<Option<TouchdownImpact>, ContactError> {
+) -> Result<TouchdownImpact, ContactError> {
     let kinetic = |v: &Coords| model.kinetic_energy(q, v);
     let finish = |impulse_set: ActiveSet,
                   sol: ImpulseSolution,
@@ -349,25 +349,17 @@ pub fn touchdown_impact(
             ..Default::default()
         };
         let sol = impulse(model, q, qd, &set)?;
-        return Ok(Some(finish(
-            set,
-            sol,
-            DlsIndicators::UNDEFINED,
-            Branch::Sls,
-            set,
-        )));
+        return Ok(finish(set, sol, DlsIndicators::UNDEFINED, Branch::Sls, set));
     }
     if !before.contact2 {
-        let Some((set, sol)) = plastic_impact(model, q, qd, sls, &stoppers)? else {
-            return Ok(None);
-        };
-        return Ok(Some(finish(
+        let (set, sol) = plastic_impact(model, q, qd, sls, &stoppers)?;
+        return Ok(finish(
             set,
             sol,
             DlsIndicators::UNDEFINED,
             Branch::RearAirborne,
             sls,
-        )));
+        ));
     }
 
     // (A1) the DLS collision.
@@ -375,9 +367,7 @@ pub fn touchdown_impact(
         contact2: true,
         ..sls
     };
-    let Some((dls_set, dls_sol)) = plastic_impact(model, q, qd, dls, &stoppers)? else {
-        return Ok(None);
-    };
+    let (dls_set, dls_sol) = plastic_impact(model, q, qd, dls, &stoppers)?;
     let lambda_i4 = dls_sol.normal_impulse(Leg::Two);
     // (B1) forces just after the DLS collision, Eqs. (6)-(7).
     let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
@@ -394,10 +384,8 @@ pub fn touchdown_impact(
 
     if model.params().impact == ImpactModel::Traditional || lambda_i4 < 0.0 {
         // (A3), or the traditional exchange: the rear leg leaves at once.
-        let Some((set, sol)) = plastic_impact(model, q, qd, sls, &stoppers)? else {
-            return Ok(None);
-        };
-        return Ok(Some(finish(set, sol, indicators, Branch::Sls, sls)));
+        let (set, sol) = plastic_impact(model, q, qd, sls, &stoppers)?;
+        return Ok(finish(set, sol, indicators, Branch::Sls, sls));
     }
     let (branch, preferred) = match (lambda_2_plus >= 0.0, lambda_4_plus >= 0.0) {
         (true, true) => (Branch::Dls, dls),
@@ -410,9 +398,18 @@ pub fn touchdown_impact(
             },
         ),
     };
-    Ok(Some(finish(
-        dls_set, dls_sol, indicators, branch, preferred,
-    )))
+    Ok(finish(dls_set, dls_sol, indicators, branch, preferred))
+}
+
+/// The stoppers that act both ways and are always active: both with `rigid_legs` (MODEL.md section 7), none
+/// otherwise. Every active-set resolution starts from this set.
+pub fn bilateral_stoppers(model: &Model) -> ActiveSet {
+    let rigid = model.params().rigid_legs;
+    ActiveSet {
+        lock1: rigid,
+        lock2: rigid,
+        ..ActiveSet::default()
+    }
 }
 
 /// Candidates for the motion right after an impact whose impulse acted on `impulse_set`: every unit that took
@@ -423,16 +420,13 @@ pub fn post_impact_candidates(
     impulse_set: &ActiveSet,
     preferred: &ActiveSet,
 ) -> (ActiveSet, Vec<Candidate>) {
-    let rigid = model.params().rigid_legs;
-    let mut forced = ActiveSet::default();
+    let forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
     for leg in Leg::BOTH {
         if impulse_set.contact(leg) {
             candidates.push(Candidate::keep(Unit::Contact(leg), preferred));
         }
-        if rigid {
-            forced.set_lock(leg, true);
-        } else if impulse_set.lock(leg) {
+        if !forced.lock(leg) && impulse_set.lock(leg) {
             candidates.push(Candidate {
                 unit: Unit::Stopper(leg),
                 preferred: Mode::On,

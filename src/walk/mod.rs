@@ -38,8 +38,8 @@ use crate::integrate::{locate_root, DenseStep, Dopri5, OdeSystem, Tolerances};
 use crate::params::SolverOptions;
 
 use impact::{
-    consistent_active_set, plastic_impact, post_impact_candidates, touchdown_impact, Candidate,
-    Mode, Unit, COMPLEMENTARITY_TOL,
+    bilateral_stoppers, consistent_active_set, plastic_impact, post_impact_candidates,
+    touchdown_impact, Candidate, Mode, Unit, COMPLEMENTARITY_TOL,
 };
 pub use impact::{Branch, DlsIndicators};
 pub use report::{EnergyAudit, StepReport};
@@ -438,21 +438,10 @@ impl<'m> Walker<'m> {
         let opts = self.opts.clone();
         let start = self.state.clone();
         let t_start = start.time;
-        let contact_error = |time: f64, phase: Phase| {
-            move |source| WalkError::Contact {
-                time,
-                phase,
-                source,
-            }
-        };
 
         let e_start = model.energy(&start.q, &start.qd);
         let td = touchdown_impact(model, &start.q, &start.qd, start.active)
-            .map_err(contact_error(t_start, Phase::SingleSupport))?
-            .ok_or(WalkError::InconsistentContacts {
-                time: t_start,
-                phase: Phase::SingleSupport,
-            })?;
+            .map_err(WalkError::contact_at(t_start, Phase::SingleSupport))?;
         let mut tally = StepTally {
             impact_loss: td.loss,
             bounce: td.branch == Branch::Bounce,
@@ -461,7 +450,7 @@ impl<'m> Walker<'m> {
         let (forced, candidates) = post_impact_candidates(model, &td.impulse_set, &td.preferred);
         let (mut active, _) =
             consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
-                .map_err(contact_error(t_start, td.preferred.phase()))?
+                .map_err(WalkError::contact_at(t_start, td.preferred.phase()))?
                 .ok_or(WalkError::InconsistentContacts {
                     time: t_start,
                     phase: td.preferred.phase(),
@@ -595,12 +584,7 @@ impl<'m> Walker<'m> {
     ) -> Result<(ActiveSet, Coords, f64), WalkError> {
         let model = self.model;
         let phase = active.phase();
-        let rigid = model.params().rigid_legs;
-        let mut forced = ActiveSet {
-            lock1: rigid,
-            lock2: rigid,
-            ..ActiveSet::default()
-        };
+        let mut forced = bilateral_stoppers(model);
         match unit {
             Unit::Contact(leg) => forced.set_contact(leg, true),
             Unit::Stopper(leg) => forced.set_lock(leg, true),
@@ -612,19 +596,13 @@ impl<'m> Walker<'m> {
             if active.contact(leg) {
                 Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(&active));
             }
-            if !rigid && active.lock(leg) && unit != Unit::Stopper(leg) {
+            if active.lock(leg) && !forced.lock(leg) {
                 candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
             }
         }
-        let err = |source| WalkError::Contact {
-            time,
-            phase,
-            source,
-        };
+        let err = WalkError::contact_at(time, phase);
         let inconsistent = WalkError::InconsistentContacts { time, phase };
-        let (impulse_set, sol) = plastic_impact(model, q, qd, forced, &candidates)
-            .map_err(err)?
-            .ok_or(inconsistent.clone())?;
+        let (impulse_set, sol) = plastic_impact(model, q, qd, forced, &candidates).map_err(err)?;
         let loss = model.kinetic_energy(q, qd) - model.kinetic_energy(q, &sol.qd_plus);
         let (forced, candidates) = post_impact_candidates(model, &impulse_set, &impulse_set);
         let (new_active, _) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)
@@ -646,12 +624,7 @@ impl<'m> Walker<'m> {
     ) -> Result<ActiveSet, WalkError> {
         let model = self.model;
         let phase = active.phase();
-        let rigid = model.params().rigid_legs;
-        let forced = ActiveSet {
-            lock1: rigid,
-            lock2: rigid,
-            ..ActiveSet::default()
-        };
+        let forced = bilateral_stoppers(model);
         let mut candidates = Vec::new();
         for leg in Leg::BOTH {
             if active.contact(leg) {
@@ -661,16 +634,12 @@ impl<'m> Walker<'m> {
                 }
                 candidates.push(c);
             }
-            if !rigid && active.lock(leg) {
+            if active.lock(leg) && !forced.lock(leg) {
                 candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
             }
         }
         let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
-            .map_err(|source| WalkError::Contact {
-                time,
-                phase,
-                source,
-            })?
+            .map_err(WalkError::contact_at(time, phase))?
             .ok_or(WalkError::InconsistentContacts { time, phase })?;
         Ok(new_active)
     }
