@@ -288,16 +288,15 @@ pub fn solve_fixed_point(
 }
 
 fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
-    let (s, residual, iterations, outcome) = (fp.section, fp.residual, fp.iterations, &fp.outcome);
     let mut multipliers: Vec<Complex<f64>> = dp.complex_eigenvalues().iter().copied().collect();
     multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
     let max_floquet = multipliers.first().map_or(0.0, |z| z.norm());
-    let report = &outcome.report;
+    let report = &fp.outcome.report;
     Gait {
-        section: s,
+        section: fp.section,
         theta: report.theta,
-        residual,
-        iterations,
+        residual: fp.residual,
+        iterations: fp.iterations,
         lambda_i4: report.indicators.lambda_i4,
         lambda_2_plus: report.indicators.lambda_2_plus,
         lambda_4_plus: report.indicators.lambda_4_plus,

@@ -17,6 +17,7 @@ use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::step_map::StepMap;
 use super::sweep::{configured, SweepPoint, SweepSpec};
 use crate::params::Config;
+use crate::walk::DlsIndicators;
 
 /// Tolerance of every threshold in the swept parameter.
 pub const PARAM_TOL: f64 = 1e-6;
@@ -73,11 +74,29 @@ impl Quantity {
 
     fn of(self, g: &Gait) -> f64 {
         match self {
-            Quantity::Lambda4Plus => g.lambda_4_plus,
-            Quantity::Lambda2Plus => g.lambda_2_plus,
-            Quantity::LambdaI4 => g.lambda_i4,
             Quantity::Stability => g.max_floquet - 1.0,
+            _ => self.of_indicators(&DlsIndicators {
+                lambda_i4: g.lambda_i4,
+                lambda_2_plus: g.lambda_2_plus,
+                lambda_4_plus: g.lambda_4_plus,
+            }),
         }
+    }
+
+    /// The quantity from the DLS indicators of a step (`NaN` for `Stability`, which needs `DP`).
+    fn of_indicators(self, i: &DlsIndicators) -> f64 {
+        match self {
+            Quantity::Lambda4Plus => i.lambda_4_plus,
+            Quantity::Lambda2Plus => i.lambda_2_plus,
+            Quantity::LambdaI4 => i.lambda_i4,
+            Quantity::Stability => f64::NAN,
+        }
+    }
+
+    /// Does the quantity change sign (both values defined) between the gaits `a` and `b`?
+    fn changes_sign(self, a: &Gait, b: &Gait) -> bool {
+        let (fa, fb) = (self.of(a), self.of(b));
+        fa.is_finite() && fb.is_finite() && (fa < 0.0) != (fb < 0.0)
     }
 }
 
@@ -114,8 +133,7 @@ pub fn find_thresholds(
         match (&a.gait, &b.gait) {
             (Some(ga), Some(gb)) => {
                 for q in Quantity::ALL {
-                    let (fa, fb) = (q.of(ga), q.of(gb));
-                    if fa.is_finite() && fb.is_finite() && (fa < 0.0) != (fb < 0.0) {
+                    if q.changes_sign(ga, gb) {
                         tasks.push(Task::Root(q, a, b));
                     }
                 }
@@ -151,8 +169,8 @@ fn sign_changes_across_gaps(points: &[SweepPoint]) -> Vec<Threshold> {
             continue;
         }
         for q in Quantity::ALL {
-            let (fa, fb) = (q.of(ga), q.of(gb));
-            if fa.is_finite() && fb.is_finite() && (fa < 0.0) != (fb < 0.0) {
+            if q.changes_sign(ga, gb) {
+                let (fa, fb) = (q.of(ga), q.of(gb));
                 out.push(Threshold {
                     name: q.name().to_string(),
                     value: f64::NAN,
@@ -187,6 +205,7 @@ fn refine_root(
         refine_jacobian: false,
         ..*options
     };
+    let guess = start.jacobian_matrix();
     let failure: Cell<Option<String>> = Cell::new(None);
     let (lo, hi) = (Cell::new(a.value), Cell::new(b.value));
     let f_a = q.of(start);
@@ -200,19 +219,13 @@ fn refine_root(
         let value = (|| {
             let (c, model) = configured(config, &spec.param, v).map_err(|e| e.to_string())?;
             let map = StepMap::new(&model, &c.solver);
-            let guess = start.jacobian_matrix();
             let y = if q == Quantity::Stability {
                 q.of(&find_gait(&map, &start.section, &continued, Some(&guess))
                     .map_err(|e| e.to_string())?)
             } else {
                 let fp = solve_fixed_point(&map, &start.section, &continued, Some(&guess))
                     .map_err(|e| e.to_string())?;
-                let i = &fp.outcome.report.indicators;
-                match q {
-                    Quantity::Lambda4Plus => i.lambda_4_plus,
-                    Quantity::Lambda2Plus => i.lambda_2_plus,
-                    _ => i.lambda_i4,
-                }
+                q.of_indicators(&fp.outcome.report.indicators)
             };
             Ok::<f64, String>(y)
         })();
