@@ -156,13 +156,14 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         let i = &last.indicators;
         println!(
             "step {}: lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, lambda_4+ = {:.6} N, branch {}, DLS {:.4} s, \
-             period {:.4} s, step {:.4} m, speed {:.4} m/s{}{}",
+             rear contact {:.4} s, period {:.4} s, step {:.4} m, speed {:.4} m/s{}{}",
             last.step,
             i.lambda_i4,
             i.lambda_2_plus,
             i.lambda_4_plus,
             last.branch,
             last.dls_duration,
+            last.rear_contact_duration,
             last.period,
             last.step_length,
             last.speed,
@@ -228,8 +229,13 @@ fn gait(args: GaitArgs) -> Result<()> {
         if g.bounce { ", bounce" } else { "" },
     );
     println!(
-        "period {:.6} s, step {:.6} m, speed {:.6} m/s, DLS {:.6} s",
-        g.period, g.step_length, g.speed, g.dls_duration
+        "period {:.6} s, step {:.6} m, speed {:.6} m/s, DLS {:.6} s, rear contact {:.6} s",
+        g.period, g.step_length, g.speed, g.dls_duration, g.rear_contact_duration
+    );
+    let c = &g.contact;
+    println!(
+        "contact audit: pull force {:.1e} N, pull impulse {:.1e} N s, penetration {:.1e} m; energy residual {:.1e} J",
+        c.pull_force, c.pull_impulse, c.penetration, g.energy_residual
     );
     let multipliers: Vec<String> = g
         .floquet_multipliers
@@ -246,7 +252,7 @@ fn gait(args: GaitArgs) -> Result<()> {
         "Floquet multipliers [{}] (Jacobian error ~{:.0e}): {}",
         multipliers.join(", "),
         g.jacobian_error,
-        if g.stable { "stable" } else { "UNSTABLE" }
+        g.stability
     );
     println!("wrote {}/gait.json", args.out.display());
     Ok(())

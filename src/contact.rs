@@ -147,6 +147,12 @@ impl ActiveSet {
         ]
     }
 
+    /// Double-limb support in the paper's sense: (C1) and (C2) both hold, both tips on the ground without
+    /// slipping.
+    pub fn double_support(&self) -> bool {
+        self.contact1 && self.contact2 && !self.slide1 && !self.slide2
+    }
+
     /// The support phase named by its contacts (MODEL.md section 4).
     pub fn phase(&self) -> Phase {
         match (self.contact1, self.contact2) {
@@ -214,6 +220,27 @@ impl ConstrainedDynamics {
     pub fn stopper_reaction(&self, leg: Leg) -> f64 {
         -self.multipliers[leg.stopper_row()]
     }
+}
+
+/// The largest pull among the unilateral units of `active` for multipliers (forces or impulses) in the fixed
+/// stacking: a negative normal multiplier (the ground pulling a tip down) or a positive stopper multiplier (a
+/// stopper pulling its leg outward), 0 if nothing pulls. Stoppers are skipped when `bilateral_stoppers` (rigid
+/// legs, where they act both ways). This is the contact audit of every step (MODEL.md section 4).
+pub fn largest_pull(
+    multipliers: &Multipliers,
+    active: &ActiveSet,
+    bilateral_stoppers: bool,
+) -> f64 {
+    let mut pull: f64 = 0.0;
+    for leg in Leg::BOTH {
+        if active.contact(leg) {
+            pull = pull.max(-multipliers[leg.normal_row()]);
+        }
+        if active.lock(leg) && !bilateral_stoppers {
+            pull = pull.max(multipliers[leg.stopper_row()]);
+        }
+    }
+    pull
 }
 
 /// Result of an impulse problem (paper Eq. (5)).

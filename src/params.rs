@@ -239,7 +239,7 @@ pub struct SolverOptions {
     /// Tolerance on located event times (root finding on the dense output) \[s\]. Default 1e-13. Positive.
     /// `MODEL.md` section 4.
     pub event_time_tol: f64,
-    /// Grazing guard for re-contact \[m\]. Default 1e-9. Positive. After a lift-off the tip leaves the
+    /// Grazing guard for re-contact \[m\]. Default 1e-11. Positive. After a lift-off the tip leaves the
     /// ground with zero velocity and acceleration, so a lifted tip's re-contact event is armed only once
     /// its height exceeds this gap; before that it fires only if the tip sinks below `-recontact_gap`.
     /// `MODEL.md` section 4 (grazing).
@@ -267,7 +267,7 @@ impl Default for SolverOptions {
             atol: 1e-12,
             max_step: 0.02,
             event_time_tol: 1e-13,
-            recontact_gap: 1e-9,
+            recontact_gap: 1e-11,
             stopper_gap: 1e-9,
             fall_hub_height: 0.3,
             max_step_time: 60.0,
@@ -826,7 +826,7 @@ mod tests {
         assert_eq!(s.atol, 1e-12);
         assert_eq!(s.max_step, 0.02);
         assert_eq!(s.event_time_tol, 1e-13);
-        assert_eq!(s.recontact_gap, 1e-9);
+        assert_eq!(s.recontact_gap, 1e-11);
         assert_eq!(s.stopper_gap, 1e-9);
         assert_eq!(s.fall_hub_height, 0.3);
         assert_eq!(s.max_step_time, 60.0);

@@ -347,17 +347,23 @@ fn gait_writes_the_fixed_point_and_its_multipliers() {
         assert!(gait["section"][key].is_f64(), "section.{key}");
     }
     for key in [
-        "lambda_i4",
+        "lambda_I4",
         "lambda_2_plus",
         "lambda_4_plus",
         "period",
         "step_length",
         "speed",
         "dls_duration",
+        "rear_contact_duration",
+        "pull_force",
+        "pull_impulse",
+        "penetration",
     ] {
         assert!(gait[key].is_f64(), "{key}");
     }
+    assert!(gait.get("lambda_i4").is_none(), "one spelling per quantity");
     assert_eq!(gait["branch"], "DLS");
+    assert_eq!(gait["stability"], "stable");
     assert_eq!(gait["stable"], true);
     let multipliers = gait["floquet_multipliers"].as_array().unwrap();
     assert_eq!(multipliers.len(), 3);

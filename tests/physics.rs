@@ -255,13 +255,13 @@ fn rebound_option_terminates_with_a_status() {
 #[test]
 fn a_walk_that_stops_is_a_status_and_the_steps_before_it_are_kept() {
     let mut config = Config::default();
-    // Just below the slope where the gait exists (0.0906 rad): two steps, then the wheel rolls back.
-    config.params.slope = 0.09;
+    // Below the slopes where the gait exists: one step, then the wheel rolls back.
+    config.params.slope = 0.08;
     let model = Model::new(&config.params).unwrap();
     let run = simulate(&model, &config.solver, &default_start(), 20, None).unwrap();
     let failure = run.failure.expect("the wheel cannot keep walking");
     assert_eq!(failure.kind(), "rolled_back", "{failure}");
-    assert_eq!(run.steps.len(), 2);
+    assert_eq!(run.steps.len(), 1);
     assert!(run
         .steps
         .iter()

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::step_map::{StepMap, StepOutcome};
 use crate::error::WalkError;
-use crate::walk::{Branch, SectionState};
+use crate::walk::{Branch, ContactAudit, SectionState};
 
 /// How a gait is searched for.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -109,14 +109,18 @@ pub struct Gait {
     pub step_length: f64,
     /// Mean speed \[m/s\].
     pub speed: f64,
-    /// Time in double support per step \[s\].
+    /// Double-limb support per step: both tips on the ground without slipping \[s\].
     pub dls_duration: f64,
+    /// Time Leg 2's tip touches the ground per step, sticking or sliding \[s\].
+    pub rear_contact_duration: f64,
     /// Leg 2 scuffs (re-contacts or slides after its lift-off).
     pub scuffing: bool,
     /// Leg 1 bounces.
     pub bounce: bool,
     /// Energy-audit residual of the gait's step \[J\].
     pub energy_residual: f64,
+    /// Contact audit of the gait's step.
+    pub contact: ContactAudit,
     /// `DP(s*)` on the free coordinates, row-major.
     pub jacobian: Vec<Vec<f64>>,
     /// Estimated error of the Jacobian entries (Richardson), or `NaN` if not refined.
@@ -125,8 +129,50 @@ pub struct Gait {
     pub floquet_multipliers: Vec<[f64; 2]>,
     /// Largest modulus of the multipliers.
     pub max_floquet: f64,
-    /// All multipliers inside the unit circle.
+    /// What the multipliers and their error estimate show (see [`Stability`]).
+    pub stability: Stability,
+    /// `stability == Stability::Stable`: all multipliers inside the unit circle by more than the error
+    /// estimate.
     pub stable: bool,
+}
+
+/// The stability verdict of a gait, honest about the Jacobian's error estimate `e`: `Stable` only when the
+/// largest `|multiplier| + e < 1`, `Unstable` when `|multiplier| - e > 1`, `Uncertain` otherwise (also when no
+/// error estimate was made).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stability {
+    /// Every multiplier inside the unit circle, by more than the error estimate.
+    Stable,
+    /// A multiplier outside the unit circle, by more than the error estimate.
+    Unstable,
+    /// The error estimate straddles the unit circle (or is unknown).
+    Uncertain,
+}
+
+impl Stability {
+    /// The verdict for the largest multiplier modulus `max_floquet` and the error estimate `error`.
+    pub fn judge(max_floquet: f64, error: f64) -> Stability {
+        if !(max_floquet.is_finite() && error.is_finite()) {
+            Stability::Uncertain
+        } else if max_floquet + error < 1.0 {
+            Stability::Stable
+        } else if max_floquet - error > 1.0 {
+            Stability::Unstable
+        } else {
+            Stability::Uncertain
+        }
+    }
+}
+
+impl std::fmt::Display for Stability {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stability::Stable => "stable",
+            Stability::Unstable => "unstable",
+            Stability::Uncertain => "uncertain",
+        })
+    }
 }
 
 /// Newton stops after this many consecutive iterations with a freshly computed `DP` that fail to halve the
@@ -305,9 +351,11 @@ fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
         step_length: report.step_length,
         speed: report.speed,
         dls_duration: report.dls_duration,
+        rear_contact_duration: report.rear_contact_duration,
         scuffing: report.scuffing,
         bounce: report.bounce,
         energy_residual: report.energy.residual,
+        contact: report.contact,
         jacobian: dp
             .row_iter()
             .map(|row| row.iter().copied().collect())
@@ -315,7 +363,8 @@ fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
         jacobian_error,
         floquet_multipliers: multipliers.iter().map(|z| [z.re, z.im]).collect(),
         max_floquet,
-        stable: max_floquet < 1.0,
+        stability: Stability::judge(max_floquet, jacobian_error),
+        stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
     }
 }
 
@@ -333,6 +382,7 @@ struct GaitRecord {
     section: SectionRecord,
     residual: f64,
     iterations: usize,
+    #[serde(rename = "lambda_I4")]
     lambda_i4: f64,
     lambda_2_plus: f64,
     lambda_4_plus: f64,
@@ -341,13 +391,17 @@ struct GaitRecord {
     step_length: f64,
     speed: f64,
     dls_duration: f64,
+    rear_contact_duration: f64,
     scuffing: bool,
     bounce: bool,
     energy_residual: f64,
+    #[serde(flatten)]
+    contact: ContactAudit,
     jacobian: Vec<Vec<f64>>,
     jacobian_error: f64,
     floquet_multipliers: Vec<[f64; 2]>,
     max_floquet: f64,
+    stability: Stability,
     stable: bool,
 }
 
@@ -368,13 +422,16 @@ impl From<Gait> for GaitRecord {
             step_length: g.step_length,
             speed: g.speed,
             dls_duration: g.dls_duration,
+            rear_contact_duration: g.rear_contact_duration,
             scuffing: g.scuffing,
             bounce: g.bounce,
             energy_residual: g.energy_residual,
+            contact: g.contact,
             jacobian: g.jacobian,
             jacobian_error: g.jacobian_error,
             floquet_multipliers: g.floquet_multipliers,
             max_floquet: g.max_floquet,
+            stability: g.stability,
             stable: g.stable,
         }
     }

@@ -128,7 +128,7 @@ pub fn gait_at_value(
     match result {
         Ok(g) => SweepPoint {
             value,
-            status: if g.stable { "stable" } else { "unstable" }.to_string(),
+            status: g.stability.to_string(),
             message: None,
             gait: Some(g),
         },

@@ -112,7 +112,7 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputErro
 }
 
 /// Header of `steps.csv`.
-pub const STEPS_HEADER: [&str; 24] = [
+pub const STEPS_HEADER: [&str; 28] = [
     "step",
     "time",
     "L2",
@@ -137,10 +137,14 @@ pub const STEPS_HEADER: [&str; 24] = [
     "impact_loss",
     "stopper_loss",
     "energy_residual",
+    "rear_contact_duration",
+    "pull_force",
+    "pull_impulse",
+    "penetration",
 ];
 
 /// Write the per-step table `steps.csv`: one row per touchdown (section state before it, DLS indicators,
-/// branch, step measures, flags and the energy audit).
+/// branch, step measures, flags, the energy audit, and the contact audit).
 pub fn write_steps_csv(path: &Path, steps: &[StepReport]) -> Result<(), OutputError> {
     let mut w = csv_writer(path)?;
     write_record(&mut w, path, STEPS_HEADER)?;
@@ -171,6 +175,10 @@ pub fn write_steps_csv(path: &Path, steps: &[StepReport]) -> Result<(), OutputEr
             num(e.impact),
             num(e.stopper),
             num(e.residual),
+            num(s.rear_contact_duration),
+            num(s.contact.pull_force),
+            num(s.contact.pull_impulse),
+            num(s.contact.penetration),
         ];
         write_record(&mut w, path, row)?;
     }
@@ -227,7 +235,7 @@ pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), Outpu
 }
 
 /// Columns of `sweep.csv` after the parameter column.
-pub const SWEEP_COLUMNS: [&str; 20] = [
+pub const SWEEP_COLUMNS: [&str; 22] = [
     "status",
     "L2",
     "thetadot",
@@ -241,10 +249,12 @@ pub const SWEEP_COLUMNS: [&str; 20] = [
     "step_length",
     "speed",
     "dls_duration",
+    "rear_contact_duration",
     "scuffing",
     "bounce",
-    "stable",
+    "stability",
     "max_floquet",
+    "jacobian_error",
     "residual",
     "iterations",
     "message",
@@ -273,10 +283,21 @@ pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Resul
                     .map(num),
                 );
                 row.push(g.branch.to_string());
-                row.extend([g.period, g.step_length, g.speed, g.dls_duration].map(num));
-                row.extend([g.scuffing, g.bounce, g.stable].map(|b| b.to_string()));
+                row.extend(
+                    [
+                        g.period,
+                        g.step_length,
+                        g.speed,
+                        g.dls_duration,
+                        g.rear_contact_duration,
+                    ]
+                    .map(num),
+                );
+                row.extend([g.scuffing, g.bounce].map(|b| b.to_string()));
+                row.push(g.stability.to_string());
                 row.extend([
                     num(g.max_floquet),
+                    num(g.jacobian_error),
                     num(g.residual),
                     g.iterations.to_string(),
                 ]);

@@ -11,8 +11,8 @@
 use serde::Serialize;
 
 use crate::contact::{
-    constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution,
-    Leg,
+    constrained_dynamics, impulse, largest_pull, ActiveSet, ConstrainedDynamics, ContactError,
+    ImpulseSolution, Leg, Multipliers,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::{ContactInconsistency, ImpactModel};
@@ -27,7 +27,8 @@ pub const COMPLEMENTARITY_TOL: f64 = 1e-9;
 /// rear leg was not on the ground at touchdown or the legs are rigid).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct DlsIndicators {
-    /// Normal impulse on Leg 2 of the DLS collision (A1) \[N s\].
+    /// Normal impulse on Leg 2 of the DLS collision (A1) \[N s\] (`lambda_I4` in every output).
+    #[serde(rename = "lambda_I4")]
     pub lambda_i4: f64,
     /// Normal force on Leg 1 just after impact, Eqs. (6)-(7) \[N\].
     pub lambda_2_plus: f64,
@@ -114,6 +115,22 @@ impl Unit {
     }
 }
 
+/// What a candidate unit is doing at the moment its mode is resolved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// Present before (or touching after an impact): any mode its kind allows.
+    Keep,
+    /// Its normal force has just fallen through zero (a lift-off event): it may leave the ground or slide, but
+    /// not stay a no-slip contact.
+    Releasing,
+    /// The unit an impact closes (a landing tip, a leg hitting its stopper): it takes the impulse, no-slip if
+    /// that impulse pushes, else (under [`ContactInconsistency::Slide`]) as a frictionless sliding contact.
+    Closing {
+        /// Sliding is allowed (the model's `inconsistent_contact = slide`).
+        allow_slide: bool,
+    },
+}
+
 /// An optional unit and the mode the caller prefers for it when several are consistent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Candidate {
@@ -121,20 +138,63 @@ pub struct Candidate {
     pub unit: Unit,
     /// Preferred mode.
     pub preferred: Mode,
+    /// What the unit is doing.
+    pub role: Role,
 }
 
 impl Candidate {
     /// The candidate `unit` preferring the mode it has in `active`.
     pub fn keep(unit: Unit, active: &ActiveSet) -> Candidate {
+        Candidate::new(unit, unit.mode(active))
+    }
+
+    /// The candidate `unit` preferring `preferred`.
+    pub fn new(unit: Unit, preferred: Mode) -> Candidate {
         Candidate {
             unit,
-            preferred: unit.mode(active),
+            preferred,
+            role: Role::Keep,
         }
     }
 
-    fn modes(&self, allow_slide: bool) -> &'static [Mode] {
-        match (self.unit, allow_slide) {
-            (Unit::Contact(_), true) => &[Mode::Off, Mode::On, Mode::Slide],
+    /// A contact whose normal force has just reached zero: preferably it leaves; it may slide (under
+    /// [`ContactInconsistency::Slide`]), but it cannot stay a no-slip contact.
+    pub fn releasing(leg: Leg) -> Candidate {
+        Candidate {
+            unit: Unit::Contact(leg),
+            preferred: Mode::Off,
+            role: Role::Releasing,
+        }
+    }
+
+    /// The unit an impact closes, preferably no-slip (see [`Role::Closing`]).
+    pub fn closing(unit: Unit, model: &Model) -> Candidate {
+        Candidate {
+            unit,
+            preferred: Mode::On,
+            role: Role::Closing {
+                allow_slide: model.params().inconsistent_contact == ContactInconsistency::Slide,
+            },
+        }
+    }
+
+    /// The modes tried for this candidate. At impulse level a contact keeps its kind: a no-slip contact may
+    /// take a full (tangential and normal) impulse or none, a sliding one a frictionless normal impulse or none;
+    /// a closing unit always takes an impulse. At force level a contact may also start to slide when
+    /// `allow_slide`.
+    fn modes(&self, level: Level) -> &'static [Mode] {
+        let contact = matches!(self.unit, Unit::Contact(_));
+        match (self.role, level) {
+            (Role::Closing { allow_slide: true }, _) if contact => &[Mode::On, Mode::Slide],
+            (Role::Closing { .. }, _) => &[Mode::On],
+            (Role::Releasing, Level::Force { allow_slide: true }) => &[Mode::Off, Mode::Slide],
+            (Role::Releasing, _) => &[Mode::Off],
+            (Role::Keep, Level::Impulse) if contact && self.preferred == Mode::Slide => {
+                &[Mode::Off, Mode::Slide]
+            }
+            (Role::Keep, Level::Force { allow_slide: true }) if contact => {
+                &[Mode::Off, Mode::On, Mode::Slide]
+            }
             _ => &[Mode::Off, Mode::On],
         }
     }
@@ -151,26 +211,35 @@ impl Candidate {
     }
 }
 
+/// Which complementarity problem an active set is resolved for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Level {
+    /// An impact (impulses and velocities just after it).
+    Impulse,
+    /// Continuous motion (forces and accelerations).
+    Force {
+        /// Contacts may slide without friction when neither sticking nor leaving is consistent.
+        allow_slide: bool,
+    },
+}
+
 /// Among `forced` plus every combination of modes of the `candidates`, the consistent set with the best
 /// preference score, or `None` if no combination is consistent.
 fn best_subset<T>(
     forced: ActiveSet,
     candidates: &[Candidate],
-    allow_slide: bool,
+    level: Level,
     mut solve: impl FnMut(&ActiveSet) -> Result<T, ContactError>,
     mut consistent: impl FnMut(&ActiveSet, &T) -> bool,
 ) -> Result<Option<(ActiveSet, T)>, ContactError> {
-    let radix: Vec<usize> = candidates
-        .iter()
-        .map(|c| c.modes(allow_slide).len())
-        .collect();
+    let radix: Vec<usize> = candidates.iter().map(|c| c.modes(level).len()).collect();
     let combinations: usize = radix.iter().product();
     let mut best: Option<(usize, ActiveSet, T)> = None;
     for mut code in 0..combinations {
         let mut set = forced;
         let mut score = 0;
         for (c, r) in candidates.iter().zip(&radix) {
-            let mode = c.modes(allow_slide)[code % r];
+            let mode = c.modes(level)[code % r];
             code /= r;
             c.unit.apply(&mut set, mode);
             score += c.score(mode);
@@ -199,8 +268,12 @@ fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
 }
 
 /// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
-/// must (impulses push, excluded units separate): paper Eq. (5) with the active set resolved. Impacts are
-/// no-slip (no sliding mode); if no combination is consistent the preferred one is used.
+/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (MODEL.md
+/// section 4). Every candidate either takes a non-negative impulse and ends at zero relative normal velocity,
+/// or takes none and separates (normal velocity after the impact `>= 0`, a free leg not moving past its
+/// stopper). A no-slip contact's impulse has a tangential part; a sliding contact's is normal only. If no
+/// combination is consistent the preferred one is used, and the step's contact audit
+/// ([`largest_pull`]) shows the pulling impulse.
 pub fn plastic_impact(
     model: &Model,
     q: &Coords,
@@ -209,7 +282,7 @@ pub fn plastic_impact(
     candidates: &[Candidate],
 ) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
     let solve = |set: &ActiveSet| impulse(model, q, qd, set);
-    let found = best_subset(forced, candidates, false, solve, |set, sol| {
+    let found = best_subset(forced, candidates, Level::Impulse, solve, |set, sol| {
         candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
             (Unit::Contact(leg), Mode::Off) => {
                 model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
@@ -244,7 +317,8 @@ pub fn consistent_active_set(
 ) -> Result<Option<(ActiveSet, ConstrainedDynamics)>, ContactError> {
     let allow_slide = model.params().inconsistent_contact == ContactInconsistency::Slide;
     let solve = |set: &ActiveSet| constrained_dynamics(model, q, qd, set);
-    let found = best_subset(forced, candidates, allow_slide, solve, |set, dynamics| {
+    let level = Level::Force { allow_slide };
+    let found = best_subset(forced, candidates, level, solve, |set, dynamics| {
         candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
             (Unit::Contact(leg), Mode::Off) => {
                 let tip = model.tip(q, qd, leg.index());
@@ -289,6 +363,8 @@ pub struct TouchdownImpact {
     pub preferred: ActiveSet,
     /// Kinetic energy lost in the impact \[J\].
     pub loss: f64,
+    /// The largest pulling impulse of the applied collision \[N s\], 0 if none pulls (contact audit).
+    pub pull_impulse: f64,
 }
 
 /// Stoppers a touchdown impulse may need: Leg 1 (at `L0`, locked before touchdown) and Leg 2 if locked.
@@ -296,10 +372,7 @@ fn stopper_candidates(before: &ActiveSet) -> Vec<Candidate> {
     Leg::BOTH
         .into_iter()
         .filter(|leg| before.lock(*leg))
-        .map(|leg| Candidate {
-            unit: Unit::Stopper(leg),
-            preferred: Mode::Off,
-        })
+        .map(|leg| Candidate::new(Unit::Stopper(leg), Mode::Off))
         .collect()
 }
 
@@ -334,6 +407,7 @@ pub fn touchdown_impact(
         impulse_set,
         preferred,
         loss: kinetic(qd) - kinetic(&sol.qd_plus),
+        pull_impulse: largest_pull(&sol.impulses, &impulse_set, model.params().rigid_legs),
     };
     let sls = ActiveSet {
         contact1: true,
@@ -412,26 +486,106 @@ pub fn bilateral_stoppers(model: &Model) -> ActiveSet {
     }
 }
 
-/// Candidates for the motion right after an impact whose impulse acted on `impulse_set`: every unit that took
-/// the impulse is closed (zero relative velocity) and may stay active; `preferred` gives the contact modes the
-/// procedure wants (the paper's branch at a touchdown). With `rigid_legs` the stoppers are bilateral and forced.
+/// Candidates for the motion right after an impact at `(q, q'+)`: every unit that took the impulse is closed
+/// (zero relative velocity) and may stay active; every other unit `present` at the impact that still touches
+/// (a tip at the ground, or a leg at its stopper, with relative velocity within [`COMPLEMENTARITY_TOL`] of
+/// zero) may engage too, so that no free tip accelerates into the ground. A unit left approaching (only the
+/// `traditional` exchange does that) stays free, and its landing event fires at once. `preferred` gives the modes
+/// the procedure wants (the paper's branch at a touchdown). With `rigid_legs` the stoppers are bilateral and
+/// forced.
 pub fn post_impact_candidates(
     model: &Model,
+    q: &Coords,
+    qd_plus: &Coords,
     impulse_set: &ActiveSet,
+    present: &ActiveSet,
     preferred: &ActiveSet,
 ) -> (ActiveSet, Vec<Candidate>) {
     let forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
     for leg in Leg::BOTH {
+        let contact = Unit::Contact(leg);
         if impulse_set.contact(leg) {
-            candidates.push(Candidate::keep(Unit::Contact(leg), preferred));
+            candidates.push(Candidate::keep(contact, preferred));
+        } else if present.contact(leg)
+            && model.tip(q, qd_plus, leg.index()).velocity(qd_plus).y.abs() <= COMPLEMENTARITY_TOL
+        {
+            candidates.push(Candidate::new(contact, Mode::Off));
         }
-        if !forced.lock(leg) && impulse_set.lock(leg) {
-            candidates.push(Candidate {
-                unit: Unit::Stopper(leg),
-                preferred: Mode::On,
-            });
+        if forced.lock(leg) {
+            continue;
+        }
+        let stopper = Unit::Stopper(leg);
+        if impulse_set.lock(leg) {
+            candidates.push(Candidate::new(stopper, Mode::On));
+        } else if present.lock(leg) && qd_plus[leg.length_coordinate()].abs() <= COMPLEMENTARITY_TOL
+        {
+            candidates.push(Candidate::new(stopper, Mode::Off));
         }
     }
     (forced, candidates)
+}
+
+/// What an impact closing one unit produced (see [`close_unit`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UnitImpact {
+    /// The units that took the impulse.
+    pub impulse_set: ActiveSet,
+    /// The active set of the motion that follows (the force-level problem at `q'+`).
+    pub active: ActiveSet,
+    /// `q'+`.
+    pub qd_plus: Coords,
+    /// The applied impulses in the fixed stacking.
+    pub impulses: Multipliers,
+    /// Kinetic energy lost \[J\].
+    pub loss: f64,
+    /// The largest pulling impulse \[N s\], 0 if none pulls (contact audit).
+    pub pull_impulse: f64,
+}
+
+/// A plastic impact closing `unit` (a tip landing on the ground or a leg hitting its stopper) at `(q, q')` with
+/// `active` the units active just before, then the active set of the motion that follows; `None` if no active
+/// set is consistent after the impact.
+///
+/// Only the closing unit must take an impulse (no-slip if that impulse pushes, else, under
+/// [`ContactInconsistency::Slide`], a frictionless one: a no-slip impact can demand a pulling normal impulse,
+/// the impulsive form of the lift-off inconsistency). Every other unit present (each ground contact, no-slip
+/// or sliding, and each locked stopper) is a candidate of the impulse-level complementarity problem of [`plastic_impact`]: it takes
+/// a non-negative impulse and ends at zero relative normal velocity, or takes none and separates. Nothing is
+/// held through the impact because it was active before: when Leg 2's stopper locks while its tip slides, the
+/// tip may leave the ground (MODEL.md section 4).
+pub fn close_unit(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+    unit: Unit,
+) -> Result<Option<UnitImpact>, ContactError> {
+    let forced = bilateral_stoppers(model);
+    let mut candidates = vec![Candidate::closing(unit, model)];
+    for leg in Leg::BOTH {
+        for other in [Unit::Contact(leg), Unit::Stopper(leg)] {
+            if other != unit && other.mode(&active) != Mode::Off && other.mode(&forced) == Mode::Off
+            {
+                candidates.push(Candidate::keep(other, &active));
+            }
+        }
+    }
+    let (impulse_set, sol) = plastic_impact(model, q, qd, forced, &candidates)?;
+    let mut present = active;
+    unit.apply(&mut present, Mode::On);
+    let (forced, candidates) =
+        post_impact_candidates(model, q, &sol.qd_plus, &impulse_set, &present, &impulse_set);
+    let Some((next, _)) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)?
+    else {
+        return Ok(None);
+    };
+    Ok(Some(UnitImpact {
+        impulse_set,
+        active: next,
+        qd_plus: sol.qd_plus,
+        impulses: sol.impulses,
+        loss: model.kinetic_energy(q, qd) - model.kinetic_energy(q, &sol.qd_plus),
+        pull_impulse: largest_pull(&sol.impulses, &impulse_set, model.params().rigid_legs),
+    }))
 }

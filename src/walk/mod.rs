@@ -7,9 +7,9 @@
 //! | event | function crossing zero from above |
 //! |---|---|
 //! | touchdown | height of the next leg's tip (length `L0`) |
-//! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (+ [`COMPLEMENTARITY_TOL`]) |
+//! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (to [`FORCE_EVENT_MARGIN`] below 0) |
 //! | landing / rear re-contact of an airborne tip | its height (armed once above `recontact_gap`, see below) |
-//! | stopper unlock | the stopper's inward reaction (+ [`COMPLEMENTARITY_TOL`]) |
+//! | stopper unlock | the stopper's inward reaction (to [`FORCE_EVENT_MARGIN`] below 0) |
 //! | stopper hit of a free leg | `L0 - L` (armed once below `L0 - stopper_gap`) |
 //! | fall | hub height minus `fall_hub_height` |
 //! | rolling back | `dtheta/dt` |
@@ -23,6 +23,17 @@
 //! after a re-contact located at `-recontact_gap`: a guard measured from the ground would start at zero and
 //! never fire, letting the tip sink.)
 
+//!
+//! **Impacts.** Every impact (touchdown, rear re-contact, stopper lock) is an impulse-level complementarity
+//! problem over every unilateral unit present (see [`impact::plastic_impact`]); only the closing unit (and at
+//! touchdown the paper's (A1)/(A3) choice for Leg 2) is forced. The force-level problem then picks the phase
+//! that follows.
+//!
+//! **Audits.** Every step reports an energy audit and a contact audit ([`ContactAudit`]): the largest pulling
+//! force at every accepted integrator step and event instant, the largest pulling impulse of its impacts, and
+//! the deepest any tip went below the ground, checked on the dense output at [`PENETRATION_SAMPLES`] points
+//! per integrator step.
+
 pub mod impact;
 pub mod report;
 pub mod section;
@@ -30,7 +41,7 @@ pub mod section;
 use nalgebra::SVector;
 
 use crate::contact::{
-    constrained_dynamics, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase,
+    constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase,
 };
 use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X};
 use crate::error::WalkError;
@@ -38,12 +49,24 @@ use crate::integrate::{locate_root, DenseStep, Dopri5, OdeSystem, Tolerances};
 use crate::params::SolverOptions;
 
 use impact::{
-    bilateral_stoppers, consistent_active_set, plastic_impact, post_impact_candidates,
-    touchdown_impact, Candidate, Mode, Unit, COMPLEMENTARITY_TOL,
+    bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
+    touchdown_impact, Candidate, Unit, COMPLEMENTARITY_TOL,
 };
 pub use impact::{Branch, DlsIndicators};
-pub use report::{EnergyAudit, StepReport};
+pub use report::{ContactAudit, EnergyAudit, StepReport};
 pub use section::SectionState;
+
+/// A lift-off or stopper-unlock event fires when the force falls this far below zero \[N\] (or below its
+/// value at the start of the phase, if the force-level problem accepted a slightly negative one within
+/// [`impact::COMPLEMENTARITY_TOL`]): small enough that the contact audit sees no pull above 1e-9 N, large
+/// enough that rounding of forces of ~100 N (~1e-12 N) cannot fire it.
+pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
+
+/// The grazing guard of a landing or stopper event whose tip (leg) starts at the ground (stopper) already moving
+/// into it \[m\]: such a contact is not grazing, so its event fires as soon as it moves this far (instead of
+/// `recontact_gap` / `stopper_gap`). It happens after the `traditional` exchange drives the rear tip into the
+/// ground, or when an impact's complementarity problem had no consistent solution.
+pub const APPROACH_GAP: f64 = 1e-12;
 
 /// Size of the integrated state `[q, q', E_damper]`.
 pub const NY: usize = 2 * NQ + 1;
@@ -218,8 +241,9 @@ impl<'a> EventSet<'a> {
         model: &'a Model,
         opts: &'a SolverOptions,
         active: ActiveSet,
-        q: &Coords,
+        y: &WalkVector,
     ) -> EventSet<'a> {
+        let (q, qd) = unpack(y);
         let mut kinds = vec![EventKind::Touchdown, EventKind::Fall, EventKind::RollBack];
         for leg in Leg::BOTH {
             kinds.push(if active.contact(leg) {
@@ -241,19 +265,30 @@ impl<'a> EventSet<'a> {
             active,
             events: Vec::with_capacity(kinds.len()),
         };
-        let zero = Coords::zeros();
+        let needed = kinds.iter().any(|k| Self::needs_forces(*k));
+        let dynamics = set.dynamics_if(needed, &q, &qd);
         for kind in kinds {
-            // Guarded events start disarmed unless their function already clears the gap.
-            let floor = match Self::guard(opts, kind) {
-                Some(gap) => {
-                    let h0 = set.raw(kind, q, &zero, &None);
-                    if h0 > gap {
-                        0.0
-                    } else {
-                        h0.min(0.0) - gap
-                    }
+            let f0 = || set.raw(kind, &q, &qd, &dynamics);
+            let floor = if Self::needs_forces(kind) {
+                // A force event fires once the force falls FORCE_EVENT_MARGIN below zero, or below its value at
+                // the phase start if that is already (within the complementarity tolerance) negative.
+                f0().min(0.0) - FORCE_EVENT_MARGIN
+            } else if let Some(gap) = Self::guard(opts, kind) {
+                // Guarded events start disarmed unless their function already clears the gap. A tip (leg) that
+                // starts at the ground (stopper) already moving into it is not grazing: it fires at once.
+                let gap = if set.approaching(kind, &q, &qd) {
+                    APPROACH_GAP
+                } else {
+                    gap
+                };
+                let h0 = f0();
+                if h0 > gap {
+                    0.0
+                } else {
+                    h0.min(0.0) - gap
                 }
-                None => 0.0,
+            } else {
+                0.0
             };
             set.events.push(Event { kind, floor });
         }
@@ -266,6 +301,17 @@ impl<'a> EventSet<'a> {
             EventKind::Landing(_) => Some(opts.recontact_gap),
             EventKind::StopperHit(_) => Some(opts.stopper_gap),
             _ => None,
+        }
+    }
+
+    /// Is the unit of a guarded event moving into the ground (past its stopper) at `(q, q')`?
+    fn approaching(&self, kind: EventKind, q: &Coords, qd: &Coords) -> bool {
+        match kind {
+            EventKind::Landing(leg) => {
+                self.model.tip(q, qd, leg.index()).velocity(qd).y < -COMPLEMENTARITY_TOL
+            }
+            EventKind::StopperHit(leg) => qd[leg.length_coordinate()] > COMPLEMENTARITY_TOL,
+            _ => false,
         }
     }
 
@@ -282,8 +328,8 @@ impl<'a> EventSet<'a> {
             EventKind::Touchdown => self.model.tip_height(q, self.model.front_leg()),
             EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
             EventKind::RollBack => qd[THETA],
-            EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)) + COMPLEMENTARITY_TOL,
-            EventKind::Unlock(leg) => force(&|d| d.stopper_reaction(leg)) + COMPLEMENTARITY_TOL,
+            EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)),
+            EventKind::Unlock(leg) => force(&|d| d.stopper_reaction(leg)),
             EventKind::Landing(leg) => self.model.tip_height(q, leg.index()),
             EventKind::StopperHit(leg) => {
                 self.model.params().stopper_length - q[leg.length_coordinate()]
@@ -312,15 +358,21 @@ impl<'a> EventSet<'a> {
             .flatten()
     }
 
-    /// Values of all event functions at `y`.
-    fn values(&self, y: &WalkVector) -> Vec<f64> {
+    /// Values of all event functions at `y`, and the largest pulling force there (0 when no unilateral unit is
+    /// active, see [`largest_pull`]).
+    fn values(&self, y: &WalkVector) -> (Vec<f64>, f64) {
         let (q, qd) = unpack(y);
         let needed = self.events.iter().any(|e| Self::needs_forces(e.kind));
         let dynamics = self.dynamics_if(needed, &q, &qd);
-        self.events
+        let values = self
+            .events
             .iter()
             .map(|e| self.shifted(e, &q, &qd, &dynamics))
-            .collect()
+            .collect();
+        let pull = dynamics.map_or(0.0, |d| {
+            largest_pull(&d.multipliers, &self.active, self.model.params().rigid_legs)
+        });
+        (values, pull)
     }
 
     /// Value of event `k` at `y`.
@@ -335,10 +387,12 @@ impl<'a> EventSet<'a> {
     fn arm(&mut self, values: &mut [f64]) {
         let opts = self.opts;
         for (e, value) in self.events.iter_mut().zip(values.iter_mut()) {
+            let Some(gap) = Self::guard(opts, e.kind) else {
+                continue;
+            };
             if e.floor == 0.0 {
                 continue;
             }
-            let gap = Self::guard(opts, e.kind).expect("only guarded events have a floor");
             let raw = *value + e.floor;
             if raw > gap {
                 e.floor = 0.0;
@@ -348,10 +402,39 @@ impl<'a> EventSet<'a> {
     }
 }
 
+/// Number of points per integrator step (besides its start) at which the dense output is checked for tips
+/// below the ground.
+pub const PENETRATION_SAMPLES: usize = 4;
+
+impl ContactAudit {
+    fn see_force(&mut self, pull: f64) {
+        self.pull_force = self.pull_force.max(pull);
+    }
+
+    /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`).
+    fn see_tips(&mut self, model: &Model, y: &WalkVector) {
+        let q = y.fixed_rows::<NQ>(0).into_owned();
+        for j in 0..model.legs() {
+            self.penetration = self.penetration.max(-model.tip_height(&q, j));
+        }
+    }
+
+    /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).
+    fn see_dense(&mut self, model: &Model, step: &DenseStep<NY>, until: f64) {
+        let t0 = step.t0();
+        for i in 1..=PENETRATION_SAMPLES {
+            let t = t0 + (until - t0) * i as f64 / PENETRATION_SAMPLES as f64;
+            self.see_tips(model, &step.eval(t));
+        }
+    }
+}
+
 /// Bookkeeping of the step in progress.
 #[derive(Debug, Default, Clone, Copy)]
 struct StepTally {
     dls_duration: f64,
+    rear_contact_duration: f64,
+    audit: ContactAudit,
     scuffing: bool,
     bounce: bool,
     impact_loss: f64,
@@ -447,7 +530,17 @@ impl<'m> Walker<'m> {
             bounce: td.branch == Branch::Bounce,
             ..StepTally::default()
         };
-        let (forced, candidates) = post_impact_candidates(model, &td.impulse_set, &td.preferred);
+        tally.audit.pull_impulse = td.pull_impulse;
+        let mut present = start.active;
+        present.set_contact(Leg::One, true);
+        let (forced, candidates) = post_impact_candidates(
+            model,
+            &start.q,
+            &td.qd_plus,
+            &td.impulse_set,
+            &present,
+            &td.preferred,
+        );
         let (mut active, _) =
             consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
                 .map_err(WalkError::contact_at(t_start, td.preferred.phase()))?
@@ -464,9 +557,10 @@ impl<'m> Walker<'m> {
         }
         let t_limit = t_start + opts.max_step_time;
         let mut solver = Dopri5::new(&PhaseSystem { model, active }, t, y, self.tolerances());
-        let (q0, _) = unpack(&y);
-        let mut events = EventSet::new(model, &opts, active, &q0);
-        let mut g_prev = events.values(&y);
+        let mut events = EventSet::new(model, &opts, active, &y);
+        let (mut g_prev, pull) = events.values(&y);
+        tally.audit.see_force(pull);
+        tally.audit.see_tips(model, &y);
 
         loop {
             let phase = active.phase();
@@ -481,7 +575,7 @@ impl<'m> Walker<'m> {
             let step = solver
                 .step(&sys, t_limit)
                 .map_err(|source| WalkError::Integration { phase, source })?;
-            let mut g_next = events.values(step.y1());
+            let (mut g_next, pull_next) = events.values(step.y1());
             let mut hit: Option<(f64, usize)> = None;
             for k in 0..g_next.len() {
                 if g_prev[k] > 0.0 && g_next[k] <= 0.0 {
@@ -500,13 +594,18 @@ impl<'m> Walker<'m> {
                 }
             }
             let t_end = hit.map_or(step.t1(), |(t_hit, _)| t_hit);
-            if active.contact1 && active.contact2 {
+            if active.double_support() {
                 tally.dls_duration += t_end - step.t0();
             }
+            if active.contact2 {
+                tally.rear_contact_duration += t_end - step.t0();
+            }
+            tally.audit.see_dense(model, &step, t_end);
             if let Some(tr) = trajectory.as_deref_mut() {
                 tr.record(model, &step, t_end, active, &start);
             }
             let Some((t_hit, k)) = hit else {
+                tally.audit.see_force(pull_next);
                 events.arm(&mut g_next);
                 g_prev = g_next;
                 t = step.t1();
@@ -517,6 +616,7 @@ impl<'m> Walker<'m> {
             t = t_hit;
             y = step.eval(t_hit);
             let (q, qd) = unpack(&y);
+            tally.audit.see_force(events.values(&y).1);
             let kind = events.events[k].kind;
             match kind {
                 EventKind::Touchdown => {
@@ -542,15 +642,19 @@ impl<'m> Walker<'m> {
                         EventKind::Landing(_) => Unit::Contact(leg),
                         _ => Unit::Stopper(leg),
                     };
-                    let (new_active, qd_plus, loss) = self.close_unit(t, &q, &qd, active, unit)?;
+                    let phase = active.phase();
+                    let closed = close_unit(model, &q, &qd, active, unit)
+                        .map_err(WalkError::contact_at(t, phase))?
+                        .ok_or(WalkError::InconsistentContacts { time: t, phase })?;
+                    tally.audit.pull_impulse = tally.audit.pull_impulse.max(closed.pull_impulse);
                     match unit {
-                        Unit::Contact(_) => tally.impact_loss += loss,
-                        Unit::Stopper(_) => tally.stopper_loss += loss,
+                        Unit::Contact(_) => tally.impact_loss += closed.loss,
+                        Unit::Stopper(_) => tally.stopper_loss += closed.loss,
                     }
-                    tally.scuffing |=
-                        (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || new_active.slide2;
-                    active = new_active;
-                    y = pack(&q, &qd_plus, y[2 * NQ]);
+                    tally.scuffing |= (leg == Leg::Two && matches!(unit, Unit::Contact(_)))
+                        || closed.active.slide2;
+                    active = closed.active;
+                    y = pack(&q, &closed.qd_plus, y[2 * NQ]);
                 }
             }
             tally.events += 1;
@@ -563,52 +667,14 @@ impl<'m> Walker<'m> {
             }
             let sys = PhaseSystem { model, active };
             solver.restart(&sys, t, y);
-            let (q, _) = unpack(&y);
-            events = EventSet::new(model, &opts, active, &q);
-            g_prev = events.values(&y);
+            events = EventSet::new(model, &opts, active, &y);
+            let pull;
+            (g_prev, pull) = events.values(&y);
+            tally.audit.see_force(pull);
             if let Some(tr) = trajectory.as_deref_mut() {
                 tr.push(model, t, &y, active, &start);
             }
         }
-    }
-
-    /// A plastic impact closing `unit` (a tip landing or a leg hitting its stopper), then the active set of the
-    /// motion that follows. Returns the new active set, `q'+` and the kinetic energy lost.
-    fn close_unit(
-        &self,
-        time: f64,
-        q: &Coords,
-        qd: &Coords,
-        active: ActiveSet,
-        unit: Unit,
-    ) -> Result<(ActiveSet, Coords, f64), WalkError> {
-        let model = self.model;
-        let phase = active.phase();
-        let mut forced = bilateral_stoppers(model);
-        match unit {
-            Unit::Contact(leg) => forced.set_contact(leg, true),
-            Unit::Stopper(leg) => forced.set_lock(leg, true),
-        }
-        // Contacts already closed stay closed through the impact (the force check below may open them);
-        // stoppers take an impulse only if they must.
-        let mut candidates = Vec::new();
-        for leg in Leg::BOTH {
-            if active.contact(leg) {
-                Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(&active));
-            }
-            if active.lock(leg) && !forced.lock(leg) {
-                candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
-            }
-        }
-        let err = WalkError::contact_at(time, phase);
-        let inconsistent = WalkError::InconsistentContacts { time, phase };
-        let (impulse_set, sol) = plastic_impact(model, q, qd, forced, &candidates).map_err(err)?;
-        let loss = model.kinetic_energy(q, qd) - model.kinetic_energy(q, &sol.qd_plus);
-        let (forced, candidates) = post_impact_candidates(model, &impulse_set, &impulse_set);
-        let (new_active, _) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)
-            .map_err(err)?
-            .ok_or(inconsistent)?;
-        Ok((new_active, sol.qd_plus, loss))
     }
 
     /// A contact's normal force reached zero: the active set of the motion that follows, preferring the tip to
@@ -628,11 +694,11 @@ impl<'m> Walker<'m> {
         let mut candidates = Vec::new();
         for leg in Leg::BOTH {
             if active.contact(leg) {
-                let mut c = Candidate::keep(Unit::Contact(leg), &active);
-                if leg == leaving {
-                    c.preferred = Mode::Off;
-                }
-                candidates.push(c);
+                candidates.push(if leg == leaving {
+                    Candidate::releasing(leg)
+                } else {
+                    Candidate::keep(Unit::Contact(leg), &active)
+                });
             }
             if active.lock(leg) && !forced.lock(leg) {
                 candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
@@ -673,6 +739,7 @@ impl<'m> Walker<'m> {
             indicators: td.indicators,
             branch: td.branch,
             dls_duration: tally.dls_duration,
+            rear_contact_duration: tally.rear_contact_duration,
             period,
             step_length,
             speed: step_length / period,
@@ -688,6 +755,7 @@ impl<'m> Walker<'m> {
                 stopper: tally.stopper_loss,
                 residual: loss - (damper + tally.impact_loss + tally.stopper_loss),
             },
+            contact: tally.audit,
         };
         match reindex(model, t, &q, &qd, active) {
             Ok((q_new, qd_new, before)) => {

@@ -26,6 +26,21 @@ pub struct EnergyAudit {
     pub residual: f64,
 }
 
+/// Contact audit of one step (MODEL.md sections 3-4): the ground only pushes, stoppers only pull a leg inward,
+/// and no tip goes below the ground. Each field is 0 when the law holds exactly; a few 1e-10 come from event
+/// location and integration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct ContactAudit {
+    /// The largest pulling normal force or outward stopper reaction seen in the step \[N\] (at every accepted
+    /// integrator step and every event instant), 0 if none.
+    pub pull_force: f64,
+    /// The largest pulling impulse at any of the step's impacts \[N s\], 0 if none.
+    pub pull_impulse: f64,
+    /// The deepest any tip went below the ground during the step \[m\] (checked on the dense output), 0 if
+    /// none.
+    pub penetration: f64,
+}
+
 /// One step of the walk: from a touchdown to the next.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct StepReport {
@@ -41,8 +56,11 @@ pub struct StepReport {
     pub indicators: DlsIndicators,
     /// Branch of the impact procedure taken.
     pub branch: Branch,
-    /// Time spent with both legs on the ground during the step \[s\].
+    /// Double-limb support during the step \[s\]: the time both tips are on the ground without slipping,
+    /// (C1) and (C2) both holding (it ends when Leg 2 starts to slide or leaves).
     pub dls_duration: f64,
+    /// Time Leg 2's tip touches the ground at all during the step, sticking or sliding \[s\].
+    pub rear_contact_duration: f64,
     /// Time to the next touchdown \[s\].
     pub period: f64,
     /// Distance along the slope between this touchdown's tip and the next one's \[m\].
@@ -57,4 +75,7 @@ pub struct StepReport {
     pub events: usize,
     /// Energy bookkeeping.
     pub energy: EnergyAudit,
+    /// Contact audit (its fields are flattened into the step's JSON record).
+    #[serde(flatten)]
+    pub contact: ContactAudit,
 }
