@@ -268,10 +268,8 @@ fn sweep(args: SweepArgs) -> Result<()> {
             points: args.points,
         },
         initial: args.initial,
-        options: GaitOptions {
-            refine_jacobian: false,
-            ..GaitOptions::default()
-        },
+        // The refined Jacobian gives each gait's stability verdict its error estimate.
+        options: GaitOptions::default(),
         out_dir: args.out.clone(),
     };
     let bar = if std::io::stderr().is_terminal() {

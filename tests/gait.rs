@@ -4,7 +4,7 @@ use approx::assert_relative_eq;
 
 use vrw::app::default_initial;
 use vrw::dynamics::Model;
-use vrw::gait::{find_gait, sweep, GaitOptions, StepMap, SweepSpec};
+use vrw::gait::{find_gait, find_thresholds, sweep, GaitOptions, StepMap, SweepSpec};
 use vrw::params::Config;
 use vrw::reference::RigidRimlessWheel;
 use vrw::walk::SectionState;
@@ -265,4 +265,75 @@ fn paper_gait_is_where_a_direct_walk_settles() {
     ] {
         assert_relative_eq!(walked, fixed, max_relative = 1e-9);
     }
+}
+
+/// The thresholds of a sweep are properties of the model, not of the grid: the first version reported
+/// `gait_lost viscosity = 113.125` for 3 points (a Newton failure from a far neighbour taken for "no gait") and
+/// 106.21 for 4. Every grid that can see the end of the gait must report the same one, with its physical cause.
+#[test]
+fn sweep_thresholds_do_not_depend_on_the_grid() {
+    let config = Config::default();
+    let start = default_initial(&config);
+    let mut found = Vec::new();
+    for points in [3, 4, 5, 7, 40] {
+        let spec = SweepSpec {
+            param: "viscosity".into(),
+            from: 1.0,
+            to: 300.0,
+            points,
+        };
+        let sweep_points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
+        let thresholds = find_thresholds(&config, &spec, &sweep_points, &GaitOptions::default());
+        let names: Vec<&str> = thresholds.iter().map(|t| t.name.as_str()).collect();
+        assert_eq!(names, ["gait_lost"], "{points} points: {thresholds:?}");
+        let t = &thresholds[0];
+        assert!(t.bracket[1] - t.bracket[0] <= 1e-6, "{t:?}");
+        assert!(
+            t.detail.as_deref().unwrap().contains("rolled_back"),
+            "{t:?}"
+        );
+        found.push(t.value);
+    }
+    for v in &found {
+        assert!((v - found[0]).abs() <= 1e-6, "{found:?}");
+    }
+    // Where the first version declared the gait lost, a gait exists.
+    let mut at = config.clone();
+    at.set_numeric("viscosity", 113.125).unwrap();
+    let model = Model::new(&at.params).unwrap();
+    let map = StepMap::new(&model, &at.solver);
+    assert!(find_gait(&map, &start, &GaitOptions::default(), None).is_ok());
+}
+
+/// Each gait carries its family, and a stability verdict that accounts for the Jacobian's error estimate.
+#[test]
+fn sweep_points_carry_their_family_and_an_honest_stability_verdict() {
+    let config = Config::default();
+    let spec = SweepSpec {
+        param: "slope".into(),
+        from: 0.05,
+        to: 0.15,
+        points: 11,
+    };
+    let start = default_initial(&config);
+    let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
+    for p in &points {
+        match &p.gait {
+            Some(g) => {
+                assert_eq!(p.family, Some(0), "one family on this range: {p:?}");
+                assert_eq!(p.status, g.stability.to_string());
+                assert!(g.jacobian_error.is_finite());
+                assert_eq!(
+                    g.stable,
+                    g.max_floquet + g.jacobian_error < 1.0,
+                    "stable only when |multiplier| + error < 1"
+                );
+            }
+            None => assert_eq!(p.family, None),
+        }
+    }
+    // The start of the family (the slope below which the wheel rolls back) is a `gait_found`, not a loss.
+    let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+    assert_eq!(thresholds.len(), 1, "{thresholds:?}");
+    assert_eq!(thresholds[0].name, "gait_found");
 }

@@ -1,12 +1,15 @@
 //! Gait analysis (MODEL.md section 6): the step map, limit cycles and their stability, parameter sweeps with
 //! continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
 
+pub mod continuation;
 pub mod limit_cycle;
 pub mod step_map;
 pub mod sweep;
 pub mod thresholds;
 
-pub use limit_cycle::{find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions};
+pub use limit_cycle::{
+    find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
+};
 pub use step_map::{StepMap, StepOutcome};
 pub use sweep::{sweep, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};

@@ -1,8 +1,11 @@
 //! Parameter sweeps with continuation (MODEL.md section 6, the paper's Fig. 2).
 //!
-//! Every point starts Newton's method from a neighbour's gait, with the neighbour's `DP` as the first Newton
-//! matrix. A point whose search fails from the neighbour is retried from the sweep's initial state with a full
-//! transient; after a failure the next point starts from the last gait found.
+//! Every point follows its neighbour's gait family in verified continuation steps (see
+//! [`super::continuation`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach
+//! is searched from the sweep's initial state with a full transient, and so are the points after it until a gait
+//! is found again. Gaits found that way are then followed backwards to fill in points the search from the
+//! initial state missed, and every gait gets a family number: points of one family are connected by
+//! continuation, so a change of family between neighbours is a branch switch, never a silent jump.
 //!
 //! Parallelism (rayon) with results bitwise identical for any number of threads: first every
 //! [`COARSE_STRIDE`]-th point is continued in order (the coarse pass); then the points between two coarse points
@@ -13,6 +16,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::continuation::{section_distance, Continuation, FamilyPoint, Followed, SAME_GAIT_TOL};
 use super::limit_cycle::{find_gait, Gait, GaitOptions};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
@@ -70,12 +74,20 @@ impl SweepSpec {
 pub struct SweepPoint {
     /// The parameter value.
     pub value: f64,
-    /// `stable`, `unstable`, or why no gait was found (`invalid_parameter`, `rolled_back`, ...).
+    /// The gait's stability verdict (`stable`, `unstable`, `uncertain`), or why no gait was found
+    /// (`invalid_parameter`, `rolled_back`, ...).
     pub status: String,
     /// The failure, in words.
     pub message: Option<String>,
     /// The gait, if found.
     pub gait: Option<Gait>,
+    /// Index of the sweep point this gait was continued from (verified from both sides, see
+    /// [`super::continuation`]); `None` if it was found from the sweep's initial state.
+    #[serde(skip)]
+    pub continued_from: Option<usize>,
+    /// Gait family: points with the same number are connected by continuation; numbered from 0 in parameter
+    /// order. `None` without a gait.
+    pub family: Option<usize>,
 }
 
 /// The configuration with the swept parameter set to `value`, validated, and its model.
@@ -91,14 +103,15 @@ pub fn configured(
     Ok((c, model))
 }
 
-/// The gait at `value`, continued from `previous` (a neighbouring gait) if given, else from `initial` with the
-/// full transient; a failed continuation is retried from `initial`.
+/// The gait at `value`, followed from `previous` (a neighbouring gait at another value, with its index) in
+/// verified continuation steps if given; if the family does not reach `value`, searched from `initial` with the
+/// full transient.
 pub fn gait_at_value(
     config: &Config,
     param: &str,
     value: f64,
     initial: &SectionState,
-    previous: Option<&Gait>,
+    previous: Option<(usize, f64, &Gait)>,
     options: &GaitOptions,
 ) -> SweepPoint {
     let (c, model) = match configured(config, param, value) {
@@ -109,21 +122,35 @@ pub fn gait_at_value(
                 status: "invalid_parameter".to_string(),
                 message: Some(e.to_string()),
                 gait: None,
+                continued_from: None,
+                family: None,
             }
         }
     };
     let solver: &SolverOptions = &c.solver;
     let map = StepMap::new(&model, solver);
-    let continued = previous.and_then(|g| {
-        let opts = GaitOptions {
-            transient_steps: 0,
-            ..*options
+    let continued = previous.and_then(|(index, from, g)| {
+        let guess = g.jacobian_matrix();
+        let start = FamilyPoint {
+            value: from,
+            section: g.section,
         };
-        find_gait(&map, &g.section, &opts, Some(&g.jacobian_matrix())).ok()
+        match Continuation::new(config, param, options).follow(start, value, Some(&guess)) {
+            Followed::Reached(p) => {
+                let opts = GaitOptions {
+                    transient_steps: 0,
+                    ..*options
+                };
+                find_gait(&map, &p.section, &opts, Some(&guess))
+                    .ok()
+                    .map(|g| (index, g))
+            }
+            Followed::Ended { .. } => None,
+        }
     });
-    let result = match continued {
-        Some(g) => Ok(g),
-        None => find_gait(&map, initial, options, None),
+    let (continued_from, result) = match continued {
+        Some((index, g)) => (Some(index), Ok(g)),
+        None => (None, find_gait(&map, initial, options, None)),
     };
     match result {
         Ok(g) => SweepPoint {
@@ -131,12 +158,16 @@ pub fn gait_at_value(
             status: g.stability.to_string(),
             message: None,
             gait: Some(g),
+            continued_from,
+            family: None,
         },
         Err(e) => SweepPoint {
             value,
             status: e.kind().to_string(),
             message: Some(e.to_string()),
             gait: None,
+            continued_from: None,
+            family: None,
         },
     }
 }
@@ -144,28 +175,128 @@ pub fn gait_at_value(
 /// Stride of the coarse continuation pass.
 pub const COARSE_STRIDE: usize = 10;
 
-/// Continue along `values` from `start` (the gait at the point before them, if any).
+/// Continue along `values` (sweep indices from `first`) from `start` (the gait at the point before them, if
+/// any). After a point without a gait, the next ones are searched from `initial` until a gait is found again:
+/// a family that ended is not followed further.
+#[allow(clippy::too_many_arguments)]
 fn continue_along(
     config: &Config,
     param: &str,
     values: &[f64],
+    first: usize,
     initial: &SectionState,
-    start: Option<Gait>,
+    start: Option<(usize, f64, Gait)>,
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Vec<SweepPoint> {
     let mut last = start;
     values
         .iter()
-        .map(|&value| {
-            let point = gait_at_value(config, param, value, initial, last.as_ref(), options);
-            if let Some(g) = &point.gait {
-                last = Some(g.clone());
-            }
+        .enumerate()
+        .map(|(i, &value)| {
+            let previous = last.as_ref().map(|(j, v, g)| (*j, *v, g));
+            let point = gait_at_value(config, param, value, initial, previous, options);
+            last = point.gait.clone().map(|g| (first + i, value, g));
             progress(&point);
             point
         })
         .collect()
+}
+
+/// Points without a gait just left of a gait (or of a stretch of gaits) may be misses of the search from the
+/// initial state: follow each such gait backwards, from right to left, and fill in the points its family
+/// reaches. Sequential and in a fixed order, so deterministic.
+fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
+    let cont = Continuation::new(config, param, options);
+    for i in (1..points.len()).rev() {
+        let (left, right) = points.split_at_mut(i);
+        let (a, b) = (&mut left[i - 1], &right[0]);
+        let (None, Some(gb)) = (&a.gait, &b.gait) else {
+            continue;
+        };
+        if a.status == "invalid_parameter" {
+            continue;
+        }
+        let guess = gb.jacobian_matrix();
+        let start = FamilyPoint {
+            value: b.value,
+            section: gb.section,
+        };
+        let Followed::Reached(p) = cont.follow(start, a.value, Some(&guess)) else {
+            continue;
+        };
+        let Ok((c, model)) = configured(config, param, a.value) else {
+            continue;
+        };
+        let map = StepMap::new(&model, &c.solver);
+        let opts = GaitOptions {
+            transient_steps: 0,
+            ..*options
+        };
+        if let Ok(g) = find_gait(&map, &p.section, &opts, Some(&guess)) {
+            a.status = g.stability.to_string();
+            a.message = None;
+            a.gait = Some(g);
+            a.continued_from = Some(i);
+        }
+    }
+}
+
+/// Number the gait families: a point continued from another shares its family; a point found from the initial
+/// state starts a new one, unless a verified continuation step connects it to its left neighbour's gait.
+fn number_families(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
+    let cont = Continuation::new(config, param, options);
+    // Roots of the continuation forest: a gait found from the initial state is its own root.
+    let mut root: Vec<Option<usize>> = vec![None; points.len()];
+    for i in 0..points.len() {
+        let mut j = i;
+        let mut hops = 0;
+        while points[j].gait.is_some() && hops <= points.len() {
+            match points[j].continued_from {
+                Some(k) if points[k].gait.is_some() => j = k,
+                _ => {
+                    root[i] = Some(j);
+                    break;
+                }
+            }
+            hops += 1;
+        }
+    }
+    // Fresh gaits that continue their left neighbour's family join it.
+    for i in 1..points.len() {
+        let (Some(ri), Some(rl)) = (root[i], root[i - 1]) else {
+            continue;
+        };
+        if ri == rl || points[i].continued_from.is_some() {
+            continue;
+        }
+        let (a, b) = (&points[i - 1], &points[i]);
+        let (Some(ga), Some(gb)) = (&a.gait, &b.gait) else {
+            continue;
+        };
+        let start = FamilyPoint {
+            value: a.value,
+            section: ga.section,
+        };
+        let connected = cont
+            .step(&start, b.value, Some(&ga.jacobian_matrix()))
+            .is_some_and(|p| section_distance(&p.section, &gb.section) <= SAME_GAIT_TOL);
+        if connected {
+            for r in root.iter_mut().filter(|r| **r == Some(ri)) {
+                *r = Some(rl);
+            }
+        }
+    }
+    let mut ids: Vec<usize> = Vec::new();
+    for (p, r) in points.iter_mut().zip(&root) {
+        p.family = r.map(|r| match ids.iter().position(|&x| x == r) {
+            Some(k) => k,
+            None => {
+                ids.push(r);
+                ids.len() - 1
+            }
+        });
+    }
 }
 
 /// Sweep `spec.param` over its range with continuation, calling `progress` after each point.
@@ -179,26 +310,33 @@ pub fn sweep(
     spec.validate(config)?;
     let values = spec.values();
     let coarse_values: Vec<f64> = values.iter().copied().step_by(COARSE_STRIDE).collect();
-    let coarse = continue_along(
-        config,
-        &spec.param,
-        &coarse_values,
-        initial,
-        None,
-        options,
-        progress,
-    );
+    // The coarse pass: every COARSE_STRIDE-th point, each continued from the previous coarse point.
+    let mut coarse: Vec<SweepPoint> = Vec::with_capacity(coarse_values.len());
+    for (k, &value) in coarse_values.iter().enumerate() {
+        let previous = coarse.last().and_then(|p: &SweepPoint| {
+            p.gait
+                .as_ref()
+                .map(|g| ((k - 1) * COARSE_STRIDE, p.value, g))
+        });
+        let point = gait_at_value(config, &spec.param, value, initial, previous, options);
+        progress(&point);
+        coarse.push(point);
+    }
     let fills: Vec<Vec<SweepPoint>> = coarse
         .par_iter()
         .enumerate()
         .map(|(i, left)| {
             let lo = i * COARSE_STRIDE + 1;
             let hi = ((i + 1) * COARSE_STRIDE).min(values.len());
-            let start = left.gait.clone();
+            let start = left
+                .gait
+                .clone()
+                .map(|g| (i * COARSE_STRIDE, left.value, g));
             continue_along(
                 config,
                 &spec.param,
                 &values[lo.min(hi)..hi],
+                lo,
                 initial,
                 start,
                 options,
@@ -211,5 +349,7 @@ pub fn sweep(
         points.push(left);
         points.extend(fill);
     }
+    backfill(config, &spec.param, &mut points, options);
+    number_families(config, &spec.param, &mut points, options);
     Ok(points)
 }

@@ -1,11 +1,22 @@
 //! Parameter values where something changes along a sweep, found by root finding in the parameter (never read
 //! off the grid): the DLS indicators crossing zero (the paper's `c = 220` for `lambda_4+` and `c = 4.0` for
-//! `lambda_2+`), the loss of stability (`max |multiplier| = 1`) and the ends of the range where a gait exists.
+//! `lambda_2+`), the loss of stability (`max |multiplier| = 1`), and the ends of gait families.
 //!
-//! Sign changes between neighbouring sweep points are refined by Brent's method (the `roots` crate) on the
-//! indicator of the gait continued from the left neighbour, to [`PARAM_TOL`] in the parameter; the existence
-//! boundary by bisection on "a gait is found". The refinements are independent and run in parallel (rayon);
-//! each is deterministic, so the results do not depend on the number of threads.
+//! Sign changes between neighbouring sweep points of one gait family are refined by Brent's method (the `roots`
+//! crate) on the indicator of the gait continued from the left neighbour, to [`PARAM_TOL`] in the parameter.
+//! Ends of families are followed in verified continuation steps to [`PARAM_TOL`] and their physical cause is
+//! looked for just past the end ([`super::continuation`]):
+//!
+//! | threshold | where |
+//! |---|---|
+//! | `gait_lost` | the family ends going up the parameter, and a walk from its last gait just past the end fails |
+//! | `gait_found` | the same going down: a family begins after a stretch without a gait |
+//! | `branch_switch` | the family ends and the walk settles on another gait family (or the neighbour is one) |
+//! | `fold` | the family ends at a multiplier of +1 (saddle-node) |
+//! | `unconfirmed` | the family ends, but nothing physical was found just past the end (the reason is given) |
+//!
+//! The refinements are independent and run in parallel (rayon); each is deterministic, so the results do not
+//! depend on the number of threads.
 
 use std::cell::Cell;
 
@@ -13,17 +24,13 @@ use rayon::prelude::*;
 use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 
+pub use super::continuation::PARAM_TOL;
+use super::continuation::{Continuation, EndCause, FamilyPoint, Followed};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::step_map::StepMap;
 use super::sweep::{configured, SweepPoint, SweepSpec};
 use crate::params::Config;
 use crate::walk::DlsIndicators;
-
-/// Tolerance of every threshold in the swept parameter.
-pub const PARAM_TOL: f64 = 1e-6;
-
-/// Newton iterations allowed at each bisection point of a gait-existence boundary.
-const BISECTION_NEWTON_ITERATIONS: usize = 8;
 
 /// Brent iterations allowed.
 const MAX_BRENT_ITERATIONS: usize = 100;
@@ -32,7 +39,8 @@ const MAX_BRENT_ITERATIONS: usize = 100;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Threshold {
     /// What crosses: `lambda_4_plus = 0`, `lambda_2_plus = 0`, `lambda_I4 = 0`, `stability_lost` (largest
-    /// Floquet multiplier modulus = 1) or `gait_lost`.
+    /// Floquet multiplier modulus = 1), or an end of a gait family: `gait_lost`, `gait_found`,
+    /// `branch_switch`, `fold` or `unconfirmed` (see the module documentation).
     pub name: String,
     /// The parameter value \[unit of the parameter\]; `NaN` if the search failed.
     pub value: f64,
@@ -40,9 +48,10 @@ pub struct Threshold {
     pub bracket: [f64; 2],
     /// The sweep points it was started between.
     pub grid_bracket: [f64; 2],
-    /// The function at `value` (the indicator \[N s or N\], or `max |multiplier| - 1`); `NaN` for `gait_lost`.
+    /// The function at `value` (the indicator \[N s or N\], or `max |multiplier| - 1`); `NaN` for the ends of
+    /// families.
     pub residual: f64,
-    /// How the gait is lost (failure kind beyond the boundary) or why the search failed.
+    /// What happens past a family's end (its physical cause) or why the search failed.
     pub detail: Option<String>,
 }
 
@@ -117,7 +126,9 @@ impl Convergency<f64> for ParamTolerance {
 
 enum Task<'a> {
     Root(Quantity, &'a SweepPoint, &'a SweepPoint),
-    Boundary(&'a SweepPoint, &'a SweepPoint),
+    /// A family ends between a point with a gait (first) and its neighbour (second), which has no gait or a
+    /// gait of another family.
+    End(&'a SweepPoint, &'a SweepPoint),
 }
 
 /// Locate every threshold in the sweep `points` of `spec` (see the module documentation).
@@ -131,60 +142,138 @@ pub fn find_thresholds(
     for pair in points.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
         match (&a.gait, &b.gait) {
-            (Some(ga), Some(gb)) => {
+            (Some(ga), Some(gb)) if a.family == b.family => {
                 for q in Quantity::ALL {
                     if q.changes_sign(ga, gb) {
                         tasks.push(Task::Root(q, a, b));
                     }
                 }
             }
-            (Some(_), None) | (None, Some(_)) => tasks.push(Task::Boundary(a, b)),
+            (Some(_), Some(_)) => tasks.push(Task::End(a, b)),
+            (Some(_), None) => tasks.push(Task::End(a, b)),
+            (None, Some(_)) => tasks.push(Task::End(b, a)),
             (None, None) => {}
         }
     }
-    let mut found: Vec<Threshold> = tasks
+    let gait_before = |v: f64| points.iter().any(|p| p.gait.is_some() && p.value < v);
+    tasks
         .par_iter()
-        .map(|task| match task {
-            Task::Root(q, a, b) => refine_root(config, spec, *q, a, b, options),
-            Task::Boundary(a, b) => refine_boundary(config, spec, a, b, options),
+        .filter_map(|task| match task {
+            Task::Root(q, a, b) => Some(refine_root(config, spec, *q, a, b, options)),
+            Task::End(from, toward) => {
+                refine_end(config, spec, from, toward, options, gait_before(from.value))
+            }
         })
-        .collect();
-    found.extend(sign_changes_across_gaps(points));
-    found
+        .collect()
 }
 
-/// Sign changes of a quantity between two gaits separated by points without a gait: the crossing cannot be
-/// refined (the gait does not exist continuously across it), so it is reported with its grid bracket and no
-/// value. This happens where the crossing switches the impact branch and the step map jumps.
-fn sign_changes_across_gaps(points: &[SweepPoint]) -> Vec<Threshold> {
-    let with_gait: Vec<(usize, &SweepPoint, &Gait)> = points
-        .iter()
-        .enumerate()
-        .filter_map(|(i, p)| p.gait.as_ref().map(|g| (i, p, g)))
-        .collect();
-    let mut out = Vec::new();
-    for pair in with_gait.windows(2) {
-        let ((ia, a, ga), (ib, b, gb)) = (pair[0], pair[1]);
-        if ib == ia + 1 {
-            continue;
-        }
-        for q in Quantity::ALL {
-            if q.changes_sign(ga, gb) {
-                let (fa, fb) = (q.of(ga), q.of(gb));
-                out.push(Threshold {
-                    name: q.name().to_string(),
-                    value: f64::NAN,
-                    bracket: [a.value, b.value],
-                    grid_bracket: [a.value, b.value],
-                    residual: f64::NAN,
-                    detail: Some(format!(
-                        "sign change from {fa} to {fb} across points without a gait: not refinable"
-                    )),
-                });
+/// Follow the family of `from`'s gait toward `toward` to its end, and name the end by what happens just past
+/// it (see the module documentation). `None` if the family reaches `toward` after all and is `toward`'s gait.
+fn refine_end(
+    config: &Config,
+    spec: &SweepSpec,
+    from: &SweepPoint,
+    toward: &SweepPoint,
+    options: &GaitOptions,
+    gait_before: bool,
+) -> Option<Threshold> {
+    let g = from.gait.as_ref().expect("an end starts at a gait");
+    let cont = Continuation::new(config, &spec.param, options);
+    let start = FamilyPoint {
+        value: from.value,
+        section: g.section,
+    };
+    let guess = g.jacobian_matrix();
+    let grid_bracket = sorted([from.value, toward.value]);
+    let (last, beyond) = match cont.follow(start, toward.value, Some(&guess)) {
+        Followed::Ended { last, beyond } => (last, beyond),
+        Followed::Reached(p) => {
+            let same = toward.gait.as_ref().is_some_and(|gt| {
+                super::continuation::section_distance(&gt.section, &p.section)
+                    <= super::continuation::SAME_GAIT_TOL
+            });
+            if same {
+                return None;
             }
+            let what = if toward.gait.is_some() {
+                "the sweep found another gait there (two gaits coexist)"
+            } else {
+                "the sweep found no gait there"
+            };
+            return Some(Threshold {
+                name: "unconfirmed".to_string(),
+                value: f64::NAN,
+                bracket: grid_bracket,
+                grid_bracket,
+                residual: f64::NAN,
+                detail: Some(format!(
+                    "the family of {} = {} reaches {} = {}, but {what}",
+                    spec.param, from.value, spec.param, toward.value
+                )),
+            });
         }
-    }
-    out
+    };
+    let upward = toward.value > from.value;
+    let cause = cont.end_cause(&last, beyond);
+    let (name, detail) = match &cause {
+        EndCause::WalkFails { failure, message } => (
+            if upward { "gait_lost" } else { "gait_found" },
+            format!(
+                "the gait family exists at {p} = {} and not at {p} = {beyond}; walking from its last gait at \
+                 {p} = {beyond}: {failure} ({message}){}",
+                last.value,
+                if !upward && gait_before {
+                    "; the gait is found again"
+                } else {
+                    ""
+                },
+                p = spec.param,
+            ),
+        ),
+        EndCause::OtherGait {
+            steps, lambda_i4, ..
+        } => (
+            "branch_switch",
+            format!(
+                "the gait family of lambda_I4 = {:.6} N s ends at {p} = {} (not reached at {beyond}); walking \
+                 {steps} steps from its last gait there settles on another gait, lambda_I4 = {lambda_i4:.6} N s",
+                g.lambda_i4,
+                last.value,
+                p = spec.param,
+            ),
+        ),
+        EndCause::Fold { multiplier } => (
+            "fold",
+            format!(
+                "the gait family ends at {p} = {} (not reached at {beyond}) with a Floquet multiplier {multiplier:.4} \
+                 near +1: a fold (saddle-node)",
+                last.value,
+                p = spec.param,
+            ),
+        ),
+        EndCause::Unconfirmed { reason } => (
+            "unconfirmed",
+            format!(
+                "the gait family is not followed past {p} = {} (to {beyond}), but no physical cause was found: \
+                 {reason}",
+                last.value,
+                p = spec.param,
+            ),
+        ),
+    };
+    Some(Threshold {
+        name: name.to_string(),
+        value: 0.5 * (last.value + beyond),
+        bracket: sorted([last.value, beyond]),
+        grid_bracket,
+        residual: f64::NAN,
+        detail: Some(detail),
+    })
+}
+
+fn sorted(mut pair: [f64; 2]) -> [f64; 2] {
+    pair.sort_by(f64::total_cmp);
+    pair
 }
 
 /// Brent on `q(gait(v))` between the sweep points `a` and `b`, continuing from `a`'s gait.
@@ -262,71 +351,12 @@ fn refine_root(
     } else {
         f64::NAN
     };
-    let mut bracket = [lo.get(), hi.get()];
-    bracket.sort_by(f64::total_cmp);
     Threshold {
         name: q.name().to_string(),
         value,
-        bracket,
+        bracket: sorted([lo.get(), hi.get()]),
         grid_bracket: [a.value, b.value],
         residual,
         detail,
-    }
-}
-
-/// Bisection on "a gait is found" between a point with a gait and one without.
-fn refine_boundary(
-    config: &Config,
-    spec: &SweepSpec,
-    a: &SweepPoint,
-    b: &SweepPoint,
-    options: &GaitOptions,
-) -> Threshold {
-    let (found, lost) = if a.gait.is_some() { (a, b) } else { (b, a) };
-    let start = found.gait.as_ref().expect("one side has a gait");
-    let guess = start.jacobian_matrix();
-    let mut section = start.section;
-    // Each bisection point is at most half the previous interval from a converged neighbour: a few Newton
-    // iterations suffice, and failing fast matters because half the attempts fail.
-    let continued = GaitOptions {
-        transient_steps: 0,
-        refine_jacobian: false,
-        max_iterations: BISECTION_NEWTON_ITERATIONS.min(options.max_iterations),
-        ..*options
-    };
-    let (mut inside, mut outside) = (found.value, lost.value);
-    let mut how = lost.status.clone();
-    while (outside - inside).abs() > PARAM_TOL {
-        let mid = 0.5 * (inside + outside);
-        let attempt = configured(config, &spec.param, mid)
-            .map_err(|e| e.to_string())
-            .and_then(|(c, model)| {
-                let map = StepMap::new(&model, &c.solver);
-                solve_fixed_point(&map, &section, &continued, Some(&guess))
-                    .map_err(|e| e.kind().to_string())
-            });
-        match attempt {
-            Ok(fp) => {
-                inside = mid;
-                section = fp.section;
-            }
-            Err(kind) => {
-                outside = mid;
-                how = kind;
-            }
-        }
-    }
-    let mut bracket = [inside, outside];
-    bracket.sort_by(f64::total_cmp);
-    Threshold {
-        name: "gait_lost".to_string(),
-        value: 0.5 * (inside + outside),
-        bracket,
-        grid_bracket: [a.value, b.value],
-        residual: f64::NAN,
-        detail: Some(format!(
-            "gait exists at {} = {inside} and not at {outside}: {how}",
-            spec.param
-        )),
     }
 }

@@ -235,7 +235,7 @@ pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), Outpu
 }
 
 /// Columns of `sweep.csv` after the parameter column.
-pub const SWEEP_COLUMNS: [&str; 22] = [
+pub const SWEEP_COLUMNS: [&str; 23] = [
     "status",
     "L2",
     "thetadot",
@@ -257,6 +257,7 @@ pub const SWEEP_COLUMNS: [&str; 22] = [
     "jacobian_error",
     "residual",
     "iterations",
+    "family",
     "message",
 ];
 
@@ -300,6 +301,7 @@ pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Resul
                     num(g.jacobian_error),
                     num(g.residual),
                     g.iterations.to_string(),
+                    p.family.map_or_else(String::new, |f| f.to_string()),
                 ]);
             }
             None => row.extend(std::iter::repeat_n(String::new(), SWEEP_COLUMNS.len() - 2)),

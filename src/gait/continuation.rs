@@ -1,0 +1,279 @@
+//! Natural-parameter continuation of a gait family, verified from both sides, and the physical cause where a
+//! family ends (MODEL.md section 6).
+//!
+//! A continuation step from the gait `s0` at `v0` to `v1` is accepted only if Newton's method from `s0` converges
+//! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within [`SAME_GAIT_TOL`]).
+//! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
+//! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved, so a
+//! family is followed in shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`].
+//!
+//! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
+//! family at the first parameter value it does not reach ([`END_WALK_STEPS`] steps). The walk fails (falls,
+//! rolls back, stalls, the rear leg is not relocked, ...), settles on another gait (a branch switch), or does
+//! neither, in which case the end is reported as unconfirmed. Newton's method failing from a neighbour is never
+//! by itself taken for "no gait".
+
+use nalgebra::DMatrix;
+use serde::Serialize;
+
+use super::limit_cycle::{solve_fixed_point, FixedPoint, GaitOptions};
+use super::step_map::StepMap;
+use super::sweep::configured;
+use crate::params::Config;
+use crate::walk::{SectionState, Walker};
+
+/// Tolerance of every threshold in the swept parameter.
+pub const PARAM_TOL: f64 = 1e-6;
+
+/// Two fixed points closer than this (largest coordinate difference of `(L2, thetadot, L2dot)`) are the same
+/// gait. Newton converges to `1e-10` in the residual, so one gait found twice agrees to far better than this;
+/// distinct families differ by `1e-3` or more.
+pub const SAME_GAIT_TOL: f64 = 1e-6;
+
+/// Newton iterations allowed in one continuation step (a step that needs more is halved instead).
+pub const STEP_NEWTON_ITERATIONS: usize = 8;
+
+/// A real Floquet multiplier this close to +1 at the last gait of a family marks a fold.
+pub const FOLD_TOL: f64 = 0.05;
+
+/// Steps walked from the last gait of a family just past its end, looking for the physical cause.
+pub const END_WALK_STEPS: usize = 300;
+
+/// Largest coordinate difference between two section states.
+pub fn section_distance(a: &SectionState, b: &SectionState) -> f64 {
+    (a.l2 - b.l2)
+        .abs()
+        .max((a.theta_dot - b.theta_dot).abs())
+        .max((a.l2_dot - b.l2_dot).abs())
+}
+
+/// Follows gait families of one configuration along one parameter.
+#[derive(Debug, Clone)]
+pub struct Continuation<'a> {
+    config: &'a Config,
+    param: &'a str,
+    options: GaitOptions,
+}
+
+/// A point of a family: the parameter value and the gait's section state there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FamilyPoint {
+    /// The parameter value.
+    pub value: f64,
+    /// The fixed point of the step map.
+    pub section: SectionState,
+}
+
+/// Where following a family led.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Followed {
+    /// The family reaches the target value.
+    Reached(FamilyPoint),
+    /// The family ends between `last.value` and `beyond` (`|beyond - last.value| <= PARAM_TOL`).
+    Ended {
+        /// The last point of the family.
+        last: FamilyPoint,
+        /// The first value it does not reach.
+        beyond: f64,
+    },
+}
+
+/// What happens just past the end of a family.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum EndCause {
+    /// The walk from the family's last gait fails: `failure` is its kind (`rolled_back`, `fell`, ...).
+    WalkFails {
+        /// Failure kind.
+        failure: String,
+        /// The failure in words, with the step it happened in.
+        message: String,
+    },
+    /// The walk settles on another gait (a branch switch).
+    OtherGait {
+        /// Steps walked before the search that found it.
+        steps: usize,
+        /// The other gait's section state.
+        section: SectionState,
+        /// Its `lambda_I4` \[N s\].
+        lambda_i4: f64,
+    },
+    /// The family folds: the largest Floquet multiplier of its last gait is within [`FOLD_TOL`] of +1 (a
+    /// saddle-node, where the gait meets an unstable one and both vanish), and the walk drifts slowly.
+    Fold {
+        /// The multiplier closest to +1.
+        multiplier: f64,
+    },
+    /// The walk neither fails nor settles on a period-1 gait: nothing physical was found.
+    Unconfirmed {
+        /// Why.
+        reason: String,
+    },
+}
+
+impl<'a> Continuation<'a> {
+    /// Continuation of `param` in `config`, with Newton settings from `options`.
+    pub fn new(config: &'a Config, param: &'a str, options: &GaitOptions) -> Continuation<'a> {
+        Continuation {
+            config,
+            param,
+            options: GaitOptions {
+                transient_steps: 0,
+                refine_jacobian: false,
+                max_iterations: STEP_NEWTON_ITERATIONS.min(options.max_iterations),
+                ..*options
+            },
+        }
+    }
+
+    /// The fixed point at `value` by Newton's method from `start` (no transient).
+    pub fn solve(
+        &self,
+        value: f64,
+        start: &SectionState,
+        guess: Option<&DMatrix<f64>>,
+    ) -> Result<FixedPoint, String> {
+        let (c, model) = configured(self.config, self.param, value).map_err(|e| e.to_string())?;
+        let map = StepMap::new(&model, &c.solver);
+        solve_fixed_point(&map, start, &self.options, guess).map_err(|e| e.to_string())
+    }
+
+    /// One verified continuation step from `from` to `value` (see the module documentation).
+    pub fn step(
+        &self,
+        from: &FamilyPoint,
+        value: f64,
+        guess: Option<&DMatrix<f64>>,
+    ) -> Option<FamilyPoint> {
+        let forward = self.solve(value, &from.section, guess).ok()?;
+        let back = self.solve(from.value, &forward.section, guess).ok()?;
+        (section_distance(&back.section, &from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
+            value,
+            section: forward.section,
+        })
+    }
+
+    /// `DP` (central differences) of the gait `at`.
+    fn jacobian(&self, at: &FamilyPoint) -> Option<DMatrix<f64>> {
+        let (c, model) = configured(self.config, self.param, at.value).ok()?;
+        let map = StepMap::new(&model, &c.solver);
+        map.central_jacobian(&at.section, self.options.fd_step).ok()
+    }
+
+    /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's
+    /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step that fails is retried once
+    /// with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere), then halved; a
+    /// step that works lets the next one double.
+    pub fn follow(&self, from: FamilyPoint, target: f64, guess: Option<&DMatrix<f64>>) -> Followed {
+        let mut current = from;
+        // The Newton matrix and the parameter value where it was computed.
+        let mut jac: Option<(f64, DMatrix<f64>)> = guess.map(|j| (from.value, j.clone()));
+        let mut h = target - current.value;
+        loop {
+            let remaining = target - current.value;
+            if remaining == 0.0 {
+                return Followed::Reached(current);
+            }
+            let next_value = if h.abs() >= remaining.abs() {
+                target
+            } else {
+                current.value + h
+            };
+            let mut next = self.step(&current, next_value, jac.as_ref().map(|(_, j)| j));
+            if next.is_none() && jac.as_ref().is_none_or(|(v, _)| *v != current.value) {
+                if let Some(j) = self.jacobian(&current) {
+                    jac = Some((current.value, j));
+                    next = self.step(&current, next_value, jac.as_ref().map(|(_, j)| j));
+                }
+            }
+            match next {
+                Some(next) => {
+                    h = 2.0 * (next.value - current.value);
+                    current = next;
+                }
+                None if (next_value - current.value).abs() <= PARAM_TOL => {
+                    return Followed::Ended {
+                        last: current,
+                        beyond: next_value,
+                    }
+                }
+                None => h = 0.5 * (next_value - current.value),
+            }
+        }
+    }
+
+    /// The real Floquet multiplier closest to +1 of the gait `at` (central-difference `DP`).
+    fn near_fold(&self, at: &FamilyPoint) -> Option<f64> {
+        self.jacobian(at)?
+            .complex_eigenvalues()
+            .iter()
+            .filter(|z| z.im.abs() < 1e-9)
+            .map(|z| z.re)
+            .min_by(|a, b| (a - 1.0).abs().total_cmp(&(b - 1.0).abs()))
+    }
+
+    /// What happens at `beyond`, just past the end of the family whose last gait is `last`: walk from it (see
+    /// [`EndCause`]).
+    pub fn end_cause(&self, last: &FamilyPoint, beyond: f64) -> EndCause {
+        let (c, model) = match configured(self.config, self.param, beyond) {
+            Ok(x) => x,
+            Err(e) => {
+                return EndCause::WalkFails {
+                    failure: "invalid_parameter".to_string(),
+                    message: e.to_string(),
+                }
+            }
+        };
+        let mut walker = match Walker::new(&model, &c.solver, &last.section) {
+            Ok(w) => w,
+            Err(e) => {
+                return EndCause::WalkFails {
+                    failure: e.kind().to_string(),
+                    message: e.to_string(),
+                }
+            }
+        };
+        for step in 1..=END_WALK_STEPS {
+            if let Err(e) = walker.step(None) {
+                return EndCause::WalkFails {
+                    failure: e.kind().to_string(),
+                    message: format!("walking from the last gait, step {step}: {e}"),
+                };
+            }
+        }
+        let walked = match walker.section() {
+            Ok(s) => s,
+            Err(e) => {
+                return EndCause::WalkFails {
+                    failure: e.kind().to_string(),
+                    message: e.to_string(),
+                }
+            }
+        };
+        let map = StepMap::new(&model, &c.solver);
+        match solve_fixed_point(&map, &walked, &self.options, None) {
+            Ok(fp) if section_distance(&fp.section, &last.section) > SAME_GAIT_TOL => {
+                EndCause::OtherGait {
+                    steps: END_WALK_STEPS,
+                    section: fp.section,
+                    lambda_i4: fp.outcome.report.indicators.lambda_i4,
+                }
+            }
+            Ok(_) => EndCause::Unconfirmed {
+                reason: "the walk from the last gait returns to it: the end of the family is numerical"
+                    .to_string(),
+            },
+            Err(_) if self.near_fold(last).is_some_and(|m| (m - 1.0).abs() < FOLD_TOL) => {
+                EndCause::Fold {
+                    multiplier: self.near_fold(last).unwrap_or(f64::NAN),
+                }
+            }
+            Err(e) => EndCause::Unconfirmed {
+                reason: format!(
+                    "the walk from the last gait neither fails nor settles on a period-1 gait within \
+                     {END_WALK_STEPS} steps ({e})"
+                ),
+            },
+        }
+    }
+}
