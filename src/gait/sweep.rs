@@ -247,21 +247,18 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
 fn number_families(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
     let cont = Continuation::new(config, param, options);
     // Roots of the continuation forest: a gait found from the initial state is its own root.
-    let mut root: Vec<Option<usize>> = vec![None; points.len()];
-    for i in 0..points.len() {
+    let root_of = |i: usize| {
         let mut j = i;
-        let mut hops = 0;
-        while points[j].gait.is_some() && hops <= points.len() {
+        for _ in 0..=points.len() {
+            points[j].gait.as_ref()?;
             match points[j].continued_from {
                 Some(k) if points[k].gait.is_some() => j = k,
-                _ => {
-                    root[i] = Some(j);
-                    break;
-                }
+                _ => return Some(j),
             }
-            hops += 1;
         }
-    }
+        None
+    };
+    let mut root: Vec<Option<usize>> = (0..points.len()).map(root_of).collect();
     // Fresh gaits that continue their left neighbour's family join it.
     for i in 1..points.len() {
         let (Some(ri), Some(rl)) = (root[i], root[i - 1]) else {
