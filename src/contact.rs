@@ -189,8 +189,33 @@ pub enum ContactError {
     #[error("mass matrix is not positive definite")]
     SingularMass,
     /// The active constraints are redundant (e.g. both legs on the ground and both on their stoppers).
-    #[error("active constraints are redundant ({0:?})")]
+    #[error("active constraints are redundant ({0})")]
     RedundantConstraints(ActiveSet),
+}
+
+/// The active units in words, e.g. `Leg 1 tip fixed, Leg 2 tip sliding, Leg 2 stopper locked`.
+impl std::fmt::Display for ActiveSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut units = Vec::new();
+        for (contact, slide, lock, leg) in [
+            (self.contact1, self.slide1, self.lock1, 1),
+            (self.contact2, self.slide2, self.lock2, 2),
+        ] {
+            match (contact, slide) {
+                (true, false) => units.push(format!("Leg {leg} tip fixed")),
+                (true, true) => units.push(format!("Leg {leg} tip sliding")),
+                (false, _) => {}
+            }
+            if lock {
+                units.push(format!("Leg {leg} stopper locked"));
+            }
+        }
+        if units.is_empty() {
+            f.write_str("no contact, no stopper")
+        } else {
+            f.write_str(&units.join(", "))
+        }
+    }
 }
 
 /// Constrained accelerations and multipliers at one instant (the solution of the KKT system).
