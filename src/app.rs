@@ -42,7 +42,7 @@ pub enum AppError {
     },
 }
 
-/// The default starting point on the Poincare section (MODEL.md section 6): `(0.72, 1.0, 0.0)`, or, with
+/// The default starting point on the Poincare section (docs/model.md section 6): `(0.72, 1.0, 0.0)`, or, with
 /// `rigid_legs`, `(L0, omega*, 0.0)` with `omega*` the closed-form gait of the rigid rimless wheel
 /// ([`RigidRimlessWheel::fixed_point`]), since rigid legs stay at `L0` and a rigid wheel started much slower
 /// than its gait rolls back.
@@ -73,6 +73,9 @@ pub fn default_initial(config: &Config) -> SectionState {
 /// A step whose energy audit leaves more than this unexplained \[J\] is reported as a warning (on stderr by the
 /// command line and in `summary.json`): the integration or an event is then not to be trusted.
 pub const ENERGY_RESIDUAL_WARNING: f64 = 1e-6;
+
+/// The smallest trajectory sampling interval `vrw simulate` accepts \[s\].
+pub const MIN_SAMPLE_DT: f64 = 1e-6;
 
 /// `summary.json` keeps the records of the last this many steps; `steps.csv` has every step.
 pub const SUMMARY_STEPS: usize = 1000;
@@ -221,6 +224,16 @@ pub fn run_simulate(
         return Err(AppError::InvalidOption {
             option: "--sample-dt",
             reason: format!("{} is not a positive time step", short(job.sample_dt)),
+        });
+    }
+    if job.sample_dt < MIN_SAMPLE_DT {
+        return Err(AppError::InvalidOption {
+            option: "--sample-dt",
+            reason: format!(
+                "{} s is below {} s (a million samples per simulated second)",
+                short(job.sample_dt),
+                short(MIN_SAMPLE_DT)
+            ),
         });
     }
     let model = Model::new(&job.config.params)?;
