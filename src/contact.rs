@@ -1,4 +1,4 @@
-//! Contacts, stoppers and the constrained dynamics (MODEL.md section 3, paper Eqs. (1)-(2), (5)-(9)).
+//! Contacts, stoppers and the constrained dynamics (docs/model.md section 3, paper Eqs. (1)-(2), (5)-(9)).
 //!
 //! A *constraint unit* is either the no-slip contact of a leg tip with the ground (two rows: tangential and
 //! normal) or the stopper of a leg holding it at `L0` (one row, `dL/dt = 0`). The rows are stacked in the
@@ -42,7 +42,7 @@ impl Leg {
     /// Both legs, Leg 1 first.
     pub const BOTH: [Leg; 2] = [Leg::One, Leg::Two];
 
-    /// The leg index `j` of MODEL.md section 1.
+    /// The leg index `j` of docs/model.md section 1.
     pub fn index(self) -> usize {
         match self {
             Leg::One => 0,
@@ -147,7 +147,7 @@ impl ActiveSet {
         ]
     }
 
-    /// The support phase named by its contacts (MODEL.md section 4).
+    /// The support phase named by its contacts (docs/model.md section 4).
     pub fn phase(&self) -> Phase {
         match (self.contact1, self.contact2) {
             (true, true) => Phase::DoubleSupport,
@@ -335,7 +335,7 @@ fn solve_schur<const K: usize>(
     Ok(chol_s.solve(&rhs))
 }
 
-/// Accelerations and multipliers of Eq. (1) with the constraints of `active` (MODEL.md section 3).
+/// Accelerations and multipliers of Eq. (1) with the constraints of `active` (docs/model.md section 3).
 pub fn constrained_dynamics(
     model: &Model,
     q: &Coords,

@@ -70,7 +70,7 @@ pub enum WalkError {
         /// Number of events in the step.
         events: usize,
     },
-    /// At touchdown the old Leg 2, which leaves `q`, was not locked at `L0` (MODEL.md section 5).
+    /// At touchdown the old Leg 2, which leaves `q`, was not locked at `L0` (docs/model.md section 5).
     #[error("old rear leg not relocked at touchdown (t = {time:.6} s, length {length:.6} m, rate {rate:.4} m/s)")]
     RearLegNotLocked {
         /// Time \[s\].

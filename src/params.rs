@@ -1,8 +1,8 @@
 //! Parameters and configuration: the first stage of the pipeline.
 //!
-//! [`Params`] holds the physical model of the viscoelastic-legged rimless wheel (`MODEL.md` sections 1, 2
+//! [`Params`] holds the physical model of the viscoelastic-legged rimless wheel (`docs/model.md` sections 1, 2
 //! and 7, defaults from the paper's Table 1), [`SolverOptions`] the numerical settings, including every
-//! tolerance that guards grazing and chatter (`MODEL.md` section 4), and [`Config`] both of them together.
+//! tolerance that guards grazing and chatter (`docs/model.md` section 4), and [`Config`] both of them together.
 //!
 //! A configuration file is a *flat* TOML file whose keys are the field names of both structs; keys that
 //! are absent keep their defaults:
@@ -26,7 +26,7 @@ use std::path::Path;
 
 use crate::error::short;
 
-/// Impact law at touchdown (`MODEL.md` section 5).
+/// Impact law at touchdown (`docs/model.md` section 5).
 ///
 /// In TOML and on the command line the values are the strings `"dlsi"` (default) and `"traditional"`;
 /// [`Display`](fmt::Display) gives the same strings.
@@ -65,7 +65,7 @@ impl fmt::Display for ImpactModel {
     }
 }
 
-/// What happens when no no-slip contact state is consistent (`MODEL.md` sections 3-4).
+/// What happens when no no-slip contact state is consistent (`docs/model.md` sections 3-4).
 ///
 /// At a lift-off where the tangential force of the no-slip contact is not zero (the paper's "scuffing" /
 /// open case), holding the tip needs a pulling normal force and releasing it drives the tip into the ground.
@@ -78,7 +78,7 @@ pub enum ContactInconsistency {
     /// The tip slides frictionlessly along the ground (normal constraint only) until its normal force
     /// vanishes: the limit of any friction cone as the normal force goes to zero. Default.
     Slide,
-    /// `MODEL.md` section 4 literally: the tip is released, re-contacts at once (plastic impact), and the
+    /// `docs/model.md` section 4 literally: the tip is released, re-contacts at once (plastic impact), and the
     /// force check (B1)-(B3) releases it again; the resulting chatter is bounded by `max_events_per_step`.
     Rebound,
 }
@@ -110,52 +110,52 @@ impl fmt::Display for ContactInconsistency {
     }
 }
 
-/// Physical parameters of the wheel and the slope (`MODEL.md` sections 1, 2 and 7).
+/// Physical parameters of the wheel and the slope (`docs/model.md` sections 1, 2 and 7).
 ///
 /// Defaults are the paper's Table 1; the viscosity `c` is the parameter the paper sweeps. Check a value
 /// built by hand with [`Params::validate`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Params {
     /// Number of legs `N` \[-\]. Default 8, i.e. the inter-leg angle `alpha = 2 pi / N = pi/4` of Table 1
-    /// (see [`Params::alpha`]). From 3 to [`MAX_LEGS`]. `MODEL.md` section 1.
+    /// (see [`Params::alpha`]). From 3 to [`MAX_LEGS`]. `docs/model.md` section 1.
     pub legs: usize,
-    /// Hub mass `mH` \[kg\]. Default 10 (Table 1). Positive. `MODEL.md` section 2.
+    /// Hub mass `mH` \[kg\]. Default 10 (Table 1). Positive. `docs/model.md` section 2.
     pub hub_mass: f64,
     /// Rotational inertia `IH` of the hub about its centre \[kg m^2\]. Default 0: the paper gives none, so
-    /// this is an **assumption** (`MODEL.md` section 2). Non-negative.
+    /// this is an **assumption** (`docs/model.md` section 2). Non-negative.
     pub hub_inertia: f64,
     /// Leg mass `m` \[kg\], a point mass on the sliding part of each leg. Default 1 (Table 1). Positive.
-    /// `MODEL.md` section 2.
+    /// `docs/model.md` section 2.
     pub leg_mass: f64,
     /// Distance `a` of the leg mass from the leg's tip \[m\]. Default 0.3 (Table 1). In
-    /// `[0, stopper_length)`. `MODEL.md` section 2.
+    /// `[0, stopper_length)`. `docs/model.md` section 2.
     pub leg_mass_offset: f64,
     /// Stopper length `L0` \[m\]: the longest a leg can be (hub to tip); legs other than Leg 1 and Leg 2
-    /// are locked at it. Default 1.0 (Table 1). Positive. `MODEL.md` section 2.
+    /// are locked at it. Default 1.0 (Table 1). Positive. `docs/model.md` section 2.
     pub stopper_length: f64,
     /// Natural length `Lstar` of the leg spring \[m\]. Default 1.02 (Table 1). At least `stopper_length`:
     /// the spring is preloaded by `k (Lstar - L0)` (10 N by default) so that an unloaded leg rests on its
-    /// stopper. `MODEL.md` section 2.
+    /// stopper. `docs/model.md` section 2.
     pub spring_natural_length: f64,
-    /// Spring stiffness `k` of Legs 1 and 2 \[N/m\]. Default 500 (Table 1). Positive. `MODEL.md` section 2.
+    /// Spring stiffness `k` of Legs 1 and 2 \[N/m\]. Default 500 (Table 1). Positive. `docs/model.md` section 2.
     pub stiffness: f64,
     /// Damper viscosity `c` of Legs 1 and 2 \[N s/m\]: the force along a leg is
     /// `k (Lstar - L) - c dL/dt`. Default 50; the paper sweeps it (thresholds near 4.0 and 220).
-    /// Non-negative. `MODEL.md` sections 2 and 6.
+    /// Non-negative. `docs/model.md` sections 2 and 6.
     pub viscosity: f64,
     /// Slope angle `phi` \[rad\]; the wheel walks down a slope with `phi > 0`. Default 0.10 (Table 1).
-    /// `|phi| < pi/2`. `MODEL.md` section 1.
+    /// `|phi| < pi/2`. `docs/model.md` section 1.
     pub slope: f64,
-    /// Gravitational acceleration `g` \[m/s^2\]. Default 9.81. Positive. `MODEL.md` section 1.
+    /// Gravitational acceleration `g` \[m/s^2\]. Default 9.81. Positive. `docs/model.md` section 1.
     pub gravity: f64,
-    /// Impact law at touchdown. Default [`ImpactModel::Dlsi`]. `MODEL.md` section 5.
+    /// Impact law at touchdown. Default [`ImpactModel::Dlsi`]. `docs/model.md` section 5.
     pub impact: ImpactModel,
     /// Rigid special case: when `true`, every leg stays locked at `stopper_length` (the stopper acts both
     /// ways, through impacts too) and the exchange is the traditional one, which makes the model the
-    /// classical rigid rimless wheel with a closed-form step map. Default `false`. `MODEL.md` section 7.
+    /// classical rigid rimless wheel with a closed-form step map. Default `false`. `docs/model.md` section 7.
     pub rigid_legs: bool,
     /// What happens when no no-slip contact state is consistent (a lift-off with a non-zero tangential
-    /// contact force). Default [`ContactInconsistency::Slide`]. `MODEL.md` sections 3-4.
+    /// contact force). Default [`ContactInconsistency::Slide`]. `docs/model.md` sections 3-4.
     pub inconsistent_contact: ContactInconsistency,
 }
 
@@ -183,7 +183,7 @@ impl Default for Params {
 }
 
 impl Params {
-    /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`MODEL.md` section 1); `pi/4` by default.
+    /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`docs/model.md` section 1); `pi/4` by default.
     pub fn alpha(&self) -> f64 {
         2.0 * PI / self.legs as f64
     }
@@ -251,7 +251,7 @@ pub const MASS_RATIO_LIMIT: f64 = 1e6;
 /// The largest accepted number of legs.
 pub const MAX_LEGS: usize = 1000;
 
-/// Numerical settings of the integration and of the walk's event handling (`MODEL.md` section 4).
+/// Numerical settings of the integration and of the walk's event handling (`docs/model.md` section 4).
 ///
 /// Every tolerance that guards grazing or chatter is a named field here. Check a value built by hand
 /// with [`SolverOptions::validate`] (and [`Config::validate`] for the rule that involves [`Params`]).
@@ -270,22 +270,22 @@ pub struct SolverOptions {
     /// Grazing guard for re-contact \[m\]. Default 1e-9. In [`GAP_RANGE`] (1e-12 to 1e-6). After a lift-off the tip leaves the
     /// ground with zero velocity and acceleration, so a lifted tip's re-contact event is armed only once
     /// its height exceeds this gap; before that it fires only if the tip sinks below `-recontact_gap`.
-    /// `MODEL.md` section 4 (grazing).
+    /// `docs/model.md` section 4 (grazing).
     pub recontact_gap: f64,
     /// The same grazing guard for an unlocked leg re-reaching its stopper \[m\]. Default 1e-9. In
     /// [`GAP_RANGE`].
-    /// The stopper-lock event is armed only once `stopper_length - L > stopper_gap`. `MODEL.md` section 4.
+    /// The stopper-lock event is armed only once `stopper_length - L > stopper_gap`. `docs/model.md` section 4.
     pub stopper_gap: f64,
     /// The run ends with the status `Fell` when the hub height above the slope drops below this \[m\].
-    /// Default 0.3. In `[0, stopper_length)`. `MODEL.md` section 4 (fall / stall).
+    /// Default 0.3. In `[0, stopper_length)`. `docs/model.md` section 4 (fall / stall).
     pub fall_hub_height: f64,
     /// The run ends with the status `Stalled` when no touchdown happens within this time of the previous
     /// one \[s\]. Default 60 (heavily damped gaits creep through long double support). In
     /// [`MAX_STEP_TIME_RANGE`] (1e-3 to 1e4).
-    /// `MODEL.md` section 4 (fall / stall).
+    /// `docs/model.md` section 4 (fall / stall).
     pub max_step_time: f64,
     /// More events than this within one step ends the run with the status `Chatter` (a Zeno sequence of
-    /// contacts) \[-\]. Default 200. From 1 to [`MAX_EVENTS_PER_STEP_LIMIT`]. `MODEL.md` section 4.
+    /// contacts) \[-\]. Default 200. From 1 to [`MAX_EVENTS_PER_STEP_LIMIT`]. `docs/model.md` section 4.
     pub max_events_per_step: usize,
 }
 
@@ -363,10 +363,10 @@ pub const MAX_EVENTS_PER_STEP_LIMIT: usize = 1_000_000;
 /// `inconsistent_contact = "rebound"`, `rtol = 1e-11`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Config {
-    /// Physical parameters (`MODEL.md` sections 1, 2 and 7). Default: the paper's Table 1.
+    /// Physical parameters (`docs/model.md` sections 1, 2 and 7). Default: the paper's Table 1.
     #[serde(flatten)]
     pub params: Params,
-    /// Numerical settings (`MODEL.md` section 4). Default: [`SolverOptions::default`].
+    /// Numerical settings (`docs/model.md` section 4). Default: [`SolverOptions::default`].
     #[serde(flatten)]
     pub solver: SolverOptions,
 }
@@ -884,7 +884,7 @@ mod tests {
         assert_eq!(p.impact, ImpactModel::Dlsi);
         assert!(!p.rigid_legs);
         assert_eq!(p.inconsistent_contact, ContactInconsistency::Slide);
-        // The preload k (Lstar - L0) = 10 N exceeds the leg weight m g (MODEL.md section 2).
+        // The preload k (Lstar - L0) = 10 N exceeds the leg weight m g (docs/model.md section 2).
         let preload = p.stiffness * (p.spring_natural_length - p.stopper_length);
         assert!(preload > p.leg_mass * p.gravity);
 

@@ -1,4 +1,4 @@
-//! Gait analysis checks (MODEL.md sections 6-7).
+//! Gait analysis checks (docs/model.md sections 6-7).
 
 use approx::assert_relative_eq;
 
@@ -23,7 +23,7 @@ fn rigid_config() -> Config {
     config
 }
 
-/// MODEL.md section 7: the rigid rimless wheel's fixed point and Floquet multiplier in closed form.
+/// docs/model.md section 7: the rigid rimless wheel's fixed point and Floquet multiplier in closed form.
 #[test]
 fn rigid_wheel_gait_matches_the_closed_form() {
     let config = rigid_config();
