@@ -128,6 +128,21 @@ fn assert_no_output(run: &Run) {
     );
 }
 
+/// The last sample of `trajectory` (default sampling interval 0.005 s) lies within one interval before
+/// `end_time`: nothing computed was lost, and nothing was sampled past the end.
+fn assert_trajectory_reaches(trajectory: &str, end_time: f64) {
+    let last_time: f64 = trajectory
+        .lines()
+        .last()
+        .and_then(|row| row.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .expect("trajectory.csv has samples");
+    assert!(
+        last_time <= end_time && end_time - last_time < 0.005 + 1e-9,
+        "last sample at {last_time} s, end time {end_time} s"
+    );
+}
+
 fn data_rows(csv: &str) -> usize {
     csv.lines().skip(1).filter(|l| !l.trim().is_empty()).count()
 }
@@ -272,6 +287,14 @@ fn initial_leg_longer_than_stopper_is_rejected() {
 fn zero_sample_interval_is_rejected() {
     let run = simulate(&["--steps", "1", "--sample-dt", "0"]);
     assert_error(&run, &["--sample-dt"]);
+    assert_no_output(&run);
+}
+
+/// A sampling interval so small that the sampler would run for ages is refused.
+#[test]
+fn tiny_sample_interval_is_refused() {
+    let run = simulate(&["--steps", "1", "--sample-dt", "1e-300"]);
+    assert_error(&run, &["--sample-dt", "1e-300"]);
     assert_no_output(&run);
 }
 
@@ -486,14 +509,7 @@ fn end_time_of_a_run_failing_in_its_first_step_is_the_failure_time() {
         message.contains(&format!("t = {end_time:.6} s")),
         "end_time {end_time} is not the failure time: {message}"
     );
-    let trajectory = run.read("trajectory.csv");
-    let last_time: f64 = trajectory
-        .lines()
-        .last()
-        .and_then(|row| row.split(',').next())
-        .and_then(|t| t.parse().ok())
-        .expect("trajectory.csv has samples");
-    assert!(last_time <= end_time && end_time - last_time < 0.005 + 1e-9);
+    assert_trajectory_reaches(&run.read("trajectory.csv"), end_time);
 }
 
 /// `simulate` streams steps.csv and summary.json keeps its aggregates; `--no-trajectory` writes no
@@ -577,14 +593,10 @@ fn interrupted_run_keeps_what_was_computed() {
         completed
     );
     let end_time = summary["end_time"].as_f64().unwrap();
-    let trajectory = fs::read_to_string(out.join("trajectory.csv")).unwrap();
-    let last_time: f64 = trajectory
-        .lines()
-        .last()
-        .and_then(|row| row.split(',').next())
-        .and_then(|t| t.parse().ok())
-        .unwrap();
-    assert!(last_time <= end_time && end_time - last_time < 0.005 + 1e-9);
+    assert_trajectory_reaches(
+        &fs::read_to_string(out.join("trajectory.csv")).unwrap(),
+        end_time,
+    );
 }
 
 /// A Newton tolerance below what the step map can reach is refused with a hint.
