@@ -94,7 +94,8 @@ pub struct SimulateJob {
     pub steps: usize,
     /// Trajectory sampling interval \[s\].
     pub sample_dt: f64,
-    /// Write `trajectory.csv` (`false`: only `steps.csv` and `summary.json`).
+    /// Write `trajectory.csv` (`false`: only `steps.csv` and `summary.json`; a `trajectory.csv` of an earlier
+    /// run in `out_dir` is removed, since it would not match).
     pub trajectory: bool,
     /// Where `steps.csv`, `trajectory.csv` and `summary.json` go.
     pub out_dir: PathBuf,
@@ -250,6 +251,8 @@ pub fn run_simulate(
         summary.files.push("trajectory.csv".to_string());
         Some(Trajectory::streaming(job.sample_dt, Box::new(sink)))
     } else {
+        // A trajectory.csv left by an earlier run would not match the new steps.csv.
+        remove_stale(&trajectory_path)?;
         None
     };
     let mut last = VecDeque::new();
@@ -293,6 +296,17 @@ pub fn run_simulate(
     summary.files.push("summary.json".to_string());
     output::write_json(&dir.join("summary.json"), &summary)?;
     Ok(summary)
+}
+
+/// Remove `path` if it exists (an output file of an earlier run that this run does not rewrite).
+fn remove_stale(path: &std::path::Path) -> Result<(), OutputError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// What `vrw gait` runs.

@@ -76,7 +76,7 @@ struct SimulateArgs {
     /// Sampling interval of trajectory.csv, in seconds of simulated time.
     #[arg(long, default_value_t = 0.005)]
     sample_dt: f64,
-    /// Do not write trajectory.csv (steps.csv and summary.json only).
+    /// Do not write trajectory.csv (steps.csv and summary.json only); an old one in --out is removed.
     #[arg(long)]
     no_trajectory: bool,
 }

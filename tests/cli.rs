@@ -516,7 +516,11 @@ fn end_time_of_a_run_failing_in_its_first_step_is_the_failure_time() {
 /// trajectory.csv.
 #[test]
 fn simulate_streams_and_no_trajectory_skips_file() {
-    let run = simulate(&["--steps", "4", "--no-trajectory"]);
+    // A trajectory.csv of an earlier run would not match: it goes.
+    let dir = temp_dir_with(&[]);
+    fs::create_dir(dir.path().join("out")).unwrap();
+    fs::write(dir.path().join("out/trajectory.csv"), "stale").unwrap();
+    let run = simulate_in(dir, &["--steps", "4", "--no-trajectory"]);
     assert_eq!(run.code(), Some(0), "stderr:\n{}", run.stderr());
     assert!(!run.out.join("trajectory.csv").exists());
     assert!(run.stdout().contains("simulated time"), "{}", run.stdout());
