@@ -81,6 +81,9 @@ struct SimulateArgs {
     no_trajectory: bool,
 }
 
+/// `GaitOptions::default().tolerance` as `--help` shows it (a test checks that they agree).
+const DEFAULT_TOLERANCE: &str = "1e-10";
+
 #[derive(Debug, Args)]
 struct GaitArgs {
     #[command(flatten)]
@@ -91,8 +94,8 @@ struct GaitArgs {
     /// Steps walked before Newton's method starts.
     #[arg(long, default_value_t = GaitOptions::default().transient_steps)]
     transient: usize,
-    /// Newton tolerance on max |P(s) - s|.
-    #[arg(long, default_value_t = GaitOptions::default().tolerance)]
+    /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
+    #[arg(long, default_value = DEFAULT_TOLERANCE)]
     tolerance: f64,
     /// Output directory for gait.json.
     #[arg(long, default_value = "out/gait")]
@@ -384,4 +387,17 @@ fn sweep(args: SweepArgs) -> Result<()> {
         bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gait_tolerance_default_is_the_library_default() {
+        assert_eq!(
+            DEFAULT_TOLERANCE.parse::<f64>().unwrap(),
+            GaitOptions::default().tolerance
+        );
+    }
 }
