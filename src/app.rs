@@ -662,6 +662,42 @@ mod tests {
         }
     }
 
+    /// A sink that fails once it has taken `left` samples (a full disk).
+    struct FailAfter(usize);
+
+    impl SampleSink for FailAfter {
+        fn write(&mut self, _: &Sample) -> std::io::Result<()> {
+            self.0 = self
+                .0
+                .checked_sub(1)
+                .ok_or(std::io::ErrorKind::StorageFull)?;
+            Ok(())
+        }
+    }
+
+    /// A trajectory whose sink fails stops the walk at once, and the error is not lost.
+    #[test]
+    fn failing_trajectory_sink_stops_the_walk() {
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let mut trajectory = Trajectory::streaming(0.01, Box::new(FailAfter(10)));
+        let end = simulate_streaming(
+            &model,
+            &config.solver,
+            &default_initial(&config),
+            1000,
+            Some(&mut trajectory),
+            None,
+            |_| Ok::<(), WalkError>(()),
+        )
+        .unwrap();
+        assert!(end.steps < 2, "{end:?}");
+        assert_eq!(
+            trajectory.take_error().map(|e| e.kind()),
+            Some(std::io::ErrorKind::StorageFull)
+        );
+    }
+
     /// A streaming trajectory hands out exactly the samples an in-memory one keeps, and keeps none.
     #[test]
     fn streaming_trajectory_matches_the_in_memory_one() {

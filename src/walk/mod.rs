@@ -873,8 +873,9 @@ pub struct WalkEnd {
 /// flushed after every step.
 ///
 /// The walk stops early when a step fails (the failure and its time are in the [`WalkEnd`]), when `on_step`
-/// returns an error (returned as is), or when `interrupt` is set; the flag is checked before every step, so
-/// an interrupted walk ends at a touchdown with every completed step reported.
+/// returns an error (returned as is), when the trajectory's sink fails (find its error with
+/// [`Trajectory::take_error`]), or when `interrupt` is set; the flag is checked before every step, so an
+/// interrupted walk ends at a touchdown with every completed step reported.
 pub fn simulate_streaming<E: From<WalkError>>(
     model: &Model,
     opts: &SolverOptions,
@@ -897,8 +898,12 @@ pub fn simulate_streaming<E: From<WalkError>>(
             break;
         }
         let result = walker.step(trajectory.as_deref_mut());
-        if let Some(tr) = trajectory.as_deref_mut() {
+        let sink_failed = trajectory.as_deref_mut().is_some_and(|tr| {
             tr.flush();
+            tr.error.is_some()
+        });
+        if sink_failed {
+            break;
         }
         match result {
             Ok(report) => {
