@@ -3,12 +3,14 @@
 use std::path::PathBuf;
 
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use vrw::app::{run_gait, run_simulate, run_sweep, GaitJob, SimulateJob, SweepJob};
+use vrw::app::{run_gait, run_simulate, run_sweep, GaitJob, SimulateEvent, SimulateJob, SweepJob};
 use vrw::gait::GaitOptions;
 use vrw::gait::SweepSpec;
 use vrw::params::Config;
@@ -64,30 +66,36 @@ struct SimulateArgs {
     /// Number of steps (touchdowns) to walk.
     #[arg(long, default_value_t = 20)]
     steps: usize,
-    /// Initial Poincare-section state `L2,thetadot,L2dot` \[m, rad/s, m/s\]; default 0.72,1.0,0.0
-    /// (L0,1.0,0.0 with rigid_legs).
+    /// Initial Poincare-section state `L2,thetadot,L2dot` (m, rad/s, m/s); default 0.72,1.0,0.0
+    /// (with rigid_legs: L0 and the rigid wheel's gait speed, from its closed form).
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
     /// Output directory for steps.csv, trajectory.csv and summary.json.
     #[arg(long, default_value = "out/simulate")]
     out: PathBuf,
-    /// Sampling interval of trajectory.csv \[s\].
+    /// Sampling interval of trajectory.csv, in seconds of simulated time.
     #[arg(long, default_value_t = 0.005)]
     sample_dt: f64,
+    /// Do not write trajectory.csv (steps.csv and summary.json only); an old one in --out is removed.
+    #[arg(long)]
+    no_trajectory: bool,
 }
+
+/// `GaitOptions::default().tolerance` as `--help` shows it (a test checks that they agree).
+const DEFAULT_TOLERANCE: &str = "1e-10";
 
 #[derive(Debug, Args)]
 struct GaitArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot`; default 0.72,1.0,0.0.
+    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot`; default as for simulate.
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
     /// Steps walked before Newton's method starts.
     #[arg(long, default_value_t = GaitOptions::default().transient_steps)]
     transient: usize,
-    /// Newton tolerance on max |P(s) - s|.
-    #[arg(long, default_value_t = GaitOptions::default().tolerance)]
+    /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
+    #[arg(long, default_value = DEFAULT_TOLERANCE)]
     tolerance: f64,
     /// Output directory for gait.json.
     #[arg(long, default_value = "out/gait")]
@@ -98,8 +106,8 @@ struct GaitArgs {
 struct SweepArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// The parameter to sweep (any numeric key, e.g. viscosity, slope, stiffness).
-    #[arg(long, default_value = "viscosity")]
+    /// The parameter to sweep: one of the real-valued keys (listed by `--help`).
+    #[arg(long, default_value = "viscosity", help = param_help())]
     param: String,
     /// First value.
     #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
@@ -110,12 +118,20 @@ struct SweepArgs {
     /// Number of values (ends included).
     #[arg(long, default_value_t = 300)]
     points: usize,
-    /// Where the search at the first point starts, `L2,thetadot,L2dot`; default 0.72,1.0,0.0.
+    /// Where the search at the first point starts, `L2,thetadot,L2dot`; default as for simulate.
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
     /// Output directory for sweep.csv, thresholds.json, fig2.svg and fig2.png.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
+}
+
+/// Help of `sweep --param`: the keys that can be swept, from [`Config::numeric_keys`].
+fn param_help() -> String {
+    format!(
+        "The parameter to sweep, one of: {}",
+        Config::numeric_keys().join(", ")
+    )
 }
 
 /// Run the parsed command.
@@ -127,15 +143,55 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// A progress bar on stderr when it is a terminal (hidden otherwise), with `template`.
+fn progress_bar(len: Option<u64>, template: &str) -> ProgressBar {
+    let bar = match len {
+        _ if !std::io::stderr().is_terminal() => ProgressBar::hidden(),
+        Some(len) => ProgressBar::new(len),
+        None => ProgressBar::new_spinner(),
+    };
+    bar.set_style(ProgressStyle::with_template(template).expect("the template is valid"));
+    bar
+}
+
+/// A flag set by Ctrl-C (a second Ctrl-C exits at once with code 130).
+fn interrupt_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let handler_flag = Arc::clone(&flag);
+    let installed = ctrlc::set_handler(move || {
+        if handler_flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: Ctrl-C will not stop the walk cleanly: {e}");
+    }
+    flag
+}
+
 fn simulate(args: SimulateArgs) -> Result<()> {
     let job = SimulateJob {
         config: args.model.load()?,
         initial: args.initial,
         steps: args.steps,
         sample_dt: args.sample_dt,
+        trajectory: !args.no_trajectory,
         out_dir: args.out.clone(),
+        interrupt: Some(interrupt_flag()),
     };
-    let summary = run_simulate(&job).context("simulate")?;
+    let bar = progress_bar(
+        Some(args.steps as u64),
+        "{bar:40} {pos}/{len} steps {msg} [{elapsed_precise}, eta {eta}]",
+    );
+    let summary = run_simulate(&job, &mut |event| match event {
+        SimulateEvent::Step(report) => {
+            bar.set_message(format!("t = {:.1} s", report.time + report.period));
+            bar.inc(1);
+        }
+        SimulateEvent::Warning(warning) => bar.suspend(|| eprintln!("warning: {warning}")),
+    })
+    .context("simulate")?;
+    bar.finish_and_clear();
     println!(
         "vrw simulate: c = {} N s/m, slope = {} rad, impact = {}; start (L2, thetadot, L2dot) = ({}, {}, {})",
         job.config.params.viscosity,
@@ -146,7 +202,7 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         summary.initial.l2_dot
     );
     println!(
-        "{} of {} steps in {:.4} s; max |energy residual| = {:.2e} J",
+        "{} of {} steps in {:.4} s of simulated time; max |energy residual| = {:.2e} J",
         summary.steps_completed,
         summary.steps_requested,
         summary.end_time,
@@ -172,25 +228,32 @@ fn simulate(args: SimulateArgs) -> Result<()> {
         );
     }
     println!(
-        "wrote {}/{{steps.csv, trajectory.csv, summary.json}}",
-        args.out.display()
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
     );
-    if let Some(message) = &summary.message {
-        bail!(
-            "walk stopped after {} steps: {message}",
-            summary.steps_completed
+    if summary.warnings_total > summary.warnings.len() {
+        eprintln!(
+            "warning: {} warnings in all ({} listed in summary.json)",
+            summary.warnings_total,
+            summary.warnings.len()
         );
     }
-    Ok(())
+    match &summary.message {
+        Some(_) if summary.status == "interrupted" => bail!(
+            "interrupted (Ctrl-C) after {} of {} steps; the results so far are written",
+            summary.steps_completed,
+            summary.steps_requested
+        ),
+        Some(message) => bail!(
+            "walk stopped after {} steps: {message}",
+            summary.steps_completed
+        ),
+        None => Ok(()),
+    }
 }
 
 fn gait(args: GaitArgs) -> Result<()> {
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        bail!(
-            "invalid --tolerance {}: must be a positive number",
-            args.tolerance
-        );
-    }
     let job = GaitJob {
         config: args.model.load()?,
         initial: args.initial,
@@ -201,7 +264,18 @@ fn gait(args: GaitArgs) -> Result<()> {
         },
         out_dir: args.out.clone(),
     };
-    let summary = run_gait(&job).context("gait")?;
+    let bar = progress_bar(
+        None,
+        "{spinner} searching the gait ({msg}) [{elapsed_precise}]",
+    );
+    bar.set_message(format!(
+        "{} transient steps, then Newton's method",
+        args.transient
+    ));
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let result = run_gait(&job);
+    bar.finish_and_clear();
+    let summary = result.context("gait")?;
     let p = &job.config.params;
     println!(
         "vrw gait: c = {} N s/m, slope = {} rad, impact = {}",
@@ -272,14 +346,9 @@ fn sweep(args: SweepArgs) -> Result<()> {
         options: GaitOptions::default(),
         out_dir: args.out.clone(),
     };
-    let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::new(args.points as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed_precise}]")
-            .expect("the template is valid"),
+    let bar = progress_bar(
+        Some(args.points as u64),
+        "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
     );
     let started = std::time::Instant::now();
     let summary = run_sweep(&job, &|p| {
@@ -322,4 +391,17 @@ fn sweep(args: SweepArgs) -> Result<()> {
         bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gait_tolerance_default_is_the_library_default() {
+        assert_eq!(
+            DEFAULT_TOLERANCE.parse::<f64>().unwrap(),
+            GaitOptions::default().tolerance
+        );
+    }
 }

@@ -1,4 +1,4 @@
-//! Contacts, stoppers and the constrained dynamics (MODEL.md section 3, paper Eqs. (1)-(2), (5)-(9)).
+//! Contacts, stoppers and the constrained dynamics (docs/model.md section 3, paper Eqs. (1)-(2), (5)-(9)).
 //!
 //! A *constraint unit* is either the no-slip contact of a leg tip with the ground (two rows: tangential and
 //! normal) or the stopper of a leg holding it at `L0` (one row, `dL/dt = 0`). The rows are stacked in the
@@ -42,7 +42,7 @@ impl Leg {
     /// Both legs, Leg 1 first.
     pub const BOTH: [Leg; 2] = [Leg::One, Leg::Two];
 
-    /// The leg index `j` of MODEL.md section 1.
+    /// The leg index `j` of docs/model.md section 1.
     pub fn index(self) -> usize {
         match self {
             Leg::One => 0,
@@ -153,7 +153,7 @@ impl ActiveSet {
         self.contact1 && self.contact2 && !self.slide1 && !self.slide2
     }
 
-    /// The support phase named by its contacts (MODEL.md section 4).
+    /// The support phase named by its contacts (docs/model.md section 4).
     pub fn phase(&self) -> Phase {
         match (self.contact1, self.contact2) {
             (true, true) => Phase::DoubleSupport,
@@ -195,8 +195,33 @@ pub enum ContactError {
     #[error("mass matrix is not positive definite")]
     SingularMass,
     /// The active constraints are redundant (e.g. both legs on the ground and both on their stoppers).
-    #[error("active constraints are redundant ({0:?})")]
+    #[error("active constraints are redundant ({0})")]
     RedundantConstraints(ActiveSet),
+}
+
+/// The active units in words, e.g. `Leg 1 tip fixed, Leg 2 tip sliding, Leg 2 stopper locked`.
+impl std::fmt::Display for ActiveSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut units = Vec::new();
+        for (contact, slide, lock, leg) in [
+            (self.contact1, self.slide1, self.lock1, 1),
+            (self.contact2, self.slide2, self.lock2, 2),
+        ] {
+            match (contact, slide) {
+                (true, false) => units.push(format!("Leg {leg} tip fixed")),
+                (true, true) => units.push(format!("Leg {leg} tip sliding")),
+                (false, _) => {}
+            }
+            if lock {
+                units.push(format!("Leg {leg} stopper locked"));
+            }
+        }
+        if units.is_empty() {
+            f.write_str("no contact, no stopper")
+        } else {
+            f.write_str(&units.join(", "))
+        }
+    }
 }
 
 /// Constrained accelerations and multipliers at one instant (the solution of the KKT system).
@@ -337,7 +362,7 @@ fn solve_schur<const K: usize>(
     Ok(chol_s.solve(&rhs))
 }
 
-/// Accelerations and multipliers of Eq. (1) with the constraints of `active` (MODEL.md section 3).
+/// Accelerations and multipliers of Eq. (1) with the constraints of `active` (docs/model.md section 3).
 pub fn constrained_dynamics(
     model: &Model,
     q: &Coords,

@@ -1,4 +1,4 @@
-//! Equations of motion of the viscoelastic-legged rimless wheel (MODEL.md sections 1-2, paper Eq. (1)).
+//! Equations of motion of the viscoelastic-legged rimless wheel (docs/model.md sections 1-2, paper Eq. (1)).
 //!
 //! The wheel is described by `q = [x, z, theta, L1, L2]` in the slope frame (`x` down the slope, `z` normal to
 //! it). `(x, z)` is the tip of Leg 1, `theta` the angle of Leg 1 from the slope normal, `L1`, `L2` the lengths of
@@ -11,7 +11,7 @@
 //! ```
 //!
 //! with `J_i = dp_i/dq` and `g_n = g (-sin phi, cos phi)` (minus the gravity vector). This is exactly Lagrange's
-//! equations for the energies of MODEL.md section 2 (the tests check it against finite differences of `T` and
+//! equations for the energies of docs/model.md section 2 (the tests check it against finite differences of `T` and
 //! `V`).
 
 use nalgebra::{SMatrix, SVector, Vector2};
@@ -57,7 +57,7 @@ impl PointKinematics {
 }
 
 /// Which leg of the wheel, counted from Leg 1 (`j = 0`) in the direction of Leg 2 (`j = 1`); the next leg to
-/// touch down is `j = N - 1` (MODEL.md section 1: `psi_j = theta + j alpha`).
+/// touch down is `j = N - 1` (docs/model.md section 1: `psi_j = theta + j alpha`).
 pub type LegIndex = usize;
 
 /// The validated model: parameters plus precomputed leg-angle offsets.
@@ -116,7 +116,7 @@ impl Model {
         self.params.hub_mass + self.legs() as f64 * self.params.leg_mass
     }
 
-    /// Length of leg `j`: `L1`, `L2` from `q`, the stopper length `L0` for the locked legs (MODEL.md section 2).
+    /// Length of leg `j`: `L1`, `L2` from `q`, the stopper length `L0` for the locked legs (docs/model.md section 2).
     pub fn leg_length(&self, q: &Coords, j: LegIndex) -> (f64, Option<usize>) {
         match j {
             0 => (q[L1], Some(L1)),
@@ -125,7 +125,7 @@ impl Model {
         }
     }
 
-    /// Hub kinematics: `p_H = (x + L1 sin theta, z + L1 cos theta)` (MODEL.md section 1).
+    /// Hub kinematics: `p_H = (x + L1 sin theta, z + L1 cos theta)` (docs/model.md section 1).
     pub fn hub(&self, q: &Coords, qd: &Coords) -> PointKinematics {
         let (s, c) = q[THETA].sin_cos();
         let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
@@ -201,7 +201,7 @@ impl Model {
     }
 
     /// Mass matrix `M(q)` and bias vector `h(q, q')` of Eq. (1): Coriolis/centrifugal terms, gravity, the leg
-    /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (MODEL.md section 2).
+    /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (docs/model.md section 2).
     ///
     /// Every point Jacobian has the form `J_i = [I_2 | b_theta | b_L1 | b_L2]` (the `x`, `z` columns are the
     /// identity), so `M = sum m_i J_i^T J_i` and `h = sum m_i J_i^T f_i` are accumulated from the three
@@ -315,7 +315,7 @@ impl Model {
     }
 
     /// Potential energy `V`: gravity of every body, `mass g (-p_x sin phi + p_z cos phi)`, plus the springs of
-    /// Legs 1 and 2, `1/2 k (Lstar - L)^2` \[J\] (MODEL.md section 2).
+    /// Legs 1 and 2, `1/2 k (Lstar - L)^2` \[J\] (docs/model.md section 2).
     pub fn potential_energy(&self, q: &Coords) -> f64 {
         let p = &self.params;
         let zero = Coords::zeros();

@@ -4,6 +4,29 @@
 use crate::contact::{ContactError, Phase};
 use crate::integrate::IntegrationError;
 
+/// A number in short form for messages: up to 6 significant digits, scientific notation when very small or
+/// very large.
+pub fn short(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-3..1e6).contains(&a) {
+        let text = format!("{v:.6}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        let text = format!("{v:.5e}");
+        match text.split_once('e') {
+            Some((mantissa, exponent)) if mantissa.contains('.') => format!(
+                "{}e{exponent}",
+                mantissa.trim_end_matches('0').trim_end_matches('.')
+            ),
+            _ => text,
+        }
+    }
+}
+
 /// A walk that cannot continue.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WalkError {
@@ -47,7 +70,7 @@ pub enum WalkError {
         /// Number of events in the step.
         events: usize,
     },
-    /// At touchdown the old Leg 2, which leaves `q`, was not locked at `L0` (MODEL.md section 5).
+    /// At touchdown the old Leg 2, which leaves `q`, was not locked at `L0` (docs/model.md section 5).
     #[error("old rear leg not relocked at touchdown (t = {time:.6} s, length {length:.6} m, rate {rate:.4} m/s)")]
     RearLegNotLocked {
         /// Time \[s\].
@@ -90,7 +113,7 @@ pub enum WalkError {
         source: IntegrationError,
     },
     /// A Poincare-section state the wheel cannot be in.
-    #[error("invalid section state: {field} = {value}: {reason}")]
+    #[error("invalid section state: {field} = {}: {reason}", short(*.value))]
     InvalidSection {
         /// Which component (`L2`, `thetadot`, `L2dot`).
         field: &'static str,
@@ -111,6 +134,25 @@ impl WalkError {
         }
     }
 
+    /// The time the walk stopped at \[s\], if the failure has one (every failure of a step has).
+    pub fn time(&self) -> Option<f64> {
+        match self {
+            WalkError::Fell { time, .. }
+            | WalkError::RolledBack { time, .. }
+            | WalkError::Stalled { time, .. }
+            | WalkError::Chatter { time, .. }
+            | WalkError::RearLegNotLocked { time, .. }
+            | WalkError::RearLegInContact { time }
+            | WalkError::InconsistentContacts { time, .. }
+            | WalkError::Contact { time, .. } => Some(*time),
+            WalkError::Integration { source, .. } => Some(match source {
+                IntegrationError::StepSizeTooSmall { time, .. }
+                | IntegrationError::NonFinite { time } => *time,
+            }),
+            WalkError::InvalidSection { .. } => None,
+        }
+    }
+
     /// A short machine-readable name of the failure (`fell`, `stalled`, ...), used in CSV and JSON output.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -124,6 +166,28 @@ impl WalkError {
             WalkError::Contact { .. } => "constraint_failure",
             WalkError::Integration { .. } => "solver_failure",
             WalkError::InvalidSection { .. } => "invalid_section",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short;
+
+    #[test]
+    fn short_numbers() {
+        for (v, text) in [
+            (0.0, "0"),
+            (1.0, "1"),
+            (-10.0, "-10"),
+            (0.1, "0.1"),
+            (123.456789, "123.456789"),
+            (1e308, "1e308"),
+            (1e-300, "1e-300"),
+            (-2.5e-7, "-2.5e-7"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(short(v), text, "{v:e}");
         }
     }
 }

@@ -3,8 +3,12 @@
 //! vrw simulates the viscoelastic-legged rimless wheel (VRW) of "Indicators for Emergence of Double-limb
 //! Support in Passive Dynamic Walking", decides at every touchdown whether double-limb support (DLS) emerges
 //! with the paper's DLS indicators (`lambda_I4`, `lambda_2+`, `lambda_4+`), finds the walking gait and its
-//! stability, sweeps parameters and draws the paper's Fig. 2. The physics is specified in `MODEL.md`; every
-//! module cites the section and the paper's equation it implements.
+//! stability, sweeps parameters and draws the paper's Fig. 2.
+//!
+//! The model is written down in `docs/model.md` of the repository: coordinates, bodies, contacts, events,
+//! the impact procedure, the step map, the audits, the numerical settings and every choice vrw makes where
+//! the paper is silent. Every module cites the section of that file (a few comments still call it
+//! `MODEL.md`; the section numbers are the same) and the paper's equation it implements.
 //!
 //! The modules follow the pipeline:
 //!
@@ -47,6 +51,11 @@
 //! assert!(gait.residual < 1e-10 && gait.stable);
 //! println!("lambda_4+ = {} N, multipliers {:?}", gait.lambda_4_plus, gait.floquet_multipliers);
 //! ```
+//!
+//! [`walk::simulate`] keeps every step report in memory. For long walks, [`walk::simulate_streaming`] hands
+//! each report to a callback as soon as its step is done and stops when an interrupt flag is set, and
+//! [`walk::Trajectory::streaming`] hands each sample to a [`walk::SampleSink`] (such as
+//! [`output::TrajectoryCsv`]). This is how `vrw simulate` runs in bounded memory ([`app::run_simulate`]).
 #![warn(missing_docs)]
 
 pub mod app;

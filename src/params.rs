@@ -1,8 +1,8 @@
 //! Parameters and configuration: the first stage of the pipeline.
 //!
-//! [`Params`] holds the physical model of the viscoelastic-legged rimless wheel (`MODEL.md` sections 1, 2
+//! [`Params`] holds the physical model of the viscoelastic-legged rimless wheel (`docs/model.md` sections 1, 2
 //! and 7, defaults from the paper's Table 1), [`SolverOptions`] the numerical settings, including every
-//! tolerance that guards grazing and chatter (`MODEL.md` section 4), and [`Config`] both of them together.
+//! tolerance that guards grazing and chatter (`docs/model.md` section 4), and [`Config`] both of them together.
 //!
 //! A configuration file is a *flat* TOML file whose keys are the field names of both structs; keys that
 //! are absent keep their defaults:
@@ -24,7 +24,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 use std::path::Path;
 
-/// Impact law at touchdown (`MODEL.md` section 5).
+use crate::error::short;
+
+/// Impact law at touchdown (`docs/model.md` section 5).
 ///
 /// In TOML and on the command line the values are the strings `"dlsi"` (default) and `"traditional"`;
 /// [`Display`](fmt::Display) gives the same strings.
@@ -63,7 +65,7 @@ impl fmt::Display for ImpactModel {
     }
 }
 
-/// What happens when no no-slip contact state is consistent (`MODEL.md` sections 3-4).
+/// What happens when no no-slip contact state is consistent (`docs/model.md` sections 3-4).
 ///
 /// At a lift-off where the tangential force of the no-slip contact is not zero (the paper's "scuffing" /
 /// open case), holding the tip needs a pulling normal force and releasing it drives the tip into the ground.
@@ -76,7 +78,7 @@ pub enum ContactInconsistency {
     /// The tip slides frictionlessly along the ground (normal constraint only) until its normal force
     /// vanishes: the limit of any friction cone as the normal force goes to zero. Default.
     Slide,
-    /// `MODEL.md` section 4 literally: the tip is released, re-contacts at once (plastic impact), and the
+    /// `docs/model.md` section 4 literally: the tip is released, re-contacts at once (plastic impact), and the
     /// force check (B1)-(B3) releases it again; the resulting chatter is bounded by `max_events_per_step`.
     Rebound,
 }
@@ -108,52 +110,52 @@ impl fmt::Display for ContactInconsistency {
     }
 }
 
-/// Physical parameters of the wheel and the slope (`MODEL.md` sections 1, 2 and 7).
+/// Physical parameters of the wheel and the slope (`docs/model.md` sections 1, 2 and 7).
 ///
 /// Defaults are the paper's Table 1; the viscosity `c` is the parameter the paper sweeps. Check a value
 /// built by hand with [`Params::validate`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Params {
     /// Number of legs `N` \[-\]. Default 8, i.e. the inter-leg angle `alpha = 2 pi / N = pi/4` of Table 1
-    /// (see [`Params::alpha`]). At least 3. `MODEL.md` section 1.
+    /// (see [`Params::alpha`]). From 3 to [`MAX_LEGS`]. `docs/model.md` section 1.
     pub legs: usize,
-    /// Hub mass `mH` \[kg\]. Default 10 (Table 1). Positive. `MODEL.md` section 2.
+    /// Hub mass `mH` \[kg\]. Default 10 (Table 1). Positive. `docs/model.md` section 2.
     pub hub_mass: f64,
     /// Rotational inertia `IH` of the hub about its centre \[kg m^2\]. Default 0: the paper gives none, so
-    /// this is an **assumption** (`MODEL.md` section 2). Non-negative.
+    /// this is an **assumption** (`docs/model.md` section 2). Non-negative.
     pub hub_inertia: f64,
     /// Leg mass `m` \[kg\], a point mass on the sliding part of each leg. Default 1 (Table 1). Positive.
-    /// `MODEL.md` section 2.
+    /// `docs/model.md` section 2.
     pub leg_mass: f64,
     /// Distance `a` of the leg mass from the leg's tip \[m\]. Default 0.3 (Table 1). In
-    /// `[0, stopper_length)`. `MODEL.md` section 2.
+    /// `[0, stopper_length)`. `docs/model.md` section 2.
     pub leg_mass_offset: f64,
     /// Stopper length `L0` \[m\]: the longest a leg can be (hub to tip); legs other than Leg 1 and Leg 2
-    /// are locked at it. Default 1.0 (Table 1). Positive. `MODEL.md` section 2.
+    /// are locked at it. Default 1.0 (Table 1). Positive. `docs/model.md` section 2.
     pub stopper_length: f64,
     /// Natural length `Lstar` of the leg spring \[m\]. Default 1.02 (Table 1). At least `stopper_length`:
     /// the spring is preloaded by `k (Lstar - L0)` (10 N by default) so that an unloaded leg rests on its
-    /// stopper. `MODEL.md` section 2.
+    /// stopper. `docs/model.md` section 2.
     pub spring_natural_length: f64,
-    /// Spring stiffness `k` of Legs 1 and 2 \[N/m\]. Default 500 (Table 1). Positive. `MODEL.md` section 2.
+    /// Spring stiffness `k` of Legs 1 and 2 \[N/m\]. Default 500 (Table 1). Positive. `docs/model.md` section 2.
     pub stiffness: f64,
     /// Damper viscosity `c` of Legs 1 and 2 \[N s/m\]: the force along a leg is
     /// `k (Lstar - L) - c dL/dt`. Default 50; the paper sweeps it (thresholds near 4.0 and 220).
-    /// Non-negative. `MODEL.md` sections 2 and 6.
+    /// Non-negative. `docs/model.md` sections 2 and 6.
     pub viscosity: f64,
     /// Slope angle `phi` \[rad\]; the wheel walks down a slope with `phi > 0`. Default 0.10 (Table 1).
-    /// `|phi| < pi/2`. `MODEL.md` section 1.
+    /// `|phi| < pi/2`. `docs/model.md` section 1.
     pub slope: f64,
-    /// Gravitational acceleration `g` \[m/s^2\]. Default 9.81. Positive. `MODEL.md` section 1.
+    /// Gravitational acceleration `g` \[m/s^2\]. Default 9.81. Positive. `docs/model.md` section 1.
     pub gravity: f64,
-    /// Impact law at touchdown. Default [`ImpactModel::Dlsi`]. `MODEL.md` section 5.
+    /// Impact law at touchdown. Default [`ImpactModel::Dlsi`]. `docs/model.md` section 5.
     pub impact: ImpactModel,
     /// Rigid special case: when `true`, every leg stays locked at `stopper_length` (the stopper acts both
     /// ways, through impacts too) and the exchange is the traditional one, which makes the model the
-    /// classical rigid rimless wheel with a closed-form step map. Default `false`. `MODEL.md` section 7.
+    /// classical rigid rimless wheel with a closed-form step map. Default `false`. `docs/model.md` section 7.
     pub rigid_legs: bool,
     /// What happens when no no-slip contact state is consistent (a lift-off with a non-zero tangential
-    /// contact force). Default [`ContactInconsistency::Slide`]. `MODEL.md` sections 3-4.
+    /// contact force). Default [`ContactInconsistency::Slide`]. `docs/model.md` sections 3-4.
     pub inconsistent_contact: ContactInconsistency,
 }
 
@@ -181,19 +183,24 @@ impl Default for Params {
 }
 
 impl Params {
-    /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`MODEL.md` section 1); `pi/4` by default.
+    /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`docs/model.md` section 1); `pi/4` by default.
     pub fn alpha(&self) -> f64 {
         2.0 * PI / self.legs as f64
     }
 
     /// Checks every rule on the physical parameters; the error names the first offending key.
     ///
-    /// Rules: `legs >= 3`; every real value finite; `hub_mass`, `leg_mass`, `gravity`, `stopper_length`,
+    /// Rules: `3 <= legs <=` [`MAX_LEGS`]; every real value finite; `hub_mass`, `leg_mass`, `gravity`, `stopper_length`,
     /// `stiffness > 0`; `hub_inertia`, `viscosity >= 0`; `|slope| < pi/2`;
-    /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length`.
+    /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length`;
+    /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        if self.legs < 3 {
-            return Err(invalid("legs", self.legs, "must be at least 3"));
+        if !(3..=MAX_LEGS).contains(&self.legs) {
+            return Err(invalid(
+                "legs",
+                self.legs,
+                format!("must be between 3 and {MAX_LEGS}"),
+            ));
         }
         positive("hub_mass", self.hub_mass)?;
         non_negative("hub_inertia", self.hub_inertia)?;
@@ -207,55 +214,79 @@ impl Params {
         if self.slope.abs() >= FRAC_PI_2 {
             return Err(invalid(
                 "slope",
-                self.slope,
+                short(self.slope),
                 "must satisfy |slope| < pi/2 (a slope angle in radians)",
             ));
         }
         positive("gravity", self.gravity)?;
+        let ratio = self.leg_mass / self.hub_mass;
+        if !(1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio) {
+            return Err(invalid(
+                "leg_mass",
+                short(self.leg_mass),
+                format!(
+                    "leg_mass / hub_mass = {} is outside [{}, {}]: the mass matrix would be singular to rounding",
+                    short(ratio),
+                    short(1.0 / MASS_RATIO_LIMIT),
+                    short(MASS_RATIO_LIMIT)
+                ),
+            ));
+        }
         below_stopper("leg_mass_offset", self.leg_mass_offset, self.stopper_length)?;
         if self.spring_natural_length < self.stopper_length {
             return Err(invalid(
                 "spring_natural_length",
-                self.spring_natural_length,
-                format!("must be >= stopper_length ({})", self.stopper_length),
+                short(self.spring_natural_length),
+                format!("must be >= stopper_length ({})", short(self.stopper_length)),
             ));
         }
         Ok(())
     }
 }
 
-/// Numerical settings of the integration and of the walk's event handling (`MODEL.md` section 4).
+/// `leg_mass / hub_mass` must lie in `[1 / MASS_RATIO_LIMIT, MASS_RATIO_LIMIT]`: beyond it `M(q)` is singular
+/// to rounding and the constraint solves fail.
+pub const MASS_RATIO_LIMIT: f64 = 1e6;
+
+/// The largest accepted number of legs.
+pub const MAX_LEGS: usize = 1000;
+
+/// Numerical settings of the integration and of the walk's event handling (`docs/model.md` section 4).
 ///
 /// Every tolerance that guards grazing or chatter is a named field here. Check a value built by hand
 /// with [`SolverOptions::validate`] (and [`Config::validate`] for the rule that involves [`Params`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SolverOptions {
-    /// Relative integration tolerance \[-\]. Default 1e-10. Positive.
+    /// Relative integration tolerance \[-\]. Default 1e-10. In [`RTOL_RANGE`] (1e-14 to 1e-3).
     pub rtol: f64,
-    /// Absolute integration tolerance \[state units: m, rad, m/s, rad/s\]. Default 1e-12. Positive.
+    /// Absolute integration tolerance \[state units: m, rad, m/s, rad/s\]. Default 1e-12. In [`ATOL_RANGE`]
+    /// (1e-16 to 1e-3).
     pub atol: f64,
-    /// Largest integrator step \[s\]. Default 0.02. Positive.
+    /// Largest integrator step \[s\]. Default 0.02. In [`MAX_STEP_RANGE`] (1e-6 to 1).
     pub max_step: f64,
-    /// Tolerance on located event times (root finding on the dense output) \[s\]. Default 1e-13. Positive.
-    /// `MODEL.md` section 4.
+    /// Tolerance on located event times (root finding on the dense output) \[s\]. Default 1e-13. In
+    /// [`EVENT_TIME_TOL_RANGE`] (1e-15 to 1e-9). `docs/model.md`, events.
     pub event_time_tol: f64,
-    /// Grazing guard for re-contact \[m\]. Default 1e-11. Positive. After a lift-off the tip leaves the
-    /// ground with zero velocity and acceleration, so a lifted tip's re-contact event is armed only once
-    /// its height exceeds this gap; before that it fires only if the tip sinks below `-recontact_gap`.
-    /// `MODEL.md` section 4 (grazing).
+    /// Grazing guard for re-contact \[m\]. Default 1e-11. In [`GAP_RANGE`] (1e-12 to 1e-6). After a lift-off
+    /// the tip leaves the ground with zero velocity and acceleration, so a lifted tip's re-contact event is
+    /// armed only once its height exceeds this gap; before that it fires only if the tip sinks `recontact_gap`
+    /// below where it started (this bounds the audit's `penetration` there).
+    /// `docs/model.md` section 4 (grazing).
     pub recontact_gap: f64,
-    /// The same grazing guard for an unlocked leg re-reaching its stopper \[m\]. Default 1e-9. Positive.
-    /// The stopper-lock event is armed only once `stopper_length - L > stopper_gap`. `MODEL.md` section 4.
+    /// The same grazing guard for an unlocked leg re-reaching its stopper \[m\]. Default 1e-9. In
+    /// [`GAP_RANGE`].
+    /// The stopper-lock event is armed only once `stopper_length - L > stopper_gap`. `docs/model.md` section 4.
     pub stopper_gap: f64,
     /// The run ends with the status `Fell` when the hub height above the slope drops below this \[m\].
-    /// Default 0.3. In `[0, stopper_length)`. `MODEL.md` section 4 (fall / stall).
+    /// Default 0.3. In `[0, stopper_length)`. `docs/model.md` section 4 (fall / stall).
     pub fall_hub_height: f64,
     /// The run ends with the status `Stalled` when no touchdown happens within this time of the previous
-    /// one \[s\]. Default 60 (heavily damped gaits creep through long double support). Positive.
-    /// `MODEL.md` section 4 (fall / stall).
+    /// one \[s\]. Default 60 (heavily damped gaits creep through long double support). In
+    /// [`MAX_STEP_TIME_RANGE`] (1e-3 to 1e4).
+    /// `docs/model.md` section 4 (fall / stall).
     pub max_step_time: f64,
     /// More events than this within one step ends the run with the status `Chatter` (a Zeno sequence of
-    /// contacts) \[-\]. Default 200. At least 1. `MODEL.md` section 4.
+    /// contacts) \[-\]. Default 200. From 1 to [`MAX_EVENTS_PER_STEP_LIMIT`]. `docs/model.md` section 4.
     pub max_events_per_step: usize,
 }
 
@@ -279,29 +310,52 @@ impl Default for SolverOptions {
 impl SolverOptions {
     /// Checks the numerical settings on their own; the error names the first offending key.
     ///
-    /// Rules: every real value finite; `rtol`, `atol`, `max_step`, `event_time_tol`, `recontact_gap`,
-    /// `stopper_gap`, `max_step_time > 0`; `fall_hub_height >= 0`; `max_events_per_step >= 1`. The upper
-    /// bound `fall_hub_height < stopper_length` needs the [`Params`] and is checked by
-    /// [`Config::validate`].
+    /// Rules: every real value finite; `rtol` in [`RTOL_RANGE`], `atol` in [`ATOL_RANGE`], `max_step` in
+    /// [`MAX_STEP_RANGE`], `event_time_tol` in [`EVENT_TIME_TOL_RANGE`], `recontact_gap` and `stopper_gap`
+    /// in [`GAP_RANGE`], `max_step_time` in [`MAX_STEP_TIME_RANGE`]; `fall_hub_height >= 0`;
+    /// `1 <= max_events_per_step <=` [`MAX_EVENTS_PER_STEP_LIMIT`]. The upper bound
+    /// `fall_hub_height < stopper_length` needs the [`Params`] and is checked by [`Config::validate`].
     pub fn validate(&self) -> Result<(), ConfigError> {
-        positive("rtol", self.rtol)?;
-        positive("atol", self.atol)?;
-        positive("max_step", self.max_step)?;
-        positive("event_time_tol", self.event_time_tol)?;
-        positive("recontact_gap", self.recontact_gap)?;
-        positive("stopper_gap", self.stopper_gap)?;
+        within("rtol", self.rtol, RTOL_RANGE)?;
+        within("atol", self.atol, ATOL_RANGE)?;
+        within("max_step", self.max_step, MAX_STEP_RANGE)?;
+        within("event_time_tol", self.event_time_tol, EVENT_TIME_TOL_RANGE)?;
+        within("recontact_gap", self.recontact_gap, GAP_RANGE)?;
+        within("stopper_gap", self.stopper_gap, GAP_RANGE)?;
         non_negative("fall_hub_height", self.fall_hub_height)?;
-        positive("max_step_time", self.max_step_time)?;
-        if self.max_events_per_step < 1 {
+        within("max_step_time", self.max_step_time, MAX_STEP_TIME_RANGE)?;
+        if !(1..=MAX_EVENTS_PER_STEP_LIMIT).contains(&self.max_events_per_step) {
             return Err(invalid(
                 "max_events_per_step",
                 self.max_events_per_step,
-                "must be at least 1",
+                format!("must be between 1 and {MAX_EVENTS_PER_STEP_LIMIT}"),
             ));
         }
         Ok(())
     }
 }
+
+/// Accepted range of `rtol` \[-\]: below 1e-14 the Dormand-Prince error estimate is rounding noise (machine
+/// epsilon is 2.2e-16); above 1e-3 the DLS indicators and thresholds are no longer meaningful.
+pub const RTOL_RANGE: [f64; 2] = [1e-14, 1e-3];
+/// Accepted range of `atol` \[state units\]: the same reasoning as [`RTOL_RANGE`], on states of order 1.
+pub const ATOL_RANGE: [f64; 2] = [1e-16, 1e-3];
+/// Accepted range of `max_step` \[s\]: a step is ~2.7 s of motion; below 1e-6 s a walk takes millions of
+/// integrator steps per touchdown.
+pub const MAX_STEP_RANGE: [f64; 2] = [1e-6, 1.0];
+/// Accepted range of `event_time_tol` \[s\]: events are located on the dense output to this; at tip speeds of
+/// order 1 m/s, 1e-9 s is already a position error of the size of the grazing guards ([`GAP_RANGE`]), so a
+/// looser tolerance would change results silently; below 1e-15 s is below the rounding of the time itself.
+pub const EVENT_TIME_TOL_RANGE: [f64; 2] = [1e-15, 1e-9];
+/// Accepted range of the grazing guards `recontact_gap` and `stopper_gap` \[m\]: they must exceed the
+/// position error of the integration and of event location (about 1e-12 m with the defaults) and stay far below
+/// the leg's scales (a guard of a millimetre would let a tip sink into the ground unseen).
+pub const GAP_RANGE: [f64; 2] = [1e-12, 1e-6];
+/// Accepted range of `max_step_time` \[s\]: a step of the paper's gait takes 2.7 s; the heavily damped gaits
+/// creep for tens of seconds.
+pub const MAX_STEP_TIME_RANGE: [f64; 2] = [1e-3, 1e4];
+/// The largest accepted `max_events_per_step`.
+pub const MAX_EVENTS_PER_STEP_LIMIT: usize = 1_000_000;
 
 /// Everything a run needs: physics ([`Params`]) and numerics ([`SolverOptions`]).
 ///
@@ -310,10 +364,10 @@ impl SolverOptions {
 /// `inconsistent_contact = "rebound"`, `rtol = 1e-11`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Config {
-    /// Physical parameters (`MODEL.md` sections 1, 2 and 7). Default: the paper's Table 1.
+    /// Physical parameters (`docs/model.md` sections 1, 2 and 7). Default: the paper's Table 1.
     #[serde(flatten)]
     pub params: Params,
-    /// Numerical settings (`MODEL.md` section 4). Default: [`SolverOptions::default`].
+    /// Numerical settings (`docs/model.md` section 4). Default: [`SolverOptions::default`].
     #[serde(flatten)]
     pub solver: SolverOptions,
 }
@@ -743,7 +797,7 @@ fn finite(key: &str, value: f64) -> Result<(), ConfigError> {
     if value.is_finite() {
         Ok(())
     } else {
-        Err(invalid(key, value, "must be finite"))
+        Err(invalid(key, short(value), "must be finite"))
     }
 }
 
@@ -753,7 +807,7 @@ fn positive(key: &str, value: f64) -> Result<(), ConfigError> {
     if value > 0.0 {
         Ok(())
     } else {
-        Err(invalid(key, value, "must be positive"))
+        Err(invalid(key, short(value), "must be positive"))
     }
 }
 
@@ -763,7 +817,21 @@ fn non_negative(key: &str, value: f64) -> Result<(), ConfigError> {
     if value >= 0.0 {
         Ok(())
     } else {
-        Err(invalid(key, value, "must be non-negative"))
+        Err(invalid(key, short(value), "must be non-negative"))
+    }
+}
+
+/// Requires a finite value in `[lo, hi]`.
+fn within(key: &str, value: f64, [lo, hi]: [f64; 2]) -> Result<(), ConfigError> {
+    finite(key, value)?;
+    if (lo..=hi).contains(&value) {
+        Ok(())
+    } else {
+        Err(invalid(
+            key,
+            short(value),
+            format!("must be between {} and {}", short(lo), short(hi)),
+        ))
     }
 }
 
@@ -774,8 +842,8 @@ fn below_stopper(key: &str, value: f64, stopper_length: f64) -> Result<(), Confi
     } else {
         Err(invalid(
             key,
-            value,
-            format!("must be < stopper_length ({stopper_length})"),
+            short(value),
+            format!("must be < stopper_length ({})", short(stopper_length)),
         ))
     }
 }
@@ -817,7 +885,7 @@ mod tests {
         assert_eq!(p.impact, ImpactModel::Dlsi);
         assert!(!p.rigid_legs);
         assert_eq!(p.inconsistent_contact, ContactInconsistency::Slide);
-        // The preload k (Lstar - L0) = 10 N exceeds the leg weight m g (MODEL.md section 2).
+        // The preload k (Lstar - L0) = 10 N exceeds the leg weight m g (docs/model.md section 2).
         let preload = p.stiffness * (p.spring_natural_length - p.stopper_length);
         assert!(preload > p.leg_mass * p.gravity);
 
@@ -1010,6 +1078,52 @@ mod tests {
             let error = Config::from_toml_str(&format!("{key} = {value}")).unwrap_err();
             assert_eq!(key_of(&error), Some(key), "TOML {assignment}: {error}");
         }
+    }
+
+    /// Every tolerance has a documented range; a value outside it (e.g. `event_time_tol = 0.01`, which would
+    /// silently change every event time) is refused with the range in the message.
+    #[test]
+    fn huge_or_tiny_tolerances_are_refused() {
+        let cases = [
+            ("rtol", RTOL_RANGE),
+            ("atol", ATOL_RANGE),
+            ("max_step", MAX_STEP_RANGE),
+            ("event_time_tol", EVENT_TIME_TOL_RANGE),
+            ("recontact_gap", GAP_RANGE),
+            ("stopper_gap", GAP_RANGE),
+            ("max_step_time", MAX_STEP_TIME_RANGE),
+        ];
+        let defaults = Config::default();
+        for (key, [lo, hi]) in cases {
+            let default = defaults.get_numeric(key).unwrap();
+            assert!(
+                (lo..=hi).contains(&default),
+                "{key}: default outside its range"
+            );
+            for bad in [lo / 10.0, hi * 10.0, 1e308] {
+                let mut config = Config::default();
+                config.set_numeric(key, bad).unwrap();
+                let error = config.validate().unwrap_err();
+                assert_eq!(key_of(&error), Some(key), "{key} = {bad}: {error}");
+                let message = error.to_string();
+                assert!(message.contains("between"), "{message}");
+                assert!(!message.contains("0000000"), "not in short form: {message}");
+            }
+        }
+        let mut config = Config::default();
+        config.solver.max_events_per_step = MAX_EVENTS_PER_STEP_LIMIT + 1;
+        assert_eq!(
+            key_of(&config.validate().unwrap_err()),
+            Some("max_events_per_step")
+        );
+        let mut config = Config::default();
+        config.params.legs = MAX_LEGS + 1;
+        assert_eq!(key_of(&config.validate().unwrap_err()), Some("legs"));
+        let mut config = Config::default();
+        config.params.leg_mass = 1e-300;
+        let error = config.validate().unwrap_err();
+        assert_eq!(key_of(&error), Some("leg_mass"));
+        assert!(error.to_string().contains("1e-300"), "{error}");
     }
 
     #[test]

@@ -86,7 +86,7 @@ impl OdeSystem<2> for HarmonicOscillator {
     }
 }
 
-/// The classical rigid rimless wheel (MODEL.md section 7): the VRW with `rigid_legs`, whose step map is known
+/// The classical rigid rimless wheel (docs/model.md section 7): the VRW with `rigid_legs`, whose step map is known
 /// in closed form. Angular momentum about the new contact point is conserved through the impact, so
 /// `omega+ = eta omega-` with `eta = 1 - M L0^2 (1 - cos alpha) / I_P`; between impacts the wheel rotates
 /// rigidly about its stance tip from `theta = -alpha/2` to `alpha/2`, gaining

@@ -128,6 +128,21 @@ fn assert_no_output(run: &Run) {
     );
 }
 
+/// The last sample of `trajectory` (default sampling interval 0.005 s) lies within one interval before
+/// `end_time`: nothing computed was lost, and nothing was sampled past the end.
+fn assert_trajectory_reaches(trajectory: &str, end_time: f64) {
+    let last_time: f64 = trajectory
+        .lines()
+        .last()
+        .and_then(|row| row.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .expect("trajectory.csv has samples");
+    assert!(
+        last_time <= end_time && end_time - last_time < 0.005 + 1e-9,
+        "last sample at {last_time} s, end time {end_time} s"
+    );
+}
+
 fn data_rows(csv: &str) -> usize {
     csv.lines().skip(1).filter(|l| !l.trim().is_empty()).count()
 }
@@ -272,6 +287,14 @@ fn initial_leg_longer_than_stopper_is_rejected() {
 fn zero_sample_interval_is_rejected() {
     let run = simulate(&["--steps", "1", "--sample-dt", "0"]);
     assert_error(&run, &["--sample-dt"]);
+    assert_no_output(&run);
+}
+
+/// A sampling interval so small that the sampler would run for ages is refused.
+#[test]
+fn tiny_sample_interval_is_refused() {
+    let run = simulate(&["--steps", "1", "--sample-dt", "1e-300"]);
+    assert_error(&run, &["--sample-dt", "1e-300"]);
     assert_no_output(&run);
 }
 
@@ -424,4 +447,206 @@ fn sweep_of_an_unknown_parameter_is_rejected() {
 fn sweep_with_an_empty_range_is_rejected() {
     let run = command_in(temp_dir_with(&[]), "sweep", &["--from", "5", "--to", "5"]);
     assert_error(&run, &["range"]);
+}
+
+/// A sweep whose range leaves the parameter's domain (a negative viscosity) is refused before anything is
+/// computed, instead of being reported as a physical threshold.
+#[test]
+fn sweep_range_below_domain_is_refused_before_computing() {
+    let run = command_in(
+        temp_dir_with(&[]),
+        "sweep",
+        &["--from=-10", "--to", "50", "--points", "3"],
+    );
+    assert_error(&run, &["viscosity", "-10", "non-negative"]);
+    assert!(!run.out.exists(), "the sweep wrote {}", run.out.display());
+}
+
+/// Tolerances have upper bounds: a huge `event_time_tol` would silently change every event time.
+#[test]
+fn huge_event_time_tol_is_refused() {
+    for value in ["0.01", "1e308"] {
+        let run = simulate(&["--steps", "1", "--set", &format!("event_time_tol={value}")]);
+        assert_error(&run, &["event_time_tol", value, "between"]);
+        assert_no_output(&run);
+    }
+}
+
+/// Errors quote numbers as given, in short form: no 300-digit expansions, no Rust debug output.
+#[test]
+fn errors_print_numbers_in_short_form() {
+    for (assignment, value) in [
+        ("leg_mass=1e-300", "1e-300"),
+        ("slope=1e308", "1e308"),
+        ("rtol=1e-300", "1e-300"),
+    ] {
+        let run = simulate(&["--steps", "1", "--set", assignment]);
+        assert_error(&run, &[value]);
+        let stderr = run.stderr();
+        assert!(
+            !stderr.contains("0000000") && !stderr.contains('{') && !stderr.contains("Some("),
+            "{assignment}: {stderr}"
+        );
+    }
+    let run = simulate(&["--steps", "1", "--initial", "1e300,1,0"]);
+    assert_error(&run, &["L2 = 1e300"]);
+}
+
+/// `--out` naming an existing file says so, for every command.
+#[test]
+fn out_naming_a_file_is_refused() {
+    for command in ["simulate", "gait", "sweep"] {
+        let run = command_in(temp_dir_with(&[("out", "not a directory")]), command, &[]);
+        assert_error(&run, &["is an existing file", "--out"]);
+    }
+}
+
+/// A run that fails in its first step ends at the time of the failure, not at 0.
+#[test]
+fn end_time_of_a_run_failing_in_its_first_step_is_the_failure_time() {
+    let run = simulate(&["--steps", "3", "--set", "legs=3"]);
+    assert_error(&run, &["stopped"]);
+    let summary = run.summary();
+    assert_eq!(summary["steps_completed"], 0);
+    let end_time = summary["end_time"].as_f64().expect("end_time is a number");
+    assert!(end_time > 0.0, "end_time = {end_time}");
+    let message = summary["message"].as_str().expect("message is a string");
+    assert!(
+        message.contains(&format!("t = {end_time:.6} s")),
+        "end_time {end_time} is not the failure time: {message}"
+    );
+    assert_trajectory_reaches(&run.read("trajectory.csv"), end_time);
+}
+
+/// `simulate` streams steps.csv and summary.json keeps its aggregates; `--no-trajectory` writes no
+/// trajectory.csv.
+#[test]
+fn simulate_streams_and_no_trajectory_skips_file() {
+    // A trajectory.csv of an earlier run would not match: it goes.
+    let dir = temp_dir_with(&[]);
+    fs::create_dir(dir.path().join("out")).unwrap();
+    fs::write(dir.path().join("out/trajectory.csv"), "stale").unwrap();
+    let run = simulate_in(dir, &["--steps", "4", "--no-trajectory"]);
+    assert_eq!(run.code(), Some(0), "stderr:\n{}", run.stderr());
+    assert!(!run.out.join("trajectory.csv").exists());
+    assert!(run.stdout().contains("simulated time"), "{}", run.stdout());
+    assert!(!run.stdout().contains("trajectory.csv"), "{}", run.stdout());
+    assert_eq!(data_rows(&run.read("steps.csv")), 4);
+    let summary = run.summary();
+    assert_eq!(summary["status"], "completed");
+    assert_eq!(
+        summary["files"],
+        serde_json::json!(["steps.csv", "summary.json"])
+    );
+    let branches: u64 = summary["branches"]
+        .as_object()
+        .expect("branches is an object")
+        .values()
+        .map(|n| n.as_u64().unwrap())
+        .sum();
+    assert_eq!(branches, 4);
+    assert!(summary["warnings"].is_array());
+}
+
+/// Ctrl-C (SIGINT) stops a long walk at the next touchdown; every completed step is in steps.csv and
+/// summary.json says `interrupted`.
+#[cfg(unix)]
+#[test]
+fn interrupted_run_keeps_what_was_computed() {
+    use std::time::{Duration, Instant};
+    let dir = temp_dir_with(&[]);
+    let out = dir.path().join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vrw"))
+        .args(["simulate", "--steps", "100000000", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("cannot run the vrw binary");
+    let started = Instant::now();
+    let steps_path = out.join("steps.csv");
+    while fs::read_to_string(&steps_path).map_or(0, |s| data_rows(&s)) < 3 {
+        if started.elapsed() > Duration::from_secs(120) {
+            child.kill().ok();
+            panic!("no steps streamed to steps.csv within 120 s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let signal = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("cannot run kill");
+    assert!(signal.success());
+    let waited = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if waited.elapsed() > Duration::from_secs(60) {
+            child.kill().ok();
+            panic!("vrw did not stop within 60 s of SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
+    assert_eq!(status.code(), Some(EXIT_FAILURE), "stderr:\n{stderr}");
+    assert!(stderr.contains("interrupted"), "stderr:\n{stderr}");
+
+    let summary: Value =
+        serde_json::from_str(&fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "interrupted");
+    let completed = summary["steps_completed"].as_u64().unwrap();
+    assert!(completed >= 3, "{completed}");
+    assert_eq!(
+        data_rows(&fs::read_to_string(&steps_path).unwrap()) as u64,
+        completed
+    );
+    let end_time = summary["end_time"].as_f64().unwrap();
+    assert_trajectory_reaches(
+        &fs::read_to_string(out.join("trajectory.csv")).unwrap(),
+        end_time,
+    );
+}
+
+/// A Newton tolerance below what the step map can reach is refused with a hint.
+#[test]
+fn gait_tolerance_below_reach_is_refused_with_a_hint() {
+    let run = command_in(temp_dir_with(&[]), "gait", &["--tolerance", "1e-20"]);
+    assert_error(&run, &["--tolerance", "1e-20", "1e-13"]);
+}
+
+/// `--help` of every command is plain text: no rustdoc escapes such as `\[s\]`; `sweep --param` lists the
+/// keys that can be swept.
+#[test]
+fn help_has_no_backslashes_and_lists_sweepable_keys() {
+    for command in [None, Some("simulate"), Some("gait"), Some("sweep")] {
+        let output = Command::new(env!("CARGO_BIN_EXE_vrw"))
+            .args(command)
+            .arg("--help")
+            .output()
+            .unwrap();
+        let help = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{command:?}");
+        assert!(!help.contains('\\'), "{command:?} --help:\n{help}");
+        if command == Some("sweep") {
+            for key in vrw::params::Config::numeric_keys() {
+                assert!(help.contains(key), "sweep --help lacks {key}:\n{help}");
+            }
+        }
+    }
+}
+
+/// With rigid legs the default start is the rigid wheel's gait, so `vrw simulate --set rigid_legs=true` walks.
+#[test]
+fn rigid_legs_default_start_walks() {
+    let run = simulate(&[
+        "--steps",
+        "5",
+        "--set",
+        "rigid_legs=true",
+        "--no-trajectory",
+    ]);
+    assert_eq!(run.code(), Some(0), "stderr:\n{}", run.stderr());
+    assert_eq!(run.summary()["status"], "completed");
 }

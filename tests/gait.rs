@@ -1,4 +1,4 @@
-//! Gait analysis checks (MODEL.md sections 6-7).
+//! Gait analysis checks (docs/model.md sections 6-7).
 
 use approx::assert_relative_eq;
 
@@ -23,7 +23,7 @@ fn rigid_config() -> Config {
     config
 }
 
-/// MODEL.md section 7: the rigid rimless wheel's fixed point and Floquet multiplier in closed form.
+/// docs/model.md section 7: the rigid rimless wheel's fixed point and Floquet multiplier in closed form.
 #[test]
 fn rigid_wheel_gait_matches_the_closed_form() {
     let config = rigid_config();
@@ -192,16 +192,21 @@ fn sweep_rejects_bad_specifications() {
             "{param} {from} {to} {points}"
         );
     }
-    // A range reaching invalid values reports those points, and keeps the others.
-    let spec = SweepSpec {
-        param: "viscosity".into(),
-        from: -10.0,
-        to: 10.0,
-        points: 3,
-    };
-    let points = sweep(&config, &spec, &start, &options, &|_| {}).unwrap();
-    assert_eq!(points[0].status, "invalid_parameter");
-    assert!(points[2].gait.is_some());
+    // A range leaving the parameter's domain is refused before anything is computed, at either end.
+    for (from, to) in [(-10.0, 10.0), (10.0, -10.0)] {
+        let spec = SweepSpec {
+            param: "viscosity".into(),
+            from,
+            to,
+            points: 3,
+        };
+        let error = sweep(&config, &spec, &start, &options, &|_| {}).unwrap_err();
+        let message = error.to_string();
+        assert!(
+            message.contains("viscosity") && message.contains("-10"),
+            "{message}"
+        );
+    }
 }
 
 /// Locks the numerics (STYLE.md point 10): the paper-parameter gait as computed when this test was written.

@@ -1,4 +1,4 @@
-//! The physics checks of MODEL.md section 7 on the full walk.
+//! The physics checks of docs/model.md section 7 on the full walk.
 
 use approx::assert_relative_eq;
 use nalgebra::Vector2;
@@ -188,7 +188,7 @@ fn model_dlsi() -> Model {
     Model::new(&Params::default()).unwrap()
 }
 
-/// Rigid special case (MODEL.md section 7): the step map of the walk equals the closed form.
+/// Rigid special case (docs/model.md section 7): the step map of the walk equals the closed form.
 #[test]
 fn rigid_legs_follow_the_closed_form_step_map() {
     let mut config = Config::default();
@@ -234,7 +234,7 @@ fn rear_scuff_does_not_lift_the_loaded_fore_leg() {
     assert!(run.steps.iter().all(|s| !s.bounce));
 }
 
-/// The grazing guard: with the literal MODEL.md rule (rebound) the walk must neither hang nor chatter forever.
+/// The grazing guard: with the literal docs/model.md rule (rebound) the walk must neither hang nor chatter forever.
 #[test]
 fn rebound_option_terminates_with_a_status() {
     let mut config = Config::default();

@@ -1,5 +1,5 @@
 //! The passive gait: a fixed point `s* = P(s*)` of the step map, found by Newton's method, and its stability
-//! from the eigenvalues of `DP(s*)` (the Floquet multipliers) (MODEL.md section 6).
+//! from the eigenvalues of `DP(s*)` (the Floquet multipliers) (docs/model.md section 6).
 
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;

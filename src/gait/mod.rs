@@ -1,4 +1,4 @@
-//! Gait analysis (MODEL.md section 6): the step map, limit cycles and their stability, parameter sweeps with
+//! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, parameter sweeps with
 //! continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
 
 pub mod continuation;

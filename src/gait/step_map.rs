@@ -1,4 +1,4 @@
-//! The step map `P` on the Poincare section (MODEL.md section 6) and its Jacobian.
+//! The step map `P` on the Poincare section (docs/model.md section 6) and its Jacobian.
 //!
 //! `P(s)` walks one step from the section state `s = (L2, dtheta/dt, dL2/dt)` to the next touchdown. With
 //! `rigid_legs` only `dtheta/dt` is free (`L2 = L0`, `dL2/dt = 0` always), so the map acts on that coordinate

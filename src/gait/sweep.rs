@@ -20,8 +20,12 @@ use super::continuation::{section_distance, Continuation, FamilyPoint, Followed,
 use super::limit_cycle::{find_gait, Gait, GaitOptions};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
+use crate::error::short;
 use crate::params::{Config, ConfigError, SolverOptions};
 use crate::walk::SectionState;
+
+/// The most points a sweep may have.
+pub const MAX_SWEEP_POINTS: usize = 100_000;
 
 /// What to sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -32,12 +36,13 @@ pub struct SweepSpec {
     pub from: f64,
     /// Last value.
     pub to: f64,
-    /// Number of values, evenly spaced, ends included (at least 2).
+    /// Number of values, evenly spaced, ends included (2 to [`MAX_SWEEP_POINTS`]).
     pub points: usize,
 }
 
 impl SweepSpec {
-    /// Check the specification against a configuration.
+    /// Check the specification against a configuration: a known numeric key, two different finite ends, at
+    /// least 2 points, and a configuration that is valid with the parameter at either end.
     pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
         config.get_numeric(&self.param)?;
         let invalid = |value: String, reason: &str| ConfigError::InvalidValue {
@@ -47,15 +52,27 @@ impl SweepSpec {
         };
         if !(self.from.is_finite() && self.to.is_finite()) || self.from == self.to {
             return Err(invalid(
-                format!("{}..{}", self.from, self.to),
+                format!("{}..{}", short(self.from), short(self.to)),
                 "the range must have two different finite ends",
             ));
         }
-        if self.points < 2 {
+        if !(2..=MAX_SWEEP_POINTS).contains(&self.points) {
             return Err(invalid(
                 self.points.to_string(),
-                "at least 2 points are needed",
+                &format!("the number of points must be between 2 and {MAX_SWEEP_POINTS}"),
             ));
+        }
+        // Every rule of the configuration must hold at both ends (the rules on one key are intervals, so the
+        // whole range is then valid), before anything is computed.
+        for (end, value) in [("from", self.from), ("to", self.to)] {
+            let mut at_end = config.clone();
+            at_end.set_numeric(&self.param, value)?;
+            if let Err(e) = at_end.validate() {
+                return Err(invalid(
+                    format!("--{end} {}", short(value)),
+                    &format!("the range leaves the valid domain: {e}"),
+                ));
+            }
         }
         Ok(())
     }

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::gait::SweepPoint;
-use crate::walk::{Sample, StepReport};
+use crate::walk::{Sample, SampleSink, StepReport};
 
 /// Writing a result file failed.
 #[derive(Debug, thiserror::Error)]
@@ -32,6 +32,12 @@ pub enum OutputError {
         path: PathBuf,
         /// Why.
         source: csv::Error,
+    },
+    /// The output directory names an existing file.
+    #[error("output directory {path} is an existing file, not a directory: choose another --out")]
+    NotADirectory {
+        /// The path.
+        path: PathBuf,
     },
     /// JSON encoding failed.
     #[error("cannot write JSON {path}: {source}")]
@@ -56,8 +62,13 @@ pub fn num(v: f64) -> String {
     }
 }
 
-/// Create `dir` (and its parents) if needed.
+/// Create `dir` (and its parents) if needed; a `dir` that is an existing file is refused.
 pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(OutputError::NotADirectory {
+            path: dir.to_path_buf(),
+        });
+    }
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
         path: dir.to_path_buf(),
         source,
@@ -143,46 +154,116 @@ pub const STEPS_HEADER: [&str; 28] = [
     "penetration",
 ];
 
+/// One row of `steps.csv` (columns of [`STEPS_HEADER`]).
+fn step_row(s: &StepReport) -> [String; STEPS_HEADER.len()] {
+    let e = &s.energy;
+    [
+        s.step.to_string(),
+        num(s.time),
+        num(s.section.l2),
+        num(s.section.theta_dot),
+        num(s.section.l2_dot),
+        num(s.theta),
+        num(s.indicators.lambda_i4),
+        num(s.indicators.lambda_2_plus),
+        num(s.indicators.lambda_4_plus),
+        s.branch.to_string(),
+        num(s.dls_duration),
+        num(s.period),
+        num(s.step_length),
+        num(s.speed),
+        s.scuffing.to_string(),
+        s.bounce.to_string(),
+        s.events.to_string(),
+        num(e.start),
+        num(e.end),
+        num(e.loss),
+        num(e.damper),
+        num(e.impact),
+        num(e.stopper),
+        num(e.residual),
+        num(s.rear_contact_duration),
+        num(s.contact.pull_force),
+        num(s.contact.pull_impulse),
+        num(s.contact.penetration),
+    ]
+}
+
+/// A CSV file written row by row: each row is flushed to the file as soon as it is written, so an
+/// interrupted or crashed run keeps every row it produced and memory does not grow with the rows.
+pub struct CsvStream {
+    w: csv::Writer<File>,
+    path: PathBuf,
+}
+
+impl CsvStream {
+    /// Create (truncate) `path` and write `header`.
+    pub fn create<I, T>(path: &Path, header: I) -> Result<CsvStream, OutputError>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<[u8]>,
+    {
+        let mut w = csv_writer(path)?;
+        write_record(&mut w, path, header)?;
+        Ok(CsvStream {
+            w,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Write one row, without flushing.
+    fn row<I, T>(&mut self, record: I) -> Result<(), csv::Error>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<[u8]>,
+    {
+        self.w.write_record(record)
+    }
+
+    /// Write one row and flush it to the file.
+    pub fn write<I, T>(&mut self, record: I) -> Result<(), OutputError>
+    where
+        I: IntoIterator<Item = T>,
+        T: AsRef<[u8]>,
+    {
+        write_record(&mut self.w, &self.path, record)?;
+        self.flush()
+    }
+
+    /// Flush the rows written so far to the file.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        self.w.flush().map_err(|source| OutputError::Io {
+            path: self.path.clone(),
+            source,
+        })
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// `steps.csv` written step by step ([`CsvStream`]).
+pub struct StepsCsv(CsvStream);
+
+impl StepsCsv {
+    /// Create `path` with the header [`STEPS_HEADER`].
+    pub fn create(path: &Path) -> Result<StepsCsv, OutputError> {
+        CsvStream::create(path, STEPS_HEADER).map(StepsCsv)
+    }
+
+    /// Write the row of one step and flush it.
+    pub fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
+        self.0.write(step_row(step))
+    }
+}
+
 /// Write the per-step table `steps.csv`: one row per touchdown (section state before it, DLS indicators,
 /// branch, step measures, flags, the energy audit, and the contact audit).
 pub fn write_steps_csv(path: &Path, steps: &[StepReport]) -> Result<(), OutputError> {
-    let mut w = csv_writer(path)?;
-    write_record(&mut w, path, STEPS_HEADER)?;
-    for s in steps {
-        let e = &s.energy;
-        let row = [
-            s.step.to_string(),
-            num(s.time),
-            num(s.section.l2),
-            num(s.section.theta_dot),
-            num(s.section.l2_dot),
-            num(s.theta),
-            num(s.indicators.lambda_i4),
-            num(s.indicators.lambda_2_plus),
-            num(s.indicators.lambda_4_plus),
-            s.branch.to_string(),
-            num(s.dls_duration),
-            num(s.period),
-            num(s.step_length),
-            num(s.speed),
-            s.scuffing.to_string(),
-            s.bounce.to_string(),
-            s.events.to_string(),
-            num(e.start),
-            num(e.end),
-            num(e.loss),
-            num(e.damper),
-            num(e.impact),
-            num(e.stopper),
-            num(e.residual),
-            num(s.rear_contact_duration),
-            num(s.contact.pull_force),
-            num(s.contact.pull_impulse),
-            num(s.contact.penetration),
-        ];
-        write_record(&mut w, path, row)?;
-    }
-    finish_csv(w, path)
+    let mut w = StepsCsv::create(path)?;
+    steps.iter().try_for_each(|s| w.write(s))
 }
 
 /// Header of `trajectory.csv`.
@@ -213,25 +294,60 @@ pub const TRAJECTORY_HEADER: [&str; 24] = [
     "leg1",
 ];
 
+/// One row of `trajectory.csv` (columns of [`TRAJECTORY_HEADER`]).
+fn sample_row(s: &Sample) -> Vec<String> {
+    let flag = |b: bool| if b { "1" } else { "0" }.to_string();
+    let mut row: Vec<String> = Vec::with_capacity(TRAJECTORY_HEADER.len());
+    row.push(num(s.time));
+    row.extend(s.q.iter().chain(s.qd.iter()).map(|v| num(*v)));
+    let a = &s.active;
+    row.extend([a.contact1, a.contact2, a.slide1, a.slide2, a.lock1, a.lock2].map(flag));
+    let m = &s.multipliers;
+    row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(num));
+    row.push(s.leg1.to_string());
+    row
+}
+
+/// `trajectory.csv` written sample by sample: the [`SampleSink`] of a streaming
+/// [`Trajectory`](crate::walk::Trajectory). Rows are buffered and flushed when the walk flushes the trajectory
+/// (after every step).
+pub struct TrajectoryCsv(CsvStream);
+
+impl TrajectoryCsv {
+    /// Create `path` with the header [`TRAJECTORY_HEADER`].
+    pub fn create(path: &Path) -> Result<TrajectoryCsv, OutputError> {
+        CsvStream::create(path, TRAJECTORY_HEADER).map(TrajectoryCsv)
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl SampleSink for TrajectoryCsv {
+    fn write(&mut self, sample: &Sample) -> std::io::Result<()> {
+        self.0.row(sample_row(sample)).map_err(std::io::Error::from)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.w.flush()
+    }
+}
+
 /// Write the sampled trajectory `trajectory.csv`: time, the ten states (`x` from the start of the walk), the
 /// active contacts and stoppers, the multipliers (stopper reactions positive inward) and which physical leg is
 /// Leg 1.
 pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), OutputError> {
-    let mut w = csv_writer(path)?;
-    write_record(&mut w, path, TRAJECTORY_HEADER)?;
-    let flag = |b: bool| if b { "1" } else { "0" }.to_string();
-    for s in samples {
-        let mut row: Vec<String> = Vec::with_capacity(TRAJECTORY_HEADER.len());
-        row.push(num(s.time));
-        row.extend(s.q.iter().chain(s.qd.iter()).map(|v| num(*v)));
-        let a = &s.active;
-        row.extend([a.contact1, a.contact2, a.slide1, a.slide2, a.lock1, a.lock2].map(flag));
-        let m = &s.multipliers;
-        row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(num));
-        row.push(s.leg1.to_string());
-        write_record(&mut w, path, row)?;
-    }
-    finish_csv(w, path)
+    let mut w = TrajectoryCsv::create(path)?;
+    samples
+        .iter()
+        .try_for_each(|s| w.write(s))
+        .and_then(|()| SampleSink::flush(&mut w))
+        .map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
 }
 
 /// Columns of `sweep.csv` after the parameter column.

@@ -146,22 +146,91 @@ pub struct Sample {
     pub leg1: usize,
 }
 
+/// Where a streaming [`Trajectory`] sends each sample as it is taken (for instance a CSV writer).
+pub trait SampleSink: Send {
+    /// Take one sample.
+    fn write(&mut self, sample: &Sample) -> std::io::Result<()>;
+    /// Push what is buffered to its destination ([`simulate_streaming`] calls it after every step).
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 /// Samples of the trajectory every `dt` seconds, plus one right after every event.
-#[derive(Debug, Clone)]
+///
+/// Two kinds: [`Trajectory::new`] keeps every sample in memory (in [`Trajectory::samples`]), for plots and
+/// tests of short walks; [`Trajectory::streaming`] hands each sample to a [`SampleSink`] as it is taken and
+/// keeps none, so a long walk runs in bounded memory. A sink that fails is not called again; its first error
+/// is kept for [`Trajectory::take_error`].
 pub struct Trajectory {
     dt: f64,
     next: usize,
-    /// The samples, in time order.
+    /// Time of the last sample taken, if any.
+    last_time: Option<f64>,
+    /// Samples taken so far.
+    taken: usize,
+    /// The samples, in time order (always empty for a streaming trajectory).
     pub samples: Vec<Sample>,
+    sink: Option<Box<dyn SampleSink>>,
+    error: Option<std::io::Error>,
+}
+
+impl std::fmt::Debug for Trajectory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Trajectory")
+            .field("dt", &self.dt)
+            .field("taken", &self.taken)
+            .field("samples", &self.samples.len())
+            .field("streaming", &self.sink.is_some())
+            .field("error", &self.error)
+            .finish()
+    }
 }
 
 impl Trajectory {
-    /// Sample every `dt` seconds of simulated time.
+    /// Sample every `dt` seconds of simulated time and keep the samples in memory.
     pub fn new(dt: f64) -> Trajectory {
         Trajectory {
             dt,
             next: 0,
+            last_time: None,
+            taken: 0,
             samples: Vec::new(),
+            sink: None,
+            error: None,
+        }
+    }
+
+    /// Sample every `dt` seconds of simulated time and hand each sample to `sink` as it is taken, keeping
+    /// none in memory.
+    pub fn streaming(dt: f64, sink: Box<dyn SampleSink>) -> Trajectory {
+        Trajectory {
+            sink: Some(sink),
+            ..Trajectory::new(dt)
+        }
+    }
+
+    /// Number of samples taken so far (kept or streamed).
+    pub fn len(&self) -> usize {
+        self.taken
+    }
+
+    /// No sample taken yet.
+    pub fn is_empty(&self) -> bool {
+        self.taken == 0
+    }
+
+    /// The first error of the sink, if it failed (it is then no longer called). Taking it clears it.
+    pub fn take_error(&mut self) -> Option<std::io::Error> {
+        self.error.take()
+    }
+
+    /// Flush the sink, if any (a failure is kept for [`Trajectory::take_error`]).
+    pub fn flush(&mut self) {
+        if let (Some(sink), None) = (&mut self.sink, &self.error) {
+            if let Err(e) = sink.flush() {
+                self.error = Some(e);
+            }
         }
     }
 
@@ -177,14 +246,26 @@ impl Trajectory {
         let multipliers = constrained_dynamics(model, &q, &qd, &active)
             .map_or(Multipliers::repeat(f64::NAN), |d| d.multipliers);
         q[X] += frame.x_origin;
-        self.samples.push(Sample {
+        let sample = Sample {
             time,
             q,
             qd,
             active,
             multipliers,
             leg1: frame.leg1,
-        });
+        };
+        self.last_time = Some(time);
+        self.taken += 1;
+        match &mut self.sink {
+            Some(sink) => {
+                if self.error.is_none() {
+                    if let Err(e) = sink.write(&sample) {
+                        self.error = Some(e);
+                    }
+                }
+            }
+            None => self.samples.push(sample),
+        }
     }
 
     fn record(
@@ -200,7 +281,7 @@ impl Trajectory {
             if t > until {
                 break;
             }
-            if t >= step.t0() && self.samples.last().is_none_or(|s| s.time < t) {
+            if t >= step.t0() && self.last_time.is_none_or(|last| last < t) {
                 self.push(model, t, &step.eval(t), active, frame);
             }
             self.next += 1;
@@ -816,33 +897,94 @@ pub struct WalkRun {
     pub steps: Vec<StepReport>,
     /// `None` if all requested steps were walked, else why the walk stopped.
     pub failure: Option<WalkError>,
-    /// Time reached \[s\].
+    /// Time reached \[s\]: the last touchdown, or the time of the failure if the walk stopped.
     pub time: f64,
 }
 
 /// Walk `steps` steps from `initial`, keeping every completed step when the walk stops early.
+///
+/// Every report is kept in memory; for long walks use [`simulate_streaming`].
 pub fn simulate(
     model: &Model,
     opts: &SolverOptions,
     initial: &SectionState,
     steps: usize,
-    mut trajectory: Option<&mut Trajectory>,
+    trajectory: Option<&mut Trajectory>,
 ) -> Result<WalkRun, WalkError> {
+    let mut reports = Vec::with_capacity(steps.min(1 << 16));
+    let end = simulate_streaming(model, opts, initial, steps, trajectory, None, |report| {
+        reports.push(*report);
+        Ok::<(), WalkError>(())
+    })?;
+    Ok(WalkRun {
+        steps: reports,
+        failure: end.failure,
+        time: end.time,
+    })
+}
+
+/// How a walk driven by [`simulate_streaming`] ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkEnd {
+    /// Steps completed.
+    pub steps: usize,
+    /// Why the walk stopped before the requested number of steps, if a step failed.
+    pub failure: Option<WalkError>,
+    /// The interrupt flag stopped the walk (between two steps).
+    pub interrupted: bool,
+    /// Time reached \[s\]: the last touchdown, or the time of the failure if a step failed.
+    pub time: f64,
+}
+
+/// Walk up to `steps` steps from `initial`, handing each step's report to `on_step` as soon as the step is
+/// done and keeping none, so memory does not grow with the number of steps. The trajectory, if any, is
+/// flushed after every step.
+///
+/// The walk stops early when a step fails (the failure and its time are in the [`WalkEnd`]), when `on_step`
+/// returns an error (returned as is), when the trajectory's sink fails (find its error with
+/// [`Trajectory::take_error`]), or when `interrupt` is set; the flag is checked before every step, so an
+/// interrupted walk ends at a touchdown with every completed step reported.
+pub fn simulate_streaming<E: From<WalkError>>(
+    model: &Model,
+    opts: &SolverOptions,
+    initial: &SectionState,
+    steps: usize,
+    mut trajectory: Option<&mut Trajectory>,
+    interrupt: Option<&std::sync::atomic::AtomicBool>,
+    mut on_step: impl FnMut(&StepReport) -> Result<(), E>,
+) -> Result<WalkEnd, E> {
     let mut walker = Walker::new(model, opts, initial)?;
-    let mut run = WalkRun {
-        steps: Vec::with_capacity(steps),
+    let mut end = WalkEnd {
+        steps: 0,
         failure: None,
-        time: 0.0,
+        interrupted: false,
+        time: walker.state().time,
     };
-    for _ in 0..steps {
-        match walker.step(trajectory.as_deref_mut()) {
-            Ok(report) => run.steps.push(report),
+    while end.steps < steps {
+        if interrupt.is_some_and(|flag| flag.load(std::sync::atomic::Ordering::Relaxed)) {
+            end.interrupted = true;
+            break;
+        }
+        let result = walker.step(trajectory.as_deref_mut());
+        let sink_failed = trajectory.as_deref_mut().is_some_and(|tr| {
+            tr.flush();
+            tr.error.is_some()
+        });
+        if sink_failed {
+            break;
+        }
+        match result {
+            Ok(report) => {
+                end.steps += 1;
+                end.time = walker.state().time;
+                on_step(&report)?;
+            }
             Err(e) => {
-                run.failure = Some(e);
+                end.time = e.time().unwrap_or(end.time);
+                end.failure = Some(e);
                 break;
             }
         }
-        run.time = walker.state().time;
     }
-    Ok(run)
+    Ok(end)
 }

@@ -1,4 +1,4 @@
-//! What a step reports (issue: per-step report and energy audit; MODEL.md sections 5 and 7).
+//! What a step reports (issue: per-step report and energy audit; docs/model.md sections 5 and 7).
 
 use serde::Serialize;
 
@@ -6,7 +6,7 @@ use super::impact::{Branch, DlsIndicators};
 use super::section::SectionState;
 
 /// Energy bookkeeping of one step, from just before its touchdown to just before the next one
-/// (MODEL.md section 7): the loss of `T + V` must equal the damper dissipation plus the impact and stopper
+/// (docs/model.md section 7): the loss of `T + V` must equal the damper dissipation plus the impact and stopper
 /// losses.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EnergyAudit {
@@ -52,7 +52,7 @@ pub struct StepReport {
     pub section: SectionState,
     /// `theta` at that touchdown, after re-indexing \[rad\].
     pub theta: f64,
-    /// The three DLS indicators of the touchdown (MODEL.md section 5).
+    /// The three DLS indicators of the touchdown (docs/model.md section 5).
     pub indicators: DlsIndicators,
     /// Branch of the impact procedure taken.
     pub branch: Branch,

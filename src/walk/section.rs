@@ -1,4 +1,4 @@
-//! The Poincare section of MODEL.md section 6: just before touchdown, after re-indexing.
+//! The Poincare section of docs/model.md section 6: just before touchdown, after re-indexing.
 //!
 //! There `x = z = 0` (the new Leg 1's tip is the origin), `L1 = L0`, `dL1/dt = 0`, and Leg 2's tip is on the
 //! ground and at rest, so the state reduces to `s = (L2, dtheta/dt, dL2/dt)`: `theta` follows from Leg 2's tip
