@@ -1,5 +1,9 @@
 //! The jobs the command line runs, as library functions (STYLE.md point 2: all science lives in the library).
 
+mod figures;
+
+pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -28,6 +32,15 @@ pub enum AppError {
     /// Results could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// A run directory could not be read back.
+    #[error(transparent)]
+    Read(#[from] crate::output::read::ReadError),
+    /// The animation could not be made.
+    #[error(transparent)]
+    Animate(#[from] crate::output::animate::AnimateError),
+    /// A figure could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] crate::output::style::PlotError),
     /// A bad command-line value that is not a model parameter.
     #[error("invalid {option}: {reason}")]
     InvalidOption {
@@ -52,6 +65,9 @@ pub fn default_initial(config: &Config) -> SectionState {
         l2_dot: 0.0,
     }
 }
+
+/// Default sampling interval of `trajectory.csv` \[s\].
+pub const DEFAULT_SAMPLE_DT: f64 = 0.005;
 
 /// What `vrw simulate` runs.
 #[derive(Debug, Clone)]
@@ -168,7 +184,7 @@ pub struct GaitJob {
     pub initial: Option<SectionState>,
     /// Search settings.
     pub options: GaitOptions,
-    /// Where `gait.json` goes.
+    /// Where `gait.json` goes, and one period of the gait in the files of `vrw simulate`.
     pub out_dir: PathBuf,
 }
 
@@ -192,7 +208,9 @@ pub struct GaitSummary {
     pub gait: Option<Gait>,
 }
 
-/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason).
+/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason), and
+/// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
+/// ([`write_gait_period`]).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     job.config.validate()?;
     let model = Model::new(&job.config.params)?;
@@ -214,7 +232,23 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     };
     output::ensure_dir(&job.out_dir)?;
     output::write_json(&job.out_dir.join("gait.json"), &summary)?;
+    if let Some(gait) = &summary.gait {
+        write_gait_period(job, gait)?;
+    }
     Ok(summary)
+}
+
+/// Walk one period from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
+/// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
+/// `vrw plot` and `vrw animate` work on a gait directly.
+pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
+    run_simulate(&SimulateJob {
+        config: job.config.clone(),
+        initial: Some(gait.section),
+        steps: 1,
+        sample_dt: DEFAULT_SAMPLE_DT,
+        out_dir: job.out_dir.clone(),
+    })
 }
 
 /// What `vrw sweep` runs.
