@@ -36,6 +36,7 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use rayon::prelude::*;
 
 use super::read::{Geometry, RunData, TipState, TrajectoryRow};
 use super::style::{
@@ -47,6 +48,8 @@ pub const SLOW_FRAMES: usize = 3;
 /// Largest frame rate: GIF delays are whole hundredths of a second and viewers slow down delays below
 /// 0.02 s, so faster frame rates would not play at their speed.
 pub const MAX_FPS: u32 = 50;
+/// Frames drawn in parallel before they are written.
+const RENDER_CHUNK: usize = 64;
 /// Smallest and largest frame side \[px\].
 pub const FRAME_SIDE: std::ops::RangeInclusive<u32> = 160..=4000;
 
@@ -195,6 +198,8 @@ pub struct SlowMotion {
     pub phase: String,
     /// Its real duration \[s\].
     pub duration: f64,
+    /// Frames it is shown in.
+    pub frames: usize,
 }
 
 /// One planned frame.
@@ -259,6 +264,7 @@ pub fn plan_frames(
             let slow = SlowMotion {
                 phase: samples[k].phase_name(),
                 duration: b - a,
+                frames: n,
             };
             frames.extend((0..n).map(|m| FrameTime {
                 time: a + (b - a) * m as f64 / n as f64,
@@ -573,15 +579,15 @@ fn draw_ground<DB: DrawingBackend>(
 ) -> DrawResult<DB> {
     let reach = 0.6 * f64::from(w) / view.scale;
     let (x0, x1) = (hub_x - reach, hub_x + reach);
-    // The band, in pixels just beyond the frame.
+    // The band, in pixels of the frame.
     let (left, right) = (view.px((x0, 0.0)), view.px((x1, 0.0)));
     let y_at = |x: i32| left.1 + (right.1 - left.1) * (x - left.0) / (right.0 - left.0).max(1);
     root.draw(&Polygon::new(
         vec![
-            (-4, y_at(-4)),
-            (w + 4, y_at(w + 4)),
-            (w + 4, h + 4),
-            (-4, h + 4),
+            (0, y_at(0)),
+            (w - 1, y_at(w - 1)),
+            (w - 1, h - 1),
+            (0, h - 1),
         ],
         GROUND.filled(),
     ))?;
@@ -590,10 +596,11 @@ fn draw_ground<DB: DrawingBackend>(
     let mut k = (x0 / hatch).floor() as i64;
     while (k as f64) * hatch <= x1 {
         let x = k as f64 * hatch;
-        root.draw(&PathElement::new(
-            vec![view.px((x, 0.0)), view.px((x - 0.6 * hatch, -0.6 * hatch))],
-            HATCH.stroke_width(2),
-        ))?;
+        // Plotters clamps points outside the frame to its edge: draw only strokes inside it.
+        let stroke = [view.px((x, 0.0)), view.px((x - 0.6 * hatch, -0.6 * hatch))];
+        if stroke.iter().all(|p| (0..w).contains(&p.0)) {
+            root.draw(&PathElement::new(stroke.to_vec(), HATCH.stroke_width(2)))?;
+        }
         let at = view.px((x, -0.12 * l0));
         if k % per_metre == 0 && (20..w - 20).contains(&at.0) {
             root.draw(&PathElement::new(
@@ -609,7 +616,7 @@ fn draw_ground<DB: DrawingBackend>(
         k += 1;
     }
     root.draw(&PathElement::new(
-        vec![view.px((x0, 0.0)), view.px((x1, 0.0))],
+        vec![(0, y_at(0)), (w - 1, y_at(w - 1))],
         INK.stroke_width(2),
     ))
 }
@@ -619,32 +626,27 @@ fn draw_legend<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, w: i32) -> Dra
     let size = 14.0;
     let x = w - 190;
     let mut y = 8;
-    let entries: [(&str, Option<TipState>); 4] = [
-        ("tip on ground, no slip", Some(TipState::Stuck)),
-        ("tip sliding", Some(TipState::Sliding)),
-        ("tip in the air", Some(TipState::Air)),
-        ("stopper locked", None),
+    // What each legend entry shows: a tip, a stopper bar, or a leg's colour.
+    enum Key {
+        Tip(TipState),
+        Bar(RGBColor, u32),
+    }
+    let entries = [
+        ("tip on ground, no slip", Key::Tip(TipState::Stuck)),
+        ("tip sliding", Key::Tip(TipState::Sliding)),
+        ("tip in the air", Key::Tip(TipState::Air)),
+        ("stopper locked", Key::Bar(STOPPER, 4)),
+        ("Leg 1", Key::Bar(COLOR_BLUE, 5)),
+        ("Leg 2", Key::Bar(COLOR_VERMILLION, 5)),
     ];
-    for (label, tip) in entries {
-        match tip {
-            Some(t) => draw_tip(root, (x, y + 8), 5, t)?,
-            None => root.draw(&PathElement::new(
+    for (label, key) in entries {
+        match key {
+            Key::Tip(t) => draw_tip(root, (x, y + 8), 5, t)?,
+            Key::Bar(color, width) => root.draw(&PathElement::new(
                 vec![(x - 7, y + 8), (x + 7, y + 8)],
-                STOPPER.stroke_width(4),
+                color.stroke_width(width),
             ))?,
         }
-        root.draw(&Text::new(
-            label,
-            (x + 14, y + 8),
-            font(size).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
-        y += 18;
-    }
-    for (label, color) in [("Leg 1", COLOR_BLUE), ("Leg 2", COLOR_VERMILLION)] {
-        root.draw(&PathElement::new(
-            vec![(x - 8, y + 8), (x + 8, y + 8)],
-            color.stroke_width(5),
-        ))?;
         root.draw(&Text::new(
             label,
             (x + 14, y + 8),
@@ -701,7 +703,10 @@ fn draw_frame<DB: DrawingBackend>(
     ))?;
     let (line, color) = match &text.slow {
         Some(s) => (
-            format!("slow motion: this phase lasts {:.4} s", s.duration),
+            format!(
+                "slow motion: {} lasts {:.4} s, shown in {} frames",
+                s.phase, s.duration, s.frames
+            ),
             SLOW,
         ),
         None if text.speed != 1.0 => (format!("playback {}x real time", text.speed), INK),
@@ -803,31 +808,53 @@ pub fn write_animation(
         .map_err(|e| write_err(e.to_string()))?;
 
     let renderer = Renderer::new(run, opts);
-    let mut rgb = vec![255u8; w * h * 3];
-    let mut previous: Option<Vec<u8>> = None;
-    let mut indices = vec![0u8; w * h];
     let centis = |k: usize| (k as f64 * 100.0 / f64::from(opts.fps)).round() as u64;
-    for (k, frame) in frames.iter().enumerate() {
-        {
-            let root =
-                BitMapBackend::with_buffer(&mut rgb, (opts.width, opts.height)).into_drawing_area();
-            renderer.draw(&root, frame, path)?;
+    // Frames are drawn, mapped to the palette and LZW-compressed in parallel, a chunk at a time, and written
+    // in order.
+    let mut previous: Option<Vec<u8>> = None;
+    for (c, chunk) in frames.chunks(RENDER_CHUNK).enumerate() {
+        let indexed: Vec<Vec<u8>> = chunk
+            .par_iter()
+            .map_init(
+                || vec![255u8; w * h * 3],
+                |rgb, frame| {
+                    {
+                        let root = BitMapBackend::with_buffer(rgb, (opts.width, opts.height))
+                            .into_drawing_area();
+                        renderer.draw(&root, frame, path)?;
+                    }
+                    Ok(rgb
+                        .chunks_exact(3)
+                        .map(|px| {
+                            lut[(usize::from(px[0] >> 3) << 10)
+                                | (usize::from(px[1] >> 3) << 5)
+                                | usize::from(px[2] >> 3)]
+                        })
+                        .collect())
+                },
+            )
+            .collect::<Result<_, PlotError>>()?;
+        let encoded: Vec<gif::Frame<'static>> = (0..indexed.len())
+            .into_par_iter()
+            .map(|i| {
+                let k = c * RENDER_CHUNK + i;
+                let before = if i == 0 {
+                    previous.as_deref()
+                } else {
+                    Some(indexed[i - 1].as_slice())
+                };
+                let delay = (centis(k + 1) - centis(k)) as u16;
+                let mut frame = changed_rect(before, &indexed[i], w, h, transparent, delay);
+                frame.make_lzw_pre_encoded();
+                frame
+            })
+            .collect();
+        for frame in &encoded {
+            encoder
+                .write_lzw_pre_encoded_frame(frame)
+                .map_err(|e| write_err(e.to_string()))?;
         }
-        for (i, px) in rgb.chunks_exact(3).enumerate() {
-            let key = (usize::from(px[0] >> 3) << 10)
-                | (usize::from(px[1] >> 3) << 5)
-                | usize::from(px[2] >> 3);
-            indices[i] = lut[key];
-        }
-        let delay = (centis(k + 1) - centis(k)) as u16;
-        let gif_frame = changed_rect(previous.as_deref(), &indices, w, h, transparent, delay);
-        encoder
-            .write_frame(&gif_frame)
-            .map_err(|e| write_err(e.to_string()))?;
-        match &mut previous {
-            Some(p) => p.copy_from_slice(&indices),
-            None => previous = Some(indices.clone()),
-        }
+        previous = indexed.into_iter().last();
     }
     let mut out = encoder.into_inner().map_err(|e| write_err(e.to_string()))?;
     out.flush().map_err(|e| write_err(e.to_string()))?;
@@ -991,4 +1018,151 @@ fn changed_rect(
     frame.delay = delay;
     frame.dispose = gif::DisposalMethod::Keep;
     frame
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sample at `time` with the given contacts and slides of Leg 2 (Leg 1 stuck, leg 0 is Leg 1).
+    fn sample(time: f64, contact2: bool, slide2: bool) -> TrajectoryRow {
+        TrajectoryRow {
+            time,
+            x: 0.0,
+            z: 0.0,
+            theta: -0.5 + 0.1 * time,
+            l1: 0.9,
+            l2: 0.8,
+            theta_dot: 0.1,
+            l1_dot: 0.0,
+            l2_dot: 0.0,
+            contact1: true,
+            contact2,
+            slide1: false,
+            slide2,
+            lock1: false,
+            lock2: !contact2,
+            lambda_1: 0.0,
+            lambda_2: 1.0,
+            lambda_3: 0.0,
+            lambda_4: 1.0,
+            leg1: 0,
+        }
+    }
+
+    /// Samples every 0.005 s over [0, 1] s with a 0.03 s slide of Leg 2 starting at 0.405 s (between the
+    /// frames at 0.40 and 0.44 s of 25 frames/s), then single support.
+    fn with_short_slide() -> Vec<TrajectoryRow> {
+        let mut out = Vec::new();
+        for k in 0..=200 {
+            let t = k as f64 * 0.005;
+            if t > 0.405 && t < 0.4051 {
+                out.push(sample(0.405, true, true));
+            }
+            let (contact2, slide2) = if t < 0.405 {
+                (true, false)
+            } else if t < 0.435 {
+                (true, true)
+            } else {
+                (false, false)
+            };
+            if (t - 0.435).abs() < 1e-12 {
+                out.push(sample(0.435, false, false));
+                continue;
+            }
+            out.push(sample(t, contact2, slide2));
+        }
+        out
+    }
+
+    #[test]
+    fn regular_frames_cover_the_window() {
+        let samples = with_short_slide();
+        let frames = plan_frames(&samples, (0.0, 1.0), 25, 1.0);
+        let regular: Vec<&FrameTime> = frames.iter().filter(|f| f.slow.is_none()).collect();
+        assert_eq!(regular.len(), 26, "0, 0.04, ..., 1.0");
+        assert!(frames.windows(2).all(|w| w[0].time <= w[1].time));
+    }
+
+    #[test]
+    fn short_slide_gets_slow_motion_frames() {
+        let samples = with_short_slide();
+        let frames = plan_frames(&samples, (0.0, 1.0), 25, 1.0);
+        let slow: Vec<&FrameTime> = frames.iter().filter(|f| f.slow.is_some()).collect();
+        assert_eq!(slow.len(), SLOW_FRAMES);
+        for f in &slow {
+            assert!((0.405..0.435).contains(&f.time), "{}", f.time);
+            let s = f.slow.as_ref().unwrap();
+            assert!(s.phase.contains("slides"), "{}", s.phase);
+            assert!((s.duration - 0.03).abs() < 1e-12);
+        }
+        // The first slow frame is the event instant itself.
+        assert_eq!(slow[0].time, 0.405);
+    }
+
+    #[test]
+    fn slide_covered_by_a_regular_frame_is_not_slowed() {
+        let samples = with_short_slide();
+        // At 50 frames/s a frame falls at 0.42 s, inside the slide.
+        let frames = plan_frames(&samples, (0.0, 1.0), 50, 1.0);
+        assert!(frames.iter().all(|f| f.slow.is_none()));
+    }
+
+    #[test]
+    fn pose_is_continuous_through_reindexing() {
+        // A touchdown at 0.5 s: theta drops by alpha and Leg 1 moves to the previous physical leg; the wheel
+        // itself does not move.
+        let geometry = Geometry {
+            legs: 8,
+            stopper_length: 1.0,
+            spring_natural_length: 1.02,
+            leg_mass_offset: 0.3,
+            slope: 0.1,
+            viscosity: 50.0,
+        };
+        let alpha = geometry.alpha();
+        let before = TrajectoryRow {
+            leg1: 0,
+            theta: 0.3,
+            ..sample(0.5, true, false)
+        };
+        let after = TrajectoryRow {
+            leg1: 7,
+            theta: 0.3 - alpha,
+            ..sample(0.5, true, false)
+        };
+        let samples = [before, after];
+        let track = Track::new(&samples, geometry);
+        assert!((track.psi0[0] - track.psi0[1]).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_options_are_named() {
+        let bad = |o: AnimateOptions, needle: &str| {
+            let e = o.validate().unwrap_err().to_string();
+            assert!(e.contains(needle), "{e}");
+        };
+        let d = AnimateOptions::default;
+        bad(AnimateOptions { fps: 0, ..d() }, "--fps");
+        bad(AnimateOptions { fps: 60, ..d() }, "--fps");
+        bad(AnimateOptions { speed: 0.0, ..d() }, "--speed");
+        bad(
+            AnimateOptions {
+                from: Some(3.0),
+                to: Some(1.0),
+                ..d()
+            },
+            "--to",
+        );
+        bad(AnimateOptions { height: 5, ..d() }, "--height");
+        assert!(d().validate().is_ok());
+    }
+
+    #[test]
+    fn palette_fits_a_gif_with_its_transparent_index() {
+        let p = palette();
+        assert!(p.len() < 256);
+        let lut = lookup(&p);
+        assert_eq!(lut[(31 << 10) | (31 << 5) | 31], 0, "white maps to white");
+    }
 }
