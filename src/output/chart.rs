@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::style::{font, padded, tick_label, PlotError, COLOR_GRID, COLOR_MARK};
+use super::style::{draw_box, font, house_mesh, padded, tick_label, PlotError, COLOR_MARK};
 
 /// Font sizes and layout of the run figures \[px\].
 pub const TITLE_FONT: f64 = 38.0;
@@ -196,14 +196,7 @@ pub fn draw_legend<DB: DrawingBackend>(
     }
     let box_w = 12 + SAMPLE_W + 10 + text_w + 12;
     let box_h = entries as i32 * LINE + 10;
-    root.draw(&Rectangle::new(
-        [(x0, y0), (x0 + box_w, y0 + box_h)],
-        WHITE.filled(),
-    ))?;
-    root.draw(&Rectangle::new(
-        [(x0, y0), (x0 + box_w, y0 + box_h)],
-        RGBColor(150, 150, 150).stroke_width(1),
-    ))?;
+    draw_box(root, [(x0, y0), (x0 + box_w, y0 + box_h)], WHITE)?;
     let sx = x0 + 12;
     let tx = sx + SAMPLE_W + 10;
     let mut y = y0 + 5 + LINE / 2;
@@ -226,14 +219,7 @@ pub fn draw_legend<DB: DrawingBackend>(
         y += LINE;
     }
     for (label, color) in swatches {
-        root.draw(&Rectangle::new(
-            [(sx, y - 11), (sx + SAMPLE_W, y + 11)],
-            color.filled(),
-        ))?;
-        root.draw(&Rectangle::new(
-            [(sx, y - 11), (sx + SAMPLE_W, y + 11)],
-            RGBColor(150, 150, 150).stroke_width(1),
-        ))?;
+        draw_box(root, [(sx, y - 11), (sx + SAMPLE_W, y + 11)], *color)?;
         root.draw(&Text::new(
             label.as_str(),
             (tx, y),
@@ -265,16 +251,11 @@ pub fn draw_axes_and_curves<DB: DrawingBackend>(
     let no_fmt = |_: &f64| String::new();
     {
         let mut mesh = chart.configure_mesh();
-        mesh.label_style(font(TICK_FONT))
-            .axis_desc_style(font(AXIS_FONT))
-            .y_desc(y_label)
+        house_mesh(&mut mesh, TICK_FONT, AXIS_FONT);
+        mesh.y_desc(y_label)
             .y_label_formatter(&y_fmt)
             .x_labels(10)
-            .y_labels(5)
-            .bold_line_style(COLOR_GRID.stroke_width(1))
-            .light_line_style(TRANSPARENT)
-            .axis_style(BLACK.stroke_width(2))
-            .set_all_tick_mark_size(8);
+            .y_labels(5);
         match x_label {
             Some(label) => mesh.x_desc(label).x_label_formatter(&x_fmt),
             None => mesh.x_label_formatter(&no_fmt),

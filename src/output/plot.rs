@@ -21,8 +21,8 @@ use plotters::style::FontTransform;
 
 pub use super::style::PlotError;
 use super::style::{
-    ensure_font, font, padded, tick_label, COLOR_BLACK, COLOR_BLUE, COLOR_GRID, COLOR_MARK,
-    COLOR_VERMILLION,
+    draw_box, ensure_font, font, house_mesh, padded, tick_label, COLOR_BLACK, COLOR_BLUE,
+    COLOR_MARK, COLOR_VERMILLION,
 };
 #[cfg(test)]
 use super::style::{png_size, FAMILY};
@@ -478,15 +478,8 @@ fn draw_panel<DB: DrawingBackend>(
     let no_fmt = |_: &f64| String::new();
     {
         let mut mesh = chart.configure_mesh();
-        mesh.label_style(font(TICK_FONT))
-            .axis_desc_style(font(AXIS_FONT))
-            .y_label_formatter(&y_fmt)
-            .x_labels(10)
-            .y_labels(7)
-            .bold_line_style(COLOR_GRID.stroke_width(1))
-            .light_line_style(TRANSPARENT)
-            .axis_style(BLACK.stroke_width(2))
-            .set_all_tick_mark_size(8);
+        house_mesh(&mut mesh, TICK_FONT, AXIS_FONT);
+        mesh.y_label_formatter(&y_fmt).x_labels(10).y_labels(7);
         if panel.bottom_axis {
             mesh.x_desc(param_label).x_label_formatter(&x_fmt);
         } else {
@@ -568,14 +561,7 @@ fn draw_legend<DB: DrawingBackend>(
     }
     let box_w = 16 + SAMPLE_W + 12 + text_w + 16;
     let box_h = entries as i32 * LINE + 12;
-    root.draw(&Rectangle::new(
-        [(x0, y0), (x0 + box_w, y0 + box_h)],
-        WHITE.filled(),
-    ))?;
-    root.draw(&Rectangle::new(
-        [(x0, y0), (x0 + box_w, y0 + box_h)],
-        RGBColor(150, 150, 150).stroke_width(1),
-    ))?;
+    draw_box(root, [(x0, y0), (x0 + box_w, y0 + box_h)], WHITE)?;
     let sx = x0 + 16;
     let tx = sx + SAMPLE_W + 12;
     let mut y = y0 + 6 + LINE / 2;

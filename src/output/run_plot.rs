@@ -16,7 +16,7 @@ use super::chart::{
     Stroke,
 };
 use super::read::{RunData, TipState, TrajectoryRow};
-use super::style::{PlotError, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
+use super::style::{draw_box, PlotError, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
 
 /// Size of `run.png` and `run.svg` \[px\].
 pub const RUN_SIZE: (u32, u32) = (1600, 2000);
@@ -115,6 +115,30 @@ fn curve(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Curve {
     }
 }
 
+/// A panel of one quantity of Leg 1 (blue) and Leg 2 (vermillion).
+fn two_legs(
+    samples: &[TrajectoryRow],
+    y_label: &str,
+    names: [&str; 2],
+    value: fn(&TrajectoryRow) -> [f64; 2],
+) -> Panel {
+    Panel {
+        y_label: y_label.to_string(),
+        curves: vec![
+            curve(
+                &format!("{} (Leg 1)", names[0]),
+                COLOR_BLUE,
+                series(samples, |r| value(r)[0]),
+            ),
+            curve(
+                &format!("{} (Leg 2)", names[1]),
+                COLOR_VERMILLION,
+                series(samples, |r| value(r)[1]),
+            ),
+        ],
+    }
+}
+
 struct RunFigure {
     title: String,
     bands: Vec<(Band, PhaseKind)>,
@@ -156,20 +180,12 @@ impl RunFigure {
                     },
                 ],
             },
-            Panel {
-                y_label: "normal force [N]".into(),
-                curves: vec![
-                    curve("λ₂ (Leg 1)", COLOR_BLUE, series(s, |r| r.lambda_2)),
-                    curve("λ₄ (Leg 2)", COLOR_VERMILLION, series(s, |r| r.lambda_4)),
-                ],
-            },
-            Panel {
-                y_label: "tangential force [N]".into(),
-                curves: vec![
-                    curve("λ₁ (Leg 1)", COLOR_BLUE, series(s, |r| r.lambda_1)),
-                    curve("λ₃ (Leg 2)", COLOR_VERMILLION, series(s, |r| r.lambda_3)),
-                ],
-            },
+            two_legs(s, "normal force [N]", ["λ₂", "λ₄"], |r| {
+                [r.lambda_2, r.lambda_4]
+            }),
+            two_legs(s, "tangential force [N]", ["λ₁", "λ₃"], |r| {
+                [r.lambda_1, r.lambda_3]
+            }),
         ];
         let name = run.dir.file_name().map_or_else(
             || run.dir.display().to_string(),
@@ -206,14 +222,7 @@ fn draw_phase_row<DB: DrawingBackend>(
     let mut x = 150;
     area.draw(&Text::new("phases:", (x - 110, y), style.clone()))?;
     for k in kinds {
-        area.draw(&Rectangle::new(
-            [(x, y), (x + 40, y + 24)],
-            k.color().filled(),
-        ))?;
-        area.draw(&Rectangle::new(
-            [(x, y), (x + 40, y + 24)],
-            RGBColor(150, 150, 150).stroke_width(1),
-        ))?;
+        draw_box(area, [(x, y), (x + 40, y + 24)], k.color())?;
         area.draw(&Text::new(k.label(), (x + 50, y), style.clone()))?;
         x += 50 + area.estimate_text_size(k.label(), &style)?.0 as i32 + 40;
     }

@@ -10,6 +10,9 @@ use std::ops::Range;
 use std::path::Path;
 use std::sync::OnceLock;
 
+use plotters::chart::MeshStyle;
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 
@@ -89,6 +92,32 @@ pub const COLOR_ORANGE: RGBColor = RGBColor(230, 159, 0);
 pub const COLOR_MARK: RGBColor = RGBColor(90, 90, 90);
 /// Grid lines.
 pub const COLOR_GRID: RGBColor = RGBColor(225, 225, 225);
+/// Border of legend boxes and colour swatches.
+pub const COLOR_FRAME: RGBColor = RGBColor(150, 150, 150);
+
+/// Applies the house style to a chart's mesh: fonts, light grid, black axes, tick marks.
+pub fn house_mesh<DB: DrawingBackend>(
+    mesh: &mut MeshStyle<'_, '_, RangedCoordf64, RangedCoordf64, DB>,
+    tick_font: f64,
+    axis_font: f64,
+) {
+    mesh.label_style(font(tick_font))
+        .axis_desc_style(font(axis_font))
+        .bold_line_style(COLOR_GRID.stroke_width(1))
+        .light_line_style(TRANSPARENT)
+        .axis_style(BLACK.stroke_width(2))
+        .set_all_tick_mark_size(8);
+}
+
+/// Draws the rectangle `corners` filled with `fill` and framed in [`COLOR_FRAME`] (legend boxes, swatches).
+pub fn draw_box<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    corners: [(i32, i32); 2],
+    fill: RGBColor,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    root.draw(&Rectangle::new(corners, fill.filled()))?;
+    root.draw(&Rectangle::new(corners, COLOR_FRAME.stroke_width(1)))
+}
 
 /// Tick label of `v` on an axis spanning `range`: as many decimals as the tick step needs (plotters' default
 /// prints "100.0"), scientific notation on a very narrow or very wide axis, and a true minus sign.
