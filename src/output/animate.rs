@@ -724,8 +724,8 @@ fn draw_frame<DB: DrawingBackend>(
     };
     root.draw(&Text::new(
         slope,
-        (12, h - 8),
-        font(size * 0.7).pos(Pos::new(HPos::Left, VPos::Bottom)),
+        (12, 10 + (size * 2.4) as i32),
+        font(size * 0.7),
     ))?;
     draw_legend(root, w)
 }

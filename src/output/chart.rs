@@ -85,6 +85,8 @@ pub struct Stack<'a> {
     pub marks: &'a [f64],
     /// The panels, top to bottom.
     pub panels: &'a [Panel],
+    /// Label only whole numbers on the x axis.
+    pub x_integer: bool,
 }
 
 /// Pixel ranges (x, y) of a plotting area on the canvas.
@@ -102,8 +104,12 @@ fn y_range(curves: &[Curve]) -> Range<f64> {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
             (lo.min(p.1), hi.max(p.1))
         });
-    if lo.is_finite() {
+    if lo.is_finite() && hi > lo {
         padded(lo, hi, 0.08)
+    } else if lo.is_finite() {
+        // A single value: a range around it on its own scale.
+        let half = (0.1 * lo.abs()).max(f64::MIN_POSITIVE.sqrt());
+        (lo - half)..(lo + half)
     } else {
         -1.0..1.0
     }
@@ -230,24 +236,41 @@ pub fn draw_legend<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Draws curves on one chart area with x range `x` and y range `y`; returns the plot's pixel rectangle.
-#[allow(clippy::too_many_arguments)]
+/// The axes of one chart.
+#[derive(Debug, Clone)]
+pub struct Axes<'a> {
+    /// X range.
+    pub x: Range<f64>,
+    /// Y range.
+    pub y: Range<f64>,
+    /// X axis description with unit; `None`: no x tick labels (a panel above another).
+    pub x_label: Option<&'a str>,
+    /// Y axis description with unit.
+    pub y_label: &'a str,
+    /// Label only whole numbers on the x axis (step numbers).
+    pub x_integer: bool,
+}
+
+/// Draws `curves` over `bands` and the dashed vertical `marks` on one chart area; returns the plot's pixel
+/// rectangle.
 pub fn draw_axes_and_curves<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    x: &Range<f64>,
-    y: &Range<f64>,
-    x_label: Option<&str>,
-    y_label: &str,
+    axes: &Axes,
     curves: &[Curve],
     bands: &[Band],
     marks: &[f64],
 ) -> Result<PixelRect, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (x, y, x_label, y_label) = (&axes.x, &axes.y, axes.x_label, axes.y_label);
     let mut chart = ChartBuilder::on(area)
         .x_label_area_size(if x_label.is_some() { X_LABEL_AREA } else { 12 })
         .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x.clone(), y.clone())?;
     let y_fmt = |v: &f64| tick_label(*v, y);
-    let x_fmt = |v: &f64| tick_label(*v, x);
+    let x_fmt = |v: &f64| match (axes.x_integer, v.fract() == 0.0) {
+        (true, true) => format!("{v:.0}"),
+        (true, false) => String::new(),
+        (false, _) => tick_label(*v, x),
+    };
     let no_fmt = |_: &f64| String::new();
     {
         let mut mesh = chart.configure_mesh();
@@ -323,17 +346,14 @@ pub fn draw_stack<DB: DrawingBackend>(
         let top = k * inner;
         let height = if last { h - top - BOTTOM_PAD } else { inner };
         let sub = area.clone().shrink((0, top), (w - LEGEND_W, height));
-        let (x_px, y_px) = draw_axes_and_curves(
-            &sub,
-            &stack.x,
-            &y_range(&panel.curves),
-            last.then_some(stack.x_label),
-            &panel.y_label,
-            &panel.curves,
-            stack.bands,
-            stack.marks,
-        )?;
-        let _ = x_px;
+        let axes = Axes {
+            x: stack.x.clone(),
+            y: y_range(&panel.curves),
+            x_label: last.then_some(stack.x_label),
+            y_label: &panel.y_label,
+            x_integer: stack.x_integer,
+        };
+        let (_, y_px) = draw_axes_and_curves(&sub, &axes, &panel.curves, stack.bands, stack.marks)?;
         let base = area.get_base_pixel();
         draw_legend(
             area,

@@ -258,6 +258,7 @@ impl Figure for RunFigure {
                 bands: &bands,
                 marks: &self.touchdowns,
                 panels: &self.panels,
+                x_integer: false,
             },
         )?;
         Ok(())

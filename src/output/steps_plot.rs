@@ -12,8 +12,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::chart::{
-    draw_axes_and_curves, draw_legend, draw_stack, finite_range, titled, write_svg_png, Curve,
-    DrawResult, Figure, Panel, Stack, Stroke, LEGEND_W,
+    draw_axes_and_curves, draw_legend, draw_stack, finite_range, titled, write_svg_png, Axes,
+    Curve, DrawResult, Figure, Panel, Stack, Stroke, LEGEND_W,
 };
 use super::read::{RunData, StepRow, TipState, TrajectoryRow};
 use super::style::{
@@ -180,6 +180,7 @@ impl Figure for StepsFigure {
                 bands: &[],
                 marks: &[],
                 panels: &self.panels,
+                x_integer: true,
             },
         )?;
         // Phase portrait, a square-ish plot with its legend under the title.
@@ -208,16 +209,14 @@ impl Figure for StepsFigure {
         let (Some(xs), Some(ys)) = (xs, ys) else {
             return Ok(());
         };
-        draw_axes_and_curves(
-            &plot_area,
-            &padded(xs.start, xs.end, 0.06),
-            &padded(ys.start, ys.end, 0.08),
-            Some("L₂ [m]"),
-            "dL₂/dt [m/s]",
-            &self.portrait,
-            &[],
-            &[self.l0],
-        )?;
+        let axes = Axes {
+            x: padded(xs.start, xs.end, 0.06),
+            y: padded(ys.start, ys.end, 0.08),
+            x_label: Some("L₂ [m]"),
+            y_label: "dL₂/dt [m/s]",
+            x_integer: false,
+        };
+        draw_axes_and_curves(&plot_area, &axes, &self.portrait, &[], &[self.l0])?;
         let l0_note = Curve {
             label: format!("L₀ = {} m", self.l0),
             color: COLOR_MARK,
