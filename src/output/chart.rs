@@ -8,7 +8,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::style::{draw_box, font, house_mesh, padded, tick_label, PlotError, COLOR_MARK};
+use super::style::{
+    draw_box, font, house_mesh, padded, tick_label, LegendLayout, PlotError, COLOR_MARK,
+};
 
 /// Font sizes and layout of the run figures \[px\].
 pub const TITLE_FONT: f64 = 38.0;
@@ -200,12 +202,8 @@ pub fn draw_legend<DB: DrawingBackend>(
     {
         text_w = text_w.max(root.estimate_text_size(label, &font(LEGEND_FONT))?.0 as i32);
     }
-    let box_w = 12 + SAMPLE_W + 10 + text_w + 12;
-    let box_h = entries as i32 * LINE + 10;
-    draw_box(root, [(x0, y0), (x0 + box_w, y0 + box_h)], WHITE)?;
-    let sx = x0 + 12;
-    let tx = sx + SAMPLE_W + 10;
-    let mut y = y0 + 5 + LINE / 2;
+    let layout = LegendLayout::new(12, SAMPLE_W, 10, LINE, 5);
+    let (sx, tx, mut y) = layout.frame(root, (x0, y0), entries, text_w)?;
     for c in curves {
         let line = [(sx, y), (sx + SAMPLE_W, y)];
         match c.stroke {

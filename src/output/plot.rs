@@ -21,7 +21,7 @@ use plotters::style::FontTransform;
 
 pub use super::style::PlotError;
 use super::style::{
-    draw_box, ensure_font, font, house_mesh, padded, tick_label, COLOR_BLACK, COLOR_BLUE,
+    ensure_font, font, house_mesh, padded, tick_label, LegendLayout, COLOR_BLACK, COLOR_BLUE,
     COLOR_MARK, COLOR_VERMILLION,
 };
 #[cfg(test)]
@@ -559,12 +559,8 @@ fn draw_legend<DB: DrawingBackend>(
     if !scuff.is_empty() {
         text_w = text_w.max(rich_width(root, &[Seg::Text(SCUFF_NOTE)], NOTE_FONT)?);
     }
-    let box_w = 16 + SAMPLE_W + 12 + text_w + 16;
-    let box_h = entries as i32 * LINE + 12;
-    draw_box(root, [(x0, y0), (x0 + box_w, y0 + box_h)], WHITE)?;
-    let sx = x0 + 16;
-    let tx = sx + SAMPLE_W + 12;
-    let mut y = y0 + 6 + LINE / 2;
+    let layout = LegendLayout::new(16, SAMPLE_W, 12, LINE, 6);
+    let (sx, tx, mut y) = layout.frame(root, (x0, y0), entries, text_w)?;
     for s in series {
         root.draw(&PathElement::new(
             vec![(sx, y), (sx + SAMPLE_W, y)],

@@ -109,6 +109,54 @@ pub fn house_mesh<DB: DrawingBackend>(
         .set_all_tick_mark_size(8);
 }
 
+/// Proportions of a legend box \[px\]: rows of a sample (line, marker or swatch) and a text.
+#[derive(Debug, Clone, Copy)]
+pub struct LegendLayout {
+    /// Padding left and right inside the box.
+    pub pad: i32,
+    /// Width of a sample.
+    pub sample_w: i32,
+    /// Gap between sample and text.
+    pub gap: i32,
+    /// Height of a row.
+    pub line: i32,
+    /// Padding above the first row.
+    pub top: i32,
+}
+
+impl LegendLayout {
+    /// A layout from its padding, sample width, gap, row height and top padding \[px\].
+    pub const fn new(pad: i32, sample_w: i32, gap: i32, line: i32, top: i32) -> LegendLayout {
+        LegendLayout {
+            pad,
+            sample_w,
+            gap,
+            line,
+            top,
+        }
+    }
+
+    /// Draws the white framed box of `rows` rows whose widest text is `text_w` at `(x0, y0)`; returns the x of
+    /// the samples, the x of the texts and the centre y of the first row.
+    pub fn frame<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        (x0, y0): (i32, i32),
+        rows: usize,
+        text_w: i32,
+    ) -> Result<(i32, i32, i32), DrawingAreaErrorKind<DB::ErrorType>> {
+        let box_w = 2 * self.pad + self.sample_w + self.gap + text_w;
+        let box_h = rows as i32 * self.line + 2 * self.top;
+        draw_box(root, [(x0, y0), (x0 + box_w, y0 + box_h)], WHITE)?;
+        let sx = x0 + self.pad;
+        Ok((
+            sx,
+            sx + self.sample_w + self.gap,
+            y0 + self.top + self.line / 2,
+        ))
+    }
+}
+
 /// Draws the rectangle `corners` filled with `fill` and framed in [`COLOR_FRAME`] (legend boxes, swatches).
 pub fn draw_box<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
