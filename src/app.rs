@@ -1,5 +1,9 @@
 //! The jobs the command line runs, as library functions (STYLE.md point 2: all science lives in the library).
 
+mod figures;
+
+pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+
 use std::collections::{BTreeMap, VecDeque};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -32,6 +36,15 @@ pub enum AppError {
     /// Results could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// A run directory could not be read back.
+    #[error(transparent)]
+    Read(#[from] crate::output::read::ReadError),
+    /// The animation could not be made.
+    #[error(transparent)]
+    Animate(#[from] crate::output::animate::AnimateError),
+    /// A figure could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] crate::output::style::PlotError),
     /// A bad command-line value that is not a model parameter.
     #[error("invalid {option}: {reason}")]
     InvalidOption {
@@ -82,6 +95,8 @@ pub const SUMMARY_STEPS: usize = 1000;
 
 /// `summary.json` keeps the first this many warnings and counts the rest.
 pub const SUMMARY_WARNINGS: usize = 100;
+/// Default sampling interval of `trajectory.csv` \[s\].
+pub const DEFAULT_SAMPLE_DT: f64 = 0.005;
 
 /// What `vrw simulate` runs.
 #[derive(Debug, Clone)]
@@ -318,7 +333,7 @@ pub struct GaitJob {
     pub initial: Option<SectionState>,
     /// Search settings.
     pub options: GaitOptions,
-    /// Where `gait.json` goes.
+    /// Where `gait.json` goes, and one period of the gait in the files of `vrw simulate`.
     pub out_dir: PathBuf,
 }
 
@@ -347,7 +362,9 @@ pub struct GaitSummary {
 /// `max |P(s) - s|` cannot be reached reliably.
 pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 
-/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason).
+/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason), and
+/// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
+/// ([`write_gait_period`]).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let tolerance = job.options.tolerance;
     if !(tolerance.is_finite() && tolerance > 0.0) {
@@ -388,7 +405,28 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     };
     output::ensure_dir(&job.out_dir)?;
     output::write_json(&job.out_dir.join("gait.json"), &summary)?;
+    if let Some(gait) = &summary.gait {
+        write_gait_period(job, gait)?;
+    }
     Ok(summary)
+}
+
+/// Walk one period from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
+/// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
+/// `vrw plot` and `vrw animate` work on a gait directly.
+pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
+    run_simulate(
+        &SimulateJob {
+            config: job.config.clone(),
+            initial: Some(gait.section),
+            steps: 1,
+            sample_dt: DEFAULT_SAMPLE_DT,
+            trajectory: true,
+            out_dir: job.out_dir.clone(),
+            interrupt: None,
+        },
+        &mut |_| {},
+    )
 }
 
 /// What `vrw sweep` runs.

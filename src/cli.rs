@@ -10,9 +10,13 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use vrw::app::{run_gait, run_simulate, run_sweep, GaitJob, SimulateEvent, SimulateJob, SweepJob};
+use vrw::app::{
+    run_animate, run_gait, run_plot, run_simulate, run_still, run_sweep, AnimateJob, GaitJob,
+    SimulateEvent, SimulateJob, SweepJob, DEFAULT_SAMPLE_DT,
+};
 use vrw::gait::GaitOptions;
 use vrw::gait::SweepSpec;
+use vrw::output::animate::AnimateOptions;
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
@@ -32,6 +36,10 @@ enum Command {
     Gait(GaitArgs),
     /// Sweep a parameter with continuation, locate the thresholds and draw Fig. 2.
     Sweep(SweepArgs),
+    /// Animate a run: DIR/walk.gif from the output directory of `simulate` or `gait`.
+    Animate(AnimateArgs),
+    /// Figures of a run: DIR/run.{png,svg} against time, DIR/steps.{png,svg} against step number.
+    Plot(PlotArgs),
 }
 
 /// Model parameters: a TOML file and `key=value` overrides.
@@ -74,7 +82,7 @@ struct SimulateArgs {
     #[arg(long, default_value = "out/simulate")]
     out: PathBuf,
     /// Sampling interval of trajectory.csv, in seconds of simulated time.
-    #[arg(long, default_value_t = 0.005)]
+    #[arg(long, default_value_t = DEFAULT_SAMPLE_DT)]
     sample_dt: f64,
     /// Do not write trajectory.csv (steps.csv and summary.json only); an old one in --out is removed.
     #[arg(long)]
@@ -97,7 +105,7 @@ struct GaitArgs {
     /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
     #[arg(long, default_value = DEFAULT_TOLERANCE)]
     tolerance: f64,
-    /// Output directory for gait.json.
+    /// Output directory for gait.json and one period of the gait (steps.csv, trajectory.csv, summary.json).
     #[arg(long, default_value = "out/gait")]
     out: PathBuf,
 }
@@ -134,12 +142,50 @@ fn param_help() -> String {
     )
 }
 
+#[derive(Debug, Args)]
+struct AnimateArgs {
+    /// Output directory of `vrw simulate` or `vrw gait` (walk.gif is written there).
+    dir: PathBuf,
+    /// Frames per second (at most 50).
+    #[arg(long, default_value_t = AnimateOptions::default().fps)]
+    fps: u32,
+    /// Playback speed: simulated seconds per second of playback.
+    #[arg(long, default_value_t = AnimateOptions::default().speed, allow_hyphen_values = true)]
+    speed: f64,
+    /// Start of the time window [s] (default: the start of the run).
+    #[arg(long, allow_hyphen_values = true)]
+    from: Option<f64>,
+    /// End of the time window [s] (default: the end of the run).
+    #[arg(long, allow_hyphen_values = true)]
+    to: Option<f64>,
+    /// Frame width [px].
+    #[arg(long, default_value_t = AnimateOptions::default().width)]
+    width: u32,
+    /// Frame height [px].
+    #[arg(long, default_value_t = AnimateOptions::default().height)]
+    height: u32,
+    /// Draw the slope horizontal instead of inclined.
+    #[arg(long)]
+    horizontal: bool,
+    /// Instead of the GIF, write the single frame at this time [s] as DIR/walk-frame.png.
+    #[arg(long, value_name = "TIME", allow_hyphen_values = true)]
+    still: Option<f64>,
+}
+
+#[derive(Debug, Args)]
+struct PlotArgs {
+    /// Output directory of `vrw simulate` or `vrw gait` (the figures are written there).
+    dir: PathBuf,
+}
+
 /// Run the parsed command.
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Simulate(args) => simulate(args),
         Command::Gait(args) => gait(args),
         Command::Sweep(args) => sweep(args),
+        Command::Animate(args) => animate(args),
+        Command::Plot(args) => plot(&args),
     }
 }
 
@@ -167,6 +213,48 @@ fn interrupt_flag() -> Arc<AtomicBool> {
         eprintln!("warning: Ctrl-C will not stop the walk cleanly: {e}");
     }
     flag
+}
+
+fn animate(args: AnimateArgs) -> Result<()> {
+    let job = AnimateJob {
+        dir: args.dir,
+        options: AnimateOptions {
+            fps: args.fps,
+            speed: args.speed,
+            from: args.from,
+            to: args.to,
+            width: args.width,
+            height: args.height,
+            horizontal: args.horizontal,
+        },
+    };
+    if let Some(time) = args.still {
+        let path = run_still(&job, time).context("animate")?;
+        println!("wrote {}", path.display());
+        return Ok(());
+    }
+    let started = std::time::Instant::now();
+    let report = run_animate(&job).context("animate")?;
+    println!(
+        "vrw animate: {} frames ({} in slow motion) of t = {:.3} .. {:.3} s, {:.1} s of playback, {:.2} MB in {:.2} s",
+        report.frames,
+        report.slow_frames,
+        report.window.0,
+        report.window.1,
+        report.playback,
+        report.bytes as f64 / 1e6,
+        started.elapsed().as_secs_f64()
+    );
+    println!("wrote {}", report.path.display());
+    Ok(())
+}
+
+fn plot(args: &PlotArgs) -> Result<()> {
+    let report = run_plot(&args.dir).context("plot")?;
+    for f in &report.files {
+        println!("wrote {}", f.display());
+    }
+    Ok(())
 }
 
 fn simulate(args: SimulateArgs) -> Result<()> {

@@ -3,7 +3,13 @@
 //! Numbers are written with Rust's shortest round-trip formatting, so a value read back is bit-identical;
 //! undefined values (e.g. `lambda_2+` after an (A3) exchange) are written as `NaN` in CSV and `null` in JSON.
 
+pub mod animate;
+pub mod chart;
 pub mod plot;
+pub mod read;
+pub mod run_plot;
+pub mod steps_plot;
+pub mod style;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};

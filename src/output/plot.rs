@@ -9,21 +9,23 @@
 //! lost) are drawn as labelled vertical dashed lines through both panels,
 //! which share the x axis.
 //!
-//! Text is rendered with DejaVu Sans, bundled under `assets/fonts/` (license
-//! next to it) and registered with plotters' `ab_glyph` font table, so no system
-//! font or font library is needed at run time. The PNG is rasterised with that
-//! font; the SVG keeps its text as `<text>` elements with
-//! `font-family="DejaVu Sans, sans-serif"`, so a viewer draws it with DejaVu
-//! Sans if installed and its own sans-serif face otherwise.
+//! Text (the bundled DejaVu Sans), colours and tick labels come from [`super::style`].
 
 use std::ops::Range;
 use std::path::Path;
-use std::sync::OnceLock;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::{register_font, FontStyle, FontTransform};
+use plotters::style::FontTransform;
+
+pub use super::style::PlotError;
+use super::style::{
+    ensure_font, font, house_mesh, padded, tick_label, LegendLayout, COLOR_BLACK, COLOR_BLUE,
+    COLOR_MARK, COLOR_VERMILLION,
+};
+#[cfg(test)]
+use super::style::{png_size, FAMILY};
 
 /// One gait on the sweep: the parameter value and its DLS indicators (MODEL.md section 5).
 #[derive(Debug, Clone, PartialEq)]
@@ -62,22 +64,6 @@ pub struct Fig2Spec<'a> {
     pub title: &'a str,
 }
 
-/// Why a figure could not be written.
-#[derive(Debug, thiserror::Error)]
-pub enum PlotError {
-    /// The backend failed to draw or to write the file at `path`.
-    #[error("cannot draw {path}: {message}")]
-    Draw {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        message: String,
-    },
-    /// Nothing finite to plot.
-    #[error("no data to plot: {0}")]
-    Empty(String),
-}
-
 /// Size of both the SVG and the PNG, in pixels.
 pub const FIG2_SIZE: (u32, u32) = (1600, 1200);
 
@@ -96,24 +82,6 @@ const NAME_4: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("4", "+")];
 const LABEL_I4: &[Seg] = &[Seg::Text("λ"), Seg::Sub("I4"), Seg::Text(" [N s]")];
 const LABEL_PLUS: &[Seg] = &[Seg::Text("λ [N]")];
 
-/// Font family name under which the bundled font is registered; it is also the
-/// CSS `font-family` list written into the SVG.
-const FAMILY: &str = "DejaVu Sans, sans-serif";
-static FONT_BYTES: &[u8] = include_bytes!(concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/assets/fonts/DejaVuSans.ttf"
-));
-static FONT_REGISTERED: OnceLock<bool> = OnceLock::new();
-
-/// Registers the bundled DejaVu Sans once per process, under [`FAMILY`] and
-/// under plotters' default `"sans-serif"`. Returns whether it succeeded.
-fn ensure_font() -> bool {
-    *FONT_REGISTERED.get_or_init(|| {
-        register_font(FAMILY, FontStyle::Normal, FONT_BYTES).is_ok()
-            && register_font("sans-serif", FontStyle::Normal, FONT_BYTES).is_ok()
-    })
-}
-
 // Layout, in pixels of the 1600 x 1200 canvas.
 const MARGIN: i32 = 24;
 const TITLE_H: i32 = 64;
@@ -128,11 +96,9 @@ const AXIS_FONT: f64 = 34.0;
 const TICK_FONT: f64 = 28.0;
 const NOTE_FONT: f64 = 27.0;
 
-const COLOR_I4: RGBColor = RGBColor(0, 0, 0);
-const COLOR_2: RGBColor = RGBColor(0, 114, 178);
-const COLOR_4: RGBColor = RGBColor(213, 94, 0);
-const COLOR_MARK: RGBColor = RGBColor(90, 90, 90);
-const COLOR_GRID: RGBColor = RGBColor(225, 225, 225);
+const COLOR_I4: RGBColor = COLOR_BLACK;
+const COLOR_2: RGBColor = COLOR_BLUE;
+const COLOR_4: RGBColor = COLOR_VERMILLION;
 
 #[derive(Clone, Copy, PartialEq)]
 enum Shape {
@@ -193,11 +159,6 @@ struct Prepared {
     panel_b: Vec<Series>,
     marks: Vec<ThresholdMark>,
     marker: i32,
-}
-
-fn padded(lo: f64, hi: f64, frac: f64) -> Range<f64> {
-    let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
-    (lo - frac * span)..(hi + frac * span)
 }
 
 /// Range of the y values of `series`, always including 0 (the zero line).
@@ -326,34 +287,6 @@ const SCUFF_NOTE: &str = "scuffing of Leg 2";
 type PixelRect = (Range<i32>, Range<i32>);
 
 type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
-
-fn font(size: f64) -> TextStyle<'static> {
-    (FontFamily::Name(FAMILY), size).into_font().color(&BLACK)
-}
-
-/// Tick label of `v` on an axis spanning `range`: as many decimals as the
-/// tick step needs (plotters' default prints "100.0"), and a true minus sign.
-fn tick_label(v: f64, range: &Range<f64>) -> String {
-    let span = (range.end - range.start).abs().max(f64::MIN_POSITIVE);
-    // Smallest 1-2-5 step giving at most 10 ticks (plotters asks for <= 10).
-    let mut step = 10f64.powf((span / 10.0).log10().floor());
-    for m in [1.0, 2.0, 5.0, 10.0] {
-        if span / (m * step) <= 10.0 {
-            step *= m;
-            break;
-        }
-    }
-    let mut decimals = (-step.log10().floor()).max(0.0) as usize;
-    let mut s = format!("{v:.decimals$}");
-    while decimals < 8 && (s.parse::<f64>().unwrap_or(v) - v).abs() > 1e-6 * step {
-        decimals += 1;
-        s = format!("{v:.decimals$}");
-    }
-    if s.parse::<f64>() == Ok(0.0) {
-        return format!("{:.decimals$}", 0.0);
-    }
-    s.replace('-', "\u{2212}")
-}
 
 /// Sizes of a subscript relative to its base text, and the baseline shifts.
 const SUB_SCALE: f64 = 0.68;
@@ -545,15 +478,8 @@ fn draw_panel<DB: DrawingBackend>(
     let no_fmt = |_: &f64| String::new();
     {
         let mut mesh = chart.configure_mesh();
-        mesh.label_style(font(TICK_FONT))
-            .axis_desc_style(font(AXIS_FONT))
-            .y_label_formatter(&y_fmt)
-            .x_labels(10)
-            .y_labels(7)
-            .bold_line_style(COLOR_GRID.stroke_width(1))
-            .light_line_style(TRANSPARENT)
-            .axis_style(BLACK.stroke_width(2))
-            .set_all_tick_mark_size(8);
+        house_mesh(&mut mesh, TICK_FONT, AXIS_FONT);
+        mesh.y_label_formatter(&y_fmt).x_labels(10).y_labels(7);
         if panel.bottom_axis {
             mesh.x_desc(param_label).x_label_formatter(&x_fmt);
         } else {
@@ -633,19 +559,8 @@ fn draw_legend<DB: DrawingBackend>(
     if !scuff.is_empty() {
         text_w = text_w.max(rich_width(root, &[Seg::Text(SCUFF_NOTE)], NOTE_FONT)?);
     }
-    let box_w = 16 + SAMPLE_W + 12 + text_w + 16;
-    let box_h = entries as i32 * LINE + 12;
-    root.draw(&Rectangle::new(
-        [(x0, y0), (x0 + box_w, y0 + box_h)],
-        WHITE.filled(),
-    ))?;
-    root.draw(&Rectangle::new(
-        [(x0, y0), (x0 + box_w, y0 + box_h)],
-        RGBColor(150, 150, 150).stroke_width(1),
-    ))?;
-    let sx = x0 + 16;
-    let tx = sx + SAMPLE_W + 12;
-    let mut y = y0 + 6 + LINE / 2;
+    let layout = LegendLayout::new(16, SAMPLE_W, 12, LINE, 6);
+    let (sx, tx, mut y) = layout.frame(root, (x0, y0), entries, text_w)?;
     for s in series {
         root.draw(&PathElement::new(
             vec![(sx, y), (sx + SAMPLE_W, y)],
@@ -812,14 +727,6 @@ mod tests {
         ]
     }
 
-    fn png_size(bytes: &[u8]) -> (u32, u32) {
-        assert!(bytes.len() > 24);
-        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG magic");
-        assert_eq!(&bytes[12..16], b"IHDR");
-        let be = |s: &[u8]| u32::from_be_bytes([s[0], s[1], s[2], s[3]]);
-        (be(&bytes[16..20]), be(&bytes[20..24]))
-    }
-
     #[test]
     fn writes_svg_and_png_for_synthetic_sweep() {
         let dir = tempfile::tempdir().unwrap();
@@ -836,7 +743,7 @@ mod tests {
         };
         write_fig2(&spec, &svg, &png).unwrap();
         let png_bytes = std::fs::read(&png).unwrap();
-        assert_eq!(png_size(&png_bytes), FIG2_SIZE);
+        assert_eq!(png_size(&png_bytes), Some(FIG2_SIZE));
         let svg_text = std::fs::read_to_string(&svg).unwrap();
         assert!(svg_text.starts_with("<svg"));
         for label in [
