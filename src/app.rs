@@ -7,7 +7,8 @@ use serde::Serialize;
 use crate::dynamics::Model;
 use crate::error::WalkError;
 use crate::gait::{
-    find_gait, find_thresholds, sweep, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec, Threshold,
+    find_gait, find_thresholds, sweep_values, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec,
+    Threshold,
 };
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
@@ -126,6 +127,18 @@ impl SimulateSummary {
 /// Run `vrw simulate`: walk, then write the three result files (also when the walk stopped early: every
 /// completed step is kept).
 pub fn run_simulate(job: &SimulateJob) -> Result<SimulateSummary, AppError> {
+    let (summary, trajectory) = compute_simulation(job, true)?;
+    let trajectory = trajectory.unwrap_or_else(|| Trajectory::new(job.sample_dt));
+    write_simulation(&job.out_dir, &summary, &trajectory)?;
+    Ok(summary)
+}
+
+/// The walk of [`run_simulate`] without writing anything (`job.out_dir` is not used): the summary, and the
+/// trajectory sampled every `job.sample_dt` if `record_trajectory`.
+pub fn compute_simulation(
+    job: &SimulateJob,
+    record_trajectory: bool,
+) -> Result<(SimulateSummary, Option<Trajectory>), AppError> {
     job.config.validate()?;
     if !(job.sample_dt.is_finite() && job.sample_dt > 0.0) {
         return Err(AppError::InvalidOption {
@@ -135,17 +148,15 @@ pub fn run_simulate(job: &SimulateJob) -> Result<SimulateSummary, AppError> {
     }
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
-    let mut trajectory = Trajectory::new(job.sample_dt);
+    let mut trajectory = record_trajectory.then(|| Trajectory::new(job.sample_dt));
     let run = simulate(
         &model,
         &job.config.solver,
         &initial,
         job.steps,
-        Some(&mut trajectory),
+        trajectory.as_mut(),
     )?;
-    let summary = SimulateSummary::new(job, initial, &run);
-    write_simulation(&job.out_dir, &summary, &trajectory)?;
-    Ok(summary)
+    Ok((SimulateSummary::new(job, initial, &run), trajectory))
 }
 
 fn write_simulation(
@@ -194,6 +205,15 @@ pub struct GaitSummary {
 
 /// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
+    let summary = compute_gait(job)?;
+    output::ensure_dir(&job.out_dir)?;
+    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
+    Ok(summary)
+}
+
+/// The search of [`run_gait`] without writing anything (`job.out_dir` is not used). A search that finds no
+/// gait is a summary with its status and message, not an error.
+pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     job.config.validate()?;
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
@@ -212,8 +232,6 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok(),
     };
-    output::ensure_dir(&job.out_dir)?;
-    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
     Ok(summary)
 }
 
@@ -262,32 +280,81 @@ pub fn run_sweep(
 ) -> Result<SweepSummary, AppError> {
     job.config.validate()?;
     job.spec.validate(&job.config)?;
-    let model = Model::new(&job.config.params)?;
-    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
-    initial.validate(&model)?;
     output::ensure_dir(&job.out_dir)?;
-    let clock = std::time::Instant::now();
-    let points = sweep(&job.config, &job.spec, &initial, &job.options, progress)?;
-    let sweep_seconds = clock.elapsed().as_secs_f64();
-    output::write_sweep_csv(&job.out_dir.join("sweep.csv"), &job.spec.param, &points)?;
-    let clock = std::time::Instant::now();
-    let mut thresholds = find_thresholds(&job.config, &job.spec, &points, &job.options);
-    let threshold_seconds = clock.elapsed().as_secs_f64();
-    thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let csv = job.out_dir.join("sweep.csv");
+    let result = compute_sweep(
+        &job.config,
+        &job.spec.param,
+        &job.spec.values(),
+        job.initial,
+        &job.options,
+        progress,
+        &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
+    )?;
     let summary = SweepSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
         spec: job.spec.clone(),
-        gaits_found: points.iter().filter(|p| p.gait.is_some()).count(),
-        points: points.len(),
-        thresholds,
-        seconds: [sweep_seconds, threshold_seconds],
+        gaits_found: result.points.iter().filter(|p| p.gait.is_some()).count(),
+        points: result.points.len(),
+        thresholds: result.thresholds,
+        seconds: result.seconds,
     };
     output::write_json(&job.out_dir.join("thresholds.json"), &summary)?;
     if summary.gaits_found > 0 {
-        write_fig2(job, &points, &summary.thresholds)?;
+        write_fig2(job, &result.points, &summary.thresholds)?;
     }
     Ok(summary)
+}
+
+/// A sweep and its thresholds, as [`compute_sweep`] returns them.
+#[derive(Debug, Clone)]
+pub struct SweepResult {
+    /// One point per parameter value, in the order given.
+    pub points: Vec<SweepPoint>,
+    /// Every located threshold, in parameter order.
+    pub thresholds: Vec<Threshold>,
+    /// Wall-clock seconds spent on the sweep and on the thresholds.
+    pub seconds: [f64; 2],
+}
+
+/// The computation of [`run_sweep`] without writing anything: sweep `param` over `values` with continuation
+/// (starting at `initial`, `None`: [`default_initial`]), then locate the thresholds between the points.
+/// `progress` is called after every point; `swept` receives the points before the thresholds are searched
+/// (where `vrw sweep` writes `sweep.csv`).
+pub fn compute_sweep(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    initial: Option<SectionState>,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+    swept: &mut dyn FnMut(&[SweepPoint]) -> Result<(), AppError>,
+) -> Result<SweepResult, AppError> {
+    config.validate()?;
+    let model = Model::new(&config.params)?;
+    let initial = initial.unwrap_or_else(|| default_initial(config));
+    initial.validate(&model)?;
+    let clock = std::time::Instant::now();
+    let points = sweep_values(config, param, values, &initial, options, progress)?;
+    let sweep_seconds = clock.elapsed().as_secs_f64();
+    swept(&points)?;
+    // The thresholds read the parameter's name from the spec; the range is the values' span.
+    let spec = SweepSpec {
+        param: param.to_string(),
+        from: values.first().copied().unwrap_or(f64::NAN),
+        to: values.last().copied().unwrap_or(f64::NAN),
+        points: values.len(),
+    };
+    let clock = std::time::Instant::now();
+    let mut thresholds = find_thresholds(config, &spec, &points, options);
+    let threshold_seconds = clock.elapsed().as_secs_f64();
+    thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
+    Ok(SweepResult {
+        points,
+        thresholds,
+        seconds: [sweep_seconds, threshold_seconds],
+    })
 }
 
 fn write_fig2(

@@ -262,10 +262,7 @@ fn sweep(args: SweepArgs) -> Result<()> {
             points: args.points,
         },
         initial: args.initial,
-        options: GaitOptions {
-            refine_jacobian: false,
-            ..GaitOptions::default()
-        },
+        options: GaitOptions::for_sweeps(),
         out_dir: args.out.clone(),
     };
     let bar = if std::io::stderr().is_terminal() {

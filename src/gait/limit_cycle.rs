@@ -36,6 +36,16 @@ impl Default for GaitOptions {
     }
 }
 
+impl GaitOptions {
+    /// The settings of a sweep (`vrw sweep`): the defaults with one central difference for the final `DP`.
+    pub fn for_sweeps() -> GaitOptions {
+        GaitOptions {
+            refine_jacobian: false,
+            ..GaitOptions::default()
+        }
+    }
+}
+
 /// Why no gait was found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GaitError {

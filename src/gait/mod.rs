@@ -8,5 +8,5 @@ pub mod thresholds;
 
 pub use limit_cycle::{find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions};
 pub use step_map::{StepMap, StepOutcome};
-pub use sweep::{sweep, SweepPoint, SweepSpec};
+pub use sweep::{sweep, sweep_values, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};

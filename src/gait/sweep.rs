@@ -177,11 +177,31 @@ pub fn sweep(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, ConfigError> {
     spec.validate(config)?;
-    let values = spec.values();
+    sweep_values(
+        config,
+        &spec.param,
+        &spec.values(),
+        initial,
+        options,
+        progress,
+    )
+}
+
+/// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
+/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values.
+pub fn sweep_values(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    initial: &SectionState,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<Vec<SweepPoint>, ConfigError> {
+    config.get_numeric(param)?;
     let coarse_values: Vec<f64> = values.iter().copied().step_by(COARSE_STRIDE).collect();
     let coarse = continue_along(
         config,
-        &spec.param,
+        param,
         &coarse_values,
         initial,
         None,
@@ -197,7 +217,7 @@ pub fn sweep(
             let start = left.gait.clone();
             continue_along(
                 config,
-                &spec.param,
+                param,
                 &values[lo.min(hi)..hi],
                 initial,
                 start,
