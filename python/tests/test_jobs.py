@@ -71,11 +71,11 @@ def test_no_gait_is_a_status_and_reason(cli, tmp_path):
 
 
 def test_sweep_equals_sweep_csv_and_thresholds_json(cli, tmp_path):
-    args = ("--from", 1, "--to", 300, "--points", 30)
+    args = ("--from", 1, "--to", 300, "--points", 100)
     cli("sweep", *args, "--out", tmp_path)
     header, rows = read_csv(tmp_path / "sweep.csv")
     values = [float(r[0]) for r in rows]
-    assert vrw.linspace(1, 300, 30) == values
+    assert vrw.linspace(1, 300, 100) == values
     result = vrw.sweep(vrw.Params(), "viscosity", np.array(values))
     assert_table_equals_csv(result["sweep"], tmp_path / "sweep.csv")
     thresholds = json.loads((tmp_path / "thresholds.json").read_text())

@@ -334,3 +334,36 @@ pub fn sweep_row(p: &SweepPoint) -> Vec<Cell> {
 pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
     write_table(path, &sweep_header(param), points.iter().map(sweep_row))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::default_initial;
+    use crate::dynamics::Model;
+    use crate::params::Config;
+    use crate::walk::{simulate, Trajectory};
+
+    /// Every row function gives one cell per header name (the CSV writers and the Python binding rely on it).
+    #[test]
+    fn rows_match_their_headers() {
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let mut trajectory = Trajectory::new(0.1);
+        let start = default_initial(&config);
+        let run = simulate(&model, &config.solver, &start, 1, Some(&mut trajectory)).unwrap();
+        assert_eq!(step_row(&run.steps[0]).len(), STEPS_HEADER.len());
+        assert_eq!(
+            trajectory_row(&trajectory.samples[0]).len(),
+            TRAJECTORY_HEADER.len()
+        );
+        let no_gait = SweepPoint {
+            value: 1.0,
+            status: "fell".to_string(),
+            message: Some("fell".to_string()),
+            gait: None,
+        };
+        assert_eq!(sweep_row(&no_gait).len(), sweep_header("c").len());
+        assert_eq!(Cell::Empty.to_csv(), "");
+        assert_eq!(Cell::Real(f64::NAN).to_csv(), "NaN");
+    }
+}
