@@ -10,6 +10,9 @@
 //!   reached after `SETTLE_STEPS` steps, to a residual below 1e-10, plus the Floquet multipliers
 //!   (`central`: one central-difference Jacobian, as in sweeps; `refined`: with the Richardson error estimate,
 //!   as `vrw gait` does).
+//! - `gait_job`: the whole `vrw gait` search on the defaults (`vrw::app::compute_gait`: transient, Newton,
+//!   refined multipliers), the function the Python binding's `vrw.find_gait(vrw.Params())` calls;
+//!   `python/bench/overhead.py` compares the two.
 //!
 //! The default sweep (300 viscosities with thresholds and Fig. 2) is timed by the command itself, which
 //! prints its wall time split into sweep and thresholds: `cargo run --release -- sweep`.
@@ -19,7 +22,7 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
-use vrw::app::default_initial;
+use vrw::app::{compute_gait, default_initial, GaitJob};
 use vrw::dynamics::Model;
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
@@ -112,5 +115,31 @@ fn gait_after_transient(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, walking_step, twenty_steps, gait_after_transient);
+fn gait_job(c: &mut Criterion) {
+    let job = GaitJob {
+        config: Config::default(),
+        initial: None,
+        options: GaitOptions::default(),
+        out_dir: Default::default(),
+    };
+    let mut group = c.benchmark_group("gait");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(5));
+    group.bench_function("job", |b| {
+        b.iter(|| {
+            let summary = compute_gait(black_box(&job)).expect("valid parameters");
+            assert!(summary.gait.is_some());
+            black_box(summary)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    walking_step,
+    twenty_steps,
+    gait_after_transient,
+    gait_job
+);
 criterion_main!(benches);

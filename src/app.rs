@@ -14,7 +14,8 @@ use serde::Serialize;
 use crate::dynamics::Model;
 use crate::error::{short, WalkError};
 use crate::gait::{
-    find_gait, find_thresholds, sweep, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec, Threshold,
+    find_gait, find_thresholds, sweep_values, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec,
+    Threshold,
 };
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
@@ -235,6 +236,73 @@ pub fn run_simulate(
     job: &SimulateJob,
     observe: &mut dyn FnMut(SimulateEvent),
 ) -> Result<SimulateSummary, AppError> {
+    let (model, initial) = simulation_setup(job)?;
+    let dir = &job.out_dir;
+    output::ensure_dir(dir)?;
+    let mut steps_csv = output::StepsCsv::create(&dir.join("steps.csv"))?;
+    let trajectory_path = dir.join("trajectory.csv");
+    let mut trajectory = if job.trajectory {
+        let sink = output::TrajectoryCsv::create(&trajectory_path)?;
+        Some(Trajectory::streaming(job.sample_dt, Box::new(sink)))
+    } else {
+        // A trajectory.csv left by an earlier run would not match the new steps.csv.
+        remove_stale(&trajectory_path)?;
+        None
+    };
+    let write_row = |report: &StepReport| -> Result<(), AppError> { Ok(steps_csv.write(report)?) };
+    let mut summary = walk_job(
+        job,
+        &model,
+        initial,
+        trajectory.as_mut(),
+        write_row,
+        observe,
+    )?;
+    if let Some(source) = trajectory.as_mut().and_then(Trajectory::take_error) {
+        return Err(OutputError::Io {
+            path: trajectory_path,
+            source,
+        }
+        .into());
+    }
+    summary.files.push("steps.csv".to_string());
+    if job.trajectory {
+        summary.files.push("trajectory.csv".to_string());
+    }
+    summary.files.push("summary.json".to_string());
+    output::write_json(&dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// The walk of [`run_simulate`] without writing anything (`job.out_dir` and `job.trajectory` are not used),
+/// for other fronts (the Python binding): the summary with **every** step record (not only the last
+/// [`SUMMARY_STEPS`]), and the trajectory sampled every `job.sample_dt` if `record_trajectory`. It is held in
+/// memory, so it suits runs of moderate length.
+pub fn compute_simulation(
+    job: &SimulateJob,
+    record_trajectory: bool,
+) -> Result<(SimulateSummary, Option<Trajectory>), AppError> {
+    let (model, initial) = simulation_setup(job)?;
+    let mut trajectory = record_trajectory.then(|| Trajectory::new(job.sample_dt));
+    let mut all = Vec::new();
+    let mut summary = walk_job(
+        job,
+        &model,
+        initial,
+        trajectory.as_mut(),
+        |report| {
+            all.push(*report);
+            Ok(())
+        },
+        &mut |_| {},
+    )?;
+    summary.steps_limit = all.len();
+    summary.steps = all;
+    Ok((summary, trajectory))
+}
+
+/// Validate a simulate job: its configuration, its sampling interval, its model and its start.
+fn simulation_setup(job: &SimulateJob) -> Result<(Model, SectionState), AppError> {
     job.config.validate()?;
     if !(job.sample_dt.is_finite() && job.sample_dt > 0.0) {
         return Err(AppError::InvalidOption {
@@ -255,31 +323,31 @@ pub fn run_simulate(
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
     initial.validate(&model)?;
-    let dir = &job.out_dir;
-    output::ensure_dir(dir)?;
+    Ok((model, initial))
+}
+
+/// Walk the job's steps, handing each report to `on_step` and then each step and warning to `observe`, and
+/// build the
+/// summary (aggregates, the last [`SUMMARY_STEPS`] records, status).
+fn walk_job(
+    job: &SimulateJob,
+    model: &Model,
+    initial: SectionState,
+    trajectory: Option<&mut Trajectory>,
+    mut on_step: impl FnMut(&StepReport) -> Result<(), AppError>,
+    observe: &mut dyn FnMut(SimulateEvent),
+) -> Result<SimulateSummary, AppError> {
     let mut summary = SimulateSummary::new(job, initial);
-    let mut steps_csv = output::StepsCsv::create(&dir.join("steps.csv"))?;
-    summary.files.push("steps.csv".to_string());
-    let trajectory_path = dir.join("trajectory.csv");
-    let mut trajectory = if job.trajectory {
-        let sink = output::TrajectoryCsv::create(&trajectory_path)?;
-        summary.files.push("trajectory.csv".to_string());
-        Some(Trajectory::streaming(job.sample_dt, Box::new(sink)))
-    } else {
-        // A trajectory.csv left by an earlier run would not match the new steps.csv.
-        remove_stale(&trajectory_path)?;
-        None
-    };
     let mut last = VecDeque::new();
     let end = simulate_streaming(
-        &model,
+        model,
         &job.config.solver,
         &initial,
         job.steps,
-        trajectory.as_mut(),
+        trajectory,
         job.interrupt.as_deref(),
         |report| -> Result<(), AppError> {
-            steps_csv.write(report)?;
+            on_step(report)?;
             let warning = summary.add_step(report, &mut last);
             observe(SimulateEvent::Step(report));
             if let Some(w) = &warning {
@@ -288,13 +356,6 @@ pub fn run_simulate(
             Ok(())
         },
     )?;
-    if let Some(source) = trajectory.as_mut().and_then(Trajectory::take_error) {
-        return Err(OutputError::Io {
-            path: trajectory_path,
-            source,
-        }
-        .into());
-    }
     summary.end_time = end.time;
     summary.steps = last.into();
     (summary.status, summary.message) = match (&end.failure, end.interrupted) {
@@ -308,8 +369,6 @@ pub fn run_simulate(
         ),
         (None, false) => ("completed".to_string(), None),
     };
-    summary.files.push("summary.json".to_string());
-    output::write_json(&dir.join("summary.json"), &summary)?;
     Ok(summary)
 }
 
@@ -366,6 +425,18 @@ pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 /// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
 /// ([`write_gait_period`]).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
+    let summary = compute_gait(job)?;
+    output::ensure_dir(&job.out_dir)?;
+    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
+    if let Some(gait) = &summary.gait {
+        write_gait_period(job, gait)?;
+    }
+    Ok(summary)
+}
+
+/// The search of [`run_gait`] without writing anything (`job.out_dir` is not used). A search that finds no
+/// gait is a summary with its status and message, not an error.
+pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let tolerance = job.options.tolerance;
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(AppError::InvalidOption {
@@ -403,11 +474,6 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok(),
     };
-    output::ensure_dir(&job.out_dir)?;
-    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
-    if let Some(gait) = &summary.gait {
-        write_gait_period(job, gait)?;
-    }
     Ok(summary)
 }
 
@@ -474,32 +540,81 @@ pub fn run_sweep(
 ) -> Result<SweepSummary, AppError> {
     job.config.validate()?;
     job.spec.validate(&job.config)?;
-    let model = Model::new(&job.config.params)?;
-    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
-    initial.validate(&model)?;
     output::ensure_dir(&job.out_dir)?;
-    let clock = std::time::Instant::now();
-    let points = sweep(&job.config, &job.spec, &initial, &job.options, progress)?;
-    let sweep_seconds = clock.elapsed().as_secs_f64();
-    output::write_sweep_csv(&job.out_dir.join("sweep.csv"), &job.spec.param, &points)?;
-    let clock = std::time::Instant::now();
-    let mut thresholds = find_thresholds(&job.config, &job.spec, &points, &job.options);
-    let threshold_seconds = clock.elapsed().as_secs_f64();
-    thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let csv = job.out_dir.join("sweep.csv");
+    let result = compute_sweep(
+        &job.config,
+        &job.spec.param,
+        &job.spec.values(),
+        job.initial,
+        &job.options,
+        progress,
+        &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
+    )?;
     let summary = SweepSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
         spec: job.spec.clone(),
-        gaits_found: points.iter().filter(|p| p.gait.is_some()).count(),
-        points: points.len(),
-        thresholds,
-        seconds: [sweep_seconds, threshold_seconds],
+        gaits_found: result.points.iter().filter(|p| p.gait.is_some()).count(),
+        points: result.points.len(),
+        thresholds: result.thresholds,
+        seconds: result.seconds,
     };
     output::write_json(&job.out_dir.join("thresholds.json"), &summary)?;
     if summary.gaits_found > 0 {
-        write_fig2(job, &points, &summary.thresholds)?;
+        write_fig2(job, &result.points, &summary.thresholds)?;
     }
     Ok(summary)
+}
+
+/// A sweep and its thresholds, as [`compute_sweep`] returns them.
+#[derive(Debug, Clone)]
+pub struct SweepResult {
+    /// One point per parameter value, in the order given.
+    pub points: Vec<SweepPoint>,
+    /// Every located threshold, in parameter order.
+    pub thresholds: Vec<Threshold>,
+    /// Wall-clock seconds spent on the sweep and on the thresholds.
+    pub seconds: [f64; 2],
+}
+
+/// The computation of [`run_sweep`] without writing anything: sweep `param` over `values` with continuation
+/// (starting at `initial`, `None`: [`default_initial`]), then locate the thresholds between the points.
+/// `progress` is called after every point; `swept` receives the points before the thresholds are searched
+/// (where `vrw sweep` writes `sweep.csv`).
+pub fn compute_sweep(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    initial: Option<SectionState>,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+    swept: &mut dyn FnMut(&[SweepPoint]) -> Result<(), AppError>,
+) -> Result<SweepResult, AppError> {
+    config.validate()?;
+    let model = Model::new(&config.params)?;
+    let initial = initial.unwrap_or_else(|| default_initial(config));
+    initial.validate(&model)?;
+    let clock = std::time::Instant::now();
+    let points = sweep_values(config, param, values, &initial, options, progress)?;
+    let sweep_seconds = clock.elapsed().as_secs_f64();
+    swept(&points)?;
+    // The thresholds read the parameter's name from the spec; the range is the values' span.
+    let spec = SweepSpec {
+        param: param.to_string(),
+        from: values.first().copied().unwrap_or(f64::NAN),
+        to: values.last().copied().unwrap_or(f64::NAN),
+        points: values.len(),
+    };
+    let clock = std::time::Instant::now();
+    let mut thresholds = find_thresholds(config, &spec, &points, options);
+    let threshold_seconds = clock.elapsed().as_secs_f64();
+    thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
+    Ok(SweepResult {
+        points,
+        thresholds,
+        seconds: [sweep_seconds, threshold_seconds],
+    })
 }
 
 fn write_fig2(

@@ -430,8 +430,7 @@ fn sweep(args: SweepArgs) -> Result<()> {
             points: args.points,
         },
         initial: args.initial,
-        // The refined Jacobian gives each gait's stability verdict its error estimate.
-        options: GaitOptions::default(),
+        options: GaitOptions::for_sweeps(),
         out_dir: args.out.clone(),
     };
     let bar = progress_bar(

@@ -493,6 +493,14 @@ impl Config {
         self.assign(key, value)
     }
 
+    /// Sets `key` from a TOML value, converted exactly as a configuration file's value is (for fronts that
+    /// receive typed values, e.g. the Python binding's keyword arguments).
+    ///
+    /// Does not validate: call [`Config::validate`] after the last change.
+    pub fn set_value(&mut self, key: &str, value: &toml::Value) -> Result<(), ConfigError> {
+        self.assign(key, value)
+    }
+
     /// Names of the keys holding a real number (sweepable): every `f64` field of [`Params`] and
     /// [`SolverOptions`], in declaration order.
     pub fn numeric_keys() -> &'static [&'static str] {

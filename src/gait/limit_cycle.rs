@@ -36,6 +36,14 @@ impl Default for GaitOptions {
     }
 }
 
+impl GaitOptions {
+    /// The settings of a sweep (`vrw sweep`): the defaults, with the refined `DP` whose error estimate gives
+    /// each gait its stability verdict.
+    pub fn for_sweeps() -> GaitOptions {
+        GaitOptions::default()
+    }
+}
+
 /// Why no gait was found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GaitError {

@@ -11,5 +11,5 @@ pub use limit_cycle::{
     find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
 };
 pub use step_map::{StepMap, StepOutcome};
-pub use sweep::{sweep, SweepPoint, SweepSpec};
+pub use sweep::{sweep, sweep_values, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};

@@ -322,7 +322,27 @@ pub fn sweep(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, ConfigError> {
     spec.validate(config)?;
-    let values = spec.values();
+    sweep_values(
+        config,
+        &spec.param,
+        &spec.values(),
+        initial,
+        options,
+        progress,
+    )
+}
+
+/// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
+/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values.
+pub fn sweep_values(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    initial: &SectionState,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<Vec<SweepPoint>, ConfigError> {
+    config.get_numeric(param)?;
     let coarse_values: Vec<f64> = values.iter().copied().step_by(COARSE_STRIDE).collect();
     // The coarse pass: every COARSE_STRIDE-th point, each continued from the previous coarse point.
     let mut coarse: Vec<SweepPoint> = Vec::with_capacity(coarse_values.len());
@@ -332,7 +352,7 @@ pub fn sweep(
                 .as_ref()
                 .map(|g| ((k - 1) * COARSE_STRIDE, p.value, g))
         });
-        let point = gait_at_value(config, &spec.param, value, initial, previous, options);
+        let point = gait_at_value(config, param, value, initial, previous, options);
         progress(&point);
         coarse.push(point);
     }
@@ -348,7 +368,7 @@ pub fn sweep(
                 .map(|g| (i * COARSE_STRIDE, left.value, g));
             continue_along(
                 config,
-                &spec.param,
+                param,
                 &values[lo.min(hi)..hi],
                 lo,
                 initial,
@@ -363,7 +383,7 @@ pub fn sweep(
         points.push(left);
         points.extend(fill);
     }
-    backfill(config, &spec.param, &mut points, options);
-    number_families(config, &spec.param, &mut points, options);
+    backfill(config, param, &mut points, options);
+    number_families(config, param, &mut points, options);
     Ok(points)
 }

@@ -128,7 +128,50 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputErro
     w.flush().map_err(io)
 }
 
-/// Header of `steps.csv`.
+/// One cell of a result table, typed so that a table can be written as CSV or handed to another front (the
+/// Python binding turns each column into an array of its type).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// A real number, written with [`num`].
+    Real(f64),
+    /// A count or an index (also the `0`/`1` flags of `trajectory.csv`).
+    Count(usize),
+    /// A flag, written `true` or `false`.
+    Flag(bool),
+    /// A word (a branch, a status, a message).
+    Text(String),
+    /// No value (e.g. the gait columns of a sweep point without a gait), written as an empty field.
+    Empty,
+}
+
+impl Cell {
+    /// The cell as a CSV field.
+    pub fn to_csv(&self) -> String {
+        match self {
+            Cell::Real(v) => num(*v),
+            Cell::Count(n) => n.to_string(),
+            Cell::Flag(b) => b.to_string(),
+            Cell::Text(t) => t.clone(),
+            Cell::Empty => String::new(),
+        }
+    }
+}
+
+/// Write a CSV table: the header, then one record per row.
+pub fn write_table<H, R>(path: &Path, header: &[H], rows: R) -> Result<(), OutputError>
+where
+    H: AsRef<[u8]>,
+    R: IntoIterator<Item = Vec<Cell>>,
+{
+    let mut w = csv_writer(path)?;
+    write_record(&mut w, path, header)?;
+    for row in rows {
+        write_record(&mut w, path, row.iter().map(Cell::to_csv))?;
+    }
+    finish_csv(w, path)
+}
+
+/// Header of `steps.csv` (the names of [`step_row`]'s cells).
 pub const STEPS_HEADER: [&str; 28] = [
     "step",
     "time",
@@ -160,38 +203,39 @@ pub const STEPS_HEADER: [&str; 28] = [
     "penetration",
 ];
 
-/// One row of `steps.csv` (columns of [`STEPS_HEADER`]).
-fn step_row(s: &StepReport) -> [String; STEPS_HEADER.len()] {
+/// One row of `steps.csv`, in the order of [`STEPS_HEADER`].
+pub fn step_row(s: &StepReport) -> Vec<Cell> {
+    use Cell::{Count, Flag, Real, Text};
     let e = &s.energy;
-    [
-        s.step.to_string(),
-        num(s.time),
-        num(s.section.l2),
-        num(s.section.theta_dot),
-        num(s.section.l2_dot),
-        num(s.theta),
-        num(s.indicators.lambda_i4),
-        num(s.indicators.lambda_2_plus),
-        num(s.indicators.lambda_4_plus),
-        s.branch.to_string(),
-        num(s.dls_duration),
-        num(s.period),
-        num(s.step_length),
-        num(s.speed),
-        s.scuffing.to_string(),
-        s.bounce.to_string(),
-        s.events.to_string(),
-        num(e.start),
-        num(e.end),
-        num(e.loss),
-        num(e.damper),
-        num(e.impact),
-        num(e.stopper),
-        num(e.residual),
-        num(s.rear_contact_duration),
-        num(s.contact.pull_force),
-        num(s.contact.pull_impulse),
-        num(s.contact.penetration),
+    vec![
+        Count(s.step),
+        Real(s.time),
+        Real(s.section.l2),
+        Real(s.section.theta_dot),
+        Real(s.section.l2_dot),
+        Real(s.theta),
+        Real(s.indicators.lambda_i4),
+        Real(s.indicators.lambda_2_plus),
+        Real(s.indicators.lambda_4_plus),
+        Text(s.branch.to_string()),
+        Real(s.dls_duration),
+        Real(s.period),
+        Real(s.step_length),
+        Real(s.speed),
+        Flag(s.scuffing),
+        Flag(s.bounce),
+        Count(s.events),
+        Real(e.start),
+        Real(e.end),
+        Real(e.loss),
+        Real(e.damper),
+        Real(e.impact),
+        Real(e.stopper),
+        Real(e.residual),
+        Real(s.rear_contact_duration),
+        Real(s.contact.pull_force),
+        Real(s.contact.pull_impulse),
+        Real(s.contact.penetration),
     ]
 }
 
@@ -261,7 +305,7 @@ impl StepsCsv {
 
     /// Write the row of one step and flush it.
     pub fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
-        self.0.write(step_row(step))
+        self.0.write(step_row(step).iter().map(Cell::to_csv))
     }
 }
 
@@ -272,7 +316,7 @@ pub fn write_steps_csv(path: &Path, steps: &[StepReport]) -> Result<(), OutputEr
     steps.iter().try_for_each(|s| w.write(s))
 }
 
-/// Header of `trajectory.csv`.
+/// Header of `trajectory.csv` (the names of [`trajectory_row`]'s cells).
 pub const TRAJECTORY_HEADER: [&str; 24] = [
     "time",
     "x",
@@ -300,17 +344,21 @@ pub const TRAJECTORY_HEADER: [&str; 24] = [
     "leg1",
 ];
 
-/// One row of `trajectory.csv` (columns of [`TRAJECTORY_HEADER`]).
-fn sample_row(s: &Sample) -> Vec<String> {
-    let flag = |b: bool| if b { "1" } else { "0" }.to_string();
-    let mut row: Vec<String> = Vec::with_capacity(TRAJECTORY_HEADER.len());
-    row.push(num(s.time));
-    row.extend(s.q.iter().chain(s.qd.iter()).map(|v| num(*v)));
+/// One row of `trajectory.csv`, in the order of [`TRAJECTORY_HEADER`]: time, the ten states (`x` from the
+/// start of the walk), the active contacts and stoppers as `0`/`1`, the multipliers (stopper reactions
+/// positive inward) and which physical leg is Leg 1.
+pub fn trajectory_row(s: &Sample) -> Vec<Cell> {
+    let mut row = Vec::with_capacity(TRAJECTORY_HEADER.len());
+    row.push(Cell::Real(s.time));
+    row.extend(s.q.iter().chain(s.qd.iter()).map(|v| Cell::Real(*v)));
     let a = &s.active;
-    row.extend([a.contact1, a.contact2, a.slide1, a.slide2, a.lock1, a.lock2].map(flag));
+    row.extend(
+        [a.contact1, a.contact2, a.slide1, a.slide2, a.lock1, a.lock2]
+            .map(|b| Cell::Count(usize::from(b))),
+    );
     let m = &s.multipliers;
-    row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(num));
-    row.push(s.leg1.to_string());
+    row.extend([m[0], m[1], m[2], m[3], -m[4], -m[5]].map(Cell::Real));
+    row.push(Cell::Count(s.leg1));
     row
 }
 
@@ -333,7 +381,9 @@ impl TrajectoryCsv {
 
 impl SampleSink for TrajectoryCsv {
     fn write(&mut self, sample: &Sample) -> std::io::Result<()> {
-        self.0.row(sample_row(sample)).map_err(std::io::Error::from)
+        self.0
+            .row(trajectory_row(sample).iter().map(Cell::to_csv))
+            .map_err(std::io::Error::from)
     }
 
     fn flush(&mut self) -> std::io::Result<()> {
@@ -383,53 +433,93 @@ pub const SWEEP_COLUMNS: [&str; 23] = [
     "message",
 ];
 
-/// Write `sweep.csv`: one row per sweep point (the parameter value, the status and the gait's scalars; empty
-/// gait fields where no gait was found).
-pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
-    let mut w = csv_writer(path)?;
-    let header: Vec<&str> = std::iter::once(param).chain(SWEEP_COLUMNS).collect();
-    write_record(&mut w, path, &header)?;
-    for p in points {
-        let mut row = vec![num(p.value), p.status.clone()];
-        match &p.gait {
-            Some(g) => {
-                row.extend(
-                    [
-                        g.section.l2,
-                        g.section.theta_dot,
-                        g.section.l2_dot,
-                        g.theta,
-                        g.lambda_i4,
-                        g.lambda_2_plus,
-                        g.lambda_4_plus,
-                    ]
-                    .map(num),
-                );
-                row.push(g.branch.to_string());
-                row.extend(
-                    [
-                        g.period,
-                        g.step_length,
-                        g.speed,
-                        g.dls_duration,
-                        g.rear_contact_duration,
-                    ]
-                    .map(num),
-                );
-                row.extend([g.scuffing, g.bounce].map(|b| b.to_string()));
-                row.push(g.stability.to_string());
-                row.extend([
-                    num(g.max_floquet),
-                    num(g.jacobian_error),
-                    num(g.residual),
-                    g.iterations.to_string(),
-                    p.family.map_or_else(String::new, |f| f.to_string()),
-                ]);
-            }
-            None => row.extend(std::iter::repeat_n(String::new(), SWEEP_COLUMNS.len() - 2)),
+/// The header of `sweep.csv` for a sweep of `param`: the parameter, then [`SWEEP_COLUMNS`].
+pub fn sweep_header(param: &str) -> Vec<&str> {
+    std::iter::once(param).chain(SWEEP_COLUMNS).collect()
+}
+
+/// One row of `sweep.csv`, in the order of [`sweep_header`]: the parameter value, the status and the gait's
+/// scalars ([`Cell::Empty`] where no gait was found).
+pub fn sweep_row(p: &SweepPoint) -> Vec<Cell> {
+    use Cell::{Count, Flag, Real, Text};
+    let mut row = vec![Real(p.value), Text(p.status.clone())];
+    match &p.gait {
+        Some(g) => {
+            row.extend(
+                [
+                    g.section.l2,
+                    g.section.theta_dot,
+                    g.section.l2_dot,
+                    g.theta,
+                    g.lambda_i4,
+                    g.lambda_2_plus,
+                    g.lambda_4_plus,
+                ]
+                .map(Real),
+            );
+            row.push(Text(g.branch.to_string()));
+            row.extend(
+                [
+                    g.period,
+                    g.step_length,
+                    g.speed,
+                    g.dls_duration,
+                    g.rear_contact_duration,
+                ]
+                .map(Real),
+            );
+            row.extend([g.scuffing, g.bounce].map(Flag));
+            row.push(Text(g.stability.to_string()));
+            row.extend([
+                Real(g.max_floquet),
+                Real(g.jacobian_error),
+                Real(g.residual),
+                Count(g.iterations),
+                p.family.map_or(Cell::Empty, Count),
+            ]);
         }
-        row.push(p.message.clone().unwrap_or_default());
-        write_record(&mut w, path, &row)?;
+        None => row.extend(std::iter::repeat_n(Cell::Empty, SWEEP_COLUMNS.len() - 2)),
     }
-    finish_csv(w, path)
+    row.push(Text(p.message.clone().unwrap_or_default()));
+    row
+}
+
+/// Write `sweep.csv`: one row per sweep point (see [`sweep_row`]).
+pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
+    write_table(path, &sweep_header(param), points.iter().map(sweep_row))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::default_initial;
+    use crate::dynamics::Model;
+    use crate::params::Config;
+    use crate::walk::{simulate, Trajectory};
+
+    /// Every row function gives one cell per header name (the CSV writers and the Python binding rely on it).
+    #[test]
+    fn rows_match_their_headers() {
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let mut trajectory = Trajectory::new(0.1);
+        let start = default_initial(&config);
+        let run = simulate(&model, &config.solver, &start, 1, Some(&mut trajectory)).unwrap();
+        assert_eq!(step_row(&run.steps[0]).len(), STEPS_HEADER.len());
+        assert_eq!(
+            trajectory_row(&trajectory.samples[0]).len(),
+            TRAJECTORY_HEADER.len()
+        );
+        let no_gait = SweepPoint {
+            value: 1.0,
+            status: "fell".to_string(),
+            message: Some("fell".to_string()),
+            gait: None,
+            continued_from: None,
+            family: None,
+        };
+        assert_eq!(sweep_row(&no_gait).len(), sweep_header("c").len());
+        assert_eq!(Cell::Empty.to_csv(), "");
+        assert_eq!(Cell::Real(f64::NAN).to_csv(), "NaN");
+    }
 }

@@ -1,0 +1,417 @@
+//! `vrw._vrw`: the Python binding of the vrw library (STYLE.md point 14).
+//!
+//! This crate only converts at the edge: keyword arguments become [`Config`] keys (typed as in a TOML file),
+//! the library's jobs run with the GIL released, and their results come back as dicts of numpy arrays keyed
+//! by the column names of the CSV files (taken from [`vrw::output`], the same functions the CSV writers use)
+//! or as the JSON structures of `summary.json`, `gait.json` and `thresholds.json` (the same `Serialize`
+//! impls, through `pythonize`). Each library error becomes one Python exception with the same message.
+
+use std::path::PathBuf;
+
+use numpy::{Complex64, IntoPyArray, PyArray2};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
+use pythonize::pythonize;
+
+use vrw::app::{compute_gait, compute_simulation, compute_sweep, AppError, GaitJob, SimulateJob};
+use vrw::error::WalkError as LibWalkError;
+use vrw::gait::{GaitOptions, SweepSpec};
+use vrw::output::{
+    step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
+};
+use vrw::params::{Config, ConfigError as LibConfigError};
+use vrw::walk::SectionState;
+
+create_exception!(
+    vrw,
+    ConfigError,
+    PyValueError,
+    "Invalid parameters: an unknown key, a value of the wrong type or one that breaks a rule, a malformed or \
+     unreadable TOML file. The message is the command line's."
+);
+create_exception!(
+    vrw,
+    WalkError,
+    PyRuntimeError,
+    "A walk that cannot start (e.g. an invalid initial section state). The message is the command line's."
+);
+
+fn config_error(e: LibConfigError) -> PyErr {
+    ConfigError::new_err(e.to_string())
+}
+
+fn walk_error(e: LibWalkError) -> PyErr {
+    WalkError::new_err(e.to_string())
+}
+
+/// One Python exception per library error, with the library's message.
+fn app_error(e: AppError) -> PyErr {
+    match e {
+        AppError::Config(e) => config_error(e),
+        AppError::Walk(e) => walk_error(e),
+        AppError::Output(e) => PyOSError::new_err(e.to_string()),
+        e @ AppError::InvalidOption { .. } => PyValueError::new_err(e.to_string()),
+        // Reading run directories and drawing figures are command-line jobs, not reached from Python.
+        e @ (AppError::Read(_) | AppError::Animate(_) | AppError::Plot(_)) => {
+            PyOSError::new_err(e.to_string())
+        }
+    }
+}
+
+/// A keyword argument as the TOML value a configuration file would hold.
+fn toml_value(key: &str, value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    if let Ok(b) = value.downcast::<PyBool>() {
+        return Ok(toml::Value::Boolean(b.is_true()));
+    }
+    if value.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(value.extract()?));
+    }
+    if value.is_instance_of::<PyInt>() {
+        return match value.extract::<i64>() {
+            Ok(n) => Ok(toml::Value::Integer(n)),
+            Err(_) => Err(config_error(LibConfigError::InvalidValue {
+                key: key.to_string(),
+                value: value.str()?.to_string(),
+                reason: "is out of range".to_string(),
+            })),
+        };
+    }
+    if let Ok(s) = value.downcast::<PyString>() {
+        return Ok(toml::Value::String(s.extract()?));
+    }
+    // numpy scalars (np.int64, np.bool_, np.float32, ...) and 0-d arrays: their Python value.
+    if value.hasattr("dtype")? && value.getattr("ndim")?.extract::<usize>()? == 0 {
+        return toml_value(key, &value.call_method0("item")?);
+    }
+    Err(PyTypeError::new_err(format!(
+        "`{key}`: expected a number, a bool or a string, got {}",
+        value.get_type().name()?
+    )))
+}
+
+/// Apply `keys` (keyword arguments or a state dict) to `config`, then validate, as the command line does.
+fn apply_keys(mut config: Config, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+    if let Some(keys) = keys {
+        for (key, value) in keys.iter() {
+            let key: String = key.extract()?;
+            let value = toml_value(&key, &value)?;
+            config.set_value(&key, &value).map_err(config_error)?;
+        }
+    }
+    config.validate().map_err(config_error)?;
+    Ok(config)
+}
+
+/// The model's parameters and the solver's settings: every key of a vrw TOML file.
+///
+/// `Params(viscosity=37, slope=0.05)` starts from the defaults (the paper's Table 1, c = 50 N s/m) and
+/// applies each keyword as a TOML key, validated as `vrw --config FILE --set key=value` does: an unknown key or
+/// a bad value raises `vrw.ConfigError` (a `ValueError`) with the command line's message.
+#[pyclass(module = "vrw", name = "Params", frozen, eq)]
+#[derive(Clone, PartialEq)]
+struct Params {
+    config: Config,
+}
+
+#[pymethods]
+impl Params {
+    #[new]
+    #[pyo3(signature = (**keys))]
+    fn new(keys: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
+        Ok(Params {
+            config: apply_keys(Config::default(), keys)?,
+        })
+    }
+
+    /// Read a flat TOML file of parameters (as `vrw --config FILE`).
+    #[staticmethod]
+    fn from_toml(path: PathBuf) -> PyResult<Params> {
+        Ok(Params {
+            config: Config::from_file(&path).map_err(config_error)?,
+        })
+    }
+
+    /// Every key and its value, as a TOML file (or `summary.json`'s `config`) holds them.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(pythonize(py, &self.config)?)
+    }
+
+    /// A copy with the given keys changed (validated as in the constructor).
+    #[pyo3(signature = (**keys))]
+    fn replace(&self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
+        Ok(Params {
+            config: apply_keys(self.config.clone(), keys)?,
+        })
+    }
+
+    /// The value of one key.
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        let all = self.to_dict(py)?;
+        match all.get_item(key) {
+            Ok(v) => Ok(v),
+            Err(_) => Err(pyo3::exceptions::PyKeyError::new_err(key.to_string())),
+        }
+    }
+
+    /// The keys holding a real number (the parameters a sweep or a grid can vary).
+    #[staticmethod]
+    fn numeric_keys() -> Vec<&'static str> {
+        Config::numeric_keys().to_vec()
+    }
+
+    fn __getnewargs_ex__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        // Pickle as `Params(**to_dict())`: the keys are re-read as the constructor reads them.
+        Ok((
+            pyo3::types::PyTuple::empty(py).into_any(),
+            self.to_dict(py)?,
+        ))
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let all = self.to_dict(py)?;
+        let defaults = pythonize(py, &Config::default())?;
+        let mut changed = Vec::new();
+        for (key, value) in all.downcast::<PyDict>()?.iter() {
+            if !value.eq(defaults.get_item(&key)?)? {
+                changed.push(format!("{}={}", key.str()?, value.repr()?));
+            }
+        }
+        Ok(format!("Params({})", changed.join(", ")))
+    }
+}
+
+/// A table (CSV header and typed rows) as a dict of numpy arrays keyed by the header: real columns as
+/// float64 (`NaN` for empty cells), counts as int64 (0 for empty cells), flags as bool (False for empty
+/// cells), words as numpy string arrays.
+fn table<'py, H: AsRef<str>>(
+    py: Python<'py>,
+    header: &[H],
+    rows: &[Vec<Cell>],
+) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    let numpy = py.import("numpy")?;
+    for (j, name) in header.iter().enumerate() {
+        let column = rows.iter().map(|r| r.get(j).unwrap_or(&Cell::Empty));
+        let kind = column.clone().find(|c| !matches!(c, Cell::Empty));
+        let array: Bound<'py, PyAny> = match kind {
+            None | Some(Cell::Real(_)) | Some(Cell::Empty) => column
+                .map(|c| match c {
+                    Cell::Real(v) => *v,
+                    _ => f64::NAN,
+                })
+                .collect::<Vec<f64>>()
+                .into_pyarray(py)
+                .into_any(),
+            Some(Cell::Count(_)) => column
+                .map(|c| match c {
+                    Cell::Count(n) => *n as i64,
+                    _ => 0,
+                })
+                .collect::<Vec<i64>>()
+                .into_pyarray(py)
+                .into_any(),
+            Some(Cell::Flag(_)) => column
+                .map(|c| matches!(c, Cell::Flag(true)))
+                .collect::<Vec<bool>>()
+                .into_pyarray(py)
+                .into_any(),
+            Some(Cell::Text(_)) => {
+                let words: Vec<String> = column.map(Cell::to_csv).collect();
+                numpy.call_method1("array", (PyList::new(py, words)?, "U"))?
+            }
+        };
+        dict.set_item(name.as_ref(), array)?;
+    }
+    Ok(dict)
+}
+
+fn section(initial: Option<[f64; 3]>) -> Option<SectionState> {
+    initial.map(SectionState::from_array)
+}
+
+/// The search settings: `defaults` with the keyword arguments `options` (the fields of the library's
+/// `GaitOptions`, as `gait.json` lists them under `options`).
+fn gait_options(
+    defaults: GaitOptions,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<GaitOptions> {
+    let mut o = defaults;
+    for (key, value) in options.into_iter().flat_map(|d| d.iter()) {
+        let key: String = key.extract()?;
+        match key.as_str() {
+            "transient_steps" => o.transient_steps = value.extract()?,
+            "max_iterations" => o.max_iterations = value.extract()?,
+            "tolerance" => o.tolerance = value.extract()?,
+            "fd_step" => o.fd_step = value.extract()?,
+            "refine_jacobian" => o.refine_jacobian = value.extract()?,
+            _ => {
+                return Err(PyTypeError::new_err(format!(
+                    "unexpected keyword argument `{key}` (search options: transient_steps, \
+                     max_iterations, tolerance, fd_step, refine_jacobian)"
+                )))
+            }
+        }
+    }
+    for (name, v) in [("tolerance", o.tolerance), ("fd_step", o.fd_step)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "invalid {name} {v}: must be a positive number"
+            )));
+        }
+    }
+    Ok(o)
+}
+
+/// Walk `steps` steps from `initial` (`vrw simulate`).
+///
+/// `initial` is the Poincare-section state `(L2, thetadot, L2dot)` (default: the command line's). Returns the
+/// fields of `summary.json`, with `steps` a dict of numpy arrays keyed like `steps.csv` and `trajectory` one
+/// keyed like `trajectory.csv` (`None` without `trajectory`). A walk that stops early is a `status`; an
+/// invalid initial state raises `vrw.WalkError`.
+#[pyfunction]
+#[pyo3(signature = (params, steps = 20, initial = None, trajectory = true, sample_dt = 0.005))]
+fn simulate<'py>(
+    py: Python<'py>,
+    params: &Params,
+    steps: usize,
+    initial: Option<[f64; 3]>,
+    trajectory: bool,
+    sample_dt: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let job = SimulateJob {
+        config: params.config.clone(),
+        initial: section(initial),
+        steps,
+        sample_dt,
+        trajectory,
+        out_dir: PathBuf::new(),
+        interrupt: None,
+    };
+    let (summary, samples) = py
+        .allow_threads(|| compute_simulation(&job, trajectory))
+        .map_err(app_error)?;
+    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
+    let rows: Vec<Vec<Cell>> = summary.steps.iter().map(step_row).collect();
+    result.set_item("steps", table(py, &STEPS_HEADER, &rows)?)?;
+    match samples {
+        Some(t) => {
+            let rows: Vec<Vec<Cell>> = t.samples.iter().map(trajectory_row).collect();
+            result.set_item("trajectory", table(py, &TRAJECTORY_HEADER, &rows)?)?
+        }
+        None => result.set_item("trajectory", py.None())?,
+    }
+    Ok(result)
+}
+
+/// Find the gait (`vrw gait`): the fields of `gait.json`.
+///
+/// `status` is `found` or why no gait was found (with `message`, as the command line reports it); a found
+/// gait adds its fields, `floquet_multipliers` as a complex numpy array and `jacobian` as a 2-D array.
+/// Keyword options: `transient_steps`, `max_iterations`, `tolerance`, `fd_step`, `refine_jacobian`.
+#[pyfunction]
+#[pyo3(signature = (params, initial = None, **options))]
+fn find_gait<'py>(
+    py: Python<'py>,
+    params: &Params,
+    initial: Option<[f64; 3]>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let job = GaitJob {
+        config: params.config.clone(),
+        initial: section(initial),
+        options: gait_options(GaitOptions::default(), options)?,
+        out_dir: PathBuf::new(),
+    };
+    let summary = py.allow_threads(|| compute_gait(&job)).map_err(app_error)?;
+    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
+    if let Some(g) = &summary.gait {
+        let multipliers: Vec<Complex64> = g
+            .floquet_multipliers
+            .iter()
+            .map(|[re, im]| Complex64::new(*re, *im))
+            .collect();
+        result.set_item("floquet_multipliers", multipliers.into_pyarray(py))?;
+        result.set_item("jacobian", PyArray2::from_vec2(py, &g.jacobian)?)?;
+    }
+    Ok(result)
+}
+
+/// Sweep `param` over `values` with continuation and locate the thresholds (`vrw sweep`, without the
+/// figure).
+///
+/// Returns `param`, `sweep` (the columns of `sweep.csv` as numpy arrays), `thresholds` (the entries of
+/// `thresholds.json`), `gaits_found` and `seconds`. Keyword options as for `find_gait`, defaulting to the
+/// command line's sweep settings. `vrw.linspace` gives the command line's values.
+#[pyfunction]
+#[pyo3(signature = (params, param, values, *, initial = None, **options))]
+fn sweep<'py>(
+    py: Python<'py>,
+    params: &Params,
+    param: &str,
+    values: Vec<f64>,
+    initial: Option<[f64; 3]>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let options = gait_options(GaitOptions::for_sweeps(), options)?;
+    let config = &params.config;
+    let result = py
+        .allow_threads(|| {
+            compute_sweep(
+                config,
+                param,
+                &values,
+                section(initial),
+                &options,
+                &|_| {},
+                &mut |_| Ok(()),
+            )
+        })
+        .map_err(app_error)?;
+    let out = PyDict::new(py);
+    out.set_item("param", param)?;
+    let rows: Vec<Vec<Cell>> = result.points.iter().map(sweep_row).collect();
+    out.set_item("sweep", table(py, &sweep_header(param), &rows)?)?;
+    out.set_item("thresholds", pythonize(py, &result.thresholds)?)?;
+    out.set_item(
+        "gaits_found",
+        result.points.iter().filter(|p| p.gait.is_some()).count(),
+    )?;
+    out.set_item("seconds", result.seconds.to_vec())?;
+    Ok(out)
+}
+
+/// The values `vrw sweep --from START --to STOP --points POINTS` visits (evenly spaced, ends included).
+#[pyfunction]
+fn linspace(start: f64, stop: f64, points: usize) -> PyResult<Vec<f64>> {
+    if !(start.is_finite() && stop.is_finite()) || start == stop || points < 2 {
+        return Err(PyValueError::new_err(format!(
+            "linspace({start}, {stop}, {points}): needs two different finite ends and at least 2 points"
+        )));
+    }
+    let spec = SweepSpec {
+        param: String::new(),
+        from: start,
+        to: stop,
+        points,
+    };
+    Ok(spec.values())
+}
+
+#[pymodule]
+fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<Params>()?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(find_gait, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(linspace, m)?)?;
+    m.add("ConfigError", py.get_type::<ConfigError>())?;
+    m.add("WalkError", py.get_type::<WalkError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,116 @@
+"""simulate, find_gait and sweep give exactly what the command line writes (compared with its files, not
+with numbers of today's physics)."""
+
+import json
+import pickle
+import threading
+
+import numpy as np
+import pytest
+
+import vrw
+from conftest import assert_table_equals_csv, cli_error, json_equal, read_csv
+
+
+def test_simulate_equals_the_command_lines_files(cli, tmp_path):
+    cli("simulate", "--steps", 4, "--set", "viscosity=37", "--out", tmp_path)
+    run = vrw.simulate(vrw.Params(viscosity=37), steps=4)
+    assert_table_equals_csv(run["steps"], tmp_path / "steps.csv")
+    assert_table_equals_csv(run["trajectory"], tmp_path / "trajectory.csv")
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    # Only the command line writes files, and its summary keeps the last steps only (steps.csv has them all);
+    # Python returns every step.
+    assert summary["files"] == ["steps.csv", "trajectory.csv", "summary.json"] and run["files"] == []
+    assert len(run["steps"]["step"]) == run["steps_limit"] == 4
+    ignored = ("steps", "trajectory", "files", "steps_limit")
+    assert json_equal(
+        {k: v for k, v in run.items() if k not in ignored},
+        {k: v for k, v in summary.items() if k not in ignored},
+    )
+    assert run["status"] == "completed"
+    assert vrw.simulate(vrw.Params(viscosity=37), steps=4, trajectory=False)["trajectory"] is None
+
+
+def test_a_walk_that_stops_is_a_status(cli, tmp_path):
+    # Uphill the wheel cannot walk: it rolls back (whatever the other parameters).
+    cli("simulate", "--steps", 3, "--set", "slope=-0.1", "--out", tmp_path, check=False)
+    run = vrw.simulate(vrw.Params(slope=-0.1), steps=3)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert run["status"] == summary["status"] != "completed"
+    assert run["message"] == summary["message"]
+    assert_table_equals_csv(run["steps"], tmp_path / "steps.csv")
+
+
+def test_invalid_initial_state_raises_the_command_lines_message(cli, tmp_path):
+    with pytest.raises(vrw.WalkError) as raised:
+        vrw.simulate(vrw.Params(), steps=1, initial=(-1.0, 1.0, 0.0))
+    done = cli("simulate", "--steps", 1, "--initial=-1,1,0", "--out", tmp_path, check=False)
+    assert str(raised.value) == cli_error(done).removeprefix("simulate: ")
+
+
+def test_find_gait_equals_gait_json(cli, tmp_path):
+    cli("gait", "--set", "viscosity=37", "--out", tmp_path)
+    gait = vrw.find_gait(vrw.Params(viscosity=37))
+    expected = json.loads((tmp_path / "gait.json").read_text())
+    assert json_equal(gait, expected)
+    assert gait["status"] == "found"
+    assert gait["floquet_multipliers"].dtype == np.complex128
+    assert gait["jacobian"].shape == (len(gait["floquet_multipliers"]),) * 2
+
+
+def test_search_options_are_the_command_lines(cli, tmp_path):
+    cli("gait", "--transient", 12, "--tolerance", 1e-11, "--out", tmp_path)
+    gait = vrw.find_gait(vrw.Params(), transient_steps=12, tolerance=1e-11)
+    assert json_equal(gait, json.loads((tmp_path / "gait.json").read_text()))
+    with pytest.raises(TypeError):
+        vrw.find_gait(vrw.Params(), transient=12)
+    with pytest.raises(ValueError):
+        vrw.find_gait(vrw.Params(), tolerance=-1.0)
+
+
+def test_no_gait_is_a_status_and_reason(cli, tmp_path):
+    done = cli("gait", "--set", "slope=-0.1", "--out", tmp_path, check=False)
+    assert done.returncode == 1
+    gait = vrw.find_gait(vrw.Params(slope=-0.1))
+    expected = json.loads((tmp_path / "gait.json").read_text())
+    assert gait["status"] != "found" and gait["message"]
+    assert json_equal(gait, expected)
+
+
+def test_sweep_equals_sweep_csv_and_thresholds_json(cli, tmp_path):
+    args = ("--from", 1, "--to", 300, "--points", 100)
+    cli("sweep", *args, "--out", tmp_path)
+    header, rows = read_csv(tmp_path / "sweep.csv")
+    values = [float(r[0]) for r in rows]
+    assert vrw.linspace(1, 300, 100) == values
+    result = vrw.sweep(vrw.Params(), "viscosity", np.array(values))
+    assert_table_equals_csv(result["sweep"], tmp_path / "sweep.csv")
+    thresholds = json.loads((tmp_path / "thresholds.json").read_text())
+    assert json_equal(result["thresholds"], thresholds["thresholds"])
+    assert result["gaits_found"] == thresholds["gaits_found"]
+
+
+def test_results_pickle():
+    p = vrw.Params(viscosity=37)
+    for result in (vrw.simulate(p, steps=2), vrw.find_gait(p), vrw.sweep(p, "viscosity", [36.0, 37.0])):
+        back = pickle.loads(pickle.dumps(result))
+        assert back.keys() == result.keys()
+        assert repr(back) == repr(result)
+
+
+def test_computation_releases_the_gil():
+    # While a search runs in another thread, this thread runs Python code. With the GIL held through the
+    # search, this thread could only resume after it, and would find it done.
+    started, done = threading.Event(), threading.Event()
+
+    def search():
+        started.set()
+        vrw.find_gait(vrw.Params(viscosity=37))
+        done.set()
+
+    worker = threading.Thread(target=search)
+    worker.start()
+    started.wait()
+    ran_meanwhile = not done.is_set()
+    worker.join()
+    assert ran_meanwhile

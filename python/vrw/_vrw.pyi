@@ -1,0 +1,101 @@
+"""Type stubs of the compiled extension ``vrw._vrw`` (re-exported by ``vrw``)."""
+
+from os import PathLike
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+from typing_extensions import TypedDict, Unpack
+
+__version__: str
+
+Value = Union[float, int, bool, str]
+Section = Union[Tuple[float, float, float], Sequence[float]]
+
+class GaitOptions(TypedDict, total=False):
+    """Search settings (the library's ``GaitOptions``; ``gait.json``'s ``options``), as keyword arguments."""
+
+    transient_steps: int  # steps walked before Newton's method starts (default 30)
+    max_iterations: int  # Newton iterations allowed (default 20)
+    tolerance: float  # convergence: max |P(s) - s| below this (default 1e-10)
+    fd_step: float  # relative finite-difference step of the Jacobian (default 1e-4)
+    refine_jacobian: bool  # Richardson-refined final Jacobian (default True; False in sweeps)
+
+class ConfigError(ValueError):
+    """Invalid parameters (unknown key, wrong type, broken rule, bad TOML file); the command line's message."""
+
+class WalkError(RuntimeError):
+    """A walk that cannot start (e.g. an invalid initial section state); the command line's message."""
+
+class Params:
+    """The model's parameters and the solver's settings: every key of a vrw TOML file.
+
+    ``Params(viscosity=37)`` starts from the defaults (the paper's Table 1, c = 50 N s/m) and applies each
+    keyword as a TOML key, validated as the command line does; an unknown key or a bad value raises
+    ``ConfigError`` (a ``ValueError``) with the command line's message. Immutable, comparable, picklable.
+    """
+
+    def __init__(self, **keys: Value) -> None: ...
+    @staticmethod
+    def from_toml(path: Union[str, "PathLike[str]"]) -> "Params":
+        """Read a flat TOML file of parameters (as ``vrw --config FILE``)."""
+    def to_dict(self) -> Dict[str, Value]:
+        """Every key and its value, as a TOML file (or ``summary.json``'s ``config``) holds them."""
+    def replace(self, **keys: Value) -> "Params":
+        """A copy with the given keys changed (validated as in the constructor)."""
+    def __getitem__(self, key: str) -> Value: ...
+    @staticmethod
+    def numeric_keys() -> List[str]:
+        """The keys holding a real number (what a sweep or a grid can vary)."""
+    def __eq__(self, other: object) -> bool: ...
+
+def simulate(
+    params: Params,
+    steps: int = 20,
+    initial: Optional[Section] = None,
+    trajectory: bool = True,
+    sample_dt: float = 0.005,
+) -> Dict[str, Any]:
+    """Walk ``steps`` steps from ``initial`` (``vrw simulate``).
+
+    ``initial`` is the Poincare-section state ``(L2, thetadot, L2dot)``; ``None`` is the command line's
+    default ``(0.72, 1.0, 0.0)`` (``(L0, 1.0, 0.0)`` with ``rigid_legs``). Returns the fields of
+    ``summary.json`` (``status``: ``completed`` or the failure kind, ``message``, ``steps_completed``,
+    ``end_time``, ``config``, ...) with ``steps`` replaced by a dict of numpy arrays keyed like the columns
+    of ``steps.csv`` and ``trajectory`` a dict of numpy arrays keyed like ``trajectory.csv`` (``None`` if
+    ``trajectory=False``). A walk that stops early is a status, not an exception; an invalid initial state
+    raises ``WalkError``.
+    """
+
+def find_gait(
+    params: Params,
+    initial: Optional[Section] = None,
+    **options: Unpack[GaitOptions],
+) -> Dict[str, Any]:
+    """Find the gait (``vrw gait``): the fields of ``gait.json``.
+
+    ``status`` is ``found`` or why no gait was found (``message`` says it in words, as the command line
+    does); a found gait adds its fields (``section``, ``lambda_i4``, ``lambda_2_plus``, ..., ``stable``),
+    with ``floquet_multipliers`` as a complex numpy array and ``jacobian`` as a 2-D numpy array. Options
+    not given take the library's defaults (see ``GaitOptions``).
+    """
+
+def sweep(
+    params: Params,
+    param: str,
+    values: Union[Sequence[float], npt.NDArray[np.float64]],
+    *,
+    initial: Optional[Section] = None,
+    **options: Unpack[GaitOptions],
+) -> Dict[str, Any]:
+    """Sweep ``param`` over ``values`` with continuation and locate the thresholds (``vrw sweep``).
+
+    Returns ``{"param", "sweep", "thresholds", "gaits_found", "seconds"}``: ``sweep`` holds the columns
+    of ``sweep.csv`` as numpy arrays (reals as float64 with NaN, flags as bool with False, counts as int64
+    with 0 and words as strings where no gait was found), ``thresholds`` the entries of
+    ``thresholds.json`` as dicts. Options default to the command line's sweep settings (one central
+    difference for the final Jacobian). ``vrw.linspace`` gives the command line's evenly spaced values.
+    """
+
+def linspace(start: float, stop: float, points: int) -> List[float]:
+    """The values ``vrw sweep --from START --to STOP --points POINTS`` visits (bit for bit)."""
