@@ -529,6 +529,9 @@ pub struct SweepSummary {
     /// reproducible).
     #[serde(skip)]
     pub seconds: [f64; 2],
+    /// The files this run wrote into the output directory (Fig. 2 only if some point has a gait; an earlier
+    /// run's figure is removed rather than left beside this run's tables).
+    pub files: Vec<String>,
 }
 
 /// Run `vrw sweep`: the sweep, its thresholds, `sweep.csv`, `thresholds.json` and Fig. 2. `progress` is called
@@ -551,18 +554,30 @@ pub fn run_sweep(
         progress,
         &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
     )?;
+    let gaits_found = result.points.iter().filter(|p| p.gait.is_some()).count();
+    let figures = ["fig2.svg", "fig2.png"];
+    let mut files = vec!["sweep.csv".to_string(), "thresholds.json".to_string()];
+    if gaits_found > 0 {
+        files.extend(figures.map(String::from));
+    }
     let summary = SweepSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
         spec: job.spec.clone(),
-        gaits_found: result.points.iter().filter(|p| p.gait.is_some()).count(),
+        gaits_found,
         points: result.points.len(),
         thresholds: result.thresholds,
         seconds: result.seconds,
+        files,
     };
     output::write_json(&job.out_dir.join("thresholds.json"), &summary)?;
-    if summary.gaits_found > 0 {
+    if gaits_found > 0 {
         write_fig2(job, &result.points, &summary.thresholds)?;
+    } else {
+        // A figure of an earlier sweep must not stand beside this sweep's tables.
+        for f in figures {
+            remove_stale(&job.out_dir.join(f))?;
+        }
     }
     Ok(summary)
 }
@@ -622,7 +637,8 @@ fn write_fig2(
     points: &[SweepPoint],
     thresholds: &[Threshold],
 ) -> Result<(), AppError> {
-    // Points without a gait are NaN, so the curves break there instead of bridging the gap.
+    // Points without a gait are NaN, so the curves break there instead of bridging the gap; a change of
+    // family breaks them too.
     let indicator_points: Vec<IndicatorPoint> = points
         .iter()
         .map(|p| match &p.gait {
@@ -632,6 +648,9 @@ fn write_fig2(
                 lambda_2_plus: g.lambda_2_plus,
                 lambda_4_plus: g.lambda_4_plus,
                 scuffing: g.scuffing,
+                family: p.family,
+                period: g.period,
+                max_floquet: g.max_floquet,
             },
             None => IndicatorPoint {
                 param: p.value,
@@ -639,15 +658,29 @@ fn write_fig2(
                 lambda_2_plus: f64::NAN,
                 lambda_4_plus: f64::NAN,
                 scuffing: false,
+                family: None,
+                period: f64::NAN,
+                max_floquet: f64::NAN,
             },
         })
         .collect();
-    let symbol = |name: &str| match name {
+    let symbol = |t: &Threshold| match t.name.as_str() {
         "lambda_4_plus = 0" => "λ₄⁺ = 0",
         "lambda_2_plus = 0" => "λ₂⁺ = 0",
         "lambda_I4 = 0" => "λI4 = 0",
         "stability_lost" => "unstable",
-        _ => "gait lost",
+        "gait_lost" => "gait lost",
+        "gait_found"
+            if t.detail
+                .as_deref()
+                .is_some_and(|d| d.contains("found again")) =>
+        {
+            "gait found again"
+        }
+        "gait_found" => "gait found",
+        "branch_switch" => "branch switch",
+        "fold" => "fold",
+        _ => "unconfirmed end",
     };
     let marks: Vec<ThresholdMark> = thresholds
         .iter()
@@ -655,24 +688,31 @@ fn write_fig2(
         .map(|t| ThresholdMark {
             label: format!(
                 "{}: {} = {:.2}",
-                symbol(&t.name),
+                symbol(t),
                 short_name(&job.spec.param),
                 t.value
             ),
             value: t.value,
         })
         .collect();
-    let p = &job.config.params;
+    let no_gait = no_gait_spans(points, thresholds);
     let title = format!(
-        "DLS indicators of the gait, slope φ = {} rad, impact {} (hollow: scuffing of Leg 2)",
-        p.slope, p.impact
+        "Gaits along {}: {} (hollow: scuffing of Leg 2; grey: no gait)",
+        short_name(&job.spec.param),
+        fixed_parameters(&job.config, &job.spec.param)
     );
     let label = axis_label(&job.spec.param);
+    let (lo, hi) = (
+        job.spec.from.min(job.spec.to),
+        job.spec.from.max(job.spec.to),
+    );
     let spec = Fig2Spec {
         points: &indicator_points,
         thresholds: &marks,
         param_label: &label,
         title: &title,
+        x_range: Some(lo..hi),
+        no_gait: &no_gait,
     };
     write_fig2_files(
         &spec,
@@ -683,6 +723,69 @@ fn write_fig2(
         option: "figure",
         reason: e.to_string(),
     })
+}
+
+/// The parameter intervals without a gait: each maximal run of sweep points without one, from the end of the
+/// family on its left (the located threshold in that grid interval, else the midpoint) to the start of the
+/// family on its right (likewise), or to the end of the sweep.
+fn no_gait_spans(points: &[SweepPoint], thresholds: &[Threshold]) -> Vec<std::ops::Range<f64>> {
+    let edge = |a: &SweepPoint, b: &SweepPoint| {
+        let (lo, hi) = (a.value.min(b.value), a.value.max(b.value));
+        thresholds
+            .iter()
+            .map(|t| t.value)
+            .find(|v| v.is_finite() && lo <= *v && *v <= hi)
+            .unwrap_or(0.5 * (a.value + b.value))
+    };
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < points.len() {
+        if points[i].gait.is_some() {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < points.len() && points[i].gait.is_none() {
+            i += 1;
+        }
+        let a = if start == 0 {
+            points[0].value
+        } else {
+            edge(&points[start - 1], &points[start])
+        };
+        let b = if i == points.len() {
+            points[i - 1].value
+        } else {
+            edge(&points[i - 1], &points[i])
+        };
+        spans.push(a.min(b)..a.max(b));
+    }
+    spans
+}
+
+/// The main parameters other than the swept one, for titles: `c = 50 N s/m, k = 500 N/m, φ = 0.1 rad, ...`.
+fn fixed_parameters(config: &Config, swept: &str) -> String {
+    let p = &config.params;
+    let mut parts: Vec<String> = [
+        ("viscosity", p.viscosity),
+        ("stiffness", p.stiffness),
+        ("slope", p.slope),
+    ]
+    .iter()
+    .filter(|(key, _)| *key != swept)
+    .map(|(key, v)| {
+        let unit = axis_label(key);
+        let unit = unit
+            .split_once('[')
+            .map_or("", |(_, u)| u.trim_end_matches(']'));
+        format!("{} = {} {unit}", short_name(key), short(*v))
+    })
+    .collect();
+    parts.push(format!("impact {}", p.impact));
+    if p.rigid_legs {
+        parts.push("rigid legs".to_string());
+    }
+    parts.join(", ")
 }
 
 /// Short symbol of a parameter for labels (`c` for viscosity, ...).

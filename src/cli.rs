@@ -471,8 +471,9 @@ fn sweep(args: SweepArgs) -> Result<()> {
         );
     }
     println!(
-        "wrote {}/{{sweep.csv, thresholds.json, fig2.svg, fig2.png}}",
-        args.out.display()
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
     );
     if summary.gaits_found == 0 {
         bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");

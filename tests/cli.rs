@@ -650,3 +650,43 @@ fn rigid_legs_default_start_walks() {
     assert_eq!(run.code(), Some(0), "stderr:\n{}", run.stderr());
     assert_eq!(run.summary()["status"], "completed");
 }
+
+/// A sweep that finds no gait used to print "wrote ... fig2.svg, fig2.png" though it wrote no figure, and left
+/// the figure of an earlier sweep into the same directory beside its new tables.
+#[test]
+fn sweep_without_gait_lists_only_what_it_wrote_and_removes_an_old_figure() {
+    let dir = temp_dir_with(&[]);
+    let path = dir.path().join("out");
+    fs::create_dir(&path).unwrap();
+    fs::write(path.join("fig2.png"), "an earlier sweep's figure").unwrap();
+    fs::write(path.join("fig2.svg"), "<svg/>").unwrap();
+    // Uphill the wheel cannot walk, whatever the viscosity.
+    let run = command_in(
+        dir,
+        "sweep",
+        &[
+            "--set",
+            "slope=-0.1",
+            "--from",
+            "40",
+            "--to",
+            "60",
+            "--points",
+            "3",
+        ],
+    );
+    assert_ne!(run.code(), Some(0));
+    assert!(
+        run.stdout().contains("{sweep.csv, thresholds.json}"),
+        "{}",
+        run.stdout()
+    );
+    assert!(!run.stdout().contains("fig2"), "{}", run.stdout());
+    assert!(path.join("sweep.csv").exists());
+    assert!(!path.join("fig2.png").exists() && !path.join("fig2.svg").exists());
+    let thresholds: Value = serde_json::from_str(&run.read("thresholds.json")).unwrap();
+    assert_eq!(
+        thresholds["files"],
+        serde_json::json!(["sweep.csv", "thresholds.json"])
+    );
+}

@@ -342,3 +342,15 @@ fn sweep_points_carry_their_family_and_an_honest_stability_verdict() {
     assert_eq!(thresholds.len(), 1, "{thresholds:?}");
     assert_eq!(thresholds[0].name, "gait_found");
 }
+
+/// `vrw gait` with the rebound option used to print "stable" with a Jacobian error estimate of ~2, twenty times
+/// the largest multiplier. The verdict now says what is known.
+#[test]
+fn stability_verdict_accounts_for_the_jacobian_error() {
+    use vrw::gait::Stability;
+    assert_eq!(Stability::judge(0.1, 2.0), Stability::Uncertain);
+    assert_eq!(Stability::judge(0.5, 0.1), Stability::Stable);
+    assert_eq!(Stability::judge(1.5, 0.1), Stability::Unstable);
+    assert_eq!(Stability::judge(0.95, 0.1), Stability::Uncertain);
+    assert_eq!(Stability::judge(0.5, f64::NAN), Stability::Uncertain);
+}

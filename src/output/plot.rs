@@ -40,6 +40,12 @@ pub struct IndicatorPoint {
     pub lambda_4_plus: f64,
     /// Whether scuffing of Leg 2 arises on this gait (drawn with hollow markers).
     pub scuffing: bool,
+    /// Gait family (points of different families are never joined by a line); `None` without a gait.
+    pub family: Option<usize>,
+    /// Step period of the gait \[s\]; NaN when there is no gait.
+    pub period: f64,
+    /// Largest Floquet multiplier modulus of the gait; NaN when there is no gait.
+    pub max_floquet: f64,
 }
 
 /// A vertical annotated marker.
@@ -62,10 +68,14 @@ pub struct Fig2Spec<'a> {
     pub param_label: &'a str,
     /// Figure title (may be empty: no title is drawn).
     pub title: &'a str,
+    /// The x range to show (the whole sweep); `None`: the span of the data and thresholds.
+    pub x_range: Option<Range<f64>>,
+    /// Parameter intervals without a gait, shaded in every panel.
+    pub no_gait: &'a [Range<f64>],
 }
 
 /// Size of both the SVG and the PNG, in pixels.
-pub const FIG2_SIZE: (u32, u32) = (1600, 1200);
+pub const FIG2_SIZE: (u32, u32) = (1600, 1600);
 
 /// A run of text on the baseline, as a subscript, or as a stacked
 /// subscript/superscript pair (plotters has no rich text).
@@ -79,10 +89,14 @@ enum Seg {
 const NAME_I4: &[Seg] = &[Seg::Text("λ"), Seg::Sub("I4")];
 const NAME_2: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("2", "+")];
 const NAME_4: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("4", "+")];
+const NAME_PERIOD: &[Seg] = &[Seg::Text("period")];
+const NAME_FLOQUET: &[Seg] = &[Seg::Text("largest |multiplier|")];
+const LABEL_PERIOD: &[Seg] = &[Seg::Text("T [s]")];
+const LABEL_FLOQUET: &[Seg] = &[Seg::Text("max |μ|")];
 const LABEL_I4: &[Seg] = &[Seg::Text("λ"), Seg::Sub("I4"), Seg::Text(" [N s]")];
 const LABEL_PLUS: &[Seg] = &[Seg::Text("λ [N]")];
 
-// Layout, in pixels of the 1600 x 1200 canvas.
+// Layout, in pixels of the 1600 x 1600 canvas.
 const MARGIN: i32 = 24;
 const TITLE_H: i32 = 64;
 const ROW_H: i32 = 36;
@@ -124,12 +138,17 @@ impl Series {
         value: fn(&IndicatorPoint) -> f64,
     ) -> Self {
         let mut runs: Vec<Vec<(f64, f64, bool)>> = vec![Vec::new()];
+        let mut family = None;
         for p in sorted {
             let v = value(p);
+            // A new run after a point without a value, and at every change of gait family (two families are
+            // never joined by a line).
+            if (!v.is_finite() || p.family != family) && !runs.last().unwrap().is_empty() {
+                runs.push(Vec::new());
+            }
             if v.is_finite() {
                 runs.last_mut().unwrap().push((p.param, v, p.scuffing));
-            } else if !runs.last().unwrap().is_empty() {
-                runs.push(Vec::new());
+                family = p.family;
             }
         }
         runs.retain(|r| !r.is_empty());
@@ -153,20 +172,22 @@ impl Series {
 /// Validated data and axis ranges.
 struct Prepared {
     x: Range<f64>,
-    y_a: Range<f64>,
-    y_b: Range<f64>,
-    panel_a: Vec<Series>,
-    panel_b: Vec<Series>,
+    /// The panels (a)-(d), each with its series and y range.
+    panels: [(Vec<Series>, Range<f64>); 4],
     marks: Vec<ThresholdMark>,
+    no_gait: Vec<Range<f64>>,
     marker: i32,
 }
 
-/// Range of the y values of `series`, always including 0 (the zero line).
-fn y_range(series: &[Series]) -> Range<f64> {
+/// Range of the y values of `series`, always including `reference` (the reference line: 0, or 1 for the
+/// multipliers).
+fn y_range(series: &[Series], reference: f64) -> Range<f64> {
     let (lo, hi) = series
         .iter()
         .flat_map(|s| s.samples())
-        .fold((0.0_f64, 0.0_f64), |(lo, hi), s| (lo.min(s.1), hi.max(s.1)));
+        .fold((0.0_f64, reference), |(lo, hi), s| {
+            (lo.min(s.1), hi.max(s.1))
+        });
     let (lo, hi) = if hi > lo { (lo, hi) } else { (-1.0, 1.0) };
     let r = padded(lo, hi, 0.07);
     // Keep the zero line on the frame only when no data lies below it.
@@ -195,14 +216,28 @@ impl Prepared {
                 p.lambda_4_plus
             }),
         ];
-        let xs: Vec<f64> = panel_a
-            .iter()
-            .chain(&panel_b)
+        let panel_c = vec![Series::new(
+            NAME_PERIOD,
+            COLOR_I4,
+            Shape::Circle,
+            &sorted,
+            |p| p.period,
+        )];
+        let panel_d = vec![Series::new(
+            NAME_FLOQUET,
+            COLOR_BLUE,
+            Shape::Circle,
+            &sorted,
+            |p| p.max_floquet,
+        )];
+        let xs: Vec<f64> = [&panel_a, &panel_b, &panel_c, &panel_d]
+            .into_iter()
+            .flatten()
             .flat_map(|s| s.samples().map(|s| s.0))
             .collect();
         if xs.is_empty() {
             return Err(PlotError::Empty(format!(
-                "none of the {} points has a finite parameter and indicator (no gait found)",
+                "none of the {} points has a gait",
                 spec.points.len()
             )));
         }
@@ -212,32 +247,47 @@ impl Prepared {
             .filter(|m| m.value.is_finite())
             .cloned()
             .collect();
-        let (lo, hi) = xs
-            .iter()
-            .copied()
-            .chain(marks.iter().map(|m| m.value))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            });
-        let mut x = padded(lo, hi, 0.03);
-        if lo >= 0.0 && x.start < 0.0 {
-            x.start = 0.0;
-        }
-        let n = panel_b
-            .iter()
-            .chain(&panel_a)
+        let x = match &spec.x_range {
+            Some(r) if r.end > r.start => r.clone(),
+            _ => {
+                let (lo, hi) = xs
+                    .iter()
+                    .copied()
+                    .chain(marks.iter().map(|m| m.value))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                        (lo.min(v), hi.max(v))
+                    });
+                let mut x = padded(lo, hi, 0.03);
+                if lo >= 0.0 && x.start < 0.0 {
+                    x.start = 0.0;
+                }
+                x
+            }
+        };
+        let n = [&panel_a, &panel_b]
+            .into_iter()
+            .flatten()
             .map(|s| s.samples().count())
             .max()
             .unwrap_or(1)
             .max(1) as i32;
         let marker = (1100 / n / 2).clamp(4, 7);
+        let (y_a, y_b, y_c, y_d) = (
+            y_range(&panel_a, 0.0),
+            y_range(&panel_b, 0.0),
+            y_range(&panel_c, 0.0),
+            y_range(&panel_d, 1.0),
+        );
         Ok(Prepared {
             x,
-            y_a: y_range(&panel_a),
-            y_b: y_range(&panel_b),
-            panel_a,
-            panel_b,
+            panels: [
+                (panel_a, y_a),
+                (panel_b, y_b),
+                (panel_c, y_c),
+                (panel_d, y_d),
+            ],
             marks,
+            no_gait: spec.no_gait.to_vec(),
             marker,
         })
     }
@@ -448,7 +498,12 @@ struct Panel {
     top: i32,
     height: i32,
     bottom_axis: bool,
+    /// The y value of the solid reference line (0, or 1 for the multipliers).
+    reference: f64,
 }
+
+/// Fill of the parameter intervals without a gait.
+const NO_GAIT_FILL: RGBColor = RGBColor(228, 228, 228);
 
 /// Draws one panel; returns the pixel rectangle of its plotting area.
 fn draw_panel<DB: DrawingBackend>(
@@ -495,11 +550,31 @@ fn draw_panel<DB: DrawingBackend>(
         let (a, b) = to_px(p);
         (a - px.start, b - py.start)
     };
-    // Zero line.
+    // Intervals without a gait, under everything else.
+    for span in &data.no_gait {
+        let (a, b) = (span.start.max(x.start), span.end.min(x.end));
+        if b > a {
+            plot.draw(&Rectangle::new(
+                [rel((a, y.end)), rel((b, y.start))],
+                NO_GAIT_FILL.filled(),
+            ))?;
+        }
+    }
+    // Reference line.
     plot.draw(&PathElement::new(
-        vec![rel((x.start, 0.0)), rel((x.end, 0.0))],
+        vec![
+            rel((x.start, panel.reference)),
+            rel((x.end, panel.reference)),
+        ],
         BLACK.stroke_width(2),
     ))?;
+    if series.iter().all(|s| s.runs.is_empty()) {
+        plot.draw(&Text::new(
+            "not defined for these gaits (e.g. rigid legs)",
+            ((px.end - px.start) / 2, (py.end - py.start) / 4),
+            font(NOTE_FONT).pos(Pos::new(HPos::Center, VPos::Center)),
+        ))?;
+    }
     // Thresholds inside the plot.
     for m in &data.marks {
         dashed_vline(root, to_px((m.value, 0.0)).0, py.start, py.end)?;
@@ -646,41 +721,35 @@ fn draw_fig2<DB: DrawingBackend>(
     let label_top = top;
     top += strip;
 
-    let avail = h - MARGIN - top - X_LABEL_AREA - TOP_TICK_AREA - PANEL_GAP;
-    let h_a = avail * 45 / 100;
-    let panel_a = Panel {
-        tag: "(a)",
-        y_label: LABEL_I4,
-        top,
-        height: h_a + TOP_TICK_AREA,
-        bottom_axis: false,
-    };
-    let top_b = top + h_a + TOP_TICK_AREA + PANEL_GAP;
-    let panel_b = Panel {
-        tag: "(b)",
-        y_label: LABEL_PLUS,
-        top: top_b,
-        height: h - MARGIN - top_b,
-        bottom_axis: true,
-    };
-    let (_, py_a) = draw_panel(
-        root,
-        &panel_a,
-        &data.panel_a,
-        &data.x,
-        &data.y_a,
-        data,
-        spec.param_label,
-    )?;
-    draw_panel(
-        root,
-        &panel_b,
-        &data.panel_b,
-        &data.x,
-        &data.y_b,
-        data,
-        spec.param_label,
-    )?;
+    // Four panels sharing the x axis; only the last one has its tick labels.
+    const TAGS: [&str; 4] = ["(a)", "(b)", "(c)", "(d)"];
+    const LABELS: [&[Seg]; 4] = [LABEL_I4, LABEL_PLUS, LABEL_PERIOD, LABEL_FLOQUET];
+    const SHARES: [i32; 4] = [30, 30, 20, 20];
+    let avail = h - MARGIN - top - X_LABEL_AREA - 3 * (TOP_TICK_AREA + PANEL_GAP);
+    let mut py_a = 0..0;
+    let mut panel_top = top;
+    for k in 0..4 {
+        let last = k == 3;
+        let inner = avail * SHARES[k] / 100;
+        let panel = Panel {
+            tag: TAGS[k],
+            y_label: LABELS[k],
+            top: panel_top,
+            height: if last {
+                h - MARGIN - panel_top
+            } else {
+                inner + TOP_TICK_AREA
+            },
+            bottom_axis: last,
+            reference: if k == 3 { 1.0 } else { 0.0 },
+        };
+        let (series, y) = &data.panels[k];
+        let (_, py) = draw_panel(root, &panel, series, &data.x, y, data, spec.param_label)?;
+        if k == 0 {
+            py_a = py;
+        }
+        panel_top += inner + TOP_TICK_AREA + PANEL_GAP;
+    }
     // Threshold labels and the dashed lines up to them.
     for ((m, (x, text)), &row) in data.marks.iter().zip(&xw).zip(&rows) {
         let y_text = label_top + strip - 10 - (row as i32) * ROW_H - ROW_H / 2;
@@ -709,6 +778,9 @@ mod tests {
                     lambda_2_plus: -5.0 + 105.0 * (1.0 - (-(c - 1.0) / 60.0).exp()) / 0.993,
                     lambda_4_plus: 60.0 - 60.0 * c / 220.1,
                     scuffing: c < 30.0,
+                    family: Some(0),
+                    period: 2.0 + c / 100.0,
+                    max_floquet: 0.1 + c / 1000.0,
                 }
             })
             .collect()
@@ -740,6 +812,8 @@ mod tests {
             thresholds: &marks,
             param_label: "c [N s/m]",
             title: "DLS indicators vs leg viscosity",
+            x_range: None,
+            no_gait: &[],
         };
         write_fig2(&spec, &svg, &png).unwrap();
         let png_bytes = std::fs::read(&png).unwrap();
@@ -767,6 +841,8 @@ mod tests {
             thresholds: &[],
             param_label: "c [N s/m]",
             title: "",
+            x_range: None,
+            no_gait: &[],
         };
         let (svg, png) = (dir.path().join("a.svg"), dir.path().join("a.png"));
         let err = write_fig2(&spec, &svg, &png).unwrap_err();
@@ -783,6 +859,9 @@ mod tests {
                 lambda_i4: f64::NAN,
                 lambda_2_plus: f64::NAN,
                 lambda_4_plus: f64::NAN,
+                period: f64::NAN,
+                max_floquet: f64::NAN,
+                family: None,
                 ..p
             })
             .collect();
@@ -792,10 +871,43 @@ mod tests {
             thresholds: &marks,
             param_label: "c [N s/m]",
             title: "",
+            x_range: None,
+            no_gait: &[],
         };
         let err =
             write_fig2(&spec, &dir.path().join("a.svg"), &dir.path().join("a.png")).unwrap_err();
         assert!(matches!(err, PlotError::Empty(_)), "{err}");
+    }
+
+    /// A sweep with rigid legs has gaits but no DLS indicators: it used to fail with "no data to plot"; it
+    /// draws what exists (period, largest multiplier) over the whole range, with the no-gait part shaded.
+    #[test]
+    fn sweep_without_indicators_draws_period_and_multipliers() {
+        let dir = tempfile::tempdir().unwrap();
+        let points: Vec<IndicatorPoint> = synthetic()
+            .into_iter()
+            .map(|p| IndicatorPoint {
+                lambda_i4: f64::NAN,
+                lambda_2_plus: f64::NAN,
+                lambda_4_plus: f64::NAN,
+                ..p
+            })
+            .collect();
+        let no_gait = [250.0..300.0];
+        let spec = Fig2Spec {
+            points: &points,
+            thresholds: &[],
+            param_label: "c [N s/m]",
+            title: "",
+            x_range: Some(0.0..300.0),
+            no_gait: &no_gait,
+        };
+        let (svg, png) = (dir.path().join("a.svg"), dir.path().join("a.png"));
+        write_fig2(&spec, &svg, &png).unwrap();
+        let svg_text = std::fs::read_to_string(&svg).unwrap();
+        for label in ["T [s]", "max |μ|", "not defined for these gaits", "(d)"] {
+            assert!(svg_text.contains(label), "SVG lacks {label:?}");
+        }
     }
 
     #[test]
@@ -806,6 +918,8 @@ mod tests {
             thresholds: &[],
             param_label: "c [N s/m]",
             title: "",
+            x_range: None,
+            no_gait: &[],
         };
         let bad = Path::new("/nonexistent-dir/for/sure/fig2.svg");
         let err = write_fig2(&spec, bad, &bad.with_extension("png")).unwrap_err();
