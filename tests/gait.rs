@@ -354,3 +354,22 @@ fn stability_verdict_accounts_for_the_jacobian_error() {
     assert_eq!(Stability::judge(0.95, 0.1), Stability::Uncertain);
     assert_eq!(Stability::judge(0.5, f64::NAN), Stability::Uncertain);
 }
+
+/// At k = 760 N/m, 1.3 N/m from where the wheel starts rolling back, the finite differences of `DP` with the
+/// default step walk perturbed states that roll back. The sweep used to drop that gait ("no gait") and then
+/// report the family's end as unconfirmed; the gait is kept, with a smaller difference step.
+#[test]
+fn a_gait_at_the_edge_of_existence_is_kept_when_its_jacobian_needs_a_smaller_step() {
+    let config = Config::default();
+    let spec = SweepSpec {
+        param: "stiffness".into(),
+        from: 740.0,
+        to: 760.0,
+        points: 2,
+    };
+    let start = default_initial(&config);
+    let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
+    let edge = points[1].gait.as_ref().expect("a gait at k = 760");
+    assert_eq!(points[1].family, points[0].family);
+    assert!(edge.jacobian_guess().is_some() || edge.jacobian_failure.is_some());
+}

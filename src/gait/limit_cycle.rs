@@ -139,6 +139,9 @@ pub struct Gait {
     pub max_floquet: f64,
     /// What the multipliers and their error estimate show (see [`Stability`]).
     pub stability: Stability,
+    /// Why `DP` could not be computed (a perturbed state of the finite differences did not walk, e.g. at the
+    /// edge of existence); `None` when it was. Then the multipliers are unknown and the stability uncertain.
+    pub jacobian_failure: Option<String>,
     /// `stability == Stability::Stable`: all multipliers inside the unit circle by more than the error
     /// estimate.
     pub stable: bool,
@@ -217,17 +220,25 @@ pub fn find_gait(
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<Gait, GaitError> {
     let fp = solve_fixed_point(map, initial, options, jacobian_guess)?;
-    let (dp, jacobian_error) = if options.refine_jacobian {
-        map.jacobian(&fp.section, options.fd_step)
-    } else {
-        map.central_jacobian(&fp.section, options.fd_step)
-            .map(|j| (j, f64::NAN))
+    // Near the edge of existence a perturbed state may fail to walk (e.g. roll back): retry with smaller
+    // differences; if none works, the gait is reported without multipliers (stability uncertain).
+    let mut last_error = None;
+    for shrink in [1.0, 0.1, 0.01] {
+        let h = options.fd_step * shrink;
+        let dp = if options.refine_jacobian {
+            map.jacobian(&fp.section, h)
+        } else {
+            map.central_jacobian(&fp.section, h).map(|j| (j, f64::NAN))
+        };
+        match dp {
+            Ok((dp, jacobian_error)) => return Ok(gait_at(&fp, dp, jacobian_error)),
+            Err(e) => last_error = Some(e),
+        }
     }
-    .map_err(|source| GaitError::Newton {
-        iteration: fp.iterations + 1,
-        source,
-    })?;
-    Ok(gait_at(&fp, dp, jacobian_error))
+    let n = map.free_coordinates().len();
+    let mut gait = gait_at(&fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
+    gait.jacobian_failure = last_error.map(|e| e.to_string());
+    Ok(gait)
 }
 
 /// The fixed point alone (no Jacobian at the end): what threshold searches need.
@@ -342,9 +353,13 @@ pub fn solve_fixed_point(
 }
 
 fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
-    let mut multipliers: Vec<Complex<f64>> = dp.complex_eigenvalues().iter().copied().collect();
+    let mut multipliers: Vec<Complex<f64>> = if dp.iter().all(|v| v.is_finite()) {
+        dp.complex_eigenvalues().iter().copied().collect()
+    } else {
+        Vec::new()
+    };
     multipliers.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
-    let max_floquet = multipliers.first().map_or(0.0, |z| z.norm());
+    let max_floquet = multipliers.first().map_or(f64::NAN, |z| z.norm());
     let report = &fp.outcome.report;
     Gait {
         section: fp.section,
@@ -372,6 +387,7 @@ fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
         floquet_multipliers: multipliers.iter().map(|z| [z.re, z.im]).collect(),
         max_floquet,
         stability: Stability::judge(max_floquet, jacobian_error),
+        jacobian_failure: None,
         stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
     }
 }
@@ -410,6 +426,8 @@ struct GaitRecord {
     floquet_multipliers: Vec<[f64; 2]>,
     max_floquet: f64,
     stability: Stability,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    jacobian_failure: Option<String>,
     stable: bool,
 }
 
@@ -440,15 +458,22 @@ impl From<Gait> for GaitRecord {
             floquet_multipliers: g.floquet_multipliers,
             max_floquet: g.max_floquet,
             stability: g.stability,
+            jacobian_failure: g.jacobian_failure,
             stable: g.stable,
         }
     }
 }
 
 impl Gait {
-    /// `DP(s*)` as a matrix.
+    /// `DP(s*)` as a matrix (`NaN` entries if it could not be computed, see [`Gait::jacobian_failure`]).
     pub fn jacobian_matrix(&self) -> DMatrix<f64> {
         let n = self.jacobian.len();
         DMatrix::from_fn(n, n, |i, j| self.jacobian[i][j])
+    }
+
+    /// `DP(s*)` as a Newton matrix for a neighbouring search, if it was computed.
+    pub fn jacobian_guess(&self) -> Option<DMatrix<f64>> {
+        let dp = self.jacobian_matrix();
+        (dp.nrows() > 0 && dp.iter().all(|v| v.is_finite())).then_some(dp)
     }
 }

@@ -147,18 +147,18 @@ pub fn gait_at_value(
     let solver: &SolverOptions = &c.solver;
     let map = StepMap::new(&model, solver);
     let continued = previous.and_then(|(index, from, g)| {
-        let guess = g.jacobian_matrix();
+        let guess = g.jacobian_guess();
         let start = FamilyPoint {
             value: from,
             section: g.section,
         };
-        match Continuation::new(config, param, options).follow(start, value, Some(&guess)) {
+        match Continuation::new(config, param, options).follow(start, value, guess.as_ref()) {
             Followed::Reached(p) => {
                 let opts = GaitOptions {
                     transient_steps: 0,
                     ..*options
                 };
-                find_gait(&map, &p.section, &opts, Some(&guess))
+                find_gait(&map, &p.section, &opts, guess.as_ref())
                     .ok()
                     .map(|g| (index, g))
             }
@@ -234,12 +234,12 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
         if a.status == "invalid_parameter" {
             continue;
         }
-        let guess = gb.jacobian_matrix();
+        let guess = gb.jacobian_guess();
         let start = FamilyPoint {
             value: b.value,
             section: gb.section,
         };
-        let Followed::Reached(p) = cont.follow(start, a.value, Some(&guess)) else {
+        let Followed::Reached(p) = cont.follow(start, a.value, guess.as_ref()) else {
             continue;
         };
         let Ok((c, model)) = configured(config, param, a.value) else {
@@ -250,7 +250,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
             transient_steps: 0,
             ..*options
         };
-        if let Ok(g) = find_gait(&map, &p.section, &opts, Some(&guess)) {
+        if let Ok(g) = find_gait(&map, &p.section, &opts, guess.as_ref()) {
             a.status = g.stability.to_string();
             a.message = None;
             a.gait = Some(g);
@@ -293,7 +293,7 @@ fn number_families(config: &Config, param: &str, points: &mut [SweepPoint], opti
             section: ga.section,
         };
         let connected = cont
-            .step(&start, b.value, Some(&ga.jacobian_matrix()))
+            .step(&start, b.value, ga.jacobian_guess().as_ref())
             .is_some_and(|p| section_distance(&p.section, &gb.section) <= SAME_GAIT_TOL);
         if connected {
             for r in root.iter_mut().filter(|r| **r == Some(ri)) {

@@ -183,9 +183,9 @@ fn refine_end(
         value: from.value,
         section: g.section,
     };
-    let guess = g.jacobian_matrix();
+    let guess = g.jacobian_guess();
     let grid_bracket = sorted([from.value, toward.value]);
-    let (last, beyond) = match cont.follow(start, toward.value, Some(&guess)) {
+    let (last, beyond) = match cont.follow(start, toward.value, guess.as_ref()) {
         Followed::Ended { last, beyond } => (last, beyond),
         Followed::Reached(p) => {
             let same = toward.gait.as_ref().is_some_and(|gt| {
@@ -294,7 +294,7 @@ fn refine_root(
         refine_jacobian: false,
         ..*options
     };
-    let guess = start.jacobian_matrix();
+    let guess = start.jacobian_guess();
     let failure: Cell<Option<String>> = Cell::new(None);
     let (lo, hi) = (Cell::new(a.value), Cell::new(b.value));
     let f_a = q.of(start);
@@ -309,10 +309,10 @@ fn refine_root(
             let (c, model) = configured(config, &spec.param, v).map_err(|e| e.to_string())?;
             let map = StepMap::new(&model, &c.solver);
             let y = if q == Quantity::Stability {
-                q.of(&find_gait(&map, &start.section, &continued, Some(&guess))
+                q.of(&find_gait(&map, &start.section, &continued, guess.as_ref())
                     .map_err(|e| e.to_string())?)
             } else {
-                let fp = solve_fixed_point(&map, &start.section, &continued, Some(&guess))
+                let fp = solve_fixed_point(&map, &start.section, &continued, guess.as_ref())
                     .map_err(|e| e.to_string())?;
                 q.of_indicators(&fp.outcome.report.indicators)
             };
