@@ -2,6 +2,7 @@
 //! never push a leg outward, no impulse pulls, and no tip goes below the ground, on every step of every walk.
 //! Also the regression test of the bilateral stopper-lock impact.
 
+use vrw::app::default_initial;
 use vrw::contact::{impulse, ActiveSet, Leg};
 use vrw::dynamics::{Coords, Model, L1, L2, THETA};
 use vrw::params::Config;
@@ -18,12 +19,9 @@ const PENETRATION_TOL: f64 = 1e-9;
 /// Largest energy-audit residual allowed per step \[J\].
 const ENERGY_TOL: f64 = 1e-8;
 
+/// The default start of `vrw simulate` (the paper's parameters walk from it).
 fn start() -> SectionState {
-    SectionState {
-        l2: 0.72,
-        theta_dot: 1.0,
-        l2_dot: 0.0,
-    }
+    default_initial(&Config::default())
 }
 
 /// The worst audit values over the steps of one walk, with where they occurred.

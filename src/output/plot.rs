@@ -850,19 +850,26 @@ mod tests {
         assert!(!svg.exists() && !png.exists());
     }
 
+    /// The point with its DLS indicators undefined (as with rigid legs).
+    fn without_indicators(p: IndicatorPoint) -> IndicatorPoint {
+        IndicatorPoint {
+            lambda_i4: f64::NAN,
+            lambda_2_plus: f64::NAN,
+            lambda_4_plus: f64::NAN,
+            ..p
+        }
+    }
+
     #[test]
     fn all_nan_sweep_is_an_error() {
         let dir = tempfile::tempdir().unwrap();
         let points: Vec<IndicatorPoint> = synthetic()
             .into_iter()
             .map(|p| IndicatorPoint {
-                lambda_i4: f64::NAN,
-                lambda_2_plus: f64::NAN,
-                lambda_4_plus: f64::NAN,
                 period: f64::NAN,
                 max_floquet: f64::NAN,
                 family: None,
-                ..p
+                ..without_indicators(p)
             })
             .collect();
         let marks = marks();
@@ -884,15 +891,7 @@ mod tests {
     #[test]
     fn sweep_without_indicators_draws_period_and_multipliers() {
         let dir = tempfile::tempdir().unwrap();
-        let points: Vec<IndicatorPoint> = synthetic()
-            .into_iter()
-            .map(|p| IndicatorPoint {
-                lambda_i4: f64::NAN,
-                lambda_2_plus: f64::NAN,
-                lambda_4_plus: f64::NAN,
-                ..p
-            })
-            .collect();
+        let points: Vec<IndicatorPoint> = synthetic().into_iter().map(without_indicators).collect();
         let no_gait = [250.0..300.0];
         let spec = Fig2Spec {
             points: &points,
