@@ -5,7 +5,9 @@
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within [`SAME_GAIT_TOL`]).
 //! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
 //! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved, so a
-//! family is followed in shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`].
+//! family is followed in shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`]. Before an
+//! end is declared, one step across it is tried by walking instead of Newton's method
+//! ([`Continuation::walk_step`]), since the step map is only piecewise smooth.
 //!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
 //! family at the first parameter value it does not reach ([`END_WALK_STEPS`] steps). The walk fails (falls,
@@ -32,6 +34,12 @@ pub const SAME_GAIT_TOL: f64 = 1e-6;
 
 /// Newton iterations allowed in one continuation step (a step that needs more is halved instead).
 pub const STEP_NEWTON_ITERATIONS: usize = 8;
+
+/// Steps a walk may take to settle on a gait in a continuation step by walking.
+pub const SETTLE_STEPS: usize = 200;
+
+/// A walk has settled when two successive section states differ by less than this.
+pub const SETTLE_TOL: f64 = 1e-11;
 
 /// A real Floquet multiplier this close to +1 at the last gait of a family marks a fold.
 pub const FOLD_TOL: f64 = 0.05;
@@ -138,7 +146,8 @@ impl<'a> Continuation<'a> {
         solve_fixed_point(&map, start, &self.options, guess).map_err(|e| e.to_string())
     }
 
-    /// One verified continuation step from `from` to `value` (see the module documentation).
+    /// One verified continuation step from `from` to `value` by Newton's method, there and back (see the module
+    /// documentation).
     pub fn step(
         &self,
         from: &FamilyPoint,
@@ -151,6 +160,35 @@ impl<'a> Continuation<'a> {
             value,
             section: forward.section,
         })
+    }
+
+    /// The same step by walking, where Newton's method fails (the step map is only piecewise smooth): the wheel
+    /// walked from the gait at `value` settles on a gait, and walked from that one at `from.value` comes back to
+    /// `from` (a stable family followed the way an experiment would).
+    pub fn walk_step(&self, from: &FamilyPoint, value: f64) -> Option<FamilyPoint> {
+        let forward = self.settle(value, &from.section)?;
+        let back = self.settle(from.value, &forward)?;
+        (section_distance(&back, &from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
+            value,
+            section: forward,
+        })
+    }
+
+    /// The section state a walk at `value` from `start` settles on: successive returns closer than
+    /// [`SETTLE_TOL`] within [`SETTLE_STEPS`] steps; `None` if the walk fails or does not settle.
+    fn settle(&self, value: f64, start: &SectionState) -> Option<SectionState> {
+        let (c, model) = configured(self.config, self.param, value).ok()?;
+        let mut walker = Walker::new(&model, &c.solver, start).ok()?;
+        let mut previous = *start;
+        for _ in 0..SETTLE_STEPS {
+            walker.step(None).ok()?;
+            let next = walker.section().ok()?;
+            if section_distance(&next, &previous) < SETTLE_TOL {
+                return Some(next);
+            }
+            previous = next;
+        }
+        None
     }
 
     /// `DP` (central differences) of the gait `at`.
@@ -169,6 +207,7 @@ impl<'a> Continuation<'a> {
         // The Newton matrix and the parameter value where it was computed.
         let mut jac: Option<(f64, DMatrix<f64>)> = guess.map(|j| (from.value, j.clone()));
         let mut h = target - current.value;
+        let mut walking = false;
         loop {
             let remaining = target - current.value;
             if remaining == 0.0 {
@@ -186,12 +225,21 @@ impl<'a> Continuation<'a> {
                     next = self.step(&current, next_value, jac.as_ref().map(|(_, j)| j));
                 }
             }
+            let at_end = (next_value - current.value).abs() <= PARAM_TOL;
+            // Where Newton's method fails at the finest step (and from then on, until it works again), a step
+            // is also tried by walking, before an end is declared.
+            if next.is_none() && (walking || at_end) {
+                next = self.walk_step(&current, next_value);
+                walking = next.is_some();
+            } else if next.is_some() {
+                walking = false;
+            }
             match next {
                 Some(next) => {
                     h = 2.0 * (next.value - current.value);
                     current = next;
                 }
-                None if (next_value - current.value).abs() <= PARAM_TOL => {
+                None if at_end => {
                     return Followed::Ended {
                         last: current,
                         beyond: next_value,
