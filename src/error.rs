@@ -86,6 +86,19 @@ pub enum WalkError {
         /// Time \[s\].
         time: f64,
     },
+    /// At touchdown the old Leg 1's tip (the new Leg 2) was sliding: the wheel is not on the Poincare section
+    /// `(L2, thetadot, L2dot)`, which assumes that tip at rest, so a step map started from a section state
+    /// would not be this walk. The walk itself can go on; the step map cannot.
+    #[error(
+        "the stance tip slides at touchdown (t = {time:.6} s, {speed:.3e} m/s): the walk leaves the Poincare \
+         section (L2, thetadot, L2dot), which assumes it at rest"
+    )]
+    OffSection {
+        /// Time \[s\].
+        time: f64,
+        /// Speed of the tip \[m/s\].
+        speed: f64,
+    },
     /// No set of active contacts and stoppers satisfies the unilateral conditions.
     #[error("no consistent contact state at t = {time:.6} s in {phase}")]
     InconsistentContacts {
@@ -143,6 +156,7 @@ impl WalkError {
             | WalkError::Chatter { time, .. }
             | WalkError::RearLegNotLocked { time, .. }
             | WalkError::RearLegInContact { time }
+            | WalkError::OffSection { time, .. }
             | WalkError::InconsistentContacts { time, .. }
             | WalkError::Contact { time, .. } => Some(*time),
             WalkError::Integration { source, .. } => Some(match source {
@@ -162,6 +176,7 @@ impl WalkError {
             WalkError::Chatter { .. } => "chatter",
             WalkError::RearLegNotLocked { .. } => "rear_leg_not_locked",
             WalkError::RearLegInContact { .. } => "rear_leg_in_contact",
+            WalkError::OffSection { .. } => "off_section",
             WalkError::InconsistentContacts { .. } => "inconsistent_contacts",
             WalkError::Contact { .. } => "constraint_failure",
             WalkError::Integration { .. } => "solver_failure",

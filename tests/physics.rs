@@ -352,3 +352,42 @@ fn airborne_tips_never_penetrate_and_free_legs_never_pass_their_stoppers() {
         }
     }
 }
+
+/// The Poincare section `(L2, thetadot, L2dot)` assumes Leg 2's tip at rest at touchdown. Where the stance tip
+/// slides into a touchdown (traditional impact, light hub, c = 6), a step map started from a section state is
+/// not the walk: the walker says so (`off_section`) instead of handing out a wrong section state, and the walk
+/// itself goes on.
+#[test]
+fn a_stance_tip_sliding_into_touchdown_is_off_the_section() {
+    let mut config = Config::default();
+    for o in [
+        "impact=traditional",
+        "hub_mass=2",
+        "stiffness=300",
+        "slope=0.15",
+        "viscosity=6",
+    ] {
+        config.apply_override(o).unwrap();
+    }
+    let model = Model::new(&config.params).unwrap();
+    let start = SectionState {
+        l2: 0.9,
+        theta_dot: 1.5,
+        l2_dot: 0.0,
+    };
+    let mut walker = Walker::new(&model, &config.solver, &start).unwrap();
+    let mut off = 0;
+    for _ in 0..30 {
+        if walker.step(None).is_err() {
+            break;
+        }
+        match walker.section() {
+            Err(e) => {
+                assert_eq!(e.kind(), "off_section", "{e}");
+                off += 1;
+            }
+            Ok(s) => assert!(s.validate(&model).is_ok()),
+        }
+    }
+    assert!(off > 0, "this walk slides into its touchdowns");
+}

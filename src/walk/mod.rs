@@ -68,6 +68,10 @@ pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
 /// ground, or when an impact's complementarity problem had no consistent solution.
 pub const APPROACH_GAP: f64 = 1e-12;
 
+/// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
+/// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
+pub const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
+
 /// Size of the integrated state `[q, q', E_damper]`.
 pub const NY: usize = 2 * NQ + 1;
 /// The integrated state: coordinates, velocities and the energy dissipated by the dampers so far in the step.
@@ -572,12 +576,21 @@ impl<'m> Walker<'m> {
         &self.state
     }
 
-    /// The current Poincare-section state, or why the walk cannot continue.
+    /// The current Poincare-section state, or why the walk cannot continue, or why the wheel is not on the
+    /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest, slides).
     pub fn section(&self) -> Result<SectionState, WalkError> {
-        match &self.blocked {
-            Some(e) => Err(e.clone()),
-            None => Ok(SectionState::from_coords(&self.state.q, &self.state.qd)),
+        if let Some(e) = &self.blocked {
+            return Err(e.clone());
         }
+        let (q, qd) = (&self.state.q, &self.state.qd);
+        let speed = self.model.tip(q, qd, Leg::Two.index()).velocity(qd).norm();
+        if speed > SECTION_TIP_SPEED_TOL {
+            return Err(WalkError::OffSection {
+                time: self.state.time,
+                speed,
+            });
+        }
+        Ok(SectionState::from_coords(q, qd))
     }
 
     fn tolerances(&self) -> Tolerances {
