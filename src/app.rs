@@ -14,7 +14,8 @@ use serde::Serialize;
 use crate::dynamics::Model;
 use crate::error::{short, WalkError};
 use crate::gait::{
-    find_gait, find_thresholds, sweep, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec, Threshold,
+    find_gait_any_period, find_thresholds, sweep, Gait, GaitOptions, StepMap, SweepPoint,
+    SweepSpec, Threshold, MAX_PERIOD,
 };
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
@@ -362,7 +363,8 @@ pub struct GaitSummary {
 /// `max |P(s) - s|` cannot be reached reliably.
 pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 
-/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason), and
+/// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
+/// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
 /// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
 /// ([`write_gait_period`]).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
@@ -390,7 +392,7 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
     initial.validate(&model)?;
     let map = StepMap::new(&model, &job.config.solver);
-    let result = find_gait(&map, &initial, &job.options, None);
+    let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
     let summary = GaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
@@ -411,7 +413,7 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     Ok(summary)
 }
 
-/// Walk one period from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
+/// Walk one period (`period_k` steps) from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
 /// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
 /// `vrw plot` and `vrw animate` work on a gait directly.
 pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
@@ -419,7 +421,7 @@ pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, 
         &SimulateJob {
             config: job.config.clone(),
             initial: Some(gait.section),
-            steps: 1,
+            steps: gait.period_k,
             sample_dt: DEFAULT_SAMPLE_DT,
             trajectory: true,
             out_dir: job.out_dir.clone(),

@@ -32,7 +32,8 @@ pub struct Cli {
 enum Command {
     /// Walk N steps from a Poincare-section state and report every touchdown.
     Simulate(SimulateArgs),
-    /// Find the walking gait (limit cycle), its DLS indicators and Floquet multipliers.
+    /// Find the walking gait (limit cycle, or a period-k gait up to k = 8), its DLS indicators and Floquet
+    /// multipliers.
     Gait(GaitArgs),
     /// Sweep a parameter with continuation, locate the thresholds and draw Fig. 2.
     Sweep(SweepArgs),
@@ -377,6 +378,24 @@ fn gait(args: GaitArgs) -> Result<()> {
         );
     };
     let s = &g.section;
+    if g.period_k > 1 {
+        println!(
+            "period-{} gait (a fixed point of P^{}, not of P): its steps",
+            g.period_k, g.period_k
+        );
+        for r in &g.cycle {
+            let (c, i) = (&r.section, &r.indicators);
+            println!(
+                "  step {}: (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}); lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
+                 lambda_4+ = {:.6} N, branch {}, period {:.6} s",
+                r.step, c.l2, c.theta_dot, c.l2_dot, i.lambda_i4, i.lambda_2_plus, i.lambda_4_plus, r.branch, r.period
+            );
+        }
+        println!(
+            "the first step in detail, and the multipliers of P^{}:",
+            g.period_k
+        );
+    }
     println!(
         "gait at (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}), theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
         s.l2, s.theta_dot, s.l2_dot, g.theta, g.residual, g.iterations

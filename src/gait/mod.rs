@@ -3,6 +3,7 @@
 
 pub mod continuation;
 pub mod limit_cycle;
+pub mod period_k;
 pub mod step_map;
 pub mod sweep;
 pub mod thresholds;
@@ -10,6 +11,7 @@ pub mod thresholds;
 pub use limit_cycle::{
     find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
 };
+pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
 pub use sweep::{sweep, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};

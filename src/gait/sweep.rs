@@ -18,6 +18,7 @@ use serde::Serialize;
 
 use super::continuation::{section_distance, Continuation, FamilyPoint, Followed, SAME_GAIT_TOL};
 use super::limit_cycle::{find_gait, Gait, GaitOptions};
+use super::period_k::{find_gait_any_period, MAX_PERIOD};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
 use crate::error::short;
@@ -122,7 +123,7 @@ pub fn configured(
 
 /// The gait at `value`, followed from `previous` (a neighbouring gait at another value, with its index) in
 /// verified continuation steps if given; if the family does not reach `value`, searched from `initial` with the
-/// full transient.
+/// full transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
 pub fn gait_at_value(
     config: &Config,
     param: &str,
@@ -167,7 +168,10 @@ pub fn gait_at_value(
     });
     let (continued_from, result) = match continued {
         Some((index, g)) => (Some(index), Ok(g)),
-        None => (None, find_gait(&map, initial, options, None)),
+        None => (
+            None,
+            find_gait_any_period(&map, initial, options, MAX_PERIOD),
+        ),
     };
     match result {
         Ok(g) => SweepPoint {
@@ -187,6 +191,12 @@ pub fn gait_at_value(
             family: None,
         },
     }
+}
+
+/// The point's gait if continuation can start from it: a period-1 gait (continuation follows fixed points of
+/// `P`; a period-k gait is searched afresh at every point).
+fn continuable(point: &SweepPoint) -> Option<&Gait> {
+    point.gait.as_ref().filter(|g| g.period_k == 1)
 }
 
 /// Stride of the coarse continuation pass.
@@ -213,7 +223,7 @@ fn continue_along(
         .map(|(i, &value)| {
             let previous = last.as_ref().map(|(j, v, g)| (*j, *v, g));
             let point = gait_at_value(config, param, value, initial, previous, options);
-            last = point.gait.clone().map(|g| (first + i, value, g));
+            last = continuable(&point).map(|g| (first + i, value, g.clone()));
             progress(&point);
             point
         })
@@ -228,7 +238,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
     for i in (1..points.len()).rev() {
         let (left, right) = points.split_at_mut(i);
         let (a, b) = (&mut left[i - 1], &right[0]);
-        let (None, Some(gb)) = (&a.gait, &b.gait) else {
+        let (None, Some(gb)) = (&a.gait, continuable(b)) else {
             continue;
         };
         if a.status == "invalid_parameter" {
@@ -328,9 +338,7 @@ pub fn sweep(
     let mut coarse: Vec<SweepPoint> = Vec::with_capacity(coarse_values.len());
     for (k, &value) in coarse_values.iter().enumerate() {
         let previous = coarse.last().and_then(|p: &SweepPoint| {
-            p.gait
-                .as_ref()
-                .map(|g| ((k - 1) * COARSE_STRIDE, p.value, g))
+            continuable(p).map(|g| ((k - 1) * COARSE_STRIDE, p.value, g))
         });
         let point = gait_at_value(config, &spec.param, value, initial, previous, options);
         progress(&point);
@@ -342,10 +350,7 @@ pub fn sweep(
         .map(|(i, left)| {
             let lo = i * COARSE_STRIDE + 1;
             let hi = ((i + 1) * COARSE_STRIDE).min(values.len());
-            let start = left
-                .gait
-                .clone()
-                .map(|g| (i * COARSE_STRIDE, left.value, g));
+            let start = continuable(left).map(|g| (i * COARSE_STRIDE, left.value, g.clone()));
             continue_along(
                 config,
                 &spec.param,

@@ -357,7 +357,7 @@ pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), Outpu
 }
 
 /// Columns of `sweep.csv` after the parameter column.
-pub const SWEEP_COLUMNS: [&str; 23] = [
+pub const SWEEP_COLUMNS: [&str; 24] = [
     "status",
     "L2",
     "thetadot",
@@ -380,6 +380,7 @@ pub const SWEEP_COLUMNS: [&str; 23] = [
     "residual",
     "iterations",
     "family",
+    "period_k",
     "message",
 ];
 
@@ -424,6 +425,7 @@ pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Resul
                     num(g.residual),
                     g.iterations.to_string(),
                     p.family.map_or_else(String::new, |f| f.to_string()),
+                    g.period_k.to_string(),
                 ]);
             }
             None => row.extend(std::iter::repeat_n(String::new(), SWEEP_COLUMNS.len() - 2)),

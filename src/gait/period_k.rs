@@ -1,0 +1,206 @@
+//! Period-k gaits: fixed points of the iterated step map `P^k` (docs/model.md section 6, issue 10 item 2).
+//!
+//! Where Newton's method on `P(s) - s` fails but the walk settles, the wheel may walk a gait that repeats every
+//! `k` steps (a period-doubled gait, `k = 2`, for example). The search:
+//!
+//! 1. walks the transient, then [`SETTLE_STEPS`] more steps, keeping their section states (the returns);
+//! 2. for each `k = 1 ..= max_period` measures how far the returns are from repeating with period `k`
+//!    (the largest coordinate difference of `s_n` and `s_{n-k}` over the last [`RETURN_WINDOW`] returns);
+//! 3. for each `k` whose distance is below [`RETURN_TOL`], smallest `k` first, runs Newton's method on
+//!    `P^k(s) - s` from the last return ([`super::limit_cycle::solve_fixed_point`] on
+//!    [`StepMap::iterated`]);
+//! 4. the first fixed point found is checked for its least period (`P^j(s*) = s*` for a divisor `j < k`
+//!    would make it a period-`j` gait) and reported with every step of its period and the eigenvalues of
+//!    `D(P^k)`, the Floquet multipliers of the period-k gait.
+//!
+//! `P^k` walks `k` steps with one walker from the state built from `s` (not `k` fresh starts): the section
+//! `s = (L2, dtheta/dt, dL2/dt)` assumes the stance tip at rest at touchdown, but when it slides without
+//! friction (`inconsistent_contact = "slide"`) its velocity is a state the section does not hold. In the
+//! period-2 reference gait ([`crate::reference::period_two_config`]) this happens before every second
+//! touchdown, so `P(P(s))` with a fresh start at the middle touchdown differs from the walk, while the walk
+//! itself repeats every two steps to 1e-11.
+
+use super::continuation::{section_distance, SAME_GAIT_TOL};
+use super::limit_cycle::{find_gait, gait_at, solve_fixed_point, Gait, GaitError, GaitOptions};
+use super::step_map::StepMap;
+use crate::walk::{SectionState, Walker};
+
+/// The longest period searched by default (`vrw gait` and sweeps).
+pub const MAX_PERIOD: usize = 8;
+
+/// Steps walked after the transient before the period is looked for.
+pub const SETTLE_STEPS: usize = 64;
+
+/// Number of recent returns over which a period must hold.
+pub const RETURN_WINDOW: usize = 4;
+
+/// A period `k` is tried when the returns repeat with period `k` to within this (largest coordinate
+/// difference of `(L2, thetadot, L2dot)`; Newton's method then converges from there).
+pub const RETURN_TOL: f64 = 1e-3;
+
+/// `d_k` for `k = 1 ..= max_period`: the largest coordinate difference between `returns[n]` and
+/// `returns[n - k]` over the last [`RETURN_WINDOW`] returns `n` (`INFINITY` where there are too few returns).
+pub fn return_distances(returns: &[SectionState], max_period: usize) -> Vec<f64> {
+    (1..=max_period)
+        .map(|k| {
+            if returns.len() < k + RETURN_WINDOW {
+                return f64::INFINITY;
+            }
+            (returns.len() - RETURN_WINDOW..returns.len())
+                .map(|n| section_distance(&returns[n], &returns[n - k]))
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+/// The least period of the returns: the smallest `k` whose return distance is below `tol`.
+pub fn least_period(returns: &[SectionState], max_period: usize, tol: f64) -> Option<usize> {
+    return_distances(returns, max_period)
+        .iter()
+        .position(|&d| d < tol)
+        .map(|i| i + 1)
+}
+
+/// The section states of `k` steps from `s` (`s` first), and the reports of those steps.
+fn walk_period(
+    map: &StepMap,
+    s: &SectionState,
+    k: usize,
+) -> Result<(Vec<SectionState>, Vec<crate::walk::StepReport>), crate::error::WalkError> {
+    let mut walker = Walker::new(map.model(), map.options(), s)?;
+    let mut states = vec![*s];
+    let mut reports = Vec::with_capacity(k);
+    for _ in 0..k {
+        reports.push(walker.step(None)?);
+        states.push(walker.section()?);
+    }
+    Ok((states, reports))
+}
+
+/// Find a gait of period `k <= max_period` from `initial` (see the module documentation). `options` are
+/// those of the period-1 search (transient, tolerance, Jacobian). Fails with the walk's failure if the wheel
+/// does not keep walking, and with [`GaitError::Unsettled`] if no period up to `max_period` is found.
+pub fn find_periodic_gait(
+    map: &StepMap,
+    initial: &SectionState,
+    options: &GaitOptions,
+    max_period: usize,
+) -> Result<Gait, GaitError> {
+    let max_period = max_period.max(1);
+    let single = map.iterated(1);
+    let walked = options.transient_steps + SETTLE_STEPS.max(max_period + RETURN_WINDOW);
+    let mut walker = Walker::new(single.model(), single.options(), initial)
+        .map_err(|source| GaitError::Transient { step: 1, source })?;
+    let mut returns = Vec::with_capacity(walked);
+    for step in 1..=walked {
+        walker
+            .step(None)
+            .and_then(|_| walker.section())
+            .map(|s| returns.push(s))
+            .map_err(|source| GaitError::Transient { step, source })?;
+    }
+    let distances = return_distances(&returns, max_period);
+    let start = returns[returns.len() - 1];
+    let newton = GaitOptions {
+        transient_steps: 0,
+        ..*options
+    };
+    let mut last_error = None;
+    for (i, _) in distances
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| **d < RETURN_TOL)
+    {
+        let k = i + 1;
+        let map_k = single.iterated(k);
+        let fp = match solve_fixed_point(&map_k, &start, &newton, None) {
+            Ok(fp) => fp,
+            Err(e) => {
+                last_error = Some(e);
+                continue;
+            }
+        };
+        let newton_error = |source| GaitError::Newton {
+            iteration: fp.iterations + 1,
+            source,
+        };
+        let (states, reports) = walk_period(&single, &fp.section, k).map_err(newton_error)?;
+        // The least period: P^j(s*) = s* for a divisor j of k.
+        let least = (1..=k)
+            .find(|&j| k % j == 0 && section_distance(&states[j], &fp.section) <= SAME_GAIT_TOL)
+            .unwrap_or(k);
+        let map_least = single.iterated(least);
+        let (dp, error) = if options.refine_jacobian {
+            map_least.jacobian(&fp.section, options.fd_step)
+        } else {
+            map_least
+                .central_jacobian(&fp.section, options.fd_step)
+                .map(|j| (j, f64::NAN))
+        }
+        .map_err(newton_error)?;
+        let mut gait = gait_at(&fp, dp, error);
+        gait.period_k = least;
+        gait.cycle = reports[..least].to_vec();
+        if least < k {
+            // The residual of the least period's map at the point.
+            gait.residual = section_distance(&states[least], &fp.section);
+        }
+        return Ok(gait);
+    }
+    Err(last_error.unwrap_or(GaitError::Unsettled {
+        max_period,
+        steps: walked,
+        distance: distances.iter().copied().fold(f64::INFINITY, f64::min),
+    }))
+}
+
+/// The gait of any period up to `max_period`: the period-1 search ([`find_gait`]) first; if the walk keeps
+/// going but Newton's method fails there, the period-k search ([`find_periodic_gait`]).
+pub fn find_gait_any_period(
+    map: &StepMap,
+    initial: &SectionState,
+    options: &GaitOptions,
+    max_period: usize,
+) -> Result<Gait, GaitError> {
+    match find_gait(map, initial, options, None) {
+        Err(e) if !matches!(e, GaitError::Transient { .. }) && max_period > 1 => {
+            find_periodic_gait(map, initial, options, max_period)
+        }
+        result => result,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn s(l2: f64) -> SectionState {
+        SectionState {
+            l2,
+            theta_dot: 1.0,
+            l2_dot: 0.0,
+        }
+    }
+
+    #[test]
+    fn least_period_of_alternating_returns_is_two() {
+        let returns: Vec<SectionState> = (0..20)
+            .map(|i| s(if i % 2 == 0 { 0.7 } else { 0.8 }))
+            .collect();
+        assert_eq!(least_period(&returns, MAX_PERIOD, 1e-9), Some(2));
+        let d = return_distances(&returns, 4);
+        assert!((d[0] - 0.1).abs() < 1e-12 && d[1] == 0.0 && d[3] == 0.0);
+    }
+
+    #[test]
+    fn too_few_returns_have_no_period() {
+        let returns: Vec<SectionState> = (0..3).map(|_| s(0.7)).collect();
+        assert_eq!(least_period(&returns, MAX_PERIOD, 1e-9), None);
+    }
+
+    #[test]
+    fn period_three_is_found_before_six() {
+        let returns: Vec<SectionState> = (0..30).map(|i| s(0.7 + 0.01 * (i % 3) as f64)).collect();
+        assert_eq!(least_period(&returns, MAX_PERIOD, 1e-9), Some(3));
+    }
+}
