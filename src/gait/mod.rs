@@ -1,7 +1,8 @@
-//! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, parameter sweeps with
-//! continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
+//! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, the grid runner
+//! ([`grid`]) behind parameter sweeps with continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
 
 pub mod continuation;
+pub mod grid;
 pub mod limit_cycle;
 pub mod period_k;
 pub mod step_map;
@@ -13,5 +14,5 @@ pub use limit_cycle::{
 };
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
-pub use sweep::{sweep, SweepPoint, SweepSpec};
+pub use sweep::{gait_rows, sweep, GaitRow, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};
