@@ -1,7 +1,11 @@
 //! The jobs the command line runs, as library functions (STYLE.md point 2: all science lives in the library).
 
+mod attractors;
 mod figures;
 
+pub use attractors::{
+    default_basin_range, run_basin, run_orbit, BasinJob, BasinSummary, OrbitJob, OrbitSummary,
+};
 pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
 
 use std::collections::{BTreeMap, VecDeque};

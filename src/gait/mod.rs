@@ -1,9 +1,11 @@
 //! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, the grid runner
 //! ([`grid`]) behind parameter sweeps with continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
 
+pub mod basin;
 pub mod continuation;
 pub mod grid;
 pub mod limit_cycle;
+pub mod orbit;
 pub mod period_k;
 pub mod step_map;
 pub mod sweep;

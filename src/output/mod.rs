@@ -4,7 +4,9 @@
 //! undefined values (e.g. `lambda_2+` after an (A3) exchange) are written as `NaN` in CSV and `null` in JSON.
 
 pub mod animate;
+pub mod basin_plot;
 pub mod chart;
+pub mod orbit_plot;
 pub mod plot;
 pub mod read;
 pub mod run_plot;
