@@ -240,7 +240,8 @@ fn orbit_figure(
     branch: &[(f64, Option<Gait>)],
 ) -> OrbitFigure {
     type Pick = fn(&StepReport) -> f64;
-    let panels: [(&str, Pick, fn(&Gait) -> f64); 2] = [
+    type OfGait = fn(&Gait) -> f64;
+    let panels: [(&str, Pick, OfGait); 2] = [
         (
             "dθ/dt before touchdown [rad/s]",
             |r| r.section.theta_dot,

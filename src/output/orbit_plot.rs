@@ -74,7 +74,9 @@ fn branch_curves(branch: &[BranchPoint]) -> Vec<Curve> {
         None => ("period-1 gait, uncertain", COLOR_MARK, Stroke::Dashed),
     };
     let mut curves: Vec<Curve> = Vec::new();
-    let mut current: Option<(Option<bool>, Vec<(f64, f64)>)> = None;
+    /// The stretch being built: its stability and points.
+    type Stretch = (Option<bool>, Vec<(f64, f64)>);
+    let mut current: Option<Stretch> = None;
     for p in branch {
         if !p.value.is_finite() {
             if let Some((kind, pts)) = current.take() {
