@@ -318,6 +318,19 @@ pub fn run_simulate(
     Ok(summary)
 }
 
+/// The validated configuration's model and the start on the section (`initial`, or [`default_initial`]),
+/// checked against the model: what every job that walks needs first.
+fn prepared(
+    config: &Config,
+    initial: Option<SectionState>,
+) -> Result<(Model, SectionState), AppError> {
+    config.validate()?;
+    let model = Model::new(&config.params)?;
+    let initial = initial.unwrap_or_else(|| default_initial(config));
+    initial.validate(&model)?;
+    Ok((model, initial))
+}
+
 /// Remove `path` if it exists (an output file of an earlier run that this run does not rewrite).
 fn remove_stale(path: &std::path::Path) -> Result<(), OutputError> {
     match std::fs::remove_file(path) {
@@ -478,11 +491,8 @@ pub fn run_sweep(
     job: &SweepJob,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<SweepSummary, AppError> {
-    job.config.validate()?;
+    let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
-    let model = Model::new(&job.config.params)?;
-    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
-    initial.validate(&model)?;
     output::ensure_dir(&job.out_dir)?;
     let clock = std::time::Instant::now();
     let points = sweep(&job.config, &job.spec, &initial, &job.options, progress)?;

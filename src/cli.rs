@@ -227,7 +227,7 @@ struct BasinArgs {
     #[arg(long, default_value_t = 100)]
     max_steps: usize,
     /// A return this close to a gait state (largest coordinate difference) has reached the gait.
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = 1e-3)]
     tolerance: f64,
     /// Output directory for basin.csv, basin.json and basin.png.
     #[arg(long, default_value = "out/basin")]

@@ -3,7 +3,8 @@
 use vrw::app::{default_initial, run_gait, GaitJob};
 use vrw::dynamics::Model;
 use vrw::gait::period_k::least_period;
-use vrw::gait::{find_gait, find_periodic_gait, GaitOptions, StepMap, MAX_PERIOD};
+use vrw::gait::{find_gait, find_periodic_gait, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use vrw::params::Config;
 use vrw::reference::period_two_config;
 use vrw::walk::{simulate, SectionState};
 
@@ -17,20 +18,31 @@ fn distance(a: &SectionState, b: &SectionState) -> f64 {
     vrw::gait::continuation::section_distance(a, b)
 }
 
+/// The reference parameters with a period-2 gait and their model.
+fn period_two() -> (Config, Model) {
+    let config = period_two_config();
+    let model = Model::new(&config.params).unwrap();
+    (config, model)
+}
+
+/// The period-k search from the default start.
+fn search(map: &StepMap, config: &Config) -> Gait {
+    find_periodic_gait(
+        map,
+        &default_initial(config),
+        &GaitOptions::default(),
+        MAX_PERIOD,
+    )
+    .unwrap()
+}
+
 /// The period-2 gait of the reference problem: `P^2(s*) = s*` to 1e-10 by a direct simulation of two steps,
 /// while `P(s*)` is another state; the cycle's records are those two steps.
 #[test]
 fn period_two_gait_is_a_fixed_point_of_p_squared() {
-    let config = period_two_config();
-    let model = Model::new(&config.params).unwrap();
+    let (config, model) = period_two();
     let map = StepMap::new(&model, &config.solver);
-    let gait = find_periodic_gait(
-        &map,
-        &default_initial(&config),
-        &GaitOptions::default(),
-        MAX_PERIOD,
-    )
-    .unwrap();
+    let gait = search(&map, &config);
     assert_eq!(gait.period_k, 2);
     assert_eq!(gait.cycle.len(), 2);
     // P^2 by a direct simulation of three touchdowns from s*: the section before the third is P^2(s*).
@@ -57,16 +69,9 @@ fn period_two_gait_is_a_fixed_point_of_p_squared() {
 /// the period).
 #[test]
 fn walk_settles_on_the_period_two_gait() {
-    let config = period_two_config();
-    let model = Model::new(&config.params).unwrap();
+    let (config, model) = period_two();
     let map = StepMap::new(&model, &config.solver);
-    let gait = find_periodic_gait(
-        &map,
-        &default_initial(&config),
-        &GaitOptions::default(),
-        MAX_PERIOD,
-    )
-    .unwrap();
+    let gait = search(&map, &config);
     let run = simulate(&model, &config.solver, &default_initial(&config), 200, None).unwrap();
     let returns: Vec<SectionState> = run.steps.iter().map(|r| r.section).collect();
     assert_eq!(least_period(&returns, MAX_PERIOD, 1e-8), Some(2));

@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use crate::dynamics::Model;
 use crate::error::short;
 use crate::gait::basin::{basin, Axis, BasinPoint, BasinSpec, Coordinate};
 use crate::gait::orbit::{orbit_diagram, OrbitColumn, OrbitSpec};
@@ -17,7 +16,7 @@ use crate::output::{self, finish_csv, num, write_record};
 use crate::params::Config;
 use crate::walk::{SectionState, StepReport};
 
-use super::{axis_label, default_initial, AppError};
+use super::{axis_label, prepared, AppError};
 
 /// What `vrw orbit` runs.
 #[derive(Debug, Clone)]
@@ -60,11 +59,8 @@ pub fn run_orbit(
     job: &OrbitJob,
     progress: &(dyn Fn(&OrbitColumn) + Sync),
 ) -> Result<OrbitSummary, AppError> {
-    job.config.validate()?;
+    let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
-    let model = Model::new(&job.config.params)?;
-    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
-    initial.validate(&model)?;
     output::ensure_dir(&job.out_dir)?;
     let clock = std::time::Instant::now();
     let columns = orbit_diagram(&job.config, &job.spec, &initial, progress)?;
@@ -126,19 +122,14 @@ pub fn run_orbit(
     Ok(summary)
 }
 
-/// The columns of `orbit.csv` after the parameter.
-const ORBIT_COLUMNS: [&str; 11] = [
-    "status",
-    "period_k",
-    "step",
+/// The section state and the three DLS indicators, as columns of `orbit.csv` and `branch.csv`.
+const STATE_COLUMNS: [&str; 6] = [
     "L2",
     "thetadot",
     "L2dot",
     "lambda_I4",
     "lambda_2_plus",
     "lambda_4_plus",
-    "branch",
-    "continued_from",
 ];
 
 /// The section state and indicators of a step as CSV fields.
@@ -163,7 +154,11 @@ fn write_orbit_csv(
     columns: &[OrbitColumn],
 ) -> Result<(), AppError> {
     let mut w = output::csv_writer(path)?;
-    let header: Vec<&str> = std::iter::once(param).chain(ORBIT_COLUMNS).collect();
+    let header: Vec<&str> = [param, "status", "period_k", "step"]
+        .into_iter()
+        .chain(STATE_COLUMNS)
+        .chain(["branch", "continued_from"])
+        .collect();
     write_record(&mut w, path, &header)?;
     for c in columns {
         let head = [
@@ -196,18 +191,11 @@ fn write_branch_csv(
     branch: &[(f64, Option<Gait>)],
 ) -> Result<(), AppError> {
     let mut w = output::csv_writer(path)?;
-    let header = [
-        param,
-        "L2",
-        "thetadot",
-        "L2dot",
-        "lambda_I4",
-        "lambda_2_plus",
-        "lambda_4_plus",
-        "max_floquet",
-        "stability",
-    ];
-    write_record(&mut w, path, header)?;
+    let header: Vec<&str> = std::iter::once(param)
+        .chain(STATE_COLUMNS)
+        .chain(["max_floquet", "stability"])
+        .collect();
+    write_record(&mut w, path, &header)?;
     for (value, gait) in branch {
         let mut row = vec![num(*value)];
         match gait {
@@ -411,11 +399,8 @@ pub fn run_basin(
     job: &BasinJob,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<BasinSummary, AppError> {
-    job.config.validate()?;
     job.validate()?;
-    let model = Model::new(&job.config.params)?;
-    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
-    initial.validate(&model)?;
+    let (model, initial) = prepared(&job.config, job.initial)?;
     let map = StepMap::new(&model, &job.config.solver);
     let gait =
         find_gait_any_period(&map, &initial, &GaitOptions::default(), MAX_PERIOD).map_err(|e| {

@@ -406,12 +406,7 @@ pub fn write_svg_png(
         root.present()
             .map_err(|e| PlotError::draw_at(svg)(e.to_string()))?;
     }
-    let root = BitMapBackend::new(png, size).into_drawing_area();
-    figure
-        .draw(&root)
-        .map_err(|e| PlotError::draw_at(png)(e.to_string()))?;
-    root.present()
-        .map_err(|e| PlotError::draw_at(png)(e.to_string()))
+    write_png(figure, png, size)
 }
 
 /// Write `figure` as a PNG only (figures with tens of thousands of marks, whose SVG would be large).
