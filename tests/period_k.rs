@@ -132,3 +132,24 @@ fn ordinary_gait_has_period_one() {
     assert_eq!(gait.cycle.len(), 1);
     assert_eq!(gait.cycle[0].section, gait.section);
 }
+
+/// Regression (a sweep reported period-4 and period-5 gaits at c = 4.5 to 8.5): where the walk settles on
+/// period 1 with the stance tip sliding at every touchdown, the section does not hold the whole state and no
+/// period-k gait may be made up from a multiple of the walk's period.
+#[test]
+fn no_spurious_period_k_gait_where_the_walk_has_period_one() {
+    let (mut config, _) = period_two();
+    config.params.viscosity = 6.0;
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let run = simulate(&model, &config.solver, &default_initial(&config), 200, None).unwrap();
+    let returns: Vec<SectionState> = run.steps.iter().map(|r| r.section).collect();
+    assert_eq!(least_period(&returns, MAX_PERIOD, 1e-8), Some(1));
+    let found = vrw::gait::find_gait_any_period(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        MAX_PERIOD,
+    );
+    assert!(found.as_ref().is_err(), "{:?}", found.map(|g| g.period_k));
+}

@@ -76,6 +76,19 @@ pub enum GaitError {
         /// Smallest return distance over the periods tried.
         distance: f64,
     },
+    /// Newton's method found a fixed point of `P^k`, but the walk from it does not repeat: the section state
+    /// does not hold the whole state at touchdown (the stance tip slides then, docs/model.md section 6).
+    #[error(
+        "the walk settles with period {period_k}, but the section state does not hold its whole state (the \
+         stance tip slides at touchdown): the walk from the fixed point of P^{period_k} misses it by \
+         {distance:e} after two periods"
+    )]
+    SectionIncomplete {
+        /// The walk's period.
+        period_k: usize,
+        /// Distance from the fixed point after `2 period_k` steps.
+        distance: f64,
+    },
     /// `DP - I` is singular (a multiplier at 1: a fold of the gait).
     #[error("DP - I is singular (a Floquet multiplier at 1), residual {residual:e}")]
     SingularJacobian {
@@ -91,6 +104,7 @@ impl GaitError {
             GaitError::Transient { source, .. } | GaitError::Newton { source, .. } => source.kind(),
             GaitError::NoConvergence { .. } => "no_convergence",
             GaitError::Unsettled { .. } => "unsettled",
+            GaitError::SectionIncomplete { .. } => "section_incomplete",
             GaitError::SingularJacobian { .. } => "singular_jacobian",
         }
     }

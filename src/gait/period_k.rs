@@ -6,19 +6,24 @@
 //! 1. walks the transient, then [`SETTLE_STEPS`] more steps, keeping their section states (the returns);
 //! 2. for each `k = 1 ..= max_period` measures how far the returns are from repeating with period `k`
 //!    (the largest coordinate difference of `s_n` and `s_{n-k}` over the last [`RETURN_WINDOW`] returns);
-//! 3. for each `k` whose distance is below [`RETURN_TOL`], smallest `k` first, runs Newton's method on
-//!    `P^k(s) - s` from the last return ([`super::limit_cycle::solve_fixed_point`] on
+//! 3. for the smallest `k` whose distance is below [`RETURN_TOL`] (the walk's period), runs Newton's method
+//!    on `P^k(s) - s` from the last return ([`super::limit_cycle::solve_fixed_point`] on
 //!    [`StepMap::iterated`]);
-//! 4. the first fixed point found is checked for its least period (`P^j(s*) = s*` for a divisor `j < k`
-//!    would make it a period-`j` gait) and reported with every step of its period and the eigenvalues of
-//!    `D(P^k)`, the Floquet multipliers of the period-k gait.
+//! 4. walks two periods from the fixed point: a periodic walk is back at it after `2k` steps too, otherwise
+//!    the fixed point is an artefact of the section ([`GaitError::SectionIncomplete`], below);
+//! 5. checks its least period (`P^j(s*) = s*` for a divisor `j < k` would make it a period-`j` gait) and
+//!    reports it with every step of its period and the eigenvalues of `D(P^k)`, the Floquet multipliers of
+//!    the period-k gait.
 //!
 //! `P^k` walks `k` steps with one walker from the state built from `s` (not `k` fresh starts): the section
 //! `s = (L2, dtheta/dt, dL2/dt)` assumes the stance tip at rest at touchdown, but when it slides without
 //! friction (`inconsistent_contact = "slide"`) its velocity is a state the section does not hold. In the
 //! period-2 reference gait ([`crate::reference::period_two_config`]) this happens before every second
 //! touchdown, so `P(P(s))` with a fresh start at the middle touchdown differs from the walk, while the walk
-//! itself repeats every two steps to 1e-11.
+//! itself repeats every two steps to 1e-11. Where the tip slides at every touchdown (the same parameters
+//! with `c` from 4.5 to 8.6 N s/m), the walk settles on period 1 but `P` started from the section has no
+//! fixed point, and a multiple `k` would give a fixed point of `P^k` that the walk does not repeat: step 4
+//! refuses it.
 
 use super::continuation::{section_distance, SAME_GAIT_TOL};
 use super::limit_cycle::{find_gait, gait_at, solve_fixed_point, Gait, GaitError, GaitOptions};
@@ -105,53 +110,54 @@ pub fn find_periodic_gait(
         transient_steps: 0,
         ..*options
     };
-    let mut last_error = None;
-    for (i, _) in distances
+    // Only the least period the walk shows: a multiple of it would let Newton's method find a spurious fixed
+    // point of P^k where the section does not hold the whole state (see the module documentation).
+    let Some(k) = distances
         .iter()
-        .enumerate()
-        .filter(|(_, d)| **d < RETURN_TOL)
-    {
-        let k = i + 1;
-        let map_k = single.iterated(k);
-        let fp = match solve_fixed_point(&map_k, &start, &newton, None) {
-            Ok(fp) => fp,
-            Err(e) => {
-                last_error = Some(e);
-                continue;
-            }
-        };
-        let newton_error = |source| GaitError::Newton {
-            iteration: fp.iterations + 1,
-            source,
-        };
-        let (states, reports) = walk_period(&single, &fp.section, k).map_err(newton_error)?;
-        // The least period: P^j(s*) = s* for a divisor j of k.
-        let least = (1..=k)
-            .find(|&j| k % j == 0 && section_distance(&states[j], &fp.section) <= SAME_GAIT_TOL)
-            .unwrap_or(k);
-        let map_least = single.iterated(least);
-        let (dp, error) = if options.refine_jacobian {
-            map_least.jacobian(&fp.section, options.fd_step)
-        } else {
-            map_least
-                .central_jacobian(&fp.section, options.fd_step)
-                .map(|j| (j, f64::NAN))
-        }
-        .map_err(newton_error)?;
-        let mut gait = gait_at(&fp, dp, error);
-        gait.period_k = least;
-        gait.cycle = reports[..least].to_vec();
-        if least < k {
-            // The residual of the least period's map at the point.
-            gait.residual = section_distance(&states[least], &fp.section);
-        }
-        return Ok(gait);
+        .position(|d| *d < RETURN_TOL)
+        .map(|i| i + 1)
+    else {
+        return Err(GaitError::Unsettled {
+            max_period,
+            steps: walked,
+            distance: distances.iter().copied().fold(f64::INFINITY, f64::min),
+        });
+    };
+    let fp = solve_fixed_point(&single.iterated(k), &start, &newton, None)?;
+    let newton_error = |source| GaitError::Newton {
+        iteration: fp.iterations + 1,
+        source,
+    };
+    // Two periods walked on: a periodic walk returns to s* after k and after 2k steps.
+    let (states, reports) = walk_period(&single, &fp.section, 2 * k).map_err(newton_error)?;
+    let distance = section_distance(&states[2 * k], &fp.section);
+    if distance > SAME_GAIT_TOL {
+        return Err(GaitError::SectionIncomplete {
+            period_k: k,
+            distance,
+        });
     }
-    Err(last_error.unwrap_or(GaitError::Unsettled {
-        max_period,
-        steps: walked,
-        distance: distances.iter().copied().fold(f64::INFINITY, f64::min),
-    }))
+    // The least period: P^j(s*) = s* for a divisor j of k.
+    let least = (1..=k)
+        .find(|&j| k % j == 0 && section_distance(&states[j], &fp.section) <= SAME_GAIT_TOL)
+        .unwrap_or(k);
+    let map_least = single.iterated(least);
+    let (dp, error) = if options.refine_jacobian {
+        map_least.jacobian(&fp.section, options.fd_step)
+    } else {
+        map_least
+            .central_jacobian(&fp.section, options.fd_step)
+            .map(|j| (j, f64::NAN))
+    }
+    .map_err(newton_error)?;
+    let mut gait = gait_at(&fp, dp, error);
+    gait.period_k = least;
+    gait.cycle = reports[..least].to_vec();
+    if least < k {
+        // The residual of the least period's map at the point.
+        gait.residual = section_distance(&states[least], &fp.section);
+    }
+    Ok(gait)
 }
 
 /// The gait of any period up to `max_period`: the period-1 search ([`find_gait`]) first; if the walk keeps
