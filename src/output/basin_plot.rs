@@ -157,8 +157,12 @@ impl Figure for BasinFigure {
         let gy = 20 + 34 * swatches.len() as i32 + 40;
         area.draw(&Circle::new((lx + 30, gy), 14, BLACK.stroke_width(3)))?;
         area.draw(&Cross::new((lx + 30, gy), 8, BLACK.stroke_width(3)))?;
+        let label = match self.gait.len() {
+            0 | 1 => "the gait".to_string(),
+            k => format!("the gait ({k} states)"),
+        };
         area.draw(&Text::new(
-            "the gait",
+            label,
             (lx + 60, gy),
             font(24.0).pos(Pos::new(HPos::Left, VPos::Center)),
         ))?;
