@@ -206,3 +206,47 @@ fn orbit_job_writes_its_files() {
     let e = run_orbit(&job, &|_| {}).unwrap_err().to_string();
     assert!(e.contains("--steps"), "{e}");
 }
+
+/// The grid runner's promise holds for the orbit diagram and the basin: the same results on one thread as
+/// on the default pool.
+#[test]
+fn orbit_and_basin_do_not_depend_on_the_thread_count() {
+    let config = period_two_config();
+    let spec = OrbitSpec {
+        range: SweepSpec {
+            param: "viscosity".to_string(),
+            from: 2.0,
+            to: 5.0,
+            points: 12,
+        },
+        transient: 8,
+        steps: 6,
+    };
+    let start = default_initial(&config);
+    let run = || orbit_diagram(&config, &spec, &start, &|_| {}).unwrap();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(run);
+    assert_eq!(one, run());
+    let dir = tempfile::tempdir().unwrap();
+    let job = basin_job(dir.path());
+    let basin_once = || run_basin(&job, &|_| {}).unwrap().outcomes;
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(basin_once);
+    assert_eq!(one, basin_once());
+    let csv_default = std::fs::read_to_string(dir.path().join("basin.csv")).unwrap();
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(basin_once);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("basin.csv")).unwrap(),
+        csv_default
+    );
+}
