@@ -254,8 +254,15 @@ fn orbit_figure(
     OrbitFigure {
         failed,
         title: format!(
-            "Orbit diagram: {} steps after a transient of {}, slope φ = {} rad, impact {}",
-            job.spec.steps, job.spec.transient, p.slope, p.impact
+            "Orbit diagram: {} steps after a transient of {}, {}impact {}",
+            job.spec.steps,
+            job.spec.transient,
+            if range.param == "slope" {
+                String::new()
+            } else {
+                format!("slope φ = {} rad, ", p.slope)
+            },
+            p.impact
         ),
         param_label: axis_label(&range.param),
         x: range.from.min(range.to)..range.from.max(range.to),
