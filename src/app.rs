@@ -1,7 +1,11 @@
 //! The jobs the command line runs, as library functions (STYLE.md point 2: all science lives in the library).
 
+mod attractors;
 mod figures;
 
+pub use attractors::{
+    default_basin_range, run_basin, run_orbit, BasinJob, BasinSummary, OrbitJob, OrbitSummary,
+};
 pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
 
 use std::collections::{BTreeMap, VecDeque};
@@ -14,8 +18,8 @@ use serde::Serialize;
 use crate::dynamics::Model;
 use crate::error::{short, WalkError};
 use crate::gait::{
-    find_gait, find_thresholds, sweep_values, Gait, GaitOptions, StepMap, SweepPoint, SweepSpec,
-    Threshold,
+    find_gait_any_period, find_thresholds, sweep_values, Gait, GaitOptions, StepMap, SweepPoint,
+    SweepSpec, Threshold, MAX_PERIOD,
 };
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
@@ -372,6 +376,19 @@ fn walk_job(
     Ok(summary)
 }
 
+/// The validated configuration's model and the start on the section (`initial`, or [`default_initial`]),
+/// checked against the model: what every job that walks needs first.
+fn prepared(
+    config: &Config,
+    initial: Option<SectionState>,
+) -> Result<(Model, SectionState), AppError> {
+    config.validate()?;
+    let model = Model::new(&config.params)?;
+    let initial = initial.unwrap_or_else(|| default_initial(config));
+    initial.validate(&model)?;
+    Ok((model, initial))
+}
+
 /// Remove `path` if it exists (an output file of an earlier run that this run does not rewrite).
 fn remove_stale(path: &std::path::Path) -> Result<(), OutputError> {
     match std::fs::remove_file(path) {
@@ -421,7 +438,8 @@ pub struct GaitSummary {
 /// `max |P(s) - s|` cannot be reached reliably.
 pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 
-/// Run `vrw gait`: search the gait and write `gait.json` (also when no gait is found, with the reason), and
+/// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
+/// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
 /// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
 /// ([`write_gait_period`]).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
@@ -461,7 +479,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
     initial.validate(&model)?;
     let map = StepMap::new(&model, &job.config.solver);
-    let result = find_gait(&map, &initial, &job.options, None);
+    let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
     let summary = GaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
@@ -477,7 +495,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     Ok(summary)
 }
 
-/// Walk one period from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
+/// Walk one period (`period_k` steps) from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
 /// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
 /// `vrw plot` and `vrw animate` work on a gait directly.
 pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
@@ -485,7 +503,7 @@ pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, 
         &SimulateJob {
             config: job.config.clone(),
             initial: Some(gait.section),
-            steps: 1,
+            steps: gait.period_k,
             sample_dt: DEFAULT_SAMPLE_DT,
             trajectory: true,
             out_dir: job.out_dir.clone(),
@@ -541,7 +559,7 @@ pub fn run_sweep(
     job: &SweepJob,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<SweepSummary, AppError> {
-    job.config.validate()?;
+    let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
     output::ensure_dir(&job.out_dir)?;
     let csv = job.out_dir.join("sweep.csv");
@@ -549,7 +567,7 @@ pub fn run_sweep(
         &job.config,
         &job.spec.param,
         &job.spec.values(),
-        job.initial,
+        Some(initial),
         &job.options,
         progress,
         &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
@@ -606,10 +624,7 @@ pub fn compute_sweep(
     progress: &(dyn Fn(&SweepPoint) + Sync),
     swept: &mut dyn FnMut(&[SweepPoint]) -> Result<(), AppError>,
 ) -> Result<SweepResult, AppError> {
-    config.validate()?;
-    let model = Model::new(&config.params)?;
-    let initial = initial.unwrap_or_else(|| default_initial(config));
-    initial.validate(&model)?;
+    let (_, initial) = prepared(config, initial)?;
     let clock = std::time::Instant::now();
     let points = sweep_values(config, param, values, &initial, options, progress)?;
     let sweep_seconds = clock.elapsed().as_secs_f64();

@@ -11,9 +11,12 @@ use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use vrw::app::{
-    run_animate, run_gait, run_plot, run_simulate, run_still, run_sweep, AnimateJob, GaitJob,
-    SimulateEvent, SimulateJob, SweepJob, DEFAULT_SAMPLE_DT,
+    run_animate, run_basin, run_gait, run_orbit, run_plot, run_simulate, run_still, run_sweep,
+    AnimateJob, BasinJob, GaitJob, OrbitJob, SimulateEvent, SimulateJob, SweepJob,
+    DEFAULT_SAMPLE_DT,
 };
+use vrw::gait::basin::Coordinate;
+use vrw::gait::orbit::OrbitSpec;
 use vrw::gait::GaitOptions;
 use vrw::gait::SweepSpec;
 use vrw::output::animate::AnimateOptions;
@@ -32,10 +35,16 @@ pub struct Cli {
 enum Command {
     /// Walk N steps from a Poincare-section state and report every touchdown.
     Simulate(SimulateArgs),
-    /// Find the walking gait (limit cycle), its DLS indicators and Floquet multipliers.
+    /// Find the walking gait (limit cycle, or a period-k gait up to k = 8), its DLS indicators and Floquet
+    /// multipliers.
     Gait(GaitArgs),
     /// Sweep a parameter with continuation, locate the thresholds and draw Fig. 2.
     Sweep(SweepArgs),
+    /// Orbit diagram along one parameter: the states the walk visits after a transient, with the period-1
+    /// branch (solid where stable, dashed where not).
+    Orbit(OrbitArgs),
+    /// Basin of the gait on a slice of the Poincare section: what the walk from every grid point does.
+    Basin(BasinArgs),
     /// Animate a run: DIR/walk.gif from the output directory of `simulate` or `gait`.
     Animate(AnimateArgs),
     /// Figures of a run: DIR/run.{png,svg} against time, DIR/steps.{png,svg} against step number.
@@ -143,6 +152,192 @@ fn param_help() -> String {
 }
 
 #[derive(Debug, Args)]
+struct OrbitArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter along the diagram: one of the real-valued keys (as for sweep).
+    #[arg(long, default_value = "viscosity")]
+    param: String,
+    /// First value.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    from: f64,
+    /// Last value.
+    #[arg(long, default_value_t = 150.0, allow_hyphen_values = true)]
+    to: f64,
+    /// Number of values (ends included).
+    #[arg(long, default_value_t = 300)]
+    points: usize,
+    /// Steps walked at each value before recording (4 times as many where a walk starts afresh).
+    #[arg(long, default_value_t = 32)]
+    transient: usize,
+    /// Steps recorded at each value.
+    #[arg(long, default_value_t = 64)]
+    steps: usize,
+    /// Where the first walk starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Do not compute and draw the period-1 branch.
+    #[arg(long)]
+    no_branch: bool,
+    /// Output directory for orbit.csv, branch.csv, orbit.json and orbit.png.
+    #[arg(long, default_value = "out/orbit")]
+    out: PathBuf,
+}
+
+/// A range `A,B` of two numbers.
+fn parse_range(s: &str) -> std::result::Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(',')
+        .ok_or_else(|| format!("'{s}' is not a range A,B"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{}' in the range '{s}' is not a number", v.trim()))
+    };
+    Ok((parse(a)?, parse(b)?))
+}
+
+#[derive(Debug, Args)]
+struct BasinArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Where the gait search starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Horizontal coordinate of the slice: L2, thetadot or L2dot.
+    #[arg(long, default_value = "L2")]
+    x: Coordinate,
+    /// Vertical coordinate of the slice (the third is held at the gait's value).
+    #[arg(long, default_value = "thetadot")]
+    y: Coordinate,
+    /// Range of x, `A,B` (default: L2 from L0/2 to L0, thetadot from 0.05 to 3 times the gait's, L2dot the
+    /// gait's +- 1.5 m/s).
+    #[arg(long, value_name = "A,B", value_parser = parse_range, allow_hyphen_values = true)]
+    x_range: Option<(f64, f64)>,
+    /// Range of y, `A,B` (defaults as for --x-range).
+    #[arg(long, value_name = "A,B", value_parser = parse_range, allow_hyphen_values = true)]
+    y_range: Option<(f64, f64)>,
+    /// Grid points along x.
+    #[arg(long, default_value_t = 61)]
+    nx: usize,
+    /// Grid points along y.
+    #[arg(long, default_value_t = 61)]
+    ny: usize,
+    /// Steps walked at most from each start.
+    #[arg(long, default_value_t = 100)]
+    max_steps: usize,
+    /// A return this close to a gait state (largest coordinate difference) has reached the gait.
+    #[arg(long, default_value_t = 1e-3)]
+    tolerance: f64,
+    /// Output directory for basin.csv, basin.json and basin.png.
+    #[arg(long, default_value = "out/basin")]
+    out: PathBuf,
+}
+
+fn orbit(args: OrbitArgs) -> Result<()> {
+    let job = OrbitJob {
+        config: args.model.load()?,
+        spec: OrbitSpec {
+            range: SweepSpec {
+                param: args.param.clone(),
+                from: args.from,
+                to: args.to,
+                points: args.points,
+            },
+            transient: args.transient,
+            steps: args.steps,
+        },
+        initial: args.initial,
+        branch: !args.no_branch,
+        out_dir: args.out.clone(),
+    };
+    let bar = progress_bar(
+        Some(args.points as u64),
+        "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_orbit(&job, &|c| {
+        bar.set_message(format!("{} = {:.4}: {}", args.param, c.value, c.status));
+        bar.inc(1);
+    })
+    .context("orbit")?;
+    bar.finish_and_clear();
+    let outcomes: Vec<String> = summary
+        .outcomes
+        .iter()
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect();
+    println!(
+        "vrw orbit: {} from {} to {} ({} values, {} + {} steps each): {}; {:.2} s (diagram {:.2} s, branch {:.2} s)",
+        args.param,
+        args.from,
+        args.to,
+        args.points,
+        args.transient,
+        args.steps,
+        outcomes.join(", "),
+        started.elapsed().as_secs_f64(),
+        summary.seconds[0],
+        summary.seconds[1]
+    );
+    if !args.no_branch {
+        println!(
+            "period-1 branch: a gait at {} values, stable at {}",
+            summary.branch_gaits[0], summary.branch_gaits[1]
+        );
+    }
+    println!(
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
+    );
+    Ok(())
+}
+
+fn basin(args: BasinArgs) -> Result<()> {
+    let job = BasinJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        coordinates: [args.x, args.y],
+        ranges: [args.x_range, args.y_range],
+        points: [args.nx, args.ny],
+        max_steps: args.max_steps,
+        tolerance: args.tolerance,
+        out_dir: args.out.clone(),
+    };
+    let bar = progress_bar(
+        Some((args.nx * args.ny) as u64),
+        "{bar:40} {pos}/{len} starts [{elapsed_precise}, eta {eta}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_basin(&job, &|_| bar.inc(1)).context("basin")?;
+    bar.finish_and_clear();
+    let g = &summary.gait;
+    println!(
+        "vrw basin: {} x {} starts on the slice ({}, {}) through the {}gait at (L2, thetadot, L2dot) = ({:.6}, {:.6}, {:.6}); {:.2} s ({:.2} s for the grid)",
+        args.nx,
+        args.ny,
+        args.x.name(),
+        args.y.name(),
+        if g.period_k > 1 { format!("period-{} ", g.period_k) } else { String::new() },
+        g.section.l2,
+        g.section.theta_dot,
+        g.section.l2_dot,
+        started.elapsed().as_secs_f64(),
+        summary.seconds
+    );
+    for (kind, n) in &summary.outcomes {
+        println!("  {kind:<20} {n}");
+    }
+    println!(
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
+    );
+    Ok(())
+}
+
+#[derive(Debug, Args)]
 struct AnimateArgs {
     /// Output directory of `vrw simulate` or `vrw gait` (walk.gif is written there).
     dir: PathBuf,
@@ -184,6 +379,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Simulate(args) => simulate(args),
         Command::Gait(args) => gait(args),
         Command::Sweep(args) => sweep(args),
+        Command::Orbit(args) => orbit(args),
+        Command::Basin(args) => basin(args),
         Command::Animate(args) => animate(args),
         Command::Plot(args) => plot(&args),
     }
@@ -377,6 +574,24 @@ fn gait(args: GaitArgs) -> Result<()> {
         );
     };
     let s = &g.section;
+    if g.period_k > 1 {
+        println!(
+            "period-{} gait (a fixed point of P^{}, not of P): its steps",
+            g.period_k, g.period_k
+        );
+        for r in &g.cycle {
+            let (c, i) = (&r.section, &r.indicators);
+            println!(
+                "  step {}: (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}); lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
+                 lambda_4+ = {:.6} N, branch {}, period {:.6} s",
+                r.step, c.l2, c.theta_dot, c.l2_dot, i.lambda_i4, i.lambda_2_plus, i.lambda_4_plus, r.branch, r.period
+            );
+        }
+        println!(
+            "the first step in detail, and the multipliers of P^{}:",
+            g.period_k
+        );
+    }
     println!(
         "gait at (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}), theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
         s.l2, s.theta_dot, s.l2_dot, g.theta, g.residual, g.iterations

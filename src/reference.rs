@@ -7,7 +7,7 @@
 use nalgebra::SVector;
 
 use crate::integrate::OdeSystem;
-use crate::params::Params;
+use crate::params::{Config, ImpactModel, Params};
 
 /// Point mass falling from height h0 with upward velocity v0 under gravity g: y=[z, vz], exact impact time
 /// of z = 0.
@@ -145,6 +145,23 @@ impl RigidRimlessWheel {
     pub fn fixed_point(&self) -> f64 {
         (self.omega_sq_gain() / (1.0 - self.eta().powi(2))).sqrt()
     }
+}
+
+/// A VRW with a period-2 gait (a fixed point of `P^2` that is not one of `P`, found by a parameter search,
+/// issue 10 item 2): a light hub (`mH = 2 kg`), weak damping (`c = 3 N s/m`), a soft spring (`k = 300 N/m`),
+/// slope 0.15 rad and the traditional impact; the other parameters are Table 1's. Its two steps alternate
+/// between `dtheta/dt` of about 1.09 and 1.66 rad/s just before touchdown; the period-1 search fails there. The
+/// walk settles on it from the default start. With `viscosity` from 1 to 10 N s/m it is the middle of a
+/// period-doubling bubble (README, "Orbit diagram").
+pub fn period_two_config() -> Config {
+    let mut config = Config::default();
+    let p = &mut config.params;
+    p.hub_mass = 2.0;
+    p.viscosity = 3.0;
+    p.stiffness = 300.0;
+    p.slope = 0.15;
+    p.impact = ImpactModel::Traditional;
+    config
 }
 
 #[cfg(test)]

@@ -690,3 +690,57 @@ fn sweep_without_gait_lists_only_what_it_wrote_and_removes_an_old_figure() {
         serde_json::json!(["sweep.csv", "thresholds.json"])
     );
 }
+#[test]
+fn orbit_and_basin_write_their_files() {
+    let args = [
+        "--from",
+        "40",
+        "--to",
+        "60",
+        "--points",
+        "3",
+        "--transient",
+        "4",
+        "--steps",
+        "6",
+    ];
+    let run = command_in(temp_dir_with(&[]), "orbit", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let table = run.read("orbit.csv");
+    assert!(table.starts_with("viscosity,status,period_k,step,L2,thetadot,L2dot,lambda_I4"));
+    assert_eq!(data_rows(&table), 3 * 6);
+    assert_eq!(data_rows(&run.read("branch.csv")), 3);
+    assert_eq!(
+        &fs::read(run.out.join("orbit.png")).unwrap()[..8],
+        b"\x89PNG\r\n\x1a\n"
+    );
+    let args = ["--nx", "3", "--ny", "2", "--max-steps", "20"];
+    let run = command_in(temp_dir_with(&[]), "basin", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    assert_eq!(data_rows(&run.read("basin.csv")), 6);
+    let summary: Value = serde_json::from_str(&run.read("basin.json")).unwrap();
+    assert_eq!(summary["gait"]["period_k"], 1);
+    assert_eq!(
+        &fs::read(run.out.join("basin.png")).unwrap()[..8],
+        b"\x89PNG\r\n\x1a\n"
+    );
+}
+
+/// Bad orbit and basin options: an error naming the option, never a panic.
+#[test]
+fn orbit_and_basin_refuse_bad_options() {
+    let run = command_in(temp_dir_with(&[]), "orbit", &["--steps", "0"]);
+    assert_error(&run, &["--steps"]);
+    let run = command_in(temp_dir_with(&[]), "basin", &["--x", "L2", "--y", "L2"]);
+    assert_error(&run, &["--x/--y", "different"]);
+    for (args, needle) in [
+        (&["--x", "speed"][..], "unknown section coordinate"),
+        (&["--x-range", "1"][..], "is not a range"),
+        (&["--y-range", "1,a"][..], "is not a number"),
+    ] {
+        let run = command_in(temp_dir_with(&[]), "basin", args);
+        assert!(!run.stderr().contains("panicked"), "{}", run.stderr());
+        assert_ne!(run.code(), Some(0));
+        assert!(run.stderr().contains(needle), "{}", run.stderr());
+    }
+}

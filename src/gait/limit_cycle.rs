@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::step_map::{StepMap, StepOutcome};
 use crate::error::WalkError;
-use crate::walk::{Branch, ContactAudit, SectionState};
+use crate::walk::{Branch, ContactAudit, SectionState, StepReport, Walker};
 
 /// How a gait is searched for.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -71,6 +71,32 @@ pub enum GaitError {
         /// Final `max |P(s) - s|`.
         residual: f64,
     },
+    /// The walk keeps going but its returns repeat with no period up to `max_period` (period-k search).
+    #[error(
+        "the walk does not settle on a gait of period 1 to {max_period} within {steps} steps (closest \
+         return {distance:e})"
+    )]
+    Unsettled {
+        /// Longest period tried.
+        max_period: usize,
+        /// Steps walked.
+        steps: usize,
+        /// Smallest return distance over the periods tried.
+        distance: f64,
+    },
+    /// Newton's method found a fixed point of `P^k`, but the walk from it does not repeat: the section state
+    /// does not hold the whole state at touchdown (the stance tip slides then, docs/model.md section 6).
+    #[error(
+        "the walk settles with period {period_k}, but the section state does not hold its whole state (the \
+         stance tip slides at touchdown): the walk from the fixed point of P^{period_k} misses it by \
+         {distance:e} after two periods"
+    )]
+    SectionIncomplete {
+        /// The walk's period.
+        period_k: usize,
+        /// Distance from the fixed point after `2 period_k` steps.
+        distance: f64,
+    },
     /// `DP - I` is singular (a multiplier at 1: a fold of the gait).
     #[error("DP - I is singular (a Floquet multiplier at 1), residual {residual:e}")]
     SingularJacobian {
@@ -85,17 +111,24 @@ impl GaitError {
         match self {
             GaitError::Transient { source, .. } | GaitError::Newton { source, .. } => source.kind(),
             GaitError::NoConvergence { .. } => "no_convergence",
+            GaitError::Unsettled { .. } => "unsettled",
+            GaitError::SectionIncomplete { .. } => "section_incomplete",
             GaitError::SingularJacobian { .. } => "singular_jacobian",
         }
     }
 }
 
-/// A walking gait (limit cycle) and what it does. Serialized with `theta` inside `section`
+/// A walking gait (limit cycle) and what it does. A period-k gait ([`super::period_k`]) is a fixed point of
+/// `P^k`: its scalar fields are those of its first step, `cycle` has every step, and the Jacobian and
+/// multipliers are those of `P^k`. Serialized with `theta` inside `section`
 /// (`{"section": {"L2", "thetadot", "L2dot", "theta"}, ...}`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(into = "GaitRecord")]
 pub struct Gait {
-    /// The fixed point on the section.
+    /// Steps per period of the gait: 1 for an ordinary gait (a fixed point of `P`), `k` for a fixed point of
+    /// `P^k` that is not one of any `P^j` with `j < k`.
+    pub period_k: usize,
+    /// The fixed point on the section (for a period-k gait, the first of its `k` section states).
     pub section: SectionState,
     /// `theta` at the section \[rad\].
     pub theta: f64,
@@ -129,11 +162,14 @@ pub struct Gait {
     pub energy_residual: f64,
     /// Contact audit of the gait's step.
     pub contact: ContactAudit,
-    /// `DP(s*)` on the free coordinates, row-major.
+    /// Every step of one period, in order (`period_k` records; each carries its section state, DLS
+    /// indicators and branch).
+    pub cycle: Vec<StepReport>,
+    /// `DP(s*)` (`D(P^k)(s*)` for a period-k gait) on the free coordinates, row-major.
     pub jacobian: Vec<Vec<f64>>,
     /// Estimated error of the Jacobian entries (Richardson), or `NaN` if not refined.
     pub jacobian_error: f64,
-    /// Eigenvalues of `DP(s*)` as `[re, im]`, largest modulus first.
+    /// Eigenvalues of `DP(s*)` (of `D(P^k)(s*)` for a period-k gait) as `[re, im]`, largest modulus first.
     pub floquet_multipliers: Vec<[f64; 2]>,
     /// Largest modulus of the multipliers.
     pub max_floquet: f64,
@@ -248,12 +284,18 @@ pub fn solve_fixed_point(
     options: &GaitOptions,
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<FixedPoint, GaitError> {
+    // The transient is one continuous walk (touchdowns on the way may be off the section, see
+    // `WalkError::OffSection`); only where it ends must be on the section.
     let mut s = *initial;
-    for step in 1..=options.transient_steps {
-        s = map
-            .eval(&s)
-            .map_err(|source| GaitError::Transient { step, source })?
-            .next;
+    if options.transient_steps > 0 {
+        let transient = |step: usize| move |source| GaitError::Transient { step, source };
+        let mut walker = Walker::new(map.model(), map.options(), initial).map_err(transient(1))?;
+        for step in 1..=options.transient_steps {
+            walker.step(None).map_err(transient(step))?;
+        }
+        s = walker
+            .section()
+            .map_err(transient(options.transient_steps))?;
     }
     let n = map.free_coordinates().len();
     let eval =
@@ -352,7 +394,9 @@ pub fn solve_fixed_point(
     })
 }
 
-fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
+/// The period-1 gait at the fixed point `fp` with Jacobian `dp` and its error estimate (`dp` not finite: no
+/// multipliers, stability uncertain).
+pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
     let mut multipliers: Vec<Complex<f64>> = if dp.iter().all(|v| v.is_finite()) {
         dp.complex_eigenvalues().iter().copied().collect()
     } else {
@@ -362,6 +406,7 @@ fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
     let max_floquet = multipliers.first().map_or(f64::NAN, |z| z.norm());
     let report = &fp.outcome.report;
     Gait {
+        period_k: 1,
         section: fp.section,
         theta: report.theta,
         residual: fp.residual,
@@ -379,6 +424,7 @@ fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) -> Gait {
         bounce: report.bounce,
         energy_residual: report.energy.residual,
         contact: report.contact,
+        cycle: vec![*report],
         jacobian: dp
             .row_iter()
             .map(|row| row.iter().copied().collect())
@@ -403,6 +449,7 @@ struct SectionRecord {
 /// The serialized shape of a [`Gait`].
 #[derive(Debug, Clone, Serialize)]
 struct GaitRecord {
+    period_k: usize,
     section: SectionRecord,
     residual: f64,
     iterations: usize,
@@ -421,6 +468,7 @@ struct GaitRecord {
     energy_residual: f64,
     #[serde(flatten)]
     contact: ContactAudit,
+    cycle: Vec<StepReport>,
     jacobian: Vec<Vec<f64>>,
     jacobian_error: f64,
     floquet_multipliers: Vec<[f64; 2]>,
@@ -434,6 +482,7 @@ struct GaitRecord {
 impl From<Gait> for GaitRecord {
     fn from(g: Gait) -> GaitRecord {
         GaitRecord {
+            period_k: g.period_k,
             section: SectionRecord {
                 state: g.section,
                 theta: g.theta,
@@ -453,6 +502,7 @@ impl From<Gait> for GaitRecord {
             bounce: g.bounce,
             energy_residual: g.energy_residual,
             contact: g.contact,
+            cycle: g.cycle,
             jacobian: g.jacobian,
             jacobian_error: g.jacobian_error,
             floquet_multipliers: g.floquet_multipliers,

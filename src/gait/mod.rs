@@ -1,8 +1,12 @@
-//! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, parameter sweeps with
-//! continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
+//! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, the grid runner
+//! ([`grid`]) behind parameter sweeps with continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
 
+pub mod basin;
 pub mod continuation;
+pub mod grid;
 pub mod limit_cycle;
+pub mod orbit;
+pub mod period_k;
 pub mod step_map;
 pub mod sweep;
 pub mod thresholds;
@@ -10,6 +14,7 @@ pub mod thresholds;
 pub use limit_cycle::{
     find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
 };
+pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
-pub use sweep::{sweep, sweep_values, SweepPoint, SweepSpec};
+pub use sweep::{gait_rows, sweep, sweep_values, GaitRow, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};

@@ -4,6 +4,10 @@
 //! `rigid_legs` only `dtheta/dt` is free (`L2 = L0`, `dL2/dt = 0` always), so the map acts on that coordinate
 //! alone.
 //!
+//! **Iterated map.** [`StepMap::iterated`] gives `P^k`, `k` steps walked in one evaluation, whose fixed points
+//! are the period-k gaits ([`super::period_k`]); everything below (Jacobian, Newton's method) works on it
+//! unchanged.
+//!
 //! **Jacobian.** `DP` is computed by central differences of the whole map with Richardson extrapolation:
 //! `D(h) = (P(s + h e_i) - P(s - h e_i)) / 2h` has an error `c2 h^2 + c4 h^4 + noise/h`, and
 //! `(4 D(h/2) - D(h)) / 3` removes the `h^2` term. The difference between the extrapolated and the plain
@@ -23,9 +27,9 @@ use crate::walk::{SectionState, StepReport, Walker};
 /// One evaluation of the step map.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepOutcome {
-    /// `P(s)`.
+    /// `P(s)` (`P^k(s)` for an iterated map).
     pub next: SectionState,
-    /// The step's report (DLS indicators, period, energy audit, ...).
+    /// The (first) step's report (DLS indicators, period, energy audit, ...).
     pub report: StepReport,
 }
 
@@ -34,6 +38,8 @@ pub struct StepOutcome {
 pub struct StepMap<'m> {
     model: &'m Model,
     opts: SolverOptions,
+    /// Steps per evaluation: 1 for `P`, `k` for `P^k`.
+    iterate: usize,
 }
 
 impl<'m> StepMap<'m> {
@@ -42,7 +48,27 @@ impl<'m> StepMap<'m> {
         StepMap {
             model,
             opts: opts.clone(),
+            iterate: 1,
         }
+    }
+
+    /// The iterated map `P^k` (`k >= 1`; `k = 0` is taken as 1): each evaluation walks `k` steps, and its
+    /// report is that of the first step.
+    pub fn iterated(&self, k: usize) -> StepMap<'m> {
+        StepMap {
+            iterate: k.max(1),
+            ..self.clone()
+        }
+    }
+
+    /// The solver options.
+    pub fn options(&self) -> &SolverOptions {
+        &self.opts
+    }
+
+    /// Steps walked per evaluation (`k` of `P^k`).
+    pub fn steps_per_eval(&self) -> usize {
+        self.iterate
     }
 
     /// The model.
@@ -50,11 +76,14 @@ impl<'m> StepMap<'m> {
         self.model
     }
 
-    /// Evaluate `P(s)`. Fails with the reason the step could not be walked (fell, stalled, old rear leg not
+    /// Evaluate `P(s)` (`P^k(s)` for an iterated map). Fails with the reason the step could not be walked (fell, stalled, old rear leg not
     /// relocked at the next touchdown, ...).
     pub fn eval(&self, s: &SectionState) -> Result<StepOutcome, WalkError> {
         let mut walker = Walker::new(self.model, &self.opts, s)?;
         let report = walker.step(None)?;
+        for _ in 1..self.iterate {
+            walker.step(None)?;
+        }
         let next = walker.section()?;
         Ok(StepOutcome { next, report })
     }

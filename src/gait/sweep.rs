@@ -7,17 +7,19 @@
 //! initial state missed, and every gait gets a family number: points of one family are connected by
 //! continuation, so a change of family between neighbours is a branch switch, never a silent jump.
 //!
-//! Parallelism (rayon) with results bitwise identical for any number of threads: first every
-//! [`COARSE_STRIDE`]-th point is continued in order (the coarse pass); then the points between two coarse points
-//! are continued from the left one, all intervals in parallel. The chunking is fixed by the sweep, not by the
-//! threads, and each point's computation is the same wherever it runs. Inside each point the step-map
-//! evaluations of the finite-difference Jacobian run in parallel as well.
+//! Parallelism (rayon) with results bitwise identical for any number of threads comes from the grid runner
+//! ([`super::grid`]): a sweep is one row of [`gait_rows`], which continues every [`COARSE_STRIDE`]-th point in
+//! order (the coarse pass) and then the points between two coarse points from the left one, all intervals in
+//! parallel; a map is many rows, run in parallel. Inside each point the step-map evaluations of the
+//! finite-difference Jacobian run in parallel as well.
 
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::continuation::{section_distance, Continuation, FamilyPoint, Followed, SAME_GAIT_TOL};
+use super::grid::{run_rows, Evaluated};
 use super::limit_cycle::{find_gait, Gait, GaitOptions};
+use super::period_k::{find_gait_any_period, MAX_PERIOD};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
 use crate::error::short;
@@ -122,7 +124,7 @@ pub fn configured(
 
 /// The gait at `value`, followed from `previous` (a neighbouring gait at another value, with its index) in
 /// verified continuation steps if given; if the family does not reach `value`, searched from `initial` with the
-/// full transient.
+/// full transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
 pub fn gait_at_value(
     config: &Config,
     param: &str,
@@ -167,7 +169,10 @@ pub fn gait_at_value(
     });
     let (continued_from, result) = match continued {
         Some((index, g)) => (Some(index), Ok(g)),
-        None => (None, find_gait(&map, initial, options, None)),
+        None => (
+            None,
+            find_gait_any_period(&map, initial, options, MAX_PERIOD),
+        ),
     };
     match result {
         Ok(g) => SweepPoint {
@@ -189,36 +194,13 @@ pub fn gait_at_value(
     }
 }
 
-/// Stride of the coarse continuation pass.
-pub const COARSE_STRIDE: usize = 10;
-
-/// Continue along `values` (sweep indices from `first`) from `start` (the gait at the point before them, if
-/// any). After a point without a gait, the next ones are searched from `initial` until a gait is found again:
-/// a family that ended is not followed further.
-#[allow(clippy::too_many_arguments)]
-fn continue_along(
-    config: &Config,
-    param: &str,
-    values: &[f64],
-    first: usize,
-    initial: &SectionState,
-    start: Option<(usize, f64, Gait)>,
-    options: &GaitOptions,
-    progress: &(dyn Fn(&SweepPoint) + Sync),
-) -> Vec<SweepPoint> {
-    let mut last = start;
-    values
-        .iter()
-        .enumerate()
-        .map(|(i, &value)| {
-            let previous = last.as_ref().map(|(j, v, g)| (*j, *v, g));
-            let point = gait_at_value(config, param, value, initial, previous, options);
-            last = point.gait.clone().map(|g| (first + i, value, g));
-            progress(&point);
-            point
-        })
-        .collect()
+/// The point's gait if continuation can start from it: a period-1 gait (continuation follows fixed points of
+/// `P`; a period-k gait is searched afresh at every point).
+fn continuable(point: &SweepPoint) -> Option<&Gait> {
+    point.gait.as_ref().filter(|g| g.period_k == 1)
 }
+
+pub use super::grid::COARSE_STRIDE;
 
 /// Points without a gait just left of a gait (or of a stretch of gaits) may be misses of the search from the
 /// initial state: follow each such gait backwards, from right to left, and fill in the points its family
@@ -228,7 +210,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
     for i in (1..points.len()).rev() {
         let (left, right) = points.split_at_mut(i);
         let (a, b) = (&mut left[i - 1], &right[0]);
-        let (None, Some(gb)) = (&a.gait, &b.gait) else {
+        let (None, Some(gb)) = (&a.gait, continuable(b)) else {
             continue;
         };
         if a.status == "invalid_parameter" {
@@ -313,7 +295,58 @@ fn number_families(config: &Config, param: &str, points: &mut [SweepPoint], opti
     }
 }
 
-/// Sweep `spec.param` over its range with continuation, calling `progress` after each point.
+/// One row of gait points: a configuration and the values one of its parameters takes along the row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaitRow {
+    /// Parameters and solver options (`param` is overridden point by point).
+    pub config: Config,
+    /// The numeric key that varies along the row ([`Config::numeric_keys`]).
+    pub param: String,
+    /// Its values, in the order they are continued.
+    pub values: Vec<f64>,
+}
+
+/// The gaits along every row, each row continued with the sweep's rules (see the module documentation):
+/// continuation from the left neighbour on the [`super::grid`] runner's schedule, a search from `initial` where
+/// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in parallel, and the
+/// results are bitwise identical for any number of threads. `progress` is called after every point.
+pub fn gait_rows(
+    rows: &[GaitRow],
+    initial: &SectionState,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Vec<Vec<SweepPoint>> {
+    let cols = rows.iter().map(|r| r.values.len()).max().unwrap_or(0);
+    let mut points = run_rows(rows.len(), cols, |cell, from: Option<(usize, &Gait)>| {
+        let row = &rows[cell.row];
+        let Some(&value) = row.values.get(cell.col) else {
+            // A shorter row: nothing here (dropped below).
+            return Evaluated {
+                point: None,
+                carry: None,
+            };
+        };
+        let previous = from.map(|(j, g)| (j, row.values[j], g));
+        let point = gait_at_value(&row.config, &row.param, value, initial, previous, options);
+        progress(&point);
+        Evaluated {
+            carry: continuable(&point).cloned(),
+            point: Some(point),
+        }
+    });
+    rows.par_iter()
+        .zip(points.par_iter_mut())
+        .map(|(row, points)| {
+            let mut points: Vec<SweepPoint> = points.drain(..).flatten().collect();
+            backfill(&row.config, &row.param, &mut points, options);
+            number_families(&row.config, &row.param, &mut points, options);
+            points
+        })
+        .collect()
+}
+
+/// Sweep `spec.param` over its range with continuation, calling `progress` after each point: one row of
+/// [`gait_rows`].
 pub fn sweep(
     config: &Config,
     spec: &SweepSpec,
@@ -333,7 +366,7 @@ pub fn sweep(
 }
 
 /// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
-/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values.
+/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of [`gait_rows`].
 pub fn sweep_values(
     config: &Config,
     param: &str,
@@ -343,47 +376,12 @@ pub fn sweep_values(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, ConfigError> {
     config.get_numeric(param)?;
-    let coarse_values: Vec<f64> = values.iter().copied().step_by(COARSE_STRIDE).collect();
-    // The coarse pass: every COARSE_STRIDE-th point, each continued from the previous coarse point.
-    let mut coarse: Vec<SweepPoint> = Vec::with_capacity(coarse_values.len());
-    for (k, &value) in coarse_values.iter().enumerate() {
-        let previous = coarse.last().and_then(|p: &SweepPoint| {
-            p.gait
-                .as_ref()
-                .map(|g| ((k - 1) * COARSE_STRIDE, p.value, g))
-        });
-        let point = gait_at_value(config, param, value, initial, previous, options);
-        progress(&point);
-        coarse.push(point);
-    }
-    let fills: Vec<Vec<SweepPoint>> = coarse
-        .par_iter()
-        .enumerate()
-        .map(|(i, left)| {
-            let lo = i * COARSE_STRIDE + 1;
-            let hi = ((i + 1) * COARSE_STRIDE).min(values.len());
-            let start = left
-                .gait
-                .clone()
-                .map(|g| (i * COARSE_STRIDE, left.value, g));
-            continue_along(
-                config,
-                param,
-                &values[lo.min(hi)..hi],
-                lo,
-                initial,
-                start,
-                options,
-                progress,
-            )
-        })
-        .collect();
-    let mut points = Vec::with_capacity(values.len());
-    for (left, fill) in coarse.into_iter().zip(fills) {
-        points.push(left);
-        points.extend(fill);
-    }
-    backfill(config, param, &mut points, options);
-    number_families(config, param, &mut points, options);
-    Ok(points)
+    let row = GaitRow {
+        config: config.clone(),
+        param: param.to_string(),
+        values: values.to_vec(),
+    };
+    Ok(gait_rows(&[row], initial, options, progress)
+        .pop()
+        .unwrap_or_default())
 }

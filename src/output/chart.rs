@@ -406,6 +406,12 @@ pub fn write_svg_png(
         root.present()
             .map_err(|e| PlotError::draw_at(svg)(e.to_string()))?;
     }
+    write_png(figure, png, size)
+}
+
+/// Write `figure` as a PNG only (figures with tens of thousands of marks, whose SVG would be large).
+pub fn write_png(figure: &impl Figure, png: &Path, size: (u32, u32)) -> Result<(), PlotError> {
+    super::style::require_font(png)?;
     let root = BitMapBackend::new(png, size).into_drawing_area();
     figure
         .draw(&root)

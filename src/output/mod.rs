@@ -4,7 +4,9 @@
 //! undefined values (e.g. `lambda_2+` after an (A3) exchange) are written as `NaN` in CSV and `null` in JSON.
 
 pub mod animate;
+pub mod basin_plot;
 pub mod chart;
+pub mod orbit_plot;
 pub mod plot;
 pub mod read;
 pub mod run_plot;
@@ -407,7 +409,7 @@ pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), Outpu
 }
 
 /// Columns of `sweep.csv` after the parameter column.
-pub const SWEEP_COLUMNS: [&str; 23] = [
+pub const SWEEP_COLUMNS: [&str; 24] = [
     "status",
     "L2",
     "thetadot",
@@ -430,6 +432,7 @@ pub const SWEEP_COLUMNS: [&str; 23] = [
     "residual",
     "iterations",
     "family",
+    "period_k",
     "message",
 ];
 
@@ -476,6 +479,7 @@ pub fn sweep_row(p: &SweepPoint) -> Vec<Cell> {
                 Real(g.residual),
                 Count(g.iterations),
                 p.family.map_or(Cell::Empty, Count),
+                Count(g.period_k),
             ]);
         }
         None => row.extend(std::iter::repeat_n(Cell::Empty, SWEEP_COLUMNS.len() - 2)),

@@ -576,6 +576,13 @@ impl<'m> Walker<'m> {
         &self.state
     }
 
+    /// The section coordinates `(L2, thetadot, L2dot)` at the current touchdown, without the check of
+    /// [`Walker::section`]: what a return map or an orbit diagram records. Where the stance tip slides they do
+    /// not hold the whole state, so they must not be used to start a walk there.
+    pub fn touchdown_coordinates(&self) -> SectionState {
+        SectionState::from_coords(&self.state.q, &self.state.qd)
+    }
+
     /// The current Poincare-section state, or why the walk cannot continue, or why the wheel is not on the
     /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest, slides).
     pub fn section(&self) -> Result<SectionState, WalkError> {

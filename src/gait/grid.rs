@@ -1,0 +1,162 @@
+//! The grid runner: evaluate something at every point of a grid of rows, each row continued from left to right,
+//! rows in parallel, with results bitwise identical for any number of threads.
+//!
+//! Sweeps and maps ([`super::sweep::gait_rows`]) and any other "evaluate the step map over a grid, continuing
+//! along rows" job use this one runner. A job supplies the evaluation of one point as a closure
+//! `eval(cell, from) -> Evaluated { point, carry }`:
+//!
+//! - `cell` is the point's place in the grid (row and column);
+//! - `from` is `Some((col, carry))` when the point continues an earlier point of the same row: `col` is that
+//!   point's column (always to the left) and `carry` what its evaluation handed on (a gait, a state, ...); `None`
+//!   for the first point of a row, or when the point continued from handed on nothing;
+//! - `carry` is what later points may continue from (`None`: nothing, e.g. no gait was found).
+//!
+//! **Schedule.** In every row, first every [`COARSE_STRIDE`]-th point is evaluated in order, each continuing the
+//! previous coarse point (the coarse pass); then the points between two coarse points are evaluated in order,
+//! continuing from the left coarse point, all intervals in parallel. Rows run in parallel. The chunking is fixed
+//! by the grid, not by the threads, and a point's evaluation depends only on its cell and on what it continues,
+//! so as long as `eval` is a deterministic function of its arguments the results do not depend on the number of
+//! threads or on the order in which rayon runs the work.
+//!
+//! ```
+//! use vrw::gait::grid::{run_rows, Evaluated};
+//!
+//! // A running sum along each row, restarted at every coarse point's left neighbour: the carry is the sum.
+//! let rows = run_rows(2, 25, |cell, from: Option<(usize, &f64)>| {
+//!     let sum = from.map_or(0.0, |(_, s)| *s) + (cell.row * 100 + cell.col) as f64;
+//!     Evaluated { point: (cell, sum), carry: Some(sum) }
+//! });
+//! assert_eq!(rows.len(), 2);
+//! assert_eq!(rows[1][24].0.col, 24);
+//! ```
+
+use rayon::prelude::*;
+
+/// Stride of the coarse continuation pass along a row.
+pub const COARSE_STRIDE: usize = 10;
+
+/// A point's place in the grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Cell {
+    /// Row index, from 0.
+    pub row: usize,
+    /// Column index along the row, from 0.
+    pub col: usize,
+}
+
+/// The result of one point's evaluation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluated<P, C> {
+    /// The point's result, returned by [`run_rows`].
+    pub point: P,
+    /// What later points of the row may continue from; `None` if nothing (they then start afresh).
+    pub carry: Option<C>,
+}
+
+/// Evaluate every point of a grid of `rows` rows of `cols` points each, continuing along rows (see the module
+/// documentation for the schedule). Returns the points row by row, in column order. `eval` must be a
+/// deterministic function of its arguments for the results to be the same for any number of threads.
+pub fn run_rows<P, C, F>(rows: usize, cols: usize, eval: F) -> Vec<Vec<P>>
+where
+    P: Send,
+    C: Send + Sync,
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
+{
+    (0..rows)
+        .into_par_iter()
+        .map(|row| run_row(row, cols, &eval))
+        .collect()
+}
+
+/// One row: the coarse pass, then the intervals between coarse points in parallel.
+fn run_row<P, C, F>(row: usize, cols: usize, eval: &F) -> Vec<P>
+where
+    P: Send,
+    C: Send + Sync,
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
+{
+    let mut coarse_points: Vec<P> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
+    let mut carries: Vec<Option<C>> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
+    for col in (0..cols).step_by(COARSE_STRIDE) {
+        let from = carries
+            .last()
+            .and_then(|c| c.as_ref().map(|c| (col - COARSE_STRIDE, c)));
+        let e = eval(Cell { row, col }, from);
+        coarse_points.push(e.point);
+        carries.push(e.carry);
+    }
+    let fills: Vec<Vec<P>> = carries
+        .par_iter()
+        .enumerate()
+        .map(|(k, left)| {
+            let first = k * COARSE_STRIDE;
+            let end = (first + COARSE_STRIDE).min(cols);
+            let mut last: Option<(usize, Option<C>)> = None;
+            let mut points = Vec::with_capacity(end - first - 1);
+            for col in first + 1..end {
+                let from = match &last {
+                    None => left.as_ref().map(|c| (first, c)),
+                    Some((j, c)) => c.as_ref().map(|c| (*j, c)),
+                };
+                let e = eval(Cell { row, col }, from);
+                points.push(e.point);
+                last = Some((col, e.carry));
+            }
+            points
+        })
+        .collect();
+    let mut points = Vec::with_capacity(cols);
+    for (left, fill) in coarse_points.into_iter().zip(fills) {
+        points.push(left);
+        points.extend(fill);
+    }
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each point records what it continued from: the schedule is the documented one.
+    #[test]
+    fn points_continue_the_documented_neighbour() {
+        let cols = 2 * COARSE_STRIDE + 3;
+        let rows = run_rows(3, cols, |cell, from: Option<(usize, &usize)>| Evaluated {
+            point: (cell, from.map(|(j, c)| (j, *c))),
+            carry: (cell.col != COARSE_STRIDE + 2).then_some(cell.col),
+        });
+        assert_eq!(rows.len(), 3);
+        for (r, row) in rows.iter().enumerate() {
+            assert_eq!(row.len(), cols);
+            for (col, (cell, from)) in row.iter().enumerate() {
+                assert_eq!(*cell, Cell { row: r, col });
+                let expected = match col {
+                    0 => None,
+                    // The point after the one that hands on nothing starts afresh.
+                    c if c == COARSE_STRIDE + 3 => None,
+                    c if c % COARSE_STRIDE == 0 => Some(c - COARSE_STRIDE),
+                    c => Some(c - 1),
+                };
+                assert_eq!(from.map(|(j, _)| j), expected, "col {col}");
+                if let Some((j, c)) = from {
+                    assert_eq!(j, c);
+                }
+            }
+        }
+    }
+
+    /// Rows of one point, and an empty grid.
+    #[test]
+    fn degenerate_grids() {
+        let eval = |cell: Cell, _: Option<(usize, &())>| Evaluated {
+            point: cell,
+            carry: None,
+        };
+        assert_eq!(
+            run_rows(2, 1, eval),
+            vec![vec![Cell { row: 0, col: 0 }], vec![Cell { row: 1, col: 0 }]]
+        );
+        assert!(run_rows(0, 5, eval).is_empty());
+        assert_eq!(run_rows(1, 0, eval), vec![Vec::<Cell>::new()]);
+    }
+}

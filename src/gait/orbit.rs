@@ -1,0 +1,181 @@
+//! The orbit diagram (issue 10 item 3): along one parameter, the section states and DLS indicators the walk
+//! visits once its transient has died out.
+//!
+//! At each parameter value the wheel walks `transient` steps, then `steps` more whose section states and step
+//! reports are kept (the points of the diagram). Each value starts from where the walk at the value it continues
+//! ended, on the [`super::grid`] runner's schedule (every [`super::grid::COARSE_STRIDE`]-th value in order,
+//! then the values between in parallel), so that the diagram follows an attractor as the parameter changes
+//! instead of jumping between coexisting ones. The first value, and a value after a walk that failed, start
+//! from the job's initial state with [`FRESH_TRANSIENT_FACTOR`] times the transient.
+//!
+//! The period of the recorded returns ([`super::period_k::least_period`]) is reported per value: a period-1
+//! gait shows as one point, a period-k gait as `k`, anything else as a cloud.
+
+use serde::Serialize;
+
+use super::grid::{run_rows, Evaluated};
+use super::period_k::{least_period, MAX_PERIOD};
+use super::sweep::{configured, SweepSpec};
+use crate::error::WalkError;
+use crate::params::{Config, ConfigError};
+use crate::walk::{SectionState, StepReport, Walker};
+
+/// A value that does not continue another walks this many times the transient.
+pub const FRESH_TRANSIENT_FACTOR: usize = 4;
+
+/// The recorded returns repeat with period `k` to within this (largest coordinate difference) for a value to
+/// be reported as period `k`.
+pub const PERIOD_TOL: f64 = 1e-6;
+
+/// The largest number of recorded steps per value.
+pub const MAX_ORBIT_STEPS: usize = 100_000;
+
+/// What to compute.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OrbitSpec {
+    /// The parameter and its values (as for a sweep).
+    pub range: SweepSpec,
+    /// Steps walked at each value before recording (default 64).
+    pub transient: usize,
+    /// Steps recorded at each value (default 64).
+    pub steps: usize,
+}
+
+impl OrbitSpec {
+    /// Check the range against `config` (as a sweep's) and the step counts.
+    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+        self.range.validate(config)?;
+        if !(1..=MAX_ORBIT_STEPS).contains(&self.steps) {
+            return Err(ConfigError::InvalidValue {
+                key: "orbit --steps".to_string(),
+                value: self.steps.to_string(),
+                reason: format!("the recorded steps must be between 1 and {MAX_ORBIT_STEPS}"),
+            });
+        }
+        if self.transient > MAX_ORBIT_STEPS {
+            return Err(ConfigError::InvalidValue {
+                key: "orbit --transient".to_string(),
+                value: self.transient.to_string(),
+                reason: format!("the transient must be at most {MAX_ORBIT_STEPS} steps"),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The walk at one parameter value.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OrbitColumn {
+    /// The parameter value.
+    pub value: f64,
+    /// `walking` when every step was walked, otherwise the failure kind (`rolled_back`, `fell`, ...,
+    /// `invalid_parameter`).
+    pub status: String,
+    /// The failure in words.
+    pub message: Option<String>,
+    /// The recorded steps (their section states, indicators and branches), in order; fewer than asked if the
+    /// walk failed while recording.
+    pub returns: Vec<StepReport>,
+    /// The least period of the recorded returns (to [`PERIOD_TOL`]), up to [`MAX_PERIOD`]; `None` if they do
+    /// not repeat (or the walk failed).
+    pub period_k: Option<usize>,
+    /// The value whose end state this walk started from (`None`: the initial state).
+    pub continued_from: Option<f64>,
+}
+
+/// Walk at `value` from `start`: `transient` steps, then `steps` recorded. Returns the column and the state
+/// the walk ended in (`None` if it failed).
+fn walk_column(
+    config: &Config,
+    param: &str,
+    value: f64,
+    start: &SectionState,
+    transient: usize,
+    steps: usize,
+) -> (OrbitColumn, Option<SectionState>) {
+    let mut column = OrbitColumn {
+        value,
+        status: "walking".to_string(),
+        message: None,
+        returns: Vec::with_capacity(steps),
+        period_k: None,
+        continued_from: None,
+    };
+    let (c, model) = match configured(config, param, value) {
+        Ok(x) => x,
+        Err(e) => {
+            column.status = "invalid_parameter".to_string();
+            column.message = Some(e.to_string());
+            return (column, None);
+        }
+    };
+    let walked = Walker::new(&model, &c.solver, start).and_then(|mut walker| {
+        for _ in 0..transient {
+            walker.step(None)?;
+        }
+        for _ in 0..steps {
+            column.returns.push(walker.step(None)?);
+        }
+        // The next value continues from a touchdown on the section (one where the stance tip is at rest).
+        for _ in 0..MAX_PERIOD {
+            match walker.section() {
+                Err(WalkError::OffSection { .. }) => {
+                    walker.step(None)?;
+                }
+                other => return other,
+            }
+        }
+        walker.section()
+    });
+    match walked {
+        Ok(end) => {
+            let returns: Vec<SectionState> = column.returns.iter().map(|r| r.section).collect();
+            column.period_k = least_period(&returns, MAX_PERIOD, PERIOD_TOL);
+            (column, Some(end))
+        }
+        Err(e) => {
+            column.status = e.kind().to_string();
+            column.message = Some(e.to_string());
+            (column, None)
+        }
+    }
+}
+
+/// The orbit diagram of `config` along `spec` from `initial` (see the module documentation). Deterministic for
+/// any number of threads.
+pub fn orbit_diagram(
+    config: &Config,
+    spec: &OrbitSpec,
+    initial: &SectionState,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<Vec<OrbitColumn>, ConfigError> {
+    spec.validate(config)?;
+    let values = spec.range.values();
+    let fresh = spec.transient.saturating_mul(FRESH_TRANSIENT_FACTOR);
+    let mut rows = run_rows(
+        1,
+        values.len(),
+        |cell, from: Option<(usize, &SectionState)>| {
+            let value = values[cell.col];
+            let (start, transient, continued_from) = match from {
+                Some((j, s)) => (*s, spec.transient, Some(values[j])),
+                None => (*initial, fresh, None),
+            };
+            let (mut column, end) = walk_column(
+                config,
+                &spec.range.param,
+                value,
+                &start,
+                transient,
+                spec.steps,
+            );
+            column.continued_from = continued_from;
+            progress(&column);
+            Evaluated {
+                point: column,
+                carry: end,
+            }
+        },
+    );
+    Ok(rows.pop().unwrap_or_default())
+}

@@ -1,0 +1,155 @@
+//! Period-k gaits (issue 10 item 2): fixed points of `P^k`, checked by evaluating the step map directly.
+
+use vrw::app::{default_initial, run_gait, GaitJob};
+use vrw::dynamics::Model;
+use vrw::gait::period_k::least_period;
+use vrw::gait::{find_gait, find_periodic_gait, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use vrw::params::Config;
+use vrw::reference::period_two_config;
+use vrw::walk::{simulate, SectionState};
+
+/// What `vrw gait --tolerance` defaults to, and what the `P^2` residual must reach.
+const P2_RESIDUAL_TOL: f64 = 1e-10;
+
+/// The two section states of a period-2 gait differ by far more than the Newton tolerance.
+const DISTINCT: f64 = 1e-3;
+
+fn distance(a: &SectionState, b: &SectionState) -> f64 {
+    vrw::gait::continuation::section_distance(a, b)
+}
+
+/// The reference parameters with a period-2 gait and their model.
+fn period_two() -> (Config, Model) {
+    let config = period_two_config();
+    let model = Model::new(&config.params).unwrap();
+    (config, model)
+}
+
+/// The period-k search from the default start.
+fn search(map: &StepMap, config: &Config) -> Gait {
+    find_periodic_gait(
+        map,
+        &default_initial(config),
+        &GaitOptions::default(),
+        MAX_PERIOD,
+    )
+    .unwrap()
+}
+
+/// The period-2 gait of the reference problem: `P^2(s*) = s*` to 1e-10 by a direct simulation of two steps,
+/// while `P(s*)` is another state; the cycle's records are those two steps.
+#[test]
+fn period_two_gait_is_a_fixed_point_of_p_squared() {
+    let (config, model) = period_two();
+    let map = StepMap::new(&model, &config.solver);
+    let gait = search(&map, &config);
+    assert_eq!(gait.period_k, 2);
+    assert_eq!(gait.cycle.len(), 2);
+    // P^2 by a direct simulation of three touchdowns from s*: the section before the third is P^2(s*).
+    let s0 = gait.section;
+    let run = simulate(&model, &config.solver, &s0, 3, None).unwrap();
+    let (s1, s2) = (run.steps[1].section, run.steps[2].section);
+    assert!(
+        distance(&s2, &s0) < P2_RESIDUAL_TOL,
+        "{}",
+        distance(&s2, &s0)
+    );
+    assert!(distance(&s1, &s0) > DISTINCT, "{}", distance(&s1, &s0));
+    assert_eq!(gait.cycle[0].section, s0);
+    assert!(distance(&gait.cycle[1].section, &s1) < 1e-12);
+    // P^2 through the map (one evaluation of the iterated map) agrees.
+    let p2 = map.iterated(2).eval(&s0).unwrap().next;
+    assert!(distance(&p2, &s0) < P2_RESIDUAL_TOL);
+    // The multipliers are those of P^2 and the gait is stable under P^2.
+    assert!(gait.max_floquet < 1.0, "{}", gait.max_floquet);
+    assert_eq!(gait.floquet_multipliers.len(), 3);
+}
+
+/// The plain walk from the default start settles on the same two states, alternating (a second route to
+/// the period).
+#[test]
+fn walk_settles_on_the_period_two_gait() {
+    let (config, model) = period_two();
+    let map = StepMap::new(&model, &config.solver);
+    let gait = search(&map, &config);
+    let run = simulate(&model, &config.solver, &default_initial(&config), 200, None).unwrap();
+    let returns: Vec<SectionState> = run.steps.iter().map(|r| r.section).collect();
+    assert_eq!(least_period(&returns, MAX_PERIOD, 1e-8), Some(2));
+    let last = returns[returns.len() - 1];
+    let near = gait
+        .cycle
+        .iter()
+        .map(|r| distance(&r.section, &last))
+        .fold(f64::INFINITY, f64::min);
+    assert!(near < 1e-8, "{near}");
+    // The period-1 search fails there: the period-2 gait is not an artefact of a missed fixed point of P.
+    assert!(find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None
+    )
+    .is_err());
+}
+
+/// `vrw gait` reports the period-2 gait: gait.json has `period_k` 2 and both steps, and one period (two
+/// steps) is written as steps.csv.
+#[test]
+fn gait_job_writes_the_period_two_gait() {
+    let dir = tempfile::tempdir().unwrap();
+    let summary = run_gait(&GaitJob {
+        config: period_two_config(),
+        initial: None,
+        options: GaitOptions::default(),
+        out_dir: dir.path().to_path_buf(),
+    })
+    .unwrap();
+    assert_eq!(summary.status, "found");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("gait.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["period_k"], 2);
+    assert_eq!(json["cycle"].as_array().unwrap().len(), 2);
+    assert!(json["cycle"][1]["indicators"]["lambda_I4"].is_number());
+    let steps = std::fs::read_to_string(dir.path().join("steps.csv")).unwrap();
+    assert_eq!(steps.lines().count(), 3);
+}
+
+/// An ordinary gait has `period_k` 1 and one cycle record, its own step.
+#[test]
+fn ordinary_gait_has_period_one() {
+    let config = vrw::params::Config::default();
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let gait = vrw::gait::find_gait_any_period(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        MAX_PERIOD,
+    )
+    .unwrap();
+    assert_eq!(gait.period_k, 1);
+    assert_eq!(gait.cycle.len(), 1);
+    assert_eq!(gait.cycle[0].section, gait.section);
+}
+
+/// Regression (a sweep reported period-4 and period-5 gaits at c = 4.5 to 8.5): where the walk settles on
+/// period 1 with the stance tip sliding at every touchdown, the section does not hold the whole state and no
+/// period-k gait may be made up from a multiple of the walk's period.
+#[test]
+fn no_spurious_period_k_gait_where_the_walk_has_period_one() {
+    let (mut config, _) = period_two();
+    config.params.viscosity = 6.0;
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let run = simulate(&model, &config.solver, &default_initial(&config), 200, None).unwrap();
+    let returns: Vec<SectionState> = run.steps.iter().map(|r| r.section).collect();
+    assert_eq!(least_period(&returns, MAX_PERIOD, 1e-8), Some(1));
+    let found = vrw::gait::find_gait_any_period(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        MAX_PERIOD,
+    );
+    assert!(found.as_ref().is_err(), "{:?}", found.map(|g| g.period_k));
+}
