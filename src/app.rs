@@ -1,8 +1,10 @@
 //! The jobs the command line runs, as library functions (STYLE.md point 2: all science lives in the library).
 
 mod figures;
+mod map;
 
 pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+pub use map::{run_map, MapJob, MapSummary};
 
 use std::collections::{BTreeMap, VecDeque};
 use std::path::PathBuf;

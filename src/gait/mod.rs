@@ -4,6 +4,7 @@
 pub mod continuation;
 pub mod grid;
 pub mod limit_cycle;
+pub mod map;
 pub mod step_map;
 pub mod sweep;
 pub mod thresholds;
@@ -11,6 +12,7 @@ pub mod thresholds;
 pub use limit_cycle::{
     find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
 };
+pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
 pub use step_map::{StepMap, StepOutcome};
 pub use sweep::{gait_rows, sweep, GaitRow, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, Threshold};

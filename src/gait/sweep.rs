@@ -163,7 +163,7 @@ pub fn gait_at_value(
                     .ok()
                     .map(|g| (index, g))
             }
-            Followed::Ended { .. } => None,
+            Followed::Ended { .. } | Followed::GaveUp { .. } => None,
         }
     });
     let (continued_from, result) = match continued {
@@ -233,7 +233,12 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
 
 /// Number the gait families: a point continued from another shares its family; a point found from the initial
 /// state starts a new one, unless a verified continuation step connects it to its left neighbour's gait.
-fn number_families(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
+pub(crate) fn number_families(
+    config: &Config,
+    param: &str,
+    points: &mut [SweepPoint],
+    options: &GaitOptions,
+) {
     let cont = Continuation::new(config, param, options);
     // Roots of the continuation forest: a gait found from the initial state is its own root.
     let root_of = |i: usize| {
