@@ -12,7 +12,7 @@
 //! to [`super::thresholds::PARAM_TOL`] in `y`; the column's gaits are those of the rows, and neighbours along the column belong to
 //! one family when a verified continuation step in `y` connects them). Each crossing lies on one edge of the
 //! grid. Within each grid cell, the crossings of one curve on its edges are joined (two crossings: one segment,
-//! as in marching squares; four: the pairing of shortest total length), and the segments are chained into
+//! as in marching squares; more: the closest pairs first), and the segments are chained into
 //! polylines. A polyline's points are all refined crossings; only the straight pieces between them are drawn.
 //!
 //! The curve of the end of existence joins `gait_lost` and `gait_found` crossings (which of the two a crossing
@@ -440,7 +440,7 @@ fn chains(nx: usize, ny: usize, own: &[&Crossing]) -> Vec<Vec<usize>> {
     out
 }
 
-/// Pair the crossings of one cell: two make a segment; of more, the pairs of shortest total length are taken
+/// Pair the crossings of one cell: two make a segment; of more, the closest pairs are taken first
 /// (an odd one out is left as the end of a curve).
 fn pair_up(here: &[usize], distance: &dyn Fn(usize, usize) -> f64) -> Vec<(usize, usize)> {
     match here.len() {

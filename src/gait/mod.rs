@@ -1,5 +1,6 @@
 //! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, the grid runner
-//! ([`grid`]) behind parameter sweeps with continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
+//! ([`grid`]) behind parameter sweeps and maps with continuation, and the parameter values where the DLS
+//! indicators change sign or the gait is lost.
 
 pub mod continuation;
 pub mod grid;

@@ -303,8 +303,9 @@ pub struct GaitRow {
 
 /// The gaits along every row, each row continued with the sweep's rules (see the module documentation):
 /// continuation from the left neighbour on the [`super::grid`] runner's schedule, a search from `initial` where
-/// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in parallel, and the
-/// results are bitwise identical for any number of threads. `progress` is called after every point.
+/// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in
+/// parallel, and the results are bitwise identical for any number of threads. `progress` is called after every
+/// point. A row's values that leave the valid domain give points with the status `invalid_parameter`.
 pub fn gait_rows(
     rows: &[GaitRow],
     initial: &SectionState,
