@@ -15,7 +15,9 @@
 //!   `python/bench/overhead.py` compares the two.
 //!
 //! The default sweep (300 viscosities with thresholds and Fig. 2) is timed by the command itself, which
-//! prints its wall time split into sweep and thresholds: `cargo run --release -- sweep`.
+//! prints its wall time split into sweep and thresholds: `cargo run --release -- sweep`. So is the default map
+//! (41 x 41 gaits, curves, heat maps), split into gaits and curves: `cargo run --release -- map`; a 100 x 100
+//! map: `cargo run --release -- map --nx 100 --ny 100`.
 
 use std::hint::black_box;
 use std::time::Duration;

@@ -2,11 +2,13 @@
 
 mod attractors;
 mod figures;
+mod map;
 
 pub use attractors::{
     default_basin_range, run_basin, run_orbit, BasinJob, BasinSummary, OrbitJob, OrbitSummary,
 };
 pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+pub use map::{run_map, MapJob, MapSummary};
 
 use std::collections::{BTreeMap, VecDeque};
 use std::path::PathBuf;

@@ -11,15 +11,16 @@ use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use vrw::app::{
-    run_animate, run_basin, run_gait, run_orbit, run_plot, run_simulate, run_still, run_sweep,
-    AnimateJob, BasinJob, GaitJob, OrbitJob, SimulateEvent, SimulateJob, SweepJob,
-    DEFAULT_SAMPLE_DT,
+    run_animate, run_basin, run_gait, run_map, run_orbit, run_plot, run_simulate, run_still,
+    run_sweep, AnimateJob, BasinJob, GaitJob, MapJob, OrbitJob, SimulateEvent, SimulateJob,
+    SweepJob, DEFAULT_SAMPLE_DT,
 };
 use vrw::gait::basin::Coordinate;
 use vrw::gait::orbit::OrbitSpec;
 use vrw::gait::GaitOptions;
-use vrw::gait::SweepSpec;
+use vrw::gait::{MapSpec, SweepSpec};
 use vrw::output::animate::AnimateOptions;
+use vrw::output::map_plot::MapMark;
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
@@ -45,6 +46,8 @@ enum Command {
     Orbit(OrbitArgs),
     /// Basin of the gait on a slice of the Poincare section: what the walk from every grid point does.
     Basin(BasinArgs),
+    /// Map the gait over two parameters: map.csv, the threshold curves (curves.json) and heat maps (map.png).
+    Map(MapArgs),
     /// Animate a run: DIR/walk.gif from the output directory of `simulate` or `gait`.
     Animate(AnimateArgs),
     /// Figures of a run: DIR/run.{png,svg} against time, DIR/steps.{png,svg} against step number.
@@ -141,6 +144,76 @@ struct SweepArgs {
     /// Output directory for sweep.csv, thresholds.json, fig2.svg and fig2.png.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
+}
+
+#[derive(Debug, Args)]
+struct MapArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter along the horizontal axis (rows), one of the keys `sweep --help` lists.
+    #[arg(long, default_value = "viscosity")]
+    x: String,
+    /// First x value.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    x_from: f64,
+    /// Last x value.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    x_to: f64,
+    /// Number of x values (ends included).
+    #[arg(long, default_value_t = 41)]
+    nx: usize,
+    /// The parameter along the vertical axis (columns).
+    #[arg(long, default_value = "stiffness")]
+    y: String,
+    /// First y value.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    y_from: f64,
+    /// Last y value.
+    #[arg(long, default_value_t = 1500.0, allow_hyphen_values = true)]
+    y_to: f64,
+    /// Number of y values (ends included).
+    #[arg(long, default_value_t = 41)]
+    ny: usize,
+    /// Where the search at the first point of every row starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Mark a point on the heat maps, `X,Y` or `X,Y,LABEL` (repeatable), e.g. `--mark "220,500,paper λ4+ = 0"`.
+    #[arg(long, value_name = "X,Y[,LABEL]", allow_hyphen_values = true)]
+    mark: Vec<MarkArg>,
+    /// Skip the threshold curves (map.csv and the heat maps only).
+    #[arg(long)]
+    no_curves: bool,
+    /// Output directory for map.csv, curves.json, map.svg and map.png.
+    #[arg(long, default_value = "out/map")]
+    out: PathBuf,
+}
+
+/// `--mark X,Y[,LABEL]`.
+#[derive(Debug, Clone)]
+struct MarkArg(MapMark);
+
+impl std::str::FromStr for MarkArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        let mut parts = s.splitn(3, ',');
+        let mut number = |what: &str| -> std::result::Result<f64, String> {
+            let text = parts.next().unwrap_or("").trim();
+            match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(format!(
+                    "{what} of `{s}` is `{text}`, not a finite number (expected X,Y or X,Y,LABEL)"
+                )),
+            }
+        };
+        let (x, y) = (number("X")?, number("Y")?);
+        let label = parts
+            .next()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .map_or_else(|| format!("({x}, {y})"), str::to_string);
+        Ok(MarkArg(MapMark { label, x, y }))
+    }
 }
 
 /// Help of `sweep --param`: the keys that can be swept, from [`Config::numeric_keys`].
@@ -381,6 +454,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Sweep(args) => sweep(args),
         Command::Orbit(args) => orbit(args),
         Command::Basin(args) => basin(args),
+        Command::Map(args) => map(args),
         Command::Animate(args) => animate(args),
         Command::Plot(args) => plot(&args),
     }
@@ -692,6 +766,86 @@ fn sweep(args: SweepArgs) -> Result<()> {
     );
     if summary.gaits_found == 0 {
         bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");
+    }
+    Ok(())
+}
+
+fn map(args: MapArgs) -> Result<()> {
+    let job = MapJob {
+        config: args.model.load()?,
+        spec: MapSpec {
+            x: SweepSpec {
+                param: args.x.clone(),
+                from: args.x_from,
+                to: args.x_to,
+                points: args.nx,
+            },
+            y: SweepSpec {
+                param: args.y.clone(),
+                from: args.y_from,
+                to: args.y_to,
+                points: args.ny,
+            },
+        },
+        initial: args.initial,
+        // The refined Jacobian gives each gait's stability verdict its error estimate.
+        options: GaitOptions::default(),
+        curves: !args.no_curves,
+        marks: args.mark.into_iter().map(|m| m.0).collect(),
+        out_dir: args.out.clone(),
+    };
+    let total = args.nx.saturating_mul(args.ny);
+    let bar = progress_bar(
+        Some(total as u64),
+        "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_map(&job, &|_| bar.inc(1)).context("map")?;
+    bar.finish_and_clear();
+    println!(
+        "vrw map: {} from {} to {} ({}) x {} from {} to {} ({}): gait found at {} of {} points; {:.2} s \
+         (gaits {:.2} s, curves {:.2} s)",
+        args.x,
+        args.x_from,
+        args.x_to,
+        args.nx,
+        args.y,
+        args.y_from,
+        args.y_to,
+        args.ny,
+        summary.gaits_found,
+        summary.points,
+        started.elapsed().as_secs_f64(),
+        summary.seconds[0],
+        summary.seconds[1]
+    );
+    let unrefined = summary
+        .thresholds
+        .iter()
+        .filter(|t| !t.threshold.value.is_finite())
+        .count();
+    let mut names: Vec<&str> = summary.curves.iter().map(|c| c.name.as_str()).collect();
+    names.dedup();
+    for name in names {
+        let own: Vec<_> = summary.curves.iter().filter(|c| c.name == name).collect();
+        println!(
+            "  {:<18} {} polyline(s), {} refined points",
+            name,
+            own.len(),
+            own.iter().map(|c| c.points.len()).sum::<usize>()
+        );
+    }
+    if unrefined > 0 {
+        println!(
+            "  {unrefined} crossings could not be refined (listed in curves.json with the reason)"
+        );
+    }
+    println!(
+        "wrote {}/{{map.csv, curves.json, map.svg, map.png}}",
+        args.out.display()
+    );
+    if summary.gaits_found == 0 {
+        bail!("no gait found anywhere on the map (see map.csv for the reasons)");
     }
     Ok(())
 }

@@ -744,3 +744,71 @@ fn orbit_and_basin_refuse_bad_options() {
         assert!(run.stderr().contains(needle), "{}", run.stderr());
     }
 }
+
+/// `vrw map` on a small grid across the lower end of existence in stiffness writes the table, the curves and
+/// the figure; the curves pass through refined points and say which line each was refined on.
+#[test]
+fn map_writes_table_curves_and_figure() {
+    let args = [
+        "--x-from",
+        "30",
+        "--x-to",
+        "70",
+        "--nx",
+        "3",
+        "--y-from",
+        "440",
+        "--y-to",
+        "560",
+        "--ny",
+        "3",
+        "--mark",
+        "50,500,a point",
+    ];
+    let run = command_in(temp_dir_with(&[]), "map", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let table = run.read("map.csv");
+    assert!(
+        table.starts_with("viscosity,stiffness,status,branch,"),
+        "{table}"
+    );
+    assert!(table.contains("max_floquet") && table.contains("stability"));
+    assert_eq!(data_rows(&table), 9);
+    let curves: Value = serde_json::from_str(&run.read("curves.json")).unwrap();
+    let list = curves["curves"].as_array().unwrap();
+    let end = list
+        .iter()
+        .find(|c| c["name"] == "existence_end")
+        .expect("the end of existence crosses the map");
+    let points = end["points"].as_array().unwrap();
+    assert_eq!(points.len(), end["refined_on"].as_array().unwrap().len());
+    assert!(points
+        .iter()
+        .all(|p| p[1].as_f64().unwrap() > 440.0 && p[1].as_f64().unwrap() < 560.0));
+    let png = fs::read(run.out.join("map.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(run.read("map.svg").contains("<svg"));
+}
+
+/// Bad map specifications are refused with an error naming the problem, before anything is computed.
+#[test]
+fn map_rejects_bad_input() {
+    for (args, needles) in [
+        (vec!["--x", "colour"], vec!["colour"]),
+        (vec!["--y", "viscosity"], vec!["different parameters"]),
+        (vec!["--nx", "1"], vec!["between 2 and"]),
+        (vec!["--y-from=-5", "--ny", "2"], vec!["stiffness", "-5"]),
+    ] {
+        let run = command_in(temp_dir_with(&[]), "map", &args);
+        assert_error(&run, &needles);
+        assert!(!run.out.join("map.csv").exists(), "{args:?}");
+    }
+    // A malformed --mark is a usage error (clap's exit code 2) naming the value.
+    let run = command_in(temp_dir_with(&[]), "map", &["--mark", "1,x"]);
+    assert_eq!(run.code(), Some(2), "{}", run.stderr());
+    assert!(
+        run.stderr().contains("not a finite number"),
+        "{}",
+        run.stderr()
+    );
+}

@@ -40,6 +40,11 @@ pub const SETTLE_STEPS: usize = 200;
 
 /// A walk has settled when two successive section states differ by less than this.
 pub const SETTLE_TOL: f64 = 1e-11;
+/// Most continuation steps (verified or failed) one [`Continuation::follow`] may try. Following a family to a
+/// neighbouring value, or to its end bracketed to [`PARAM_TOL`], takes a few dozen; a family that only advances
+/// in ever tinier steps (it winds through a region where Newton's method barely converges) is given up rather
+/// than followed for hours.
+pub const MAX_FOLLOW_STEPS: usize = 60;
 
 /// A real Floquet multiplier this close to +1 at the last gait of a family marks a fold.
 pub const FOLD_TOL: f64 = 0.05;
@@ -83,6 +88,13 @@ pub enum Followed {
         last: FamilyPoint,
         /// The first value it does not reach.
         beyond: f64,
+    },
+    /// Neither within [`MAX_FOLLOW_STEPS`] steps: the family was followed to `last` and given up there.
+    GaveUp {
+        /// The last point of the family reached.
+        last: FamilyPoint,
+        /// The value being followed to.
+        target: f64,
     },
 }
 
@@ -201,9 +213,11 @@ impl<'a> Continuation<'a> {
     /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's
     /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step that fails is retried once
     /// with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere), then halved; a
-    /// step that works lets the next one double.
+    /// step that works lets the next one double. At most [`MAX_FOLLOW_STEPS`] steps are tried
+    /// ([`Followed::GaveUp`]).
     pub fn follow(&self, from: FamilyPoint, target: f64, guess: Option<&DMatrix<f64>>) -> Followed {
         let mut current = from;
+        let mut steps = 0;
         // The Newton matrix and the parameter value where it was computed.
         let mut jac: Option<(f64, DMatrix<f64>)> = guess.map(|j| (from.value, j.clone()));
         let mut h = target - current.value;
@@ -213,6 +227,13 @@ impl<'a> Continuation<'a> {
             if remaining == 0.0 {
                 return Followed::Reached(current);
             }
+            if steps == MAX_FOLLOW_STEPS {
+                return Followed::GaveUp {
+                    last: current,
+                    target,
+                };
+            }
+            steps += 1;
             let next_value = if h.abs() >= remaining.abs() {
                 target
             } else {

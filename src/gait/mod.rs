@@ -1,10 +1,12 @@
 //! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, the grid runner
-//! ([`grid`]) behind parameter sweeps with continuation, and the parameter values where the DLS indicators change sign or the gait is lost.
+//! ([`grid`]) behind parameter sweeps and maps with continuation, and the parameter values where the DLS
+//! indicators change sign or the gait is lost.
 
 pub mod basin;
 pub mod continuation;
 pub mod grid;
 pub mod limit_cycle;
+pub mod map;
 pub mod orbit;
 pub mod period_k;
 pub mod step_map;
@@ -14,6 +16,7 @@ pub mod thresholds;
 pub use limit_cycle::{
     find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
 };
+pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
 pub use sweep::{gait_rows, sweep, sweep_values, GaitRow, SweepPoint, SweepSpec};

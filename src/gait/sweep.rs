@@ -164,7 +164,7 @@ pub fn gait_at_value(
                     .ok()
                     .map(|g| (index, g))
             }
-            Followed::Ended { .. } => None,
+            Followed::Ended { .. } | Followed::GaveUp { .. } => None,
         }
     });
     let (continued_from, result) = match continued {
@@ -243,7 +243,12 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
 
 /// Number the gait families: a point continued from another shares its family; a point found from the initial
 /// state starts a new one, unless a verified continuation step connects it to its left neighbour's gait.
-fn number_families(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
+pub(crate) fn number_families(
+    config: &Config,
+    param: &str,
+    points: &mut [SweepPoint],
+    options: &GaitOptions,
+) {
     let cont = Continuation::new(config, param, options);
     // Roots of the continuation forest: a gait found from the initial state is its own root.
     let root_of = |i: usize| {
@@ -308,8 +313,9 @@ pub struct GaitRow {
 
 /// The gaits along every row, each row continued with the sweep's rules (see the module documentation):
 /// continuation from the left neighbour on the [`super::grid`] runner's schedule, a search from `initial` where
-/// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in parallel, and the
-/// results are bitwise identical for any number of threads. `progress` is called after every point.
+/// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in
+/// parallel, and the results are bitwise identical for any number of threads. `progress` is called after every
+/// point. A row's values that leave the valid domain give points with the status `invalid_parameter`.
 pub fn gait_rows(
     rows: &[GaitRow],
     initial: &SectionState,

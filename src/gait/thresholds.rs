@@ -187,6 +187,24 @@ fn refine_end(
     let grid_bracket = sorted([from.value, toward.value]);
     let (last, beyond) = match cont.follow(start, toward.value, guess.as_ref()) {
         Followed::Ended { last, beyond } => (last, beyond),
+        Followed::GaveUp { last, .. } => {
+            return Some(Threshold {
+                name: "unconfirmed".to_string(),
+                value: f64::NAN,
+                bracket: grid_bracket,
+                grid_bracket,
+                residual: f64::NAN,
+                detail: Some(format!(
+                    "the family of {p} = {} was followed only to {p} = {} toward {p} = {} (given up after {} \
+                     continuation steps)",
+                    from.value,
+                    last.value,
+                    toward.value,
+                    super::continuation::MAX_FOLLOW_STEPS,
+                    p = spec.param,
+                )),
+            })
+        }
         Followed::Reached(p) => {
             let same = toward.gait.as_ref().is_some_and(|gt| {
                 super::continuation::section_distance(&gt.section, &p.section)

@@ -6,6 +6,7 @@
 pub mod animate;
 pub mod basin_plot;
 pub mod chart;
+pub mod map_plot;
 pub mod orbit_plot;
 pub mod plot;
 pub mod read;
@@ -491,6 +492,63 @@ pub fn sweep_row(p: &SweepPoint) -> Vec<Cell> {
 /// Write `sweep.csv`: one row per sweep point (see [`sweep_row`]).
 pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
     write_table(path, &sweep_header(param), points.iter().map(sweep_row))
+}
+
+/// Columns of `map.csv` after the two parameter columns.
+pub const MAP_COLUMNS: [&str; 12] = [
+    "status",
+    "branch",
+    "family",
+    "lambda_I4",
+    "lambda_2_plus",
+    "lambda_4_plus",
+    "period",
+    "speed",
+    "max_floquet",
+    "stability",
+    "scuffing",
+    "message",
+];
+
+/// Write `map.csv`: one row per map point, row by row (`y` outer, `x` inner): both parameter values, the status
+/// (the stability verdict, or why no gait was found), the impact branch, the gait family (numbered within the
+/// row), the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
+/// verdict; empty gait fields where no gait was found.
+pub fn write_map_csv(path: &Path, map: &crate::gait::GaitMap) -> Result<(), OutputError> {
+    let mut w = csv_writer(path)?;
+    let header: Vec<&str> = [map.spec.x.param.as_str(), map.spec.y.param.as_str()]
+        .into_iter()
+        .chain(MAP_COLUMNS)
+        .collect();
+    write_record(&mut w, path, &header)?;
+    for (row, &y) in map.rows.iter().zip(&map.ys) {
+        for p in row {
+            let mut record = vec![num(p.value), num(y), p.status.clone()];
+            match &p.gait {
+                Some(g) => {
+                    record.push(g.branch.to_string());
+                    record.push(p.family.map_or_else(String::new, |f| f.to_string()));
+                    record.extend(
+                        [
+                            g.lambda_i4,
+                            g.lambda_2_plus,
+                            g.lambda_4_plus,
+                            g.period,
+                            g.speed,
+                            g.max_floquet,
+                        ]
+                        .map(num),
+                    );
+                    record.push(g.stability.to_string());
+                    record.push(g.scuffing.to_string());
+                }
+                None => record.extend(std::iter::repeat_n(String::new(), MAP_COLUMNS.len() - 2)),
+            }
+            record.push(p.message.clone().unwrap_or_default());
+            write_record(&mut w, path, &record)?;
+        }
+    }
+    finish_csv(w, path)
 }
 
 #[cfg(test)]

@@ -1,0 +1,145 @@
+//! The job of `vrw map`: the gait over a grid of two parameters, the threshold curves across it, `map.csv`,
+//! `curves.json` and the heat maps.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::dynamics::Model;
+use crate::gait::map::{LineThreshold, ThresholdCurve};
+use crate::gait::{map_curves, map_gaits, GaitMap, GaitOptions, MapSpec, SweepPoint};
+use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
+use crate::output::{self, write_map_csv};
+use crate::params::Config;
+use crate::walk::SectionState;
+
+use super::{axis_label, default_initial, short_name, AppError};
+
+/// What `vrw map` runs.
+#[derive(Debug, Clone)]
+pub struct MapJob {
+    /// Parameters and solver options (the two mapped keys are overridden point by point).
+    pub config: Config,
+    /// The two parameters and their ranges.
+    pub spec: MapSpec,
+    /// Where the search at the first point of every row starts (`None`: [`default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Search settings.
+    pub options: GaitOptions,
+    /// Trace the threshold curves (`curves.json`, lines on the heat maps).
+    pub curves: bool,
+    /// Points to mark on the heat maps (e.g. the paper's thresholds).
+    pub marks: Vec<MapMark>,
+    /// Where `map.csv`, `curves.json`, `map.svg` and `map.png` go.
+    pub out_dir: PathBuf,
+}
+
+/// `curves.json`: the map's parameters, its curves and the 1-D thresholds they pass through.
+#[derive(Debug, Clone, Serialize)]
+pub struct MapSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options (the mapped keys at their configured values).
+    pub config: Config,
+    /// The two axes.
+    pub spec: MapSpec,
+    /// Points with a gait / all points.
+    pub gaits_found: usize,
+    /// Number of map points.
+    pub points: usize,
+    /// The threshold curves (empty when they were not traced).
+    pub curves: Vec<ThresholdCurve>,
+    /// Every 1-D threshold of the rows (`along = "x"`) and columns (`along = "y"`).
+    pub thresholds: Vec<LineThreshold>,
+    /// Wall-clock seconds spent on the gaits and on the curves (printed, not written: files are
+    /// reproducible).
+    #[serde(skip)]
+    pub seconds: [f64; 2],
+}
+
+/// Run `vrw map`: the gaits (written to `map.csv` at once), the curves (`curves.json`) and the heat maps
+/// (`map.svg`, `map.png`). `progress` is called after every map point.
+pub fn run_map(
+    job: &MapJob,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<MapSummary, AppError> {
+    job.config.validate()?;
+    job.spec.validate(&job.config)?;
+    let model = Model::new(&job.config.params)?;
+    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
+    initial.validate(&model)?;
+    for m in &job.marks {
+        if !(m.x.is_finite() && m.y.is_finite()) {
+            return Err(AppError::InvalidOption {
+                option: "--mark",
+                reason: format!("{} is not a point of two finite numbers", m.label),
+            });
+        }
+    }
+    output::ensure_dir(&job.out_dir)?;
+    let clock = std::time::Instant::now();
+    let map = map_gaits(&job.config, &job.spec, &initial, &job.options, progress)?;
+    let gait_seconds = clock.elapsed().as_secs_f64();
+    write_map_csv(&job.out_dir.join("map.csv"), &map)?;
+    let clock = std::time::Instant::now();
+    let (curves, thresholds) = if job.curves {
+        let c = map_curves(&job.config, &map, &job.options);
+        (c.curves, c.thresholds)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let curve_seconds = clock.elapsed().as_secs_f64();
+    let summary = MapSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec: job.spec.clone(),
+        gaits_found: map
+            .rows
+            .iter()
+            .flatten()
+            .filter(|p| p.gait.is_some())
+            .count(),
+        points: map.xs.len() * map.ys.len(),
+        curves,
+        thresholds,
+        seconds: [gait_seconds, curve_seconds],
+    };
+    output::write_json(&job.out_dir.join("curves.json"), &summary)?;
+    write_figure(job, &map, &summary.curves)?;
+    Ok(summary)
+}
+
+fn write_figure(job: &MapJob, map: &GaitMap, curves: &[ThresholdCurve]) -> Result<(), AppError> {
+    let p = &job.config.params;
+    let preload = p.stiffness * (p.spring_natural_length - p.stopper_length);
+    let fixed = |key: &str| key == job.spec.x.param || key == job.spec.y.param;
+    let mut context = vec![format!("slope φ = {} rad", p.slope)];
+    if !fixed("stiffness") && !fixed("spring_natural_length") && !fixed("stopper_length") {
+        context.push(format!("preload {} N", crate::error::short(preload)));
+    } else if !fixed("spring_natural_length") && !fixed("stopper_length") {
+        context.push(format!(
+            "L* − L0 = {} m",
+            crate::error::short(p.spring_natural_length - p.stopper_length)
+        ));
+    }
+    context.push(format!("impact {}", p.impact));
+    let title = format!(
+        "Gaits over ({}, {}), {}",
+        short_name(&job.spec.x.param),
+        short_name(&job.spec.y.param),
+        context.join(", ")
+    );
+    let figure = MapFigure {
+        map,
+        curves,
+        marks: &job.marks,
+        x_label: axis_label(&job.spec.x.param),
+        y_label: axis_label(&job.spec.y.param),
+        title,
+    };
+    Ok(write_map_figure(
+        &figure,
+        &job.out_dir.join("map.svg"),
+        &job.out_dir.join("map.png"),
+    )?)
+}

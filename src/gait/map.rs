@@ -1,0 +1,510 @@
+//! Maps over two parameters: the gait at every point of an `x` by `y` grid, and the threshold curves across
+//! the plane (docs/model.md section 6).
+//!
+//! **Gaits.** Every row (fixed `y`) is a sweep along `x` with the sweep's rules ([`super::sweep::gait_rows`] on
+//! the [`super::grid`] runner): continuation from the left neighbour, a search from the initial state where the
+//! family ends, backward fill and family numbers. Rows run in parallel and the map is bitwise identical for any
+//! number of threads. So row `j` of a map is exactly the sweep along `x` at `y_j`.
+//!
+//! **Curves.** The threshold curves (`lambda_4+ = 0`, `lambda_2+ = 0`, `lambda_I4 = 0`, loss of stability, the
+//! end of existence, branch switches, folds) are never read off the grid. Every row is searched for the 1-D
+//! thresholds of [`find_thresholds`] (refined to [`super::thresholds::PARAM_TOL`] in `x`), and so is every column (fixed `x`, refined
+//! to [`super::thresholds::PARAM_TOL`] in `y`; the column's gaits are those of the rows, and neighbours along the column belong to
+//! one family when a verified continuation step in `y` connects them). Each crossing lies on one edge of the
+//! grid. Within each grid cell, the crossings of one curve on its edges are joined (two crossings: one segment,
+//! as in marching squares; more: the closest pairs first), and the segments are chained into
+//! polylines. A polyline's points are all refined crossings; only the straight pieces between them are drawn.
+//!
+//! The curve of the end of existence joins `gait_lost` and `gait_found` crossings (which of the two a crossing
+//! is depends only on the direction of the line it was refined on).
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::limit_cycle::GaitOptions;
+use super::sweep::{gait_rows, number_families, GaitRow, SweepPoint, SweepSpec};
+use super::thresholds::{find_thresholds, Threshold};
+use crate::error::short;
+use crate::params::{Config, ConfigError};
+use crate::walk::SectionState;
+
+/// The most values along one axis of a map.
+pub const MAX_MAP_AXIS_POINTS: usize = 2000;
+
+/// What to map: two parameters and their ranges.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MapSpec {
+    /// The parameter along rows (horizontal axis) and its values.
+    pub x: SweepSpec,
+    /// The parameter along columns (vertical axis) and its values.
+    pub y: SweepSpec,
+}
+
+impl MapSpec {
+    /// Check the specification: each axis as a sweep ([`SweepSpec::validate`]), two different parameters, at
+    /// most [`MAX_MAP_AXIS_POINTS`] values per axis, and a valid configuration at the four corners (the rules
+    /// that join two keys are linear inequalities, so the whole rectangle is then valid).
+    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+        self.x.validate(config)?;
+        self.y.validate(config)?;
+        let invalid = |key: &str, value: String, reason: String| ConfigError::InvalidValue {
+            key: key.to_string(),
+            value,
+            reason,
+        };
+        if self.x.param == self.y.param {
+            return Err(invalid(
+                "map",
+                format!("--x {} --y {}", self.x.param, self.y.param),
+                "the two axes must be different parameters".to_string(),
+            ));
+        }
+        for axis in [&self.x, &self.y] {
+            if axis.points > MAX_MAP_AXIS_POINTS {
+                return Err(invalid(
+                    &format!("map {}", axis.param),
+                    axis.points.to_string(),
+                    format!("at most {MAX_MAP_AXIS_POINTS} values per axis"),
+                ));
+            }
+        }
+        for x in [self.x.from, self.x.to] {
+            for y in [self.y.from, self.y.to] {
+                let mut corner = config.clone();
+                corner.set_numeric(&self.x.param, x)?;
+                corner.set_numeric(&self.y.param, y)?;
+                if let Err(e) = corner.validate() {
+                    return Err(invalid(
+                        "map",
+                        format!(
+                            "{} = {}, {} = {}",
+                            self.x.param,
+                            short(x),
+                            self.y.param,
+                            short(y)
+                        ),
+                        format!("a corner of the map leaves the valid domain: {e}"),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The configuration with the `y` parameter at `y` (a row's configuration).
+    fn with_y(&self, config: &Config, y: f64) -> Config {
+        let mut c = config.clone();
+        // Validated: the key exists.
+        let _ = c.set_numeric(&self.y.param, y);
+        c
+    }
+
+    /// The configuration with the `x` parameter at `x` (a column's configuration).
+    fn with_x(&self, config: &Config, x: f64) -> Config {
+        let mut c = config.clone();
+        let _ = c.set_numeric(&self.x.param, x);
+        c
+    }
+}
+
+/// The gaits of a map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaitMap {
+    /// What was mapped.
+    pub spec: MapSpec,
+    /// The `x` values (columns).
+    pub xs: Vec<f64>,
+    /// The `y` values (rows).
+    pub ys: Vec<f64>,
+    /// `rows[j][i]` is the point at `(xs[i], ys[j])`; its `value` is `xs[i]`, its family is numbered within
+    /// row `j`.
+    pub rows: Vec<Vec<SweepPoint>>,
+}
+
+/// The gait at every point of the map, rows continued along `x` with the sweep's rules, rows in parallel
+/// (see the module documentation). `progress` is called after every point.
+pub fn map_gaits(
+    config: &Config,
+    spec: &MapSpec,
+    initial: &SectionState,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<GaitMap, ConfigError> {
+    spec.validate(config)?;
+    let xs = spec.x.values();
+    let ys = spec.y.values();
+    let rows: Vec<GaitRow> = ys
+        .iter()
+        .map(|&y| GaitRow {
+            config: spec.with_y(config, y),
+            param: spec.x.param.clone(),
+            values: xs.clone(),
+        })
+        .collect();
+    let rows = gait_rows(&rows, initial, options, progress);
+    Ok(GaitMap {
+        spec: spec.clone(),
+        xs,
+        ys,
+        rows,
+    })
+}
+
+/// Which grid line a crossing was refined on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Along {
+    /// A row: `y` fixed at `ys[line]`, refined in `x`.
+    X,
+    /// A column: `x` fixed at `xs[line]`, refined in `y`.
+    Y,
+}
+
+/// Where a curve point comes from: the 1-D threshold it is.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RefinedOn {
+    /// The direction it was refined in.
+    pub along: Along,
+    /// The row (for [`Along::X`]) or column (for [`Along::Y`]) index.
+    pub line: usize,
+    /// The 1-D threshold's name (`gait_lost`, `lambda_4_plus = 0`, ...).
+    pub threshold: String,
+}
+
+/// A threshold curve across the map: a polyline through refined crossings.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThresholdCurve {
+    /// `lambda_4_plus = 0`, `lambda_2_plus = 0`, `lambda_I4 = 0`, `stability_lost`, `existence_end`
+    /// (`gait_lost` and `gait_found`), `branch_switch`, `fold` or `unconfirmed`.
+    pub name: String,
+    /// The points `[x, y]`, in order along the curve.
+    pub points: Vec<[f64; 2]>,
+    /// For each point, the line it was refined on.
+    pub refined_on: Vec<RefinedOn>,
+    /// The curve is closed (its last point joins its first).
+    pub closed: bool,
+}
+
+/// A 1-D threshold of a row or a column.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LineThreshold {
+    /// The line.
+    pub along: Along,
+    /// Its index.
+    pub line: usize,
+    /// The threshold, in the line's parameter.
+    pub threshold: Threshold,
+}
+
+/// The curves of a map, and the 1-D thresholds they come from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MapCurves {
+    /// The curves.
+    pub curves: Vec<ThresholdCurve>,
+    /// Every 1-D threshold of the rows and columns, including those that could not be refined (`value` NaN,
+    /// with the reason in `detail`), which are in no curve.
+    pub thresholds: Vec<LineThreshold>,
+}
+
+/// The curve a 1-D threshold belongs to.
+pub fn curve_name(threshold: &str) -> &str {
+    match threshold {
+        "gait_lost" | "gait_found" => "existence_end",
+        other => other,
+    }
+}
+
+/// The 1-D thresholds of every row and column of `map`, and the curves through them (see the module
+/// documentation).
+pub fn map_curves(config: &Config, map: &GaitMap, options: &GaitOptions) -> MapCurves {
+    let spec = &map.spec;
+    let row_spec = SweepSpec {
+        points: map.xs.len(),
+        ..spec.x.clone()
+    };
+    let col_spec = SweepSpec {
+        points: map.ys.len(),
+        ..spec.y.clone()
+    };
+    let rows: Vec<Vec<LineThreshold>> = map
+        .rows
+        .par_iter()
+        .enumerate()
+        .map(|(j, points)| {
+            let c = spec.with_y(config, map.ys[j]);
+            line_thresholds(Along::X, j, find_thresholds(&c, &row_spec, points, options))
+        })
+        .collect();
+    let cols: Vec<Vec<LineThreshold>> = (0..map.xs.len())
+        .into_par_iter()
+        .map(|i| {
+            let c = spec.with_x(config, map.xs[i]);
+            let mut points: Vec<SweepPoint> = map
+                .rows
+                .iter()
+                .zip(&map.ys)
+                .map(|(row, &y)| SweepPoint {
+                    value: y,
+                    continued_from: None,
+                    family: None,
+                    ..row[i].clone()
+                })
+                .collect();
+            number_families(&c, &spec.y.param, &mut points, options);
+            line_thresholds(
+                Along::Y,
+                i,
+                find_thresholds(&c, &col_spec, &points, options),
+            )
+        })
+        .collect();
+    let thresholds: Vec<LineThreshold> = rows.into_iter().chain(cols).flatten().collect();
+    let curves = connect(&map.xs, &map.ys, &thresholds);
+    MapCurves { curves, thresholds }
+}
+
+fn line_thresholds(along: Along, line: usize, thresholds: Vec<Threshold>) -> Vec<LineThreshold> {
+    let mut thresholds: Vec<LineThreshold> = thresholds
+        .into_iter()
+        .map(|threshold| LineThreshold {
+            along,
+            line,
+            threshold,
+        })
+        .collect();
+    thresholds.sort_by(|a, b| a.threshold.value.total_cmp(&b.threshold.value));
+    thresholds
+}
+
+/// A refined crossing on a grid edge.
+#[derive(Debug, Clone, Copy)]
+struct Crossing<'a> {
+    /// Index of the threshold it comes from.
+    index: usize,
+    /// The edge: the lower-left grid point `(i, j)` and the direction of the edge.
+    edge: (usize, usize, Along),
+    /// In grid units (`i + fraction`, `j + fraction`), for distances.
+    grid: [f64; 2],
+    point: [f64; 2],
+    name: &'a str,
+}
+
+/// Position of `v` in `values` (exact: the grid brackets are copies of the grid values).
+fn grid_index(values: &[f64], v: f64) -> Option<usize> {
+    values.iter().position(|&x| x == v)
+}
+
+/// Join the refined crossings into curves (see the module documentation).
+fn connect(xs: &[f64], ys: &[f64], thresholds: &[LineThreshold]) -> Vec<ThresholdCurve> {
+    let fraction = |values: &[f64], k: usize, v: f64| {
+        let step = values.get(k + 1).map_or(1.0, |next| next - values[k]);
+        k as f64 + (v - values[k]) / step
+    };
+    let crossings: Vec<Crossing> = thresholds
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| t.threshold.value.is_finite())
+        .filter_map(|(index, t)| {
+            let th = &t.threshold;
+            let lo = th.grid_bracket[0].min(th.grid_bracket[1]);
+            let name = curve_name(&th.name);
+            match t.along {
+                Along::X => {
+                    let i = grid_index(xs, lo)?;
+                    let (x, y) = (th.value, ys[t.line]);
+                    Some(Crossing {
+                        index,
+                        edge: (i, t.line, Along::X),
+                        grid: [fraction(xs, i, x), t.line as f64],
+                        point: [x, y],
+                        name,
+                    })
+                }
+                Along::Y => {
+                    let j = grid_index(ys, lo)?;
+                    let (x, y) = (xs[t.line], th.value);
+                    Some(Crossing {
+                        index,
+                        edge: (t.line, j, Along::Y),
+                        grid: [t.line as f64, fraction(ys, j, y)],
+                        point: [x, y],
+                        name,
+                    })
+                }
+            }
+        })
+        .collect();
+    let mut names: Vec<&str> = crossings.iter().map(|c| c.name).collect();
+    names.sort_unstable();
+    names.dedup();
+    let mut curves = Vec::new();
+    for name in names {
+        let own: Vec<&Crossing> = crossings.iter().filter(|c| c.name == name).collect();
+        for chain in chains(xs.len(), ys.len(), &own) {
+            let closed = chain.len() > 2 && chain.first() == chain.last();
+            let chain = if closed {
+                &chain[..chain.len() - 1]
+            } else {
+                &chain[..]
+            };
+            curves.push(ThresholdCurve {
+                name: name.to_string(),
+                points: chain.iter().map(|&k| own[k].point).collect(),
+                refined_on: chain
+                    .iter()
+                    .map(|&k| {
+                        let t = &thresholds[own[k].index];
+                        RefinedOn {
+                            along: t.along,
+                            line: t.line,
+                            threshold: t.threshold.name.clone(),
+                        }
+                    })
+                    .collect(),
+                closed,
+            });
+        }
+    }
+    curves
+}
+
+/// The crossings of one curve (indices into `own`) chained into polylines: segments within each grid cell,
+/// then chains through shared crossings. A closed chain repeats its first index at the end.
+fn chains(nx: usize, ny: usize, own: &[&Crossing]) -> Vec<Vec<usize>> {
+    let distance = |a: usize, b: usize| {
+        let (p, q) = (own[a].grid, own[b].grid);
+        (p[0] - q[0]).hypot(p[1] - q[1])
+    };
+    // Crossings by edge; an edge may carry more than one crossing of a curve only by a refinement oddity, and
+    // then each is kept.
+    let mut by_edge: std::collections::BTreeMap<(usize, usize, u8), Vec<usize>> =
+        std::collections::BTreeMap::new();
+    for (k, c) in own.iter().enumerate() {
+        let (i, j, along) = c.edge;
+        by_edge
+            .entry((i, j, u8::from(along == Along::Y)))
+            .or_default()
+            .push(k);
+    }
+    let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); own.len()];
+    for i in 0..nx.saturating_sub(1) {
+        for j in 0..ny.saturating_sub(1) {
+            // The cell's edges: bottom, top (rows j and j + 1), left, right (columns i and i + 1).
+            let mut here: Vec<usize> = [(i, j, 0), (i, j + 1, 0), (i, j, 1), (i + 1, j, 1)]
+                .iter()
+                .filter_map(|e| by_edge.get(e))
+                .flatten()
+                .copied()
+                .collect();
+            here.sort_unstable();
+            for (a, b) in pair_up(&here, &distance) {
+                neighbours[a].push(b);
+                neighbours[b].push(a);
+            }
+        }
+    }
+    let mut used = vec![false; own.len()];
+    let mut out = Vec::new();
+    let walk = |start: usize, used: &mut Vec<bool>| {
+        let mut chain = vec![start];
+        used[start] = true;
+        let mut current = start;
+        loop {
+            let next = neighbours[current].iter().copied().find(|&n| !used[n]);
+            match next {
+                Some(n) => {
+                    used[n] = true;
+                    chain.push(n);
+                    current = n;
+                }
+                None => {
+                    if chain.len() > 2 && neighbours[current].contains(&start) {
+                        chain.push(start);
+                    }
+                    return chain;
+                }
+            }
+        }
+    };
+    // Open chains start at their ends (a crossing with at most one neighbour), then what is left is closed.
+    for k in 0..own.len() {
+        if !used[k] && neighbours[k].len() <= 1 {
+            out.push(walk(k, &mut used));
+        }
+    }
+    for k in 0..own.len() {
+        if !used[k] {
+            out.push(walk(k, &mut used));
+        }
+    }
+    out
+}
+
+/// Pair the crossings of one cell: two make a segment; of more, the closest pairs are taken first
+/// (an odd one out is left as the end of a curve).
+fn pair_up(here: &[usize], distance: &dyn Fn(usize, usize) -> f64) -> Vec<(usize, usize)> {
+    match here.len() {
+        0 | 1 => Vec::new(),
+        2 => vec![(here[0], here[1])],
+        _ => {
+            // Greedy by distance: exact for four points in the usual saddle case, and deterministic.
+            let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+            for (ia, &a) in here.iter().enumerate() {
+                for &b in &here[ia + 1..] {
+                    pairs.push((distance(a, b), a, b));
+                }
+            }
+            pairs.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)).then(p.2.cmp(&q.2)));
+            let mut taken: Vec<usize> = Vec::new();
+            let mut out = Vec::new();
+            for (_, a, b) in pairs {
+                if !taken.contains(&a) && !taken.contains(&b) {
+                    taken.extend([a, b]);
+                    out.push((a, b));
+                }
+            }
+            out
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn crossing(index: usize, edge: (usize, usize, Along), grid: [f64; 2]) -> Crossing<'static> {
+        Crossing {
+            index,
+            edge,
+            grid,
+            point: grid,
+            name: "c",
+        }
+    }
+
+    /// A straight curve across three cells of one row of cells, and a closed loop around one grid point.
+    #[test]
+    fn crossings_chain_into_open_and_closed_curves() {
+        // The line y = 0.5 crosses the columns 0..3 (vertical edges of cells (0,0), (1,0), (2,0)).
+        let line: Vec<Crossing> = (0..4)
+            .map(|i| crossing(i, (i, 0, Along::Y), [i as f64, 0.5]))
+            .collect();
+        let refs: Vec<&Crossing> = line.iter().rev().collect();
+        let found = chains(4, 2, &refs);
+        assert_eq!(found.len(), 1);
+        let order: Vec<usize> = found[0].iter().map(|&k| refs[k].index).collect();
+        assert!(order == [0, 1, 2, 3] || order == [3, 2, 1, 0], "{order:?}");
+        // A small loop around the grid point (1, 1): four crossings on the four edges meeting there.
+        let ring = [
+            crossing(0, (0, 1, Along::X), [0.5, 1.0]),
+            crossing(1, (1, 0, Along::Y), [1.0, 0.5]),
+            crossing(2, (1, 1, Along::X), [1.5, 1.0]),
+            crossing(3, (1, 1, Along::Y), [1.0, 1.5]),
+        ];
+        let refs: Vec<&Crossing> = ring.iter().collect();
+        let found = chains(3, 3, &refs);
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert_eq!(found[0].len(), 5, "closed: {found:?}");
+        assert_eq!(found[0].first(), found[0].last());
+    }
+}

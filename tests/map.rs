@@ -1,0 +1,161 @@
+//! Maps over two parameters (docs/model.md section 6): rows are sweeps, curves are refined 1-D thresholds.
+
+use vrw::app::default_initial;
+use vrw::gait::map::Along;
+use vrw::gait::{find_thresholds, map_curves, map_gaits, sweep, GaitOptions, MapSpec, SweepSpec};
+use vrw::params::Config;
+
+/// Tolerance of every threshold in its parameter (the 1-D refinement's tolerance).
+const CURVE_TOL: f64 = 1e-6;
+
+/// A small map across the lower end of the gait's existence in stiffness (k near 480 N/m at c = 50).
+fn spec() -> MapSpec {
+    MapSpec {
+        x: SweepSpec {
+            param: "viscosity".into(),
+            from: 30.0,
+            to: 70.0,
+            points: 5,
+        },
+        y: SweepSpec {
+            param: "stiffness".into(),
+            from: 440.0,
+            to: 560.0,
+            points: 4,
+        },
+    }
+}
+
+fn options() -> GaitOptions {
+    GaitOptions {
+        refine_jacobian: false,
+        ..GaitOptions::default()
+    }
+}
+
+/// The points as JSON: shortest round-trip numbers, so equal text is equal bits (and NaN, e.g. an unrefined
+/// Jacobian's error, compares equal to itself as `null`).
+fn same_bits(points: &[vrw::gait::SweepPoint]) -> String {
+    serde_json::to_string(points).unwrap()
+}
+
+/// Row j of a map is the 1-D sweep along x at y_j, bit for bit, and the curve points refined on that row are
+/// the sweep's thresholds to the refinement tolerance; likewise a column against a sweep along y.
+#[test]
+fn map_rows_and_curves_agree_with_one_dimensional_sweeps() {
+    let config = Config::default();
+    let start = default_initial(&config);
+    let spec = spec();
+    let map = map_gaits(&config, &spec, &start, &options(), &|_| {}).unwrap();
+    let curves = map_curves(&config, &map, &options());
+    assert!(
+        curves.curves.iter().any(|c| c.name == "existence_end"),
+        "{:?}",
+        curves.curves
+    );
+    let mut checked = 0;
+    for (along, line) in [(Along::X, 1), (Along::X, 2), (Along::Y, 2)] {
+        let (line_config, line_spec) = match along {
+            Along::X => {
+                let mut c = config.clone();
+                c.set_numeric("stiffness", map.ys[line]).unwrap();
+                (c, spec.x.clone())
+            }
+            Along::Y => {
+                let mut c = config.clone();
+                c.set_numeric("viscosity", map.xs[line]).unwrap();
+                (c, spec.y.clone())
+            }
+        };
+        let points = sweep(&line_config, &line_spec, &start, &options(), &|_| {}).unwrap();
+        if along == Along::X {
+            assert_eq!(
+                same_bits(&points),
+                same_bits(&map.rows[line]),
+                "row {line} of the map is the sweep along x"
+            );
+        }
+        let mut expected: Vec<f64> = find_thresholds(&line_config, &line_spec, &points, &options())
+            .iter()
+            .map(|t| t.value)
+            .filter(|v| v.is_finite())
+            .collect();
+        expected.sort_by(f64::total_cmp);
+        let coordinate = usize::from(along == Along::Y);
+        let mut on_line: Vec<f64> = curves
+            .curves
+            .iter()
+            .flat_map(|c| c.points.iter().zip(&c.refined_on))
+            .filter(|(_, r)| r.along == along && r.line == line)
+            .map(|(p, _)| p[coordinate])
+            .collect();
+        on_line.sort_by(f64::total_cmp);
+        assert_eq!(
+            on_line.len(),
+            expected.len(),
+            "{along:?} {line}: {on_line:?} vs {expected:?}"
+        );
+        for (a, b) in on_line.iter().zip(&expected) {
+            assert!((a - b).abs() <= CURVE_TOL, "{along:?} {line}: {a} vs {b}");
+        }
+        checked += on_line.len();
+    }
+    assert!(checked > 0, "the lines checked cross a curve");
+}
+
+/// The map is the same for any number of threads.
+#[test]
+fn map_is_bitwise_identical_across_thread_counts() {
+    let config = Config::default();
+    let start = default_initial(&config);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| map_gaits(&config, &spec(), &start, &options(), &|_| {}).unwrap())
+    };
+    let (one, three) = (run(1), run(3));
+    for (a, b) in one.rows.iter().zip(&three.rows) {
+        assert_eq!(same_bits(a), same_bits(b));
+    }
+}
+
+#[test]
+fn map_rejects_bad_specifications() {
+    let config = Config::default();
+    let start = default_initial(&config);
+    let base = spec();
+    let mut same = base.clone();
+    same.y.param = "viscosity".into();
+    let mut unknown = base.clone();
+    unknown.x.param = "foo".into();
+    let mut one = base.clone();
+    one.y.points = 1;
+    let mut outside = base.clone();
+    outside.y.from = -10.0;
+    // A corner outside the domain although each axis alone is valid: L* < L0 at the corner.
+    let mut corner = base.clone();
+    corner.x = SweepSpec {
+        param: "stopper_length".into(),
+        from: 0.9,
+        to: 1.1,
+        points: 3,
+    };
+    corner.y = SweepSpec {
+        param: "spring_natural_length".into(),
+        from: 1.0,
+        to: 1.2,
+        points: 3,
+    };
+    for (what, s) in [
+        ("same", same),
+        ("unknown", unknown),
+        ("one", one),
+        ("outside", outside),
+        ("corner", corner),
+    ] {
+        let e = map_gaits(&config, &s, &start, &options(), &|_| {});
+        assert!(e.is_err(), "{what}");
+    }
+}
