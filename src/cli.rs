@@ -160,7 +160,7 @@ struct MapArgs {
     #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
     x_to: f64,
     /// Number of x values (ends included).
-    #[arg(long, default_value_t = 41)]
+    #[arg(long, default_value_t = 21)]
     nx: usize,
     /// The parameter along the vertical axis (columns).
     #[arg(long, default_value = "stiffness")]
@@ -172,7 +172,7 @@ struct MapArgs {
     #[arg(long, default_value_t = 1500.0, allow_hyphen_values = true)]
     y_to: f64,
     /// Number of y values (ends included).
-    #[arg(long, default_value_t = 41)]
+    #[arg(long, default_value_t = 21)]
     ny: usize,
     /// Where the search at the first point of every row starts, `L2,thetadot,L2dot`; default as for simulate.
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
