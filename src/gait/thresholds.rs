@@ -188,13 +188,9 @@ fn refine_end(
     let (last, beyond) = match cont.follow(start, toward.value, guess.as_ref()) {
         Followed::Ended { last, beyond } => (last, beyond),
         Followed::GaveUp { last, .. } => {
-            return Some(Threshold {
-                name: "unconfirmed".to_string(),
-                value: f64::NAN,
-                bracket: grid_bracket,
+            return Some(unconfirmed(
                 grid_bracket,
-                residual: f64::NAN,
-                detail: Some(format!(
+                format!(
                     "the family of {p} = {} was followed only to {p} = {} toward {p} = {} (given up after {} \
                      continuation steps)",
                     from.value,
@@ -202,8 +198,8 @@ fn refine_end(
                     toward.value,
                     super::continuation::MAX_FOLLOW_STEPS,
                     p = spec.param,
-                )),
-            })
+                ),
+            ))
         }
         Followed::Reached(p) => {
             let same = toward.gait.as_ref().is_some_and(|gt| {
@@ -218,17 +214,13 @@ fn refine_end(
             } else {
                 "the sweep found no gait there"
             };
-            return Some(Threshold {
-                name: "unconfirmed".to_string(),
-                value: f64::NAN,
-                bracket: grid_bracket,
+            return Some(unconfirmed(
                 grid_bracket,
-                residual: f64::NAN,
-                detail: Some(format!(
+                format!(
                     "the family of {} = {} reaches {} = {}, but {what}",
                     spec.param, from.value, spec.param, toward.value
-                )),
-            });
+                ),
+            ));
         }
     };
     let upward = toward.value > from.value;
@@ -287,6 +279,18 @@ fn refine_end(
         residual: f64::NAN,
         detail: Some(detail),
     })
+}
+
+/// A family end that could not be located, reported over its grid interval with the reason.
+fn unconfirmed(grid_bracket: [f64; 2], detail: String) -> Threshold {
+    Threshold {
+        name: "unconfirmed".to_string(),
+        value: f64::NAN,
+        bracket: grid_bracket,
+        grid_bracket,
+        residual: f64::NAN,
+        detail: Some(detail),
+    }
 }
 
 fn sorted(mut pair: [f64; 2]) -> [f64; 2] {
