@@ -495,10 +495,11 @@ pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Resul
 }
 
 /// Columns of `map.csv` after the two parameter columns.
-pub const MAP_COLUMNS: [&str; 12] = [
+pub const MAP_COLUMNS: [&str; 13] = [
     "status",
     "branch",
     "family",
+    "period_k",
     "lambda_I4",
     "lambda_2_plus",
     "lambda_4_plus",
@@ -512,7 +513,7 @@ pub const MAP_COLUMNS: [&str; 12] = [
 
 /// Write `map.csv`: one row per map point, row by row (`y` outer, `x` inner): both parameter values, the status
 /// (the stability verdict, or why no gait was found), the impact branch, the gait family (numbered within the
-/// row), the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
+/// row), `period_k`, the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
 /// verdict; empty gait fields where no gait was found.
 pub fn write_map_csv(path: &Path, map: &crate::gait::GaitMap) -> Result<(), OutputError> {
     let mut w = csv_writer(path)?;
@@ -528,6 +529,7 @@ pub fn write_map_csv(path: &Path, map: &crate::gait::GaitMap) -> Result<(), Outp
                 Some(g) => {
                     record.push(g.branch.to_string());
                     record.push(p.family.map_or_else(String::new, |f| f.to_string()));
+                    record.push(g.period_k.to_string());
                     record.extend(
                         [
                             g.lambda_i4,
