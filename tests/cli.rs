@@ -818,12 +818,20 @@ fn map_rejects_bad_input() {
 /// axis spans the whole range asked for.
 #[test]
 fn slope_sweep_figure_names_only_fixed_parameters_and_spans_the_range() {
-    let args = ["--param", "slope", "--from", "0.05", "--to", "0.12", "--points", "4"];
+    let args = [
+        "--param", "slope", "--from", "0.05", "--to", "0.12", "--points", "4",
+    ];
     let run = command_in(temp_dir_with(&[]), "sweep", &args);
     assert_eq!(run.code(), Some(0), "{}", run.stderr());
     let svg = run.read("fig2.svg");
-    assert!(svg.contains("Gaits along φ: c = 50 N s/m, k = 500 N/m"), "title");
-    assert!(!svg.contains("φ = 0.1 rad"), "the swept parameter's configured value is not in the title");
+    assert!(
+        svg.contains("Gaits along φ: c = 50 N s/m, k = 500 N/m"),
+        "title"
+    );
+    assert!(
+        !svg.contains("φ = 0.1 rad"),
+        "the swept parameter's configured value is not in the title"
+    );
     // No gait at 0.05 (the family begins near 0.0849): the axis still starts there, with the span shaded.
     let ticks: Vec<&str> = svg.lines().map(str::trim).collect();
     for tick in ["0.05", "0.06", "0.07", "0.08", "0.12"] {
