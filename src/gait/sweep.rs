@@ -149,23 +149,7 @@ pub fn gait_at_value(
     let solver: &SolverOptions = &c.solver;
     let map = StepMap::new(&model, solver);
     let continued = previous.and_then(|(index, from, g)| {
-        let guess = g.jacobian_guess();
-        let start = FamilyPoint {
-            value: from,
-            section: g.section,
-        };
-        match Continuation::new(config, param, options).follow(start, value, guess.as_ref()) {
-            Followed::Reached(p) => {
-                let opts = GaitOptions {
-                    transient_steps: 0,
-                    ..*options
-                };
-                find_gait(&map, &p.section, &opts, guess.as_ref())
-                    .ok()
-                    .map(|g| (index, g))
-            }
-            Followed::Ended { .. } | Followed::GaveUp { .. } => None,
-        }
+        follow_gait(config, param, from, g, value, options).map(|g| (index, g))
     });
     let (continued_from, result) = match continued {
         Some((index, g)) => (Some(index), Ok(g)),
@@ -194,6 +178,35 @@ pub fn gait_at_value(
     }
 }
 
+/// The gait at `value` of the family of `g`, the gait at `from`: the family followed in verified steps
+/// ([`Continuation::follow`]), then the full gait (with `DP`) where it lands; `None` if the family does not
+/// reach `value`.
+fn follow_gait(
+    config: &Config,
+    param: &str,
+    from: f64,
+    g: &Gait,
+    value: f64,
+    options: &GaitOptions,
+) -> Option<Gait> {
+    let guess = g.jacobian_guess();
+    let start = FamilyPoint {
+        value: from,
+        section: g.section,
+    };
+    let cont = Continuation::new(config, param, options);
+    let Followed::Reached(p) = cont.follow(start, value, guess.as_ref()) else {
+        return None;
+    };
+    let (c, model) = configured(config, param, value).ok()?;
+    let map = StepMap::new(&model, &c.solver);
+    let opts = GaitOptions {
+        transient_steps: 0,
+        ..*options
+    };
+    find_gait(&map, &p.section, &opts, guess.as_ref()).ok()
+}
+
 /// The point's gait if continuation can start from it: a period-1 gait (continuation follows fixed points of
 /// `P`; a period-k gait is searched afresh at every point).
 fn continuable(point: &SweepPoint) -> Option<&Gait> {
@@ -206,7 +219,6 @@ pub use super::grid::COARSE_STRIDE;
 /// initial state: follow each such gait backwards, from right to left, and fill in the points its family
 /// reaches. Sequential and in a fixed order, so deterministic.
 fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
-    let cont = Continuation::new(config, param, options);
     for i in (1..points.len()).rev() {
         let (left, right) = points.split_at_mut(i);
         let (a, b) = (&mut left[i - 1], &right[0]);
@@ -216,23 +228,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
         if a.status == "invalid_parameter" {
             continue;
         }
-        let guess = gb.jacobian_guess();
-        let start = FamilyPoint {
-            value: b.value,
-            section: gb.section,
-        };
-        let Followed::Reached(p) = cont.follow(start, a.value, guess.as_ref()) else {
-            continue;
-        };
-        let Ok((c, model)) = configured(config, param, a.value) else {
-            continue;
-        };
-        let map = StepMap::new(&model, &c.solver);
-        let opts = GaitOptions {
-            transient_steps: 0,
-            ..*options
-        };
-        if let Ok(g) = find_gait(&map, &p.section, &opts, guess.as_ref()) {
+        if let Some(g) = follow_gait(config, param, b.value, gb, a.value, options) {
             a.status = g.stability.to_string();
             a.message = None;
             a.gait = Some(g);

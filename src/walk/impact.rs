@@ -395,7 +395,6 @@ pub fn touchdown_impact(
     qd: &Coords,
     before: ActiveSet,
 ) -> Result<TouchdownImpact, ContactError> {
-    let kinetic = |v: &Coords| model.kinetic_energy(q, v);
     let finish = |impulse_set: ActiveSet,
                   sol: ImpulseSolution,
                   indicators: DlsIndicators,
@@ -406,8 +405,8 @@ pub fn touchdown_impact(
         branch,
         impulse_set,
         preferred,
-        loss: kinetic(qd) - kinetic(&sol.qd_plus),
-        pull_impulse: largest_pull(&sol.impulses, &impulse_set, model.params().rigid_legs),
+        loss: kinetic_loss(model, q, qd, &sol),
+        pull_impulse: pull_of(model, &impulse_set, &sol),
     };
     let sls = ActiveSet {
         contact1: true,
@@ -585,7 +584,18 @@ pub fn close_unit(
         active: next,
         qd_plus: sol.qd_plus,
         impulses: sol.impulses,
-        loss: model.kinetic_energy(q, qd) - model.kinetic_energy(q, &sol.qd_plus),
-        pull_impulse: largest_pull(&sol.impulses, &impulse_set, model.params().rigid_legs),
+        loss: kinetic_loss(model, q, qd, &sol),
+        pull_impulse: pull_of(model, &impulse_set, &sol),
     }))
+}
+
+/// Kinetic energy an impact from `q'` to `sol.qd_plus` takes away \[J\].
+fn kinetic_loss(model: &Model, q: &Coords, qd: &Coords, sol: &ImpulseSolution) -> f64 {
+    model.kinetic_energy(q, qd) - model.kinetic_energy(q, &sol.qd_plus)
+}
+
+/// The largest pulling impulse of the units of `impulse_set` in `sol` \[N s\] (contact audit; stoppers of rigid
+/// legs act both ways and are not audited).
+fn pull_of(model: &Model, impulse_set: &ActiveSet, sol: &ImpulseSolution) -> f64 {
+    largest_pull(&sol.impulses, impulse_set, model.params().rigid_legs)
 }

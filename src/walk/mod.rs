@@ -22,7 +22,6 @@
 //! Stoppers use `stopper_gap` the same way. Both are options of [`SolverOptions`]. (Measuring from `h0` matters
 //! after a re-contact located at `-recontact_gap`: a guard measured from the ground would start at zero and
 //! never fire, letting the tip sink.)
-
 //!
 //! **Impacts.** Every impact (touchdown, rear re-contact, stopper lock) is an impulse-level complementarity
 //! problem over every unilateral unit present (see [`impact::plastic_impact`]); only the closing unit (and at
@@ -498,7 +497,7 @@ impl ContactAudit {
 
     /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`).
     fn see_tips(&mut self, model: &Model, y: &WalkVector) {
-        let q = y.fixed_rows::<NQ>(0).into_owned();
+        let (q, _) = unpack(y);
         for j in 0..model.legs() {
             self.penetration = self.penetration.max(-model.tip_height(&q, j));
         }
@@ -597,7 +596,7 @@ impl<'m> Walker<'m> {
                 speed,
             });
         }
-        Ok(SectionState::from_coords(q, qd))
+        Ok(self.touchdown_coordinates())
     }
 
     fn tolerances(&self) -> Tolerances {
