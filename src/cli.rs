@@ -183,6 +183,11 @@ struct MapArgs {
     /// Skip the threshold curves (map.csv and the heat maps only).
     #[arg(long)]
     no_curves: bool,
+    /// Refine the curves' crossings on at most this many columns, evenly spread with both ends (every row is
+    /// refined); at least 2, and a value of --nx or more refines every column.
+    #[arg(long, default_value_t = vrw::gait::map::DEFAULT_CURVE_COLUMNS as u64,
+          value_parser = clap::value_parser!(u64).range(2..))]
+    curve_columns: u64,
     /// Output directory for map.csv, curves.json, map.svg and map.png.
     #[arg(long, default_value = "out/map")]
     out: PathBuf,
@@ -791,6 +796,7 @@ fn map(args: MapArgs) -> Result<()> {
         // The refined Jacobian gives each gait's stability verdict its error estimate.
         options: GaitOptions::default(),
         curves: !args.no_curves,
+        curve_columns: usize::try_from(args.curve_columns).unwrap_or(usize::MAX),
         marks: args.mark.into_iter().map(|m| m.0).collect(),
         out_dir: args.out.clone(),
     };

@@ -1,7 +1,7 @@
 //! Maps over two parameters (docs/model.md section 6): rows are sweeps, curves are refined 1-D thresholds.
 
 use vrw::app::default_initial;
-use vrw::gait::map::Along;
+use vrw::gait::map::{Along, DEFAULT_CURVE_COLUMNS};
 use vrw::gait::{find_thresholds, map_curves, map_gaits, sweep, GaitOptions, MapSpec, SweepSpec};
 use vrw::params::Config;
 
@@ -47,7 +47,7 @@ fn map_rows_and_curves_agree_with_one_dimensional_sweeps() {
     let start = default_initial(&config);
     let spec = spec();
     let map = map_gaits(&config, &spec, &start, &options(), &|_| {}).unwrap();
-    let curves = map_curves(&config, &map, &options());
+    let curves = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS);
     assert!(
         curves.curves.iter().any(|c| c.name == "existence_end"),
         "{:?}",

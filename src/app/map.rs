@@ -28,6 +28,8 @@ pub struct MapJob {
     pub options: GaitOptions,
     /// Trace the threshold curves (`curves.json`, lines on the heat maps).
     pub curves: bool,
+    /// The most columns the curves are refined on ([`crate::gait::map::curve_columns`]; every row is).
+    pub curve_columns: usize,
     /// Points to mark on the heat maps (e.g. the paper's thresholds).
     pub marks: Vec<MapMark>,
     /// Where `map.csv`, `curves.json`, `map.svg` and `map.png` go.
@@ -83,7 +85,7 @@ pub fn run_map(
     write_map_csv(&job.out_dir.join("map.csv"), &map)?;
     let clock = std::time::Instant::now();
     let (curves, thresholds) = if job.curves {
-        let c = map_curves(&job.config, &map, &job.options);
+        let c = map_curves(&job.config, &map, &job.options, job.curve_columns);
         (c.curves, c.thresholds)
     } else {
         (Vec::new(), Vec::new())

@@ -214,9 +214,33 @@ pub fn curve_name(threshold: &str) -> &str {
     }
 }
 
-/// The 1-D thresholds of every row and column of `map`, and the curves through them (see the module
-/// documentation).
-pub fn map_curves(config: &Config, map: &GaitMap, options: &GaitOptions) -> MapCurves {
+/// The most columns [`map_curves`] refines by default (`vrw map --curve-columns`).
+pub const DEFAULT_CURVE_COLUMNS: usize = 25;
+
+/// The columns the curves are refined on, for `nx` columns and at most `max_columns` of them (at least 2):
+/// every `ceil((nx - 1) / (max_columns - 1))`-th column from the first, and the last; all of them when
+/// `max_columns >= nx`.
+pub fn curve_columns(nx: usize, max_columns: usize) -> Vec<usize> {
+    if nx == 0 {
+        return Vec::new();
+    }
+    let stride = (nx - 1).div_ceil(max_columns.max(2) - 1).max(1);
+    let mut columns: Vec<usize> = (0..nx).step_by(stride).collect();
+    if columns.last() != Some(&(nx - 1)) {
+        columns.push(nx - 1);
+    }
+    columns
+}
+
+/// The 1-D thresholds of every row of `map` and of the columns [`curve_columns`] picks (at most `max_columns`),
+/// and the curves through them (see the module documentation).
+pub fn map_curves(
+    config: &Config,
+    map: &GaitMap,
+    options: &GaitOptions,
+    max_columns: usize,
+) -> MapCurves {
+    let columns = curve_columns(map.xs.len(), max_columns);
     let spec = &map.spec;
     let row_spec = SweepSpec {
         points: map.xs.len(),
@@ -235,9 +259,9 @@ pub fn map_curves(config: &Config, map: &GaitMap, options: &GaitOptions) -> MapC
             line_thresholds(Along::X, j, find_thresholds(&c, &row_spec, points, options))
         })
         .collect();
-    let cols: Vec<Vec<LineThreshold>> = (0..map.xs.len())
-        .into_par_iter()
-        .map(|i| {
+    let cols: Vec<Vec<LineThreshold>> = columns
+        .par_iter()
+        .map(|&i| {
             let c = spec.with_x(config, map.xs[i]);
             let mut points: Vec<SweepPoint> = map
                 .rows
@@ -247,6 +271,8 @@ pub fn map_curves(config: &Config, map: &GaitMap, options: &GaitOptions) -> MapC
                     value: y,
                     continued_from: None,
                     family: None,
+                    // The rows' continuations were along x: none of them is a step along this column.
+                    attempts: Vec::new(),
                     ..row[i].clone()
                 })
                 .collect();
@@ -259,7 +285,7 @@ pub fn map_curves(config: &Config, map: &GaitMap, options: &GaitOptions) -> MapC
         })
         .collect();
     let thresholds: Vec<LineThreshold> = rows.into_iter().chain(cols).flatten().collect();
-    let curves = connect(&map.xs, &map.ys, &thresholds);
+    let curves = connect(&map.xs, &map.ys, &columns, &thresholds);
     MapCurves { curves, thresholds }
 }
 
@@ -294,8 +320,13 @@ fn grid_index(values: &[f64], v: f64) -> Option<usize> {
     values.iter().position(|&x| x == v)
 }
 
-/// Join the refined crossings into curves (see the module documentation).
-fn connect(xs: &[f64], ys: &[f64], thresholds: &[LineThreshold]) -> Vec<ThresholdCurve> {
+/// Join the refined crossings into curves (see the module documentation); `columns` are the refined columns.
+fn connect(
+    xs: &[f64],
+    ys: &[f64],
+    columns: &[usize],
+    thresholds: &[LineThreshold],
+) -> Vec<ThresholdCurve> {
     let fraction = |values: &[f64], k: usize, v: f64| {
         let step = values.get(k + 1).map_or(1.0, |next| next - values[k]);
         k as f64 + (v - values[k]) / step
@@ -340,7 +371,7 @@ fn connect(xs: &[f64], ys: &[f64], thresholds: &[LineThreshold]) -> Vec<Threshol
     let mut curves = Vec::new();
     for name in names {
         let own: Vec<&Crossing> = crossings.iter().filter(|c| c.name == name).collect();
-        for chain in chains(xs.len(), ys.len(), &own) {
+        for chain in chains(columns, ys.len(), &own) {
             let closed = chain.len() > 2 && chain.first() == chain.last();
             let chain = if closed {
                 &chain[..chain.len() - 1]
@@ -368,9 +399,10 @@ fn connect(xs: &[f64], ys: &[f64], thresholds: &[LineThreshold]) -> Vec<Threshol
     curves
 }
 
-/// The crossings of one curve (indices into `own`) chained into polylines: segments within each grid cell,
-/// then chains through shared crossings. A closed chain repeats its first index at the end.
-fn chains(nx: usize, ny: usize, own: &[&Crossing]) -> Vec<Vec<usize>> {
+/// The crossings of one curve (indices into `own`) chained into polylines: segments within each cell, then
+/// chains through shared crossings. A cell lies between two neighbouring refined `columns` and two neighbouring
+/// rows (one grid cell wide when every column is refined). A closed chain repeats its first index at the end.
+fn chains(columns: &[usize], ny: usize, own: &[&Crossing]) -> Vec<Vec<usize>> {
     let distance = |a: usize, b: usize| {
         let (p, q) = (own[a].grid, own[b].grid);
         (p[0] - q[0]).hypot(p[1] - q[1])
@@ -387,12 +419,16 @@ fn chains(nx: usize, ny: usize, own: &[&Crossing]) -> Vec<Vec<usize>> {
             .push(k);
     }
     let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); own.len()];
-    for i in 0..nx.saturating_sub(1) {
+    for pair in columns.windows(2) {
+        let (left, right) = (pair[0], pair[1]);
         for j in 0..ny.saturating_sub(1) {
-            // The cell's edges: bottom, top (rows j and j + 1), left, right (columns i and i + 1).
-            let mut here: Vec<usize> = [(i, j, 0), (i, j + 1, 0), (i, j, 1), (i + 1, j, 1)]
-                .iter()
-                .filter_map(|e| by_edge.get(e))
+            // The cell's edges: bottom, top (the grid edges of rows j and j + 1 between the two columns), left,
+            // right (the two columns between rows j and j + 1).
+            let edges = (left..right)
+                .flat_map(|i| [(i, j, 0), (i, j + 1, 0)])
+                .chain([(left, j, 1), (right, j, 1)]);
+            let mut here: Vec<usize> = edges
+                .filter_map(|e| by_edge.get(&e))
                 .flatten()
                 .copied()
                 .collect();
@@ -490,7 +526,7 @@ mod tests {
             .map(|i| crossing(i, (i, 0, Along::Y), [i as f64, 0.5]))
             .collect();
         let refs: Vec<&Crossing> = line.iter().rev().collect();
-        let found = chains(4, 2, &refs);
+        let found = chains(&[0, 1, 2, 3], 2, &refs);
         assert_eq!(found.len(), 1);
         let order: Vec<usize> = found[0].iter().map(|&k| refs[k].index).collect();
         assert!(order == [0, 1, 2, 3] || order == [3, 2, 1, 0], "{order:?}");
@@ -502,9 +538,37 @@ mod tests {
             crossing(3, (1, 1, Along::Y), [1.0, 1.5]),
         ];
         let refs: Vec<&Crossing> = ring.iter().collect();
-        let found = chains(3, 3, &refs);
+        let found = chains(&[0, 1, 2], 3, &refs);
         assert_eq!(found.len(), 1, "{found:?}");
         assert_eq!(found[0].len(), 5, "closed: {found:?}");
         assert_eq!(found[0].first(), found[0].last());
+    }
+
+    /// With only columns 0 and 3 refined, a cell spans three grid cells: a curve entering through column 0 and
+    /// crossing rows 1 and 2 is still one polyline.
+    #[test]
+    fn crossings_chain_across_cells_between_refined_columns() {
+        let curve = [
+            crossing(0, (0, 0, Along::Y), [0.0, 0.5]),
+            crossing(1, (1, 1, Along::X), [1.5, 1.0]),
+            crossing(2, (2, 2, Along::X), [2.5, 2.0]),
+        ];
+        let refs: Vec<&Crossing> = curve.iter().collect();
+        let found = chains(&[0, 3], 3, &refs);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let order: Vec<usize> = found[0].iter().map(|&k| refs[k].index).collect();
+        assert!(order == [0, 1, 2] || order == [2, 1, 0], "{order:?}");
+    }
+
+    #[test]
+    fn curve_columns_spread_evenly_and_keep_both_ends() {
+        assert_eq!(curve_columns(5, 3), [0, 2, 4]);
+        assert_eq!(curve_columns(21, 25), (0..21).collect::<Vec<_>>());
+        assert_eq!(curve_columns(4, 2), [0, 3]);
+        assert_eq!(curve_columns(1, 25), [0]);
+        assert!(curve_columns(0, 25).is_empty());
+        let hundred = curve_columns(100, DEFAULT_CURVE_COLUMNS);
+        assert!(hundred.len() <= DEFAULT_CURVE_COLUMNS, "{hundred:?}");
+        assert_eq!((hundred[0], hundred[hundred.len() - 1]), (0, 99));
     }
 }

@@ -107,6 +107,36 @@ pub struct SweepPoint {
     /// Gait family: points with the same number are connected by continuation; numbered from 0 in parameter
     /// order. `None` without a gait.
     pub family: Option<usize>,
+    /// The continuations toward this point that did not reach it (from the left neighbour in the sweep, from
+    /// the right one in the backward fill), kept so that the threshold search between the same two points
+    /// reuses them instead of following the family to its end a second time ([`FollowAttempt`]).
+    #[serde(skip)]
+    pub attempts: Vec<FollowAttempt>,
+}
+
+/// A continuation that did not reach its target: where it started, where it was going and where it led (the
+/// family's end bracketed to [`super::continuation::PARAM_TOL`], or given up). [`Continuation::follow`] is a
+/// deterministic function of its start, target and Newton matrix, so a threshold search that would follow the
+/// same family from the same start to the same target takes this result as it is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FollowAttempt {
+    /// The gait followed from.
+    pub from: FamilyPoint,
+    /// The value followed to.
+    pub target: f64,
+    /// Where it led (never [`Followed::Reached`]).
+    pub followed: Followed,
+}
+
+impl SweepPoint {
+    /// The recorded continuation toward this point from `from` (same value and bitwise the same section state),
+    /// if there is one.
+    pub fn attempt_from(&self, from: &FamilyPoint) -> Option<&Followed> {
+        self.attempts
+            .iter()
+            .find(|a| a.from == *from && a.target == self.value)
+            .map(|a| &a.followed)
+    }
 }
 
 /// The configuration with the swept parameter set to `value`, validated, and its model.
@@ -143,13 +173,21 @@ pub fn gait_at_value(
                 gait: None,
                 continued_from: None,
                 family: None,
+                attempts: Vec::new(),
             }
         }
     };
     let solver: &SolverOptions = &c.solver;
     let map = StepMap::new(&model, solver);
+    let mut attempts = Vec::new();
     let continued = previous.and_then(|(index, from, g)| {
-        follow_gait(config, param, from, g, value, options).map(|g| (index, g))
+        match follow_gait(config, param, from, g, value, options) {
+            Ok(g) => Some((index, g)),
+            Err(attempt) => {
+                attempts.extend(attempt);
+                None
+            }
+        }
     });
     let (continued_from, result) = match continued {
         Some((index, g)) => (Some(index), Ok(g)),
@@ -166,6 +204,7 @@ pub fn gait_at_value(
             gait: Some(g),
             continued_from,
             family: None,
+            attempts,
         },
         Err(e) => SweepPoint {
             value,
@@ -174,13 +213,15 @@ pub fn gait_at_value(
             gait: None,
             continued_from: None,
             family: None,
+            attempts,
         },
     }
 }
 
 /// The gait at `value` of the family of `g`, the gait at `from`: the family followed in verified steps
-/// ([`Continuation::follow`]), then the full gait (with `DP`) where it lands; `None` if the family does not
-/// reach `value`.
+/// ([`Continuation::follow`]), then the full gait (with `DP`) where it lands. If the family does not reach
+/// `value`, the attempt (for [`SweepPoint::attempts`]); `Err(None)` if it reaches it but the gait there cannot be
+/// completed.
 fn follow_gait(
     config: &Config,
     param: &str,
@@ -188,23 +229,30 @@ fn follow_gait(
     g: &Gait,
     value: f64,
     options: &GaitOptions,
-) -> Option<Gait> {
+) -> Result<Gait, Option<FollowAttempt>> {
     let guess = g.jacobian_guess();
     let start = FamilyPoint {
         value: from,
         section: g.section,
     };
     let cont = Continuation::new(config, param, options);
-    let Followed::Reached(p) = cont.follow(start, value, guess.as_ref()) else {
-        return None;
+    let p = match cont.follow(start, value, guess.as_ref()) {
+        Followed::Reached(p) => p,
+        followed => {
+            return Err(Some(FollowAttempt {
+                from: start,
+                target: value,
+                followed,
+            }))
+        }
     };
-    let (c, model) = configured(config, param, value).ok()?;
+    let (c, model) = configured(config, param, value).map_err(|_| None)?;
     let map = StepMap::new(&model, &c.solver);
     let opts = GaitOptions {
         transient_steps: 0,
         ..*options
     };
-    find_gait(&map, &p.section, &opts, guess.as_ref()).ok()
+    find_gait(&map, &p.section, &opts, guess.as_ref()).map_err(|_| None)
 }
 
 /// The point's gait if continuation can start from it: a period-1 gait (continuation follows fixed points of
@@ -228,11 +276,14 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
         if a.status == "invalid_parameter" {
             continue;
         }
-        if let Some(g) = follow_gait(config, param, b.value, gb, a.value, options) {
-            a.status = g.stability.to_string();
-            a.message = None;
-            a.gait = Some(g);
-            a.continued_from = Some(i);
+        match follow_gait(config, param, b.value, gb, a.value, options) {
+            Ok(g) => {
+                a.status = g.stability.to_string();
+                a.message = None;
+                a.gait = Some(g);
+                a.continued_from = Some(i);
+            }
+            Err(attempt) => a.attempts.extend(attempt),
         }
     }
 }

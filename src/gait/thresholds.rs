@@ -185,7 +185,13 @@ fn refine_end(
     };
     let guess = g.jacobian_guess();
     let grid_bracket = sorted([from.value, toward.value]);
-    let (last, beyond) = match cont.follow(start, toward.value, guess.as_ref()) {
+    // The sweep may have followed this family from this gait toward this point already (and failed): take
+    // that result rather than follow it again (the same computation, see `SweepPoint::attempts`).
+    let followed = match toward.attempt_from(&start) {
+        Some(f) => f.clone(),
+        None => cont.follow(start, toward.value, guess.as_ref()),
+    };
+    let (last, beyond) = match followed {
         Followed::Ended { last, beyond } => (last, beyond),
         Followed::GaveUp { last, .. } => {
             return Some(unconfirmed(

@@ -581,6 +581,7 @@ mod tests {
             gait: None,
             continued_from: None,
             family: None,
+            attempts: Vec::new(),
         };
         assert_eq!(sweep_row(&no_gait).len(), sweep_header("c").len());
         assert_eq!(Cell::Empty.to_csv(), "");
