@@ -19,6 +19,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::limit_cycle::{solve_fixed_point, FixedPoint, GaitOptions};
+use super::period_k::{least_period, MAX_PERIOD, RETURN_TOL};
 use super::step_map::StepMap;
 use super::sweep::configured;
 use crate::params::Config;
@@ -46,6 +47,12 @@ pub const SETTLE_TOL: f64 = 1e-11;
 /// than followed for hours.
 pub const MAX_FOLLOW_STEPS: usize = 60;
 
+/// After Newton's method fails this many continuation steps in a row (each half the one before), steps are
+/// also tried by walking ([`Continuation::walk_step`]): near a border of the map's smooth pieces (a DLS
+/// indicator near zero) the finite-difference `DP` straddles the border and Newton's method fails at every
+/// step length, while the walk follows the stable gait.
+pub const WALK_AFTER_FAILURES: usize = 3;
+
 /// A real Floquet multiplier this close to +1 at the last gait of a family marks a fold.
 pub const FOLD_TOL: f64 = 0.05;
 
@@ -60,12 +67,15 @@ pub fn section_distance(a: &SectionState, b: &SectionState) -> f64 {
         .max((a.l2_dot - b.l2_dot).abs())
 }
 
-/// Follows gait families of one configuration along one parameter.
+/// Follows gait families of one configuration along one parameter: fixed points of the step map `P`, or of
+/// `P^k` for a family of period-k gaits ([`Continuation::with_period`]).
 #[derive(Debug, Clone)]
 pub struct Continuation<'a> {
     config: &'a Config,
     param: &'a str,
     options: GaitOptions,
+    /// Steps per period of the family followed (1: fixed points of `P`).
+    period: usize,
 }
 
 /// A point of a family: the parameter value and the gait's section state there.
@@ -109,7 +119,7 @@ pub enum EndCause {
         /// The failure in words, with the step it happened in.
         message: String,
     },
-    /// The walk settles on another gait (a branch switch).
+    /// The walk settles on another gait (a branch switch), possibly of another period.
     OtherGait {
         /// Steps walked before the search that found it.
         steps: usize,
@@ -117,6 +127,8 @@ pub enum EndCause {
         section: SectionState,
         /// Its `lambda_I4` \[N s\].
         lambda_i4: f64,
+        /// Its period in steps (1 for a fixed point of `P`).
+        period_k: usize,
     },
     /// The family folds: the largest Floquet multiplier of its last gait is within [`FOLD_TOL`] of +1 (a
     /// saddle-node, where the gait meets an unstable one and both vanish), and the walk drifts slowly.
@@ -143,7 +155,21 @@ impl<'a> Continuation<'a> {
                 max_iterations: STEP_NEWTON_ITERATIONS.min(options.max_iterations),
                 ..*options
             },
+            period: 1,
         }
+    }
+
+    /// The same continuation for a family of period-`k` gaits: fixed points of `P^k` (`k = 0` is taken as 1).
+    pub fn with_period(self, k: usize) -> Continuation<'a> {
+        Continuation {
+            period: k.max(1),
+            ..self
+        }
+    }
+
+    /// The step map at `value` (`P^k` for a period-k family) and the configuration it was built from.
+    fn map_at(&self, value: f64) -> Result<(Config, crate::dynamics::Model), String> {
+        configured(self.config, self.param, value).map_err(|e| e.to_string())
     }
 
     /// The fixed point at `value` by Newton's method from `start` (no transient).
@@ -153,8 +179,8 @@ impl<'a> Continuation<'a> {
         start: &SectionState,
         guess: Option<&DMatrix<f64>>,
     ) -> Result<FixedPoint, String> {
-        let (c, model) = configured(self.config, self.param, value).map_err(|e| e.to_string())?;
-        let map = StepMap::new(&model, &c.solver);
+        let (c, model) = self.map_at(value)?;
+        let map = StepMap::new(&model, &c.solver).iterated(self.period);
         solve_fixed_point(&map, start, &self.options, guess).map_err(|e| e.to_string())
     }
 
@@ -186,14 +212,17 @@ impl<'a> Continuation<'a> {
         })
     }
 
-    /// The section state a walk at `value` from `start` settles on: successive returns closer than
-    /// [`SETTLE_TOL`] within [`SETTLE_STEPS`] steps; `None` if the walk fails or does not settle.
+    /// The section state a walk at `value` from `start` settles on: successive returns (every `k` steps for a
+    /// period-k family) closer than [`SETTLE_TOL`] within [`SETTLE_STEPS`] steps; `None` if the walk fails or
+    /// does not settle.
     fn settle(&self, value: f64, start: &SectionState) -> Option<SectionState> {
-        let (c, model) = configured(self.config, self.param, value).ok()?;
+        let (c, model) = self.map_at(value).ok()?;
         let mut walker = Walker::new(&model, &c.solver, start).ok()?;
         let mut previous = *start;
-        for _ in 0..SETTLE_STEPS {
-            walker.step(None).ok()?;
+        for _ in 0..SETTLE_STEPS.div_ceil(self.period) {
+            for _ in 0..self.period {
+                walker.step(None).ok()?;
+            }
             let next = walker.section().ok()?;
             if section_distance(&next, &previous) < SETTLE_TOL {
                 return Some(next);
@@ -203,17 +232,17 @@ impl<'a> Continuation<'a> {
         None
     }
 
-    /// `DP` (central differences) of the gait `at`.
+    /// `DP` (`D(P^k)` for a period-k family; central differences) of the gait `at`.
     fn jacobian(&self, at: &FamilyPoint) -> Option<DMatrix<f64>> {
-        let (c, model) = configured(self.config, self.param, at.value).ok()?;
-        let map = StepMap::new(&model, &c.solver);
+        let (c, model) = self.map_at(at.value).ok()?;
+        let map = StepMap::new(&model, &c.solver).iterated(self.period);
         map.central_jacobian(&at.section, self.options.fd_step).ok()
     }
 
     /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's
     /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step that fails is retried once
     /// with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere), then halved; a
-    /// step that works lets the next one double. At most [`MAX_FOLLOW_STEPS`] steps are tried
+    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end). At most [`MAX_FOLLOW_STEPS`] steps are tried
     /// ([`Followed::GaveUp`]).
     pub fn follow(&self, from: FamilyPoint, target: f64, guess: Option<&DMatrix<f64>>) -> Followed {
         let mut current = from;
@@ -222,6 +251,9 @@ impl<'a> Continuation<'a> {
         let mut jac: Option<(f64, DMatrix<f64>)> = guess.map(|j| (from.value, j.clone()));
         let mut h = target - current.value;
         let mut walking = false;
+        let mut failed_before = false;
+        // Newton's method failed this many steps in a row.
+        let mut newton_failures = 0;
         loop {
             let remaining = target - current.value;
             if remaining == 0.0 {
@@ -247,18 +279,28 @@ impl<'a> Continuation<'a> {
                 }
             }
             let at_end = (next_value - current.value).abs() <= PARAM_TOL;
-            // Where Newton's method fails at the finest step (and from then on, until it works again), a step
-            // is also tried by walking, before an end is declared.
-            if next.is_none() && (walking || at_end) {
+            // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and
+            // from then on, until it works again, also through the halvings of a walking step that fails), a
+            // step is also tried by walking, before an end is declared.
+            if next.is_none() {
+                newton_failures += 1;
+            } else {
+                newton_failures = 0;
+            }
+            if next.is_none() && (walking || at_end || newton_failures >= WALK_AFTER_FAILURES) {
                 next = self.walk_step(&current, next_value);
-                walking = next.is_some();
+                walking = walking || next.is_some();
             } else if next.is_some() {
                 walking = false;
             }
             match next {
                 Some(next) => {
-                    h = 2.0 * (next.value - current.value);
+                    // A step that works doubles the next one, unless the step before (twice as long) failed:
+                    // then the next one is half as long, which bisects toward the family's end.
+                    let grow = if failed_before { 0.5 } else { 2.0 };
+                    h = grow * (next.value - current.value);
                     current = next;
+                    failed_before = false;
                 }
                 None if at_end => {
                     return Followed::Ended {
@@ -266,7 +308,10 @@ impl<'a> Continuation<'a> {
                         beyond: next_value,
                     }
                 }
-                None => h = 0.5 * (next_value - current.value),
+                None => {
+                    h = 0.5 * (next_value - current.value);
+                    failed_before = true;
+                }
             }
         }
     }
@@ -302,6 +347,8 @@ impl<'a> Continuation<'a> {
                 }
             }
         };
+        // The touchdowns of the walk, for its period.
+        let mut returns = Vec::with_capacity(END_WALK_STEPS);
         for step in 1..=END_WALK_STEPS {
             if let Err(e) = walker.step(None) {
                 return EndCause::WalkFails {
@@ -309,6 +356,7 @@ impl<'a> Continuation<'a> {
                     message: format!("walking from the last gait, step {step}: {e}"),
                 };
             }
+            returns.push(walker.touchdown_coordinates());
         }
         let walked = match walker.section() {
             Ok(s) => s,
@@ -319,13 +367,17 @@ impl<'a> Continuation<'a> {
                 }
             }
         };
-        let map = StepMap::new(&model, &c.solver);
-        match solve_fixed_point(&map, &walked, &self.options, None) {
-            Ok(fp) if section_distance(&fp.section, &last.section) > SAME_GAIT_TOL => {
+        // The period the walk shows (up to MAX_PERIOD), else the family's own: a period-1 family may end where
+        // a period-2 gait takes over, for instance.
+        let k = least_period(&returns, MAX_PERIOD, RETURN_TOL).unwrap_or(self.period);
+        let single = StepMap::new(&model, &c.solver);
+        match solve_fixed_point(&single.iterated(k), &walked, &self.options, None) {
+            Ok(fp) if k != self.period || !on_orbit(&single, &fp.section, k, &last.section) => {
                 EndCause::OtherGait {
                     steps: END_WALK_STEPS,
                     section: fp.section,
                     lambda_i4: fp.outcome.report.indicators.lambda_i4,
+                    period_k: k,
                 }
             }
             Ok(_) => EndCause::Unconfirmed {
@@ -339,10 +391,30 @@ impl<'a> Continuation<'a> {
             }
             Err(e) => EndCause::Unconfirmed {
                 reason: format!(
-                    "the walk from the last gait neither fails nor settles on a period-1 gait within \
-                     {END_WALK_STEPS} steps ({e})"
+                    "the walk from the last gait neither fails nor settles on a gait of period 1 to \
+                     {MAX_PERIOD} within {END_WALK_STEPS} steps ({e})"
                 ),
             },
         }
     }
+}
+
+/// Is `s` within [`SAME_GAIT_TOL`] of a state of the period-`k` orbit through `orbit` (the orbit walked `k`
+/// steps with `map`)? The phases of a period-k gait are all fixed points of `P^k`.
+fn on_orbit(map: &StepMap, orbit: &SectionState, k: usize, s: &SectionState) -> bool {
+    if section_distance(orbit, s) <= SAME_GAIT_TOL {
+        return true;
+    }
+    let Ok(mut walker) = Walker::new(map.model(), map.options(), orbit) else {
+        return false;
+    };
+    for _ in 1..k {
+        if walker.step(None).is_err() {
+            return false;
+        }
+        if section_distance(&walker.touchdown_coordinates(), s) <= SAME_GAIT_TOL {
+            return true;
+        }
+    }
+    false
 }

@@ -26,7 +26,9 @@
 //! refuses it.
 
 use super::continuation::{section_distance, SAME_GAIT_TOL};
-use super::limit_cycle::{find_gait, gait_at, solve_fixed_point, Gait, GaitError, GaitOptions};
+use super::limit_cycle::{
+    find_gait, gait_at, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions,
+};
 use super::step_map::StepMap;
 use crate::walk::{SectionState, Walker};
 
@@ -143,12 +145,24 @@ pub fn find_periodic_gait(
         });
     };
     let fp = solve_fixed_point(&single.iterated(k), &start, &newton, None)?;
+    periodic_gait_at(&single, &fp, k, options)
+}
+
+/// The period-`k` gait at `fp`, a fixed point of `P^k` (`single` is `P`): steps 4 and 5 of the module
+/// documentation (two periods walked, the least period, `D(P^k)` with the settings of `options`). Also what a
+/// continuation of a period-k family completes its gaits with.
+pub fn periodic_gait_at(
+    single: &StepMap,
+    fp: &FixedPoint,
+    k: usize,
+    options: &GaitOptions,
+) -> Result<Gait, GaitError> {
     let newton_error = |source| GaitError::Newton {
         iteration: fp.iterations + 1,
         source,
     };
     // Two periods walked on: a periodic walk returns to s* after k and after 2k steps.
-    let (states, reports) = walk_period(&single, &fp.section, 2 * k).map_err(newton_error)?;
+    let (states, reports) = walk_period(single, &fp.section, 2 * k).map_err(newton_error)?;
     let distance = section_distance(&states[2 * k], &fp.section);
     if distance > SAME_GAIT_TOL {
         return Err(GaitError::SectionIncomplete {
@@ -169,7 +183,7 @@ pub fn find_periodic_gait(
             .map(|j| (j, f64::NAN))
     }
     .map_err(newton_error)?;
-    let mut gait = gait_at(&fp, dp, error);
+    let mut gait = gait_at(fp, dp, error);
     gait.period_k = least;
     gait.cycle = reports[..least].to_vec();
     if least < k {

@@ -18,8 +18,8 @@ use serde::Serialize;
 
 use super::continuation::{section_distance, Continuation, FamilyPoint, Followed, SAME_GAIT_TOL};
 use super::grid::{run_rows, Evaluated};
-use super::limit_cycle::{find_gait, Gait, GaitOptions};
-use super::period_k::{find_gait_any_period, MAX_PERIOD};
+use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
+use super::period_k::{find_gait_any_period, periodic_gait_at, MAX_PERIOD};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
 use crate::error::short;
@@ -235,7 +235,7 @@ fn follow_gait(
         value: from,
         section: g.section,
     };
-    let cont = Continuation::new(config, param, options);
+    let cont = Continuation::new(config, param, options).with_period(g.period_k);
     let p = match cont.follow(start, value, guess.as_ref()) {
         Followed::Reached(p) => p,
         followed => {
@@ -252,13 +252,22 @@ fn follow_gait(
         transient_steps: 0,
         ..*options
     };
-    find_gait(&map, &p.section, &opts, guess.as_ref()).map_err(|_| None)
+    if g.period_k == 1 {
+        return find_gait(&map, &p.section, &opts, guess.as_ref()).map_err(|_| None);
+    }
+    let fp = solve_fixed_point(&map.iterated(g.period_k), &p.section, &opts, guess.as_ref())
+        .map_err(|_| None)?;
+    periodic_gait_at(&map, &fp, g.period_k, &opts)
+        .ok()
+        // The family keeps its period: a point where the gait's least period drops is not continued.
+        .filter(|gait| gait.period_k == g.period_k)
+        .ok_or(None)
 }
 
-/// The point's gait if continuation can start from it: a period-1 gait (continuation follows fixed points of
-/// `P`; a period-k gait is searched afresh at every point).
+/// The point's gait if continuation can start from it: any gait (a period-k gait is continued as a fixed
+/// point of `P^k`) whose Jacobian was computed or not.
 fn continuable(point: &SweepPoint) -> Option<&Gait> {
-    point.gait.as_ref().filter(|g| g.period_k == 1)
+    point.gait.as_ref()
 }
 
 pub use super::grid::COARSE_STRIDE;
@@ -296,7 +305,6 @@ pub(crate) fn number_families(
     points: &mut [SweepPoint],
     options: &GaitOptions,
 ) {
-    let cont = Continuation::new(config, param, options);
     // Roots of the continuation forest: a gait found from the initial state is its own root.
     let root_of = |i: usize| {
         let mut j = i;
@@ -322,11 +330,15 @@ pub(crate) fn number_families(
         let (Some(ga), Some(gb)) = (&a.gait, &b.gait) else {
             continue;
         };
+        if ga.period_k != gb.period_k {
+            continue;
+        }
         let start = FamilyPoint {
             value: a.value,
             section: ga.section,
         };
-        let connected = cont
+        let connected = Continuation::new(config, param, options)
+            .with_period(ga.period_k)
             .step(&start, b.value, ga.jacobian_guess().as_ref())
             .is_some_and(|p| section_distance(&p.section, &gb.section) <= SAME_GAIT_TOL);
         if connected {

@@ -53,6 +53,9 @@ pub struct Threshold {
     pub residual: f64,
     /// What happens past a family's end (its physical cause) or why the search failed.
     pub detail: Option<String>,
+    /// For the end of a family: its last gait (the parameter value and the fixed point).
+    #[serde(skip)]
+    pub last: Option<FamilyPoint>,
 }
 
 /// What a threshold measures on a gait.
@@ -158,11 +161,65 @@ pub fn find_thresholds(
     let gait_before = |v: f64| points.iter().any(|p| p.gait.is_some() && p.value < v);
     tasks
         .par_iter()
-        .filter_map(|task| match task {
-            Task::Root(q, a, b) => Some(refine_root(config, spec, *q, a, b, options)),
+        .flat_map_iter(|task| match task {
+            Task::Root(q, a, b) => vec![refine_root(config, spec, *q, a, b, options)],
             Task::End(from, toward) => {
-                refine_end(config, spec, from, toward, options, gait_before(from.value))
+                match refine_end(config, spec, from, toward, options, gait_before(from.value)) {
+                    Some(end) => {
+                        let vanishing = vanishing_at_end(config, spec, from, &end);
+                        std::iter::once(end).chain(vanishing).collect()
+                    }
+                    None => Vec::new(),
+                }
             }
+        })
+        .collect()
+}
+
+/// The DLS indicators that vanish where a gait family ends: the family's end is then the indicator's zero (a
+/// border collision, e.g. the period-1 DLS gait that ends at `lambda_2+ = 0` where a period-2 BOUNCE gait takes
+/// over). An indicator counts as vanishing when, extrapolated linearly from the grid point `from` to the last
+/// gait of the family, it reaches zero within [`PARAM_TOL`] of the end. Each is reported as its own threshold at
+/// the end's value, with the indicator's value at the last gait as its residual.
+fn vanishing_at_end(
+    config: &Config,
+    spec: &SweepSpec,
+    from: &SweepPoint,
+    end: &Threshold,
+) -> Vec<Threshold> {
+    let (Some(g), Some(last)) = (from.gait.as_ref(), end.last) else {
+        return Vec::new();
+    };
+    let Ok((c, model)) = configured(config, &spec.param, last.value) else {
+        return Vec::new();
+    };
+    let map = StepMap::new(&model, &c.solver).iterated(g.period_k);
+    let Ok(out) = map.eval(&last.section) else {
+        return Vec::new();
+    };
+    let run = last.value - from.value;
+    [Quantity::Lambda4Plus, Quantity::Lambda2Plus, Quantity::LambdaI4]
+        .into_iter()
+        .filter_map(|q| {
+            let (at_from, at_last) = (q.of(g), q.of_indicators(&out.report.indicators));
+            let slope = (at_last - at_from) / run;
+            let to_zero = (at_last / slope).abs();
+            (at_last.is_finite() && slope.is_finite() && to_zero <= PARAM_TOL).then(|| Threshold {
+                name: q.name().to_string(),
+                value: end.value,
+                bracket: end.bracket,
+                grid_bracket: end.grid_bracket,
+                residual: at_last,
+                detail: Some(format!(
+                    "where the gait family ends ({}): {} of its last gait, at {p} = {}, is {at_last:.3e} and \
+                     extrapolates to zero within {to_zero:.1e} of the end; the family ends where it vanishes",
+                    end.name,
+                    q.name().trim_end_matches(" = 0"),
+                    last.value,
+                    p = spec.param,
+                )),
+                last: None,
+            })
         })
         .collect()
 }
@@ -178,7 +235,7 @@ fn refine_end(
     gait_before: bool,
 ) -> Option<Threshold> {
     let g = from.gait.as_ref().expect("an end starts at a gait");
-    let cont = Continuation::new(config, &spec.param, options);
+    let cont = Continuation::new(config, &spec.param, options).with_period(g.period_k);
     let start = FamilyPoint {
         value: from.value,
         section: g.section,
@@ -247,13 +304,18 @@ fn refine_end(
             ),
         ),
         EndCause::OtherGait {
-            steps, lambda_i4, ..
+            steps,
+            lambda_i4,
+            period_k,
+            ..
         } => (
             "branch_switch",
             format!(
-                "the gait family of lambda_I4 = {:.6} N s ends at {p} = {} (not reached at {beyond}); walking \
-                 {steps} steps from its last gait there settles on another gait, lambda_I4 = {lambda_i4:.6} N s",
+                "the gait family of lambda_I4 = {:.6} N s (period {}) ends at {p} = {} (not reached at \
+                 {beyond}); walking {steps} steps from its last gait there settles on another gait, of period \
+                 {period_k}, lambda_I4 = {lambda_i4:.6} N s",
                 g.lambda_i4,
+                g.period_k,
                 last.value,
                 p = spec.param,
             ),
@@ -284,6 +346,7 @@ fn refine_end(
         grid_bracket,
         residual: f64::NAN,
         detail: Some(detail),
+        last: Some(last),
     })
 }
 
@@ -296,6 +359,7 @@ fn unconfirmed(grid_bracket: [f64; 2], detail: String) -> Threshold {
         grid_bracket,
         residual: f64::NAN,
         detail: Some(detail),
+        last: None,
     }
 }
 
@@ -335,7 +399,8 @@ fn refine_root(
         }
         let value = (|| {
             let (c, model) = configured(config, &spec.param, v).map_err(|e| e.to_string())?;
-            let map = StepMap::new(&model, &c.solver);
+            // A period-k family's gaits are fixed points of P^k; the indicators are those of its first step.
+            let map = StepMap::new(&model, &c.solver).iterated(start.period_k);
             let y = if q == Quantity::Stability {
                 q.of(&find_gait(&map, &start.section, &continued, guess.as_ref())
                     .map_err(|e| e.to_string())?)
@@ -386,5 +451,6 @@ fn refine_root(
         grid_bracket: [a.value, b.value],
         residual,
         detail,
+        last: None,
     }
 }
