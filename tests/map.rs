@@ -159,3 +159,67 @@ fn map_rejects_bad_specifications() {
         assert!(e.is_err(), "{what}");
     }
 }
+
+/// The threshold search takes the sweep's failed continuations as they are: clearing them (so every end is
+/// followed afresh) gives the same thresholds, bit for bit.
+#[test]
+fn thresholds_reuse_the_sweeps_failed_continuations_exactly() {
+    let config = Config::default();
+    let spec = SweepSpec {
+        param: "viscosity".into(),
+        from: 120.0,
+        to: 140.0,
+        points: 5,
+    };
+    let start = default_initial(&config);
+    let points = sweep(&config, &spec, &start, &options(), &|_| {}).unwrap();
+    assert!(
+        points.iter().any(|p| !p.attempts.is_empty()),
+        "the sweep recorded the continuation that did not reach the point past the end"
+    );
+    let reused = find_thresholds(&config, &spec, &points, &options());
+    let mut cleared = points.clone();
+    for p in &mut cleared {
+        p.attempts.clear();
+    }
+    let afresh = find_thresholds(&config, &spec, &cleared, &options());
+    assert!(reused.iter().any(|t| t.name == "gait_lost"), "{reused:?}");
+    assert_eq!(
+        serde_json::to_string(&reused).unwrap(),
+        serde_json::to_string(&afresh).unwrap()
+    );
+}
+
+/// With fewer refined columns the curves still pass through every row's crossings, and the columns' crossings
+/// are only on the refined columns.
+#[test]
+fn curves_on_fewer_columns_keep_every_row_crossing() {
+    let config = Config::default();
+    let start = default_initial(&config);
+    let map = map_gaits(&config, &spec(), &start, &options(), &|_| {}).unwrap();
+    let all = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS);
+    let few = map_curves(&config, &map, &options(), 3);
+    let refined = vrw::gait::map::curve_columns(map.xs.len(), 3);
+    assert_eq!(refined, [0, 2, 4]);
+    let rows = |c: &vrw::gait::MapCurves| -> Vec<String> {
+        c.thresholds
+            .iter()
+            .filter(|t| t.along == Along::X)
+            .map(|t| serde_json::to_string(t).unwrap())
+            .collect()
+    };
+    assert_eq!(rows(&all), rows(&few));
+    assert!(few
+        .thresholds
+        .iter()
+        .filter(|t| t.along == Along::Y)
+        .all(|t| refined.contains(&t.line)));
+    assert!(
+        few.curves.iter().any(|c| c.points.len() > 1),
+        "{:?}",
+        few.curves
+    );
+    for r in few.curves.iter().flat_map(|c| &c.refined_on) {
+        assert!(r.along == Along::X || refined.contains(&r.line), "{r:?}");
+    }
+}

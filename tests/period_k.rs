@@ -153,3 +153,86 @@ fn no_spurious_period_k_gait_where_the_walk_has_period_one() {
     );
     assert!(found.as_ref().is_err(), "{:?}", found.map(|g| g.period_k));
 }
+
+/// The paper's parameters at `c = 20 N s/m`, with the stiffness swept from `from` to `to` over `points` values.
+fn stiffness_sweep(from: f64, to: f64, points: usize) -> (Config, vrw::gait::SweepSpec) {
+    let mut config = Config::default();
+    config.set_numeric("viscosity", 20.0).unwrap();
+    let spec = vrw::gait::SweepSpec {
+        param: "stiffness".into(),
+        from,
+        to,
+        points,
+    };
+    (config, spec)
+}
+
+/// Period-2 BOUNCE gaits (k = 596..604 N/m at c = 20) are one family, continued as fixed points of `P^2`:
+/// every point after the first is continued from its neighbour, and each is a fixed point of `P^2` (checked
+/// by walking two steps) that `P` does not fix.
+#[test]
+fn period_two_gaits_are_continued_as_one_family() {
+    let (config, spec) = stiffness_sweep(596.0, 604.0, 5);
+    let options = GaitOptions::default();
+    let points =
+        vrw::gait::sweep(&config, &spec, &default_initial(&config), &options, &|_| {}).unwrap();
+    for (i, p) in points.iter().enumerate() {
+        let g = p
+            .gait
+            .as_ref()
+            .unwrap_or_else(|| panic!("{}: {:?}", p.value, p.message));
+        assert_eq!(g.period_k, 2, "{}", p.value);
+        assert_eq!(p.family, Some(0), "{}", p.value);
+        if i > 0 {
+            assert_eq!(p.continued_from, Some(i - 1), "{}", p.value);
+        }
+        let mut c = config.clone();
+        c.set_numeric("stiffness", p.value).unwrap();
+        let model = Model::new(&c.params).unwrap();
+        let map = StepMap::new(&model, &c.solver);
+        let once = map.eval(&g.section).unwrap().next;
+        let twice = map.iterated(2).eval(&g.section).unwrap().next;
+        assert!(distance(&twice, &g.section) < 1e-9, "{}", p.value);
+        assert!(distance(&once, &g.section) > DISTINCT, "{}", p.value);
+    }
+}
+
+/// `lambda_2+ = 0` at c = 20 N s/m lies where the period-1 DLS family ends and a period-2 BOUNCE gait takes
+/// over (k = 593.866724 N/m). Two sweeps over different grids give the same threshold to 1e-6, its residual
+/// (lambda_2+ of the family's last gait) is below 1e-6 N, and the end's cause is a walk settling on period 2.
+#[test]
+fn lambda_two_plus_vanishes_where_the_period_one_family_gives_way_to_period_two() {
+    let located = |from: f64, to: f64, points: usize| {
+        let (config, spec) = stiffness_sweep(from, to, points);
+        let options = GaitOptions::default();
+        let points =
+            vrw::gait::sweep(&config, &spec, &default_initial(&config), &options, &|_| {}).unwrap();
+        let thresholds = vrw::gait::find_thresholds(&config, &spec, &points, &options);
+        let zero = thresholds
+            .iter()
+            .find(|t| t.name == "lambda_2_plus = 0")
+            .unwrap_or_else(|| panic!("{thresholds:#?}"))
+            .clone();
+        let end = thresholds
+            .iter()
+            .find(|t| t.name == "branch_switch" && (t.value - zero.value).abs() < 1e-6)
+            .unwrap_or_else(|| panic!("{thresholds:#?}"))
+            .clone();
+        (zero, end)
+    };
+    let (a, end) = located(590.0, 596.0, 4);
+    let (b, _) = located(586.0, 600.0, 3);
+    assert!(
+        (a.value - b.value).abs() <= 1e-6,
+        "{} vs {}",
+        a.value,
+        b.value
+    );
+    assert!((a.value - 593.866724).abs() <= 2e-6, "{}", a.value);
+    assert!(a.residual.abs() < 1e-6, "{}", a.residual);
+    assert!(
+        end.detail.as_deref().unwrap_or("").contains("of period 2"),
+        "{:?}",
+        end.detail
+    );
+}
