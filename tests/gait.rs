@@ -310,6 +310,38 @@ fn sweep_thresholds_do_not_depend_on_the_grid() {
     assert!(find_gait(&map, &start, &GaitOptions::default(), None).is_ok());
 }
 
+/// Along the stiffness at c = 50 the gait is lost at k = 761.311031 N/m (the wheel rolls back), approached in
+/// ever shorter continuation steps: grids of 6 and 26 points find the same end, which needs well over 60
+/// steps from the grid point before it.
+#[test]
+fn stiffness_sweep_follows_the_gait_to_where_it_rolls_back() {
+    let config = Config::default();
+    let start = default_initial(&config);
+    let mut found = Vec::new();
+    for points in [6, 26] {
+        let spec = SweepSpec {
+            param: "stiffness".into(),
+            from: 500.0,
+            to: 1000.0,
+            points,
+        };
+        let sweep_points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
+        let thresholds = find_thresholds(&config, &spec, &sweep_points, &GaitOptions::default());
+        let lost = thresholds
+            .iter()
+            .find(|t| t.name == "gait_lost")
+            .unwrap_or_else(|| panic!("{points} points: {thresholds:#?}"));
+        assert!(
+            lost.detail.as_deref().unwrap().contains("rolled_back"),
+            "{lost:?}"
+        );
+        found.push(lost.value);
+    }
+    for v in &found {
+        assert!((v - 761.311031).abs() <= 1e-6, "{found:?}");
+    }
+}
+
 /// Each gait carries its family, and a stability verdict that accounts for the Jacobian's error estimate.
 #[test]
 fn sweep_points_carry_their_family_and_an_honest_stability_verdict() {

@@ -42,10 +42,12 @@ pub const SETTLE_STEPS: usize = 200;
 /// A walk has settled when two successive section states differ by less than this.
 pub const SETTLE_TOL: f64 = 1e-11;
 /// Most continuation steps (verified or failed) one [`Continuation::follow`] may try. Following a family to a
-/// neighbouring value, or to its end bracketed to [`PARAM_TOL`], takes a few dozen; a family that only advances
-/// in ever tinier steps (it winds through a region where Newton's method barely converges) is given up rather
-/// than followed for hours.
-pub const MAX_FOLLOW_STEPS: usize = 60;
+/// neighbouring value, or to its end bracketed to [`PARAM_TOL`], takes a few dozen; approaching an end where
+/// the steps Newton's method takes shrink with the distance to it (the wheel about to roll back, e.g. at
+/// `k = 761.311031 N/m` for `c = 50`) takes about four steps per halving, 100 to 150 from a grid interval of
+/// 20; a family that only advances in ever tinier steps without end is given up rather than followed for
+/// hours.
+pub const MAX_FOLLOW_STEPS: usize = 200;
 
 /// After Newton's method fails this many continuation steps in a row (each half the one before), steps are
 /// also tried by walking ([`Continuation::walk_step`]): near a border of the map's smooth pieces (a DLS

@@ -172,7 +172,9 @@ pub fn periodic_gait_at(
     }
     // The least period: P^j(s*) = s* for a divisor j of k.
     let least = (1..=k)
-        .find(|&j| k.is_multiple_of(j) && section_distance(&states[j], &fp.section) <= SAME_GAIT_TOL)
+        .find(|&j| {
+            k.is_multiple_of(j) && section_distance(&states[j], &fp.section) <= SAME_GAIT_TOL
+        })
         .unwrap_or(k);
     let map_least = single.iterated(least);
     let (dp, error) = if options.refine_jacobian {
