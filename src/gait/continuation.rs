@@ -39,6 +39,10 @@ pub const STEP_NEWTON_ITERATIONS: usize = 8;
 /// Steps a walk may take to settle on a gait in a continuation step by walking.
 pub const SETTLE_STEPS: usize = 200;
 
+/// Most steps one [`Continuation::follow`] may try by walking (each walks up to twice [`SETTLE_STEPS`] steps):
+/// where only walking carries the family on, it is given up after these, as after [`MAX_FOLLOW_STEPS`].
+pub const MAX_FOLLOW_WALKS: usize = 60;
+
 /// A walk has settled when two successive section states differ by less than this.
 pub const SETTLE_TOL: f64 = 1e-11;
 /// Most continuation steps (verified or failed) one [`Continuation::follow`] may try. Following a family to a
@@ -101,7 +105,8 @@ pub enum Followed {
         /// The first value it does not reach.
         beyond: f64,
     },
-    /// Neither within [`MAX_FOLLOW_STEPS`] steps: the family was followed to `last` and given up there.
+    /// Neither within [`MAX_FOLLOW_STEPS`] steps (or [`MAX_FOLLOW_WALKS`] walking steps): the family was
+    /// followed to `last` and given up there.
     GaveUp {
         /// The last point of the family reached.
         last: FamilyPoint,
@@ -256,12 +261,14 @@ impl<'a> Continuation<'a> {
         let mut failed_before = false;
         // Newton's method failed this many steps in a row.
         let mut newton_failures = 0;
+        // Steps tried by walking.
+        let mut walks = 0;
         loop {
             let remaining = target - current.value;
             if remaining == 0.0 {
                 return Followed::Reached(current);
             }
-            if steps == MAX_FOLLOW_STEPS {
+            if steps == MAX_FOLLOW_STEPS || walks == MAX_FOLLOW_WALKS {
                 return Followed::GaveUp {
                     last: current,
                     target,
@@ -291,6 +298,7 @@ impl<'a> Continuation<'a> {
             }
             if next.is_none() && (walking || at_end || newton_failures >= WALK_AFTER_FAILURES) {
                 next = self.walk_step(&current, next_value);
+                walks += 1;
                 walking = walking || next.is_some();
             } else if next.is_some() {
                 walking = false;

@@ -255,11 +255,12 @@ fn refine_end(
                 grid_bracket,
                 format!(
                     "the family of {p} = {} was followed only to {p} = {} toward {p} = {} (given up after {} \
-                     continuation steps)",
+                     continuation steps or {} steps by walking)",
                     from.value,
                     last.value,
                     toward.value,
                     super::continuation::MAX_FOLLOW_STEPS,
+                    super::continuation::MAX_FOLLOW_WALKS,
                     p = spec.param,
                 ),
             ))
