@@ -4,16 +4,18 @@
 //! A continuation step from the gait `s0` at `v0` to `v1` is accepted only if Newton's method from `s0` converges
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within [`SAME_GAIT_TOL`]).
 //! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
-//! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved, so a
-//! family is followed in shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`]. Before an
-//! end is declared, one step across it is tried by walking instead of Newton's method
-//! ([`Continuation::walk_step`]), since the step map is only piecewise smooth.
+//! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved (and the
+//! step after a failure that works halves the next, which bisects toward an end), so a family is followed in
+//! shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`]. Where Newton's method fails at
+//! the finest step, or [`WALK_AFTER_FAILURES`] times in a row, steps are also tried by walking instead
+//! ([`Continuation::walk_step`]), since the step map is only piecewise smooth. A family of period-k gaits is
+//! followed the same way, as fixed points of `P^k` ([`Continuation::with_period`]).
 //!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
 //! family at the first parameter value it does not reach ([`END_WALK_STEPS`] steps). The walk fails (falls,
-//! rolls back, stalls, the rear leg is not relocked, ...), settles on another gait (a branch switch), or does
-//! neither, in which case the end is reported as unconfirmed. Newton's method failing from a neighbour is never
-//! by itself taken for "no gait".
+//! rolls back, stalls, the rear leg is not relocked, ...), settles on another gait of any period up to
+//! [`MAX_PERIOD`] (a branch switch), or does neither, in which case the end is reported as unconfirmed. Newton's
+//! method failing from a neighbour is never by itself taken for "no gait".
 
 use nalgebra::DMatrix;
 use serde::Serialize;
