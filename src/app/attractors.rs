@@ -257,11 +257,15 @@ fn orbit_figure(
             "Orbit diagram: {} steps after a transient of {}, {}impact {}",
             job.spec.steps,
             job.spec.transient,
-            if range.param == "slope" {
-                String::new()
-            } else {
-                format!("slope φ = {} rad, ", p.slope)
-            },
+            [
+                ("viscosity", format!("c = {} N s/m, ", short(p.viscosity))),
+                ("stiffness", format!("k = {} N/m, ", short(p.stiffness))),
+                ("slope", format!("slope φ = {} rad, ", p.slope)),
+            ]
+            .into_iter()
+            .filter(|(key, _)| *key != range.param)
+            .map(|(_, fixed)| fixed)
+            .collect::<String>(),
             p.impact
         ),
         param_label: axis_label(&range.param),
