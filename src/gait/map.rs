@@ -8,12 +8,15 @@
 //!
 //! **Curves.** The threshold curves (`lambda_4+ = 0`, `lambda_2+ = 0`, `lambda_I4 = 0`, loss of stability, the
 //! end of existence, branch switches, folds) are never read off the grid. Every row is searched for the 1-D
-//! thresholds of [`find_thresholds`] (refined to [`super::thresholds::PARAM_TOL`] in `x`), and so is every column (fixed `x`, refined
-//! to [`super::thresholds::PARAM_TOL`] in `y`; the column's gaits are those of the rows, and neighbours along the column belong to
-//! one family when a verified continuation step in `y` connects them). Each crossing lies on one edge of the
-//! grid. Within each grid cell, the crossings of one curve on its edges are joined (two crossings: one segment,
-//! as in marching squares; more: the closest pairs first), and the segments are chained into
-//! polylines. A polyline's points are all refined crossings; only the straight pieces between them are drawn.
+//! thresholds of [`find_thresholds`] (refined to [`super::thresholds::PARAM_TOL`] in `x`; the family ends come
+//! from the continuations that found the row's gaits, [`super::sweep::SweepPoint::attempts`]), and so are the
+//! columns [`curve_columns`] picks, at most `max_columns` of them, evenly spread with both ends (fixed `x`,
+//! refined to [`super::thresholds::PARAM_TOL`] in `y`; the column's gaits are those of the rows, and neighbours
+//! along the column belong to one family when a verified continuation step in `y` connects them). Each crossing
+//! lies on one edge of the grid. Within each cell between two neighbouring rows and two neighbouring refined
+//! columns, the crossings of one curve on its edges are joined (two crossings: one segment, as in marching
+//! squares; more: the closest pairs first), and the segments are chained into polylines. A polyline's points
+//! are all refined crossings; only the straight pieces between them are drawn.
 //!
 //! The curve of the end of existence joins `gait_lost` and `gait_found` crossings (which of the two a crossing
 //! is depends only on the direction of the line it was refined on).

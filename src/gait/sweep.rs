@@ -265,7 +265,7 @@ fn follow_gait(
 }
 
 /// The point's gait if continuation can start from it: any gait (a period-k gait is continued as a fixed
-/// point of `P^k`) whose Jacobian was computed or not.
+/// point of `P^k`).
 fn continuable(point: &SweepPoint) -> Option<&Gait> {
     point.gait.as_ref()
 }
