@@ -236,3 +236,48 @@ fn lambda_two_plus_vanishes_where_the_period_one_family_gives_way_to_period_two(
         end.detail
     );
 }
+
+/// The same threshold by a second route: period-1 gaits found afresh from the default start (no continuation)
+/// at `k = 593.0`, `593.4` and `593.8`, their `lambda_2+` extrapolated by the parabola through them, vanish within
+/// 1e-5 N/m of the `k = 593.866724` located by continuation (at 593.8667245). (Walks cannot confirm it more closely: near the
+/// border the period-1 gait's basin shrinks to nothing on the bouncing side, and a walk from a state 1e-4 away
+/// already goes over to the coexisting period-2 gait.)
+#[test]
+fn lambda_two_plus_extrapolated_from_fresh_gaits_vanishes_at_the_threshold() {
+    let lambda_2_plus = |k: f64| {
+        let (mut config, _) = stiffness_sweep(k, k + 1.0, 2);
+        config.set_numeric("stiffness", k).unwrap();
+        let model = Model::new(&config.params).unwrap();
+        let map = StepMap::new(&model, &config.solver);
+        let g = find_gait(
+            &map,
+            &default_initial(&config),
+            &GaitOptions::default(),
+            None,
+        )
+        .unwrap();
+        assert_eq!(g.period_k, 1, "{k}");
+        g.lambda_2_plus
+    };
+    let ks = [593.0, 593.4, 593.8];
+    let ls: Vec<f64> = ks.iter().map(|&k| lambda_2_plus(k)).collect();
+    // Newton's method on the Lagrange parabola through the three points, from the last one.
+    let parabola = |k: f64| -> f64 {
+        (0..3)
+            .map(|i| {
+                let others: Vec<usize> = (0..3).filter(|&j| j != i).collect();
+                ls[i]
+                    * others
+                        .iter()
+                        .map(|&j| (k - ks[j]) / (ks[i] - ks[j]))
+                        .product::<f64>()
+            })
+            .sum()
+    };
+    let mut k = ks[2];
+    for _ in 0..20 {
+        let slope = (parabola(k + 1e-6) - parabola(k - 1e-6)) / 2e-6;
+        k -= parabola(k) / slope;
+    }
+    assert!((k - 593.866724).abs() < 1e-5, "{k} ({ls:?})");
+}
