@@ -167,6 +167,14 @@ fn stiffness_sweep(from: f64, to: f64, points: usize) -> (Config, vrw::gait::Swe
     (config, spec)
 }
 
+/// The paper's parameters at `c = 20 N s/m` and stiffness `k`, and their model.
+fn at_c20(k: f64) -> (Config, Model) {
+    let (mut config, _) = stiffness_sweep(k, k + 1.0, 2);
+    config.set_numeric("stiffness", k).unwrap();
+    let model = Model::new(&config.params).unwrap();
+    (config, model)
+}
+
 /// Period-2 BOUNCE gaits (k = 596..604 N/m at c = 20) are one family, continued as fixed points of `P^2`:
 /// every point after the first is continued from its neighbour, and each is a fixed point of `P^2` (checked
 /// by walking two steps) that `P` does not fix.
@@ -186,9 +194,7 @@ fn period_two_gaits_are_continued_as_one_family() {
         if i > 0 {
             assert_eq!(p.continued_from, Some(i - 1), "{}", p.value);
         }
-        let mut c = config.clone();
-        c.set_numeric("stiffness", p.value).unwrap();
-        let model = Model::new(&c.params).unwrap();
+        let (c, model) = at_c20(p.value);
         let map = StepMap::new(&model, &c.solver);
         let once = map.eval(&g.section).unwrap().next;
         let twice = map.iterated(2).eval(&g.section).unwrap().next;
@@ -245,10 +251,9 @@ fn lambda_two_plus_vanishes_where_the_period_one_family_gives_way_to_period_two(
 #[test]
 fn lambda_two_plus_extrapolated_from_fresh_gaits_vanishes_at_the_threshold() {
     let lambda_2_plus = |k: f64| {
-        let (mut config, _) = stiffness_sweep(k, k + 1.0, 2);
-        config.set_numeric("stiffness", k).unwrap();
-        let model = Model::new(&config.params).unwrap();
+        let (config, model) = at_c20(k);
         let map = StepMap::new(&model, &config.solver);
+        // The period-1 search (Newton's method on P after the transient), not the walk's period.
         let g = find_gait(
             &map,
             &default_initial(&config),
