@@ -176,7 +176,7 @@ impl<'a> Continuation<'a> {
         }
     }
 
-    /// The step map at `value` (`P^k` for a period-k family) and the configuration it was built from.
+    /// The configuration with the followed parameter at `value`, and its model.
     fn map_at(&self, value: f64) -> Result<(Config, crate::dynamics::Model), String> {
         configured(self.config, self.param, value).map_err(|e| e.to_string())
     }
@@ -251,7 +251,8 @@ impl<'a> Continuation<'a> {
     /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's
     /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step that fails is retried once
     /// with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere), then halved; a
-    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end). At most [`MAX_FOLLOW_STEPS`] steps are tried
+    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end). At
+    /// most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
     /// ([`Followed::GaveUp`]).
     pub fn follow(&self, from: FamilyPoint, target: f64, guess: Option<&DMatrix<f64>>) -> Followed {
         let mut current = from;
