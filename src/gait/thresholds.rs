@@ -53,9 +53,6 @@ pub struct Threshold {
     pub residual: f64,
     /// What happens past a family's end (its physical cause) or why the search failed.
     pub detail: Option<String>,
-    /// For the end of a family: its last gait (the parameter value and the fixed point).
-    #[serde(skip)]
-    pub last: Option<FamilyPoint>,
 }
 
 /// What a threshold measures on a gait.
@@ -164,13 +161,7 @@ pub fn find_thresholds(
         .flat_map_iter(|task| match task {
             Task::Root(q, a, b) => vec![refine_root(config, spec, *q, a, b, options)],
             Task::End(from, toward) => {
-                match refine_end(config, spec, from, toward, options, gait_before(from.value)) {
-                    Some(end) => {
-                        let vanishing = vanishing_at_end(config, spec, from, &end);
-                        std::iter::once(end).chain(vanishing).collect()
-                    }
-                    None => Vec::new(),
-                }
+                refine_end(config, spec, from, toward, options, gait_before(from.value))
             }
         })
         .collect()
@@ -185,9 +176,10 @@ fn vanishing_at_end(
     config: &Config,
     spec: &SweepSpec,
     from: &SweepPoint,
+    last: &FamilyPoint,
     end: &Threshold,
 ) -> Vec<Threshold> {
-    let (Some(g), Some(last)) = (from.gait.as_ref(), end.last) else {
+    let Some(g) = from.gait.as_ref() else {
         return Vec::new();
     };
     let Ok((c, model)) = configured(config, &spec.param, last.value) else {
@@ -198,7 +190,8 @@ fn vanishing_at_end(
         return Vec::new();
     };
     let run = last.value - from.value;
-    [Quantity::Lambda4Plus, Quantity::Lambda2Plus, Quantity::LambdaI4]
+    // Stability has no value from the indicators (NaN), so only the three DLS indicators can vanish here.
+    Quantity::ALL
         .into_iter()
         .filter_map(|q| {
             let (at_from, at_last) = (q.of(g), q.of_indicators(&out.report.indicators));
@@ -218,14 +211,14 @@ fn vanishing_at_end(
                     last.value,
                     p = spec.param,
                 )),
-                last: None,
             })
         })
         .collect()
 }
 
 /// Follow the family of `from`'s gait toward `toward` to its end, and name the end by what happens just past
-/// it (see the module documentation). `None` if the family reaches `toward` after all and is `toward`'s gait.
+/// it (see the module documentation), followed by the DLS indicators that vanish there
+/// ([`vanishing_at_end`]). Nothing if the family reaches `toward` after all and is `toward`'s gait.
 fn refine_end(
     config: &Config,
     spec: &SweepSpec,
@@ -233,7 +226,7 @@ fn refine_end(
     toward: &SweepPoint,
     options: &GaitOptions,
     gait_before: bool,
-) -> Option<Threshold> {
+) -> Vec<Threshold> {
     let g = from.gait.as_ref().expect("an end starts at a gait");
     let cont = Continuation::new(config, &spec.param, options).with_period(g.period_k);
     let start = FamilyPoint {
@@ -251,7 +244,7 @@ fn refine_end(
     let (last, beyond) = match followed {
         Followed::Ended { last, beyond } => (last, beyond),
         Followed::GaveUp { last, .. } => {
-            return Some(unconfirmed(
+            return vec![unconfirmed(
                 grid_bracket,
                 format!(
                     "the family of {p} = {} was followed only to {p} = {} toward {p} = {} (given up after {} \
@@ -263,7 +256,7 @@ fn refine_end(
                     super::continuation::MAX_FOLLOW_WALKS,
                     p = spec.param,
                 ),
-            ))
+            )]
         }
         Followed::Reached(p) => {
             let same = toward.gait.as_ref().is_some_and(|gt| {
@@ -271,20 +264,20 @@ fn refine_end(
                     <= super::continuation::SAME_GAIT_TOL
             });
             if same {
-                return None;
+                return Vec::new();
             }
             let what = if toward.gait.is_some() {
                 "the sweep found another gait there (two gaits coexist)"
             } else {
                 "the sweep found no gait there"
             };
-            return Some(unconfirmed(
+            return vec![unconfirmed(
                 grid_bracket,
                 format!(
                     "the family of {} = {} reaches {} = {}, but {what}",
                     spec.param, from.value, spec.param, toward.value
                 ),
-            ));
+            )];
         }
     };
     let upward = toward.value > from.value;
@@ -340,15 +333,16 @@ fn refine_end(
             ),
         ),
     };
-    Some(Threshold {
+    let end = Threshold {
         name: name.to_string(),
         value: 0.5 * (last.value + beyond),
         bracket: sorted([last.value, beyond]),
         grid_bracket,
         residual: f64::NAN,
         detail: Some(detail),
-        last: Some(last),
-    })
+    };
+    let vanishing = vanishing_at_end(config, spec, from, &last, &end);
+    std::iter::once(end).chain(vanishing).collect()
 }
 
 /// A family end that could not be located, reported over its grid interval with the reason.
@@ -360,7 +354,6 @@ fn unconfirmed(grid_bracket: [f64; 2], detail: String) -> Threshold {
         grid_bracket,
         residual: f64::NAN,
         detail: Some(detail),
-        last: None,
     }
 }
 
@@ -452,6 +445,5 @@ fn refine_root(
         grid_bracket: [a.value, b.value],
         residual,
         detail,
-        last: None,
     }
 }
