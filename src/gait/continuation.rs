@@ -177,7 +177,7 @@ impl<'a> Continuation<'a> {
     }
 
     /// The configuration with the followed parameter at `value`, and its model.
-    fn map_at(&self, value: f64) -> Result<(Config, crate::dynamics::Model), String> {
+    fn configured_at(&self, value: f64) -> Result<(Config, crate::dynamics::Model), String> {
         configured(self.config, self.param, value).map_err(|e| e.to_string())
     }
 
@@ -188,7 +188,7 @@ impl<'a> Continuation<'a> {
         start: &SectionState,
         guess: Option<&DMatrix<f64>>,
     ) -> Result<FixedPoint, String> {
-        let (c, model) = self.map_at(value)?;
+        let (c, model) = self.configured_at(value)?;
         let map = StepMap::new(&model, &c.solver).iterated(self.period);
         solve_fixed_point(&map, start, &self.options, guess).map_err(|e| e.to_string())
     }
@@ -225,7 +225,7 @@ impl<'a> Continuation<'a> {
     /// period-k family) closer than [`SETTLE_TOL`] within [`SETTLE_STEPS`] steps; `None` if the walk fails or
     /// does not settle.
     fn settle(&self, value: f64, start: &SectionState) -> Option<SectionState> {
-        let (c, model) = self.map_at(value).ok()?;
+        let (c, model) = self.configured_at(value).ok()?;
         let mut walker = Walker::new(&model, &c.solver, start).ok()?;
         let mut previous = *start;
         for _ in 0..SETTLE_STEPS.div_ceil(self.period) {
@@ -243,7 +243,7 @@ impl<'a> Continuation<'a> {
 
     /// `DP` (`D(P^k)` for a period-k family; central differences) of the gait `at`.
     fn jacobian(&self, at: &FamilyPoint) -> Option<DMatrix<f64>> {
-        let (c, model) = self.map_at(at.value).ok()?;
+        let (c, model) = self.configured_at(at.value).ok()?;
         let map = StepMap::new(&model, &c.solver).iterated(self.period);
         map.central_jacobian(&at.section, self.options.fd_step).ok()
     }
@@ -342,12 +342,12 @@ impl<'a> Continuation<'a> {
     /// What happens at `beyond`, just past the end of the family whose last gait is `last`: walk from it (see
     /// [`EndCause`]).
     pub fn end_cause(&self, last: &FamilyPoint, beyond: f64) -> EndCause {
-        let (c, model) = match configured(self.config, self.param, beyond) {
+        let (c, model) = match self.configured_at(beyond) {
             Ok(x) => x,
-            Err(e) => {
+            Err(message) => {
                 return EndCause::WalkFails {
                     failure: "invalid_parameter".to_string(),
-                    message: e.to_string(),
+                    message,
                 }
             }
         };
