@@ -31,6 +31,9 @@
 
 use nalgebra::SVector;
 
+mod dop853;
+pub use dop853::Dop853;
+
 /// A first-order system y' = f(t, y).
 pub trait OdeSystem<const N: usize> {
     /// The right-hand side f(t, y).
@@ -178,22 +181,25 @@ fn scaled_rms<const N: usize>(
     (sum / N as f64).sqrt()
 }
 
-/// One accepted Dormand-Prince 5(4) step with its 4th-order continuous extension (Hairer's DOPRI5 dense output).
+/// One accepted step with its continuous extension (dense output), in the nested form of Hairer's codes.
 ///
-/// With `θ = (t - t0)/(t1 - t0)` the interpolant is (HNW I, Sec. II.6; Shampine 1986)
-/// `y(t) = y0 + θ (Δ + (1-θ) (b + θ (c4 + (1-θ) c5)))` with `Δ = y1 - y0`, `b = h k1 - Δ`,
-/// `c4 = Δ - h k7 - b`, `c5 = h Σ d_i k_i`. It matches y0, y1, f0 and f1 and is 4th-order accurate.
+/// With `θ = (t - t0)/(t1 - t0)` the interpolant is
+/// `y(t) = c0 + θ (c1 + (1-θ) (c2 + θ (c3 + (1-θ) (c4 + θ (c5 + (1-θ) (c6 + θ c7))))))`, truncated after the
+/// last coefficient the method has: five for [`Dopri5`] (`c0 = y0`, `c1 = Δ = y1 - y0`, `c2 = h k1 - Δ`,
+/// `c3 = Δ - h k7 - c2`, `c4 = h Σ d_i k_i`: Shampine's 4th-order extension, `contd5` of `dopri5`), eight for
+/// [`Dop853`] (its 7th-order extension, `contd8` of `dop853`). It matches y0, y1, f0 and f1.
 #[derive(Debug, Clone)]
 pub struct DenseStep<const N: usize> {
     t0: f64,
     t1: f64,
-    y0: SVector<f64, N>,
     y1: SVector<f64, N>,
-    delta: SVector<f64, N>,
-    bspl: SVector<f64, N>,
-    c4: SVector<f64, N>,
-    c5: SVector<f64, N>,
+    /// `c0 .. c7`; only the first `terms` are used.
+    cont: [SVector<f64, N>; MAX_DENSE_TERMS],
+    terms: usize,
 }
+
+/// Most coefficients of a continuous extension ([`Dop853`] has eight).
+const MAX_DENSE_TERMS: usize = 8;
 
 impl<const N: usize> DenseStep<N> {
     /// Start time of the step \[s\].
@@ -208,7 +214,7 @@ impl<const N: usize> DenseStep<N> {
 
     /// State at [`t0`](Self::t0).
     pub fn y0(&self) -> &SVector<f64, N> {
-        &self.y0
+        &self.cont[0]
     }
 
     /// State at [`t1`](Self::t1).
@@ -226,7 +232,31 @@ impl<const N: usize> DenseStep<N> {
         }
         let theta = (t - self.t0) / (self.t1 - self.t0);
         let theta1 = 1.0 - theta;
-        self.y0 + (self.delta + (self.bspl + (self.c4 + self.c5 * theta1) * theta) * theta1) * theta
+        // Innermost first: c_{n-1}, then c_k + (θ or 1-θ) * (...) down to c0 + θ (...).
+        let mut acc = self.cont[self.terms - 1];
+        for k in (0..self.terms - 1).rev() {
+            let factor = if k % 2 == 0 { theta } else { theta1 };
+            acc = self.cont[k] + acc * factor;
+        }
+        acc
+    }
+
+    /// A dense step from its coefficients `c0 ..` (see the type's documentation).
+    fn from_coefficients(
+        t0: f64,
+        t1: f64,
+        y1: SVector<f64, N>,
+        coefficients: &[SVector<f64, N>],
+    ) -> Self {
+        let mut cont = [SVector::zeros(); MAX_DENSE_TERMS];
+        cont[..coefficients.len()].copy_from_slice(coefficients);
+        DenseStep {
+            t0,
+            t1,
+            y1,
+            cont,
+            terms: coefficients.len(),
+        }
     }
 }
 
@@ -415,16 +445,18 @@ impl<const N: usize> Dopri5<N> {
 
                 let delta = y1 - y0;
                 let bspl = k1 * h - delta;
-                let dense = DenseStep {
-                    t0: t,
+                let dense = DenseStep::from_coefficients(
+                    t,
                     t1,
-                    y0,
                     y1,
-                    delta,
-                    bspl,
-                    c4: delta - k7 * h - bspl,
-                    c5: (k1 * D1 + k3 * D3 + k4 * D4 + k5 * D5 + k6 * D6 + k7 * D7) * h,
-                };
+                    &[
+                        y0,
+                        delta,
+                        bspl,
+                        delta - k7 * h - bspl,
+                        (k1 * D1 + k3 * D3 + k4 * D4 + k5 * D5 + k6 * D6 + k7 * D7) * h,
+                    ],
+                );
                 self.t = t1;
                 self.y = y1;
                 self.dy = k7;
@@ -446,29 +478,40 @@ impl<const N: usize> Dopri5<N> {
         self.h = self.initial_step(sys);
     }
 
-    /// Hairer's starting-step heuristic: h0 = 0.01 ||y0|| / ||f0||, one explicit Euler step to
-    /// estimate ||y''||, then h = min(100 h0, (0.01 / max(||f0||, ||y''||))^(1/5), h_max).
     fn initial_step(&mut self, sys: &impl OdeSystem<N>) -> f64 {
-        let (y0, f0) = (&self.y, &self.dy);
-        let d0 = scaled_rms(&self.tol, y0, y0, y0);
-        let d1 = scaled_rms(&self.tol, f0, y0, y0);
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-            1e-6
-        } else {
-            0.01 * d0 / d1
-        }
-        .min(self.tol.h_max);
-        let f1 = sys.rhs(self.t + h0, &(y0 + f0 * h0));
         self.stats.rhs_evals += 2;
-        let d2 = scaled_rms(&self.tol, &(f1 - f0), y0, y0) / h0;
-        let d12 = d1.max(d2);
-        let h1 = if d12 <= 1e-15 {
-            (h0 * 1e-3).max(1e-6)
-        } else {
-            (0.01 / d12).powf(1.0 / f64::from(HINIT_ORDER))
-        };
-        (100.0 * h0).min(h1).min(self.tol.h_max)
+        initial_step(sys, &self.tol, self.t, &self.y, &self.dy, HINIT_ORDER)
     }
+}
+
+/// Hairer's starting-step heuristic for a method whose local error is `~ h^order`: h0 = 0.01 ||y0|| / ||f0||,
+/// one explicit Euler step to estimate ||y''||, then h = min(100 h0, (0.01 / max(||f0||, ||y''||))^(1/order),
+/// h_max). Costs one right-hand-side evaluation (the caller counts it with the one of `f0`).
+fn initial_step<const N: usize>(
+    sys: &impl OdeSystem<N>,
+    tol: &Tolerances,
+    t: f64,
+    y0: &SVector<f64, N>,
+    f0: &SVector<f64, N>,
+    order: i32,
+) -> f64 {
+    let d0 = scaled_rms(tol, y0, y0, y0);
+    let d1 = scaled_rms(tol, f0, y0, y0);
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    }
+    .min(tol.h_max);
+    let f1 = sys.rhs(t + h0, &(y0 + f0 * h0));
+    let d2 = scaled_rms(tol, &(f1 - f0), y0, y0) / h0;
+    let d12 = d1.max(d2);
+    let h1 = if d12 <= 1e-15 {
+        (h0 * 1e-3).max(1e-6)
+    } else {
+        (0.01 / d12).powf(1.0 / f64::from(order))
+    };
+    (100.0 * h0).min(h1).min(tol.h_max)
 }
 
 fn all_finite<const N: usize>(v: &SVector<f64, N>) -> bool {
@@ -564,6 +607,126 @@ pub fn locate_root<const N: usize>(
     hi
 }
 
+/// Which Runge-Kutta pair integrates (the `integrator` key of a configuration).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// [`Dop853`]: order 8 with a 7th-order dense output. Default.
+    Dop853,
+    /// [`Dopri5`]: order 5 with a 4th-order dense output.
+    Dopri5,
+}
+
+impl Method {
+    /// The name of the method (`"dop853"` or `"dopri5"`), as in configurations.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Dop853 => "dop853",
+            Method::Dopri5 => "dopri5",
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An adaptive integrator of either [`Method`], driven one accepted step at a time.
+#[derive(Debug, Clone)]
+pub enum Integrator<const N: usize> {
+    /// DOP853.
+    Dop853(Dop853<N>),
+    /// DOPRI5.
+    Dopri5(Dopri5<N>),
+}
+
+impl<const N: usize> Integrator<N> {
+    /// Start `method` at (t0, y0) (see [`Dopri5::new`]).
+    pub fn new(
+        method: Method,
+        sys: &impl OdeSystem<N>,
+        t0: f64,
+        y0: SVector<f64, N>,
+        tol: Tolerances,
+    ) -> Self {
+        match method {
+            Method::Dop853 => Integrator::Dop853(Dop853::new(sys, t0, y0, tol)),
+            Method::Dopri5 => Integrator::Dopri5(Dopri5::new(sys, t0, y0, tol)),
+        }
+    }
+
+    /// One accepted step, never passing `t_stop` (see [`Dopri5::step`]).
+    ///
+    /// # Errors
+    /// As [`Dopri5::step`].
+    pub fn step(
+        &mut self,
+        sys: &impl OdeSystem<N>,
+        t_stop: f64,
+    ) -> Result<DenseStep<N>, IntegrationError> {
+        match self {
+            Integrator::Dop853(s) => s.step(sys, t_stop),
+            Integrator::Dopri5(s) => s.step(sys, t_stop),
+        }
+    }
+
+    /// Restart at (t, y), possibly with a new vector field (see [`Dopri5::restart`]).
+    pub fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
+        match self {
+            Integrator::Dop853(s) => s.restart(sys, t, y),
+            Integrator::Dopri5(s) => s.restart(sys, t, y),
+        }
+    }
+
+    /// Work counters.
+    pub fn stats(&self) -> Stats {
+        match self {
+            Integrator::Dop853(s) => s.stats(),
+            Integrator::Dopri5(s) => s.stats(),
+        }
+    }
+
+    /// Current time \[s\].
+    pub fn t(&self) -> f64 {
+        match self {
+            Integrator::Dop853(s) => s.t(),
+            Integrator::Dopri5(s) => s.t(),
+        }
+    }
+
+    /// Current state.
+    pub fn y(&self) -> &SVector<f64, N> {
+        match self {
+            Integrator::Dop853(s) => s.y(),
+            Integrator::Dopri5(s) => s.y(),
+        }
+    }
+
+    /// Derivative f(t, y) at the current point (FSAL value).
+    pub fn dy(&self) -> &SVector<f64, N> {
+        match self {
+            Integrator::Dop853(s) => s.dy(),
+            Integrator::Dopri5(s) => s.dy(),
+        }
+    }
+
+    /// Move back to time `t` inside the last step, possibly with a new vector field (see [`Dopri5::rewind`]).
+    ///
+    /// # Panics
+    /// If `t` is outside `[step.t0(), step.t1()]`.
+    pub fn rewind(&mut self, sys: &impl OdeSystem<N>, step: &DenseStep<N>, t: f64) {
+        assert!(
+            step.t0 <= t && t <= step.t1,
+            "rewind time {t} outside the step [{}, {}]",
+            step.t0,
+            step.t1
+        );
+        self.restart(sys, t, step.eval(t));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -585,6 +748,12 @@ mod tests {
     /// A 4th-order continuous extension has local error O(h^5): halving h divides it by ~32.
     /// Requiring >= 16 (= 2^4) fails for an interpolant of order 3 or less.
     const MIN_DENSE_ERROR_RATIO: f64 = 16.0;
+    /// The same for DOP853's 7th-order extension (local error O(h^8), ~256 per halving): >= 2^7.
+    const MIN_DENSE853_ERROR_RATIO: f64 = 128.0;
+    /// Largest distance of the observed convergence order from the method's order.
+    const ORDER_TOL: f64 = 0.5;
+    /// Both methods, for the tests that hold for each.
+    const METHODS: [Method; 2] = [Method::Dop853, Method::Dopri5];
     /// Roundoff allowance for times built from sums of floating-point steps \[s\].
     const TIME_ROUNDOFF: f64 = 1e-14;
     /// Safety cap on steps in test loops, so a broken solver fails instead of hanging.
@@ -596,7 +765,7 @@ mod tests {
 
     /// Step until `g` goes from > 0 to <= 0; returns the located time and the step holding it.
     fn first_downward_crossing<const N: usize>(
-        solver: &mut Dopri5<N>,
+        solver: &mut Integrator<N>,
         sys: &impl OdeSystem<N>,
         t_end: f64,
         g: impl Fn(f64, &SVector<f64, N>) -> f64,
@@ -627,116 +796,123 @@ mod tests {
 
     #[test]
     fn falling_point_impact_time_is_exact() {
-        for v0 in [0.5, 0.0, -0.3] {
-            let sys = FallingPoint {
-                h0: 1.0,
-                v0,
-                g: 9.81,
-            };
-            let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tight());
-            let (t, step) =
-                first_downward_crossing(&mut solver, &sys, 10.0, |_, y| y[0], ROOT_T_TOL);
-            let err = t - sys.exact_impact_time();
-            eprintln!("falling point v0 = {v0}: impact time error {err:e} s");
-            assert_abs_diff_eq!(t, sys.exact_impact_time(), epsilon = IMPACT_TIME_TOL);
-            assert!(
-                step.eval(t)[0] <= 0.0,
-                "located time is before the crossing"
-            );
+        for method in METHODS {
+            for v0 in [0.5, 0.0, -0.3] {
+                let sys = FallingPoint {
+                    h0: 1.0,
+                    v0,
+                    g: 9.81,
+                };
+                let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tight());
+                let (t, step) =
+                    first_downward_crossing(&mut solver, &sys, 10.0, |_, y| y[0], ROOT_T_TOL);
+                let err = t - sys.exact_impact_time();
+                eprintln!("falling point v0 = {v0}: impact time error {err:e} s");
+                assert_abs_diff_eq!(t, sys.exact_impact_time(), epsilon = IMPACT_TIME_TOL);
+                assert!(
+                    step.eval(t)[0] <= 0.0,
+                    "located time is before the crossing"
+                );
+            }
         }
     }
 
     #[test]
     fn locate_root_is_after_crossing_within_t_tol() {
-        let sys = FallingPoint {
-            h0: 1.0,
-            v0: 0.5,
-            g: 9.81,
-        };
-        let t_exact = sys.exact_impact_time();
-        for t_tol in [1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 1e-13] {
-            let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tight());
-            let (t, step) = first_downward_crossing(&mut solver, &sys, 10.0, |_, y| y[0], t_tol);
-            assert!(
-                step.eval(t)[0] <= 0.0,
-                "t_tol {t_tol:e}: located time before the crossing"
-            );
-            assert!(
-                t >= t_exact - TIME_ROUNDOFF,
-                "t_tol {t_tol:e}: {t} before {t_exact}"
-            );
-            assert!(
-                t <= t_exact + t_tol + TIME_ROUNDOFF,
-                "t_tol {t_tol:e}: {t} too late"
-            );
+        for method in METHODS {
+            let sys = FallingPoint {
+                h0: 1.0,
+                v0: 0.5,
+                g: 9.81,
+            };
+            let t_exact = sys.exact_impact_time();
+            for t_tol in [1e-3, 1e-5, 1e-7, 1e-9, 1e-11, 1e-13] {
+                let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tight());
+                let (t, step) =
+                    first_downward_crossing(&mut solver, &sys, 10.0, |_, y| y[0], t_tol);
+                assert!(
+                    step.eval(t)[0] <= 0.0,
+                    "t_tol {t_tol:e}: located time before the crossing"
+                );
+                assert!(
+                    t >= t_exact - TIME_ROUNDOFF,
+                    "t_tol {t_tol:e}: {t} before {t_exact}"
+                );
+                assert!(
+                    t <= t_exact + t_tol + TIME_ROUNDOFF,
+                    "t_tol {t_tol:e}: {t} too late"
+                );
+            }
         }
     }
 
     #[test]
     fn oscillator_crossings_final_state_and_energy() {
-        let sys = HarmonicOscillator {
-            omega: 3.0,
-            amplitude: 0.7,
-            phase: 0.3,
-        };
-        let tol = Tolerances {
-            rtol: 1e-10,
-            atol: 1e-12,
-            ..Tolerances::default()
-        };
-        let t_end = 10.0 * 2.0 * PI / sys.omega;
-        let energy =
-            |y: &SVector<f64, 2>| 0.5 * (y[1] * y[1] + sys.omega * sys.omega * y[0] * y[0]);
-        let e0 = energy(&sys.exact(0.0));
-        let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tol);
-        let mut crossings = Vec::new();
-        let mut max_drift: f64 = 0.0;
-        while solver.t() < t_end {
-            let step = solver.step(&sys, t_end).expect("integration failed");
-            max_drift = max_drift.max(((energy(step.y1()) - e0) / e0).abs());
-            let (g_a, g_b) = (step.y0()[0], step.y1()[0]);
-            if g_a != 0.0 && g_a * g_b <= 0.0 {
-                let t = locate_root(
-                    &step,
-                    |_, y| y[0],
-                    step.t0(),
-                    g_a,
-                    step.t1(),
-                    g_b,
-                    ROOT_T_TOL,
-                );
-                let x = step.eval(t)[0];
-                assert!(
-                    x == 0.0 || x.signum() == g_b.signum(),
-                    "crossing at {t} not past the root"
-                );
-                crossings.push(t);
+        for method in METHODS {
+            let sys = HarmonicOscillator {
+                omega: 3.0,
+                amplitude: 0.7,
+                phase: 0.3,
+            };
+            let tol = Tolerances {
+                rtol: 1e-10,
+                atol: 1e-12,
+                ..Tolerances::default()
+            };
+            let t_end = 10.0 * 2.0 * PI / sys.omega;
+            let energy =
+                |y: &SVector<f64, 2>| 0.5 * (y[1] * y[1] + sys.omega * sys.omega * y[0] * y[0]);
+            let e0 = energy(&sys.exact(0.0));
+            let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tol);
+            let mut crossings = Vec::new();
+            let mut max_drift: f64 = 0.0;
+            while solver.t() < t_end {
+                let step = solver.step(&sys, t_end).expect("integration failed");
+                max_drift = max_drift.max(((energy(step.y1()) - e0) / e0).abs());
+                let (g_a, g_b) = (step.y0()[0], step.y1()[0]);
+                if g_a != 0.0 && g_a * g_b <= 0.0 {
+                    let t = locate_root(
+                        &step,
+                        |_, y| y[0],
+                        step.t0(),
+                        g_a,
+                        step.t1(),
+                        g_b,
+                        ROOT_T_TOL,
+                    );
+                    let x = step.eval(t)[0];
+                    assert!(
+                        x == 0.0 || x.signum() == g_b.signum(),
+                        "crossing at {t} not past the root"
+                    );
+                    crossings.push(t);
+                }
             }
-        }
-        assert_eq!(solver.t(), t_end);
-        assert!(crossings.len() >= 10);
-        let max_crossing_err = crossings
-            .iter()
-            .take(10)
-            .enumerate()
-            .map(|(k, t)| (t - sys.zero_crossing(k)).abs())
-            .fold(0.0, f64::max);
-        let final_err = (solver.y() - sys.exact(t_end)).amax();
-        eprintln!(
+            assert_eq!(solver.t(), t_end);
+            assert!(crossings.len() >= 10);
+            let max_crossing_err = crossings
+                .iter()
+                .take(10)
+                .enumerate()
+                .map(|(k, t)| (t - sys.zero_crossing(k)).abs())
+                .fold(0.0, f64::max);
+            let final_err = (solver.y() - sys.exact(t_end)).amax();
+            eprintln!(
             "oscillator: max crossing error {max_crossing_err:e} s, final state error {final_err:e}, \
              max relative energy drift {max_drift:e}, {:?}",
             solver.stats()
         );
-        for (k, t) in crossings.iter().take(10).enumerate() {
-            assert_abs_diff_eq!(*t, sys.zero_crossing(k), epsilon = CROSSING_TIME_TOL);
+            for (k, t) in crossings.iter().take(10).enumerate() {
+                assert_abs_diff_eq!(*t, sys.zero_crossing(k), epsilon = CROSSING_TIME_TOL);
+            }
+            assert_abs_diff_eq!(*solver.y(), sys.exact(t_end), epsilon = FINAL_STATE_TOL);
+            assert!(max_drift < ENERGY_DRIFT_TOL, "energy drift {max_drift:e}");
         }
-        assert_abs_diff_eq!(*solver.y(), sys.exact(t_end), epsilon = FINAL_STATE_TOL);
-        assert!(max_drift < ENERGY_DRIFT_TOL, "energy drift {max_drift:e}");
     }
 
     /// Largest dense-output error inside steps of size exactly `h_max`, against the exact flow
     /// from each step's start (so only the interpolation error is measured).
-    fn max_dense_error(h_max: f64) -> f64 {
+    fn max_dense_error(method: Method, h_max: f64) -> f64 {
         let sys = HarmonicOscillator {
             omega: 2.0,
             amplitude: 1.0,
@@ -749,7 +925,7 @@ mod tests {
             h_max,
             ..Tolerances::default()
         };
-        let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tol);
+        let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tol);
         let (mut max_err, mut full_steps) = (0.0_f64, 0);
         while solver.t() < 4.0 {
             let step = solver.step(&sys, 4.0).expect("integration failed");
@@ -769,106 +945,162 @@ mod tests {
     }
 
     #[test]
-    fn dense_output_is_fourth_order() {
-        let (coarse, fine) = (max_dense_error(0.1), max_dense_error(0.05));
-        let ratio = coarse / fine;
-        eprintln!("dense output error: h=0.1 {coarse:e}, h=0.05 {fine:e}, ratio {ratio:.1}");
-        assert!(ratio >= MIN_DENSE_ERROR_RATIO, "ratio {ratio}");
+    fn dense_output_has_the_methods_order() {
+        // DOPRI5's continuous extension is of order 4, DOP853's of order 7.
+        for (method, min_ratio) in [
+            (Method::Dopri5, MIN_DENSE_ERROR_RATIO),
+            (Method::Dop853, MIN_DENSE853_ERROR_RATIO),
+        ] {
+            let (coarse, fine) = (max_dense_error(method, 0.1), max_dense_error(method, 0.05));
+            let ratio = coarse / fine;
+            eprintln!(
+                "{method} dense output error: h=0.1 {coarse:e}, h=0.05 {fine:e}, ratio {ratio:.1}"
+            );
+            assert!(ratio >= min_ratio, "{method}: ratio {ratio}");
+        }
+    }
+
+    /// Error at t = 4 of the oscillator integrated in steps of exactly `h` (the tolerance so loose that `h`
+    /// binds).
+    fn global_error(method: Method, h: f64) -> f64 {
+        let sys = HarmonicOscillator {
+            omega: 2.0,
+            amplitude: 1.0,
+            phase: 0.0,
+        };
+        let tol = Tolerances {
+            rtol: 1.0,
+            atol: 1.0,
+            h_max: h,
+            ..Tolerances::default()
+        };
+        let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tol);
+        while solver.t() < 4.0 {
+            solver.step(&sys, 4.0).expect("integration failed");
+        }
+        (solver.y() - sys.exact(4.0)).amax()
+    }
+
+    /// The tableau taken from `differential-equations` gives a method of order 8 (and DOPRI5 one of order 5):
+    /// halving the step divides the global error by about 2^8 (2^5).
+    #[test]
+    fn methods_converge_with_their_order() {
+        for (method, order) in [(Method::Dopri5, 5), (Method::Dop853, 8)] {
+            let (coarse, fine) = (global_error(method, 0.2), global_error(method, 0.1));
+            let observed = (coarse / fine).log2();
+            eprintln!(
+                "{method}: global error {coarse:e} -> {fine:e}, observed order {observed:.2}"
+            );
+            assert!(
+                (observed - f64::from(order)).abs() < ORDER_TOL,
+                "{method}: observed order {observed}"
+            );
+        }
     }
 
     #[test]
     fn dense_output_matches_step_ends() {
-        let sys = HarmonicOscillator {
-            omega: 3.0,
-            amplitude: 0.7,
-            phase: 0.3,
-        };
-        let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tight());
-        let y_start = *solver.y();
-        let step = solver.step(&sys, 1.0).unwrap();
-        assert_eq!(step.eval(step.t0()), y_start);
-        assert_eq!(step.eval(step.t1()), *solver.y());
-        assert_eq!(step.y1(), solver.y());
-        assert_eq!(step.t1(), solver.t());
+        for method in METHODS {
+            let sys = HarmonicOscillator {
+                omega: 3.0,
+                amplitude: 0.7,
+                phase: 0.3,
+            };
+            let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tight());
+            let y_start = *solver.y();
+            let step = solver.step(&sys, 1.0).unwrap();
+            assert_eq!(step.eval(step.t0()), y_start);
+            assert_eq!(step.eval(step.t1()), *solver.y());
+            assert_eq!(step.y1(), solver.y());
+            assert_eq!(step.t1(), solver.t());
+        }
     }
 
     #[test]
     fn step_lands_exactly_on_t_stop() {
-        let sys = HarmonicOscillator {
-            omega: 3.0,
-            amplitude: 0.7,
-            phase: 0.3,
-        };
-        let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tight());
-        let t_stop = 0.123_456_789;
-        while solver.t() < t_stop {
-            let step = solver.step(&sys, t_stop).unwrap();
-            assert!(step.t1() <= t_stop);
+        for method in METHODS {
+            let sys = HarmonicOscillator {
+                omega: 3.0,
+                amplitude: 0.7,
+                phase: 0.3,
+            };
+            let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tight());
+            let t_stop = 0.123_456_789;
+            while solver.t() < t_stop {
+                let step = solver.step(&sys, t_stop).unwrap();
+                assert!(step.t1() <= t_stop);
+            }
+            assert_eq!(solver.t(), t_stop);
+            // A sliver far below h_min still lands exactly (h_min limits the controller only).
+            let t_sliver = t_stop + 1e-16;
+            assert!(t_sliver > t_stop);
+            let step = solver.step(&sys, t_sliver).unwrap();
+            assert_eq!(step.t1(), t_sliver);
+            assert_eq!(solver.t(), t_sliver);
+            assert_abs_diff_eq!(*solver.y(), sys.exact(t_sliver), epsilon = FINAL_STATE_TOL);
         }
-        assert_eq!(solver.t(), t_stop);
-        // A sliver far below h_min still lands exactly (h_min limits the controller only).
-        let t_sliver = t_stop + 1e-16;
-        assert!(t_sliver > t_stop);
-        let step = solver.step(&sys, t_sliver).unwrap();
-        assert_eq!(step.t1(), t_sliver);
-        assert_eq!(solver.t(), t_sliver);
-        assert_abs_diff_eq!(*solver.y(), sys.exact(t_sliver), epsilon = FINAL_STATE_TOL);
     }
 
     #[test]
     fn restart_with_reset_state_and_new_vector_field() {
-        // A ball bounces with restitution e on a floor and lands on a planet with other gravity.
-        let (e, g2) = (0.8, 3.7);
-        let fall = FallingPoint {
-            h0: 1.0,
-            v0: 0.5,
-            g: 9.81,
-        };
-        let mut solver = Dopri5::new(&fall, 0.0, fall.exact(0.0), tight());
-        let (t1, step) = first_downward_crossing(&mut solver, &fall, 10.0, |_, y| y[0], ROOT_T_TOL);
-        let y1 = step.eval(t1);
-        let rise = FallingPoint {
-            h0: 0.0,
-            v0: -e * y1[1],
-            g: g2,
-        };
-        solver.restart(&rise, t1, SVector::<f64, 2>::new(y1[0], -e * y1[1]));
-        assert_eq!(solver.t(), t1);
-        assert_eq!(*solver.dy(), rise.rhs(t1, solver.y()));
-        // z starts at <= 0 (post-crossing side) and rises: no spurious re-detection of t1.
-        let (t2, _) = first_downward_crossing(&mut solver, &rise, 10.0, |_, y| y[0], ROOT_T_TOL);
-        let t1_exact = fall.exact_impact_time();
-        let t2_exact = t1_exact + 2.0 * e * (fall.g * t1_exact - fall.v0) / g2;
-        eprintln!("bounce: second impact error {:e} s", t2 - t2_exact);
-        assert!(t2 - t1 > 0.1, "reset re-reported the old root");
-        assert_abs_diff_eq!(t2, t2_exact, epsilon = IMPACT_TIME_TOL);
+        for method in METHODS {
+            // A ball bounces with restitution e on a floor and lands on a planet with other gravity.
+            let (e, g2) = (0.8, 3.7);
+            let fall = FallingPoint {
+                h0: 1.0,
+                v0: 0.5,
+                g: 9.81,
+            };
+            let mut solver = Integrator::new(method, &fall, 0.0, fall.exact(0.0), tight());
+            let (t1, step) =
+                first_downward_crossing(&mut solver, &fall, 10.0, |_, y| y[0], ROOT_T_TOL);
+            let y1 = step.eval(t1);
+            let rise = FallingPoint {
+                h0: 0.0,
+                v0: -e * y1[1],
+                g: g2,
+            };
+            solver.restart(&rise, t1, SVector::<f64, 2>::new(y1[0], -e * y1[1]));
+            assert_eq!(solver.t(), t1);
+            assert_eq!(*solver.dy(), rise.rhs(t1, solver.y()));
+            // z starts at <= 0 (post-crossing side) and rises: no spurious re-detection of t1.
+            let (t2, _) =
+                first_downward_crossing(&mut solver, &rise, 10.0, |_, y| y[0], ROOT_T_TOL);
+            let t1_exact = fall.exact_impact_time();
+            let t2_exact = t1_exact + 2.0 * e * (fall.g * t1_exact - fall.v0) / g2;
+            eprintln!("bounce: second impact error {:e} s", t2 - t2_exact);
+            assert!(t2 - t1 > 0.1, "reset re-reported the old root");
+            assert_abs_diff_eq!(t2, t2_exact, epsilon = IMPACT_TIME_TOL);
+        }
     }
 
     #[test]
     fn rewind_to_event_inside_step_with_new_vector_field() {
-        // At the first zero of x the frequency changes from w1 to w2 (same state, new field).
-        let osc1 = HarmonicOscillator {
-            omega: 3.0,
-            amplitude: 0.7,
-            phase: 0.3,
-        };
-        let osc2 = HarmonicOscillator { omega: 5.0, ..osc1 };
-        let mut solver = Dopri5::new(&osc1, 0.0, osc1.exact(0.0), tight());
-        let (t_c, step) =
-            first_downward_crossing(&mut solver, &osc1, 10.0, |_, y| y[0], ROOT_T_TOL);
-        assert!(t_c < step.t1(), "event should be inside the step");
-        solver.rewind(&osc2, &step, t_c);
-        assert_eq!(solver.t(), t_c);
-        assert_eq!(*solver.y(), step.eval(t_c));
-        let y_c = *solver.y();
-        // x now goes negative then comes back up; its next zero is half a period of w2 later.
-        let (t_next, _) =
-            first_downward_crossing(&mut solver, &osc2, 10.0, |_, y| -y[0], ROOT_T_TOL);
-        let t_exact = osc1.zero_crossing(0) + PI / osc2.omega;
-        eprintln!("rewind: next crossing error {:e} s", t_next - t_exact);
-        assert_abs_diff_eq!(t_next, t_exact, epsilon = CROSSING_TIME_TOL);
-        let at_next = oscillator_flow(osc2.omega, &y_c, t_next - t_c);
-        assert_abs_diff_eq!(at_next[0], 0.0, epsilon = FINAL_STATE_TOL);
+        for method in METHODS {
+            // At the first zero of x the frequency changes from w1 to w2 (same state, new field).
+            let osc1 = HarmonicOscillator {
+                omega: 3.0,
+                amplitude: 0.7,
+                phase: 0.3,
+            };
+            let osc2 = HarmonicOscillator { omega: 5.0, ..osc1 };
+            let mut solver = Integrator::new(method, &osc1, 0.0, osc1.exact(0.0), tight());
+            let (t_c, step) =
+                first_downward_crossing(&mut solver, &osc1, 10.0, |_, y| y[0], ROOT_T_TOL);
+            assert!(t_c < step.t1(), "event should be inside the step");
+            solver.rewind(&osc2, &step, t_c);
+            assert_eq!(solver.t(), t_c);
+            assert_eq!(*solver.y(), step.eval(t_c));
+            let y_c = *solver.y();
+            // x now goes negative then comes back up; its next zero is half a period of w2 later.
+            let (t_next, _) =
+                first_downward_crossing(&mut solver, &osc2, 10.0, |_, y| -y[0], ROOT_T_TOL);
+            let t_exact = osc1.zero_crossing(0) + PI / osc2.omega;
+            eprintln!("rewind: next crossing error {:e} s", t_next - t_exact);
+            assert_abs_diff_eq!(t_next, t_exact, epsilon = CROSSING_TIME_TOL);
+            let at_next = oscillator_flow(osc2.omega, &y_c, t_next - t_c);
+            assert_abs_diff_eq!(at_next[0], 0.0, epsilon = FINAL_STATE_TOL);
+        }
     }
 
     /// y' = y², y(0) = 1: y = 1/(1 - t) blows up at t = 1.
@@ -889,7 +1121,7 @@ mod tests {
 
     /// Run until the first error (the test systems never reach `t_end`).
     fn run_until_error<const N: usize>(
-        solver: &mut Dopri5<N>,
+        solver: &mut Integrator<N>,
         sys: &impl OdeSystem<N>,
         t_end: f64,
     ) -> IntegrationError {
@@ -904,49 +1136,62 @@ mod tests {
 
     #[test]
     fn blow_up_returns_step_size_too_small() {
-        let tol = tight();
-        let mut solver = Dopri5::new(&Riccati, 0.0, SVector::<f64, 1>::new(1.0), tol);
-        let err = run_until_error(&mut solver, &Riccati, 2.0);
-        eprintln!(
-            "blow-up: {err} after {:?}, y = {:e}",
-            solver.stats(),
-            solver.y()[0]
-        );
-        match err {
-            IntegrationError::StepSizeTooSmall { time, h_min } => {
-                assert_eq!(h_min, tol.h_min);
-                assert_eq!(time, solver.t());
-                assert!(time < 1.0 && time > 1.0 - 1e-6, "stopped at {time}");
+        for method in METHODS {
+            let tol = tight();
+            let mut solver =
+                Integrator::new(method, &Riccati, 0.0, SVector::<f64, 1>::new(1.0), tol);
+            let err = run_until_error(&mut solver, &Riccati, 2.0);
+            eprintln!(
+                "blow-up: {err} after {:?}, y = {:e}",
+                solver.stats(),
+                solver.y()[0]
+            );
+            match err {
+                IntegrationError::StepSizeTooSmall { time, h_min } => {
+                    assert_eq!(h_min, tol.h_min);
+                    assert_eq!(time, solver.t());
+                    // Within rounding of the singularity (DOP853 may step a hair past it).
+                    assert!((time - 1.0).abs() < 1e-6, "stopped at {time}");
+                }
+                other => panic!("expected StepSizeTooSmall, got {other:?}"),
             }
-            other => panic!("expected StepSizeTooSmall, got {other:?}"),
         }
     }
 
     #[test]
     fn nan_system_returns_non_finite() {
-        let nan_everywhere = |_: f64| SVector::<f64, 1>::new(f64::NAN);
-        struct AlwaysNan<F>(F);
-        impl<F: Fn(f64) -> SVector<f64, 1>> OdeSystem<1> for AlwaysNan<F> {
-            fn rhs(&self, t: f64, _y: &SVector<f64, 1>) -> SVector<f64, 1> {
-                (self.0)(t)
+        for method in METHODS {
+            let nan_everywhere = |_: f64| SVector::<f64, 1>::new(f64::NAN);
+            struct AlwaysNan<F>(F);
+            impl<F: Fn(f64) -> SVector<f64, 1>> OdeSystem<1> for AlwaysNan<F> {
+                fn rhs(&self, t: f64, _y: &SVector<f64, 1>) -> SVector<f64, 1> {
+                    (self.0)(t)
+                }
             }
-        }
-        let sys = AlwaysNan(nan_everywhere);
-        let mut solver = Dopri5::new(&sys, 0.0, SVector::<f64, 1>::new(1.0), tight());
-        assert_eq!(
-            solver.step(&sys, 1.0).unwrap_err(),
-            IntegrationError::NonFinite { time: 0.0 }
-        );
+            let sys = AlwaysNan(nan_everywhere);
+            let mut solver =
+                Integrator::new(method, &sys, 0.0, SVector::<f64, 1>::new(1.0), tight());
+            assert_eq!(
+                solver.step(&sys, 1.0).unwrap_err(),
+                IntegrationError::NonFinite { time: 0.0 }
+            );
 
-        let mut solver = Dopri5::new(&NanAfterHalf, 0.0, SVector::<f64, 1>::new(0.0), tight());
-        let err = run_until_error(&mut solver, &NanAfterHalf, 1.0);
-        eprintln!("NaN after 0.5: {err} after {:?}", solver.stats());
-        match err {
-            IntegrationError::NonFinite { time } => {
-                assert!(time < 0.5 && time > 0.5 - 1e-12, "stopped at {time}");
-                assert_relative_eq!(solver.y()[0], time, max_relative = 1e-12);
+            let mut solver = Integrator::new(
+                method,
+                &NanAfterHalf,
+                0.0,
+                SVector::<f64, 1>::new(0.0),
+                tight(),
+            );
+            let err = run_until_error(&mut solver, &NanAfterHalf, 1.0);
+            eprintln!("NaN after 0.5: {err} after {:?}", solver.stats());
+            match err {
+                IntegrationError::NonFinite { time } => {
+                    assert!(time < 0.5 && time > 0.5 - 1e-12, "stopped at {time}");
+                    assert_relative_eq!(solver.y()[0], time, max_relative = 1e-12);
+                }
+                other => panic!("expected NonFinite, got {other:?}"),
             }
-            other => panic!("expected NonFinite, got {other:?}"),
         }
     }
 
@@ -957,15 +1202,22 @@ mod tests {
             amplitude: 0.7,
             phase: 0.3,
         };
-        let mut solver = Dopri5::new(&sys, 0.0, sys.exact(0.0), tight());
-        assert_eq!(solver.stats().rhs_evals, 2);
-        for _ in 0..20 {
-            solver.step(&sys, 10.0).unwrap();
+        // Per trial step, and per accepted step on top (DOP853: f(t1, y1) and three dense-output stages).
+        for (method, per_trial, per_accepted) in [(Method::Dopri5, 6, 0), (Method::Dop853, 11, 4)] {
+            let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tight());
+            assert_eq!(solver.stats().rhs_evals, 2);
+            for _ in 0..20 {
+                solver.step(&sys, 10.0).unwrap();
+            }
+            let y = *solver.y();
+            solver.restart(&sys, solver.t(), y);
+            let s = solver.stats();
+            assert_eq!(s.accepted, 20);
+            assert_eq!(
+                s.rhs_evals,
+                2 + per_trial * (s.accepted + s.rejected) + per_accepted * s.accepted + 2,
+                "{method}"
+            );
         }
-        let y = *solver.y();
-        solver.restart(&sys, solver.t(), y);
-        let s = solver.stats();
-        assert_eq!(s.accepted, 20);
-        assert_eq!(s.rhs_evals, 2 + 6 * (s.accepted + s.rejected) + 2);
     }
 }

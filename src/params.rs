@@ -25,6 +25,7 @@ use std::fmt;
 use std::path::Path;
 
 use crate::error::short;
+use crate::integrate::Method;
 
 /// Impact law at touchdown (`docs/model.md` section 5).
 ///
@@ -41,21 +42,15 @@ pub enum ImpactModel {
     Traditional,
 }
 
-impl ImpactModel {
-    /// Every impact law.
-    const ALL: [ImpactModel; 2] = [ImpactModel::Dlsi, ImpactModel::Traditional];
+impl Choice for ImpactModel {
+    const ALL: &'static [ImpactModel] = &[ImpactModel::Dlsi, ImpactModel::Traditional];
+    const EXPECTED: &'static str = "the string \"dlsi\" or \"traditional\"";
 
-    /// The name of this model (`"dlsi"` or `"traditional"`).
     fn name(self) -> &'static str {
         match self {
             ImpactModel::Dlsi => "dlsi",
             ImpactModel::Traditional => "traditional",
         }
-    }
-
-    /// The model called `name`, if there is one.
-    fn from_name(name: &str) -> Option<ImpactModel> {
-        Self::ALL.into_iter().find(|model| model.name() == name)
     }
 }
 
@@ -83,24 +78,41 @@ pub enum ContactInconsistency {
     Rebound,
 }
 
-impl ContactInconsistency {
-    /// Every treatment of an inconsistent contact.
-    const ALL: [ContactInconsistency; 2] =
-        [ContactInconsistency::Slide, ContactInconsistency::Rebound];
+impl Choice for ContactInconsistency {
+    const ALL: &'static [ContactInconsistency] =
+        &[ContactInconsistency::Slide, ContactInconsistency::Rebound];
+    const EXPECTED: &'static str = "the string \"slide\" or \"rebound\"";
 
-    /// The name of this treatment (`"slide"` or `"rebound"`).
     fn name(self) -> &'static str {
         match self {
             ContactInconsistency::Slide => "slide",
             ContactInconsistency::Rebound => "rebound",
         }
     }
+}
 
-    /// The treatment called `name`, if there is one.
-    fn from_name(name: &str) -> Option<ContactInconsistency> {
-        Self::ALL
-            .into_iter()
-            .find(|treatment| treatment.name() == name)
+impl Choice for Method {
+    const ALL: &'static [Method] = &[Method::Dop853, Method::Dopri5];
+    const EXPECTED: &'static str = "the string \"dop853\" or \"dopri5\"";
+
+    fn name(self) -> &'static str {
+        self.name()
+    }
+}
+
+/// A key whose value is one of a few names (`impact`, `inconsistent_contact`, `integrator`).
+trait Choice: Copy + 'static {
+    /// Every value.
+    const ALL: &'static [Self];
+    /// What the key accepts, as shown in errors.
+    const EXPECTED: &'static str;
+
+    /// The name of this value, as in TOML and on the command line.
+    fn name(self) -> &'static str;
+
+    /// The value called `name`, if there is one.
+    fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.iter().copied().find(|c| c.name() == name)
     }
 }
 
@@ -257,12 +269,16 @@ pub const MAX_LEGS: usize = 1000;
 /// with [`SolverOptions::validate`] (and [`Config::validate`] for the rule that involves [`Params`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SolverOptions {
+    /// The Runge-Kutta pair that integrates the continuous phases: `"dop853"` (default; order 8, the fastest at
+    /// the default tolerances) or `"dopri5"` (order 5). Both locate events on their dense output; running a
+    /// result again with the other one is a check that it does not depend on the integrator.
+    pub integrator: Method,
     /// Relative integration tolerance \[-\]. Default 1e-10. In [`RTOL_RANGE`] (1e-14 to 1e-3).
     pub rtol: f64,
     /// Absolute integration tolerance \[state units: m, rad, m/s, rad/s\]. Default 1e-12. In [`ATOL_RANGE`]
     /// (1e-16 to 1e-3).
     pub atol: f64,
-    /// Largest integrator step \[s\]. Default 0.02. In [`MAX_STEP_RANGE`] (1e-6 to 1).
+    /// Largest integrator step \[s\]. Default 0.04 (events are still resolved to a quarter of a step, see `walk::EVENT_SAMPLES`). In [`MAX_STEP_RANGE`] (1e-6 to 1).
     pub max_step: f64,
     /// Tolerance on located event times (root finding on the dense output) \[s\]. Default 1e-13. In
     /// [`EVENT_TIME_TOL_RANGE`] (1e-15 to 1e-9). `docs/model.md`, events.
@@ -294,9 +310,10 @@ impl Default for SolverOptions {
     /// Tolerances tight enough to locate the paper's thresholds by root finding in `c`.
     fn default() -> Self {
         SolverOptions {
+            integrator: Method::Dop853,
             rtol: 1e-10,
             atol: 1e-12,
-            max_step: 0.02,
+            max_step: 0.04,
             event_time_tol: 1e-13,
             recontact_gap: 1e-11,
             stopper_gap: 1e-9,
@@ -374,7 +391,7 @@ pub struct Config {
 
 /// Every key of a configuration, in declaration order: the fields of [`Params`], then of
 /// [`SolverOptions`].
-const ALL_KEYS: [&str; 23] = [
+const ALL_KEYS: [&str; 24] = [
     "legs",
     "hub_mass",
     "hub_inertia",
@@ -389,6 +406,7 @@ const ALL_KEYS: [&str; 23] = [
     "impact",
     "rigid_legs",
     "inconsistent_contact",
+    "integrator",
     "rtol",
     "atol",
     "max_step",
@@ -562,10 +580,9 @@ impl Config {
             "legs" => self.params.legs = value.count(key)?,
             "max_events_per_step" => self.solver.max_events_per_step = value.count(key)?,
             "rigid_legs" => self.params.rigid_legs = value.flag(key)?,
-            "impact" => self.params.impact = value.impact(key)?,
-            "inconsistent_contact" => {
-                self.params.inconsistent_contact = value.inconsistency(key)?
-            }
+            "impact" => self.params.impact = value.choice(key)?,
+            "inconsistent_contact" => self.params.inconsistent_contact = value.choice(key)?,
+            "integrator" => self.solver.integrator = value.choice(key)?,
             _ => {
                 return Err(ConfigError::UnknownKey {
                     key: key.to_string(),
@@ -641,10 +658,8 @@ trait RawValue {
     fn count(&self, key: &str) -> Result<usize, ConfigError>;
     /// A boolean.
     fn flag(&self, key: &str) -> Result<bool, ConfigError>;
-    /// An impact law, by its name.
-    fn impact(&self, key: &str) -> Result<ImpactModel, ConfigError>;
-    /// A treatment of an inconsistent contact, by its name.
-    fn inconsistency(&self, key: &str) -> Result<ContactInconsistency, ConfigError>;
+    /// One of a few names (an impact law, an integrator, ...).
+    fn choice<T: Choice>(&self, key: &str) -> Result<T, ConfigError>;
 }
 
 /// Text of a `--set` override.
@@ -674,12 +689,8 @@ impl RawValue for str {
             .map_err(|_| wrong_type(key, EXPECTED_FLAG, format!("{self:?}")))
     }
 
-    fn impact(&self, key: &str) -> Result<ImpactModel, ConfigError> {
-        impact_from_name(key, self)
-    }
-
-    fn inconsistency(&self, key: &str) -> Result<ContactInconsistency, ConfigError> {
-        inconsistency_from_name(key, self)
+    fn choice<T: Choice>(&self, key: &str) -> Result<T, ConfigError> {
+        choice_from_name(key, self)
     }
 }
 
@@ -707,17 +718,10 @@ impl RawValue for toml::Value {
         }
     }
 
-    fn impact(&self, key: &str) -> Result<ImpactModel, ConfigError> {
+    fn choice<T: Choice>(&self, key: &str) -> Result<T, ConfigError> {
         match self {
-            toml::Value::String(name) => impact_from_name(key, name),
-            other => Err(wrong_type(key, EXPECTED_IMPACT, describe(other))),
-        }
-    }
-
-    fn inconsistency(&self, key: &str) -> Result<ContactInconsistency, ConfigError> {
-        match self {
-            toml::Value::String(name) => inconsistency_from_name(key, name),
-            other => Err(wrong_type(key, EXPECTED_INCONSISTENCY, describe(other))),
+            toml::Value::String(name) => choice_from_name(key, name),
+            other => Err(wrong_type(key, T::EXPECTED, describe(other))),
         }
     }
 }
@@ -728,10 +732,6 @@ const EXPECTED_REAL: &str = "a real number";
 const EXPECTED_COUNT: &str = "a non-negative integer";
 /// Expected type of a boolean key, as shown in [`ConfigError::WrongType`].
 const EXPECTED_FLAG: &str = "true or false";
-/// Expected type of the `impact` key, as shown in [`ConfigError::WrongType`].
-const EXPECTED_IMPACT: &str = "the string \"dlsi\" or \"traditional\"";
-/// Expected type of the `inconsistent_contact` key, as shown in [`ConfigError::WrongType`].
-const EXPECTED_INCONSISTENCY: &str = "the string \"slide\" or \"rebound\"";
 
 /// A TOML value's type and value, for [`ConfigError::WrongType`].
 fn describe(value: &toml::Value) -> String {
@@ -751,27 +751,10 @@ fn count_from_integer(key: &str, n: i64) -> Result<usize, ConfigError> {
     usize::try_from(n).map_err(|_| invalid(key, n, "must be a non-negative integer"))
 }
 
-/// The impact law called `name`, or an [`ConfigError::InvalidValue`] listing the known names.
-fn impact_from_name(key: &str, name: &str) -> Result<ImpactModel, ConfigError> {
-    ImpactModel::from_name(name).ok_or_else(|| {
-        invalid(
-            key,
-            format!("{name:?}"),
-            format!("must be {EXPECTED_IMPACT}"),
-        )
-    })
-}
-
-/// The treatment of an inconsistent contact called `name`, or an [`ConfigError::InvalidValue`] listing
-/// the known names.
-fn inconsistency_from_name(key: &str, name: &str) -> Result<ContactInconsistency, ConfigError> {
-    ContactInconsistency::from_name(name).ok_or_else(|| {
-        invalid(
-            key,
-            format!("{name:?}"),
-            format!("must be {EXPECTED_INCONSISTENCY}"),
-        )
-    })
+/// The value called `name` of a [`Choice`] key, or an [`ConfigError::InvalidValue`] listing the known names.
+fn choice_from_name<T: Choice>(key: &str, name: &str) -> Result<T, ConfigError> {
+    T::from_name(name)
+        .ok_or_else(|| invalid(key, format!("{name:?}"), format!("must be {}", T::EXPECTED)))
 }
 
 /// The error for a key that is not one of [`Config::numeric_keys`].
@@ -900,7 +883,7 @@ mod tests {
         let s = SolverOptions::default();
         assert_eq!(s.rtol, 1e-10);
         assert_eq!(s.atol, 1e-12);
-        assert_eq!(s.max_step, 0.02);
+        assert_eq!(s.max_step, 0.04);
         assert_eq!(s.event_time_tol, 1e-13);
         assert_eq!(s.recontact_gap, 1e-11);
         assert_eq!(s.stopper_gap, 1e-9);
@@ -914,7 +897,7 @@ mod tests {
 
     #[test]
     fn impact_names_match_serde_and_display() {
-        for model in ImpactModel::ALL {
+        for &model in ImpactModel::ALL {
             let via_serde = toml::Value::try_from(model).unwrap();
             assert_eq!(via_serde.as_str(), Some(model.to_string().as_str()));
             let back: ImpactModel = via_serde.try_into().unwrap();
@@ -926,7 +909,7 @@ mod tests {
 
     #[test]
     fn inconsistency_names_match_serde_and_display() {
-        for treatment in ContactInconsistency::ALL {
+        for &treatment in ContactInconsistency::ALL {
             let via_serde = toml::Value::try_from(treatment).unwrap();
             assert_eq!(via_serde.as_str(), Some(treatment.to_string().as_str()));
             let back: ContactInconsistency = via_serde.try_into().unwrap();
@@ -938,7 +921,7 @@ mod tests {
 
     #[test]
     fn inconsistent_contact_parses_both_values() {
-        for treatment in ContactInconsistency::ALL {
+        for &treatment in ContactInconsistency::ALL {
             let name = treatment.name();
             let config =
                 Config::from_toml_str(&format!("inconsistent_contact = \"{name}\"")).unwrap();
@@ -1006,6 +989,7 @@ mod tests {
         config.params.inconsistent_contact = ContactInconsistency::Rebound;
         config.solver.rtol = 3e-11;
         config.solver.max_events_per_step = 17;
+        config.solver.integrator = Method::Dopri5;
 
         let text = toml::to_string(&config).unwrap();
         // The file is flat and holds exactly the documented keys.
@@ -1014,9 +998,10 @@ mod tests {
         let mut expected = ALL_KEYS.to_vec();
         written.sort_unstable();
         expected.sort_unstable();
-        assert_eq!(written.len(), 23);
+        assert_eq!(written.len(), 24);
         assert_eq!(written, expected);
         assert_eq!(table["inconsistent_contact"].as_str(), Some("rebound"));
+        assert_eq!(table["integrator"].as_str(), Some("dopri5"));
 
         let path = temp_path("round-trip.toml");
         std::fs::write(&path, &text).unwrap();

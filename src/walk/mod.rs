@@ -44,7 +44,7 @@ use crate::contact::{
 };
 use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X};
 use crate::error::WalkError;
-use crate::integrate::{locate_root, DenseStep, Dopri5, OdeSystem, Tolerances};
+use crate::integrate::{locate_root, DenseStep, Integrator, OdeSystem, Tolerances};
 use crate::params::SolverOptions;
 
 use impact::{
@@ -490,6 +490,11 @@ impl<'a> EventSet<'a> {
 /// below the ground.
 pub const PENETRATION_SAMPLES: usize = 4;
 
+/// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
+/// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
+/// however long the steps of a high-order integrator are.
+pub const EVENT_SAMPLES: usize = 4;
+
 impl ContactAudit {
     fn see_force(&mut self, pull: f64) {
         self.pull_force = self.pull_force.max(pull);
@@ -656,7 +661,13 @@ impl<'m> Walker<'m> {
             tr.push(model, t, &y, active, &start);
         }
         let t_limit = t_start + opts.max_step_time;
-        let mut solver = Dopri5::new(&PhaseSystem { model, active }, t, y, self.tolerances());
+        let mut solver = Integrator::new(
+            opts.integrator,
+            &PhaseSystem { model, active },
+            t,
+            y,
+            self.tolerances(),
+        );
         let mut events = EventSet::new(model, &opts, active, &y);
         let (mut g_prev, pull) = events.values(&y);
         tally.audit.see_force(pull);
@@ -675,23 +686,43 @@ impl<'m> Walker<'m> {
             let step = solver
                 .step(&sys, t_limit)
                 .map_err(|source| WalkError::Integration { phase, source })?;
-            let (mut g_next, pull_next) = events.values(step.y1());
+            // Events are looked for on EVENT_SAMPLES sub-intervals of the step's dense output, the first one
+            // with a crossing first: an event function that dips below its floor and back within a step is
+            // still caught if the dip is longer than a sub-interval.
             let mut hit: Option<(f64, usize)> = None;
-            for k in 0..g_next.len() {
-                if g_prev[k] > 0.0 && g_next[k] <= 0.0 {
-                    let tk = locate_root(
-                        &step,
-                        |_, y| events.value(k, y),
-                        step.t0(),
-                        g_prev[k],
-                        step.t1(),
-                        g_next[k],
-                        opts.event_time_tol,
-                    );
-                    if hit.is_none_or(|(t_hit, _)| tk < t_hit) {
-                        hit = Some((tk, k));
+            let (mut t_a, mut pull_next) = (step.t0(), 0.0);
+            let mut g_next = Vec::new();
+            for i in 1..=EVENT_SAMPLES {
+                let t_b = if i == EVENT_SAMPLES {
+                    step.t1()
+                } else {
+                    step.t0() + (step.t1() - step.t0()) * i as f64 / EVENT_SAMPLES as f64
+                };
+                (g_next, pull_next) = events.values(&step.eval(t_b));
+                for k in 0..g_next.len() {
+                    if g_prev[k] > 0.0 && g_next[k] <= 0.0 {
+                        let tk = locate_root(
+                            &step,
+                            |_, y| events.value(k, y),
+                            t_a,
+                            g_prev[k],
+                            t_b,
+                            g_next[k],
+                            opts.event_time_tol,
+                        );
+                        if hit.is_none_or(|(t_hit, _)| tk < t_hit) {
+                            hit = Some((tk, k));
+                        }
                     }
                 }
+                if hit.is_some() {
+                    break;
+                }
+                if i < EVENT_SAMPLES {
+                    tally.audit.see_force(pull_next);
+                    g_prev = std::mem::take(&mut g_next);
+                }
+                t_a = t_b;
             }
             let t_end = hit.map_or(step.t1(), |(t_hit, _)| t_hit);
             if active.double_support() {

@@ -1,0 +1,300 @@
+//! The explicit Runge–Kutta pair DOP853 of Dormand & Prince (order 8, with error estimators of orders 5 and 3)
+//! and its 7th-order continuous extension, driven one accepted step at a time like [`super::Dopri5`].
+//!
+//! At the tight tolerances of the walk (rtol 1e-10) it takes steps several times longer than DOPRI5 for the
+//! same accuracy, which more than pays for its 12 stages per step (plus 3 for the dense output).
+//!
+//! The coefficients are those of Hairer's `dop853` (HNW I, Sec. II.10), taken from the `differential-equations`
+//! crate's Butcher tableau (`ButcherTableau::dop853`) rather than typed in again; the tests check them against
+//! the order conditions and the method's convergence order. The stepping itself is hand-written for the same
+//! reasons as `Dopri5` (stack state, caller-located events, restarts; see the parent module): error norm and
+//! step-size control as in `dop853` (HNW I, Sec. II.10, Eq. (10.17); no PI term, `fac1 = 0.333`, `fac2 = 6`).
+//!
+//! # References
+//! - E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I*, 2nd ed., Springer, 1993,
+//!   Sec. II.10 (DOP853, its error estimate and dense output).
+//! - P. J. Prince, J. R. Dormand, "High order embedded Runge-Kutta formulae", J. Comput. Appl. Math.
+//!   7(1):67–75, 1981.
+
+use std::sync::OnceLock;
+
+use differential_equations::tableau::ButcherTableau;
+use nalgebra::SVector;
+
+use super::{
+    all_finite, initial_step, scaled_rms, DenseStep, IntegrationError, OdeSystem, Stats,
+    Tolerances, LAND_STRETCH,
+};
+
+/// Stages of one step.
+const STAGES: usize = 12;
+/// Stages including the three extra ones of the dense output and `f(t1, y1)`.
+const DENSE_STAGES: usize = 16;
+/// Safety factor on the optimal step.
+const SAFE: f64 = 0.9;
+/// Exponent of the error: 1/8.
+const EXPO: f64 = 1.0 / 8.0;
+/// Largest divisor h_old/h_new (a step shrinks at most ~3x per trial; `dop853`'s `1/fac1`).
+const FAC_SHRINK_MAX: f64 = 1.0 / 0.333;
+/// Smallest divisor h_old/h_new (a step grows at most 6x; `dop853`'s `1/fac2`).
+const FAC_GROW_MAX: f64 = 1.0 / 6.0;
+/// Weight of the 3rd-order estimate in the error norm (`dop853`: `deno = err5 + 0.01 err3`).
+const ERR3_WEIGHT: f64 = 0.01;
+/// Order used by the starting-step heuristic.
+const HINIT_ORDER: i32 = 8;
+
+/// The coefficients of DOP853, with the zero entries of `a` skipped.
+struct Tableau {
+    c: [f64; DENSE_STAGES],
+    /// `a[i]`: the nonzero `(j, a_ij)` of stage `i`.
+    a: Vec<Vec<(usize, f64)>>,
+    b: [f64; STAGES],
+    /// 3rd-order weights (`bhh` of `dop853`).
+    bh: [f64; STAGES],
+    /// 5th-order error weights.
+    er: [f64; STAGES],
+    /// Dense-output rows `d4 .. d7` over the 16 stages.
+    d: [[f64; DENSE_STAGES]; 4],
+}
+
+fn tableau() -> &'static Tableau {
+    static TABLEAU: OnceLock<Tableau> = OnceLock::new();
+    TABLEAU.get_or_init(|| {
+        let t = ButcherTableau::<f64, STAGES, DENSE_STAGES>::dop853();
+        let a =
+            t.a.iter()
+                .map(|row| {
+                    row.iter()
+                        .enumerate()
+                        .filter(|(_, &v)| v != 0.0)
+                        .map(|(j, &v)| (j, v))
+                        .collect()
+                })
+                .collect();
+        let bi = t.bi.expect("DOP853 has a dense output");
+        Tableau {
+            c: t.c,
+            a,
+            b: t.b,
+            bh: t.bh.expect("DOP853 has a 3rd-order estimate"),
+            er: t.er.expect("DOP853 has a 5th-order estimate"),
+            d: [bi[4], bi[5], bi[6], bi[7]],
+        }
+    })
+}
+
+/// Adaptive DOP853 with FSAL, the step-size control of `dop853` and its 7th-order dense output.
+///
+/// The same interface as [`super::Dopri5`]: [`step`](Self::step) returns a [`DenseStep`]; after an event,
+/// [`restart`](Self::restart).
+#[derive(Debug, Clone)]
+pub struct Dop853<const N: usize> {
+    tol: Tolerances,
+    t: f64,
+    y: SVector<f64, N>,
+    /// FSAL value f(t, y).
+    dy: SVector<f64, N>,
+    /// Step size the controller proposes for the next trial \[s\].
+    h: f64,
+    /// Size of the last accepted step \[s\], if any.
+    h_accepted: Option<f64>,
+    stats: Stats,
+}
+
+impl<const N: usize> Dop853<N> {
+    /// Start at (t0, y0); computes f(t0, y0) and an initial step. Costs two right-hand-side evaluations.
+    pub fn new(sys: &impl OdeSystem<N>, t0: f64, y0: SVector<f64, N>, tol: Tolerances) -> Self {
+        let mut solver = Self {
+            tol,
+            t: t0,
+            y: y0,
+            dy: SVector::zeros(),
+            h: 0.0,
+            h_accepted: None,
+            stats: Stats::default(),
+        };
+        solver.reset_point(sys, t0, y0);
+        solver
+    }
+
+    /// Restart at (t, y) with a possibly new vector field: recomputes f and keeps the last accepted step
+    /// size as the first trial step (bounded by a fresh initial-step estimate). Two evaluations.
+    pub fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
+        self.reset_point(sys, t, y);
+        if let Some(h_acc) = self.h_accepted {
+            self.h = self.h.min(h_acc);
+        }
+    }
+
+    /// Current time \[s\].
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Current state.
+    pub fn y(&self) -> &SVector<f64, N> {
+        &self.y
+    }
+
+    /// Derivative f(t, y) at the current point (FSAL value).
+    pub fn dy(&self) -> &SVector<f64, N> {
+        &self.dy
+    }
+
+    /// Counters for benchmarks.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Take one accepted step, never passing `t_stop` (the same contract as [`super::Dopri5::step`]).
+    ///
+    /// # Errors
+    /// As [`super::Dopri5::step`].
+    ///
+    /// # Panics
+    /// If `t_stop` is not after the current time.
+    pub fn step(
+        &mut self,
+        sys: &impl OdeSystem<N>,
+        t_stop: f64,
+    ) -> Result<DenseStep<N>, IntegrationError> {
+        assert!(
+            t_stop > self.t,
+            "t_stop = {t_stop} is not after the current time {}",
+            self.t
+        );
+        if !(all_finite(&self.y) && all_finite(&self.dy)) {
+            return Err(IntegrationError::NonFinite { time: self.t });
+        }
+        let tab = tableau();
+        let t = self.t;
+        let y0 = self.y;
+        let mut k = [SVector::<f64, N>::zeros(); DENSE_STAGES];
+        k[0] = self.dy;
+        let stage_state = |k: &[SVector<f64, N>], i: usize, h: f64| {
+            let mut sum = SVector::<f64, N>::zeros();
+            for &(j, a) in &tab.a[i] {
+                sum += k[j] * a;
+            }
+            y0 + sum * h
+        };
+        let mut rejected_before = false;
+        let mut last_non_finite = false;
+        loop {
+            let h_ctrl = self.h.min(self.tol.h_max);
+            if !(h_ctrl >= self.tol.h_min && t + h_ctrl > t) {
+                return Err(if last_non_finite {
+                    IntegrationError::NonFinite { time: t }
+                } else {
+                    IntegrationError::StepSizeTooSmall {
+                        time: t,
+                        h_min: self.tol.h_min,
+                    }
+                });
+            }
+            let (h, t1) = if t + LAND_STRETCH * h_ctrl >= t_stop {
+                (t_stop - t, t_stop)
+            } else {
+                (h_ctrl, t + h_ctrl)
+            };
+            for i in 1..STAGES {
+                let yi = stage_state(&k, i, h);
+                k[i] = sys.rhs(t + tab.c[i] * h, &yi);
+            }
+            self.stats.rhs_evals += STAGES - 1;
+            let mut yseg = SVector::<f64, N>::zeros();
+            let mut e5 = SVector::<f64, N>::zeros();
+            let mut e3 = SVector::<f64, N>::zeros();
+            for (i, ki) in k.iter().take(STAGES).enumerate() {
+                yseg += ki * tab.b[i];
+                e5 += ki * tab.er[i];
+                e3 += ki * tab.bh[i];
+            }
+            e3 = yseg - e3;
+            let y1 = y0 + yseg * h;
+            // HNW I, Eq. (10.17): err = |h| err5^2 / sqrt(n (err5^2 + 0.01 err3^2)), each a scaled sum of squares.
+            let n = N as f64;
+            let err5 = scaled_rms(&self.tol, &e5, &y0, &y1).powi(2) * n;
+            let err3 = scaled_rms(&self.tol, &e3, &y0, &y1).powi(2) * n;
+            let mut deno = err5 + ERR3_WEIGHT * err3;
+            if deno <= 0.0 {
+                deno = 1.0;
+            }
+            let err = h.abs() * err5 * (1.0 / (n * deno)).sqrt();
+
+            if !(err.is_finite() && all_finite(&y1)) {
+                self.stats.rejected += 1;
+                rejected_before = true;
+                last_non_finite = true;
+                self.h = h / FAC_SHRINK_MAX;
+                continue;
+            }
+            last_non_finite = false;
+
+            let fac11 = err.powf(EXPO);
+            if err <= 1.0 {
+                let k13 = sys.rhs(t1, &y1);
+                self.stats.rhs_evals += 1;
+                if !all_finite(&k13) {
+                    self.stats.rejected += 1;
+                    rejected_before = true;
+                    last_non_finite = true;
+                    self.h = h / FAC_SHRINK_MAX;
+                    continue;
+                }
+                let fac = (fac11 / SAFE).clamp(FAC_GROW_MAX, FAC_SHRINK_MAX);
+                let mut h_new = h / fac;
+                if rejected_before {
+                    h_new = h_new.min(h);
+                }
+                self.h = h_new.min(self.tol.h_max);
+                self.h_accepted = Some(h);
+                self.stats.accepted += 1;
+
+                // The dense output: f(t1, y1) and three more stages.
+                k[STAGES] = k13;
+                for i in STAGES + 1..DENSE_STAGES {
+                    let yi = stage_state(&k, i, h);
+                    k[i] = sys.rhs(t + tab.c[i] * h, &yi);
+                }
+                self.stats.rhs_evals += DENSE_STAGES - STAGES - 1;
+                let delta = y1 - y0;
+                let bspl = k[0] * h - delta;
+                let mut cont = [
+                    y0,
+                    delta,
+                    bspl,
+                    delta - k13 * h - bspl,
+                    SVector::zeros(),
+                    SVector::zeros(),
+                    SVector::zeros(),
+                    SVector::zeros(),
+                ];
+                for (row, c) in tab.d.iter().zip(cont[4..].iter_mut()) {
+                    for (ki, &d) in k.iter().zip(row) {
+                        if d != 0.0 {
+                            *c += ki * d;
+                        }
+                    }
+                    *c *= h;
+                }
+                self.t = t1;
+                self.y = y1;
+                self.dy = k13;
+                return Ok(DenseStep::from_coefficients(t, t1, y1, &cont));
+            }
+            self.stats.rejected += 1;
+            rejected_before = true;
+            self.h = h / FAC_SHRINK_MAX.min(fac11 / SAFE);
+        }
+    }
+
+    /// Set the current point, recompute the FSAL derivative and a fresh starting step.
+    fn reset_point(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
+        self.t = t;
+        self.y = y;
+        self.dy = sys.rhs(t, &y);
+        self.stats.rhs_evals += 2;
+        self.h = initial_step(sys, &self.tol, t, &self.y, &self.dy, HINIT_ORDER);
+    }
+}
