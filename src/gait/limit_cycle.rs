@@ -381,6 +381,17 @@ pub fn solve_fixed_point(
         fresh = false;
         if norm(&r_trial) > 0.1 * norm(&r) {
             newton_matrix = None;
+        } else if let Some(a) = &mut newton_matrix {
+            // Broyden's ("good") rank-one update (Broyden 1965): the matrix then maps this step to the change
+            // of the residual it made, which turns the linear convergence of a stale matrix (the neighbour's DP
+            // in a continuation: 10-15x per iteration, seven or eight iterations to 1e-10) into superlinear
+            // convergence (three to five) at no extra evaluation. Three lines, so no crate.
+            let dx = map.reduce(&trial) - &x;
+            let dr = &r_trial - &r;
+            let denom = dx.dot(&dx);
+            if denom > 0.0 {
+                *a += (dr - &*a * &dx) * dx.transpose() / denom;
+            }
         }
         s = trial;
         outcome = out;
