@@ -7,7 +7,8 @@
 //! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved (and the
 //! step after a failure that works halves the next, which bisects toward an end), so a family is followed in
 //! shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`]. Where Newton's method fails at
-//! the finest step, or [`WALK_AFTER_FAILURES`] times in a row, steps are also tried by walking instead
+//! the finest step, or [`WALK_AFTER_FAILURES`] times in a row (and every [`WALK_AFTER_FAILURES`] failures after
+//! that), steps are also tried by walking instead
 //! ([`Continuation::walk_step`]), since the step map is only piecewise smooth. A family of period-k gaits is
 //! followed the same way, as fixed points of `P^k` ([`Continuation::with_period`]).
 //!
@@ -59,6 +60,10 @@ pub const MAX_FOLLOW_STEPS: usize = 200;
 /// also tried by walking ([`Continuation::walk_step`]): near a border of the map's smooth pieces (a DLS
 /// indicator near zero) the finite-difference `DP` straddles the border and Newton's method fails at every
 /// step length, while the walk follows the stable gait.
+///
+/// While walking has not yet carried the family on, a walk that fails is tried again only after as many more
+/// Newton failures (each halving the step): most ends (the wheel rolls back, a fold) cannot be walked past
+/// either, and a walk per bisection step was a fifth of a map's evaluations.
 pub const WALK_AFTER_FAILURES: usize = 3;
 
 /// A real Floquet multiplier this close to +1 at the last gait of a family marks a fold.
@@ -291,15 +296,18 @@ impl<'a> Continuation<'a> {
                 }
             }
             let at_end = (next_value - current.value).abs() <= PARAM_TOL;
-            // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and
-            // from then on, until it works again, also through the halvings of a walking step that fails), a
-            // step is also tried by walking, before an end is declared.
+            // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and at
+            // every WALK_AFTER_FAILURES-th one after that; once a walk works, through every halving of a walking
+            // step that fails, until Newton's method works again), a step is also tried by walking, before an
+            // end is declared.
             if next.is_none() {
                 newton_failures += 1;
             } else {
                 newton_failures = 0;
             }
-            if next.is_none() && (walking || at_end || newton_failures >= WALK_AFTER_FAILURES) {
+            let walk_due = newton_failures >= WALK_AFTER_FAILURES
+                && newton_failures % WALK_AFTER_FAILURES == 0;
+            if next.is_none() && (walking || at_end || walk_due) {
                 next = self.walk_step(&current, next_value);
                 walks += 1;
                 walking = walking || next.is_some();
