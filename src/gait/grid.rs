@@ -11,23 +11,26 @@
 //!   for the first point of a row, or when the point continued from handed on nothing;
 //! - `carry` is what later points may continue from (`None`: nothing, e.g. no gait was found).
 //!
-//! **Schedule.** In every row, first every [`COARSE_STRIDE`]-th point is evaluated in order, each continuing the
-//! previous coarse point (the coarse pass); then the points between two coarse points are evaluated in order,
-//! continuing from the left coarse point, all intervals in parallel. Rows run in parallel. The chunking is fixed
-//! by the grid, not by the threads, and a point's evaluation depends only on its cell and on what it continues,
-//! so as long as `eval` is a deterministic function of its arguments the results do not depend on the number of
-//! threads or on the order in which rayon runs the work.
+//! **Schedule.** A grid of several rows runs its rows in parallel, each row in order from left to right, every
+//! point continuing its left neighbour. A grid of one row (a sweep, an orbit diagram) is split so that it too
+//! uses every core: first every [`COARSE_STRIDE`]-th point is evaluated in order, each continuing the previous
+//! coarse point (the coarse pass); then the points between two coarse points are evaluated in order, continuing
+//! from the left coarse point, all intervals in parallel. (A coarse pass costs extra work, continuation over ten
+//! grid intervals at a time: a fifth of a 30 x 30 map's gait search, so rows that can run in parallel anyway
+//! skip it.) The schedule is fixed by the grid, not by the threads, and a point's evaluation depends only on its
+//! cell and on what it continues, so as long as `eval` is a deterministic function of its arguments the results
+//! do not depend on the number of threads or on the order in which rayon runs the work.
 //!
 //! ```
-//! use vrw::gait::grid::{run_rows, Evaluated};
+//! use vrw::gait::grid::{run_rows, Cell, Evaluated};
 //!
-//! // A running sum along each row, restarted at every coarse point's left neighbour: the carry is the sum.
+//! // A running sum along each row: the carry is the sum so far.
 //! let rows = run_rows(2, 25, |cell, from: Option<(usize, &f64)>| {
 //!     let sum = from.map_or(0.0, |(_, s)| *s) + (cell.row * 100 + cell.col) as f64;
 //!     Evaluated { point: (cell, sum), carry: Some(sum) }
 //! });
 //! assert_eq!(rows.len(), 2);
-//! assert_eq!(rows[1][24].0.col, 24);
+//! assert_eq!(rows[1][24], (Cell { row: 1, col: 24 }, 2800.0));
 //! ```
 
 use rayon::prelude::*;
@@ -62,14 +65,32 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
+    if rows == 1 {
+        return vec![run_split_row(0, cols, &eval)];
+    }
     (0..rows)
         .into_par_iter()
-        .map(|row| run_row(row, cols, &eval))
+        .map(|row| run_row_in_order(row, cols, &eval))
         .collect()
 }
 
-/// One row: the coarse pass, then the intervals between coarse points in parallel.
-fn run_row<P, C, F>(row: usize, cols: usize, eval: &F) -> Vec<P>
+/// One row in order, every point continuing the one before.
+fn run_row_in_order<P, C, F>(row: usize, cols: usize, eval: &F) -> Vec<P>
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    let mut points = Vec::with_capacity(cols);
+    let mut last: Option<(usize, C)> = None;
+    for col in 0..cols {
+        let e = eval(Cell { row, col }, last.as_ref().map(|(j, c)| (*j, c)));
+        points.push(e.point);
+        last = e.carry.map(|c| (col, c));
+    }
+    points
+}
+
+/// One row split for parallelism: the coarse pass, then the intervals between coarse points in parallel.
+fn run_split_row<P, C, F>(row: usize, cols: usize, eval: &F) -> Vec<P>
 where
     P: Send,
     C: Send + Sync,
@@ -117,29 +138,34 @@ where
 mod tests {
     use super::*;
 
-    /// Each point records what it continued from: the schedule is the documented one.
+    /// Each point records what it continued from: the schedule is the documented one, split into a coarse
+    /// pass and fills for one row, in order for several.
     #[test]
     fn points_continue_the_documented_neighbour() {
         let cols = 2 * COARSE_STRIDE + 3;
-        let rows = run_rows(3, cols, |cell, from: Option<(usize, &usize)>| Evaluated {
+        // Column COARSE_STRIDE + 2 hands on nothing.
+        let eval = |cell: Cell, from: Option<(usize, &usize)>| Evaluated {
             point: (cell, from.map(|(j, c)| (j, *c))),
             carry: (cell.col != COARSE_STRIDE + 2).then_some(cell.col),
-        });
-        assert_eq!(rows.len(), 3);
-        for (r, row) in rows.iter().enumerate() {
-            assert_eq!(row.len(), cols);
-            for (col, (cell, from)) in row.iter().enumerate() {
-                assert_eq!(*cell, Cell { row: r, col });
-                let expected = match col {
-                    0 => None,
-                    // The point after the one that hands on nothing starts afresh.
-                    c if c == COARSE_STRIDE + 3 => None,
-                    c if c % COARSE_STRIDE == 0 => Some(c - COARSE_STRIDE),
-                    c => Some(c - 1),
-                };
-                assert_eq!(from.map(|(j, _)| j), expected, "col {col}");
-                if let Some((j, c)) = from {
-                    assert_eq!(j, c);
+        };
+        for (rows, split) in [(1, true), (3, false)] {
+            let grid = run_rows(rows, cols, eval);
+            assert_eq!(grid.len(), rows);
+            for (r, row) in grid.iter().enumerate() {
+                assert_eq!(row.len(), cols);
+                for (col, (cell, from)) in row.iter().enumerate() {
+                    assert_eq!(*cell, Cell { row: r, col });
+                    let expected = match col {
+                        0 => None,
+                        // The point after the one that hands on nothing starts afresh.
+                        c if c == COARSE_STRIDE + 3 => None,
+                        c if split && c % COARSE_STRIDE == 0 => Some(c - COARSE_STRIDE),
+                        c => Some(c - 1),
+                    };
+                    assert_eq!(from.map(|(j, _)| j), expected, "{rows} rows, col {col}");
+                    if let Some((j, c)) = from {
+                        assert_eq!(j, c);
+                    }
                 }
             }
         }
