@@ -378,7 +378,7 @@ pub fn constrained_dynamics(
         return solve_with_fixed_leg_one(&eom, active);
     }
     // The general case (Leg 1 sliding or off the ground): all five coordinates.
-    let mut rows = ActiveRows::<NQ>::default();
+    let mut rows = ActiveRows::<NQ, NROWS>::default();
     let mask = active.row_mask();
     let rear = &eom.rear_tip;
     // Leg 1's tip is the point (x, z): constant rows, dJ/dt q' = 0.
@@ -408,7 +408,7 @@ pub fn constrained_dynamics(
         }
     }
     let f = std::array::from_fn(|i| -eom.bias[i]);
-    let (x, lam) = solve_active_rows(m, &f, &rows, NROWS, active)?;
+    let (x, lam) = solve_active_rows(m, &f, &mut rows, active)?;
     let mut multipliers = Multipliers::zeros();
     for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
         multipliers[stacked] = lam[i];
@@ -439,7 +439,7 @@ fn solve_with_fixed_leg_one(
     // Remaining rows (C2, stoppers) restricted to (theta, L1, L2), numbered from 0 after C1's rows.
     let rear = &eom.rear_tip;
     let mask = active.row_mask();
-    let mut rows = ActiveRows::<R>::default();
+    let mut rows = ActiveRows::<R, { NROWS - 2 }>::default();
     for axis in 0..2 {
         if mask[2 + axis] {
             let row = std::array::from_fn(|k| rear.jacobian[(axis, 2 + k)]);
@@ -451,7 +451,7 @@ fn solve_with_fixed_leg_one(
             rows.push(unit_row(coordinate - 2), 0.0, stacked);
         }
     }
-    let (qdd_r, lam) = solve_active_rows(m_rr, &f_r, &rows, NROWS - 2, active)?;
+    let (qdd_r, lam) = solve_active_rows(m_rr, &f_r, &mut rows, active)?;
     let mut qdd = Coords::zeros();
     let mut multipliers = Multipliers::zeros();
     for k in 0..R {
@@ -474,28 +474,28 @@ fn unit_row<const N: usize>(i: usize) -> [f64; N] {
     std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 })
 }
 
-/// The active constraint rows of a KKT system over `N` unknowns, compacted: row `a_i`, right-hand side `b_i`
-/// (of `a_i . x = b_i`) and the position of the row in its stacking.
+/// The active constraint rows of a KKT system over `N` unknowns whose constraints stack `K` rows, compacted:
+/// row `a_i`, right-hand side `b_i` (of `a_i . x = b_i`) and the position of the row in the stacking.
 #[derive(Debug, Clone, Copy)]
-struct ActiveRows<const N: usize> {
-    rows: [[f64; N]; NROWS],
-    rhs: [f64; NROWS],
-    stacked: [usize; NROWS],
+struct ActiveRows<const N: usize, const K: usize> {
+    rows: [[f64; N]; K],
+    rhs: [f64; K],
+    stacked: [usize; K],
     len: usize,
 }
 
-impl<const N: usize> Default for ActiveRows<N> {
+impl<const N: usize, const K: usize> Default for ActiveRows<N, K> {
     fn default() -> Self {
         ActiveRows {
-            rows: [[0.0; N]; NROWS],
-            rhs: [0.0; NROWS],
-            stacked: [0; NROWS],
+            rows: [[0.0; N]; K],
+            rhs: [0.0; K],
+            stacked: [0; K],
             len: 0,
         }
     }
 }
 
-impl<const N: usize> ActiveRows<N> {
+impl<const N: usize, const K: usize> ActiveRows<N, K> {
     fn push(&mut self, row: [f64; N], rhs: f64, stacked: usize) {
         self.rows[self.len] = row;
         self.rhs[self.len] = rhs;
@@ -505,18 +505,17 @@ impl<const N: usize> ActiveRows<N> {
 }
 
 /// Solve `[M -A^T; A 0] [x; lam] = [f; b]` for the active rows `A`, `b` of `rows` through the Schur complement
-/// `S = A M^-1 A^T`, returning `x` and `lam` in the order of `rows`.
+/// `S = A M^-1 A^T`, returning `x` and `lam` in the order of `rows` (whose rows it overwrites).
 ///
 /// The same algorithm as [`solve_saddle`] / [`solve_schur`], on the active rows only: the redundancy test sees
-/// the Schur complement of all `stacked` rows of which the inactive ones are identity rows, so when some row
+/// the Schur complement of all `K` stacked rows of which the inactive ones are identity rows, so when some row
 /// of the stacking is inactive, its pivot 1 enters the largest diagonal and the smallest pivot as there.
-fn solve_active_rows<const N: usize>(
+fn solve_active_rows<const N: usize, const K: usize>(
     mut chol: Ldl<N>,
     f: &[f64; N],
-    rows: &ActiveRows<N>,
-    stacked: usize,
+    rows: &mut ActiveRows<N, K>,
     active: &ActiveSet,
-) -> Result<([f64; N], [f64; NROWS]), ContactError> {
+) -> Result<([f64; N], [f64; K]), ContactError> {
     let k = rows.len;
     if !chol.factor() {
         return Err(ContactError::SingularMass);
@@ -524,14 +523,15 @@ fn solve_active_rows<const N: usize>(
     // M = L D L^T; with g = L^-1 f and W_i = L^-1 a_i: a_i . M^-1 f = W_i . D^-1 g, S_ij = W_i . D^-1 W_j.
     let mut g = *f;
     chol.forward(&mut g);
-    let mut w = rows.rows;
+    // W_i = L^-1 a_i, in place of a_i.
+    let w = &mut rows.rows;
     for w_i in &mut w[..k] {
         chol.forward(w_i);
     }
     let scaled_dot =
-        |u: &[f64; N], v: &[f64; N]| (0..N).map(|l| u[l] * v[l] / chol.d[l]).sum::<f64>();
-    let mut schur = Ldl::<NROWS>::zeros(k);
-    let mut lam = [0.0; NROWS];
+        |u: &[f64; N], v: &[f64; N]| (0..N).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
+    let mut schur = Ldl::<K>::zeros(k);
+    let mut lam = [0.0; K];
     for i in 0..k {
         lam[i] = rows.rhs[i] - scaled_dot(&w[i], &g);
         for j in 0..=i {
@@ -539,7 +539,7 @@ fn solve_active_rows<const N: usize>(
         }
     }
     // The identity rows of the inactive units, if any, as `solve_schur` sees them.
-    let (diagonal, pivot) = if k < stacked {
+    let (diagonal, pivot) = if k < K {
         (1.0, 1.0)
     } else {
         (f64::NEG_INFINITY, f64::INFINITY)
@@ -579,6 +579,8 @@ struct Ldl<const N: usize> {
     l: [[f64; N]; N],
     /// The pivots `D` (the squares of the diagonal of the Cholesky factor).
     d: [f64; N],
+    /// `1 / D`, so that the solves multiply rather than divide.
+    d_inv: [f64; N],
     n: usize,
 }
 
@@ -588,6 +590,7 @@ impl<const N: usize> Ldl<N> {
         Ldl {
             l: [[0.0; N]; N],
             d: [0.0; N],
+            d_inv: [0.0; N],
             n,
         }
     }
@@ -595,7 +598,7 @@ impl<const N: usize> Ldl<N> {
     /// Factor in place; `false` when a pivot is not positive (or not a number), as nalgebra's
     /// `Cholesky::new` fails.
     fn factor(&mut self) -> bool {
-        let (l, d) = (&mut self.l, &mut self.d);
+        let (l, d, d_inv) = (&mut self.l, &mut self.d, &mut self.d_inv);
         for j in 0..self.n {
             let mut pivot = l[j][j];
             for k in 0..j {
@@ -605,12 +608,13 @@ impl<const N: usize> Ldl<N> {
                 return false;
             }
             d[j] = pivot;
+            d_inv[j] = 1.0 / pivot;
             for i in j + 1..self.n {
                 let mut s = l[i][j];
                 for k in 0..j {
                     s -= l[i][k] * l[j][k] * d[k];
                 }
-                l[i][j] = s / pivot;
+                l[i][j] = s * d_inv[j];
             }
         }
         true
@@ -628,7 +632,7 @@ impl<const N: usize> Ldl<N> {
     /// `y <- L^-T D^-1 y`, so that `forward` then `backward_scaled` solve `A x = b`.
     fn backward_scaled(&self, y: &mut [f64; N]) {
         for i in (0..self.n).rev() {
-            y[i] /= self.d[i];
+            y[i] *= self.d_inv[i];
             for k in i + 1..self.n {
                 y[i] -= self.l[k][i] * y[k];
             }
