@@ -249,6 +249,18 @@ impl Model {
         q[Z] + q[L1] * ct - length * cp
     }
 
+    /// Height of the lowest tip above the slope, over every leg \[m\]: the least [`Model::tip_height`], with one
+    /// sine and cosine of `theta` for all legs (the penetration audit runs it several times per integrator step).
+    pub fn lowest_tip_height(&self, q: &Coords) -> f64 {
+        let (st, ct) = q[THETA].sin_cos();
+        let hub_height = q[Z] + q[L1] * ct;
+        self.offsets
+            .iter()
+            .enumerate()
+            .map(|(j, &(sj, cj))| hub_height - self.leg_length(q, j).0 * (ct * cj - st * sj))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Mass matrix `M(q)` and bias vector `h(q, q')` of Eq. (1): Coriolis/centrifugal terms, gravity, the leg
     /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (docs/model.md section 2).
     ///
@@ -509,6 +521,23 @@ mod tests {
                         "{context}: h = {h}, reference {h_ref}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn lowest_tip_height_is_the_least_tip_height() {
+        for legs in [3, 8, 13] {
+            let model = Model::new(&Params {
+                legs,
+                ..Params::default()
+            })
+            .unwrap();
+            for (q, _) in random_states(10) {
+                let least = (0..legs)
+                    .map(|j| model.tip_height(&q, j))
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(model.lowest_tip_height(&q), least);
             }
         }
     }
