@@ -5,6 +5,8 @@
 //!
 //! - `walking_step`: one `Walker::step` (touchdown impact, the DLS/SLS phases and their events, re-indexing)
 //!   from a state on the gait, reached by first walking `SETTLE_STEPS` steps.
+//! - `rhs/<active set>`: one evaluation of the constrained dynamics (`vrw::contact::constrained_dynamics`,
+//!   the integrator's right-hand side) at a stance state, for the active sets the walk spends its time in.
 //! - `twenty_steps`: `vrw::walk::simulate` for 20 steps from the reference start, without a trajectory.
 //! - `gait_after_transient`: the gait search once its transient is done: Newton's method from the state
 //!   reached after `SETTLE_STEPS` steps, to a residual below 1e-10, plus the Floquet multipliers
@@ -25,7 +27,8 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 use vrw::app::{compute_gait, default_initial, GaitJob};
-use vrw::dynamics::Model;
+use vrw::contact::{constrained_dynamics, ActiveSet};
+use vrw::dynamics::{Coords, Model};
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::walk::{simulate, Walker};
@@ -57,6 +60,59 @@ fn walking_step(c: &mut Criterion) {
             BatchSize::SmallInput,
         )
     });
+    group.finish();
+}
+
+fn rhs(c: &mut Criterion) {
+    let config = Config::default();
+    let model = Model::new(&config.params).expect("the paper's parameters are valid");
+    // A stance state near double support: Leg 1 compressed, Leg 2 near its stopper.
+    let q = Coords::new(0.0, 0.0, -0.3, 0.97, 0.99);
+    let qd = Coords::new(0.0, 0.0, 1.0, -0.2, 0.1);
+    let sets = [
+        (
+            "sls",
+            ActiveSet {
+                contact1: true,
+                ..Default::default()
+            },
+        ),
+        (
+            "sls_lock2",
+            ActiveSet {
+                contact1: true,
+                lock2: true,
+                ..Default::default()
+            },
+        ),
+        (
+            "dls",
+            ActiveSet {
+                contact1: true,
+                contact2: true,
+                ..Default::default()
+            },
+        ),
+        (
+            "rear_support",
+            ActiveSet {
+                contact2: true,
+                lock1: true,
+                ..Default::default()
+            },
+        ),
+    ];
+    let mut group = c.benchmark_group("rhs");
+    group.sample_size(20);
+    group.measurement_time(Duration::from_secs(2));
+    for (name, active) in sets {
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                constrained_dynamics(&model, black_box(&q), black_box(&qd), black_box(&active))
+                    .expect("a regular active set")
+            })
+        });
+    }
     group.finish();
 }
 
@@ -140,6 +196,7 @@ fn gait_job(c: &mut Criterion) {
 criterion_group!(
     benches,
     walking_step,
+    rhs,
     twenty_steps,
     gait_after_transient,
     gait_job

@@ -60,6 +60,49 @@ impl PointKinematics {
 /// touch down is `j = N - 1` (docs/model.md section 1: `psi_j = theta + j alpha`).
 pub type LegIndex = usize;
 
+/// `M`, `h` and the tip of Leg 2 at one state, from [`Model::equations_of_motion`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EquationsOfMotion {
+    /// Mass matrix `M(q)`.
+    pub mass: Mat5,
+    /// Bias vector `h(q, q')`: Coriolis/centrifugal terms, gravity, springs and dampers.
+    pub bias: Coords,
+    /// Kinematics of the tip of Leg 2 (the rows of (C2)), as [`Model::tip`] gives them.
+    pub rear_tip: PointKinematics,
+}
+
+/// Sums over point masses `m_i` with Jacobian columns `b_i = [b_theta, b_L1, b_L2]` (the `x`, `z` columns
+/// being the identity) and forces `f_i = m_i (dJ_i/dt q' + g_n)`, from which `M` and `h` are assembled.
+#[derive(Debug, Default)]
+struct PointSums {
+    /// `sum m_i`.
+    mass: f64,
+    /// `sum m_i b_ik`.
+    b: [Vector2<f64>; 3],
+    /// `sum m_i b_ik . b_il` for `k <= l`.
+    bb: [[f64; 3]; 3],
+    /// `sum f_i`.
+    f: Vector2<f64>,
+    /// `sum b_ik . f_i`.
+    bf: [f64; 3],
+}
+
+impl PointSums {
+    /// Add a point of mass `m`, Jacobian columns `b` and acceleration `a = dJ/dt q' + g_n`.
+    fn add(&mut self, m: f64, b: &[Vector2<f64>; 3], a: Vector2<f64>) {
+        let f = m * a;
+        self.mass += m;
+        self.f += f;
+        for k in 0..3 {
+            self.b[k] += m * b[k];
+            self.bf[k] += b[k].dot(&f);
+            for l in k..3 {
+                self.bb[k][l] += m * b[k].dot(&b[l]);
+            }
+        }
+    }
+}
+
 /// The validated model: parameters plus precomputed leg-angle offsets.
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -67,6 +110,8 @@ pub struct Model {
     alpha: f64,
     /// `(sin j alpha, cos j alpha)` for `j = 0..N`.
     offsets: Vec<(f64, f64)>,
+    /// `sum_j (sin j alpha, cos j alpha)` over the locked legs `j = 2..N`.
+    locked_offsets: (f64, f64),
     /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame \[m/s^2\].
     up: Vector2<f64>,
 }
@@ -76,17 +121,21 @@ impl Model {
     pub fn new(params: &Params) -> Result<Model, ConfigError> {
         params.validate()?;
         let alpha = params.alpha();
-        let offsets = (0..params.legs)
+        let offsets: Vec<(f64, f64)> = (0..params.legs)
             .map(|j| {
                 let a = j as f64 * alpha;
                 (a.sin(), a.cos())
             })
             .collect();
+        // The N-th roots of unity sum to zero, so the locked legs' sum is minus that of legs 0 and 1 (exact,
+        // without the rounding of a sum over up to `MAX_LEGS` terms).
+        let locked_offsets = (-alpha.sin(), -1.0 - alpha.cos());
         let up = params.gravity * Vector2::new(-params.slope.sin(), params.slope.cos());
         Ok(Model {
             params: params.clone(),
             alpha,
             offsets,
+            locked_offsets,
             up,
         })
     }
@@ -200,16 +249,42 @@ impl Model {
         q[Z] + q[L1] * ct - length * cp
     }
 
+    /// Height of the lowest tip above the slope, over every leg \[m\]: the least [`Model::tip_height`], with one
+    /// sine and cosine of `theta` for all legs (the penetration audit runs it several times per integrator step).
+    pub fn lowest_tip_height(&self, q: &Coords) -> f64 {
+        let (st, ct) = q[THETA].sin_cos();
+        let hub_height = q[Z] + q[L1] * ct;
+        self.offsets
+            .iter()
+            .enumerate()
+            .map(|(j, &(sj, cj))| hub_height - self.leg_length(q, j).0 * (ct * cj - st * sj))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Mass matrix `M(q)` and bias vector `h(q, q')` of Eq. (1): Coriolis/centrifugal terms, gravity, the leg
     /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (docs/model.md section 2).
     ///
+    /// See [`Model::equations_of_motion`] for how they are assembled; [`Model::mass_and_bias_reference`] is the
+    /// plain formula the tests compare against.
+    pub fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+        let eom = self.equations_of_motion(q, qd);
+        (eom.mass, eom.bias)
+    }
+
+    /// `M(q)` and `h(q, q')` of Eq. (1) (as [`Model::mass_and_bias`]) together with the kinematics of Leg 2's tip,
+    /// which share the sine and cosine of `theta` and the hub terms (docs/model.md sections 2-3).
+    ///
     /// Every point Jacobian has the form `J_i = [I_2 | b_theta | b_L1 | b_L2]` (the `x`, `z` columns are the
     /// identity), so `M = sum m_i J_i^T J_i` and `h = sum m_i J_i^T f_i` are accumulated from the three
-    /// columns `b` only; [`Model::mass_and_bias_reference`] is the plain formula the tests compare against.
-    pub fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+    /// columns `b` only. The hub, Leg 1 and Leg 2 are added point by point. The `N - 2` locked legs are added in
+    /// closed form: leg `j` has `b_theta = b_H + d e(psi_j)'`, `b_L1 = b_L1,H`, `b_L2 = 0` and
+    /// `f = m (a_H + g_n - d w^2 e(psi_j))` with the same `d = L0 - a` for all, and `|e'|^2 = 1`,
+    /// `e . e' = 0`, so their sums need only `sum_j e(psi_j)` (and `sum_j e(psi_j)' `), a rotation by `theta` of
+    /// the constant `sum_j (sin j alpha, cos j alpha)`. The cost is independent of `N`.
+    pub fn equations_of_motion(&self, q: &Coords, qd: &Coords) -> EquationsOfMotion {
         let p = &self.params;
         let (st, ct) = q[THETA].sin_cos();
-        let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
+        let (l1, dl1, l2, dl2, w) = (q[L1], qd[L1], q[L2], qd[L2], qd[THETA]);
         // Hub: b_theta = (L1 c, -L1 s), b_L1 = (s, c), b_L2 = 0; dJ/dt q' as in `hub`.
         let hub_b = [
             Vector2::new(l1 * ct, -l1 * st),
@@ -220,69 +295,91 @@ impl Model {
             2.0 * dl1 * ct * w - l1 * st * w * w,
             -2.0 * dl1 * st * w - l1 * ct * w * w,
         );
-        // Accumulators: total mass, sum m b_k, sum m b_k . b_l, sum f, sum b_k . f.
-        let mut mass_total = 0.0;
-        let mut sum_b = [Vector2::zeros(); 3];
-        let mut bb = [[0.0; 3]; 3];
-        let mut sum_f = Vector2::zeros();
-        let mut bf = [0.0; 3];
-        let mut add = |m: f64, b: &[Vector2<f64>; 3], vp: Vector2<f64>| {
-            let f = m * (vp + self.up);
-            mass_total += m;
-            sum_f += f;
-            for k in 0..3 {
-                sum_b[k] += m * b[k];
-                bf[k] += b[k].dot(&f);
-                for l in k..3 {
-                    bb[k][l] += m * b[k].dot(&b[l]);
-                }
+        // psi = theta + j alpha; e = (-sin psi, -cos psi), e_psi = de/dpsi = (-cos psi, sin psi)
+        let directions = |(sj, cj): (f64, f64)| {
+            let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
+            (Vector2::new(-sp, -cp), Vector2::new(-cp, sp))
+        };
+        let hub_position = Vector2::new(q[X] + l1 * st, q[Z] + l1 * ct);
+        // Leg j with length L and rate dL/dt, its length column b_L in `slot`: a point of it at distance
+        // `from_tip` from its tip, as Jacobian columns b, dJ/dt q' and position.
+        let leg = |j: usize, length: f64, dlength: f64, slot: usize| {
+            let (e, e_psi) = directions(self.offsets[j]);
+            move |from_tip: f64| {
+                let d = length - from_tip;
+                let mut b = hub_b;
+                b[0] += d * e_psi;
+                b[slot] += e;
+                let vp = hub_vp + 2.0 * dlength * w * e_psi - d * w * w * e;
+                (b, vp, hub_position + d * e)
             }
         };
-        add(p.hub_mass, &hub_b, hub_vp);
-        for (j, &(sj, cj)) in self.offsets.iter().enumerate() {
-            // psi = theta + j alpha; e = (-sin psi, -cos psi), e_psi = de/dpsi = (-cos psi, sin psi)
-            let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
-            let e = Vector2::new(-sp, -cp);
-            let e_psi = Vector2::new(-cp, sp);
-            let (length, dlength, slot) = match j {
-                0 => (l1, dl1, Some(1)),
-                1 => (q[L2], qd[L2], Some(2)),
-                _ => (p.stopper_length, 0.0, None),
-            };
-            let d = length - p.leg_mass_offset;
-            let mut b = hub_b;
-            b[0] += d * e_psi;
-            if let Some(k) = slot {
-                b[k] += e;
-            }
-            add(
-                p.leg_mass,
-                &b,
-                hub_vp + 2.0 * dlength * w * e_psi - d * w * w * e,
-            );
+        let (leg_one, leg_two) = (leg(0, l1, dl1, 1), leg(1, l2, dl2, 2));
+        let mut sums = PointSums::default();
+        sums.add(p.hub_mass, &hub_b, hub_vp + self.up);
+        for point in [leg_one, leg_two] {
+            let (b, vp, _) = point(p.leg_mass_offset);
+            sums.add(p.leg_mass, &b, vp + self.up);
         }
-        let mut m = Mat5::zeros();
-        let mut h = Coords::zeros();
-        m[(X, X)] = mass_total;
-        m[(Z, Z)] = mass_total;
-        h[X] = sum_f.x;
-        h[Z] = sum_f.y;
+        // The locked legs j = 2..N, all of length L0 (see above).
+        let n = (self.legs() - 2) as f64;
+        let d = p.stopper_length - p.leg_mass_offset;
+        let (ss, sc) = self.locked_offsets;
+        let (sum_sin, sum_cos) = (st * sc + ct * ss, ct * sc - st * ss);
+        let sum_e = Vector2::new(-sum_sin, -sum_cos);
+        let sum_e_psi = Vector2::new(-sum_cos, sum_sin);
+        let a = hub_vp + self.up;
+        let m = p.leg_mass;
+        sums.mass += n * m;
+        sums.f += m * (n * a - d * w * w * sum_e);
+        sums.b[0] += m * (n * hub_b[0] + d * sum_e_psi);
+        sums.b[1] += m * n * hub_b[1];
+        sums.bb[0][0] +=
+            m * (n * hub_b[0].norm_squared() + 2.0 * d * hub_b[0].dot(&sum_e_psi) + n * d * d);
+        sums.bb[0][1] += m * (n * hub_b[0].dot(&hub_b[1]) + d * hub_b[1].dot(&sum_e_psi));
+        sums.bb[1][1] += m * n * hub_b[1].norm_squared();
+        sums.bf[0] +=
+            m * (n * hub_b[0].dot(&a) - d * w * w * hub_b[0].dot(&sum_e) + d * sum_e_psi.dot(&a));
+        sums.bf[1] += m * (n * hub_b[1].dot(&a) - d * w * w * hub_b[1].dot(&sum_e));
+
+        let mut mass = Mat5::zeros();
+        let mut bias = Coords::zeros();
+        mass[(X, X)] = sums.mass;
+        mass[(Z, Z)] = sums.mass;
+        bias[X] = sums.f.x;
+        bias[Z] = sums.f.y;
         for k in 0..3 {
             let c = THETA + k;
-            m[(X, c)] = sum_b[k].x;
-            m[(c, X)] = sum_b[k].x;
-            m[(Z, c)] = sum_b[k].y;
-            m[(c, Z)] = sum_b[k].y;
-            h[c] = bf[k];
+            mass[(X, c)] = sums.b[k].x;
+            mass[(c, X)] = sums.b[k].x;
+            mass[(Z, c)] = sums.b[k].y;
+            mass[(c, Z)] = sums.b[k].y;
+            bias[c] = sums.bf[k];
             for l in k..3 {
-                m[(c, THETA + l)] = bb[k][l];
-                m[(THETA + l, c)] = bb[k][l];
+                mass[(c, THETA + l)] = sums.bb[k][l];
+                mass[(THETA + l, c)] = sums.bb[k][l];
             }
         }
-        m[(THETA, THETA)] += p.hub_inertia;
-        h[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
-        h[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
-        (m, h)
+        mass[(THETA, THETA)] += p.hub_inertia;
+        bias[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
+        bias[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
+
+        let (b, velocity_product, position) = leg_two(0.0);
+        let mut jacobian = PointJacobian::zeros();
+        jacobian[(0, X)] = 1.0;
+        jacobian[(1, Z)] = 1.0;
+        for (k, column) in b.iter().enumerate() {
+            jacobian.set_column(THETA + k, column);
+        }
+        EquationsOfMotion {
+            mass,
+            bias,
+            rear_tip: PointKinematics {
+                position,
+                jacobian,
+                velocity_product,
+            },
+        }
     }
 
     /// `M` and `h` by the plain point-mass formula `sum m_i J_i^T J_i`, `sum m_i J_i^T (dJ_i/dt q' + g_n)`:
@@ -373,6 +470,108 @@ mod tests {
         let (m_ref, h_ref) = model.mass_and_bias_reference(&q, &qd);
         assert_relative_eq!(m, m_ref, epsilon = 1e-12, max_relative = 1e-13);
         assert_relative_eq!(h, h_ref, epsilon = 1e-11, max_relative = 1e-13);
+    }
+
+    /// A small deterministic generator of states (xorshift), uniform in `[-1, 1)` per component.
+    fn random_states(count: usize) -> Vec<(Coords, Coords)> {
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut uniform = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        };
+        (0..count)
+            .map(|_| {
+                let q = Coords::new(
+                    uniform(),
+                    uniform(),
+                    3.0 * uniform(),
+                    0.9 + 0.1 * uniform(),
+                    0.9 + 0.1 * uniform(),
+                );
+                let qd = Coords::from_fn(|_, _| 2.0 * uniform());
+                (q, qd)
+            })
+            .collect()
+    }
+
+    /// The closed-form sums over the locked legs equal the leg-by-leg point-mass formula for any number of
+    /// legs, hub inertia and mass offset.
+    #[test]
+    fn locked_legs_in_closed_form_equal_the_point_mass_formula() {
+        for legs in [3, 4, 5, 8, 12, 1000] {
+            for (hub_inertia, leg_mass_offset) in [(0.0, 0.3), (0.3, 0.0), (1.2, 0.9)] {
+                let params = Params {
+                    legs,
+                    hub_inertia,
+                    leg_mass_offset,
+                    ..Params::default()
+                };
+                let model = Model::new(&params).unwrap();
+                // The reference sums N terms: its rounding grows with N and with the size of the entries.
+                let scale = model.total_mass() * (1.0 + params.gravity);
+                for (q, qd) in random_states(20) {
+                    let (m, h) = model.mass_and_bias(&q, &qd);
+                    let (m_ref, h_ref) = model.mass_and_bias_reference(&q, &qd);
+                    let context = format!("N = {legs}, IH = {hub_inertia}, a = {leg_mass_offset}");
+                    assert_relative_eq!(m, m_ref, epsilon = 1e-13 * scale, max_relative = 1e-13);
+                    assert!(
+                        (h - h_ref).amax() <= 1e-13 * scale * (1.0 + qd.amax().powi(2)),
+                        "{context}: h = {h}, reference {h_ref}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn lowest_tip_height_is_the_least_tip_height() {
+        for legs in [3, 8, 13] {
+            let model = Model::new(&Params {
+                legs,
+                ..Params::default()
+            })
+            .unwrap();
+            for (q, _) in random_states(10) {
+                let least = (0..legs)
+                    .map(|j| model.tip_height(&q, j))
+                    .fold(f64::INFINITY, f64::min);
+                assert_eq!(model.lowest_tip_height(&q), least);
+            }
+        }
+    }
+
+    #[test]
+    fn rear_tip_of_the_equations_of_motion_is_the_tip_of_leg_two() {
+        let model = model();
+        for (q, qd) in random_states(10) {
+            let tip = model.tip(&q, &qd, 1);
+            let eom = model.equations_of_motion(&q, &qd);
+            assert_relative_eq!(eom.rear_tip.position, tip.position, epsilon = 1e-14);
+            assert_relative_eq!(eom.rear_tip.jacobian, tip.jacobian, epsilon = 1e-14);
+            assert_relative_eq!(
+                eom.rear_tip.velocity_product,
+                tip.velocity_product,
+                epsilon = 1e-13
+            );
+        }
+    }
+
+    #[test]
+    fn locked_leg_offsets_are_the_sum_over_the_locked_legs() {
+        for legs in [3, 8, 1000] {
+            let model = Model::new(&Params {
+                legs,
+                ..Params::default()
+            })
+            .unwrap();
+            let (ss, sc) = model.offsets[2..]
+                .iter()
+                .fold((0.0, 0.0), |(ss, sc), &(s, c)| (ss + s, sc + c));
+            assert_relative_eq!(model.locked_offsets.0, ss, epsilon = 1e-12);
+            assert_relative_eq!(model.locked_offsets.1, sc, epsilon = 1e-12);
+        }
     }
 
     #[test]

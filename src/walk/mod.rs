@@ -503,9 +503,7 @@ impl ContactAudit {
     /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`).
     fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
-        for j in 0..model.legs() {
-            self.penetration = self.penetration.max(-model.tip_height(&q, j));
-        }
+        self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
     }
 
     /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).
