@@ -1,6 +1,10 @@
-//! Adaptive Dormand–Prince 5(4) integration with dense output and event-root location.
+//! Adaptive Dormand–Prince integration with dense output and event-root location.
 //!
-//! The integrator is the explicit Runge–Kutta pair of Dormand & Prince (1980) used in
+//! Two explicit Runge–Kutta pairs, chosen by [`Method`] (the `integrator` key of a configuration) and driven
+//! through [`Integrator`]: [`Dop853`] (order 8, the default, in its own module) and [`Dopri5`] (order 5, below).
+//! Both hand out each accepted step as a [`DenseStep`], on which the caller locates events ([`locate_root`]).
+//!
+//! [`Dopri5`] is the explicit Runge–Kutta pair of Dormand & Prince (1980) used in
 //! local extrapolation mode (the 5th-order solution is propagated, the embedded 4th-order one
 //! only estimates the error), with FSAL (the last stage is f at the new point), the PI
 //! ("Lund-stabilised") step-size controller of Gustafsson (1991) as in Hairer's `dopri5`, the

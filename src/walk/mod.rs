@@ -2,7 +2,8 @@
 //!
 //! A [`Walker`] holds the wheel at the Poincare section (just before a touchdown, after re-indexing) and
 //! [`Walker::step`] advances it to the next one: the touchdown impact of [`impact`], then phases of constrained
-//! motion, each integrated by [`Dopri5`] until the earliest event, located on the dense output:
+//! motion, each integrated by an [`Integrator`] (DOP853 by default) until the earliest event, located on the dense
+//! output (every event function is evaluated at the ends of [`EVENT_SAMPLES`] equal parts of each step):
 //!
 //! | event | function crossing zero from above |
 //! |---|---|
@@ -29,7 +30,8 @@
 //! that follows.
 //!
 //! **Audits.** Every step reports an energy audit and a contact audit ([`ContactAudit`]): the largest pulling
-//! force at every accepted integrator step and event instant, the largest pulling impulse of its impacts, and
+//! force at the ends of the [`EVENT_SAMPLES`] parts of every accepted integrator step and at every event instant,
+//! the largest pulling impulse of its impacts, and
 //! the deepest any tip went below the ground, checked on the dense output at [`PENETRATION_SAMPLES`] points
 //! per integrator step.
 

@@ -32,7 +32,7 @@ pub struct EnergyAudit {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct ContactAudit {
     /// The largest pulling normal force or outward stopper reaction seen in the step \[N\] (at every accepted
-    /// integrator step and every event instant), 0 if none.
+    /// integrator step, at three more points inside it, and at every event instant), 0 if none.
     pub pull_force: f64,
     /// The largest pulling impulse at any of the step's impacts \[N s\], 0 if none.
     pub pull_impulse: f64,
