@@ -20,8 +20,8 @@ use serde::Serialize;
 use crate::dynamics::Model;
 use crate::error::{short, WalkError};
 use crate::gait::{
-    find_gait_any_period, find_thresholds, sweep_values, Gait, GaitOptions, StepMap, SweepPoint,
-    SweepSpec, Threshold, MAX_PERIOD,
+    find_gait_any_period, find_thresholds, sweep_values, Gait, GaitOptions, SecondRoute, StepMap,
+    SweepPoint, SweepSpec, Threshold, MAX_PERIOD,
 };
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
@@ -526,8 +526,20 @@ pub struct SweepJob {
     pub initial: Option<SectionState>,
     /// Search settings.
     pub options: GaitOptions,
+    /// Search every threshold again by a second route (the whole sweep with the other integrator) and record
+    /// in each whether it is confirmed ([`SecondRoute`]).
+    pub second_route: bool,
     /// Where `sweep.csv`, `thresholds.json`, `fig2.svg` and `fig2.png` go.
     pub out_dir: PathBuf,
+}
+
+/// The configuration of the second route for a result computed with `config`: the other integrator, and the
+/// route's name.
+pub fn second_route_config(config: &Config) -> (Config, String) {
+    let mut second = config.clone();
+    second.solver.integrator = config.solver.integrator.other();
+    let route = format!("integrator = {}", second.solver.integrator);
+    (second, route)
 }
 
 /// `thresholds.json`.
@@ -549,6 +561,9 @@ pub struct SweepSummary {
     /// reproducible).
     #[serde(skip)]
     pub seconds: [f64; 2],
+    /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
+    #[serde(skip)]
+    pub second_route_seconds: f64,
     /// The files this run wrote into the output directory (Fig. 2 only if some point has a gait; an earlier
     /// run's figure is removed rather than left beside this run's tables).
     pub files: Vec<String>,
@@ -574,6 +589,29 @@ pub fn run_sweep(
         progress,
         &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
     )?;
+    let mut thresholds = result.thresholds;
+    let clock = std::time::Instant::now();
+    if job.second_route {
+        // sweep.csv is written already: nothing is lost if the second route fails.
+        let (second_config, route) = second_route_config(&job.config);
+        let second = compute_sweep(
+            &second_config,
+            &job.spec.param,
+            &job.spec.values(),
+            Some(initial),
+            &job.options,
+            progress,
+            &mut |_| Ok(()),
+        )?;
+        for t in &mut thresholds {
+            t.second_route = Some(SecondRoute::check(t, &second.thresholds, &route));
+        }
+    }
+    let second_route_seconds = if job.second_route {
+        clock.elapsed().as_secs_f64()
+    } else {
+        0.0
+    };
     let gaits_found = result.points.iter().filter(|p| p.gait.is_some()).count();
     let figures = ["fig2.svg", "fig2.png"];
     let mut files = vec!["sweep.csv".to_string(), "thresholds.json".to_string()];
@@ -586,8 +624,9 @@ pub fn run_sweep(
         spec: job.spec.clone(),
         gaits_found,
         points: result.points.len(),
-        thresholds: result.thresholds,
+        thresholds,
         seconds: result.seconds,
+        second_route_seconds,
         files,
     };
     output::write_json(&job.out_dir.join("thresholds.json"), &summary)?;

@@ -18,7 +18,7 @@ use vrw::app::{
 use vrw::gait::basin::Coordinate;
 use vrw::gait::orbit::OrbitSpec;
 use vrw::gait::GaitOptions;
-use vrw::gait::{MapSpec, SweepSpec};
+use vrw::gait::{MapSpec, SecondRoute, SweepSpec, Threshold, SECOND_ROUTE_TOL};
 use vrw::output::animate::AnimateOptions;
 use vrw::output::map_plot::MapMark;
 use vrw::params::Config;
@@ -141,6 +141,10 @@ struct SweepArgs {
     /// Where the search at the first point starts, `L2,thetadot,L2dot`; default as for simulate.
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
+    /// Search every threshold again by a second route, the whole sweep with the other integrator (dopri5 for
+    /// the default dop853), and say of each whether it is confirmed (in thresholds.json: `second_route`).
+    #[arg(long)]
+    second_route: bool,
     /// Output directory for sweep.csv, thresholds.json, fig2.svg and fig2.png.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
@@ -188,6 +192,10 @@ struct MapArgs {
     #[arg(long, default_value_t = vrw::gait::map::DEFAULT_CURVE_COLUMNS as u64,
           value_parser = clap::value_parser!(u64).range(2..))]
     curve_columns: u64,
+    /// Search every threshold again by a second route, the whole map with the other integrator (dopri5 for
+    /// the default dop853), and say of each whether it is confirmed (in curves.json: `second_route`).
+    #[arg(long, conflicts_with = "no_curves")]
+    second_route: bool,
     /// Output directory for map.csv, curves.json, map.svg and map.png.
     #[arg(long, default_value = "out/map")]
     out: PathBuf,
@@ -725,10 +733,12 @@ fn sweep(args: SweepArgs) -> Result<()> {
         },
         initial: args.initial,
         options: GaitOptions::for_sweeps(),
+        second_route: args.second_route,
         out_dir: args.out.clone(),
     };
+    let routes = if args.second_route { 2 } else { 1 };
     let bar = progress_bar(
-        Some(args.points as u64),
+        Some(routes * args.points as u64),
         "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
     );
     let started = std::time::Instant::now();
@@ -751,7 +761,7 @@ fn sweep(args: SweepArgs) -> Result<()> {
     );
     for t in &summary.thresholds {
         println!(
-            "  {:<18} {} = {:.6}  (bracket [{:.7}, {:.7}], residual {:.1e}){}",
+            "  {:<18} {} = {:.6}  (bracket [{:.7}, {:.7}], residual {:.1e}){}{}",
             t.name,
             args.param,
             t.value,
@@ -761,7 +771,18 @@ fn sweep(args: SweepArgs) -> Result<()> {
             t.detail
                 .as_deref()
                 .map(|d| format!(": {d}"))
+                .unwrap_or_default(),
+            t.second_route
+                .as_ref()
+                .map(|r| format!("\n    {}", second_route_words(r)))
                 .unwrap_or_default()
+        );
+    }
+    if args.second_route {
+        println!(
+            "  second route: {:.2} s; {}",
+            summary.second_route_seconds,
+            confirmed_count(summary.thresholds.iter())
         );
     }
     println!(
@@ -797,10 +818,12 @@ fn map(args: MapArgs) -> Result<()> {
         options: GaitOptions::default(),
         curves: !args.no_curves,
         curve_columns: usize::try_from(args.curve_columns).unwrap_or(usize::MAX),
+        second_route: args.second_route,
         marks: args.mark.into_iter().map(|m| m.0).collect(),
         out_dir: args.out.clone(),
     };
-    let total = args.nx.saturating_mul(args.ny);
+    let routes = if args.second_route { 2 } else { 1 };
+    let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
     let bar = progress_bar(
         Some(total as u64),
         "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",
@@ -846,6 +869,34 @@ fn map(args: MapArgs) -> Result<()> {
             "  {unrefined} crossings could not be refined (listed in curves.json with the reason)"
         );
     }
+    if args.second_route {
+        println!(
+            "  second route: {:.2} s; {}",
+            summary.second_route_seconds,
+            confirmed_count(summary.thresholds.iter().map(|t| &t.threshold))
+        );
+        for t in &summary.thresholds {
+            if let Some(r) = t.threshold.second_route.as_ref().filter(|r| !r.confirmed) {
+                let param = match t.along {
+                    vrw::gait::map::Along::X => &args.x,
+                    vrw::gait::map::Along::Y => &args.y,
+                };
+                println!(
+                    "    {} {} = {:.6} on {} {}: {}",
+                    t.threshold.name,
+                    param,
+                    t.threshold.value,
+                    if t.along == vrw::gait::map::Along::X {
+                        "row"
+                    } else {
+                        "column"
+                    },
+                    t.line,
+                    second_route_words(r)
+                );
+            }
+        }
+    }
     println!(
         "wrote {}/{{map.csv, curves.json, map.svg, map.png}}",
         args.out.display()
@@ -854,6 +905,33 @@ fn map(args: MapArgs) -> Result<()> {
         bail!("no gait found anywhere on the map (see map.csv for the reasons)");
     }
     Ok(())
+}
+
+/// A threshold's second route in words.
+fn second_route_words(r: &SecondRoute) -> String {
+    let found = match &r.name {
+        Some(name) if r.value.is_finite() => format!("{name} at {:.6}", r.value),
+        Some(name) => format!("{name}, not located either"),
+        None => "nothing between the same grid points".to_string(),
+    };
+    if r.confirmed {
+        format!(
+            "confirmed by {}: {found} (difference {:.1e})",
+            r.route, r.difference
+        )
+    } else {
+        format!("NOT confirmed by {}: it finds {found}", r.route)
+    }
+}
+
+/// "N of M thresholds confirmed to 2e-6" for the thresholds of a run with a second route.
+fn confirmed_count<'a>(thresholds: impl Iterator<Item = &'a Threshold>) -> String {
+    let (mut confirmed, mut all) = (0, 0);
+    for t in thresholds {
+        all += 1;
+        confirmed += usize::from(t.second_route.as_ref().is_some_and(|r| r.confirmed));
+    }
+    format!("{confirmed} of {all} thresholds confirmed (same kind, values within {SECOND_ROUTE_TOL:.0e})")
 }
 
 #[cfg(test)]

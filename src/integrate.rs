@@ -622,6 +622,14 @@ pub enum Method {
 }
 
 impl Method {
+    /// The other method: the second route for a result computed with this one.
+    pub fn other(self) -> Method {
+        match self {
+            Method::Dop853 => Method::Dopri5,
+            Method::Dopri5 => Method::Dop853,
+        }
+    }
+
     /// The name of the method (`"dop853"` or `"dopri5"`), as in configurations.
     pub fn name(self) -> &'static str {
         match self {

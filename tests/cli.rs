@@ -433,6 +433,59 @@ fn sweep_writes_table_thresholds_and_figure() {
     assert!(run.read("fig2.svg").contains("<svg"));
 }
 
+/// `--second-route` searches every threshold again with the other integrator and says whether it is confirmed:
+/// the gait end near c = 135.5 is (the two integrators agree on it to 1e-6); the output says so on the terminal
+/// and in thresholds.json.
+#[test]
+fn sweep_second_route_confirms_the_threshold() {
+    let args = [
+        "--from",
+        "130",
+        "--to",
+        "140",
+        "--points",
+        "6",
+        "--second-route",
+    ];
+    let run = command_in(temp_dir_with(&[]), "sweep", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    assert!(
+        run.stdout()
+            .contains("confirmed by integrator = dopri5: gait_lost at 135.48923"),
+        "{}",
+        run.stdout()
+    );
+    assert!(run.stdout().contains("1 of 1 thresholds confirmed"));
+    let thresholds: Value = serde_json::from_str(&run.read("thresholds.json")).unwrap();
+    let lost = &thresholds["thresholds"][0];
+    assert_eq!(lost["name"], "gait_lost");
+    let second = &lost["second_route"];
+    assert_eq!(second["route"], "integrator = dopri5");
+    assert_eq!(second["confirmed"], true);
+    assert!(second["difference"].as_f64().unwrap() <= 2e-6, "{second}");
+    // Without the option, no second route is claimed.
+    let run = command_in(
+        temp_dir_with(&[]),
+        "sweep",
+        &["--from", "130", "--to", "140", "--points", "6"],
+    );
+    let thresholds: Value = serde_json::from_str(&run.read("thresholds.json")).unwrap();
+    assert!(thresholds["thresholds"][0].get("second_route").is_none());
+}
+
+/// A second route of the curves needs the curves: `--second-route --no-curves` is a usage error.
+#[test]
+fn map_second_route_without_curves_is_a_usage_error() {
+    let run = command_in(
+        temp_dir_with(&[]),
+        "map",
+        &["--nx", "2", "--ny", "2", "--no-curves", "--second-route"],
+    );
+    assert_eq!(run.code(), Some(2), "{}", run.stderr());
+    assert!(run.stderr().contains("--no-curves"), "{}", run.stderr());
+    assert!(!run.out.exists());
+}
+
 #[test]
 fn sweep_of_an_unknown_parameter_is_rejected() {
     let run = command_in(
@@ -788,6 +841,39 @@ fn map_writes_table_curves_and_figure() {
     let png = fs::read(run.out.join("map.png")).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     assert!(run.read("map.svg").contains("<svg"));
+}
+
+/// `vrw map --second-route` on the same small grid: every row's and column's end of existence is found again
+/// by the other integrator and confirmed, in curves.json and on the terminal.
+#[test]
+fn map_second_route_confirms_the_curves_points() {
+    let args = [
+        "--x-from",
+        "30",
+        "--x-to",
+        "70",
+        "--nx",
+        "3",
+        "--y-from",
+        "440",
+        "--y-to",
+        "560",
+        "--ny",
+        "3",
+        "--second-route",
+    ];
+    let run = command_in(temp_dir_with(&[]), "map", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let curves: Value = serde_json::from_str(&run.read("curves.json")).unwrap();
+    let thresholds = curves["thresholds"].as_array().unwrap();
+    assert!(!thresholds.is_empty());
+    for t in thresholds {
+        let second = &t["threshold"]["second_route"];
+        assert_eq!(second["route"], "integrator = dopri5", "{t}");
+        assert_eq!(second["confirmed"], true, "{t}");
+    }
+    let all = format!("{0} of {0} thresholds confirmed", thresholds.len());
+    assert!(run.stdout().contains(&all), "{}", run.stdout());
 }
 
 /// Bad map specifications are refused with an error naming the problem, before anything is computed.

@@ -7,13 +7,13 @@ use serde::Serialize;
 
 use crate::dynamics::Model;
 use crate::gait::map::{LineThreshold, ThresholdCurve};
-use crate::gait::{map_curves, map_gaits, GaitMap, GaitOptions, MapSpec, SweepPoint};
+use crate::gait::{map_curves, map_gaits, GaitMap, GaitOptions, MapSpec, SecondRoute, SweepPoint};
 use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
 use crate::output::{self, write_map_csv};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{axis_label, default_initial, short_name, AppError};
+use super::{axis_label, default_initial, second_route_config, short_name, AppError};
 
 /// What `vrw map` runs.
 #[derive(Debug, Clone)]
@@ -30,6 +30,9 @@ pub struct MapJob {
     pub curves: bool,
     /// The most columns the curves are refined on ([`crate::gait::map::curve_columns`]; every row is).
     pub curve_columns: usize,
+    /// Search every threshold again by a second route (the whole map with the other integrator) and record in
+    /// each whether it is confirmed ([`SecondRoute`]); only with `curves`.
+    pub second_route: bool,
     /// Points to mark on the heat maps (e.g. the paper's thresholds).
     pub marks: Vec<MapMark>,
     /// Where `map.csv`, `curves.json`, `map.svg` and `map.png` go.
@@ -57,6 +60,9 @@ pub struct MapSummary {
     /// reproducible).
     #[serde(skip)]
     pub seconds: [f64; 2],
+    /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
+    #[serde(skip)]
+    pub second_route_seconds: f64,
 }
 
 /// Run `vrw map`: the gaits (written to `map.csv` at once), the curves (`curves.json`) and the heat maps
@@ -91,6 +97,27 @@ pub fn run_map(
         (Vec::new(), Vec::new())
     };
     let curve_seconds = clock.elapsed().as_secs_f64();
+    // map.csv is written already: nothing is lost if the second route fails.
+    let clock = std::time::Instant::now();
+    let mut thresholds = thresholds;
+    if job.second_route && job.curves {
+        let (second_config, route) = second_route_config(&job.config);
+        let second_map = map_gaits(&second_config, &job.spec, &initial, &job.options, progress)?;
+        let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
+        for t in &mut thresholds {
+            let same_line = second
+                .thresholds
+                .iter()
+                .filter(|o| o.along == t.along && o.line == t.line)
+                .map(|o| &o.threshold);
+            t.threshold.second_route = Some(SecondRoute::check(&t.threshold, same_line, &route));
+        }
+    }
+    let second_route_seconds = if job.second_route && job.curves {
+        clock.elapsed().as_secs_f64()
+    } else {
+        0.0
+    };
     let summary = MapSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
@@ -105,6 +132,7 @@ pub fn run_map(
         curves,
         thresholds,
         seconds: [gait_seconds, curve_seconds],
+        second_route_seconds,
     };
     output::write_json(&job.out_dir.join("curves.json"), &summary)?;
     write_figure(job, &map, &summary.curves)?;

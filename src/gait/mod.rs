@@ -20,4 +20,4 @@ pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
 pub use sweep::{gait_rows, sweep, sweep_values, FollowAttempt, GaitRow, SweepPoint, SweepSpec};
-pub use thresholds::{find_thresholds, Threshold};
+pub use thresholds::{find_thresholds, SecondRoute, Threshold, SECOND_ROUTE_TOL};

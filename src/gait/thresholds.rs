@@ -53,6 +53,66 @@ pub struct Threshold {
     pub residual: f64,
     /// What happens past a family's end (its physical cause) or why the search failed.
     pub detail: Option<String>,
+    /// The same threshold searched again by a second route (`vrw sweep --second-route`), if it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub second_route: Option<SecondRoute>,
+}
+
+/// Two routes agree on a threshold when their values differ by at most this: each value is the middle of a
+/// bracket at most [`PARAM_TOL`] wide.
+pub const SECOND_ROUTE_TOL: f64 = 2.0 * PARAM_TOL;
+
+/// A threshold searched again by a second route: the whole computation (gaits, continuation, thresholds) run
+/// once more with the other integrator, so that a value that depends on the integration (or on the path the
+/// continuation took with it) shows.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SecondRoute {
+    /// The route, e.g. `integrator = dopri5`.
+    pub route: String,
+    /// The threshold the second route found between the same grid points, closest in value: its name, or
+    /// `None` if it found none there.
+    pub name: Option<String>,
+    /// Its value (`NaN` if none, or if its search failed).
+    pub value: f64,
+    /// `|value - first value|` (`NaN` if either is unknown).
+    pub difference: f64,
+    /// The same name, and values within [`SECOND_ROUTE_TOL`].
+    pub confirmed: bool,
+}
+
+impl SecondRoute {
+    /// `threshold` checked against `found`, the thresholds the second route `route` found along the same line:
+    /// the one between the same grid points closest in value (by name first) is its counterpart.
+    pub fn check<'a>(
+        threshold: &Threshold,
+        found: impl IntoIterator<Item = &'a Threshold>,
+        route: &str,
+    ) -> SecondRoute {
+        let distance = |t: &Threshold| {
+            let d = (t.value - threshold.value).abs();
+            (
+                t.name != threshold.name,
+                if d.is_nan() { f64::INFINITY } else { d },
+            )
+        };
+        let counterpart = found
+            .into_iter()
+            .filter(|t| t.grid_bracket == threshold.grid_bracket)
+            .min_by(|a, b| {
+                let (da, db) = (distance(a), distance(b));
+                da.0.cmp(&db.0).then(da.1.total_cmp(&db.1))
+            });
+        let value = counterpart.map_or(f64::NAN, |t| t.value);
+        let difference = (value - threshold.value).abs();
+        SecondRoute {
+            route: route.to_string(),
+            name: counterpart.map(|t| t.name.clone()),
+            value,
+            difference,
+            confirmed: counterpart.is_some_and(|t| t.name == threshold.name)
+                && difference <= SECOND_ROUTE_TOL,
+        }
+    }
 }
 
 /// What a threshold measures on a gait.
@@ -211,6 +271,7 @@ fn vanishing_at_end(
                     last.value,
                     p = spec.param,
                 )),
+                second_route: None,
             })
         })
         .collect()
@@ -340,6 +401,7 @@ fn refine_end(
         grid_bracket,
         residual: f64::NAN,
         detail: Some(detail),
+        second_route: None,
     };
     let vanishing = vanishing_at_end(config, spec, from, &last, &end);
     std::iter::once(end).chain(vanishing).collect()
@@ -354,6 +416,7 @@ fn unconfirmed(grid_bracket: [f64; 2], detail: String) -> Threshold {
         grid_bracket,
         residual: f64::NAN,
         detail: Some(detail),
+        second_route: None,
     }
 }
 
@@ -445,5 +508,53 @@ fn refine_root(
         grid_bracket: [a.value, b.value],
         residual,
         detail,
+        second_route: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn threshold(name: &str, value: f64, grid_bracket: [f64; 2]) -> Threshold {
+        Threshold {
+            name: name.to_string(),
+            value,
+            bracket: [value, value],
+            grid_bracket,
+            residual: f64::NAN,
+            detail: None,
+            second_route: None,
+        }
+    }
+
+    /// The counterpart is the one between the same grid points, of the same kind first, closest in value; a
+    /// threshold is confirmed only by one of its kind within SECOND_ROUTE_TOL.
+    #[test]
+    fn second_route_confirms_only_the_same_threshold() {
+        let first = threshold("gait_lost", 135.489237, [120.0, 140.0]);
+        let found = [
+            threshold("gait_lost", 135.4892375, [100.0, 120.0]),
+            threshold("lambda_2_plus = 0", 135.489237, [120.0, 140.0]),
+            threshold("gait_lost", 135.4892381, [120.0, 140.0]),
+        ];
+        let r = SecondRoute::check(&first, &found, "integrator = dopri5");
+        assert_eq!(r.name.as_deref(), Some("gait_lost"));
+        assert_eq!(r.value, 135.4892381);
+        assert!(r.confirmed, "{r:?}");
+        assert_eq!(r.route, "integrator = dopri5");
+
+        // Too far apart, another kind, nothing there, or not located at all: not confirmed.
+        let far = [threshold("gait_lost", 135.48925, [120.0, 140.0])];
+        assert!(!SecondRoute::check(&first, &far, "r").confirmed);
+        let other_kind = [threshold("branch_switch", 135.489237, [120.0, 140.0])];
+        let r = SecondRoute::check(&first, &other_kind, "r");
+        assert!(!r.confirmed);
+        assert_eq!(r.name.as_deref(), Some("branch_switch"));
+        let r = SecondRoute::check(&first, &[], "r");
+        assert!(!r.confirmed && r.name.is_none() && r.value.is_nan());
+        let lost = threshold("unconfirmed", f64::NAN, [120.0, 140.0]);
+        let again = [threshold("unconfirmed", f64::NAN, [120.0, 140.0])];
+        assert!(!SecondRoute::check(&lost, &again, "r").confirmed);
     }
 }
