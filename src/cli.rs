@@ -876,7 +876,11 @@ fn map(args: MapArgs) -> Result<()> {
             confirmed_count(summary.thresholds.iter().map(|t| &t.threshold))
         );
         for t in &summary.thresholds {
-            if let Some(r) = t.threshold.second_route.as_ref().filter(|r| !r.confirmed) {
+            // Thresholds neither route located are among the crossings that could not be refined.
+            let shown = |r: &&SecondRoute| {
+                !r.confirmed && (t.threshold.value.is_finite() || r.value.is_finite())
+            };
+            if let Some(r) = t.threshold.second_route.as_ref().filter(shown) {
                 let param = match t.along {
                     vrw::gait::map::Along::X => &args.x,
                     vrw::gait::map::Along::Y => &args.y,
@@ -924,14 +928,26 @@ fn second_route_words(r: &SecondRoute) -> String {
     }
 }
 
-/// "N of M thresholds confirmed to 2e-6" for the thresholds of a run with a second route.
+/// "N of M located thresholds confirmed" for the thresholds of a run with a second route (a threshold whose
+/// search failed, value NaN, is counted apart: it was never stated).
 fn confirmed_count<'a>(thresholds: impl Iterator<Item = &'a Threshold>) -> String {
-    let (mut confirmed, mut all) = (0, 0);
+    let (mut confirmed, mut located, mut lost) = (0, 0, 0);
     for t in thresholds {
-        all += 1;
-        confirmed += usize::from(t.second_route.as_ref().is_some_and(|r| r.confirmed));
+        if t.value.is_finite() {
+            located += 1;
+            confirmed += usize::from(t.second_route.as_ref().is_some_and(|r| r.confirmed));
+        } else {
+            lost += 1;
+        }
     }
-    format!("{confirmed} of {all} thresholds confirmed (same kind, values within {SECOND_ROUTE_TOL:.0e})")
+    let mut words = format!(
+        "{confirmed} of {located} located thresholds confirmed (same kind, values within \
+         {SECOND_ROUTE_TOL:.0e})"
+    );
+    if lost > 0 {
+        words += &format!("; {lost} not located by the first route");
+    }
+    words
 }
 
 #[cfg(test)]

@@ -455,7 +455,7 @@ fn sweep_second_route_confirms_the_threshold() {
         "{}",
         run.stdout()
     );
-    assert!(run.stdout().contains("1 of 1 thresholds confirmed"));
+    assert!(run.stdout().contains("1 of 1 located thresholds confirmed"));
     let thresholds: Value = serde_json::from_str(&run.read("thresholds.json")).unwrap();
     let lost = &thresholds["thresholds"][0];
     assert_eq!(lost["name"], "gait_lost");
@@ -872,7 +872,7 @@ fn map_second_route_confirms_the_curves_points() {
         assert_eq!(second["route"], "integrator = dopri5", "{t}");
         assert_eq!(second["confirmed"], true, "{t}");
     }
-    let all = format!("{0} of {0} thresholds confirmed", thresholds.len());
+    let all = format!("{0} of {0} located thresholds confirmed", thresholds.len());
     assert!(run.stdout().contains(&all), "{}", run.stdout());
 }
 
