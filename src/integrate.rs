@@ -245,6 +245,20 @@ impl<const N: usize> DenseStep<N> {
         acc
     }
 
+    /// Dense output at `t`, which must lie inside the step (a rewind to an event).
+    ///
+    /// # Panics
+    /// If `t` is outside `[t0, t1]`.
+    fn eval_inside(&self, t: f64) -> SVector<f64, N> {
+        assert!(
+            self.t0 <= t && t <= self.t1,
+            "rewind time {t} outside the step [{}, {}]",
+            self.t0,
+            self.t1
+        );
+        self.eval(t)
+    }
+
     /// A dense step from its coefficients `c0 ..` (see the type's documentation).
     fn from_coefficients(
         t0: f64,
@@ -264,13 +278,10 @@ impl<const N: usize> DenseStep<N> {
     }
 }
 
-/// Adaptive Dormand-Prince 5(4) with FSAL, PI step-size control, dense output.
-///
-/// Drive it one accepted step at a time with [`step`](Self::step); after an event, continue
-/// with [`restart`](Self::restart) (new state or vector field) or [`rewind`](Self::rewind)
-/// (back to a time inside the last step). No heap allocation: all stages live on the stack.
+/// What both Runge-Kutta pairs keep between steps, and the parts of a step they share: the checks before a
+/// step, the trial step size, a rejection and an acceptance.
 #[derive(Debug, Clone)]
-pub struct Dopri5<const N: usize> {
+struct Core<const N: usize> {
     tol: Tolerances,
     t: f64,
     y: SVector<f64, N>,
@@ -280,9 +291,121 @@ pub struct Dopri5<const N: usize> {
     h: f64,
     /// Size of the last accepted step \[s\], if any.
     h_accepted: Option<f64>,
+    stats: Stats,
+}
+
+impl<const N: usize> Core<N> {
+    /// At (t0, y0), for a method whose local error is `~ h^order`: f(t0, y0) and a starting step (two
+    /// evaluations).
+    fn new(
+        sys: &impl OdeSystem<N>,
+        t0: f64,
+        y0: SVector<f64, N>,
+        tol: Tolerances,
+        order: i32,
+    ) -> Self {
+        let mut core = Core {
+            tol,
+            t: t0,
+            y: y0,
+            dy: SVector::zeros(),
+            h: 0.0,
+            h_accepted: None,
+            stats: Stats::default(),
+        };
+        core.reset_point(sys, t0, y0, order);
+        core
+    }
+
+    /// Set the current point, recompute the FSAL derivative and a fresh starting step (HNW I, Sec. II.4,
+    /// "Starting step size").
+    fn reset_point(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>, order: i32) {
+        self.t = t;
+        self.y = y;
+        self.dy = sys.rhs(t, &y);
+        self.stats.rhs_evals += 2;
+        self.h = initial_step(sys, &self.tol, t, &self.y, &self.dy, order);
+    }
+
+    /// [`Core::reset_point`], keeping the last accepted step size as a bound on the first trial step.
+    fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>, order: i32) {
+        self.reset_point(sys, t, y, order);
+        if let Some(h_acc) = self.h_accepted {
+            self.h = self.h.min(h_acc);
+        }
+    }
+
+    /// The checks before a step: `t_stop` after the current time (else a panic), a finite current point.
+    fn begin(&self, t_stop: f64) -> Result<(), IntegrationError> {
+        assert!(
+            t_stop > self.t,
+            "t_stop = {t_stop} is not after the current time {}",
+            self.t
+        );
+        if all_finite(&self.y) && all_finite(&self.dy) {
+            Ok(())
+        } else {
+            Err(IntegrationError::NonFinite { time: self.t })
+        }
+    }
+
+    /// The next trial step `(h, t1)`: the controller's proposal, at most `h_max`, stretched or shortened to land
+    /// on `t_stop`; an error if the proposal fell below `h_min` (`NonFinite` if the last trial was).
+    fn trial(&self, t_stop: f64, last_non_finite: bool) -> Result<(f64, f64), IntegrationError> {
+        let t = self.t;
+        let h_ctrl = self.h.min(self.tol.h_max);
+        if !(h_ctrl >= self.tol.h_min && t + h_ctrl > t) {
+            return Err(if last_non_finite {
+                IntegrationError::NonFinite { time: t }
+            } else {
+                IntegrationError::StepSizeTooSmall {
+                    time: t,
+                    h_min: self.tol.h_min,
+                }
+            });
+        }
+        Ok(if t + LAND_STRETCH * h_ctrl >= t_stop {
+            (t_stop - t, t_stop)
+        } else {
+            (h_ctrl, t + h_ctrl)
+        })
+    }
+
+    /// Reject a trial of size `h`: the next one is `h / divisor`.
+    fn reject(&mut self, h: f64, divisor: f64) {
+        self.stats.rejected += 1;
+        self.h = h / divisor;
+    }
+
+    /// Accept a trial of size `h` ending at `(t1, y1)` with `f1 = f(t1, y1)`; the next trial is `h_new`, not
+    /// grown right after a rejection, and at most `h_max`.
+    fn accept(
+        &mut self,
+        h: f64,
+        (t1, y1, f1): (f64, SVector<f64, N>, SVector<f64, N>),
+        h_new: f64,
+        rejected_before: bool,
+    ) {
+        let h_new = if rejected_before { h_new.min(h) } else { h_new };
+        self.h = h_new.min(self.tol.h_max);
+        self.h_accepted = Some(h);
+        self.stats.accepted += 1;
+        self.t = t1;
+        self.y = y1;
+        self.dy = f1;
+    }
+}
+
+/// Adaptive Dormand-Prince 5(4) with FSAL, PI step-size control, dense output.
+///
+/// Drive it one accepted step at a time with [`step`](Self::step); after an event, continue
+/// with [`restart`](Self::restart) (new state or vector field) or [`rewind`](Self::rewind)
+/// (back to a time inside the last step). No heap allocation: all stages live on the stack.
+#[derive(Debug, Clone)]
+pub struct Dopri5<const N: usize> {
+    core: Core<N>,
     /// Previous accepted error norm, for the PI controller.
     err_old: f64,
-    stats: Stats,
 }
 
 impl<const N: usize> Dopri5<N> {
@@ -291,18 +414,10 @@ impl<const N: usize> Dopri5<N> {
     /// Costs two right-hand-side evaluations. A non-finite f(t0, y0) is reported by the first
     /// [`step`](Self::step) as [`IntegrationError::NonFinite`].
     pub fn new(sys: &impl OdeSystem<N>, t0: f64, y0: SVector<f64, N>, tol: Tolerances) -> Self {
-        let mut solver = Self {
-            tol,
-            t: t0,
-            y: y0,
-            dy: SVector::zeros(),
-            h: 0.0,
-            h_accepted: None,
+        Self {
+            core: Core::new(sys, t0, y0, tol, HINIT_ORDER),
             err_old: ERR_OLD_MIN,
-            stats: Stats::default(),
-        };
-        solver.reset_point(sys, t0, y0);
-        solver
+        }
     }
 
     /// Restart at (t, y) after a reset (new state, possibly new vector field): recomputes f, keeps the
@@ -310,10 +425,8 @@ impl<const N: usize> Dopri5<N> {
     ///
     /// Costs two right-hand-side evaluations; the PI controller memory is reset.
     pub fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
-        self.reset_point(sys, t, y);
-        if let Some(h_acc) = self.h_accepted {
-            self.h = self.h.min(h_acc);
-        }
+        self.core.restart(sys, t, y, HINIT_ORDER);
+        self.err_old = ERR_OLD_MIN;
     }
 
     /// Move the solver back to time t inside the last step (t0 <= t <= t1) using the dense output:
@@ -325,33 +438,27 @@ impl<const N: usize> Dopri5<N> {
     /// # Panics
     /// If `t` is outside `[step.t0(), step.t1()]`.
     pub fn rewind(&mut self, sys: &impl OdeSystem<N>, step: &DenseStep<N>, t: f64) {
-        assert!(
-            step.t0 <= t && t <= step.t1,
-            "rewind time {t} outside the step [{}, {}]",
-            step.t0,
-            step.t1
-        );
-        self.restart(sys, t, step.eval(t));
+        self.restart(sys, t, step.eval_inside(t));
     }
 
     /// Current time \[s\].
     pub fn t(&self) -> f64 {
-        self.t
+        self.core.t
     }
 
     /// Current state.
     pub fn y(&self) -> &SVector<f64, N> {
-        &self.y
+        &self.core.y
     }
 
     /// Derivative f(t, y) at the current point (FSAL value).
     pub fn dy(&self) -> &SVector<f64, N> {
-        &self.dy
+        &self.core.dy
     }
 
     /// Counters for benchmarks/snapshots.
     pub fn stats(&self) -> Stats {
-        self.stats
+        self.core.stats
     }
 
     /// Take one accepted step, never passing `t_stop` (it lands exactly on t_stop if it would pass it).
@@ -376,37 +483,14 @@ impl<const N: usize> Dopri5<N> {
         sys: &impl OdeSystem<N>,
         t_stop: f64,
     ) -> Result<DenseStep<N>, IntegrationError> {
-        assert!(
-            t_stop > self.t,
-            "t_stop = {t_stop} is not after the current time {}",
-            self.t
-        );
-        if !(all_finite(&self.y) && all_finite(&self.dy)) {
-            return Err(IntegrationError::NonFinite { time: self.t });
-        }
-        let t = self.t;
-        let y0 = self.y;
-        let k1 = self.dy;
+        self.core.begin(t_stop)?;
+        let t = self.core.t;
+        let y0 = self.core.y;
+        let k1 = self.core.dy;
         let mut rejected_before = false;
         let mut last_non_finite = false;
         loop {
-            let h_ctrl = self.h.min(self.tol.h_max);
-            if !(h_ctrl >= self.tol.h_min && t + h_ctrl > t) {
-                return Err(if last_non_finite {
-                    IntegrationError::NonFinite { time: t }
-                } else {
-                    IntegrationError::StepSizeTooSmall {
-                        time: t,
-                        h_min: self.tol.h_min,
-                    }
-                });
-            }
-            let (h, t1) = if t + LAND_STRETCH * h_ctrl >= t_stop {
-                (t_stop - t, t_stop)
-            } else {
-                (h_ctrl, t + h_ctrl)
-            };
-
+            let (h, t1) = self.core.trial(t_stop, last_non_finite)?;
             let k2 = sys.rhs(t + C2 * h, &(y0 + k1 * (h * A21)));
             let k3 = sys.rhs(t + C3 * h, &(y0 + (k1 * A31 + k2 * A32) * h));
             let k4 = sys.rhs(t + C4 * h, &(y0 + (k1 * A41 + k2 * A42 + k3 * A43) * h));
@@ -420,16 +504,15 @@ impl<const N: usize> Dopri5<N> {
             );
             let y1 = y0 + (k1 * A71 + k3 * A73 + k4 * A74 + k5 * A75 + k6 * A76) * h;
             let k7 = sys.rhs(t1, &y1);
-            self.stats.rhs_evals += 6;
+            self.core.stats.rhs_evals += 6;
 
             let e = (k1 * E1 + k3 * E3 + k4 * E4 + k5 * E5 + k6 * E6 + k7 * E7) * h;
-            let err = scaled_rms(&self.tol, &e, &y0, &y1);
+            let err = scaled_rms(&self.core.tol, &e, &y0, &y1);
 
             if !(err.is_finite() && all_finite(&y1) && all_finite(&k7)) {
-                self.stats.rejected += 1;
                 rejected_before = true;
                 last_non_finite = true;
-                self.h = h / FAC_SHRINK_MAX;
+                self.core.reject(h, FAC_SHRINK_MAX);
                 continue;
             }
             last_non_finite = false;
@@ -438,18 +521,11 @@ impl<const N: usize> Dopri5<N> {
             if err <= 1.0 {
                 let fac =
                     (fac11 / self.err_old.powf(BETA) / SAFE).clamp(FAC_GROW_MAX, FAC_SHRINK_MAX);
-                let mut h_new = h / fac;
-                if rejected_before {
-                    h_new = h_new.min(h);
-                }
-                self.h = h_new.min(self.tol.h_max);
                 self.err_old = err.max(ERR_OLD_MIN);
-                self.h_accepted = Some(h);
-                self.stats.accepted += 1;
-
+                self.core.accept(h, (t1, y1, k7), h / fac, rejected_before);
                 let delta = y1 - y0;
                 let bspl = k1 * h - delta;
-                let dense = DenseStep::from_coefficients(
+                return Ok(DenseStep::from_coefficients(
                     t,
                     t1,
                     y1,
@@ -460,31 +536,11 @@ impl<const N: usize> Dopri5<N> {
                         delta - k7 * h - bspl,
                         (k1 * D1 + k3 * D3 + k4 * D4 + k5 * D5 + k6 * D6 + k7 * D7) * h,
                     ],
-                );
-                self.t = t1;
-                self.y = y1;
-                self.dy = k7;
-                return Ok(dense);
+                ));
             }
-            self.stats.rejected += 1;
             rejected_before = true;
-            self.h = h / FAC_SHRINK_MAX.min(fac11 / SAFE);
+            self.core.reject(h, FAC_SHRINK_MAX.min(fac11 / SAFE));
         }
-    }
-
-    /// Set the current point, recompute the FSAL derivative and a fresh starting step
-    /// (HNW I, Sec. II.4, "Starting step size"); resets the PI controller memory.
-    fn reset_point(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
-        self.t = t;
-        self.y = y;
-        self.dy = sys.rhs(t, &y);
-        self.err_old = ERR_OLD_MIN;
-        self.h = self.initial_step(sys);
-    }
-
-    fn initial_step(&mut self, sys: &impl OdeSystem<N>) -> f64 {
-        self.stats.rhs_evals += 2;
-        initial_step(sys, &self.tol, self.t, &self.y, &self.dy, HINIT_ORDER)
     }
 }
 
@@ -729,13 +785,7 @@ impl<const N: usize> Integrator<N> {
     /// # Panics
     /// If `t` is outside `[step.t0(), step.t1()]`.
     pub fn rewind(&mut self, sys: &impl OdeSystem<N>, step: &DenseStep<N>, t: f64) {
-        assert!(
-            step.t0 <= t && t <= step.t1,
-            "rewind time {t} outside the step [{}, {}]",
-            step.t0,
-            step.t1
-        );
-        self.restart(sys, t, step.eval(t));
+        self.restart(sys, t, step.eval_inside(t));
     }
 }
 
@@ -922,22 +972,29 @@ mod tests {
         }
     }
 
-    /// Largest dense-output error inside steps of size exactly `h_max`, against the exact flow
-    /// from each step's start (so only the interpolation error is measured).
-    fn max_dense_error(method: Method, h_max: f64) -> f64 {
+    /// The oscillator x'' = -4 x from x = 1 and `method` on it with largest step `h_max` and tolerances `tol`
+    /// (loose, so that `h_max` sets the step).
+    fn steps_of(method: Method, h_max: f64, tol: f64) -> (HarmonicOscillator, Integrator<2>) {
         let sys = HarmonicOscillator {
             omega: 2.0,
             amplitude: 1.0,
             phase: 0.0,
         };
-        // So loose that h_max, not the error control, sets the step.
         let tol = Tolerances {
-            rtol: 1e-3,
-            atol: 1e-3,
+            rtol: tol,
+            atol: tol,
             h_max,
             ..Tolerances::default()
         };
-        let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tol);
+        let solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tol);
+        (sys, solver)
+    }
+
+    /// Largest dense-output error inside steps of size exactly `h_max`, against the exact flow
+    /// from each step's start (so only the interpolation error is measured).
+    fn max_dense_error(method: Method, h_max: f64) -> f64 {
+        // So loose that h_max, not the error control, sets the step.
+        let (sys, mut solver) = steps_of(method, h_max, 1e-3);
         let (mut max_err, mut full_steps) = (0.0_f64, 0);
         while solver.t() < 4.0 {
             let step = solver.step(&sys, 4.0).expect("integration failed");
@@ -975,18 +1032,7 @@ mod tests {
     /// Error at t = 4 of the oscillator integrated in steps of exactly `h` (the tolerance so loose that `h`
     /// binds).
     fn global_error(method: Method, h: f64) -> f64 {
-        let sys = HarmonicOscillator {
-            omega: 2.0,
-            amplitude: 1.0,
-            phase: 0.0,
-        };
-        let tol = Tolerances {
-            rtol: 1.0,
-            atol: 1.0,
-            h_max: h,
-            ..Tolerances::default()
-        };
-        let mut solver = Integrator::new(method, &sys, 0.0, sys.exact(0.0), tol);
+        let (sys, mut solver) = steps_of(method, h, 1.0);
         while solver.t() < 4.0 {
             solver.step(&sys, 4.0).expect("integration failed");
         }

@@ -798,26 +798,16 @@ fn orbit_and_basin_refuse_bad_options() {
     }
 }
 
+/// A 3 x 3 map across the lower end of existence in stiffness (c = 30 to 70, k = 440 to 560).
+const SMALL_MAP: [&str; 12] = [
+    "--x-from", "30", "--x-to", "70", "--nx", "3", "--y-from", "440", "--y-to", "560", "--ny", "3",
+];
+
 /// `vrw map` on a small grid across the lower end of existence in stiffness writes the table, the curves and
 /// the figure; the curves pass through refined points and say which line each was refined on.
 #[test]
 fn map_writes_table_curves_and_figure() {
-    let args = [
-        "--x-from",
-        "30",
-        "--x-to",
-        "70",
-        "--nx",
-        "3",
-        "--y-from",
-        "440",
-        "--y-to",
-        "560",
-        "--ny",
-        "3",
-        "--mark",
-        "50,500,a point",
-    ];
+    let args = [&SMALL_MAP[..], &["--mark", "50,500,a point"]].concat();
     let run = command_in(temp_dir_with(&[]), "map", &args);
     assert_eq!(run.code(), Some(0), "{}", run.stderr());
     let table = run.read("map.csv");
@@ -847,21 +837,7 @@ fn map_writes_table_curves_and_figure() {
 /// by the other integrator and confirmed, in curves.json and on the terminal.
 #[test]
 fn map_second_route_confirms_the_curves_points() {
-    let args = [
-        "--x-from",
-        "30",
-        "--x-to",
-        "70",
-        "--nx",
-        "3",
-        "--y-from",
-        "440",
-        "--y-to",
-        "560",
-        "--ny",
-        "3",
-        "--second-route",
-    ];
+    let args = [&SMALL_MAP[..], &["--second-route"]].concat();
     let run = command_in(temp_dir_with(&[]), "map", &args);
     assert_eq!(run.code(), Some(0), "{}", run.stderr());
     let curves: Value = serde_json::from_str(&run.read("curves.json")).unwrap();

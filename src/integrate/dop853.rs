@@ -22,8 +22,7 @@ use differential_equations::tableau::ButcherTableau;
 use nalgebra::SVector;
 
 use super::{
-    all_finite, initial_step, scaled_rms, DenseStep, IntegrationError, OdeSystem, Stats,
-    Tolerances, LAND_STRETCH,
+    all_finite, scaled_rms, Core, DenseStep, IntegrationError, OdeSystem, Stats, Tolerances,
 };
 
 /// Stages of one step.
@@ -89,61 +88,41 @@ fn tableau() -> &'static Tableau {
 /// [`restart`](Self::restart).
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
-    tol: Tolerances,
-    t: f64,
-    y: SVector<f64, N>,
-    /// FSAL value f(t, y).
-    dy: SVector<f64, N>,
-    /// Step size the controller proposes for the next trial \[s\].
-    h: f64,
-    /// Size of the last accepted step \[s\], if any.
-    h_accepted: Option<f64>,
-    stats: Stats,
+    core: Core<N>,
 }
 
 impl<const N: usize> Dop853<N> {
     /// Start at (t0, y0); computes f(t0, y0) and an initial step. Costs two right-hand-side evaluations.
     pub fn new(sys: &impl OdeSystem<N>, t0: f64, y0: SVector<f64, N>, tol: Tolerances) -> Self {
-        let mut solver = Self {
-            tol,
-            t: t0,
-            y: y0,
-            dy: SVector::zeros(),
-            h: 0.0,
-            h_accepted: None,
-            stats: Stats::default(),
-        };
-        solver.reset_point(sys, t0, y0);
-        solver
+        Self {
+            core: Core::new(sys, t0, y0, tol, HINIT_ORDER),
+        }
     }
 
     /// Restart at (t, y) with a possibly new vector field: recomputes f and keeps the last accepted step
     /// size as the first trial step (bounded by a fresh initial-step estimate). Two evaluations.
     pub fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
-        self.reset_point(sys, t, y);
-        if let Some(h_acc) = self.h_accepted {
-            self.h = self.h.min(h_acc);
-        }
+        self.core.restart(sys, t, y, HINIT_ORDER);
     }
 
     /// Current time \[s\].
     pub fn t(&self) -> f64 {
-        self.t
+        self.core.t
     }
 
     /// Current state.
     pub fn y(&self) -> &SVector<f64, N> {
-        &self.y
+        &self.core.y
     }
 
     /// Derivative f(t, y) at the current point (FSAL value).
     pub fn dy(&self) -> &SVector<f64, N> {
-        &self.dy
+        &self.core.dy
     }
 
     /// Counters for benchmarks.
     pub fn stats(&self) -> Stats {
-        self.stats
+        self.core.stats
     }
 
     /// Take one accepted step, never passing `t_stop` (the same contract as [`super::Dopri5::step`]).
@@ -158,19 +137,12 @@ impl<const N: usize> Dop853<N> {
         sys: &impl OdeSystem<N>,
         t_stop: f64,
     ) -> Result<DenseStep<N>, IntegrationError> {
-        assert!(
-            t_stop > self.t,
-            "t_stop = {t_stop} is not after the current time {}",
-            self.t
-        );
-        if !(all_finite(&self.y) && all_finite(&self.dy)) {
-            return Err(IntegrationError::NonFinite { time: self.t });
-        }
+        self.core.begin(t_stop)?;
         let tab = tableau();
-        let t = self.t;
-        let y0 = self.y;
+        let t = self.core.t;
+        let y0 = self.core.y;
         let mut k = [SVector::<f64, N>::zeros(); DENSE_STAGES];
-        k[0] = self.dy;
+        k[0] = self.core.dy;
         let stage_state = |k: &[SVector<f64, N>], i: usize, h: f64| {
             let mut sum = SVector::<f64, N>::zeros();
             for &(j, a) in &tab.a[i] {
@@ -181,27 +153,12 @@ impl<const N: usize> Dop853<N> {
         let mut rejected_before = false;
         let mut last_non_finite = false;
         loop {
-            let h_ctrl = self.h.min(self.tol.h_max);
-            if !(h_ctrl >= self.tol.h_min && t + h_ctrl > t) {
-                return Err(if last_non_finite {
-                    IntegrationError::NonFinite { time: t }
-                } else {
-                    IntegrationError::StepSizeTooSmall {
-                        time: t,
-                        h_min: self.tol.h_min,
-                    }
-                });
-            }
-            let (h, t1) = if t + LAND_STRETCH * h_ctrl >= t_stop {
-                (t_stop - t, t_stop)
-            } else {
-                (h_ctrl, t + h_ctrl)
-            };
+            let (h, t1) = self.core.trial(t_stop, last_non_finite)?;
             for i in 1..STAGES {
                 let yi = stage_state(&k, i, h);
                 k[i] = sys.rhs(t + tab.c[i] * h, &yi);
             }
-            self.stats.rhs_evals += STAGES - 1;
+            self.core.stats.rhs_evals += STAGES - 1;
             let mut yseg = SVector::<f64, N>::zeros();
             let mut e5 = SVector::<f64, N>::zeros();
             let mut e3 = SVector::<f64, N>::zeros();
@@ -214,87 +171,66 @@ impl<const N: usize> Dop853<N> {
             let y1 = y0 + yseg * h;
             // HNW I, Eq. (10.17): err = |h| err5^2 / sqrt(n (err5^2 + 0.01 err3^2)), each a scaled sum of squares.
             let n = N as f64;
-            let err5 = scaled_rms(&self.tol, &e5, &y0, &y1).powi(2) * n;
-            let err3 = scaled_rms(&self.tol, &e3, &y0, &y1).powi(2) * n;
+            let err5 = scaled_rms(&self.core.tol, &e5, &y0, &y1).powi(2) * n;
+            let err3 = scaled_rms(&self.core.tol, &e3, &y0, &y1).powi(2) * n;
             let mut deno = err5 + ERR3_WEIGHT * err3;
             if deno <= 0.0 {
                 deno = 1.0;
             }
             let err = h.abs() * err5 * (1.0 / (n * deno)).sqrt();
-
-            if !(err.is_finite() && all_finite(&y1)) {
-                self.stats.rejected += 1;
+            // f(t1, y1): the next step's first stage, and a stage of the dense output.
+            let k13 = if err.is_finite() && err <= 1.0 && all_finite(&y1) {
+                self.core.stats.rhs_evals += 1;
+                Some(sys.rhs(t1, &y1))
+            } else {
+                None
+            };
+            let finite = err.is_finite() && all_finite(&y1) && k13.as_ref().is_none_or(all_finite);
+            if !finite {
                 rejected_before = true;
                 last_non_finite = true;
-                self.h = h / FAC_SHRINK_MAX;
+                self.core.reject(h, FAC_SHRINK_MAX);
                 continue;
             }
             last_non_finite = false;
 
             let fac11 = err.powf(EXPO);
-            if err <= 1.0 {
-                let k13 = sys.rhs(t1, &y1);
-                self.stats.rhs_evals += 1;
-                if !all_finite(&k13) {
-                    self.stats.rejected += 1;
-                    rejected_before = true;
-                    last_non_finite = true;
-                    self.h = h / FAC_SHRINK_MAX;
-                    continue;
-                }
-                let fac = (fac11 / SAFE).clamp(FAC_GROW_MAX, FAC_SHRINK_MAX);
-                let mut h_new = h / fac;
-                if rejected_before {
-                    h_new = h_new.min(h);
-                }
-                self.h = h_new.min(self.tol.h_max);
-                self.h_accepted = Some(h);
-                self.stats.accepted += 1;
+            let Some(k13) = k13 else {
+                rejected_before = true;
+                self.core.reject(h, FAC_SHRINK_MAX.min(fac11 / SAFE));
+                continue;
+            };
+            let fac = (fac11 / SAFE).clamp(FAC_GROW_MAX, FAC_SHRINK_MAX);
+            self.core.accept(h, (t1, y1, k13), h / fac, rejected_before);
 
-                // The dense output: f(t1, y1) and three more stages.
-                k[STAGES] = k13;
-                for i in STAGES + 1..DENSE_STAGES {
-                    let yi = stage_state(&k, i, h);
-                    k[i] = sys.rhs(t + tab.c[i] * h, &yi);
-                }
-                self.stats.rhs_evals += DENSE_STAGES - STAGES - 1;
-                let delta = y1 - y0;
-                let bspl = k[0] * h - delta;
-                let mut cont = [
-                    y0,
-                    delta,
-                    bspl,
-                    delta - k13 * h - bspl,
-                    SVector::zeros(),
-                    SVector::zeros(),
-                    SVector::zeros(),
-                    SVector::zeros(),
-                ];
-                for (row, c) in tab.d.iter().zip(cont[4..].iter_mut()) {
-                    for (ki, &d) in k.iter().zip(row) {
-                        if d != 0.0 {
-                            *c += ki * d;
-                        }
-                    }
-                    *c *= h;
-                }
-                self.t = t1;
-                self.y = y1;
-                self.dy = k13;
-                return Ok(DenseStep::from_coefficients(t, t1, y1, &cont));
+            // The dense output: f(t1, y1) and three more stages.
+            k[STAGES] = k13;
+            for i in STAGES + 1..DENSE_STAGES {
+                let yi = stage_state(&k, i, h);
+                k[i] = sys.rhs(t + tab.c[i] * h, &yi);
             }
-            self.stats.rejected += 1;
-            rejected_before = true;
-            self.h = h / FAC_SHRINK_MAX.min(fac11 / SAFE);
+            self.core.stats.rhs_evals += DENSE_STAGES - STAGES - 1;
+            let delta = y1 - y0;
+            let bspl = k[0] * h - delta;
+            let mut cont = [
+                y0,
+                delta,
+                bspl,
+                delta - k13 * h - bspl,
+                SVector::zeros(),
+                SVector::zeros(),
+                SVector::zeros(),
+                SVector::zeros(),
+            ];
+            for (row, c) in tab.d.iter().zip(cont[4..].iter_mut()) {
+                for (ki, &d) in k.iter().zip(row) {
+                    if d != 0.0 {
+                        *c += ki * d;
+                    }
+                }
+                *c *= h;
+            }
+            return Ok(DenseStep::from_coefficients(t, t1, y1, &cont));
         }
-    }
-
-    /// Set the current point, recompute the FSAL derivative and a fresh starting step.
-    fn reset_point(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
-        self.t = t;
-        self.y = y;
-        self.dy = sys.rhs(t, &y);
-        self.stats.rhs_evals += 2;
-        self.h = initial_step(sys, &self.tol, t, &self.y, &self.dy, HINIT_ORDER);
     }
 }
