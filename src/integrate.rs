@@ -711,6 +711,14 @@ pub enum Integrator<const N: usize> {
 }
 
 impl<const N: usize> Integrator<N> {
+    /// The state between steps.
+    fn core(&self) -> &Core<N> {
+        match self {
+            Integrator::Dop853(s) => s.core(),
+            Integrator::Dopri5(s) => &s.core,
+        }
+    }
+
     /// Start `method` at (t0, y0) (see [`Dopri5::new`]).
     pub fn new(
         method: Method,
@@ -750,34 +758,22 @@ impl<const N: usize> Integrator<N> {
 
     /// Work counters.
     pub fn stats(&self) -> Stats {
-        match self {
-            Integrator::Dop853(s) => s.stats(),
-            Integrator::Dopri5(s) => s.stats(),
-        }
+        self.core().stats
     }
 
     /// Current time \[s\].
     pub fn t(&self) -> f64 {
-        match self {
-            Integrator::Dop853(s) => s.t(),
-            Integrator::Dopri5(s) => s.t(),
-        }
+        self.core().t
     }
 
     /// Current state.
     pub fn y(&self) -> &SVector<f64, N> {
-        match self {
-            Integrator::Dop853(s) => s.y(),
-            Integrator::Dopri5(s) => s.y(),
-        }
+        &self.core().y
     }
 
     /// Derivative f(t, y) at the current point (FSAL value).
     pub fn dy(&self) -> &SVector<f64, N> {
-        match self {
-            Integrator::Dop853(s) => s.dy(),
-            Integrator::Dopri5(s) => s.dy(),
-        }
+        &self.core().dy
     }
 
     /// Move back to time `t` inside the last step, possibly with a new vector field (see [`Dopri5::rewind`]).

@@ -21,9 +21,7 @@ use std::sync::OnceLock;
 use differential_equations::tableau::ButcherTableau;
 use nalgebra::SVector;
 
-use super::{
-    all_finite, scaled_rms, Core, DenseStep, IntegrationError, OdeSystem, Stats, Tolerances,
-};
+use super::{all_finite, scaled_rms, Core, DenseStep, IntegrationError, OdeSystem, Tolerances};
 
 /// Stages of one step.
 const STAGES: usize = 12;
@@ -84,8 +82,8 @@ fn tableau() -> &'static Tableau {
 
 /// Adaptive DOP853 with FSAL, the step-size control of `dop853` and its 7th-order dense output.
 ///
-/// The same interface as [`super::Dopri5`]: [`step`](Self::step) returns a [`DenseStep`]; after an event,
-/// [`restart`](Self::restart).
+/// Driven like [`super::Dopri5`]: [`step`](Self::step) returns a [`DenseStep`]; after an event,
+/// [`restart`](Self::restart). Its time, state and counters are read through [`super::Integrator`].
 #[derive(Debug, Clone)]
 pub struct Dop853<const N: usize> {
     core: Core<N>,
@@ -105,24 +103,9 @@ impl<const N: usize> Dop853<N> {
         self.core.restart(sys, t, y, HINIT_ORDER);
     }
 
-    /// Current time \[s\].
-    pub fn t(&self) -> f64 {
-        self.core.t
-    }
-
-    /// Current state.
-    pub fn y(&self) -> &SVector<f64, N> {
-        &self.core.y
-    }
-
-    /// Derivative f(t, y) at the current point (FSAL value).
-    pub fn dy(&self) -> &SVector<f64, N> {
-        &self.core.dy
-    }
-
-    /// Counters for benchmarks.
-    pub fn stats(&self) -> Stats {
-        self.core.stats
+    /// The state between steps (time, state, FSAL derivative, counters), read through [`super::Integrator`].
+    pub(super) fn core(&self) -> &Core<N> {
+        &self.core
     }
 
     /// Take one accepted step, never passing `t_stop` (the same contract as [`super::Dopri5::step`]).
