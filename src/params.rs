@@ -96,7 +96,8 @@ impl Choice for Method {
     const EXPECTED: &'static str = "the string \"dop853\" or \"dopri5\"";
 
     fn name(self) -> &'static str {
-        self.name()
+        // The inherent `Method::name`, which the integrator module uses too.
+        Method::name(self)
     }
 }
 
@@ -278,7 +279,8 @@ pub struct SolverOptions {
     /// Absolute integration tolerance \[state units: m, rad, m/s, rad/s\]. Default 1e-12. In [`ATOL_RANGE`]
     /// (1e-16 to 1e-3).
     pub atol: f64,
-    /// Largest integrator step \[s\]. Default 0.04 (events are still resolved to a quarter of a step, see `walk::EVENT_SAMPLES`). In [`MAX_STEP_RANGE`] (1e-6 to 1).
+    /// Largest integrator step \[s\]. Default 0.04 (events are still resolved to a quarter of a step, see
+    /// `walk::EVENT_SAMPLES`). In [`MAX_STEP_RANGE`] (1e-6 to 1).
     pub max_step: f64,
     /// Tolerance on located event times (root finding on the dense output) \[s\]. Default 1e-13. In
     /// [`EVENT_TIME_TOL_RANGE`] (1e-15 to 1e-9). `docs/model.md`, events.

@@ -45,6 +45,7 @@ def test_replace_and_round_trips():
         ({"spring_natural_length": 0.5}, "spring_natural_length=0.5"),
         ({"impact": "elastic"}, "impact=elastic"),
         ({"inconsistent_contact": "bounce"}, "inconsistent_contact=bounce"),
+        ({"integrator": "rk4"}, "integrator=rk4"),
     ],
 )
 def test_bad_keys_raise_the_command_lines_message(cli, tmp_path, keys, override):
