@@ -589,10 +589,36 @@ pub fn run_sweep(
         progress,
         &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
     )?;
-    let mut thresholds = result.thresholds;
-    let clock = std::time::Instant::now();
+    let gaits_found = result.points.iter().filter(|p| p.gait.is_some()).count();
+    let figures = ["fig2.svg", "fig2.png"];
+    let mut files = vec!["sweep.csv".to_string(), "thresholds.json".to_string()];
+    if gaits_found > 0 {
+        files.extend(figures.map(String::from));
+    }
+    let mut summary = SweepSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec: job.spec.clone(),
+        gaits_found,
+        points: result.points.len(),
+        thresholds: result.thresholds,
+        seconds: result.seconds,
+        second_route_seconds: 0.0,
+        files,
+    };
+    let thresholds_json = job.out_dir.join("thresholds.json");
+    output::write_json(&thresholds_json, &summary)?;
+    if gaits_found > 0 {
+        write_fig2(job, &result.points, &summary.thresholds)?;
+    } else {
+        // A figure of an earlier sweep must not stand beside this sweep's tables.
+        for f in figures {
+            remove_stale(&job.out_dir.join(f))?;
+        }
+    }
     if job.second_route {
-        // sweep.csv is written already: nothing is lost if the second route fails.
+        // Everything of the first route is written: nothing is lost if this fails.
+        let clock = std::time::Instant::now();
         let (second_config, route) = second_route_config(&job.config);
         let second = compute_sweep(
             &second_config,
@@ -603,40 +629,11 @@ pub fn run_sweep(
             progress,
             &mut |_| Ok(()),
         )?;
-        for t in &mut thresholds {
+        for t in &mut summary.thresholds {
             t.second_route = Some(SecondRoute::check(t, &second.thresholds, &route));
         }
-    }
-    let second_route_seconds = if job.second_route {
-        clock.elapsed().as_secs_f64()
-    } else {
-        0.0
-    };
-    let gaits_found = result.points.iter().filter(|p| p.gait.is_some()).count();
-    let figures = ["fig2.svg", "fig2.png"];
-    let mut files = vec!["sweep.csv".to_string(), "thresholds.json".to_string()];
-    if gaits_found > 0 {
-        files.extend(figures.map(String::from));
-    }
-    let summary = SweepSummary {
-        vrw_version: env!("CARGO_PKG_VERSION"),
-        config: job.config.clone(),
-        spec: job.spec.clone(),
-        gaits_found,
-        points: result.points.len(),
-        thresholds,
-        seconds: result.seconds,
-        second_route_seconds,
-        files,
-    };
-    output::write_json(&job.out_dir.join("thresholds.json"), &summary)?;
-    if gaits_found > 0 {
-        write_fig2(job, &result.points, &summary.thresholds)?;
-    } else {
-        // A figure of an earlier sweep must not stand beside this sweep's tables.
-        for f in figures {
-            remove_stale(&job.out_dir.join(f))?;
-        }
+        summary.second_route_seconds = clock.elapsed().as_secs_f64();
+        output::write_json(&thresholds_json, &summary)?;
     }
     Ok(summary)
 }

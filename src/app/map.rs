@@ -97,28 +97,7 @@ pub fn run_map(
         (Vec::new(), Vec::new())
     };
     let curve_seconds = clock.elapsed().as_secs_f64();
-    // map.csv is written already: nothing is lost if the second route fails.
-    let clock = std::time::Instant::now();
-    let mut thresholds = thresholds;
-    if job.second_route && job.curves {
-        let (second_config, route) = second_route_config(&job.config);
-        let second_map = map_gaits(&second_config, &job.spec, &initial, &job.options, progress)?;
-        let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
-        for t in &mut thresholds {
-            let same_line = second
-                .thresholds
-                .iter()
-                .filter(|o| o.along == t.along && o.line == t.line)
-                .map(|o| &o.threshold);
-            t.threshold.second_route = Some(SecondRoute::check(&t.threshold, same_line, &route));
-        }
-    }
-    let second_route_seconds = if job.second_route && job.curves {
-        clock.elapsed().as_secs_f64()
-    } else {
-        0.0
-    };
-    let summary = MapSummary {
+    let mut summary = MapSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
         spec: job.spec.clone(),
@@ -132,10 +111,28 @@ pub fn run_map(
         curves,
         thresholds,
         seconds: [gait_seconds, curve_seconds],
-        second_route_seconds,
+        second_route_seconds: 0.0,
     };
-    output::write_json(&job.out_dir.join("curves.json"), &summary)?;
+    let curves_json = job.out_dir.join("curves.json");
+    output::write_json(&curves_json, &summary)?;
     write_figure(job, &map, &summary.curves)?;
+    if job.second_route && job.curves {
+        // Everything of the first route is written: nothing is lost if this fails.
+        let clock = std::time::Instant::now();
+        let (second_config, route) = second_route_config(&job.config);
+        let second_map = map_gaits(&second_config, &job.spec, &initial, &job.options, progress)?;
+        let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
+        for t in &mut summary.thresholds {
+            let same_line = second
+                .thresholds
+                .iter()
+                .filter(|o| o.along == t.along && o.line == t.line)
+                .map(|o| &o.threshold);
+            t.threshold.second_route = Some(SecondRoute::check(&t.threshold, same_line, &route));
+        }
+        summary.second_route_seconds = clock.elapsed().as_secs_f64();
+        output::write_json(&curves_json, &summary)?;
+    }
     Ok(summary)
 }
 
