@@ -488,14 +488,15 @@ impl<'a> EventSet<'a> {
     }
 }
 
-/// Number of points per integrator step (besides its start) at which the dense output is checked for tips
-/// below the ground.
-pub const PENETRATION_SAMPLES: usize = 4;
-
 /// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
 /// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
 /// however long the steps of a high-order integrator are.
 pub const EVENT_SAMPLES: usize = 4;
+
+/// Number of points per integrator step (besides its start) at which the dense output is checked for tips
+/// below the ground: the event search's points, whose states the audit reuses (up to an event, the part of
+/// the step before it is sampled the same way).
+pub const PENETRATION_SAMPLES: usize = EVENT_SAMPLES;
 
 impl ContactAudit {
     fn see_force(&mut self, pull: f64) {
@@ -692,13 +693,16 @@ impl<'m> Walker<'m> {
             let mut hit: Option<(f64, usize)> = None;
             let (mut t_a, mut pull_next) = (step.t0(), 0.0);
             let mut g_next = Vec::new();
-            for i in 1..=EVENT_SAMPLES {
+            // The states at the sample points, for the penetration audit when no event cuts the step short.
+            let mut sampled = [WalkVector::zeros(); EVENT_SAMPLES];
+            for (i, y_b) in (1..=EVENT_SAMPLES).zip(sampled.iter_mut()) {
                 let t_b = if i == EVENT_SAMPLES {
                     step.t1()
                 } else {
                     step.t0() + (step.t1() - step.t0()) * i as f64 / EVENT_SAMPLES as f64
                 };
-                (g_next, pull_next) = events.values(&step.eval(t_b));
+                *y_b = step.eval(t_b);
+                (g_next, pull_next) = events.values(y_b);
                 for k in 0..g_next.len() {
                     if g_prev[k] > 0.0 && g_next[k] <= 0.0 {
                         let tk = locate_root(
@@ -731,7 +735,11 @@ impl<'m> Walker<'m> {
             if active.contact2 {
                 tally.rear_contact_duration += t_end - step.t0();
             }
-            tally.audit.see_dense(model, &step, t_end);
+            match hit {
+                // The same points see_dense would take (t0 + (t1 - t0) i / PENETRATION_SAMPLES), evaluated once.
+                None => sampled.iter().for_each(|y| tally.audit.see_tips(model, y)),
+                Some(_) => tally.audit.see_dense(model, &step, t_end),
+            }
             if let Some(tr) = trajectory.as_deref_mut() {
                 tr.record(model, &step, t_end, active, &start);
             }
