@@ -18,7 +18,7 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use crate::dynamics::Model;
-use crate::error::{short, WalkError};
+use crate::fmt::short;
 use crate::gait::{
     find_gait_any_period, find_thresholds, sweep_values, Gait, GaitOptions, SecondRoute, StepMap,
     SweepPoint, SweepSpec, Threshold, MAX_PERIOD,
@@ -29,6 +29,7 @@ use crate::output::plot::{
 use crate::output::{self, OutputError};
 use crate::params::{Config, ConfigError};
 use crate::reference::RigidRimlessWheel;
+use crate::walk::WalkError;
 use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
 
 /// A job could not run or could not write its results.

@@ -24,7 +24,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 use std::path::Path;
 
-use crate::error::short;
+use crate::fmt::short;
 use crate::integrate::Method;
 
 /// Impact law at touchdown (`docs/model.md` section 5).

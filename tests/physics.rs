@@ -243,7 +243,7 @@ fn rebound_option_terminates_with_a_status() {
     let run = simulate(&model, &config.solver, &default_start(), 5, None).unwrap();
     if let Some(failure) = &run.failure {
         assert!(
-            matches!(failure, vrw::error::WalkError::Chatter { .. }),
+            matches!(failure, vrw::walk::WalkError::Chatter { .. }),
             "{failure}"
         );
     }
@@ -267,7 +267,7 @@ fn a_walk_that_stops_is_a_status_and_the_steps_before_it_are_kept() {
         .iter()
         .all(|s| s.energy.residual.abs() < AUDIT_TOL));
     match failure {
-        vrw::error::WalkError::RolledBack { time, phase } => {
+        vrw::walk::WalkError::RolledBack { time, phase } => {
             let last = run.steps.last().unwrap();
             assert!(
                 time > last.time + last.period,

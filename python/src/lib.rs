@@ -16,13 +16,13 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
 use vrw::app::{compute_gait, compute_simulation, compute_sweep, AppError, GaitJob, SimulateJob};
-use vrw::error::WalkError as LibWalkError;
 use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::output::{
     step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
+use vrw::walk::WalkError as LibWalkError;
 
 create_exception!(
     vrw,

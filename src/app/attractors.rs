@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use crate::error::short;
+use crate::fmt::short;
 use crate::gait::basin::{basin, Axis, BasinPoint, BasinSpec, Coordinate};
 use crate::gait::orbit::{orbit_diagram, OrbitColumn, OrbitSpec};
 use crate::gait::{find_gait_any_period, sweep, Gait, GaitOptions, Stability, StepMap, MAX_PERIOD};

@@ -142,11 +142,11 @@ fn write_figure(job: &MapJob, map: &GaitMap, curves: &[ThresholdCurve]) -> Resul
     let fixed = |key: &str| key == job.spec.x.param || key == job.spec.y.param;
     let mut context = vec![format!("slope φ = {} rad", p.slope)];
     if !fixed("stiffness") && !fixed("spring_natural_length") && !fixed("stopper_length") {
-        context.push(format!("preload {} N", crate::error::short(preload)));
+        context.push(format!("preload {} N", crate::fmt::short(preload)));
     } else if !fixed("spring_natural_length") && !fixed("stopper_length") {
         context.push(format!(
             "L* − L0 = {} m",
-            crate::error::short(p.spring_natural_length - p.stopper_length)
+            crate::fmt::short(p.spring_natural_length - p.stopper_length)
         ));
     }
     context.push(format!("impact {}", p.impact));

@@ -5,7 +5,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 use super::step_map::{StepMap, StepOutcome};
-use crate::error::WalkError;
+use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport, Walker};
 
 /// How a gait is searched for.

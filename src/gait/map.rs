@@ -27,7 +27,7 @@ use serde::Serialize;
 use super::limit_cycle::GaitOptions;
 use super::sweep::{gait_rows, number_families, GaitRow, SweepPoint, SweepSpec};
 use super::thresholds::{find_thresholds, Threshold};
-use crate::error::short;
+use crate::fmt::short;
 use crate::params::{Config, ConfigError};
 use crate::walk::SectionState;
 

@@ -16,8 +16,8 @@ use serde::Serialize;
 use super::grid::{run_rows, Evaluated};
 use super::period_k::{least_period, MAX_PERIOD};
 use super::sweep::{configured, SweepSpec};
-use crate::error::WalkError;
 use crate::params::{Config, ConfigError};
+use crate::walk::WalkError;
 use crate::walk::{SectionState, StepReport, Walker};
 
 /// A value that does not continue another walks this many times the transient.

@@ -73,7 +73,7 @@ fn walk_period(
     map: &StepMap,
     s: &SectionState,
     k: usize,
-) -> Result<(Vec<SectionState>, Vec<crate::walk::StepReport>), crate::error::WalkError> {
+) -> Result<(Vec<SectionState>, Vec<crate::walk::StepReport>), crate::walk::WalkError> {
     let mut walker = Walker::new(map.model(), map.options(), s)?;
     let mut states = vec![*s];
     let mut reports = Vec::with_capacity(k);
@@ -113,7 +113,7 @@ pub fn find_periodic_gait(
         returns.push(walker.touchdown_coordinates());
         match walker.section() {
             Ok(s) => last_on_section = Some(s),
-            Err(crate::error::WalkError::OffSection { .. }) => {}
+            Err(crate::walk::WalkError::OffSection { .. }) => {}
             Err(source) => return Err(transient(source)),
         }
     }

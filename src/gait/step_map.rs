@@ -20,8 +20,8 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::dynamics::Model;
-use crate::error::WalkError;
 use crate::params::SolverOptions;
+use crate::walk::WalkError;
 use crate::walk::{SectionState, StepReport, Walker};
 
 /// One evaluation of the step map.

@@ -22,7 +22,7 @@ use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::period_k::{find_gait_any_period, periodic_gait_at, MAX_PERIOD};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
-use crate::error::short;
+use crate::fmt::short;
 use crate::params::{Config, ConfigError, SolverOptions};
 use crate::walk::SectionState;
 

@@ -35,6 +35,7 @@
 //! the deepest any tip went below the ground, checked on the dense output at [`PENETRATION_SAMPLES`] points
 //! per integrator step.
 
+mod error;
 pub mod impact;
 pub mod report;
 pub mod section;
@@ -45,10 +46,10 @@ use crate::contact::{
     constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Multipliers, Phase,
 };
 use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X};
-use crate::error::WalkError;
 use crate::integrate::{locate_root, DenseStep, Integrator, OdeSystem, Tolerances};
 use crate::params::SolverOptions;
 
+pub use error::WalkError;
 use impact::{
     bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
     touchdown_impact, Candidate, Unit, COMPLEMENTARITY_TOL,

@@ -6,9 +6,9 @@
 
 use serde::Serialize;
 
+use super::WalkError;
 use crate::contact::Leg;
 use crate::dynamics::{Coords, Model, L2, THETA, X, Z};
-use crate::error::WalkError;
 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
 /// by rounding only \[m, m/s\].
