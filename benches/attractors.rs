@@ -14,12 +14,13 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use vrw::app::{default_basin_range, default_initial};
+use vrw::app::default_basin_range;
 use vrw::dynamics::Model;
 use vrw::gait::basin::{basin, Axis, BasinSpec, Coordinate};
 use vrw::gait::orbit::{orbit_diagram, OrbitSpec};
 use vrw::gait::{find_gait, GaitOptions, StepMap, SweepSpec};
 use vrw::params::Config;
+use vrw::reference::default_initial;
 
 fn orbit(c: &mut Criterion) {
     let config = Config::default();

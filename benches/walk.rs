@@ -26,11 +26,12 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
-use vrw::app::{compute_gait, default_initial, GaitJob};
+use vrw::app::{compute_gait, GaitJob};
 use vrw::contact::{constrained_dynamics, ActiveSet};
 use vrw::dynamics::{Coords, Model};
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
+use vrw::reference::default_initial;
 use vrw::walk::{simulate, Walker};
 
 /// Steps walked from the reference start before timing a single step, so that the step timed is on the

@@ -28,7 +28,7 @@ use crate::output::plot::{
 };
 use crate::output::{self, OutputError};
 use crate::params::{Config, ConfigError};
-use crate::reference::RigidRimlessWheel;
+use crate::reference::default_initial;
 use crate::walk::WalkError;
 use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
 
@@ -61,34 +61,6 @@ pub enum AppError {
         /// Why.
         reason: String,
     },
-}
-
-/// The default starting point on the Poincare section (docs/model.md section 6): `(0.72, 1.0, 0.0)`, or, with
-/// `rigid_legs`, `(L0, omega*, 0.0)` with `omega*` the closed-form gait of the rigid rimless wheel
-/// ([`RigidRimlessWheel::fixed_point`]), since rigid legs stay at `L0` and a rigid wheel started much slower
-/// than its gait rolls back.
-pub fn default_initial(config: &Config) -> SectionState {
-    if config.params.rigid_legs {
-        let omega = RigidRimlessWheel {
-            params: config.params.clone(),
-        }
-        .fixed_point();
-        SectionState {
-            l2: config.params.stopper_length,
-            theta_dot: if omega.is_finite() && omega > 0.0 {
-                omega
-            } else {
-                1.0
-            },
-            l2_dot: 0.0,
-        }
-    } else {
-        SectionState {
-            l2: 0.72,
-            theta_dot: 1.0,
-            l2_dot: 0.0,
-        }
-    }
 }
 
 /// A step whose energy audit leaves more than this unexplained \[J\] is reported as a warning (on stderr by the

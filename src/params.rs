@@ -534,6 +534,15 @@ impl Config {
             .ok_or_else(|| unknown_numeric_key(key))
     }
 
+    /// A copy with the real-valued key `key` set to `value` and validated: the configuration at one point of a
+    /// sweep, a map or a continuation.
+    pub fn with(&self, key: &str, value: f64) -> Result<Config, ConfigError> {
+        let mut c = self.clone();
+        c.set_numeric(key, value)?;
+        c.validate()?;
+        Ok(c)
+    }
+
     /// Sets the real-valued key `key` (one of [`Config::numeric_keys`]) to `value`, as a sweep does.
     ///
     /// Does not validate: call [`Config::validate`] afterwards.

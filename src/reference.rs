@@ -8,6 +8,7 @@ use nalgebra::SVector;
 
 use crate::integrate::OdeSystem;
 use crate::params::{Config, ImpactModel, Params};
+use crate::walk::SectionState;
 
 /// Point mass falling from height h0 with upward velocity v0 under gravity g: y=[z, vz], exact impact time
 /// of z = 0.
@@ -144,6 +145,34 @@ impl RigidRimlessWheel {
     /// The fixed point `omega* = sqrt(2 Delta E / (I_P (1 - eta^2)))`.
     pub fn fixed_point(&self) -> f64 {
         (self.omega_sq_gain() / (1.0 - self.eta().powi(2))).sqrt()
+    }
+}
+
+/// The default starting point on the Poincare section (docs/model.md section 6): `(0.72, 1.0, 0.0)`, or, with
+/// `rigid_legs`, `(L0, omega*, 0.0)` with `omega*` the closed-form gait of the rigid rimless wheel
+/// ([`RigidRimlessWheel::fixed_point`]), since rigid legs stay at `L0` and a rigid wheel started much slower
+/// than its gait rolls back.
+pub fn default_initial(config: &Config) -> SectionState {
+    if config.params.rigid_legs {
+        let omega = RigidRimlessWheel {
+            params: config.params.clone(),
+        }
+        .fixed_point();
+        SectionState {
+            l2: config.params.stopper_length,
+            theta_dot: if omega.is_finite() && omega > 0.0 {
+                omega
+            } else {
+                1.0
+            },
+            l2_dot: 0.0,
+        }
+    } else {
+        SectionState {
+            l2: 0.72,
+            theta_dot: 1.0,
+            l2_dot: 0.0,
+        }
     }
 }
 

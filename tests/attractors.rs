@@ -2,13 +2,14 @@
 
 use std::path::Path;
 
-use vrw::app::{default_initial, run_basin, run_orbit, BasinJob, OrbitJob};
+use vrw::app::{run_basin, run_orbit, BasinJob, OrbitJob};
 use vrw::dynamics::Model;
 use vrw::gait::basin::{basin, Axis, BasinSpec, Coordinate};
 use vrw::gait::continuation::section_distance;
 use vrw::gait::orbit::{orbit_diagram, OrbitSpec};
 use vrw::gait::{find_gait, GaitOptions, StepMap, SweepSpec};
 use vrw::params::Config;
+use vrw::reference::default_initial;
 use vrw::reference::period_two_config;
 use vrw::walk::simulate;
 

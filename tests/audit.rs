@@ -2,10 +2,10 @@
 //! never push a leg outward, no impulse pulls, and no tip goes below the ground, on every step of every walk.
 //! Also the regression test of the bilateral stopper-lock impact.
 
-use vrw::app::default_initial;
 use vrw::contact::{impulse, ActiveSet, Leg};
 use vrw::dynamics::{Coords, Model, L1, L2, THETA};
 use vrw::params::Config;
+use vrw::reference::default_initial;
 use vrw::walk::impact::{close_unit, Unit};
 use vrw::walk::{simulate, SectionState, StepReport};
 

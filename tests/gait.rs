@@ -2,11 +2,11 @@
 
 use approx::assert_relative_eq;
 
-use vrw::app::default_initial;
 use vrw::dynamics::Model;
 use vrw::gait::{find_gait, find_thresholds, sweep, GaitOptions, StepMap, SweepSpec};
 use vrw::integrate::Method;
 use vrw::params::Config;
+use vrw::reference::default_initial;
 use vrw::reference::RigidRimlessWheel;
 use vrw::walk::SectionState;
 

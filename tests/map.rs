@@ -1,9 +1,9 @@
 //! Maps over two parameters (docs/model.md section 6): rows are sweeps, curves are refined 1-D thresholds.
 
-use vrw::app::default_initial;
 use vrw::gait::map::{Along, DEFAULT_CURVE_COLUMNS};
 use vrw::gait::{find_thresholds, map_curves, map_gaits, sweep, GaitOptions, MapSpec, SweepSpec};
 use vrw::params::Config;
+use vrw::reference::default_initial;
 
 /// Tolerance of every threshold in its parameter (the 1-D refinement's tolerance).
 const CURVE_TOL: f64 = 1e-6;

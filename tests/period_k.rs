@@ -1,10 +1,11 @@
 //! Period-k gaits (issue 10 item 2): fixed points of `P^k`, checked by evaluating the step map directly.
 
-use vrw::app::{default_initial, run_gait, GaitJob};
+use vrw::app::{run_gait, GaitJob};
 use vrw::dynamics::Model;
 use vrw::gait::period_k::least_period;
 use vrw::gait::{find_gait, find_periodic_gait, Gait, GaitOptions, StepMap, MAX_PERIOD};
 use vrw::params::Config;
+use vrw::reference::default_initial;
 use vrw::reference::period_two_config;
 use vrw::walk::{simulate, SectionState};
 

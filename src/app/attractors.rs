@@ -25,7 +25,7 @@ pub struct OrbitJob {
     pub config: Config,
     /// The parameter, its values, the transient and the recorded steps.
     pub spec: OrbitSpec,
-    /// Where the first walk starts (`None`: [`super::default_initial`]).
+    /// Where the first walk starts (`None`: [`crate::reference::default_initial`]).
     pub initial: Option<SectionState>,
     /// Draw the period-1 branch (a sweep with continuation over the same values).
     pub branch: bool,
@@ -314,7 +314,7 @@ pub const MAX_BASIN_POINTS: usize = 2000;
 pub struct BasinJob {
     /// Parameters and solver options.
     pub config: Config,
-    /// Where the gait search starts (`None`: [`super::default_initial`]).
+    /// Where the gait search starts (`None`: [`crate::reference::default_initial`]).
     pub initial: Option<SectionState>,
     /// Horizontal and vertical coordinates of the slice.
     pub coordinates: [Coordinate; 2],

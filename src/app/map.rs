@@ -13,7 +13,8 @@ use crate::output::{self, write_map_csv};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{axis_label, default_initial, second_route_config, short_name, AppError};
+use super::{axis_label, second_route_config, short_name, AppError};
+use crate::reference::default_initial;
 
 /// What `vrw map` runs.
 #[derive(Debug, Clone)]

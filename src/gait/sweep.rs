@@ -145,9 +145,7 @@ pub fn configured(
     param: &str,
     value: f64,
 ) -> Result<(Config, Model), ConfigError> {
-    let mut c = config.clone();
-    c.set_numeric(param, value)?;
-    c.validate()?;
+    let c = config.with(param, value)?;
     let model = Model::new(&c.params)?;
     Ok((c, model))
 }

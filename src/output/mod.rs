@@ -556,9 +556,9 @@ pub fn write_map_csv(path: &Path, map: &crate::gait::GaitMap) -> Result<(), Outp
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::app::default_initial;
     use crate::dynamics::Model;
     use crate::params::Config;
+    use crate::reference::default_initial;
     use crate::walk::{simulate, Trajectory};
 
     /// Every row function gives one cell per header name (the CSV writers and the Python binding rely on it).
