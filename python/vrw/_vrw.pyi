@@ -75,7 +75,7 @@ def find_gait(
     """Find the gait (``vrw gait``): the fields of ``gait.json``.
 
     ``status`` is ``found`` or why no gait was found (``message`` says it in words, as the command line
-    does); a found gait adds its fields (``section``, ``lambda_i4``, ``lambda_2_plus``, ..., ``stable``),
+    does); a found gait adds its fields (``section``, ``lambda_I4``, ``lambda_2_plus``, ..., ``stable``),
     with ``floquet_multipliers`` as a complex numpy array and ``jacobian`` as a 2-D numpy array. Options
     not given take the library's defaults (see ``GaitOptions``).
     """
