@@ -5,8 +5,8 @@
 //! same accuracy, which more than pays for its 12 stages per step (plus 3 for the dense output).
 //!
 //! The coefficients are those of Hairer's `dop853` (HNW I, Sec. II.10), taken from the `differential-equations`
-//! crate's Butcher tableau (`ButcherTableau::dop853`) rather than typed in again; the tests check them against
-//! the order conditions and the method's convergence order. The stepping itself is hand-written for the same
+//! crate's Butcher tableau (`ButcherTableau::dop853`) rather than typed in again; the tests check them through
+//! the method's convergence order. The stepping itself is hand-written for the same
 //! reasons as `Dopri5` (stack state, caller-located events, restarts; see the parent module): error norm and
 //! step-size control as in `dop853` (HNW I, Sec. II.10, Eq. (10.17); no PI term, `fac1 = 0.333`, `fac2 = 6`).
 //!
@@ -21,7 +21,9 @@ use std::sync::OnceLock;
 use differential_equations::tableau::ButcherTableau;
 use nalgebra::SVector;
 
-use super::{all_finite, scaled_rms, Core, DenseStep, IntegrationError, OdeSystem, Tolerances};
+use super::core::{all_finite, Core};
+use super::tolerances::scaled_rms;
+use super::{DenseStep, IntegrationError, OdeSystem, Tolerances};
 
 /// Stages of one step.
 const STAGES: usize = 12;
@@ -214,6 +216,42 @@ impl<const N: usize> Dop853<N> {
                 *c *= h;
             }
             return Ok(DenseStep::from_coefficients(t, t1, y1, &cont));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::integrate::testing::steps_of;
+    use crate::integrate::Method;
+
+    /// Largest distance of the observed convergence order from the method's order.
+    const ORDER_TOL: f64 = 0.5;
+
+    /// Error at t = 4 of the oscillator integrated in steps of exactly `h` (the tolerance so loose that `h`
+    /// binds).
+    fn global_error(method: Method, h: f64) -> f64 {
+        let (sys, mut solver) = steps_of(method, h, 1.0);
+        while solver.t() < 4.0 {
+            solver.step(&sys, 4.0).expect("integration failed");
+        }
+        (solver.y() - sys.exact(4.0)).amax()
+    }
+
+    /// The tableau taken from `differential-equations` gives a method of order 8 (and DOPRI5 one of order 5):
+    /// halving the step divides the global error by about 2^8 (2^5).
+    #[test]
+    fn methods_converge_with_their_order() {
+        for (method, order) in [(Method::Dopri5, 5), (Method::Dop853, 8)] {
+            let (coarse, fine) = (global_error(method, 0.2), global_error(method, 0.1));
+            let observed = (coarse / fine).log2();
+            eprintln!(
+                "{method}: global error {coarse:e} -> {fine:e}, observed order {observed:.2}"
+            );
+            assert!(
+                (observed - f64::from(order)).abs() < ORDER_TOL,
+                "{method}: observed order {observed}"
+            );
         }
     }
 }
