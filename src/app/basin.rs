@@ -1,0 +1,219 @@
+//! The job of `vrw basin`: the basin of the gait on a slice of the Poincare section (what the walk from every
+//! grid point does), `basin.csv`, `basin.json` and `basin.png`.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::fmt::short;
+use crate::gait::basin::{basin, Axis, BasinPoint, BasinSpec, Coordinate};
+use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use crate::output;
+use crate::output::basin_plot::{write_basin_figure, BasinFigure};
+use crate::params::Config;
+use crate::walk::SectionState;
+
+use super::attractor_tables::write_basin_csv;
+use super::{prepared, AppError};
+
+/// Default range of a coordinate on the basin slice around the gait's value `at`: `L2` from `L0 / 2` to `L0`,
+/// `dtheta/dt` from a twentieth of the gait's to three times it, `dL2/dt` the gait's plus and minus 1.5 m/s.
+pub fn default_basin_range(config: &Config, coordinate: Coordinate, at: f64) -> (f64, f64) {
+    let l0 = config.params.stopper_length;
+    match coordinate {
+        Coordinate::L2 => (0.5 * l0, l0),
+        Coordinate::ThetaDot => (0.05 * at, 3.0 * at),
+        Coordinate::L2Dot => (at - 1.5, at + 1.5),
+    }
+}
+
+/// The most grid points along one axis of a basin.
+pub const MAX_BASIN_POINTS: usize = 2000;
+
+/// What `vrw basin` runs.
+#[derive(Debug, Clone)]
+pub struct BasinJob {
+    /// Parameters and solver options.
+    pub config: Config,
+    /// Where the gait search starts (`None`: [`crate::reference::default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Horizontal and vertical coordinates of the slice.
+    pub coordinates: [Coordinate; 2],
+    /// Their ranges (`None`: [`default_basin_range`]).
+    pub ranges: [Option<(f64, f64)>; 2],
+    /// Grid points along x and y.
+    pub points: [usize; 2],
+    /// Steps walked at most from each start.
+    pub max_steps: usize,
+    /// Distance to a gait state that counts as reaching it.
+    pub tolerance: f64,
+    /// Where `basin.csv`, `basin.json` and `basin.png` go.
+    pub out_dir: PathBuf,
+}
+
+/// `basin.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct BasinSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options.
+    pub config: Config,
+    /// The slice and the rules.
+    pub spec: BasinSpec,
+    /// The gait whose basin it is.
+    pub gait: Gait,
+    /// Number of grid points per outcome.
+    pub outcomes: BTreeMap<String, usize>,
+    /// The files written.
+    pub files: Vec<String>,
+    /// Wall-clock seconds of the grid (printed, not written).
+    #[serde(skip)]
+    pub seconds: f64,
+}
+
+impl BasinJob {
+    fn invalid(option: &'static str, reason: String) -> AppError {
+        AppError::InvalidOption { option, reason }
+    }
+
+    /// Check the options that do not depend on the gait.
+    fn validate(&self) -> Result<(), AppError> {
+        if self.coordinates[0] == self.coordinates[1] {
+            return Err(Self::invalid(
+                "--x/--y",
+                format!(
+                    "the two axes must be different coordinates (both are {})",
+                    self.coordinates[0].name()
+                ),
+            ));
+        }
+        for (option, n) in [("--nx", self.points[0]), ("--ny", self.points[1])] {
+            if !(2..=MAX_BASIN_POINTS).contains(&n) {
+                return Err(Self::invalid(
+                    option,
+                    format!("{n} grid points; use 2 to {MAX_BASIN_POINTS}"),
+                ));
+            }
+        }
+        for (option, range) in [("--x-range", self.ranges[0]), ("--y-range", self.ranges[1])] {
+            if let Some((a, b)) = range {
+                if !(a.is_finite() && b.is_finite() && a != b) {
+                    return Err(Self::invalid(
+                        option,
+                        format!(
+                            "{},{} is not a range with two different finite ends",
+                            short(a),
+                            short(b)
+                        ),
+                    ));
+                }
+            }
+        }
+        if !(1..=100_000).contains(&self.max_steps) {
+            return Err(Self::invalid(
+                "--max-steps",
+                format!("{} steps; use 1 to 100000", self.max_steps),
+            ));
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return Err(Self::invalid(
+                "--tolerance",
+                format!("{} is not a positive distance", short(self.tolerance)),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Run `vrw basin`: find the gait (any period up to 8), walk from every grid point of the slice through it,
+/// write `basin.csv`, `basin.json` and `basin.png`. `progress` is called after every grid point.
+pub fn run_basin(
+    job: &BasinJob,
+    progress: &(dyn Fn(&BasinPoint) + Sync),
+) -> Result<BasinSummary, AppError> {
+    job.validate()?;
+    let (model, initial) = prepared(&job.config, job.initial)?;
+    let map = StepMap::new(&model, &job.config.solver);
+    let gait =
+        find_gait_any_period(&map, &initial, &GaitOptions::default(), MAX_PERIOD).map_err(|e| {
+            AppError::InvalidOption {
+                option: "basin",
+                reason: format!("no gait to draw the basin of: {e}"),
+            }
+        })?;
+    let through = gait.section.to_array();
+    let axis = |k: usize| {
+        let c = job.coordinates[k];
+        let (from, to) = job.ranges[k]
+            .unwrap_or_else(|| default_basin_range(&job.config, c, through[c.index()]));
+        Axis {
+            coordinate: c,
+            from,
+            to,
+            points: job.points[k],
+        }
+    };
+    let spec = BasinSpec {
+        x: axis(0),
+        y: axis(1),
+        through: gait.section,
+        max_steps: job.max_steps,
+        tolerance: job.tolerance,
+    };
+    output::ensure_dir(&job.out_dir)?;
+    let clock = std::time::Instant::now();
+    let grid = basin(&model, &job.config.solver, &gait, &spec, progress);
+    let seconds = clock.elapsed().as_secs_f64();
+    let mut outcomes = BTreeMap::new();
+    for p in grid.iter().flatten() {
+        *outcomes.entry(p.outcome.kind.clone()).or_insert(0) += 1;
+    }
+    write_basin_csv(&job.out_dir.join("basin.csv"), &grid)?;
+    let (cx, cy) = (spec.x.coordinate.index(), spec.y.coordinate.index());
+    let figure = BasinFigure {
+        title: format!(
+            "Basin of the {}gait on the slice {} = {:.4} (c = {} N s/m, slope φ = {} rad, impact {})",
+            if gait.period_k > 1 {
+                format!("period-{} ", gait.period_k)
+            } else {
+                String::new()
+            },
+            Coordinate::ALL[3 - cx - cy].name(),
+            through[3 - cx - cy],
+            job.config.params.viscosity,
+            job.config.params.slope,
+            job.config.params.impact
+        ),
+        x_label: spec.x.coordinate.label().to_string(),
+        y_label: spec.y.coordinate.label().to_string(),
+        xs: (0..spec.x.points).map(|i| spec.x.value(i)).collect(),
+        ys: (0..spec.y.points).map(|i| spec.y.value(i)).collect(),
+        outcomes: grid
+            .iter()
+            .map(|row| row.iter().map(|p| p.outcome.kind.clone()).collect())
+            .collect(),
+        gait: gait
+            .cycle
+            .iter()
+            .map(|r| {
+                let a = r.section.to_array();
+                (a[cx], a[cy])
+            })
+            .collect(),
+    };
+    write_basin_figure(&figure, &job.out_dir.join("basin.png"))?;
+    let summary = BasinSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec,
+        gait,
+        outcomes,
+        files: ["basin.csv", "basin.png", "basin.json"]
+            .map(String::from)
+            .to_vec(),
+        seconds,
+    };
+    output::write_json(&job.out_dir.join("basin.json"), &summary)?;
+    Ok(summary)
+}

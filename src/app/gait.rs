@@ -1,0 +1,130 @@
+//! The job of `vrw gait`: search the gait (period 1, or period k), write `gait.json` and one period of the
+//! walk in the files of `vrw simulate`.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::dynamics::Model;
+use crate::fmt::short;
+use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use crate::output;
+use crate::params::Config;
+use crate::reference::default_initial;
+use crate::walk::SectionState;
+
+use super::simulate::{run_simulate, SimulateJob, SimulateSummary, DEFAULT_SAMPLE_DT};
+use super::AppError;
+
+/// What `vrw gait` runs.
+#[derive(Debug, Clone)]
+pub struct GaitJob {
+    /// Parameters and solver options.
+    pub config: Config,
+    /// Where the search starts (`None`: [`default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Search settings.
+    pub options: GaitOptions,
+    /// Where `gait.json` goes, and one period of the gait in the files of `vrw simulate`.
+    pub out_dir: PathBuf,
+}
+
+/// `gait.json`: the parameters, and the gait or why none was found.
+#[derive(Debug, Clone, Serialize)]
+pub struct GaitSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options used.
+    pub config: Config,
+    /// Search settings.
+    pub options: GaitOptions,
+    /// Initial section state of the search.
+    pub initial: SectionState,
+    /// `found`, or the failure kind.
+    pub status: String,
+    /// The failure, in words, if any.
+    pub message: Option<String>,
+    /// The gait, if found (its fields are also flattened into the top level of the JSON).
+    #[serde(flatten)]
+    pub gait: Option<Gait>,
+}
+
+/// The smallest Newton tolerance `vrw gait` accepts: the step map is computed to about 1e-13 (integration
+/// and event-location tolerances, rounding over a step of thousands of solves), so a smaller
+/// `max |P(s) - s|` cannot be reached reliably.
+pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
+
+/// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
+/// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
+/// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
+/// ([`write_gait_period`]).
+pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
+    let summary = compute_gait(job)?;
+    output::ensure_dir(&job.out_dir)?;
+    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
+    if let Some(gait) = &summary.gait {
+        write_gait_period(job, gait)?;
+    }
+    Ok(summary)
+}
+
+/// The search of [`run_gait`] without writing anything (`job.out_dir` is not used). A search that finds no
+/// gait is a summary with its status and message, not an error.
+pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
+    let tolerance = job.options.tolerance;
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(AppError::InvalidOption {
+            option: "--tolerance",
+            reason: format!("{} is not a positive number", short(tolerance)),
+        });
+    }
+    if tolerance < MIN_GAIT_TOLERANCE {
+        return Err(AppError::InvalidOption {
+            option: "--tolerance",
+            reason: format!(
+                "{} is below what the step map can reach (about {}, set by rtol, atol and \
+                 event_time_tol and by rounding); use --tolerance {} or more",
+                short(tolerance),
+                short(MIN_GAIT_TOLERANCE),
+                short(MIN_GAIT_TOLERANCE)
+            ),
+        });
+    }
+    job.config.validate()?;
+    let model = Model::new(&job.config.params)?;
+    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
+    initial.validate(&model)?;
+    let map = StepMap::new(&model, &job.config.solver);
+    let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
+    let summary = GaitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        options: job.options,
+        initial,
+        status: result
+            .as_ref()
+            .map_or_else(|e| e.kind(), |_| "found")
+            .to_string(),
+        message: result.as_ref().err().map(ToString::to_string),
+        gait: result.ok(),
+    };
+    Ok(summary)
+}
+
+/// Walk one period (`period_k` steps) from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
+/// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
+/// `vrw plot` and `vrw animate` work on a gait directly.
+pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
+    run_simulate(
+        &SimulateJob {
+            config: job.config.clone(),
+            initial: Some(gait.section),
+            steps: gait.period_k,
+            sample_dt: DEFAULT_SAMPLE_DT,
+            trajectory: true,
+            out_dir: job.out_dir.clone(),
+            interrupt: None,
+        },
+        &mut |_| {},
+    )
+}

@@ -1,0 +1,130 @@
+//! The jobs the command line runs, as library functions (STYLE.md point 2: all science lives in the library).
+//!
+//! One file per job: [`simulate`](run_simulate) (`simulate.rs`), [`gait`](run_gait) (`gait.rs`),
+//! [`sweep`](run_sweep) with its Fig. 2 (`sweep.rs`), [`map`](run_map) (`map.rs`), [`orbit`](run_orbit)
+//! (`orbit.rs`), [`basin`](run_basin) (`basin.rs`), and [`plot`](run_plot) / [`animate`](run_animate) of a run
+//! directory (`figures.rs`); the tables of the orbit and basin jobs are in `attractor_tables.rs`. This file
+//! holds what they share: the error type, the start of every walk, and the names of parameters on figures.
+
+mod attractor_tables;
+mod basin;
+mod figures;
+mod gait;
+mod map;
+mod orbit;
+mod simulate;
+mod sweep;
+
+pub use basin::{default_basin_range, run_basin, BasinJob, BasinSummary};
+pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+pub use gait::{
+    compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
+};
+pub use map::{run_map, MapJob, MapSummary};
+pub use orbit::{run_orbit, OrbitJob, OrbitSummary};
+pub use simulate::{
+    compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
+    DEFAULT_SAMPLE_DT, ENERGY_RESIDUAL_WARNING, MIN_SAMPLE_DT, SUMMARY_STEPS, SUMMARY_WARNINGS,
+};
+pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
+
+use crate::dynamics::Model;
+use crate::output::OutputError;
+use crate::params::{Config, ConfigError};
+use crate::reference::default_initial;
+use crate::walk::{SectionState, WalkError};
+
+/// A job could not run or could not write its results.
+#[derive(Debug, thiserror::Error)]
+pub enum AppError {
+    /// Bad parameters.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// A bad initial state or a walk that could not start.
+    #[error(transparent)]
+    Walk(#[from] WalkError),
+    /// Results could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// A run directory could not be read back.
+    #[error(transparent)]
+    Read(#[from] crate::output::read::ReadError),
+    /// The animation could not be made.
+    #[error(transparent)]
+    Animate(#[from] crate::output::animate::AnimateError),
+    /// A figure could not be drawn.
+    #[error(transparent)]
+    Plot(#[from] crate::output::style::PlotError),
+    /// A bad command-line value that is not a model parameter.
+    #[error("invalid {option}: {reason}")]
+    InvalidOption {
+        /// The option.
+        option: &'static str,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// The validated configuration's model and the start on the section (`initial`, or [`default_initial`]),
+/// checked against the model: what every job that walks needs first.
+fn prepared(
+    config: &Config,
+    initial: Option<SectionState>,
+) -> Result<(Model, SectionState), AppError> {
+    config.validate()?;
+    let model = Model::new(&config.params)?;
+    let initial = initial.unwrap_or_else(|| default_initial(config));
+    initial.validate(&model)?;
+    Ok((model, initial))
+}
+
+/// Remove `path` if it exists (an output file of an earlier run that this run does not rewrite).
+fn remove_stale(path: &std::path::Path) -> Result<(), OutputError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The configuration of the second route for a result computed with `config`: the other integrator, and the
+/// route's name.
+pub fn second_route_config(config: &Config) -> (Config, String) {
+    let mut second = config.clone();
+    second.solver.integrator = config.solver.integrator.other();
+    let route = format!("integrator = {}", second.solver.integrator);
+    (second, route)
+}
+
+/// Short symbol of a parameter for labels (`c` for viscosity, ...).
+fn short_name(param: &str) -> &str {
+    match param {
+        "viscosity" => "c",
+        "stiffness" => "k",
+        "slope" => "φ",
+        "hub_mass" => "mH",
+        "leg_mass" => "m",
+        other => other,
+    }
+}
+
+/// Axis label with unit.
+fn axis_label(param: &str) -> String {
+    let unit = match param {
+        "viscosity" => "N s/m",
+        "stiffness" => "N/m",
+        "slope" => "rad",
+        "hub_mass" | "leg_mass" => "kg",
+        "hub_inertia" => "kg m²",
+        "gravity" => "m/s²",
+        "leg_mass_offset" | "stopper_length" | "spring_natural_length" => "m",
+        _ => "",
+    };
+    if unit.is_empty() {
+        short_name(param).to_string()
+    } else {
+        format!("{} [{unit}]", short_name(param))
+    }
+}

@@ -1,0 +1,196 @@
+//! The job of `vrw orbit`: the orbit diagram along one parameter (the states the walk visits after a
+//! transient), the period-1 branch beside it, `orbit.csv`, `branch.csv`, `orbit.json` and `orbit.png`.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::fmt::short;
+use crate::gait::orbit::{orbit_diagram, OrbitColumn, OrbitSpec};
+use crate::gait::{sweep, Gait, GaitOptions, Stability};
+use crate::output;
+use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
+use crate::params::Config;
+use crate::walk::{SectionState, StepReport};
+
+use super::attractor_tables::{write_branch_csv, write_orbit_csv};
+use super::{axis_label, prepared, AppError};
+
+/// What `vrw orbit` runs.
+#[derive(Debug, Clone)]
+pub struct OrbitJob {
+    /// Parameters and solver options (the swept key is overridden value by value).
+    pub config: Config,
+    /// The parameter, its values, the transient and the recorded steps.
+    pub spec: OrbitSpec,
+    /// Where the first walk starts (`None`: [`crate::reference::default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Draw the period-1 branch (a sweep with continuation over the same values).
+    pub branch: bool,
+    /// Where `orbit.csv`, `branch.csv`, `orbit.json` and `orbit.png` go.
+    pub out_dir: PathBuf,
+}
+
+/// `orbit.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct OrbitSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options.
+    pub config: Config,
+    /// What was computed.
+    pub spec: OrbitSpec,
+    /// Number of values whose walk settled on a period `k` (key `k`), did not settle (`none`) or failed
+    /// (the failure kind).
+    pub outcomes: BTreeMap<String, usize>,
+    /// Values with a period-1 gait on the branch, and how many of them are stable.
+    pub branch_gaits: [usize; 2],
+    /// The files written.
+    pub files: Vec<String>,
+    /// Wall-clock seconds of the diagram and of the branch (printed, not written).
+    #[serde(skip)]
+    pub seconds: [f64; 2],
+}
+
+/// Run `vrw orbit`. `progress` is called after every value of the diagram.
+pub fn run_orbit(
+    job: &OrbitJob,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<OrbitSummary, AppError> {
+    let (_, initial) = prepared(&job.config, job.initial)?;
+    job.spec.validate(&job.config)?;
+    output::ensure_dir(&job.out_dir)?;
+    let clock = std::time::Instant::now();
+    let columns = orbit_diagram(&job.config, &job.spec, &initial, progress)?;
+    let orbit_seconds = clock.elapsed().as_secs_f64();
+    let param = &job.spec.range.param;
+    let mut files = vec!["orbit.csv".to_string()];
+    write_orbit_csv(&job.out_dir.join("orbit.csv"), param, &columns)?;
+    let clock = std::time::Instant::now();
+    let branch: Vec<(f64, Option<Gait>)> = if job.branch {
+        sweep(
+            &job.config,
+            &job.spec.range,
+            &initial,
+            &GaitOptions::default(),
+            &|_| {},
+        )?
+        .into_iter()
+        .map(|p| (p.value, p.gait.filter(|g| g.period_k == 1)))
+        .collect()
+    } else {
+        Vec::new()
+    };
+    let branch_seconds = clock.elapsed().as_secs_f64();
+    if job.branch {
+        write_branch_csv(&job.out_dir.join("branch.csv"), param, &branch)?;
+        files.push("branch.csv".to_string());
+    }
+    let mut outcomes = BTreeMap::new();
+    for c in &columns {
+        let key = match (c.status.as_str(), c.period_k) {
+            ("walking", Some(k)) => format!("period_{k}"),
+            ("walking", None) => "not_settled".to_string(),
+            (kind, _) => kind.to_string(),
+        };
+        *outcomes.entry(key).or_insert(0) += 1;
+    }
+    let gaits = branch.iter().filter_map(|(_, g)| g.as_ref());
+    let branch_gaits = [
+        gaits.clone().count(),
+        gaits.filter(|g| g.stability == Stability::Stable).count(),
+    ];
+    let figure = orbit_figure(job, &columns, &branch);
+    match write_orbit_figure(&figure, &job.out_dir.join("orbit.png")) {
+        Ok(()) => files.push("orbit.png".to_string()),
+        Err(crate::output::style::PlotError::Empty(_)) => {}
+        Err(e) => return Err(e.into()),
+    }
+    files.push("orbit.json".to_string());
+    let summary = OrbitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec: job.spec.clone(),
+        outcomes,
+        branch_gaits,
+        files,
+        seconds: [orbit_seconds, branch_seconds],
+    };
+    output::write_json(&job.out_dir.join("orbit.json"), &summary)?;
+    Ok(summary)
+}
+
+/// The two panels of the orbit diagram: `dtheta/dt` on the section and `lambda_I4`.
+fn orbit_figure(
+    job: &OrbitJob,
+    columns: &[OrbitColumn],
+    branch: &[(f64, Option<Gait>)],
+) -> OrbitFigure {
+    type Pick = fn(&StepReport) -> f64;
+    type OfGait = fn(&Gait) -> f64;
+    let panels: [(&str, Pick, OfGait); 2] = [
+        (
+            "dθ/dt before touchdown [rad/s]",
+            |r| r.section.theta_dot,
+            |g| g.section.theta_dot,
+        ),
+        ("λI4 [N s]", |r| r.indicators.lambda_i4, |g| g.lambda_i4),
+    ];
+    let p = &job.config.params;
+    let range = &job.spec.range;
+    // Each failed value shades half a spacing on either side; a label per failure kind.
+    let half = 0.5 * (range.to - range.from).abs() / (range.points.max(2) - 1) as f64;
+    let failed = columns
+        .iter()
+        .filter(|c| c.status != "walking")
+        .map(|c| {
+            (
+                (c.value - half)..(c.value + half),
+                format!("walk fails: {}", c.status.replace('_', " ")),
+            )
+        })
+        .collect();
+    OrbitFigure {
+        failed,
+        title: format!(
+            "Orbit diagram: {} steps after a transient of {}, {}impact {}",
+            job.spec.steps,
+            job.spec.transient,
+            [
+                ("viscosity", format!("c = {} N s/m, ", short(p.viscosity))),
+                ("stiffness", format!("k = {} N/m, ", short(p.stiffness))),
+                ("slope", format!("slope φ = {} rad, ", p.slope)),
+            ]
+            .into_iter()
+            .filter(|(key, _)| *key != range.param)
+            .map(|(_, fixed)| fixed)
+            .collect::<String>(),
+            p.impact
+        ),
+        param_label: axis_label(&range.param),
+        x: range.from.min(range.to)..range.from.max(range.to),
+        panels: panels
+            .iter()
+            .map(|(label, pick, of_gait)| OrbitPanel {
+                y_label: label.to_string(),
+                points: columns
+                    .iter()
+                    .flat_map(|c| c.returns.iter().map(move |r| (c.value, pick(r))))
+                    .collect(),
+                branch: branch
+                    .iter()
+                    .map(|(v, g)| BranchPoint {
+                        param: *v,
+                        value: g.as_ref().map_or(f64::NAN, of_gait),
+                        stable: g.as_ref().and_then(|g| match g.stability {
+                            Stability::Stable => Some(true),
+                            Stability::Unstable => Some(false),
+                            Stability::Uncertain => None,
+                        }),
+                    })
+                    .collect(),
+            })
+            .collect(),
+    }
+}

@@ -1,0 +1,458 @@
+//! The job of `vrw simulate`: walk N steps, streaming `steps.csv` and `trajectory.csv`, then write
+//! `summary.json`; and the same walk held in memory for other fronts ([`compute_simulation`]).
+
+use std::collections::{BTreeMap, VecDeque};
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use crate::dynamics::Model;
+use crate::fmt::short;
+use crate::output::{self, OutputError};
+use crate::params::Config;
+use crate::reference::default_initial;
+use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
+
+use super::{remove_stale, AppError};
+
+/// A step whose energy audit leaves more than this unexplained \[J\] is reported as a warning (on stderr by the
+/// command line and in `summary.json`): the integration or an event is then not to be trusted.
+pub const ENERGY_RESIDUAL_WARNING: f64 = 1e-6;
+
+/// The smallest trajectory sampling interval `vrw simulate` accepts \[s\].
+pub const MIN_SAMPLE_DT: f64 = 1e-6;
+
+/// `summary.json` keeps the records of the last this many steps; `steps.csv` has every step.
+pub const SUMMARY_STEPS: usize = 1000;
+
+/// `summary.json` keeps the first this many warnings and counts the rest.
+pub const SUMMARY_WARNINGS: usize = 100;
+/// Default sampling interval of `trajectory.csv` \[s\].
+pub const DEFAULT_SAMPLE_DT: f64 = 0.005;
+
+/// What `vrw simulate` runs.
+#[derive(Debug, Clone)]
+pub struct SimulateJob {
+    /// Parameters and solver options (validated by the job).
+    pub config: Config,
+    /// Start on the Poincare section (`None`: [`default_initial`]).
+    pub initial: Option<SectionState>,
+    /// Number of steps to walk.
+    pub steps: usize,
+    /// Trajectory sampling interval \[s\].
+    pub sample_dt: f64,
+    /// Write `trajectory.csv` (`false`: only `steps.csv` and `summary.json`; a `trajectory.csv` of an earlier
+    /// run in `out_dir` is removed, since it would not match).
+    pub trajectory: bool,
+    /// Where `steps.csv`, `trajectory.csv` and `summary.json` go.
+    pub out_dir: PathBuf,
+    /// Set it (e.g. from a Ctrl-C handler) to stop the walk at the next touchdown; the results so far are
+    /// written with the status `interrupted`.
+    pub interrupt: Option<Arc<AtomicBool>>,
+}
+
+/// `summary.json`: the parameters used, how the run ended, aggregates over every step, and the records of the
+/// last [`SUMMARY_STEPS`] steps (`steps.csv` has every step).
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulateSummary {
+    /// Version of vrw that produced the file.
+    pub vrw_version: &'static str,
+    /// Parameters and solver options used.
+    pub config: Config,
+    /// Initial section state.
+    pub initial: SectionState,
+    /// Steps asked for.
+    pub steps_requested: usize,
+    /// Steps completed.
+    pub steps_completed: usize,
+    /// `completed`, `interrupted` (Ctrl-C), or the failure kind (`fell`, `stalled`, ...).
+    pub status: String,
+    /// The failure or the interruption, in words, if any.
+    pub message: Option<String>,
+    /// Simulated time reached \[s\]: the last touchdown, or the time of the failure.
+    pub end_time: f64,
+    /// Largest `|energy_residual|` over all steps \[J\].
+    pub max_abs_energy_residual: f64,
+    /// Steps with `scuffing` (Leg 2 slid or came back to the ground), over all steps.
+    pub scuffing_steps: usize,
+    /// Steps with `bounce` (Leg 1 left the ground), over all steps.
+    pub bounce_steps: usize,
+    /// Number of steps per impact branch (`DLS`, `SLS`, ...), over all steps.
+    pub branches: BTreeMap<String, usize>,
+    /// Files written to the output directory.
+    pub files: Vec<String>,
+    /// What may make the numbers untrustworthy (e.g. a step whose energy residual exceeds
+    /// [`ENERGY_RESIDUAL_WARNING`]); the first [`SUMMARY_WARNINGS`] of them.
+    pub warnings: Vec<String>,
+    /// Number of warnings, including those not listed.
+    pub warnings_total: usize,
+    /// The most step records `steps` holds ([`SUMMARY_STEPS`]).
+    pub steps_limit: usize,
+    /// Records of the last `min(steps_completed, steps_limit)` steps, in order; `steps.csv` has every step.
+    pub steps: Vec<StepReport>,
+}
+
+impl SimulateSummary {
+    fn new(job: &SimulateJob, initial: SectionState) -> SimulateSummary {
+        SimulateSummary {
+            vrw_version: env!("CARGO_PKG_VERSION"),
+            config: job.config.clone(),
+            initial,
+            steps_requested: job.steps,
+            steps_completed: 0,
+            status: String::new(),
+            message: None,
+            end_time: 0.0,
+            max_abs_energy_residual: 0.0,
+            scuffing_steps: 0,
+            bounce_steps: 0,
+            branches: BTreeMap::new(),
+            files: Vec::new(),
+            warnings: Vec::new(),
+            warnings_total: 0,
+            steps_limit: SUMMARY_STEPS,
+            steps: Vec::new(),
+        }
+    }
+
+    /// Account for one completed step; returns the warning it raises, if any.
+    fn add_step(&mut self, report: &StepReport, last: &mut VecDeque<StepReport>) -> Option<String> {
+        self.steps_completed += 1;
+        let residual = report.energy.residual;
+        self.max_abs_energy_residual = self.max_abs_energy_residual.max(residual.abs());
+        self.scuffing_steps += usize::from(report.scuffing);
+        self.bounce_steps += usize::from(report.bounce);
+        *self.branches.entry(report.branch.to_string()).or_default() += 1;
+        if last.len() == SUMMARY_STEPS {
+            last.pop_front();
+        }
+        last.push_back(*report);
+        // A NaN residual is a warning too.
+        let within = residual.abs() <= ENERGY_RESIDUAL_WARNING;
+        let warning = (!within).then(|| {
+            format!(
+                "step {}: energy residual {} J exceeds {} J (the energy audit does not close)",
+                report.step,
+                short(residual),
+                short(ENERGY_RESIDUAL_WARNING)
+            )
+        })?;
+        self.warnings_total += 1;
+        (self.warnings.len() < SUMMARY_WARNINGS).then(|| {
+            self.warnings.push(warning.clone());
+            warning
+        })
+    }
+
+    /// Did the walk complete every requested step?
+    pub fn completed(&self) -> bool {
+        self.message.is_none()
+    }
+}
+
+/// What `vrw simulate` reports while it runs.
+#[derive(Debug, Clone, Copy)]
+pub enum SimulateEvent<'a> {
+    /// A step is done (its row is in `steps.csv`).
+    Step(&'a StepReport),
+    /// Something the user should know (also listed in `summary.json`).
+    Warning(&'a str),
+}
+
+/// Run `vrw simulate`: walk, streaming every step to `steps.csv` and the samples to `trajectory.csv` as they
+/// are computed, then write `summary.json`. Memory does not grow with the number of steps. A walk that stops
+/// early (a failure, or the [`SimulateJob::interrupt`] flag) keeps every completed step. `observe` sees every
+/// step and warning as it happens.
+pub fn run_simulate(
+    job: &SimulateJob,
+    observe: &mut dyn FnMut(SimulateEvent),
+) -> Result<SimulateSummary, AppError> {
+    let (model, initial) = simulation_setup(job)?;
+    let dir = &job.out_dir;
+    output::ensure_dir(dir)?;
+    let mut steps_csv = output::StepsCsv::create(&dir.join("steps.csv"))?;
+    let trajectory_path = dir.join("trajectory.csv");
+    let mut trajectory = if job.trajectory {
+        let sink = output::TrajectoryCsv::create(&trajectory_path)?;
+        Some(Trajectory::streaming(job.sample_dt, Box::new(sink)))
+    } else {
+        // A trajectory.csv left by an earlier run would not match the new steps.csv.
+        remove_stale(&trajectory_path)?;
+        None
+    };
+    let write_row = |report: &StepReport| -> Result<(), AppError> { Ok(steps_csv.write(report)?) };
+    let mut summary = walk_job(
+        job,
+        &model,
+        initial,
+        trajectory.as_mut(),
+        write_row,
+        observe,
+    )?;
+    if let Some(source) = trajectory.as_mut().and_then(Trajectory::take_error) {
+        return Err(OutputError::Io {
+            path: trajectory_path,
+            source,
+        }
+        .into());
+    }
+    summary.files.push("steps.csv".to_string());
+    if job.trajectory {
+        summary.files.push("trajectory.csv".to_string());
+    }
+    summary.files.push("summary.json".to_string());
+    output::write_json(&dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+/// The walk of [`run_simulate`] without writing anything (`job.out_dir` and `job.trajectory` are not used),
+/// for other fronts (the Python binding): the summary with **every** step record (not only the last
+/// [`SUMMARY_STEPS`]), and the trajectory sampled every `job.sample_dt` if `record_trajectory`. It is held in
+/// memory, so it suits runs of moderate length.
+pub fn compute_simulation(
+    job: &SimulateJob,
+    record_trajectory: bool,
+) -> Result<(SimulateSummary, Option<Trajectory>), AppError> {
+    let (model, initial) = simulation_setup(job)?;
+    let mut trajectory = record_trajectory.then(|| Trajectory::new(job.sample_dt));
+    let mut all = Vec::new();
+    let mut summary = walk_job(
+        job,
+        &model,
+        initial,
+        trajectory.as_mut(),
+        |report| {
+            all.push(*report);
+            Ok(())
+        },
+        &mut |_| {},
+    )?;
+    summary.steps_limit = all.len();
+    summary.steps = all;
+    Ok((summary, trajectory))
+}
+
+/// Validate a simulate job: its configuration, its sampling interval, its model and its start.
+fn simulation_setup(job: &SimulateJob) -> Result<(Model, SectionState), AppError> {
+    job.config.validate()?;
+    if !(job.sample_dt.is_finite() && job.sample_dt > 0.0) {
+        return Err(AppError::InvalidOption {
+            option: "--sample-dt",
+            reason: format!("{} is not a positive time step", short(job.sample_dt)),
+        });
+    }
+    if job.sample_dt < MIN_SAMPLE_DT {
+        return Err(AppError::InvalidOption {
+            option: "--sample-dt",
+            reason: format!(
+                "{} s is below {} s (a million samples per simulated second)",
+                short(job.sample_dt),
+                short(MIN_SAMPLE_DT)
+            ),
+        });
+    }
+    let model = Model::new(&job.config.params)?;
+    let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
+    initial.validate(&model)?;
+    Ok((model, initial))
+}
+
+/// Walk the job's steps, handing each report to `on_step` and then each step and warning to `observe`, and
+/// build the
+/// summary (aggregates, the last [`SUMMARY_STEPS`] records, status).
+fn walk_job(
+    job: &SimulateJob,
+    model: &Model,
+    initial: SectionState,
+    trajectory: Option<&mut Trajectory>,
+    mut on_step: impl FnMut(&StepReport) -> Result<(), AppError>,
+    observe: &mut dyn FnMut(SimulateEvent),
+) -> Result<SimulateSummary, AppError> {
+    let mut summary = SimulateSummary::new(job, initial);
+    let mut last = VecDeque::new();
+    let end = simulate_streaming(
+        model,
+        &job.config.solver,
+        &initial,
+        job.steps,
+        trajectory,
+        job.interrupt.as_deref(),
+        |report| -> Result<(), AppError> {
+            on_step(report)?;
+            let warning = summary.add_step(report, &mut last);
+            observe(SimulateEvent::Step(report));
+            if let Some(w) = &warning {
+                observe(SimulateEvent::Warning(w));
+            }
+            Ok(())
+        },
+    )?;
+    summary.end_time = end.time;
+    summary.steps = last.into();
+    (summary.status, summary.message) = match (&end.failure, end.interrupted) {
+        (Some(e), _) => (e.kind().to_string(), Some(e.to_string())),
+        (None, true) => (
+            "interrupted".to_string(),
+            Some(format!(
+                "interrupted after {} of {} steps",
+                end.steps, job.steps
+            )),
+        ),
+        (None, false) => ("completed".to_string(), None),
+    };
+    Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::walk::{simulate, Sample, SampleSink, WalkError};
+    use std::sync::atomic::Ordering;
+    use std::sync::Mutex;
+
+    fn job(dir: &std::path::Path, steps: usize, trajectory: bool) -> SimulateJob {
+        SimulateJob {
+            config: Config::default(),
+            initial: None,
+            steps,
+            sample_dt: 0.005,
+            trajectory,
+            out_dir: dir.to_path_buf(),
+            interrupt: None,
+        }
+    }
+
+    fn rows(path: &std::path::Path) -> usize {
+        std::fs::read_to_string(path).unwrap().lines().count() - 1
+    }
+
+    /// The interrupt flag (what Ctrl-C sets) stops the walk at the next touchdown; everything computed is
+    /// written, with the status `interrupted`.
+    #[test]
+    fn interrupted_run_keeps_what_was_computed() {
+        let dir = tempfile::tempdir().unwrap();
+        let flag = Arc::new(AtomicBool::new(false));
+        let mut job = job(dir.path(), 1_000_000, true);
+        job.interrupt = Some(Arc::clone(&flag));
+        let mut seen = 0;
+        let summary = run_simulate(&job, &mut |event| {
+            if let SimulateEvent::Step(_) = event {
+                seen += 1;
+                if seen == 3 {
+                    flag.store(true, Ordering::Relaxed);
+                }
+            }
+        })
+        .unwrap();
+        assert_eq!(summary.status, "interrupted");
+        assert_eq!(summary.steps_completed, 3);
+        assert_eq!(rows(&dir.path().join("steps.csv")), 3);
+        let written: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(written["status"], "interrupted");
+        assert_eq!(written["end_time"], summary.end_time);
+        assert!(rows(&dir.path().join("trajectory.csv")) > 3);
+    }
+
+    /// summary.json keeps only the last [`SUMMARY_STEPS`] step records; steps.csv has every step.
+    #[test]
+    fn summary_keeps_the_last_steps_and_csv_every_step() {
+        let dir = tempfile::tempdir().unwrap();
+        let steps = SUMMARY_STEPS + 7;
+        let summary = run_simulate(&job(dir.path(), steps, false), &mut |_| {}).unwrap();
+        assert_eq!(summary.status, "completed");
+        assert_eq!(summary.steps.len(), SUMMARY_STEPS);
+        assert_eq!(summary.steps[0].step, 8);
+        assert_eq!(summary.steps.last().unwrap().step, steps);
+        assert_eq!(rows(&dir.path().join("steps.csv")), steps);
+        assert!(!dir.path().join("trajectory.csv").exists());
+        assert_eq!(summary.branches.values().sum::<usize>(), steps);
+    }
+
+    /// A step whose energy audit does not close is a warning, counted and listed.
+    #[test]
+    fn energy_residual_above_the_bound_warns() {
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let run = simulate(&model, &config.solver, &default_initial(&config), 1, None).unwrap();
+        let mut report = run.steps[0];
+        let dir = tempfile::tempdir().unwrap();
+        let mut summary =
+            SimulateSummary::new(&job(dir.path(), 1, false), default_initial(&config));
+        let mut last = VecDeque::new();
+        assert_eq!(summary.add_step(&report, &mut last), None);
+        report.energy.residual = 10.0 * ENERGY_RESIDUAL_WARNING;
+        let warning = summary.add_step(&report, &mut last).unwrap();
+        assert!(warning.contains("energy residual 1e-5 J"), "{warning}");
+        report.energy.residual = f64::NAN;
+        assert!(summary.add_step(&report, &mut last).is_some());
+        assert_eq!(summary.warnings.len(), 2);
+        assert_eq!(summary.warnings_total, 2);
+    }
+
+    /// A sink that collects the samples it is handed.
+    struct Collect(Arc<Mutex<Vec<Sample>>>);
+
+    impl SampleSink for Collect {
+        fn write(&mut self, sample: &Sample) -> std::io::Result<()> {
+            self.0.lock().unwrap().push(sample.clone());
+            Ok(())
+        }
+    }
+
+    /// A sink that fails once it has taken `left` samples (a full disk).
+    struct FailAfter(usize);
+
+    impl SampleSink for FailAfter {
+        fn write(&mut self, _: &Sample) -> std::io::Result<()> {
+            self.0 = self
+                .0
+                .checked_sub(1)
+                .ok_or(std::io::ErrorKind::StorageFull)?;
+            Ok(())
+        }
+    }
+
+    /// A trajectory whose sink fails stops the walk at once, and the error is not lost.
+    #[test]
+    fn failing_trajectory_sink_stops_the_walk() {
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let mut trajectory = Trajectory::streaming(0.01, Box::new(FailAfter(10)));
+        let end = simulate_streaming(
+            &model,
+            &config.solver,
+            &default_initial(&config),
+            1000,
+            Some(&mut trajectory),
+            None,
+            |_| Ok::<(), WalkError>(()),
+        )
+        .unwrap();
+        assert!(end.steps < 2, "{end:?}");
+        assert_eq!(
+            trajectory.take_error().map(|e| e.kind()),
+            Some(std::io::ErrorKind::StorageFull)
+        );
+    }
+
+    /// A streaming trajectory hands out exactly the samples an in-memory one keeps, and keeps none.
+    #[test]
+    fn streaming_trajectory_matches_the_in_memory_one() {
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let start = default_initial(&config);
+        let mut kept = Trajectory::new(0.01);
+        simulate(&model, &config.solver, &start, 2, Some(&mut kept)).unwrap();
+        let streamed = Arc::new(Mutex::new(Vec::new()));
+        let mut streaming = Trajectory::streaming(0.01, Box::new(Collect(Arc::clone(&streamed))));
+        simulate(&model, &config.solver, &start, 2, Some(&mut streaming)).unwrap();
+        assert!(streaming.samples.is_empty());
+        assert_eq!(streaming.len(), kept.len());
+        assert_eq!(*streamed.lock().unwrap(), kept.samples);
+    }
+}

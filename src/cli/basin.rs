@@ -1,0 +1,93 @@
+//! The `vrw basin` command: its options and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use vrw::app::{run_basin, BasinJob};
+use vrw::gait::basin::Coordinate;
+use vrw::walk::SectionState;
+
+use super::{parse_range, progress_bar, ModelArgs};
+
+#[derive(Debug, Args)]
+pub(super) struct BasinArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Where the gait search starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Horizontal coordinate of the slice: L2, thetadot or L2dot.
+    #[arg(long, default_value = "L2")]
+    x: Coordinate,
+    /// Vertical coordinate of the slice (the third is held at the gait's value).
+    #[arg(long, default_value = "thetadot")]
+    y: Coordinate,
+    /// Range of x, `A,B` (default: L2 from L0/2 to L0, thetadot from 0.05 to 3 times the gait's, L2dot the
+    /// gait's +- 1.5 m/s).
+    #[arg(long, value_name = "A,B", value_parser = parse_range, allow_hyphen_values = true)]
+    x_range: Option<(f64, f64)>,
+    /// Range of y, `A,B` (defaults as for --x-range).
+    #[arg(long, value_name = "A,B", value_parser = parse_range, allow_hyphen_values = true)]
+    y_range: Option<(f64, f64)>,
+    /// Grid points along x.
+    #[arg(long, default_value_t = 61)]
+    nx: usize,
+    /// Grid points along y.
+    #[arg(long, default_value_t = 61)]
+    ny: usize,
+    /// Steps walked at most from each start.
+    #[arg(long, default_value_t = 100)]
+    max_steps: usize,
+    /// A return this close to a gait state (largest coordinate difference) has reached the gait.
+    #[arg(long, default_value_t = 1e-3)]
+    tolerance: f64,
+    /// Output directory for basin.csv, basin.json and basin.png.
+    #[arg(long, default_value = "out/basin")]
+    out: PathBuf,
+}
+
+/// Run `vrw basin` and print its summary.
+pub(super) fn run(args: BasinArgs) -> Result<()> {
+    let job = BasinJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        coordinates: [args.x, args.y],
+        ranges: [args.x_range, args.y_range],
+        points: [args.nx, args.ny],
+        max_steps: args.max_steps,
+        tolerance: args.tolerance,
+        out_dir: args.out.clone(),
+    };
+    let bar = progress_bar(
+        Some((args.nx * args.ny) as u64),
+        "{bar:40} {pos}/{len} starts [{elapsed_precise}, eta {eta}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_basin(&job, &|_| bar.inc(1)).context("basin")?;
+    bar.finish_and_clear();
+    let g = &summary.gait;
+    println!(
+        "vrw basin: {} x {} starts on the slice ({}, {}) through the {}gait at (L2, thetadot, L2dot) = ({:.6}, {:.6}, {:.6}); {:.2} s ({:.2} s for the grid)",
+        args.nx,
+        args.ny,
+        args.x.name(),
+        args.y.name(),
+        if g.period_k > 1 { format!("period-{} ", g.period_k) } else { String::new() },
+        g.section.l2,
+        g.section.theta_dot,
+        g.section.l2_dot,
+        started.elapsed().as_secs_f64(),
+        summary.seconds
+    );
+    for (kind, n) in &summary.outcomes {
+        println!("  {kind:<20} {n}");
+    }
+    println!(
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
+    );
+    Ok(())
+}

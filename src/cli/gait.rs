@@ -1,0 +1,144 @@
+//! The `vrw gait` command: its options and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+
+use vrw::app::{run_gait, GaitJob};
+use vrw::gait::GaitOptions;
+use vrw::walk::SectionState;
+
+use super::{progress_bar, ModelArgs};
+
+/// `GaitOptions::default().tolerance` as `--help` shows it (a test checks that they agree).
+const DEFAULT_TOLERANCE: &str = "1e-10";
+
+#[derive(Debug, Args)]
+pub(super) struct GaitArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Steps walked before Newton's method starts.
+    #[arg(long, default_value_t = GaitOptions::default().transient_steps)]
+    transient: usize,
+    /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
+    #[arg(long, default_value = DEFAULT_TOLERANCE)]
+    tolerance: f64,
+    /// Output directory for gait.json and one period of the gait (steps.csv, trajectory.csv, summary.json).
+    #[arg(long, default_value = "out/gait")]
+    out: PathBuf,
+}
+
+/// Run `vrw gait` and print its summary.
+pub(super) fn run(args: GaitArgs) -> Result<()> {
+    let job = GaitJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        options: GaitOptions {
+            transient_steps: args.transient,
+            tolerance: args.tolerance,
+            ..GaitOptions::default()
+        },
+        out_dir: args.out.clone(),
+    };
+    let bar = progress_bar(
+        None,
+        "{spinner} searching the gait ({msg}) [{elapsed_precise}]",
+    );
+    bar.set_message(format!(
+        "{} transient steps, then Newton's method",
+        args.transient
+    ));
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    let result = run_gait(&job);
+    bar.finish_and_clear();
+    let summary = result.context("gait")?;
+    let p = &job.config.params;
+    println!(
+        "vrw gait: c = {} N s/m, slope = {} rad, impact = {}",
+        p.viscosity, p.slope, p.impact
+    );
+    let Some(g) = &summary.gait else {
+        println!("wrote {}/gait.json", args.out.display());
+        bail!(
+            "no gait found: {}",
+            summary.message.as_deref().unwrap_or("unknown reason")
+        );
+    };
+    let s = &g.section;
+    if g.period_k > 1 {
+        println!(
+            "period-{} gait (a fixed point of P^{}, not of P): its steps",
+            g.period_k, g.period_k
+        );
+        for r in &g.cycle {
+            let (c, i) = (&r.section, &r.indicators);
+            println!(
+                "  step {}: (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}); lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
+                 lambda_4+ = {:.6} N, branch {}, period {:.6} s",
+                r.step, c.l2, c.theta_dot, c.l2_dot, i.lambda_i4, i.lambda_2_plus, i.lambda_4_plus, r.branch, r.period
+            );
+        }
+        println!(
+            "the first step in detail, and the multipliers of P^{}:",
+            g.period_k
+        );
+    }
+    println!(
+        "gait at (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}), theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
+        s.l2, s.theta_dot, s.l2_dot, g.theta, g.residual, g.iterations
+    );
+    println!(
+        "lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, lambda_4+ = {:.6} N, branch {}{}{}",
+        g.lambda_i4,
+        g.lambda_2_plus,
+        g.lambda_4_plus,
+        g.branch,
+        if g.scuffing { ", scuffing" } else { "" },
+        if g.bounce { ", bounce" } else { "" },
+    );
+    println!(
+        "period {:.6} s, step {:.6} m, speed {:.6} m/s, DLS {:.6} s, rear contact {:.6} s",
+        g.period, g.step_length, g.speed, g.dls_duration, g.rear_contact_duration
+    );
+    let c = &g.contact;
+    println!(
+        "contact audit: pull force {:.1e} N, pull impulse {:.1e} N s, penetration {:.1e} m; energy residual {:.1e} J",
+        c.pull_force, c.pull_impulse, c.penetration, g.energy_residual
+    );
+    let multipliers: Vec<String> = g
+        .floquet_multipliers
+        .iter()
+        .map(|[re, im]| {
+            if *im == 0.0 {
+                format!("{re:.6}")
+            } else {
+                format!("{re:.6}{im:+.6}i")
+            }
+        })
+        .collect();
+    println!(
+        "Floquet multipliers [{}] (Jacobian error ~{:.0e}): {}",
+        multipliers.join(", "),
+        g.jacobian_error,
+        g.stability
+    );
+    println!("wrote {}/gait.json", args.out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gait_tolerance_default_is_the_library_default() {
+        assert_eq!(
+            DEFAULT_TOLERANCE.parse::<f64>().unwrap(),
+            GaitOptions::default().tolerance
+        );
+    }
+}

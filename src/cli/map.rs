@@ -1,0 +1,208 @@
+//! The `vrw map` command: its options (with `--mark`) and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+
+use vrw::app::{run_map, MapJob};
+use vrw::gait::{GaitOptions, MapSpec, SecondRoute, SweepSpec};
+use vrw::output::map_plot::MapMark;
+use vrw::walk::SectionState;
+
+use super::{confirmed_count, progress_bar, second_route_words, ModelArgs};
+
+#[derive(Debug, Args)]
+pub(super) struct MapArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter along the horizontal axis (rows), one of the keys `sweep --help` lists.
+    #[arg(long, default_value = "viscosity")]
+    x: String,
+    /// First x value.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    x_from: f64,
+    /// Last x value.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    x_to: f64,
+    /// Number of x values (ends included).
+    #[arg(long, default_value_t = 21)]
+    nx: usize,
+    /// The parameter along the vertical axis (columns).
+    #[arg(long, default_value = "stiffness")]
+    y: String,
+    /// First y value.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    y_from: f64,
+    /// Last y value.
+    #[arg(long, default_value_t = 1500.0, allow_hyphen_values = true)]
+    y_to: f64,
+    /// Number of y values (ends included).
+    #[arg(long, default_value_t = 21)]
+    ny: usize,
+    /// Where the search at the first point of every row starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Mark a point on the heat maps, `X,Y` or `X,Y,LABEL` (repeatable), e.g. `--mark "220,500,paper λ4+ = 0"`.
+    #[arg(long, value_name = "X,Y[,LABEL]", allow_hyphen_values = true)]
+    mark: Vec<MarkArg>,
+    /// Skip the threshold curves (map.csv and the heat maps only).
+    #[arg(long)]
+    no_curves: bool,
+    /// Refine the curves' crossings on at most this many columns, evenly spread with both ends (every row is
+    /// refined); at least 2, and a value of --nx or more refines every column.
+    #[arg(long, default_value_t = vrw::gait::map::DEFAULT_CURVE_COLUMNS as u64,
+          value_parser = clap::value_parser!(u64).range(2..))]
+    curve_columns: u64,
+    /// Search every threshold again by a second route, the whole map with the other integrator (dopri5 for
+    /// the default dop853), and say of each whether it is confirmed (in curves.json: `second_route`).
+    #[arg(long, conflicts_with = "no_curves")]
+    second_route: bool,
+    /// Output directory for map.csv, curves.json, map.svg and map.png.
+    #[arg(long, default_value = "out/map")]
+    out: PathBuf,
+}
+
+/// `--mark X,Y[,LABEL]`.
+#[derive(Debug, Clone)]
+struct MarkArg(MapMark);
+
+impl std::str::FromStr for MarkArg {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        let mut parts = s.splitn(3, ',');
+        let mut number = |what: &str| -> std::result::Result<f64, String> {
+            let text = parts.next().unwrap_or("").trim();
+            match text.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(format!(
+                    "{what} of `{s}` is `{text}`, not a finite number (expected X,Y or X,Y,LABEL)"
+                )),
+            }
+        };
+        let (x, y) = (number("X")?, number("Y")?);
+        let label = parts
+            .next()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .map_or_else(|| format!("({x}, {y})"), str::to_string);
+        Ok(MarkArg(MapMark { label, x, y }))
+    }
+}
+
+/// Run `vrw map` and print its summary.
+pub(super) fn run(args: MapArgs) -> Result<()> {
+    let job = MapJob {
+        config: args.model.load()?,
+        spec: MapSpec {
+            x: SweepSpec {
+                param: args.x.clone(),
+                from: args.x_from,
+                to: args.x_to,
+                points: args.nx,
+            },
+            y: SweepSpec {
+                param: args.y.clone(),
+                from: args.y_from,
+                to: args.y_to,
+                points: args.ny,
+            },
+        },
+        initial: args.initial,
+        // The refined Jacobian gives each gait's stability verdict its error estimate.
+        options: GaitOptions::default(),
+        curves: !args.no_curves,
+        curve_columns: usize::try_from(args.curve_columns).unwrap_or(usize::MAX),
+        second_route: args.second_route,
+        marks: args.mark.into_iter().map(|m| m.0).collect(),
+        out_dir: args.out.clone(),
+    };
+    let routes = if args.second_route { 2 } else { 1 };
+    let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
+    let bar = progress_bar(
+        Some(total as u64),
+        "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_map(&job, &|_| bar.inc(1)).context("map")?;
+    bar.finish_and_clear();
+    println!(
+        "vrw map: {} from {} to {} ({}) x {} from {} to {} ({}): gait found at {} of {} points; {:.2} s \
+         (gaits {:.2} s, curves {:.2} s)",
+        args.x,
+        args.x_from,
+        args.x_to,
+        args.nx,
+        args.y,
+        args.y_from,
+        args.y_to,
+        args.ny,
+        summary.gaits_found,
+        summary.points,
+        started.elapsed().as_secs_f64(),
+        summary.seconds[0],
+        summary.seconds[1]
+    );
+    let unrefined = summary
+        .thresholds
+        .iter()
+        .filter(|t| !t.threshold.value.is_finite())
+        .count();
+    let mut names: Vec<&str> = summary.curves.iter().map(|c| c.name.as_str()).collect();
+    names.dedup();
+    for name in names {
+        let own: Vec<_> = summary.curves.iter().filter(|c| c.name == name).collect();
+        println!(
+            "  {:<18} {} polyline(s), {} refined points",
+            name,
+            own.len(),
+            own.iter().map(|c| c.points.len()).sum::<usize>()
+        );
+    }
+    if unrefined > 0 {
+        println!(
+            "  {unrefined} crossings could not be refined (listed in curves.json with the reason)"
+        );
+    }
+    if args.second_route {
+        println!(
+            "  second route: {:.2} s; {}",
+            summary.second_route_seconds,
+            confirmed_count(summary.thresholds.iter().map(|t| &t.threshold))
+        );
+        for t in &summary.thresholds {
+            // Thresholds neither route located are among the crossings that could not be refined.
+            let shown = |r: &&SecondRoute| {
+                !r.confirmed && (t.threshold.value.is_finite() || r.value.is_finite())
+            };
+            if let Some(r) = t.threshold.second_route.as_ref().filter(shown) {
+                let param = match t.along {
+                    vrw::gait::map::Along::X => &args.x,
+                    vrw::gait::map::Along::Y => &args.y,
+                };
+                println!(
+                    "    {} {} = {:.6} on {} {}: {}",
+                    t.threshold.name,
+                    param,
+                    t.threshold.value,
+                    if t.along == vrw::gait::map::Along::X {
+                        "row"
+                    } else {
+                        "column"
+                    },
+                    t.line,
+                    second_route_words(r)
+                );
+            }
+        }
+    }
+    println!(
+        "wrote {}/{{map.csv, curves.json, map.svg, map.png}}",
+        args.out.display()
+    );
+    if summary.gaits_found == 0 {
+        bail!("no gait found anywhere on the map (see map.csv for the reasons)");
+    }
+    Ok(())
+}

@@ -1,0 +1,171 @@
+//! The `vrw` command line (clap derive): the [`Cli`] with one subcommand per job, and what the commands share
+//! (the model's TOML file and `--set` overrides, the progress bar, the Ctrl-C flag, ranges `A,B`, the second
+//! route in words). Each command has its own file with its options beside the summary it prints.
+
+mod animate;
+mod basin;
+mod gait;
+mod map;
+mod orbit;
+mod plot;
+mod simulate;
+mod sweep;
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use vrw::gait::{SecondRoute, Threshold, SECOND_ROUTE_TOL};
+use vrw::params::Config;
+
+/// Passive dynamic walking of a viscoelastic-legged rimless wheel, with the DLS indicators.
+#[derive(Debug, Parser)]
+#[command(name = "vrw", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Walk N steps from a Poincare-section state and report every touchdown.
+    Simulate(simulate::SimulateArgs),
+    /// Find the walking gait (limit cycle, or a period-k gait up to k = 8), its DLS indicators and Floquet
+    /// multipliers.
+    Gait(gait::GaitArgs),
+    /// Sweep a parameter with continuation, locate the thresholds and draw Fig. 2.
+    Sweep(sweep::SweepArgs),
+    /// Orbit diagram along one parameter: the states the walk visits after a transient, with the period-1
+    /// branch (solid where stable, dashed where not).
+    Orbit(orbit::OrbitArgs),
+    /// Basin of the gait on a slice of the Poincare section: what the walk from every grid point does.
+    Basin(basin::BasinArgs),
+    /// Map the gait over two parameters: map.csv, the threshold curves (curves.json) and heat maps (map.png).
+    Map(map::MapArgs),
+    /// Animate a run: DIR/walk.gif from the output directory of `simulate` or `gait`.
+    Animate(animate::AnimateArgs),
+    /// Figures of a run: DIR/run.{png,svg} against time, DIR/steps.{png,svg} against step number.
+    Plot(plot::PlotArgs),
+}
+
+/// Model parameters: a TOML file and `key=value` overrides.
+#[derive(Debug, Args)]
+struct ModelArgs {
+    /// TOML file with parameters (flat keys, e.g. `viscosity = 50`); defaults are the paper's Table 1.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Override one parameter, e.g. `--set viscosity=120` (repeatable, applied after --config).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+impl ModelArgs {
+    fn load(&self) -> Result<Config> {
+        let mut config = match &self.config {
+            Some(path) => Config::from_file(path)?,
+            None => Config::default(),
+        };
+        for assignment in &self.set {
+            config.apply_override(assignment)?;
+        }
+        config.validate()?;
+        Ok(config)
+    }
+}
+
+/// Run the parsed command.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Simulate(args) => simulate::run(args),
+        Command::Gait(args) => gait::run(args),
+        Command::Sweep(args) => sweep::run(args),
+        Command::Orbit(args) => orbit::run(args),
+        Command::Basin(args) => basin::run(args),
+        Command::Map(args) => map::run(args),
+        Command::Animate(args) => animate::run(args),
+        Command::Plot(args) => plot::run(&args),
+    }
+}
+
+/// A progress bar on stderr when it is a terminal (hidden otherwise), with `template`.
+fn progress_bar(len: Option<u64>, template: &str) -> ProgressBar {
+    let bar = match len {
+        _ if !std::io::stderr().is_terminal() => ProgressBar::hidden(),
+        Some(len) => ProgressBar::new(len),
+        None => ProgressBar::new_spinner(),
+    };
+    bar.set_style(ProgressStyle::with_template(template).expect("the template is valid"));
+    bar
+}
+
+/// A flag set by Ctrl-C (a second Ctrl-C exits at once with code 130).
+fn interrupt_flag() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let handler_flag = Arc::clone(&flag);
+    let installed = ctrlc::set_handler(move || {
+        if handler_flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    if let Err(e) = installed {
+        eprintln!("warning: Ctrl-C will not stop the walk cleanly: {e}");
+    }
+    flag
+}
+
+/// A range `A,B` of two numbers.
+fn parse_range(s: &str) -> std::result::Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(',')
+        .ok_or_else(|| format!("'{s}' is not a range A,B"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{}' in the range '{s}' is not a number", v.trim()))
+    };
+    Ok((parse(a)?, parse(b)?))
+}
+
+/// A threshold's second route in words.
+fn second_route_words(r: &SecondRoute) -> String {
+    let found = match &r.name {
+        Some(name) if r.value.is_finite() => format!("{name} at {:.6}", r.value),
+        Some(name) => format!("{name}, not located either"),
+        None => "nothing between the same grid points".to_string(),
+    };
+    if r.confirmed {
+        format!(
+            "confirmed by {}: {found} (difference {:.1e})",
+            r.route, r.difference
+        )
+    } else {
+        format!("NOT confirmed by {}: it finds {found}", r.route)
+    }
+}
+
+/// "N of M located thresholds confirmed" for the thresholds of a run with a second route (a threshold whose
+/// search failed, value NaN, is counted apart: it was never stated).
+fn confirmed_count<'a>(thresholds: impl Iterator<Item = &'a Threshold>) -> String {
+    let (mut confirmed, mut located, mut lost) = (0, 0, 0);
+    for t in thresholds {
+        if t.value.is_finite() {
+            located += 1;
+            confirmed += usize::from(t.second_route.as_ref().is_some_and(|r| r.confirmed));
+        } else {
+            lost += 1;
+        }
+    }
+    let mut words = format!(
+        "{confirmed} of {located} located thresholds confirmed (same kind, values within \
+         {SECOND_ROUTE_TOL:.0e})"
+    );
+    if lost > 0 {
+        words += &format!("; {lost} not located by the first route");
+    }
+    words
+}

@@ -1,0 +1,107 @@
+//! The `vrw orbit` command: its options and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use vrw::app::{run_orbit, OrbitJob};
+use vrw::gait::orbit::OrbitSpec;
+use vrw::gait::SweepSpec;
+use vrw::walk::SectionState;
+
+use super::{progress_bar, ModelArgs};
+
+#[derive(Debug, Args)]
+pub(super) struct OrbitArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter along the diagram: one of the real-valued keys (as for sweep).
+    #[arg(long, default_value = "viscosity")]
+    param: String,
+    /// First value.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    from: f64,
+    /// Last value.
+    #[arg(long, default_value_t = 150.0, allow_hyphen_values = true)]
+    to: f64,
+    /// Number of values (ends included).
+    #[arg(long, default_value_t = 300)]
+    points: usize,
+    /// Steps walked at each value before recording (4 times as many where a walk starts afresh).
+    #[arg(long, default_value_t = 32)]
+    transient: usize,
+    /// Steps recorded at each value.
+    #[arg(long, default_value_t = 64)]
+    steps: usize,
+    /// Where the first walk starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Do not compute and draw the period-1 branch.
+    #[arg(long)]
+    no_branch: bool,
+    /// Output directory for orbit.csv, branch.csv, orbit.json and orbit.png.
+    #[arg(long, default_value = "out/orbit")]
+    out: PathBuf,
+}
+
+/// Run `vrw orbit` and print its summary.
+pub(super) fn run(args: OrbitArgs) -> Result<()> {
+    let job = OrbitJob {
+        config: args.model.load()?,
+        spec: OrbitSpec {
+            range: SweepSpec {
+                param: args.param.clone(),
+                from: args.from,
+                to: args.to,
+                points: args.points,
+            },
+            transient: args.transient,
+            steps: args.steps,
+        },
+        initial: args.initial,
+        branch: !args.no_branch,
+        out_dir: args.out.clone(),
+    };
+    let bar = progress_bar(
+        Some(args.points as u64),
+        "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_orbit(&job, &|c| {
+        bar.set_message(format!("{} = {:.4}: {}", args.param, c.value, c.status));
+        bar.inc(1);
+    })
+    .context("orbit")?;
+    bar.finish_and_clear();
+    let outcomes: Vec<String> = summary
+        .outcomes
+        .iter()
+        .map(|(k, n)| format!("{k} {n}"))
+        .collect();
+    println!(
+        "vrw orbit: {} from {} to {} ({} values, {} + {} steps each): {}; {:.2} s (diagram {:.2} s, branch {:.2} s)",
+        args.param,
+        args.from,
+        args.to,
+        args.points,
+        args.transient,
+        args.steps,
+        outcomes.join(", "),
+        started.elapsed().as_secs_f64(),
+        summary.seconds[0],
+        summary.seconds[1]
+    );
+    if !args.no_branch {
+        println!(
+            "period-1 branch: a gait at {} values, stable at {}",
+            summary.branch_gaits[0], summary.branch_gaits[1]
+        );
+    }
+    println!(
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
+    );
+    Ok(())
+}

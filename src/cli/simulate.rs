@@ -1,0 +1,118 @@
+//! The `vrw simulate` command: its options and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+
+use vrw::app::{run_simulate, SimulateEvent, SimulateJob, DEFAULT_SAMPLE_DT};
+use vrw::walk::SectionState;
+
+use super::{interrupt_flag, progress_bar, ModelArgs};
+
+#[derive(Debug, Args)]
+pub(super) struct SimulateArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Number of steps (touchdowns) to walk.
+    #[arg(long, default_value_t = 20)]
+    steps: usize,
+    /// Initial Poincare-section state `L2,thetadot,L2dot` (m, rad/s, m/s); default 0.72,1.0,0.0
+    /// (with rigid_legs: L0 and the rigid wheel's gait speed, from its closed form).
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Output directory for steps.csv, trajectory.csv and summary.json.
+    #[arg(long, default_value = "out/simulate")]
+    out: PathBuf,
+    /// Sampling interval of trajectory.csv, in seconds of simulated time.
+    #[arg(long, default_value_t = DEFAULT_SAMPLE_DT)]
+    sample_dt: f64,
+    /// Do not write trajectory.csv (steps.csv and summary.json only); an old one in --out is removed.
+    #[arg(long)]
+    no_trajectory: bool,
+}
+
+/// Run `vrw simulate` and print its summary.
+pub(super) fn run(args: SimulateArgs) -> Result<()> {
+    let job = SimulateJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        steps: args.steps,
+        sample_dt: args.sample_dt,
+        trajectory: !args.no_trajectory,
+        out_dir: args.out.clone(),
+        interrupt: Some(interrupt_flag()),
+    };
+    let bar = progress_bar(
+        Some(args.steps as u64),
+        "{bar:40} {pos}/{len} steps {msg} [{elapsed_precise}, eta {eta}]",
+    );
+    let summary = run_simulate(&job, &mut |event| match event {
+        SimulateEvent::Step(report) => {
+            bar.set_message(format!("t = {:.1} s", report.time + report.period));
+            bar.inc(1);
+        }
+        SimulateEvent::Warning(warning) => bar.suspend(|| eprintln!("warning: {warning}")),
+    })
+    .context("simulate")?;
+    bar.finish_and_clear();
+    println!(
+        "vrw simulate: c = {} N s/m, slope = {} rad, impact = {}; start (L2, thetadot, L2dot) = ({}, {}, {})",
+        job.config.params.viscosity,
+        job.config.params.slope,
+        job.config.params.impact,
+        summary.initial.l2,
+        summary.initial.theta_dot,
+        summary.initial.l2_dot
+    );
+    println!(
+        "{} of {} steps in {:.4} s of simulated time; max |energy residual| = {:.2e} J",
+        summary.steps_completed,
+        summary.steps_requested,
+        summary.end_time,
+        summary.max_abs_energy_residual
+    );
+    if let Some(last) = summary.steps.last() {
+        let i = &last.indicators;
+        println!(
+            "step {}: lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, lambda_4+ = {:.6} N, branch {}, DLS {:.4} s, \
+             rear contact {:.4} s, period {:.4} s, step {:.4} m, speed {:.4} m/s{}{}",
+            last.step,
+            i.lambda_i4,
+            i.lambda_2_plus,
+            i.lambda_4_plus,
+            last.branch,
+            last.dls_duration,
+            last.rear_contact_duration,
+            last.period,
+            last.step_length,
+            last.speed,
+            if last.scuffing { ", scuffing" } else { "" },
+            if last.bounce { ", bounce" } else { "" },
+        );
+    }
+    println!(
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
+    );
+    if summary.warnings_total > summary.warnings.len() {
+        eprintln!(
+            "warning: {} warnings in all ({} listed in summary.json)",
+            summary.warnings_total,
+            summary.warnings.len()
+        );
+    }
+    match &summary.message {
+        Some(_) if summary.status == "interrupted" => bail!(
+            "interrupted (Ctrl-C) after {} of {} steps; the results so far are written",
+            summary.steps_completed,
+            summary.steps_requested
+        ),
+        Some(message) => bail!(
+            "walk stopped after {} steps: {message}",
+            summary.steps_completed
+        ),
+        None => Ok(()),
+    }
+}

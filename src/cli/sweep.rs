@@ -1,0 +1,124 @@
+//! The `vrw sweep` command: its options and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+
+use vrw::app::{run_sweep, SweepJob};
+use vrw::gait::{GaitOptions, SweepSpec};
+use vrw::params::Config;
+use vrw::walk::SectionState;
+
+use super::{confirmed_count, progress_bar, second_route_words, ModelArgs};
+
+#[derive(Debug, Args)]
+pub(super) struct SweepArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter to sweep: one of the real-valued keys (listed by `--help`).
+    #[arg(long, default_value = "viscosity", help = param_help())]
+    param: String,
+    /// First value.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    from: f64,
+    /// Last value.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    to: f64,
+    /// Number of values (ends included).
+    #[arg(long, default_value_t = 300)]
+    points: usize,
+    /// Where the search at the first point starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Search every threshold again by a second route, the whole sweep with the other integrator (dopri5 for
+    /// the default dop853), and say of each whether it is confirmed (in thresholds.json: `second_route`).
+    #[arg(long)]
+    second_route: bool,
+    /// Output directory for sweep.csv, thresholds.json, fig2.svg and fig2.png.
+    #[arg(long, default_value = "out/sweep")]
+    out: PathBuf,
+}
+
+/// Help of `sweep --param`: the keys that can be swept, from [`Config::numeric_keys`].
+fn param_help() -> String {
+    format!(
+        "The parameter to sweep, one of: {}",
+        Config::numeric_keys().join(", ")
+    )
+}
+
+/// Run `vrw sweep` and print its summary.
+pub(super) fn run(args: SweepArgs) -> Result<()> {
+    let job = SweepJob {
+        config: args.model.load()?,
+        spec: SweepSpec {
+            param: args.param.clone(),
+            from: args.from,
+            to: args.to,
+            points: args.points,
+        },
+        initial: args.initial,
+        options: GaitOptions::for_sweeps(),
+        second_route: args.second_route,
+        out_dir: args.out.clone(),
+    };
+    let routes = if args.second_route { 2 } else { 1 };
+    let bar = progress_bar(
+        Some(routes * args.points as u64),
+        "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
+    );
+    let started = std::time::Instant::now();
+    let summary = run_sweep(&job, &|p| {
+        bar.set_message(format!("{} = {:.4}: {}", args.param, p.value, p.status));
+        bar.inc(1);
+    })
+    .context("sweep")?;
+    bar.finish_and_clear();
+    println!(
+        "vrw sweep: {} from {} to {} ({} points): gait found at {} points; {:.2} s (sweep {:.2} s, thresholds {:.2} s)",
+        args.param,
+        args.from,
+        args.to,
+        args.points,
+        summary.gaits_found,
+        started.elapsed().as_secs_f64(),
+        summary.seconds[0],
+        summary.seconds[1]
+    );
+    for t in &summary.thresholds {
+        println!(
+            "  {:<18} {} = {:.6}  (bracket [{:.7}, {:.7}], residual {:.1e}){}{}",
+            t.name,
+            args.param,
+            t.value,
+            t.bracket[0],
+            t.bracket[1],
+            t.residual,
+            t.detail
+                .as_deref()
+                .map(|d| format!(": {d}"))
+                .unwrap_or_default(),
+            t.second_route
+                .as_ref()
+                .map(|r| format!("\n    {}", second_route_words(r)))
+                .unwrap_or_default()
+        );
+    }
+    if args.second_route {
+        println!(
+            "  second route: {:.2} s; {}",
+            summary.second_route_seconds,
+            confirmed_count(summary.thresholds.iter())
+        );
+    }
+    println!(
+        "wrote {}/{{{}}}",
+        args.out.display(),
+        summary.files.join(", ")
+    );
+    if summary.gaits_found == 0 {
+        bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");
+    }
+    Ok(())
+}
