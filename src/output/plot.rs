@@ -3,13 +3,14 @@
 //!
 //! Panel (a) plots `lambda_I4` (the impulse indicator, \[N s\]); panel (b) plots
 //! `lambda_2+` and `lambda_4+` (the normal forces just after impact, \[N\]); see
-//! `MODEL.md` sections 5 and 6 and section 3 of the paper. Points where
+//! `docs/model.md` sections 5 and 6 and section 3 of the paper. Points where
 //! scuffing of Leg 2 arises are drawn with hollow markers, the others with
 //! filled ones. Thresholds (where an indicator crosses zero, where the gait is
 //! lost) are drawn as labelled vertical dashed lines through both panels,
 //! which share the x axis.
 //!
-//! Text (the bundled DejaVu Sans), colours and tick labels come from [`super::style`].
+//! Text (the bundled DejaVu Sans), colours and tick labels come from [`super::style`]; the axes, shading,
+//! markers, legends and the title from [`super::chart`], at Fig. 2's own proportions.
 
 use std::ops::Range;
 use std::path::Path;
@@ -17,12 +18,15 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use plotters::style::FontTransform;
 
+use super::chart::{
+    dashed_with, draw_legend_rows, draw_marker, title_size, write_svg_png, Axes, AxisStyle, Band,
+    DrawResult, Figure, Label, LegendRow, Marker, PixelRect, PlotArea, Sample, Stroke,
+};
 pub use super::style::PlotError;
 use super::style::{
-    ensure_font, font, house_mesh, padded, tick_label, LegendLayout, COLOR_BLACK, COLOR_BLUE,
-    COLOR_MARK, COLOR_VERMILLION,
+    draw_rich, font, padded, rich_width, LegendLayout, Seg, COLOR_BLACK, COLOR_BLUE, COLOR_MARK,
+    COLOR_VERMILLION,
 };
 #[cfg(test)]
 use super::style::{png_size, FAMILY};
@@ -77,15 +81,6 @@ pub struct Fig2Spec<'a> {
 /// Size of both the SVG and the PNG, in pixels.
 pub const FIG2_SIZE: (u32, u32) = (1600, 1600);
 
-/// A run of text on the baseline, as a subscript, or as a stacked
-/// subscript/superscript pair (plotters has no rich text).
-#[derive(Clone, Copy)]
-enum Seg {
-    Text(&'static str),
-    Sub(&'static str),
-    SubSup(&'static str, &'static str),
-}
-
 const NAME_I4: &[Seg] = &[Seg::Text("λ"), Seg::Sub("I4")];
 const NAME_2: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("2", "+")];
 const NAME_4: &[Seg] = &[Seg::Text("λ"), Seg::SubSup("4", "+")];
@@ -110,22 +105,32 @@ const AXIS_FONT: f64 = 34.0;
 const TICK_FONT: f64 = 28.0;
 const NOTE_FONT: f64 = 27.0;
 
+/// The axes of Fig. 2's panels: no y description from plotters (each panel writes its own, with subscripts).
+const FIG2_AXES: AxisStyle = AxisStyle {
+    tick_font: TICK_FONT,
+    axis_font: AXIS_FONT,
+    y_label_area: Y_LABEL_AREA,
+    x_label_area: X_LABEL_AREA,
+    bare_x_area: TOP_TICK_AREA,
+    y_labels: 7,
+    margin_right: LEGEND_W,
+    min_band_px: 0,
+};
+/// Dash and gap of the threshold lines \[px\].
+const THRESHOLD_DASH: (f64, f64) = (10.0, 7.0);
+/// The legend boxes.
+const LEGEND: LegendLayout = LegendLayout::new(16, 56, 12, 40, 6);
+
 const COLOR_I4: RGBColor = COLOR_BLACK;
 const COLOR_2: RGBColor = COLOR_BLUE;
 const COLOR_4: RGBColor = COLOR_VERMILLION;
-
-#[derive(Clone, Copy, PartialEq)]
-enum Shape {
-    Circle,
-    Triangle,
-}
 
 /// One plotted indicator: its finite samples sorted by parameter, split into
 /// runs that are not interrupted by points without a gait.
 struct Series {
     name: &'static [Seg],
     color: RGBColor,
-    shape: Shape,
+    shape: Marker,
     runs: Vec<Vec<(f64, f64, bool)>>,
 }
 
@@ -133,7 +138,7 @@ impl Series {
     fn new(
         name: &'static [Seg],
         color: RGBColor,
-        shape: Shape,
+        shape: Marker,
         sorted: &[&IndicatorPoint],
         value: fn(&IndicatorPoint) -> f64,
     ) -> Self {
@@ -206,27 +211,29 @@ impl Prepared {
         let panel_a = vec![Series::new(
             NAME_I4,
             COLOR_I4,
-            Shape::Circle,
+            Marker::Circle,
             &sorted,
             |p| p.lambda_i4,
         )];
         let panel_b = vec![
-            Series::new(NAME_2, COLOR_2, Shape::Circle, &sorted, |p| p.lambda_2_plus),
-            Series::new(NAME_4, COLOR_4, Shape::Triangle, &sorted, |p| {
+            Series::new(NAME_2, COLOR_2, Marker::Circle, &sorted, |p| {
+                p.lambda_2_plus
+            }),
+            Series::new(NAME_4, COLOR_4, Marker::Triangle, &sorted, |p| {
                 p.lambda_4_plus
             }),
         ];
         let panel_c = vec![Series::new(
             NAME_PERIOD,
             COLOR_I4,
-            Shape::Circle,
+            Marker::Circle,
             &sorted,
             |p| p.period,
         )];
         let panel_d = vec![Series::new(
             NAME_FLOQUET,
             COLOR_BLUE,
-            Shape::Circle,
+            Marker::Circle,
             &sorted,
             |p| p.max_floquet,
         )];
@@ -308,103 +315,22 @@ impl Prepared {
 /// file cannot be drawn or written.
 pub fn write_fig2(spec: &Fig2Spec, svg_path: &Path, png_path: &Path) -> Result<(), PlotError> {
     let data = Prepared::new(spec)?;
-    let fail = |path: &Path, message: String| PlotError::Draw {
-        path: path.display().to_string(),
-        message,
-    };
-    if !ensure_font() {
-        return Err(fail(
-            svg_path,
-            "the bundled DejaVu Sans font is invalid".into(),
-        ));
+    write_svg_png(&Fig2 { spec, data: &data }, svg_path, png_path, FIG2_SIZE)
+}
+
+/// Fig. 2 ready to draw.
+struct Fig2<'a> {
+    spec: &'a Fig2Spec<'a>,
+    data: &'a Prepared,
+}
+
+impl Figure for Fig2<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        draw_fig2(root, self.spec, self.data)
     }
-    {
-        let root = SVGBackend::new(svg_path, FIG2_SIZE).into_drawing_area();
-        draw_fig2(&root, spec, &data).map_err(|e| fail(svg_path, e.to_string()))?;
-        root.present().map_err(|e| fail(svg_path, e.to_string()))?;
-    }
-    {
-        let root = BitMapBackend::new(png_path, FIG2_SIZE).into_drawing_area();
-        draw_fig2(&root, spec, &data).map_err(|e| fail(png_path, e.to_string()))?;
-        root.present().map_err(|e| fail(png_path, e.to_string()))?;
-    }
-    Ok(())
 }
 
 const SCUFF_NOTE: &str = "scuffing of Leg 2";
-
-/// Pixel ranges (x, y) of a plotting area on the canvas.
-type PixelRect = (Range<i32>, Range<i32>);
-
-type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
-
-/// Sizes of a subscript relative to its base text, and the baseline shifts.
-const SUB_SCALE: f64 = 0.68;
-const SUB_DROP: f64 = 0.16;
-const SUP_RISE: f64 = 0.36;
-
-/// Width in pixels of rich text at font size `size`.
-fn rich_width<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    segs: &[Seg],
-    size: f64,
-) -> Result<i32, DrawingAreaErrorKind<DB::ErrorType>> {
-    let w = |t: &str, sz: f64| root.estimate_text_size(t, &font(sz)).map(|s| s.0 as i32);
-    let mut total = 0;
-    for seg in segs {
-        total += match *seg {
-            Seg::Text(t) => w(t, size)?,
-            Seg::Sub(t) => w(t, size * SUB_SCALE)? + 2,
-            Seg::SubSup(a, b) => w(a, size * SUB_SCALE)?.max(w(b, size * SUB_SCALE)?) + 2,
-        };
-    }
-    Ok(total)
-}
-
-/// Draws rich text whose first line box has its top-left corner at `at`
-/// (with `rotated`, the text runs upwards from `at`, its top facing left).
-/// Baselines follow plotters' ab_glyph rasteriser: `size / 2` below the top.
-fn draw_rich<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    segs: &[Seg],
-    at: (i32, i32),
-    size: f64,
-    rotated: bool,
-) -> DrawResult<DB> {
-    let small = size * SUB_SCALE;
-    let base = size / 2.0;
-    let mut advance = 0;
-    let put = |t: &str, sz: f64, baseline: f64, advance: i32| {
-        let down = (baseline - sz / 2.0).round() as i32;
-        let (pos, style) = if rotated {
-            (
-                (at.0 + down, at.1 - advance),
-                font(sz).transform(FontTransform::Rotate270),
-            )
-        } else {
-            ((at.0 + advance, at.1 + down), font(sz))
-        };
-        root.draw(&Text::new(t.to_string(), pos, style))
-    };
-    for seg in segs {
-        match *seg {
-            Seg::Text(t) => {
-                // SVG drops leading blanks of a <text>: advance past them instead.
-                let body = t.trim_start();
-                let lead = rich_width(root, &[Seg::Text(t)], size)?
-                    - rich_width(root, &[Seg::Text(body)], size)?;
-                put(body, size, base, advance + lead)?
-            }
-            Seg::Sub(t) => put(t, small, base + SUB_DROP * size, advance + 1)?,
-            Seg::SubSup(a, b) => {
-                put(a, small, base + SUB_DROP * size, advance + 1)?;
-                put(b, small, base - SUP_RISE * size, advance + 1)?;
-            }
-        }
-        advance += rich_width(root, &[*seg], size)?;
-    }
-    Ok(())
-}
 
 /// Assigns each threshold label a row of the label strip (row 0 is next to
 /// the plot). `labels` holds each line's x and its text's x interval. A label
@@ -438,58 +364,22 @@ fn label_rows(labels: &[(i32, Range<i32>)]) -> Vec<usize> {
     rows
 }
 
+/// Draws a threshold line from `y0` down to `y1` at `x` (nothing if `y1` is not below `y0`).
 fn dashed_vline<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     x: i32,
     y0: i32,
     y1: i32,
 ) -> DrawResult<DB> {
-    let style = COLOR_MARK.stroke_width(2);
-    let mut y = y0;
-    while y < y1 {
-        let e = (y + 10).min(y1);
-        root.draw(&PathElement::new(vec![(x, y), (x, e)], style))?;
-        y += 17;
+    if y0 >= y1 {
+        return Ok(());
     }
-    Ok(())
-}
-
-fn draw_marker<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    at: (i32, i32),
-    shape: Shape,
-    color: RGBColor,
-    hollow: bool,
-    r: i32,
-) -> DrawResult<DB> {
-    match shape {
-        Shape::Circle => {
-            if hollow {
-                area.draw(&Circle::new(at, r, WHITE.filled()))?;
-                area.draw(&Circle::new(at, r, color.stroke_width(2)))?;
-            } else {
-                area.draw(&Circle::new(at, r, color.filled()))?;
-            }
-        }
-        Shape::Triangle => {
-            let s = r + 2;
-            let h = (s as f64 * 0.87).round() as i32;
-            let pts = vec![
-                (at.0, at.1 - s),
-                (at.0 - h, at.1 + s / 2),
-                (at.0 + h, at.1 + s / 2),
-            ];
-            if hollow {
-                area.draw(&Polygon::new(pts.clone(), WHITE.filled()))?;
-                let mut closed = pts.clone();
-                closed.push(pts[0]);
-                area.draw(&PathElement::new(closed, color.stroke_width(2)))?;
-            } else {
-                area.draw(&Polygon::new(pts, color.filled()))?;
-            }
-        }
-    }
-    Ok(())
+    dashed_with(
+        root,
+        &[(x, y0), (x, y1)],
+        COLOR_MARK.stroke_width(2),
+        THRESHOLD_DASH,
+    )
 }
 
 struct Panel {
@@ -519,57 +409,36 @@ fn draw_panel<DB: DrawingBackend>(
     let area = root
         .clone()
         .shrink((MARGIN, panel.top), (w as i32 - 2 * MARGIN, panel.height));
-    let mut chart = ChartBuilder::on(&area)
-        .margin_right(LEGEND_W)
-        .x_label_area_size(if panel.bottom_axis {
-            X_LABEL_AREA
-        } else {
-            TOP_TICK_AREA
-        })
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(x.clone(), y.clone())?;
-    let y_fmt = |v: &f64| tick_label(*v, y);
-    let x_fmt = |v: &f64| tick_label(*v, x);
-    let no_fmt = |_: &f64| String::new();
-    {
-        let mut mesh = chart.configure_mesh();
-        house_mesh(&mut mesh, TICK_FONT, AXIS_FONT);
-        mesh.y_label_formatter(&y_fmt).x_labels(10).y_labels(7);
-        if panel.bottom_axis {
-            mesh.x_desc(param_label).x_label_formatter(&x_fmt);
-        } else {
-            mesh.x_label_formatter(&no_fmt);
-        }
-        mesh.draw()?;
-    }
-    let plot = chart.plotting_area().strip_coord_spec();
-    let to_px = |p: (f64, f64)| chart.backend_coord(&p);
-    let (px, py) = chart.plotting_area().get_pixel_range();
-    // Coordinates relative to `plot` (what `plot.draw` expects).
-    let rel = |p: (f64, f64)| {
-        let (a, b) = to_px(p);
-        (a - px.start, b - py.start)
+    let axes = Axes {
+        x: x.clone(),
+        y: y.clone(),
+        x_label: panel.bottom_axis.then_some(param_label),
+        y_label: "",
+        x_integer: false,
     };
+    let plot = PlotArea::new(&area, &axes, &FIG2_AXES)?;
+    let (px, py) = (plot.px.clone(), plot.py.clone());
     // Intervals without a gait, under everything else.
-    for span in &data.no_gait {
-        let (a, b) = (span.start.max(x.start), span.end.min(x.end));
-        if b > a {
-            plot.draw(&Rectangle::new(
-                [rel((a, y.end)), rel((b, y.start))],
-                NO_GAIT_FILL.filled(),
-            ))?;
-        }
-    }
+    let no_gait: Vec<Band> = data
+        .no_gait
+        .iter()
+        .map(|span| Band {
+            from: span.start,
+            to: span.end,
+            color: NO_GAIT_FILL,
+        })
+        .collect();
+    plot.draw_bands(&no_gait)?;
     // Reference line.
-    plot.draw(&PathElement::new(
+    plot.area.draw(&PathElement::new(
         vec![
-            rel((x.start, panel.reference)),
-            rel((x.end, panel.reference)),
+            plot.rel((x.start, panel.reference)),
+            plot.rel((x.end, panel.reference)),
         ],
         BLACK.stroke_width(2),
     ))?;
     if series.iter().all(|s| s.runs.is_empty()) {
-        plot.draw(&Text::new(
+        plot.area.draw(&Text::new(
             "not defined for these gaits (e.g. rigid legs)",
             ((px.end - px.start) / 2, (py.end - py.start) / 4),
             font(NOTE_FONT).pos(Pos::new(HPos::Center, VPos::Center)),
@@ -577,27 +446,32 @@ fn draw_panel<DB: DrawingBackend>(
     }
     // Thresholds inside the plot.
     for m in &data.marks {
-        dashed_vline(root, to_px((m.value, 0.0)).0, py.start, py.end)?;
+        dashed_vline(root, plot.to_px((m.value, 0.0)).0, py.start, py.end)?;
     }
     // Lines, then markers on top.
     for s in series {
         for run in &s.runs {
-            plot.draw(&PathElement::new(
-                run.iter().map(|&(a, b, _)| rel((a, b))).collect::<Vec<_>>(),
+            plot.area.draw(&PathElement::new(
+                run.iter()
+                    .map(|&(a, b, _)| plot.rel((a, b)))
+                    .collect::<Vec<_>>(),
                 s.color.stroke_width(2),
             ))?;
         }
     }
     for s in series {
         for &(a, b, scuff) in s.samples() {
-            draw_marker(&plot, rel((a, b)), s.shape, s.color, scuff, data.marker)?;
+            draw_marker(
+                &plot.area,
+                plot.rel((a, b)),
+                s.shape,
+                s.color,
+                scuff,
+                data.marker,
+            )?;
         }
     }
-    // Frame on the top and right sides.
-    plot.draw(&Rectangle::new(
-        [(0, 0), (px.end - px.start - 1, py.end - py.start - 1)],
-        BLACK.stroke_width(2),
-    ))?;
+    plot.draw_outline()?;
     // Axis label, rotated and centred on the plot's height.
     let label_w = rich_width(root, panel.y_label, AXIS_FONT)?;
     draw_rich(
@@ -613,63 +487,35 @@ fn draw_panel<DB: DrawingBackend>(
         (MARGIN, py.start - 4),
         font(AXIS_FONT),
     ))?;
-    // Legend, to the right of the plot.
-    draw_legend(root, series, (px.end + 28, py.start + 6))?;
+    // Legend, to the right of the plot: a row per series, and one for the hollow markers of scuffing.
+    let mut rows: Vec<LegendRow> = series
+        .iter()
+        .map(|s| LegendRow {
+            sample: Sample::Line {
+                color: s.color,
+                stroke: Stroke::Solid,
+                width: 2,
+                marker: Some((s.shape, 7)),
+            },
+            label: Label::Rich(s.name),
+        })
+        .collect();
+    let scuff: Vec<(Marker, RGBColor)> = series
+        .iter()
+        .filter(|s| s.any_scuffing())
+        .map(|s| (s.shape, s.color))
+        .collect();
+    if !scuff.is_empty() {
+        rows.push(LegendRow {
+            sample: Sample::Hollow {
+                markers: scuff,
+                r: 7,
+            },
+            label: Label::Plain(SCUFF_NOTE),
+        });
+    }
+    draw_legend_rows(root, &rows, &LEGEND, NOTE_FONT, (px.end + 28, py.start + 6))?;
     Ok((px, py))
-}
-
-fn draw_legend<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    series: &[Series],
-    (x0, y0): (i32, i32),
-) -> DrawResult<DB> {
-    const LINE: i32 = 40;
-    const SAMPLE_W: i32 = 56;
-    let scuff: Vec<&Series> = series.iter().filter(|s| s.any_scuffing()).collect();
-    let entries = series.len() + usize::from(!scuff.is_empty());
-    let mut text_w = 0;
-    for s in series {
-        text_w = text_w.max(rich_width(root, s.name, NOTE_FONT)?);
-    }
-    if !scuff.is_empty() {
-        text_w = text_w.max(rich_width(root, &[Seg::Text(SCUFF_NOTE)], NOTE_FONT)?);
-    }
-    let layout = LegendLayout::new(16, SAMPLE_W, 12, LINE, 6);
-    let (sx, tx, mut y) = layout.frame(root, (x0, y0), entries, text_w)?;
-    for s in series {
-        root.draw(&PathElement::new(
-            vec![(sx, y), (sx + SAMPLE_W, y)],
-            s.color.stroke_width(2),
-        ))?;
-        draw_marker(root, (sx + SAMPLE_W / 2, y), s.shape, s.color, false, 7)?;
-        draw_rich(
-            root,
-            s.name,
-            (tx, y - NOTE_FONT as i32 / 2),
-            NOTE_FONT,
-            false,
-        )?;
-        y += LINE;
-    }
-    if !scuff.is_empty() {
-        let step = SAMPLE_W / (scuff.len() as i32 + 1);
-        for (k, s) in scuff.iter().enumerate() {
-            draw_marker(
-                root,
-                (sx + step * (k as i32 + 1), y),
-                s.shape,
-                s.color,
-                true,
-                7,
-            )?;
-        }
-        root.draw(&Text::new(
-            SCUFF_NOTE,
-            (tx, y),
-            font(NOTE_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
-    }
-    Ok(())
 }
 
 fn draw_fig2<DB: DrawingBackend>(
@@ -683,9 +529,7 @@ fn draw_fig2<DB: DrawingBackend>(
     let mut top = MARGIN;
     if !spec.title.is_empty() {
         // Shrink a long title to fit the width.
-        let (tw, _) = root.estimate_text_size(spec.title, &font(TITLE_FONT))?;
-        let fit = f64::from(w - 2 * MARGIN) / f64::from(tw.max(1));
-        let size = TITLE_FONT * fit.min(1.0);
+        let size = title_size(root, spec.title, TITLE_FONT)?;
         root.draw(&Text::new(
             spec.title,
             (w / 2, top + ((TITLE_FONT - size) / 2.0) as i32),
