@@ -1,5 +1,6 @@
-//! Styling shared by every figure (STYLE.md point 16): the bundled font, text styles, tick labels, the
-//! colour palette and the figure error type.
+//! Styling shared by every figure (STYLE.md point 16): the bundled font, text styles (with rich text: the
+//! subscripts and superscripts of Fig. 2's labels), tick labels, the colour palette and the figure error
+//! type.
 //!
 //! Text is rendered with DejaVu Sans, bundled under `assets/fonts/` (license next to it) and registered with
 //! plotters' `ab_glyph` font table, so no system font or font library is needed at run time. PNGs and GIF
@@ -14,7 +15,7 @@ use plotters::chart::MeshStyle;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
+use plotters::style::{register_font, FontStyle, FontTransform};
 
 /// Why a figure could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -74,6 +75,86 @@ pub fn require_font(path: &Path) -> Result<(), PlotError> {
 /// Black text in the bundled font at `size` pixels.
 pub fn font(size: f64) -> TextStyle<'static> {
     (FontFamily::Name(FAMILY), size).into_font().color(&BLACK)
+}
+
+/// A run of rich text: text on the baseline, a subscript, or a stacked subscript/superscript pair (plotters
+/// has no rich text).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Seg {
+    /// Text on the baseline.
+    Text(&'static str),
+    /// A subscript.
+    Sub(&'static str),
+    /// A subscript with a superscript above it.
+    SubSup(&'static str, &'static str),
+}
+
+/// Sizes of a subscript relative to its base text, and the baseline shifts.
+const SUB_SCALE: f64 = 0.68;
+const SUB_DROP: f64 = 0.16;
+const SUP_RISE: f64 = 0.36;
+
+/// Width in pixels of rich text at font size `size`.
+pub fn rich_width<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    segs: &[Seg],
+    size: f64,
+) -> Result<i32, DrawingAreaErrorKind<DB::ErrorType>> {
+    let w = |t: &str, sz: f64| root.estimate_text_size(t, &font(sz)).map(|s| s.0 as i32);
+    let mut total = 0;
+    for seg in segs {
+        total += match *seg {
+            Seg::Text(t) => w(t, size)?,
+            Seg::Sub(t) => w(t, size * SUB_SCALE)? + 2,
+            Seg::SubSup(a, b) => w(a, size * SUB_SCALE)?.max(w(b, size * SUB_SCALE)?) + 2,
+        };
+    }
+    Ok(total)
+}
+
+/// Draws rich text whose first line box has its top-left corner at `at`
+/// (with `rotated`, the text runs upwards from `at`, its top facing left).
+/// Baselines follow plotters' ab_glyph rasteriser: `size / 2` below the top.
+pub fn draw_rich<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    segs: &[Seg],
+    at: (i32, i32),
+    size: f64,
+    rotated: bool,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let small = size * SUB_SCALE;
+    let base = size / 2.0;
+    let mut advance = 0;
+    let put = |t: &str, sz: f64, baseline: f64, advance: i32| {
+        let down = (baseline - sz / 2.0).round() as i32;
+        let (pos, style) = if rotated {
+            (
+                (at.0 + down, at.1 - advance),
+                font(sz).transform(FontTransform::Rotate270),
+            )
+        } else {
+            ((at.0 + advance, at.1 + down), font(sz))
+        };
+        root.draw(&Text::new(t.to_string(), pos, style))
+    };
+    for seg in segs {
+        match *seg {
+            Seg::Text(t) => {
+                // SVG drops leading blanks of a <text>: advance past them instead.
+                let body = t.trim_start();
+                let lead = rich_width(root, &[Seg::Text(t)], size)?
+                    - rich_width(root, &[Seg::Text(body)], size)?;
+                put(body, size, base, advance + lead)?
+            }
+            Seg::Sub(t) => put(t, small, base + SUB_DROP * size, advance + 1)?,
+            Seg::SubSup(a, b) => {
+                put(a, small, base + SUB_DROP * size, advance + 1)?;
+                put(b, small, base - SUP_RISE * size, advance + 1)?;
+            }
+        }
+        advance += rich_width(root, &[*seg], size)?;
+    }
+    Ok(())
 }
 
 /// Black (Fig. 2's `lambda_I4`, the first series of a panel).

@@ -1,5 +1,8 @@
-//! Panels of curves sharing one x axis, for the run figures (`run.png`, `steps.png`): the common layout,
-//! axes, shading, vertical marks and legends, in the look of Fig. 2 (bundled font, units on every axis).
+//! The panel, axis and legend drawing every figure shares: a chart's axes and plotting area ([`PlotArea`]:
+//! mesh, shading, vertical marks, curves, frame), markers, dashed lines, legend boxes ([`draw_legend_rows`]),
+//! titles, and panels of curves stacked on one x axis for the run figures (`run.png`, `steps.png`). Fig. 2
+//! (`fig2.png`) draws with the same code at its own proportions ([`AxisStyle`]), and the run figures share
+//! its look (bundled font, units on every axis).
 
 use std::ops::Range;
 use std::path::Path;
@@ -8,9 +11,13 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::style::{
-    draw_box, font, house_mesh, padded, tick_label, LegendLayout, PlotError, COLOR_MARK,
-};
+mod axes;
+mod legend;
+
+pub use axes::{draw_axes_and_curves, Axes, AxisStyle, PlotArea, RUN_AXES};
+pub use legend::{draw_legend, draw_legend_rows, draw_marker, Label, LegendRow, Marker, Sample};
+
+use super::style::{font, padded, PlotError};
 
 /// Font sizes and layout of the run figures \[px\].
 pub const TITLE_FONT: f64 = 38.0;
@@ -29,6 +36,9 @@ const X_LABEL_AREA: i32 = 90;
 const BOTTOM_PAD: i32 = 12;
 /// Narrowest shaded band \[px\].
 const MIN_BAND_PX: i32 = 3;
+
+/// Dash and gap lengths of [`dashed`] lines \[px\].
+pub const DASH_GAP: (f64, f64) = (12.0, 8.0);
 
 /// How a curve is drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -127,30 +137,22 @@ pub fn finite_range(values: impl Iterator<Item = f64>) -> Option<Range<f64>> {
     lo.is_finite().then_some(lo..hi)
 }
 
-/// Runs of consecutive finite points.
-fn runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
-    let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for &p in points {
-        if p.0.is_finite() && p.1.is_finite() {
-            if let Some(r) = out.last_mut() {
-                r.push(p);
-            }
-        } else if out.last().is_some_and(|r| !r.is_empty()) {
-            out.push(Vec::new());
-        }
-    }
-    out.retain(|r| !r.is_empty());
-    out
-}
-
-/// Draws a dashed polyline in pixel coordinates of `area`.
+/// Draws a dashed polyline in pixel coordinates of `area` ([`DASH_GAP`] pattern).
 pub fn dashed<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     pts: &[(i32, i32)],
     style: ShapeStyle,
 ) -> DrawResult<DB> {
-    const DASH: f64 = 12.0;
-    const GAP: f64 = 8.0;
+    dashed_with(area, pts, style, DASH_GAP)
+}
+
+/// Draws a dashed polyline in pixel coordinates of `area`, with dashes of `dash` and gaps of `gap` pixels.
+pub fn dashed_with<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    pts: &[(i32, i32)],
+    style: ShapeStyle,
+    (dash, gap): (f64, f64),
+) -> DrawResult<DB> {
     let mut pen = 0.0; // distance along the dash pattern
     for seg in pts.windows(2) {
         let (a, b) = (seg[0], seg[1]);
@@ -158,14 +160,14 @@ pub fn dashed<DB: DrawingBackend>(
         let len = dx.hypot(dy);
         let mut s = 0.0;
         while s < len {
-            let phase = pen % (DASH + GAP);
-            let step = if phase < DASH {
-                DASH - phase
+            let phase = pen % (dash + gap);
+            let step = if phase < dash {
+                dash - phase
             } else {
-                DASH + GAP - phase
+                dash + gap - phase
             }
             .min(len - s);
-            if phase < DASH {
+            if phase < dash {
                 let at = |u: f64| {
                     (
                         a.0 + (dx * u / len).round() as i32,
@@ -179,153 +181,6 @@ pub fn dashed<DB: DrawingBackend>(
         }
     }
     Ok(())
-}
-
-/// Draws a legend box with one entry per curve (and extra `(label, colour)` swatches) at `(x0, y0)`.
-pub fn draw_legend<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    curves: &[Curve],
-    swatches: &[(String, RGBColor)],
-    (x0, y0): (i32, i32),
-) -> DrawResult<DB> {
-    const LINE: i32 = 34;
-    const SAMPLE_W: i32 = 44;
-    let entries = curves.len() + swatches.len();
-    if entries == 0 {
-        return Ok(());
-    }
-    let mut text_w = 0;
-    for label in curves
-        .iter()
-        .map(|c| &c.label)
-        .chain(swatches.iter().map(|s| &s.0))
-    {
-        text_w = text_w.max(root.estimate_text_size(label, &font(LEGEND_FONT))?.0 as i32);
-    }
-    let layout = LegendLayout::new(12, SAMPLE_W, 10, LINE, 5);
-    let (sx, tx, mut y) = layout.frame(root, (x0, y0), entries, text_w)?;
-    for c in curves {
-        let line = [(sx, y), (sx + SAMPLE_W, y)];
-        match c.stroke {
-            Stroke::Dashed => dashed(root, &line, c.color.stroke_width(3))?,
-            Stroke::Solid | Stroke::Markers => {
-                root.draw(&PathElement::new(line.to_vec(), c.color.stroke_width(3)))?
-            }
-        }
-        if c.stroke == Stroke::Markers {
-            root.draw(&Circle::new((sx + SAMPLE_W / 2, y), 6, c.color.filled()))?;
-        }
-        root.draw(&Text::new(
-            c.label.as_str(),
-            (tx, y),
-            font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
-        y += LINE;
-    }
-    for (label, color) in swatches {
-        draw_box(root, [(sx, y - 11), (sx + SAMPLE_W, y + 11)], *color)?;
-        root.draw(&Text::new(
-            label.as_str(),
-            (tx, y),
-            font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
-        y += LINE;
-    }
-    Ok(())
-}
-
-/// The axes of one chart.
-#[derive(Debug, Clone)]
-pub struct Axes<'a> {
-    /// X range.
-    pub x: Range<f64>,
-    /// Y range.
-    pub y: Range<f64>,
-    /// X axis description with unit; `None`: no x tick labels (a panel above another).
-    pub x_label: Option<&'a str>,
-    /// Y axis description with unit.
-    pub y_label: &'a str,
-    /// Label only whole numbers on the x axis (step numbers).
-    pub x_integer: bool,
-}
-
-/// Draws `curves` over `bands` and the dashed vertical `marks` on one chart area; returns the plot's pixel
-/// rectangle.
-pub fn draw_axes_and_curves<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    axes: &Axes,
-    curves: &[Curve],
-    bands: &[Band],
-    marks: &[f64],
-) -> Result<PixelRect, DrawingAreaErrorKind<DB::ErrorType>> {
-    let (x, y, x_label, y_label) = (&axes.x, &axes.y, axes.x_label, axes.y_label);
-    let mut chart = ChartBuilder::on(area)
-        .x_label_area_size(if x_label.is_some() { X_LABEL_AREA } else { 12 })
-        .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d(x.clone(), y.clone())?;
-    let y_fmt = |v: &f64| tick_label(*v, y);
-    let x_fmt = |v: &f64| match (axes.x_integer, v.fract() == 0.0) {
-        (true, true) => format!("{v:.0}"),
-        (true, false) => String::new(),
-        (false, _) => tick_label(*v, x),
-    };
-    let no_fmt = |_: &f64| String::new();
-    {
-        let mut mesh = chart.configure_mesh();
-        house_mesh(&mut mesh, TICK_FONT, AXIS_FONT);
-        mesh.y_desc(y_label)
-            .y_label_formatter(&y_fmt)
-            .x_labels(10)
-            .y_labels(5);
-        match x_label {
-            Some(label) => mesh.x_desc(label).x_label_formatter(&x_fmt),
-            None => mesh.x_label_formatter(&no_fmt),
-        };
-        mesh.draw()?;
-    }
-    let (px, py) = chart.plotting_area().get_pixel_range();
-    let plot = chart.plotting_area().strip_coord_spec();
-    let rel = |p: (f64, f64)| {
-        let (a, b) = chart.backend_coord(&p);
-        (a - px.start, b - py.start)
-    };
-    for b in bands {
-        let (lo, hi) = (b.from.max(x.start), b.to.min(x.end));
-        if hi > lo {
-            // At least MIN_BAND_PX wide, so that a short phase stays visible on a long run.
-            let (mut a, c) = (rel((lo, y.end)), rel((hi, y.start)));
-            a.0 = a.0.min(c.0 - MIN_BAND_PX);
-            plot.draw(&Rectangle::new([a, c], b.color.filled()))?;
-        }
-    }
-    for &m in marks.iter().filter(|m| x.contains(m)) {
-        dashed(
-            &plot,
-            &[rel((m, y.end)), rel((m, y.start))],
-            COLOR_MARK.stroke_width(2),
-        )?;
-    }
-    for c in curves {
-        for run in runs(&c.points) {
-            let pts: Vec<(i32, i32)> = run.iter().map(|&p| rel(p)).collect();
-            match c.stroke {
-                Stroke::Dashed => dashed(&plot, &pts, c.color.stroke_width(3))?,
-                Stroke::Solid | Stroke::Markers => {
-                    plot.draw(&PathElement::new(pts.clone(), c.color.stroke_width(3)))?
-                }
-            }
-            if c.stroke == Stroke::Markers {
-                for p in pts {
-                    plot.draw(&Circle::new(p, 6, c.color.filled()))?;
-                }
-            }
-        }
-    }
-    plot.draw(&Rectangle::new(
-        [(0, 0), (px.end - px.start - 1, py.end - py.start - 1)],
-        BLACK.stroke_width(2),
-    ))?;
-    Ok((px, py))
 }
 
 /// Draws the stack into `area`: the panels share the height equally and the x axis is labelled on the
@@ -363,6 +218,17 @@ pub fn draw_stack<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The font size, at most `max`, at which `title` fits the width of `root` within [`MARGIN`] on each side.
+pub fn title_size<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    max: f64,
+) -> Result<f64, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (w, _) = root.dim_in_pixel();
+    let (tw, _) = root.estimate_text_size(title, &font(max))?;
+    Ok(max * (f64::from(w as i32 - 2 * MARGIN) / f64::from(tw.max(1))).min(1.0))
+}
+
 /// Draws `title` centred at the top of `root` and returns the area below it.
 pub fn titled<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -370,8 +236,7 @@ pub fn titled<DB: DrawingBackend>(
 ) -> Result<DrawingArea<DB, Shift>, DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
     let (w, h) = root.dim_in_pixel();
-    let (tw, _) = root.estimate_text_size(title, &font(TITLE_FONT))?;
-    let size = TITLE_FONT * (f64::from(w as i32 - 2 * MARGIN) / f64::from(tw.max(1))).min(1.0);
+    let size = title_size(root, title, TITLE_FONT)?;
     root.draw(&Text::new(
         title,
         (w as i32 / 2, MARGIN),
