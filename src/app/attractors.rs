@@ -10,9 +10,9 @@ use crate::fmt::short;
 use crate::gait::basin::{basin, Axis, BasinPoint, BasinSpec, Coordinate};
 use crate::gait::orbit::{orbit_diagram, OrbitColumn, OrbitSpec};
 use crate::gait::{find_gait_any_period, sweep, Gait, GaitOptions, Stability, StepMap, MAX_PERIOD};
+use crate::output;
 use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
-use crate::output;
 use crate::params::Config;
 use crate::walk::{SectionState, StepReport};
 

@@ -22,7 +22,9 @@ pub use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv}
 pub use tables::map::write_map_csv;
 pub use tables::steps::{step_row, write_steps_csv, StepsCsv, STEPS_HEADER};
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
-pub use tables::trajectory::{trajectory_row, write_trajectory_csv, TrajectoryCsv, TRAJECTORY_HEADER};
+pub use tables::trajectory::{
+    trajectory_row, write_trajectory_csv, TrajectoryCsv, TRAJECTORY_HEADER,
+};
 pub use tables::{Cell, Column};
 
 use std::fs::File;
@@ -30,7 +32,6 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-
 
 /// Writing a result file failed.
 #[derive(Debug, thiserror::Error)]

@@ -116,9 +116,11 @@ pub const BRANCH: [Column<(f64, Option<Gait>)>; 9] = [
     Column::param(0, "The parameter's value (its config key's unit).", |b| {
         Real(b.0)
     }),
-    Column::new("L2", "Length of Leg 2 at the gait's fixed point [m].", |b| {
-        of_gait(b, |g| Real(g.section.l2))
-    }),
+    Column::new(
+        "L2",
+        "Length of Leg 2 at the gait's fixed point [m].",
+        |b| of_gait(b, |g| Real(g.section.l2)),
+    ),
     Column::new(
         "thetadot",
         "Angular velocity of the wheel at the gait's fixed point [rad/s].",
@@ -165,7 +167,10 @@ pub fn write_branch_csv(
 
 /// A coordinate of the section state where the walk ended, [`Cell::Empty`] if none was reached.
 fn of_end(p: &BasinPoint, coordinate: impl Fn(&SectionState) -> f64) -> Cell {
-    p.outcome.end.as_ref().map_or(Empty, |e| Real(coordinate(e)))
+    p.outcome
+        .end
+        .as_ref()
+        .map_or(Empty, |e| Real(coordinate(e)))
 }
 
 /// The columns of `basin.csv`: the grid point, its start on the section, and what the walk from it did.
@@ -173,34 +178,42 @@ pub const BASIN: [Column<BasinPoint>; 11] = [
     Column::new("ix", "Grid column (x index, from 0).", |p| Count(p.ix)),
     Column::new("iy", "Grid row (y index, from 0).", |p| Count(p.iy)),
     Column::new("L2", "Start: length of Leg 2 [m].", |p| Real(p.start.l2)),
-    Column::new("thetadot", "Start: angular velocity of the wheel [rad/s].", |p| {
-        Real(p.start.theta_dot)
-    }),
-    Column::new("L2dot", "Start: rate of change of Leg 2's length [m/s].", |p| {
-        Real(p.start.l2_dot)
-    }),
+    Column::new(
+        "thetadot",
+        "Start: angular velocity of the wheel [rad/s].",
+        |p| Real(p.start.theta_dot),
+    ),
+    Column::new(
+        "L2dot",
+        "Start: rate of change of Leg 2's length [m/s].",
+        |p| Real(p.start.l2_dot),
+    ),
     Column::new(
         "outcome",
         "gait, other, undecided, invalid_start or the walk's failure kind.",
         |p| Text(p.outcome.kind.clone()),
     ),
-    Column::new(
-        "steps",
-        "Steps walked until the outcome was known.",
-        |p| Count(p.outcome.steps),
-    ),
+    Column::new("steps", "Steps walked until the outcome was known.", |p| {
+        Count(p.outcome.steps)
+    }),
     Column::new(
         "period_k",
         "For other, the period of the attractor reached (empty otherwise).",
         |p| p.outcome.period_k.map_or(Empty, Count),
     ),
-    Column::new("end_L2", "End: length of Leg 2 [m].", |p| of_end(p, |e| e.l2)),
-    Column::new("end_thetadot", "End: angular velocity of the wheel [rad/s].", |p| {
-        of_end(p, |e| e.theta_dot)
+    Column::new("end_L2", "End: length of Leg 2 [m].", |p| {
+        of_end(p, |e| e.l2)
     }),
-    Column::new("end_L2dot", "End: rate of change of Leg 2's length [m/s].", |p| {
-        of_end(p, |e| e.l2_dot)
-    }),
+    Column::new(
+        "end_thetadot",
+        "End: angular velocity of the wheel [rad/s].",
+        |p| of_end(p, |e| e.theta_dot),
+    ),
+    Column::new(
+        "end_L2dot",
+        "End: rate of change of Leg 2's length [m/s].",
+        |p| of_end(p, |e| e.l2_dot),
+    ),
 ];
 
 /// Write `basin.csv`: one row per grid point, row by row.

@@ -113,7 +113,10 @@ pub const fn fixed_names<T, const N: usize, const M: usize>(
     columns: &[Column<T>; N],
     skip: usize,
 ) -> [&'static str; M] {
-    assert!(M + skip == N, "the header's length is not the number of columns");
+    assert!(
+        M + skip == N,
+        "the header's length is not the number of columns"
+    );
     let mut names = [""; M];
     let mut k = 0;
     while k < M {

@@ -17,17 +17,21 @@ pub(crate) fn of_gait(p: &SweepPoint, cell: impl Fn(&Gait) -> Cell) -> Cell {
 /// The columns of `sweep.csv`: the swept parameter (named after its config key), the status, the gait's
 /// scalars (empty where no gait was found) and the failure message.
 pub const SWEEP: [Column<SweepPoint>; 25] = [
-    Column::param(0, "The swept parameter's value (its config key's unit).", |p| {
-        Real(p.value)
-    }),
+    Column::param(
+        0,
+        "The swept parameter's value (its config key's unit).",
+        |p| Real(p.value),
+    ),
     Column::new(
         "status",
         "The gait's stability verdict (stable, unstable, uncertain), or why no gait was found.",
         |p| Text(p.status.clone()),
     ),
-    Column::new("L2", "Length of Leg 2 at the gait's fixed point [m].", |p| {
-        of_gait(p, |g| Real(g.section.l2))
-    }),
+    Column::new(
+        "L2",
+        "Length of Leg 2 at the gait's fixed point [m].",
+        |p| of_gait(p, |g| Real(g.section.l2)),
+    ),
     Column::new(
         "thetadot",
         "Angular velocity of the wheel at the gait's fixed point [rad/s].",

@@ -1,6 +1,7 @@
 //! Tests of the table declarations: every table is written and read back by column name, the readers of
-//! [`crate::output::read`] name their fields as the declarations do, and a column that appears in several
-//! tables means the same quantity in each.
+//! [`crate::output::read`] name their fields as the declarations do and hold the quantities those names say,
+//! and a column name that appears in several tables means the same quantity in each (so two columns whose
+//! accessors are swapped in one declaration fail).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -73,12 +74,13 @@ fn sweep_points(gait: &Gait) -> [SweepPoint; 2] {
     [found, lost]
 }
 
-/// Does the CSV field `text` hold `cell`, as [`Cell::to_csv`] writes it?
+/// Does the CSV field `text` hold `cell`, as [`Cell::to_csv`] writes it? (Reals read back equal, and
+/// [`num`](crate::output::num) writes `-0` as `0`.)
 fn holds(text: &str, cell: &Cell) -> bool {
     match cell {
         Cell::Real(v) => text
             .parse::<f64>()
-            .is_ok_and(|r| r.to_bits() == v.to_bits() || (r.is_nan() && v.is_nan())),
+            .is_ok_and(|r| r == *v || (r.is_nan() && v.is_nan())),
         Cell::Count(n) => text.parse::<usize>() == Ok(*n),
         Cell::Flag(b) => text.parse::<bool>() == Ok(*b),
         Cell::Text(t) => text == t,
@@ -219,7 +221,12 @@ fn every_table_reads_back_by_name() {
         column: &diagram[1],
         step: None,
     });
-    check_by_name(&path("orbit.csv"), &orbit_columns(), &["viscosity"], &orbit_rows);
+    check_by_name(
+        &path("orbit.csv"),
+        &orbit_columns(),
+        &["viscosity"],
+        &orbit_rows,
+    );
 
     let branch = [(50.0, Some(f.gait.clone())), (60.0, None)];
     write_branch_csv(&path("branch.csv"), "viscosity", &branch).unwrap();
@@ -237,7 +244,10 @@ fn every_table_reads_back_by_name() {
             end,
         },
     };
-    let grid = vec![vec![point(0, Some(f.gait.section), "other"), point(1, None, "fell")]];
+    let grid = vec![vec![
+        point(0, Some(f.gait.section), "other"),
+        point(1, None, "fell"),
+    ]];
     write_basin_csv(&path("basin.csv"), &grid).unwrap();
     check_by_name(&path("basin.csv"), &BASIN, &[], &grid[0]);
 }
@@ -264,8 +274,10 @@ fn reads_as(value: &serde_json::Value, cell: &Cell) -> bool {
     }
 }
 
-/// Every field of the readers `StepRow` and `TrajectoryRow` is a declared column of its table, and reads back
-/// what that column's accessor wrote (so a reader field named after the wrong column fails).
+/// Every field of the readers `StepRow` and `TrajectoryRow` is named after a declared column of its table and
+/// reads back what that column's accessor wrote, with the column's kind (a reader field named after a column
+/// that is not declared, or of another kind, fails; [`readers_hold_the_named_quantities`] checks that each
+/// field holds the quantity its name says).
 #[test]
 fn readers_follow_the_declarations() {
     fn check<T, R: serde::Serialize>(file: &str, columns: &[Column<T>], items: &[T], read: &[R]) {
@@ -275,9 +287,14 @@ fn readers_follow_the_declarations() {
                 let column = columns
                     .iter()
                     .find(|c| matches!(c.name, Name::Fixed(n) if n == name))
-                    .unwrap_or_else(|| panic!("{file}: the reader's {name} is not a declared column"));
+                    .unwrap_or_else(|| {
+                        panic!("{file}: the reader's {name} is not a declared column")
+                    });
                 let cell = (column.get)(item);
-                assert!(reads_as(&value, &cell), "{file}: {name} reads {value}, was {cell:?}");
+                assert!(
+                    reads_as(&value, &cell),
+                    "{file}: {name} reads {value}, was {cell:?}"
+                );
             }
         }
     }
@@ -305,9 +322,15 @@ fn readers_hold_the_named_quantities() {
     for (s, r) in f.samples.iter().zip(&rows) {
         let q = [r.x, r.z, r.theta, r.l1, r.l2];
         assert_eq!(q, [s.q[0], s.q[1], s.q[2], s.q[3], s.q[4]]);
-        assert_eq!([r.theta_dot, r.l1_dot, r.l2_dot], [s.qd[2], s.qd[3], s.qd[4]]);
+        assert_eq!(
+            [r.theta_dot, r.l1_dot, r.l2_dot],
+            [s.qd[2], s.qd[3], s.qd[4]]
+        );
         let m = &s.multipliers;
-        assert_eq!([r.lambda_1, r.lambda_2, r.lambda_3, r.lambda_4], [m[0], m[1], m[2], m[3]]);
+        assert_eq!(
+            [r.lambda_1, r.lambda_2, r.lambda_3, r.lambda_4],
+            [m[0], m[1], m[2], m[3]]
+        );
         let a = &s.active;
         assert_eq!(
             [r.contact1, r.contact2, r.slide1, r.slide2, r.lock1, r.lock2],
@@ -326,11 +349,23 @@ fn readers_hold_the_named_quantities() {
         );
         let e = &s.energy;
         assert_eq!(
-            [r.energy_loss, r.damper_loss, r.impact_loss, r.stopper_loss, r.energy_residual],
+            [
+                r.energy_loss,
+                r.damper_loss,
+                r.impact_loss,
+                r.stopper_loss,
+                r.energy_residual
+            ],
             [e.loss, e.damper, e.impact, e.stopper, e.residual]
         );
-        assert_eq!([r.time, r.dls_duration, r.period], [s.time, s.dls_duration, s.period]);
-        assert_eq!((r.step, r.branch.as_str()), (s.step, s.branch.to_string().as_str()));
+        assert_eq!(
+            [r.time, r.dls_duration, r.period],
+            [s.time, s.dls_duration, s.period]
+        );
+        assert_eq!(
+            (r.step, r.branch.as_str()),
+            (s.step, s.branch.to_string().as_str())
+        );
     }
 }
 
@@ -356,29 +391,54 @@ fn shared_names_mean_the_same_quantity() {
     };
     let tables = [
         ("steps.csv", named(header(&STEPS, &[]), row(&STEPS, step))),
-        ("sweep.csv", named(header(&SWEEP, &params), row(&SWEEP, &found))),
+        (
+            "sweep.csv",
+            named(header(&SWEEP, &params), row(&SWEEP, &found)),
+        ),
         (
             "map.csv",
             named(
                 header(&map_columns(), &params),
-                row(&map_columns(), &MapPoint { y: 1.0, point: &found }),
+                row(
+                    &map_columns(),
+                    &MapPoint {
+                        y: 1.0,
+                        point: &found,
+                    },
+                ),
             ),
         ),
         (
             "orbit.csv",
             named(
                 header(&orbit_columns(), &params),
-                row(&orbit_columns(), &OrbitRow { column: &column, step: Some((1, step)) }),
+                row(
+                    &orbit_columns(),
+                    &OrbitRow {
+                        column: &column,
+                        step: Some((1, step)),
+                    },
+                ),
             ),
         ),
         (
             "branch.csv",
-            named(header(&BRANCH, &params), row(&BRANCH, &(50.0, Some(f.gait.clone())))),
+            named(
+                header(&BRANCH, &params),
+                row(&BRANCH, &(50.0, Some(f.gait.clone()))),
+            ),
         ),
     ];
     // Names whose meaning differs by design: the start of `basin.csv` is not in these tables, `status` and
     // `period_k` are the outcome of a sweep point or of an orbit column, `step` and `time` belong to a walk.
-    let own = ["viscosity", "stiffness", "status", "step", "time", "message"];
+    let own = [
+        "viscosity",
+        "stiffness",
+        "status",
+        "step",
+        "time",
+        "message",
+    ];
     let mut shared = 0;
     for (k, (a, first)) in tables.iter().enumerate() {
         for (b, second) in &tables[k + 1..] {

@@ -25,9 +25,11 @@ pub const TRAJECTORY: [Column<Sample>; 24] = [
     Column::new("z", "Height of Leg 1's tip above the slope [m].", |s| {
         Real(s.q[1])
     }),
-    Column::new("theta", "Angle of Leg 1 from the slope normal [rad].", |s| {
-        Real(s.q[2])
-    }),
+    Column::new(
+        "theta",
+        "Angle of Leg 1 from the slope normal [rad].",
+        |s| Real(s.q[2]),
+    ),
     Column::new("L1", "Length of Leg 1 [m].", |s| Real(s.q[3])),
     Column::new("L2", "Length of Leg 2 [m].", |s| Real(s.q[4])),
     Column::new("xdot", "dx/dt [m/s].", |s| Real(s.qd[0])),
