@@ -14,8 +14,8 @@ use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::attractor_tables::write_basin_csv;
 use super::{prepared, AppError};
+use crate::output::write_basin_csv;
 
 /// Default range of a coordinate on the basin slice around the gait's value `at`: `L2` from `L0 / 2` to `L0`,
 /// `dtheta/dt` from a twentieth of the gait's to three times it, `dL2/dt` the gait's plus and minus 1.5 m/s.

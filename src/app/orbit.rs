@@ -14,8 +14,8 @@ use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, Or
 use crate::params::Config;
 use crate::walk::{SectionState, StepReport};
 
-use super::attractor_tables::{write_branch_csv, write_orbit_csv};
 use super::{axis_label, prepared, AppError};
+use crate::output::{write_branch_csv, write_orbit_csv};
 
 /// What `vrw orbit` runs.
 #[derive(Debug, Clone)]

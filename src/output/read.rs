@@ -9,7 +9,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
-use serde::{Deserialize, Deserializer};
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// A run directory could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -95,7 +95,7 @@ fn flag<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
 }
 
 /// One row of `trajectory.csv` (MODEL.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub struct TrajectoryRow {
     /// Time \[s\].
     pub time: f64,
@@ -213,7 +213,7 @@ impl TrajectoryRow {
 }
 
 /// One row of `steps.csv` (the columns the figures use).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 pub struct StepRow {
     /// Step number, from 1.
     pub step: usize,

@@ -1,0 +1,226 @@
+//! The tables of `vrw orbit` and `vrw basin`: `orbit.csv` (the returns of the orbit diagram), `branch.csv`
+//! (the period-1 gait along the same values) and `basin.csv` (the outcome of every start of the basin's
+//! grid), and their writers.
+
+use std::path::Path;
+
+use super::{header, row, Cell, Column};
+use crate::gait::basin::BasinPoint;
+use crate::gait::orbit::OrbitColumn;
+use crate::gait::Gait;
+use crate::output::{write_table, OutputError};
+use crate::walk::{SectionState, StepReport};
+
+use Cell::{Count, Empty, Real, Text};
+
+/// One row of `orbit.csv`: a value of the diagram and one of its recorded steps (its number from 1 after the
+/// transient), or no step for a value whose walk failed before recording anything.
+pub struct OrbitRow<'a> {
+    /// The value's column of the diagram.
+    pub column: &'a OrbitColumn,
+    /// The step number and the step.
+    pub step: Option<(usize, &'a StepReport)>,
+}
+
+/// A cell of the row's step, [`Cell::Empty`] without one.
+fn of_step(r: &OrbitRow, cell: impl Fn(&StepReport) -> Cell) -> Cell {
+    r.step.map_or(Empty, |(_, s)| cell(s))
+}
+
+/// The columns of `orbit.csv`: the parameter (named after its config key), the outcome of its walk, and per
+/// recorded step the section state, the DLS indicators and the branch (docs/model.md sections 4-5).
+pub fn orbit_columns<'a>() -> [Column<OrbitRow<'a>>; 12] {
+    [
+        Column::param(0, "The parameter's value (its config key's unit).", |r| {
+            Real(r.column.value)
+        }),
+        Column::new(
+            "status",
+            "walking when every step was walked, otherwise the failure kind.",
+            |r| Text(r.column.status.clone()),
+        ),
+        Column::new(
+            "period_k",
+            "Least period of the recorded returns, empty if they do not repeat.",
+            |r| r.column.period_k.map_or(Empty, Count),
+        ),
+        Column::new(
+            "step",
+            "Number of the recorded step, from 1 after the transient.",
+            |r| r.step.map_or(Empty, |(n, _)| Count(n)),
+        ),
+        Column::new(
+            "L2",
+            "Length of Leg 2 just before the step's touchdown (section state) [m].",
+            |r| of_step(r, |s| Real(s.section.l2)),
+        ),
+        Column::new(
+            "thetadot",
+            "Angular velocity of the wheel just before the touchdown [rad/s].",
+            |r| of_step(r, |s| Real(s.section.theta_dot)),
+        ),
+        Column::new(
+            "L2dot",
+            "Rate of change of Leg 2's length just before the touchdown [m/s].",
+            |r| of_step(r, |s| Real(s.section.l2_dot)),
+        ),
+        Column::new("lambda_I4", "DLS indicator lambda_I4 [N s].", |r| {
+            of_step(r, |s| Real(s.indicators.lambda_i4))
+        }),
+        Column::new("lambda_2_plus", "DLS indicator lambda_2+ [N].", |r| {
+            of_step(r, |s| Real(s.indicators.lambda_2_plus))
+        }),
+        Column::new("lambda_4_plus", "DLS indicator lambda_4+ [N].", |r| {
+            of_step(r, |s| Real(s.indicators.lambda_4_plus))
+        }),
+        Column::new("branch", "Branch of the impact procedure.", |r| {
+            of_step(r, |s| Text(s.branch.to_string()))
+        }),
+        Column::new(
+            "continued_from",
+            "The value whose end state this walk started from, empty for the initial state.",
+            |r| r.column.continued_from.map_or(Empty, Real),
+        ),
+    ]
+}
+
+/// Write `orbit.csv` for a diagram along `param`: one row per recorded step; a value whose walk failed
+/// before recording anything has one row with empty step fields.
+pub fn write_orbit_csv(
+    path: &Path,
+    param: &str,
+    columns: &[OrbitColumn],
+) -> Result<(), OutputError> {
+    let table = orbit_columns();
+    let rows = columns.iter().flat_map(|column| {
+        let steps = column.returns.iter().enumerate();
+        let steps: Vec<_> = steps.map(|(n, s)| Some((n + 1, s))).collect();
+        let steps = if steps.is_empty() { vec![None] } else { steps };
+        steps.into_iter().map(move |step| OrbitRow { column, step })
+    });
+    write_table(
+        path,
+        &header(&table, &[param]),
+        rows.map(|r| row(&table, &r)),
+    )
+}
+
+/// A cell of the branch's gait, [`Cell::Empty`] where there is none.
+fn of_gait(b: &(f64, Option<Gait>), cell: impl Fn(&Gait) -> Cell) -> Cell {
+    b.1.as_ref().map_or(Empty, cell)
+}
+
+/// The columns of `branch.csv`: the parameter (named after its config key) and the period-1 gait's section
+/// state, DLS indicators and stability (empty where there is no gait).
+pub const BRANCH: [Column<(f64, Option<Gait>)>; 9] = [
+    Column::param(0, "The parameter's value (its config key's unit).", |b| {
+        Real(b.0)
+    }),
+    Column::new(
+        "L2",
+        "Length of Leg 2 at the gait's fixed point [m].",
+        |b| of_gait(b, |g| Real(g.section.l2)),
+    ),
+    Column::new(
+        "thetadot",
+        "Angular velocity of the wheel at the gait's fixed point [rad/s].",
+        |b| of_gait(b, |g| Real(g.section.theta_dot)),
+    ),
+    Column::new(
+        "L2dot",
+        "Rate of change of Leg 2's length at the gait's fixed point [m/s].",
+        |b| of_gait(b, |g| Real(g.section.l2_dot)),
+    ),
+    Column::new("lambda_I4", "DLS indicator lambda_I4 [N s].", |b| {
+        of_gait(b, |g| Real(g.lambda_i4))
+    }),
+    Column::new("lambda_2_plus", "DLS indicator lambda_2+ [N].", |b| {
+        of_gait(b, |g| Real(g.lambda_2_plus))
+    }),
+    Column::new("lambda_4_plus", "DLS indicator lambda_4+ [N].", |b| {
+        of_gait(b, |g| Real(g.lambda_4_plus))
+    }),
+    Column::new(
+        "max_floquet",
+        "Largest modulus of the Floquet multipliers.",
+        |b| of_gait(b, |g| Real(g.max_floquet)),
+    ),
+    Column::new(
+        "stability",
+        "What the Floquet multipliers and their error estimate show.",
+        |b| of_gait(b, |g| Text(g.stability.to_string())),
+    ),
+];
+
+/// Write `branch.csv` for a branch along `param`: the period-1 gait at each value (empty where there is none).
+pub fn write_branch_csv(
+    path: &Path,
+    param: &str,
+    branch: &[(f64, Option<Gait>)],
+) -> Result<(), OutputError> {
+    write_table(
+        path,
+        &header(&BRANCH, &[param]),
+        branch.iter().map(|b| row(&BRANCH, b)),
+    )
+}
+
+/// A coordinate of the section state where the walk ended, [`Cell::Empty`] if none was reached.
+fn of_end(p: &BasinPoint, coordinate: impl Fn(&SectionState) -> f64) -> Cell {
+    p.outcome
+        .end
+        .as_ref()
+        .map_or(Empty, |e| Real(coordinate(e)))
+}
+
+/// The columns of `basin.csv`: the grid point, its start on the section, and what the walk from it did.
+pub const BASIN: [Column<BasinPoint>; 11] = [
+    Column::new("ix", "Grid column (x index, from 0).", |p| Count(p.ix)),
+    Column::new("iy", "Grid row (y index, from 0).", |p| Count(p.iy)),
+    Column::new("L2", "Start: length of Leg 2 [m].", |p| Real(p.start.l2)),
+    Column::new(
+        "thetadot",
+        "Start: angular velocity of the wheel [rad/s].",
+        |p| Real(p.start.theta_dot),
+    ),
+    Column::new(
+        "L2dot",
+        "Start: rate of change of Leg 2's length [m/s].",
+        |p| Real(p.start.l2_dot),
+    ),
+    Column::new(
+        "outcome",
+        "gait, other, undecided, invalid_start or the walk's failure kind.",
+        |p| Text(p.outcome.kind.clone()),
+    ),
+    Column::new("steps", "Steps walked until the outcome was known.", |p| {
+        Count(p.outcome.steps)
+    }),
+    Column::new(
+        "period_k",
+        "For other, the period of the attractor reached (empty otherwise).",
+        |p| p.outcome.period_k.map_or(Empty, Count),
+    ),
+    Column::new("end_L2", "End: length of Leg 2 [m].", |p| {
+        of_end(p, |e| e.l2)
+    }),
+    Column::new(
+        "end_thetadot",
+        "End: angular velocity of the wheel [rad/s].",
+        |p| of_end(p, |e| e.theta_dot),
+    ),
+    Column::new(
+        "end_L2dot",
+        "End: rate of change of Leg 2's length [m/s].",
+        |p| of_end(p, |e| e.l2_dot),
+    ),
+];
+
+/// Write `basin.csv`: one row per grid point, row by row.
+pub fn write_basin_csv(path: &Path, grid: &[Vec<BasinPoint>]) -> Result<(), OutputError> {
+    write_table(
+        path,
+        &header(&BASIN, &[]),
+        grid.iter().flatten().map(|p| row(&BASIN, p)),
+    )
+}

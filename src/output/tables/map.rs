@@ -1,0 +1,102 @@
+//! `map.csv`: one row per point of a two-parameter gait map (both parameter values, the status and the gait's
+//! main scalars), and its writer.
+
+use std::path::Path;
+
+use super::sweep::of_gait;
+use super::{header, row, Cell, Column};
+use crate::gait::{GaitMap, SweepPoint};
+use crate::output::{write_table, OutputError};
+
+use Cell::{Count, Empty, Flag, Real, Text};
+
+/// One row of `map.csv`: a point of the map and the `y` value of its row (its `value` is the `x` value).
+pub struct MapPoint<'a> {
+    /// The `y` value.
+    pub y: f64,
+    /// The point.
+    pub point: &'a SweepPoint,
+}
+
+/// The columns of `map.csv`: both parameters (named after their config keys), the status (the stability
+/// verdict, or why no gait was found), the gait's scalars (empty where no gait was found) and the failure
+/// message.
+pub fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
+    [
+        Column::param(0, "The x parameter's value (its config key's unit).", |m| {
+            Real(m.point.value)
+        }),
+        Column::param(1, "The y parameter's value (its config key's unit).", |m| {
+            Real(m.y)
+        }),
+        Column::new(
+            "status",
+            "The gait's stability verdict (stable, unstable, uncertain), or why no gait was found.",
+            |m| Text(m.point.status.clone()),
+        ),
+        Column::new("branch", "Branch of the impact procedure.", |m| {
+            of_gait(m.point, |g| Text(g.branch.to_string()))
+        }),
+        Column::new(
+            "family",
+            "Gait family, numbered within the row: points with the same number are connected by \
+             continuation along x.",
+            |m| of_gait(m.point, |_| m.point.family.map_or(Empty, Count)),
+        ),
+        Column::new("period_k", "Steps per period of the gait.", |m| {
+            of_gait(m.point, |g| Count(g.period_k))
+        }),
+        Column::new("lambda_I4", "DLS indicator lambda_I4 [N s].", |m| {
+            of_gait(m.point, |g| Real(g.lambda_i4))
+        }),
+        Column::new("lambda_2_plus", "DLS indicator lambda_2+ [N].", |m| {
+            of_gait(m.point, |g| Real(g.lambda_2_plus))
+        }),
+        Column::new("lambda_4_plus", "DLS indicator lambda_4+ [N].", |m| {
+            of_gait(m.point, |g| Real(g.lambda_4_plus))
+        }),
+        Column::new("period", "Step period [s].", |m| {
+            of_gait(m.point, |g| Real(g.period))
+        }),
+        Column::new("speed", "Mean speed [m/s].", |m| {
+            of_gait(m.point, |g| Real(g.speed))
+        }),
+        Column::new(
+            "max_floquet",
+            "Largest modulus of the Floquet multipliers.",
+            |m| of_gait(m.point, |g| Real(g.max_floquet)),
+        ),
+        Column::new(
+            "stability",
+            "What the Floquet multipliers and their error estimate show.",
+            |m| of_gait(m.point, |g| Text(g.stability.to_string())),
+        ),
+        Column::new(
+            "scuffing",
+            "Leg 2 scuffs (re-contacts or slides after its lift-off).",
+            |m| of_gait(m.point, |g| Flag(g.scuffing)),
+        ),
+        Column::new("message", "The failure, in words (empty if none).", |m| {
+            Text(m.point.message.clone().unwrap_or_default())
+        }),
+    ]
+}
+
+/// Write `map.csv`: one row per map point, row by row (`y` outer, `x` inner): both parameter values, the status
+/// (the stability verdict, or why no gait was found), the impact branch, the gait family (numbered within the
+/// row), `period_k`, the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
+/// verdict; empty gait fields where no gait was found.
+pub fn write_map_csv(path: &Path, map: &GaitMap) -> Result<(), OutputError> {
+    let columns = map_columns();
+    let params = [map.spec.x.param.as_str(), map.spec.y.param.as_str()];
+    let points = map
+        .rows
+        .iter()
+        .zip(&map.ys)
+        .flat_map(|(points, &y)| points.iter().map(move |point| MapPoint { y, point }));
+    write_table(
+        path,
+        &header(&columns, &params),
+        points.map(|m| row(&columns, &m)),
+    )
+}

@@ -1,0 +1,138 @@
+//! `sweep.csv`: one row per value of a one-parameter sweep (the parameter value, the status and the gait's
+//! scalars), and its writer. The gait columns are shared with `map.csv` ([`super::map`]).
+
+use std::path::Path;
+
+use super::{fixed_names, header, row, Cell, Column};
+use crate::gait::{Gait, SweepPoint};
+use crate::output::{write_table, OutputError};
+
+use Cell::{Count, Empty, Flag, Real, Text};
+
+/// A cell of the point's gait, [`Cell::Empty`] where no gait was found.
+pub(crate) fn of_gait(p: &SweepPoint, cell: impl Fn(&Gait) -> Cell) -> Cell {
+    p.gait.as_ref().map_or(Empty, cell)
+}
+
+/// The columns of `sweep.csv`: the swept parameter (named after its config key), the status, the gait's
+/// scalars (empty where no gait was found) and the failure message.
+pub const SWEEP: [Column<SweepPoint>; 25] = [
+    Column::param(
+        0,
+        "The swept parameter's value (its config key's unit).",
+        |p| Real(p.value),
+    ),
+    Column::new(
+        "status",
+        "The gait's stability verdict (stable, unstable, uncertain), or why no gait was found.",
+        |p| Text(p.status.clone()),
+    ),
+    Column::new(
+        "L2",
+        "Length of Leg 2 at the gait's fixed point [m].",
+        |p| of_gait(p, |g| Real(g.section.l2)),
+    ),
+    Column::new(
+        "thetadot",
+        "Angular velocity of the wheel at the gait's fixed point [rad/s].",
+        |p| of_gait(p, |g| Real(g.section.theta_dot)),
+    ),
+    Column::new(
+        "L2dot",
+        "Rate of change of Leg 2's length at the gait's fixed point [m/s].",
+        |p| of_gait(p, |g| Real(g.section.l2_dot)),
+    ),
+    Column::new("theta", "theta at the section [rad].", |p| {
+        of_gait(p, |g| Real(g.theta))
+    }),
+    Column::new("lambda_I4", "DLS indicator lambda_I4 [N s].", |p| {
+        of_gait(p, |g| Real(g.lambda_i4))
+    }),
+    Column::new("lambda_2_plus", "DLS indicator lambda_2+ [N].", |p| {
+        of_gait(p, |g| Real(g.lambda_2_plus))
+    }),
+    Column::new("lambda_4_plus", "DLS indicator lambda_4+ [N].", |p| {
+        of_gait(p, |g| Real(g.lambda_4_plus))
+    }),
+    Column::new("branch", "Branch of the impact procedure.", |p| {
+        of_gait(p, |g| Text(g.branch.to_string()))
+    }),
+    Column::new("period", "Step period [s].", |p| {
+        of_gait(p, |g| Real(g.period))
+    }),
+    Column::new("step_length", "Step length [m].", |p| {
+        of_gait(p, |g| Real(g.step_length))
+    }),
+    Column::new("speed", "Mean speed [m/s].", |p| {
+        of_gait(p, |g| Real(g.speed))
+    }),
+    Column::new(
+        "dls_duration",
+        "Double-limb support per step: both tips on the ground without slipping [s].",
+        |p| of_gait(p, |g| Real(g.dls_duration)),
+    ),
+    Column::new(
+        "rear_contact_duration",
+        "Time Leg 2's tip touches the ground per step, sticking or sliding [s].",
+        |p| of_gait(p, |g| Real(g.rear_contact_duration)),
+    ),
+    Column::new(
+        "scuffing",
+        "Leg 2 scuffs (re-contacts or slides after its lift-off).",
+        |p| of_gait(p, |g| Flag(g.scuffing)),
+    ),
+    Column::new("bounce", "Leg 1 bounces.", |p| {
+        of_gait(p, |g| Flag(g.bounce))
+    }),
+    Column::new(
+        "stability",
+        "What the Floquet multipliers and their error estimate show.",
+        |p| of_gait(p, |g| Text(g.stability.to_string())),
+    ),
+    Column::new(
+        "max_floquet",
+        "Largest modulus of the Floquet multipliers.",
+        |p| of_gait(p, |g| Real(g.max_floquet)),
+    ),
+    Column::new(
+        "jacobian_error",
+        "Estimated error of the Jacobian entries, NaN if not refined.",
+        |p| of_gait(p, |g| Real(g.jacobian_error)),
+    ),
+    Column::new("residual", "max |P(s*) - s*| at the fixed point.", |p| {
+        of_gait(p, |g| Real(g.residual))
+    }),
+    Column::new("iterations", "Newton iterations used.", |p| {
+        of_gait(p, |g| Count(g.iterations))
+    }),
+    Column::new(
+        "family",
+        "Gait family: points with the same number are connected by continuation.",
+        |p| of_gait(p, |_| p.family.map_or(Empty, Count)),
+    ),
+    Column::new("period_k", "Steps per period of the gait.", |p| {
+        of_gait(p, |g| Count(g.period_k))
+    }),
+    Column::new("message", "The failure, in words (empty if none).", |p| {
+        Text(p.message.clone().unwrap_or_default())
+    }),
+];
+
+/// Columns of `sweep.csv` after the parameter column.
+pub const SWEEP_COLUMNS: [&str; 24] = fixed_names(&SWEEP, 1);
+
+/// The header of `sweep.csv` for a sweep of `param`: the parameter, then [`SWEEP_COLUMNS`].
+pub fn sweep_header(param: &str) -> Vec<&str> {
+    header(&SWEEP, &[param])
+}
+
+/// One row of `sweep.csv`, in the order of [`sweep_header`]: the parameter value, the status and the gait's
+/// scalars ([`Cell::Empty`] where no gait was found).
+pub fn sweep_row(p: &SweepPoint) -> Vec<Cell> {
+    row(&SWEEP, p)
+}
+
+/// Write `sweep.csv`: one row per sweep point (see [`sweep_row`]).
+pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
+    write_table(path, &sweep_header(param), points.iter().map(sweep_row))
+}

@@ -1,0 +1,137 @@
+//! `trajectory.csv`: the sampled trajectory of a walk (time, the ten states, the active contacts and stoppers,
+//! the multipliers and which physical leg is Leg 1), and its writers.
+
+use std::path::Path;
+
+use super::{fixed_names, row, Cell, Column};
+use crate::output::{CsvStream, OutputError};
+use crate::walk::{Sample, SampleSink};
+
+use Cell::{Count, Real};
+
+/// `0`/`1` for a flag of `trajectory.csv`.
+fn bit(b: bool) -> Cell {
+    Count(usize::from(b))
+}
+
+/// The columns of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
+pub const TRAJECTORY: [Column<Sample>; 24] = [
+    Column::new("time", "Time [s].", |s| Real(s.time)),
+    Column::new(
+        "x",
+        "Slope coordinate of Leg 1's tip, from the start of the walk [m].",
+        |s| Real(s.q[0]),
+    ),
+    Column::new("z", "Height of Leg 1's tip above the slope [m].", |s| {
+        Real(s.q[1])
+    }),
+    Column::new(
+        "theta",
+        "Angle of Leg 1 from the slope normal [rad].",
+        |s| Real(s.q[2]),
+    ),
+    Column::new("L1", "Length of Leg 1 [m].", |s| Real(s.q[3])),
+    Column::new("L2", "Length of Leg 2 [m].", |s| Real(s.q[4])),
+    Column::new("xdot", "dx/dt [m/s].", |s| Real(s.qd[0])),
+    Column::new("zdot", "dz/dt [m/s].", |s| Real(s.qd[1])),
+    Column::new("thetadot", "dtheta/dt [rad/s].", |s| Real(s.qd[2])),
+    Column::new("L1dot", "dL1/dt [m/s].", |s| Real(s.qd[3])),
+    Column::new("L2dot", "dL2/dt [m/s].", |s| Real(s.qd[4])),
+    Column::new("contact1", "1 if Leg 1's tip is on the ground.", |s| {
+        bit(s.active.contact1)
+    }),
+    Column::new("contact2", "1 if Leg 2's tip is on the ground.", |s| {
+        bit(s.active.contact2)
+    }),
+    Column::new("slide1", "1 if Leg 1's contact slides.", |s| {
+        bit(s.active.slide1)
+    }),
+    Column::new("slide2", "1 if Leg 2's contact slides.", |s| {
+        bit(s.active.slide2)
+    }),
+    Column::new("lock1", "1 if Leg 1 is held on its stopper.", |s| {
+        bit(s.active.lock1)
+    }),
+    Column::new("lock2", "1 if Leg 2 is held on its stopper.", |s| {
+        bit(s.active.lock2)
+    }),
+    Column::new("lambda_1", "Tangential force on Leg 1's tip [N].", |s| {
+        Real(s.multipliers[0])
+    }),
+    Column::new("lambda_2", "Normal force on Leg 1's tip [N].", |s| {
+        Real(s.multipliers[1])
+    }),
+    Column::new("lambda_3", "Tangential force on Leg 2's tip [N].", |s| {
+        Real(s.multipliers[2])
+    }),
+    Column::new("lambda_4", "Normal force on Leg 2's tip [N].", |s| {
+        Real(s.multipliers[3])
+    }),
+    Column::new(
+        "stopper_1",
+        "Stopper reaction on Leg 1, positive inward (-mu_1) [N].",
+        |s| Real(-s.multipliers[4]),
+    ),
+    Column::new(
+        "stopper_2",
+        "Stopper reaction on Leg 2, positive inward (-mu_2) [N].",
+        |s| Real(-s.multipliers[5]),
+    ),
+    Column::new("leg1", "Which physical leg (0 to N-1) is Leg 1.", |s| {
+        Count(s.leg1)
+    }),
+];
+
+/// Header of `trajectory.csv` (the names of [`TRAJECTORY`]).
+pub const TRAJECTORY_HEADER: [&str; 24] = fixed_names(&TRAJECTORY, 0);
+
+/// One row of `trajectory.csv`, in the order of [`TRAJECTORY_HEADER`]: time, the ten states (`x` from the
+/// start of the walk), the active contacts and stoppers as `0`/`1`, the multipliers (stopper reactions
+/// positive inward) and which physical leg is Leg 1.
+pub fn trajectory_row(s: &Sample) -> Vec<Cell> {
+    row(&TRAJECTORY, s)
+}
+
+/// `trajectory.csv` written sample by sample: the [`SampleSink`] of a streaming
+/// [`Trajectory`](crate::walk::Trajectory). Rows are buffered and flushed when the walk flushes the trajectory
+/// (after every step).
+pub struct TrajectoryCsv(CsvStream);
+
+impl TrajectoryCsv {
+    /// Create `path` with the header [`TRAJECTORY_HEADER`].
+    pub fn create(path: &Path) -> Result<TrajectoryCsv, OutputError> {
+        CsvStream::create(path, TRAJECTORY_HEADER).map(TrajectoryCsv)
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl SampleSink for TrajectoryCsv {
+    fn write(&mut self, sample: &Sample) -> std::io::Result<()> {
+        self.0
+            .row(trajectory_row(sample).iter().map(Cell::to_csv))
+            .map_err(std::io::Error::from)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.w.flush()
+    }
+}
+
+/// Write the sampled trajectory `trajectory.csv`: time, the ten states (`x` from the start of the walk), the
+/// active contacts and stoppers, the multipliers (stopper reactions positive inward) and which physical leg is
+/// Leg 1.
+pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), OutputError> {
+    let mut w = TrajectoryCsv::create(path)?;
+    samples
+        .iter()
+        .try_for_each(|s| w.write(s))
+        .and_then(|()| SampleSink::flush(&mut w))
+        .map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+}
