@@ -3,7 +3,8 @@
 //! One file per job: [`simulate`](run_simulate) (`simulate.rs`), [`gait`](run_gait) (`gait.rs`),
 //! [`sweep`](run_sweep) with its Fig. 2 (`sweep.rs`), [`map`](run_map) (`map.rs`), [`orbit`](run_orbit)
 //! (`orbit.rs`), [`basin`](run_basin) (`basin.rs`), and [`plot`](run_plot) / [`animate`](run_animate) of a run
-//! directory (`figures.rs`); the tables they write are declared in `output::tables`. This file holds what they share: the error type, the start of every walk, and the names of parameters on figures.
+//! directory (`figures.rs`); the tables they write are declared in `output::tables`. This file holds what they
+//! share: the error type, the start of every walk, and the names of parameters on figures.
 
 mod basin;
 mod figures;
