@@ -159,9 +159,9 @@ impl<'m> Walker<'m> {
     /// Advance from this touchdown to the next one: the impact procedure, then the continuous phases and their
     /// events. Returns the step's report; the walker is then at the next section. Samples go to `trajectory`.
     ///
-    /// The stages: [`Walker::walk_to_touchdown`] (the touchdown impact, then [`Phases::integrate_to_event`] and
-    /// [`Phases::handle_event`] until the next touchdown), then [`Walker::finish_step`] (the report and the
-    /// re-indexing). The step's work, failed or not, is added to [`Walker::work`].
+    /// The stages: `walk_to_touchdown` (the touchdown impact, then `integrate_to_event` and `handle_event`
+    /// until the next touchdown), then `finish_step` (the report and the re-indexing). The step's work, failed
+    /// or not, is added to [`Walker::work`].
     pub fn step(&mut self, trajectory: Option<&mut Trajectory>) -> Result<StepReport, WalkError> {
         if let Some(e) = &self.blocked {
             return Err(e.clone());
@@ -486,8 +486,8 @@ impl<'a> Phases<'a> {
             };
             *y_b = step.eval(t_b);
             (g_next, pull_next) = self.events.values(y_b);
-            for k in 0..g_next.len() {
-                if self.g_prev[k] > 0.0 && g_next[k] <= 0.0 {
+            for (k, (&g_a, &g_b)) in self.g_prev.iter().zip(&g_next).enumerate() {
+                if g_a > 0.0 && g_b <= 0.0 {
                     let root_evals = Cell::new(0);
                     let tk = locate_root(
                         step,
@@ -496,9 +496,9 @@ impl<'a> Phases<'a> {
                             self.events.value(k, y)
                         },
                         t_a,
-                        self.g_prev[k],
+                        g_a,
                         t_b,
-                        g_next[k],
+                        g_b,
                         opts.event_time_tol,
                     );
                     self.work.crossings += 1;
