@@ -1,0 +1,36 @@
+//! The contact audit's per-step checks (docs/model.md section 7): the largest pulling force seen, and tips
+//! below the ground on the dense output ([`PENETRATION_SAMPLES`] points per integrator step).
+
+use crate::dynamics::Model;
+use crate::integrate::DenseStep;
+
+use super::events::EVENT_SAMPLES;
+use super::phase::{unpack, WalkVector, NY};
+use super::report::ContactAudit;
+
+/// Number of points per integrator step (besides its start) at which the dense output is checked for tips
+/// below the ground: the event search's points, whose states the audit reuses (up to an event, the part of
+/// the step before it is sampled the same way).
+pub const PENETRATION_SAMPLES: usize = EVENT_SAMPLES;
+
+impl ContactAudit {
+    /// A pulling force (or reaction) seen at some instant of the step.
+    pub(crate) fn see_force(&mut self, pull: f64) {
+        self.pull_force = self.pull_force.max(pull);
+    }
+
+    /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`).
+    pub(crate) fn see_tips(&mut self, model: &Model, y: &WalkVector) {
+        let (q, _) = unpack(y);
+        self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
+    }
+
+    /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).
+    pub(crate) fn see_dense(&mut self, model: &Model, step: &DenseStep<NY>, until: f64) {
+        let t0 = step.t0();
+        for i in 1..=PENETRATION_SAMPLES {
+            let t = t0 + (until - t0) * i as f64 / PENETRATION_SAMPLES as f64;
+            self.see_tips(model, &step.eval(t));
+        }
+    }
+}

@@ -1,0 +1,223 @@
+//! The events of a phase (docs/model.md section 4): their kinds, the event functions, the grazing guards that
+//! arm them, and the constants of the event search ([`EVENT_SAMPLES`], [`FORCE_EVENT_MARGIN`],
+//! [`APPROACH_GAP`]). The table of event functions is in the [module documentation](super).
+
+use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg};
+use crate::dynamics::{Coords, Model, THETA};
+use crate::params::SolverOptions;
+
+use super::impact::COMPLEMENTARITY_TOL;
+use super::phase::{unpack, WalkVector};
+
+/// A lift-off or stopper-unlock event fires when the force falls this far below zero \[N\] (or below its
+/// value at the start of the phase, if the force-level problem accepted a slightly negative one within
+/// [`super::impact::COMPLEMENTARITY_TOL`]): small enough that the contact audit sees no pull above 1e-9 N, large
+/// enough that rounding of forces of ~100 N (~1e-12 N) cannot fire it.
+pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
+
+/// The grazing guard of a landing or stopper event whose tip (leg) starts at the ground (stopper) already moving
+/// into it \[m\]: such a contact is not grazing, so its event fires as soon as it moves this far (instead of
+/// `recontact_gap` / `stopper_gap`). It happens after the `traditional` exchange drives the rear tip into the
+/// ground, or when an impact's complementarity problem had no consistent solution.
+pub const APPROACH_GAP: f64 = 1e-12;
+
+/// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
+/// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
+/// however long the steps of a high-order integrator are.
+pub const EVENT_SAMPLES: usize = 4;
+
+/// Kinds of events (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum EventKind {
+    Touchdown,
+    Fall,
+    RollBack,
+    LiftOff(Leg),
+    Unlock(Leg),
+    Landing(Leg),
+    StopperHit(Leg),
+}
+
+/// One event of a phase: its kind and the level at which its function fires.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Event {
+    /// What happens when it fires.
+    pub(crate) kind: EventKind,
+    /// The event fires when its unshifted function falls to this level: 0 once armed, and
+    /// `min(h0, 0) - gap` while a guarded event is disarmed (see the module documentation).
+    pub(crate) floor: f64,
+}
+
+/// Event functions of one phase.
+pub(crate) struct EventSet<'a> {
+    model: &'a Model,
+    opts: &'a SolverOptions,
+    active: ActiveSet,
+    pub(crate) events: Vec<Event>,
+}
+
+impl<'a> EventSet<'a> {
+    pub(crate) fn new(
+        model: &'a Model,
+        opts: &'a SolverOptions,
+        active: ActiveSet,
+        y: &WalkVector,
+    ) -> EventSet<'a> {
+        let (q, qd) = unpack(y);
+        let mut kinds = vec![EventKind::Touchdown, EventKind::Fall, EventKind::RollBack];
+        for leg in Leg::BOTH {
+            kinds.push(if active.contact(leg) {
+                EventKind::LiftOff(leg)
+            } else {
+                EventKind::Landing(leg)
+            });
+            if !model.params().rigid_legs {
+                kinds.push(if active.lock(leg) {
+                    EventKind::Unlock(leg)
+                } else {
+                    EventKind::StopperHit(leg)
+                });
+            }
+        }
+        let mut set = EventSet {
+            model,
+            opts,
+            active,
+            events: Vec::with_capacity(kinds.len()),
+        };
+        let needed = kinds.iter().any(|k| Self::needs_forces(*k));
+        let dynamics = set.dynamics_if(needed, &q, &qd);
+        for kind in kinds {
+            let f0 = || set.raw(kind, &q, &qd, &dynamics);
+            let floor = if Self::needs_forces(kind) {
+                // A force event fires once the force falls FORCE_EVENT_MARGIN below zero, or below its value at
+                // the phase start if that is already (within the complementarity tolerance) negative.
+                f0().min(0.0) - FORCE_EVENT_MARGIN
+            } else if let Some(gap) = Self::guard(opts, kind) {
+                // Guarded events start disarmed unless their function already clears the gap. A tip (leg) that
+                // starts at the ground (stopper) already moving into it is not grazing: it fires at once.
+                let gap = if set.approaching(kind, &q, &qd) {
+                    APPROACH_GAP
+                } else {
+                    gap
+                };
+                let h0 = f0();
+                if h0 > gap {
+                    0.0
+                } else {
+                    h0.min(0.0) - gap
+                }
+            } else {
+                0.0
+            };
+            set.events.push(Event { kind, floor });
+        }
+        set
+    }
+
+    /// The grazing guard of an event kind, if it has one.
+    fn guard(opts: &SolverOptions, kind: EventKind) -> Option<f64> {
+        match kind {
+            EventKind::Landing(_) => Some(opts.recontact_gap),
+            EventKind::StopperHit(_) => Some(opts.stopper_gap),
+            _ => None,
+        }
+    }
+
+    /// Is the unit of a guarded event moving into the ground (past its stopper) at `(q, q')`?
+    fn approaching(&self, kind: EventKind, q: &Coords, qd: &Coords) -> bool {
+        match kind {
+            EventKind::Landing(leg) => {
+                self.model.tip(q, qd, leg.index()).velocity(qd).y < -COMPLEMENTARITY_TOL
+            }
+            EventKind::StopperHit(leg) => qd[leg.length_coordinate()] > COMPLEMENTARITY_TOL,
+            _ => false,
+        }
+    }
+
+    /// The unshifted function of an event.
+    fn raw(
+        &self,
+        kind: EventKind,
+        q: &Coords,
+        qd: &Coords,
+        dynamics: &Option<ConstrainedDynamics>,
+    ) -> f64 {
+        let force = |f: &dyn Fn(&ConstrainedDynamics) -> f64| dynamics.as_ref().map_or(f64::NAN, f);
+        match kind {
+            EventKind::Touchdown => self.model.tip_height(q, self.model.front_leg()),
+            EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
+            EventKind::RollBack => qd[THETA],
+            EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)),
+            EventKind::Unlock(leg) => force(&|d| d.stopper_reaction(leg)),
+            EventKind::Landing(leg) => self.model.tip_height(q, leg.index()),
+            EventKind::StopperHit(leg) => {
+                self.model.params().stopper_length - q[leg.length_coordinate()]
+            }
+        }
+    }
+
+    /// The value of event `e` at `(q, q')`: its function measured from its floor.
+    fn shifted(
+        &self,
+        e: &Event,
+        q: &Coords,
+        qd: &Coords,
+        dynamics: &Option<ConstrainedDynamics>,
+    ) -> f64 {
+        self.raw(e.kind, q, qd, dynamics) - e.floor
+    }
+
+    fn needs_forces(kind: EventKind) -> bool {
+        matches!(kind, EventKind::LiftOff(_) | EventKind::Unlock(_))
+    }
+
+    fn dynamics_if(&self, needed: bool, q: &Coords, qd: &Coords) -> Option<ConstrainedDynamics> {
+        needed
+            .then(|| constrained_dynamics(self.model, q, qd, &self.active).ok())
+            .flatten()
+    }
+
+    /// Values of all event functions at `y`, and the largest pulling force there (0 when no unilateral unit is
+    /// active, see [`largest_pull`]).
+    pub(crate) fn values(&self, y: &WalkVector) -> (Vec<f64>, f64) {
+        let (q, qd) = unpack(y);
+        let needed = self.events.iter().any(|e| Self::needs_forces(e.kind));
+        let dynamics = self.dynamics_if(needed, &q, &qd);
+        let values = self
+            .events
+            .iter()
+            .map(|e| self.shifted(e, &q, &qd, &dynamics))
+            .collect();
+        let pull = dynamics.map_or(0.0, |d| {
+            largest_pull(&d.multipliers, &self.active, self.model.params().rigid_legs)
+        });
+        (values, pull)
+    }
+
+    /// Value of event `k` at `y`.
+    pub(crate) fn value(&self, k: usize, y: &WalkVector) -> f64 {
+        let (q, qd) = unpack(y);
+        let e = &self.events[k];
+        let dynamics = self.dynamics_if(Self::needs_forces(e.kind), &q, &qd);
+        self.shifted(e, &q, &qd, &dynamics)
+    }
+
+    /// Arm guarded events whose function has cleared its gap; `values` are updated to the new definitions.
+    pub(crate) fn arm(&mut self, values: &mut [f64]) {
+        let opts = self.opts;
+        for (e, value) in self.events.iter_mut().zip(values.iter_mut()) {
+            let Some(gap) = Self::guard(opts, e.kind) else {
+                continue;
+            };
+            if e.floor == 0.0 {
+                continue;
+            }
+            let raw = *value + e.floor;
+            if raw > gap {
+                e.floor = 0.0;
+                *value = raw;
+            }
+        }
+    }
+}

@@ -1,0 +1,52 @@
+//! The phase ODE (docs/model.md section 4): the integrated state `[q, q', E_damper]` ([`WalkVector`]), its
+//! packing, and the vector field of one phase of constrained motion ([`PhaseSystem`]).
+
+use nalgebra::SVector;
+
+use crate::contact::{constrained_dynamics, ActiveSet};
+use crate::dynamics::{Coords, Model, L1, L2, NQ};
+use crate::integrate::OdeSystem;
+
+/// Size of the integrated state `[q, q', E_damper]`.
+pub const NY: usize = 2 * NQ + 1;
+/// The integrated state: coordinates, velocities and the energy dissipated by the dampers so far in the step.
+pub type WalkVector = SVector<f64, NY>;
+
+pub(crate) fn pack(q: &Coords, qd: &Coords, dissipated: f64) -> WalkVector {
+    let mut y = WalkVector::zeros();
+    y.fixed_rows_mut::<NQ>(0).copy_from(q);
+    y.fixed_rows_mut::<NQ>(NQ).copy_from(qd);
+    y[2 * NQ] = dissipated;
+    y
+}
+
+pub(crate) fn unpack(y: &WalkVector) -> (Coords, Coords) {
+    (
+        y.fixed_rows::<NQ>(0).into_owned(),
+        y.fixed_rows::<NQ>(NQ).into_owned(),
+    )
+}
+
+/// The vector field of one phase: Eq. (1) with the constraints of `active`, plus the damper power
+/// `c (dL1^2 + dL2^2)` as a quadrature.
+#[derive(Debug, Clone, Copy)]
+pub struct PhaseSystem<'a> {
+    /// The model.
+    pub model: &'a Model,
+    /// Active contacts and stoppers.
+    pub active: ActiveSet,
+}
+
+impl OdeSystem<NY> for PhaseSystem<'_> {
+    fn rhs(&self, _t: f64, y: &WalkVector) -> WalkVector {
+        let (q, qd) = unpack(y);
+        match constrained_dynamics(self.model, &q, &qd, &self.active) {
+            Ok(d) => {
+                let c = self.model.params().viscosity;
+                pack(&qd, &d.qdd, c * (qd[L1] * qd[L1] + qd[L2] * qd[L2]))
+            }
+            // The integrator reports a non-finite derivative as an error with its time.
+            Err(_) => WalkVector::repeat(f64::NAN),
+        }
+    }
+}

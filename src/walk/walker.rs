@@ -1,0 +1,671 @@
+//! The walker (docs/model.md sections 4-5): [`Walker`] takes the wheel from one touchdown to the next
+//! ([`Walker::step`]) in named stages: the touchdown impact, integration to the next event, the event's
+//! handling (release of a contact, an impact, a stopper), and at the next touchdown the step's report and the
+//! re-indexing of the legs.
+
+use std::cell::Cell;
+
+use crate::contact::{ActiveSet, Leg, Phase};
+use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X};
+use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
+use crate::params::SolverOptions;
+
+use super::error::WalkError;
+use super::events::{EventKind, EventSet, EVENT_SAMPLES};
+use super::impact::{
+    bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
+    touchdown_impact, Branch, Candidate, TouchdownImpact, Unit,
+};
+use super::phase::{pack, unpack, PhaseSystem, WalkVector, NY};
+use super::report::{ContactAudit, EnergyAudit, StepReport};
+use super::section::SectionState;
+use super::trajectory::Trajectory;
+use super::work::{add_to_total, WorkCounts};
+
+/// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
+/// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
+pub const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
+
+/// The wheel between events, in the frame of its current Leg 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkState {
+    /// Time \[s\].
+    pub time: f64,
+    /// `q` (with `x` relative to `x_origin`).
+    pub q: Coords,
+    /// `q'`.
+    pub qd: Coords,
+    /// Active contacts and stoppers (before the touchdown impact, when at the section).
+    pub active: ActiveSet,
+    /// Position along the slope of this frame's origin (the touchdown point of Leg 1) \[m\].
+    pub x_origin: f64,
+    /// Which physical leg (0..N) is Leg 1.
+    pub leg1: usize,
+}
+
+/// Bookkeeping of the step in progress.
+#[derive(Debug, Default, Clone, Copy)]
+struct StepTally {
+    dls_duration: f64,
+    rear_contact_duration: f64,
+    audit: ContactAudit,
+    scuffing: bool,
+    bounce: bool,
+    impact_loss: f64,
+    stopper_loss: f64,
+    events: usize,
+}
+
+/// Walks the wheel from touchdown to touchdown.
+#[derive(Debug, Clone)]
+pub struct Walker<'m> {
+    model: &'m Model,
+    opts: SolverOptions,
+    /// At the section: just before the touchdown impact, after re-indexing.
+    state: WalkState,
+    steps_done: usize,
+    /// Why the next step cannot start (the re-indexing at the last touchdown failed).
+    blocked: Option<WalkError>,
+    /// The work of every step taken so far.
+    work: WorkCounts,
+}
+
+/// Where the phases of a step end: the touchdown event, with what the step's report needs.
+struct Touchdown {
+    /// The impact that started the step.
+    td: TouchdownImpact,
+    tally: StepTally,
+    /// `T + V` at the start of the step \[J\].
+    e_start: f64,
+    /// Time of the touchdown event \[s\].
+    t: f64,
+    /// The state then.
+    y: WalkVector,
+    /// The active set then.
+    active: ActiveSet,
+}
+
+impl<'m> Walker<'m> {
+    /// Start at a Poincare-section state (docs/model.md section 6), at time 0 and position 0.
+    pub fn new(
+        model: &'m Model,
+        opts: &SolverOptions,
+        section: &SectionState,
+    ) -> Result<Walker<'m>, WalkError> {
+        section.validate(model)?;
+        let (q, qd) = section.to_coords(model);
+        let state = WalkState {
+            time: 0.0,
+            q,
+            qd,
+            active: ActiveSet {
+                contact1: false,
+                contact2: true,
+                lock1: true,
+                lock2: model.params().rigid_legs,
+                ..Default::default()
+            },
+            x_origin: 0.0,
+            leg1: 0,
+        };
+        Ok(Walker {
+            model,
+            opts: opts.clone(),
+            state,
+            steps_done: 0,
+            blocked: None,
+            work: WorkCounts::ZERO,
+        })
+    }
+
+    /// The current state (at the section).
+    pub fn state(&self) -> &WalkState {
+        &self.state
+    }
+
+    /// The section coordinates `(L2, thetadot, L2dot)` at the current touchdown, without the check of
+    /// [`Walker::section`]: what a return map or an orbit diagram records. Where the stance tip slides they do
+    /// not hold the whole state, so they must not be used to start a walk there.
+    pub fn touchdown_coordinates(&self) -> SectionState {
+        SectionState::from_coords(&self.state.q, &self.state.qd)
+    }
+
+    /// The current Poincare-section state, or why the walk cannot continue, or why the wheel is not on the
+    /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest, slides).
+    pub fn section(&self) -> Result<SectionState, WalkError> {
+        if let Some(e) = &self.blocked {
+            return Err(e.clone());
+        }
+        let (q, qd) = (&self.state.q, &self.state.qd);
+        let speed = self.model.tip(q, qd, Leg::Two.index()).velocity(qd).norm();
+        if speed > SECTION_TIP_SPEED_TOL {
+            return Err(WalkError::OffSection {
+                time: self.state.time,
+                speed,
+            });
+        }
+        Ok(self.touchdown_coordinates())
+    }
+
+    fn tolerances(&self) -> Tolerances {
+        Tolerances {
+            rtol: self.opts.rtol,
+            atol: self.opts.atol,
+            h_max: self.opts.max_step,
+            ..Tolerances::default()
+        }
+    }
+
+    /// Advance from this touchdown to the next one: the impact procedure, then the continuous phases and their
+    /// events. Returns the step's report; the walker is then at the next section. Samples go to `trajectory`.
+    ///
+    /// The stages: `walk_to_touchdown` (the touchdown impact, then `integrate_to_event` and `handle_event`
+    /// until the next touchdown), then `finish_step` (the report and the re-indexing). The step's work, failed
+    /// or not, is added to [`Walker::work`].
+    pub fn step(&mut self, trajectory: Option<&mut Trajectory>) -> Result<StepReport, WalkError> {
+        if let Some(e) = &self.blocked {
+            return Err(e.clone());
+        }
+        let start = self.state.clone();
+        let mut work = WorkCounts {
+            steps: 1,
+            ..WorkCounts::ZERO
+        };
+        let reached = self.walk_to_touchdown(&start, trajectory, &mut work);
+        self.work += work;
+        add_to_total(work);
+        reached.map(|touchdown| self.finish_step(&start, touchdown))
+    }
+
+    /// The work of every step this walker took, failed ones included.
+    pub fn work(&self) -> WorkCounts {
+        self.work
+    }
+
+    /// From the section state `start` to the next touchdown event: the touchdown impact and the active set
+    /// that follows it, then the phases up to the touchdown. Counts its work in `work`.
+    fn walk_to_touchdown(
+        &self,
+        start: &WalkState,
+        trajectory: Option<&mut Trajectory>,
+        work: &mut WorkCounts,
+    ) -> Result<Touchdown, WalkError> {
+        let model = self.model;
+        let t_start = start.time;
+
+        let e_start = model.energy(&start.q, &start.qd);
+        let td = touchdown_impact(model, &start.q, &start.qd, start.active)
+            .map_err(WalkError::contact_at(t_start, Phase::SingleSupport))?;
+        work.impacts += 1;
+        let mut tally = StepTally {
+            impact_loss: td.loss,
+            bounce: td.branch == Branch::Bounce,
+            ..StepTally::default()
+        };
+        tally.audit.pull_impulse = td.pull_impulse;
+        let mut present = start.active;
+        present.set_contact(Leg::One, true);
+        let (forced, candidates) = post_impact_candidates(
+            model,
+            &start.q,
+            &td.qd_plus,
+            &td.impulse_set,
+            &present,
+            &td.preferred,
+        );
+        let (active, _) = consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
+            .map_err(WalkError::contact_at(t_start, td.preferred.phase()))?
+            .ok_or(WalkError::InconsistentContacts {
+                time: t_start,
+                phase: td.preferred.phase(),
+            })?;
+        tally.scuffing |= active.slide2;
+
+        let y = pack(&start.q, &td.qd_plus, 0.0);
+        let mut phases = Phases::start(self, start, trajectory, tally, active, y);
+        let reached = phases.run();
+        *work += phases.work();
+        let (t, y) = reached?;
+        Ok(Touchdown {
+            td,
+            tally: phases.tally,
+            e_start,
+            t,
+            y,
+            active: phases.active,
+        })
+    }
+
+    /// Stage 3, at the touchdown event: the step's report, then re-indexing for the next step.
+    fn finish_step(&mut self, start: &WalkState, touchdown: Touchdown) -> StepReport {
+        let Touchdown {
+            td,
+            tally,
+            e_start,
+            t,
+            y,
+            active,
+        } = touchdown;
+        let model = self.model;
+        let (q, qd) = unpack(&y);
+        let e_end = model.energy(&q, &qd);
+        let damper = y[2 * NQ];
+        let loss = e_start - e_end;
+        let front = model.tip(&q, &qd, model.front_leg());
+        let step_length = front.position.x - start.q[X];
+        let period = t - start.time;
+        self.steps_done += 1;
+        let report = StepReport {
+            step: self.steps_done,
+            time: start.time,
+            section: SectionState::from_coords(&start.q, &start.qd),
+            theta: start.q[THETA],
+            indicators: td.indicators,
+            branch: td.branch,
+            dls_duration: tally.dls_duration,
+            rear_contact_duration: tally.rear_contact_duration,
+            period,
+            step_length,
+            speed: step_length / period,
+            scuffing: tally.scuffing,
+            bounce: tally.bounce,
+            events: tally.events,
+            energy: EnergyAudit {
+                start: e_start,
+                end: e_end,
+                loss,
+                damper,
+                impact: tally.impact_loss,
+                stopper: tally.stopper_loss,
+                residual: loss - (damper + tally.impact_loss + tally.stopper_loss),
+            },
+            contact: tally.audit,
+        };
+        match reindex(model, t, &q, &qd, active) {
+            Ok((q_new, qd_new, before)) => {
+                self.state = WalkState {
+                    time: t,
+                    q: q_new,
+                    qd: qd_new,
+                    active: before,
+                    x_origin: start.x_origin + front.position.x,
+                    leg1: (start.leg1 + model.legs() - 1) % model.legs(),
+                };
+            }
+            Err(e) => self.blocked = Some(e),
+        }
+        report
+    }
+}
+
+/// The continuous part of a step in progress: the phases between the touchdown impact and the next touchdown,
+/// integrated one accepted step at a time ([`Phases::integrate_to_event`]) with the events handled as they
+/// come ([`Phases::handle_event`]).
+struct Phases<'a> {
+    model: &'a Model,
+    opts: &'a SolverOptions,
+    /// The section state the step started from (its frame and time).
+    start: &'a WalkState,
+    trajectory: Option<&'a mut Trajectory>,
+    tally: StepTally,
+    /// Time of the integrator's current point \[s\].
+    t: f64,
+    /// The state at the last event (or the start of the step).
+    y: WalkVector,
+    active: ActiveSet,
+    /// A step that has not reached its touchdown by then stalls.
+    t_limit: f64,
+    solver: Integrator<NY>,
+    events: EventSet<'a>,
+    /// Event values at the integrator's current point.
+    g_prev: Vec<f64>,
+    /// Crossings, root evaluations, events and impacts so far (the integrator counts its own work).
+    work: WorkCounts,
+}
+
+/// An event located in an integrator step.
+struct Hit {
+    /// When \[s\].
+    time: f64,
+    /// Which event of the phase's [`EventSet`].
+    index: usize,
+    /// The state then, on the step's dense output.
+    y: WalkVector,
+}
+
+/// The event search over one integrator step ([`Phases::search_step`]).
+struct StepSearch {
+    /// The earliest crossing `(time, event index)`, if any.
+    hit: Option<(f64, usize)>,
+    /// Event values at the last sample point evaluated.
+    g_next: Vec<f64>,
+    /// The largest pulling force at that point.
+    pull_next: f64,
+    /// The states at the sample points (all of them when no event cuts the step short).
+    sampled: [WalkVector; EVENT_SAMPLES],
+}
+
+impl<'a> Phases<'a> {
+    /// Start the first phase at `(start.time, y)` with `active`, right after the touchdown impact.
+    fn start(
+        walker: &'a Walker<'_>,
+        start: &'a WalkState,
+        mut trajectory: Option<&'a mut Trajectory>,
+        mut tally: StepTally,
+        active: ActiveSet,
+        y: WalkVector,
+    ) -> Phases<'a> {
+        let (model, opts) = (walker.model, &walker.opts);
+        let t = start.time;
+        if let Some(tr) = trajectory.as_deref_mut() {
+            tr.push(model, t, &y, active, start);
+        }
+        let t_limit = start.time + opts.max_step_time;
+        let solver = Integrator::new(
+            opts.integrator,
+            &PhaseSystem { model, active },
+            t,
+            y,
+            walker.tolerances(),
+        );
+        let events = EventSet::new(model, opts, active, &y);
+        let (g_prev, pull) = events.values(&y);
+        tally.audit.see_force(pull);
+        tally.audit.see_tips(model, &y);
+        Phases {
+            model,
+            opts,
+            start,
+            trajectory,
+            tally,
+            t,
+            y,
+            active,
+            t_limit,
+            solver,
+            events,
+            g_prev,
+            work: WorkCounts::ZERO,
+        }
+    }
+
+    /// Integrate until the touchdown event: its time and state.
+    fn run(&mut self) -> Result<(f64, WalkVector), WalkError> {
+        loop {
+            let Some(hit) = self.integrate_to_event()? else {
+                continue;
+            };
+            if let Some(touchdown) = self.handle_event(hit)? {
+                return Ok(touchdown);
+            }
+        }
+    }
+
+    /// The work so far, the integrator's included.
+    fn work(&self) -> WorkCounts {
+        let stats = self.solver.stats();
+        WorkCounts {
+            accepted: stats.accepted,
+            rejected: stats.rejected,
+            rhs_evals: stats.rhs_evals,
+            ..self.work
+        }
+    }
+
+    /// Stage 1: one accepted integrator step, searched for events on its dense output, with the step's share
+    /// of the durations, the contact audit and the trajectory. Returns the earliest event in the step, or
+    /// `None` when there is none (the integrator's point is then the step's end, with the guards armed).
+    fn integrate_to_event(&mut self) -> Result<Option<Hit>, WalkError> {
+        let (model, active) = (self.model, self.active);
+        let phase = active.phase();
+        if self.t >= self.t_limit {
+            return Err(WalkError::Stalled {
+                time: self.t,
+                phase,
+                limit: self.opts.max_step_time,
+            });
+        }
+        let sys = PhaseSystem { model, active };
+        let step = self
+            .solver
+            .step(&sys, self.t_limit)
+            .map_err(|source| WalkError::Integration { phase, source })?;
+        let StepSearch {
+            hit,
+            mut g_next,
+            pull_next,
+            sampled,
+        } = self.search_step(&step);
+        let t_end = hit.map_or(step.t1(), |(t_hit, _)| t_hit);
+        if active.double_support() {
+            self.tally.dls_duration += t_end - step.t0();
+        }
+        if active.contact2 {
+            self.tally.rear_contact_duration += t_end - step.t0();
+        }
+        match hit {
+            // The same points see_dense would take (t0 + (t1 - t0) i / PENETRATION_SAMPLES), evaluated once.
+            None => sampled
+                .iter()
+                .for_each(|y| self.tally.audit.see_tips(model, y)),
+            Some(_) => self.tally.audit.see_dense(model, &step, t_end),
+        }
+        if let Some(tr) = self.trajectory.as_deref_mut() {
+            tr.record(model, &step, t_end, active, self.start);
+        }
+        let Some((t_hit, k)) = hit else {
+            self.tally.audit.see_force(pull_next);
+            self.events.arm(&mut g_next);
+            self.g_prev = g_next;
+            self.t = step.t1();
+            return Ok(None);
+        };
+        Ok(Some(Hit {
+            time: t_hit,
+            index: k,
+            y: step.eval(t_hit),
+        }))
+    }
+
+    /// The event search of stage 1. Events are looked for on [`EVENT_SAMPLES`] sub-intervals of the step's
+    /// dense output, the first one with a crossing first: an event function that dips below its floor and back
+    /// within a step is still caught if the dip is longer than a sub-interval. The pulling force at the sample
+    /// points before the last one goes to the contact audit.
+    fn search_step(&mut self, step: &DenseStep<NY>) -> StepSearch {
+        let opts = self.opts;
+        let mut hit: Option<(f64, usize)> = None;
+        let (mut t_a, mut pull_next) = (step.t0(), 0.0);
+        let mut g_next = Vec::new();
+        // The states at the sample points, for the penetration audit when no event cuts the step short.
+        let mut sampled = [WalkVector::zeros(); EVENT_SAMPLES];
+        for (i, y_b) in (1..=EVENT_SAMPLES).zip(sampled.iter_mut()) {
+            let t_b = if i == EVENT_SAMPLES {
+                step.t1()
+            } else {
+                step.t0() + (step.t1() - step.t0()) * i as f64 / EVENT_SAMPLES as f64
+            };
+            *y_b = step.eval(t_b);
+            (g_next, pull_next) = self.events.values(y_b);
+            for (k, (&g_a, &g_b)) in self.g_prev.iter().zip(&g_next).enumerate() {
+                if g_a > 0.0 && g_b <= 0.0 {
+                    let root_evals = Cell::new(0);
+                    let tk = locate_root(
+                        step,
+                        |_, y| {
+                            root_evals.set(root_evals.get() + 1);
+                            self.events.value(k, y)
+                        },
+                        t_a,
+                        g_a,
+                        t_b,
+                        g_b,
+                        opts.event_time_tol,
+                    );
+                    self.work.crossings += 1;
+                    self.work.root_evals += root_evals.get();
+                    if hit.is_none_or(|(t_hit, _)| tk < t_hit) {
+                        hit = Some((tk, k));
+                    }
+                }
+            }
+            if hit.is_some() {
+                break;
+            }
+            if i < EVENT_SAMPLES {
+                self.tally.audit.see_force(pull_next);
+                self.g_prev = std::mem::take(&mut g_next);
+            }
+            t_a = t_b;
+        }
+        StepSearch {
+            hit,
+            g_next,
+            pull_next,
+            sampled,
+        }
+    }
+
+    /// Stage 2: the event `hit`. A touchdown ends the phases (its time and state are returned), a fall or a
+    /// roll-back fails the step; any other event changes the active set (through an impact for a landing or a
+    /// stopper hit) and the next phase starts there.
+    fn handle_event(&mut self, hit: Hit) -> Result<Option<(f64, WalkVector)>, WalkError> {
+        let model = self.model;
+        let phase = self.active.phase();
+        let t = hit.time;
+        self.t = t;
+        self.y = hit.y;
+        let (q, qd) = unpack(&self.y);
+        self.tally.audit.see_force(self.events.values(&self.y).1);
+        let kind = self.events.events[hit.index].kind;
+        self.work.events.count(kind);
+        match kind {
+            EventKind::Touchdown => return Ok(Some((t, self.y))),
+            EventKind::Fall => {
+                return Err(WalkError::Fell {
+                    time: t,
+                    phase,
+                    hub_height: model.hub_height(&q),
+                })
+            }
+            EventKind::RollBack => return Err(WalkError::RolledBack { time: t, phase }),
+            EventKind::LiftOff(leg) => {
+                self.active = release_contact(model, t, &q, &qd, self.active, leg)?;
+                self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
+                self.tally.scuffing |= self.active.slide2;
+            }
+            EventKind::Unlock(leg) => self.active.set_lock(leg, false),
+            EventKind::Landing(leg) | EventKind::StopperHit(leg) => {
+                let unit = match kind {
+                    EventKind::Landing(_) => Unit::Contact(leg),
+                    _ => Unit::Stopper(leg),
+                };
+                let closed = close_unit(model, &q, &qd, self.active, unit)
+                    .map_err(WalkError::contact_at(t, phase))?
+                    .ok_or(WalkError::InconsistentContacts { time: t, phase })?;
+                self.work.impacts += 1;
+                let tally = &mut self.tally;
+                tally.audit.pull_impulse = tally.audit.pull_impulse.max(closed.pull_impulse);
+                match unit {
+                    Unit::Contact(_) => tally.impact_loss += closed.loss,
+                    Unit::Stopper(_) => tally.stopper_loss += closed.loss,
+                }
+                tally.scuffing |=
+                    (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
+                self.active = closed.active;
+                self.y = pack(&q, &closed.qd_plus, self.y[2 * NQ]);
+            }
+        }
+        self.tally.events += 1;
+        if self.tally.events > self.opts.max_events_per_step {
+            return Err(WalkError::Chatter {
+                time: t,
+                phase: self.active.phase(),
+                events: self.tally.events,
+            });
+        }
+        self.restart_phase();
+        Ok(None)
+    }
+
+    /// Start the next phase at the event just handled: the integrator and the event functions restart with the
+    /// new active set, and the trajectory takes a sample there.
+    fn restart_phase(&mut self) {
+        let (model, active) = (self.model, self.active);
+        let sys = PhaseSystem { model, active };
+        self.solver.restart(&sys, self.t, self.y);
+        self.events = EventSet::new(model, self.opts, active, &self.y);
+        let pull;
+        (self.g_prev, pull) = self.events.values(&self.y);
+        self.tally.audit.see_force(pull);
+        if let Some(tr) = self.trajectory.as_deref_mut() {
+            tr.push(model, self.t, &self.y, active, self.start);
+        }
+    }
+}
+
+/// A contact's normal force reached zero: the active set of the motion that follows, preferring the tip to
+/// leave the ground (it slides instead if leaving would drive it into the ground, see
+/// [`crate::params::ContactInconsistency`]).
+fn release_contact(
+    model: &Model,
+    time: f64,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+    leaving: Leg,
+) -> Result<ActiveSet, WalkError> {
+    let phase = active.phase();
+    let forced = bilateral_stoppers(model);
+    let mut candidates = Vec::new();
+    for leg in Leg::BOTH {
+        if active.contact(leg) {
+            candidates.push(if leg == leaving {
+                Candidate::releasing(leg)
+            } else {
+                Candidate::keep(Unit::Contact(leg), &active)
+            });
+        }
+        if active.lock(leg) && !forced.lock(leg) {
+            candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
+        }
+    }
+    let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
+        .map_err(WalkError::contact_at(time, phase))?
+        .ok_or(WalkError::InconsistentContacts { time, phase })?;
+    Ok(new_active)
+}
+
+/// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg becomes Leg 1, the old Leg 1
+/// becomes Leg 2, the old Leg 2 (which must be locked at `L0` and in the air) leaves `q`. The origin moves to
+/// the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
+fn reindex(
+    model: &Model,
+    time: f64,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+) -> Result<(Coords, Coords, ActiveSet), WalkError> {
+    if active.contact2 {
+        return Err(WalkError::RearLegInContact { time });
+    }
+    if !active.lock2 {
+        return Err(WalkError::RearLegNotLocked {
+            time,
+            length: q[L2],
+            rate: qd[L2],
+        });
+    }
+    let front = model.tip(q, qd, model.front_leg());
+    let v = front.velocity(qd);
+    let l0 = model.params().stopper_length;
+    let q_new = Coords::new(0.0, front.position.y, q[THETA] - model.alpha(), l0, q[L1]);
+    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, qd[L1]);
+    let before = ActiveSet {
+        contact1: false,
+        contact2: active.contact1,
+        lock1: true,
+        lock2: active.lock1,
+        ..Default::default()
+    };
+    Ok((q_new, qd_new, before))
+}
