@@ -16,7 +16,7 @@ use std::fmt;
 use serde::de::{self, DeserializeOwned, DeserializeSeed, IntoDeserializer, MapAccess, Visitor};
 use serde::forward_to_deserialize_any;
 
-use super::{file, invalid, ConfigError};
+use super::{invalid, load, ConfigError};
 
 /// One key's value on its way into a configuration, with where it came from.
 #[derive(Debug, Clone)]
@@ -49,8 +49,11 @@ impl Raw {
 /// defaults or a configuration's stored values, a file, overrides), a later value replacing an earlier one.
 pub(crate) type Table = BTreeMap<String, Raw>;
 
+/// One key of a table and its value.
+pub(crate) type Entry<'a> = (&'a str, &'a Raw);
+
 /// Reads the struct `T` (whose fields are keys) from `entries`, in their order; the first error stops it.
-pub(crate) fn read<T: DeserializeOwned>(entries: &[(&str, &Raw)]) -> Result<T, ConfigError> {
+pub(crate) fn read<T: DeserializeOwned>(entries: &[Entry<'_>]) -> Result<T, ConfigError> {
     let last_key = Cell::new("");
     let fields = Fields(Entries {
         entries: entries.iter(),
@@ -130,7 +133,7 @@ impl de::Error for ReadError {
     fn unknown_field(field: &str, _expected: &'static [&'static str]) -> Self {
         ReadError::Config(ConfigError::UnknownKey {
             key: field.to_string(),
-            known: file::all_keys().join(", "),
+            known: load::all_keys().join(", "),
         })
     }
 }
@@ -160,9 +163,9 @@ impl<'de> de::Deserializer<'de> for Fields<'_> {
 /// The entries of a table, handed to serde one key and value at a time.
 struct Entries<'a> {
     /// The entries not read yet.
-    entries: std::slice::Iter<'a, (&'a str, &'a Raw)>,
+    entries: std::slice::Iter<'a, Entry<'a>>,
     /// The entry whose key was read and whose value is next.
-    value: Option<(&'a str, &'a Raw)>,
+    value: Option<Entry<'a>>,
     /// The key read last, for errors that come without one.
     last_key: &'a Cell<&'a str>,
 }

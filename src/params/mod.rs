@@ -5,7 +5,7 @@
 //! every tolerance that guards grazing and chatter (`docs/model.md` section 4; in [`solver`], with the named
 //! choices [`ImpactModel`] and [`ContactInconsistency`]), and [`Config`] both of them together. Reading a
 //! configuration (a TOML file, `--set key=value` overrides, typed values from the Python binding) is in
-//! [`file`].
+//! [`load`].
 //!
 //! A configuration file is a *flat* TOML file whose keys are the field names of both structs; keys that
 //! are absent keep their defaults:
@@ -29,7 +29,7 @@ use std::fmt;
 use crate::fmt::short;
 
 mod de;
-pub mod file;
+pub mod load;
 pub mod model;
 pub mod solver;
 
@@ -45,7 +45,7 @@ pub use solver::{
 /// (e.g. `viscosity = 50.0`, `impact = "traditional"`, `rigid_legs = true`,
 /// `inconsistent_contact = "rebound"`, `rtol = 1e-11`).
 ///
-/// It is read by serde, one struct at a time ([`file`] says why not through `#[serde(flatten)]`).
+/// It is read by serde, one struct at a time ([`load`] says why not through `#[serde(flatten)]`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Config {
     /// Physical parameters (`docs/model.md` sections 1, 2 and 7). Default: the paper's Table 1.

@@ -82,7 +82,7 @@ impl fmt::Display for ContactInconsistency {
 /// Every tolerance that guards grazing or chatter is a named field here. Check a value built by hand
 /// with [`SolverOptions::validate`] (and [`Config::validate`](super::Config::validate) for the rule that involves [`Params`](super::Params)).
 ///
-/// Each field is a key of a configuration file, read by serde ([`super::file`]); absent keys keep their
+/// Each field is a key of a configuration file, read by serde ([`super::load`]); absent keys keep their
 /// defaults and unknown keys are refused.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]

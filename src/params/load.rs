@@ -17,7 +17,7 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use super::de::{self, Raw, Table};
+use super::de::{self, Entry, Raw, Table};
 use super::{Config, ConfigError, Params, SolverOptions};
 
 /// The keys of a configuration, found once from the structs.
@@ -202,7 +202,7 @@ impl Config {
     /// Reads `table` over the defaults, without validating.
     fn read(table: &Table) -> Result<Config, ConfigError> {
         let solver_keys = keys().solver;
-        let (solver, params): (Vec<(&str, &Raw)>, Vec<(&str, &Raw)>) = table
+        let (solver, params): (Vec<Entry>, Vec<Entry>) = table
             .iter()
             .map(|(key, value)| (key.as_str(), value))
             .partition(|(key, _)| solver_keys.contains(key));
@@ -596,5 +596,200 @@ mod tests {
             assert!(matches!(error, ConfigError::UnknownKey { .. }), "{error}");
             assert!(config.set_numeric(key, 1.0).is_err());
         }
+    }
+
+    /// Every key of the default configuration is written by the TOML writer and read back to the same value,
+    /// alone or all together, and the writer's keys are exactly the keys serde reads.
+    #[test]
+    fn every_default_key_round_trips_through_toml() {
+        let defaults = Config::default();
+        let table = toml::Table::try_from(&defaults).unwrap();
+        let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
+        let mut read = all_keys().to_vec();
+        written.sort_unstable();
+        read.sort_unstable();
+        assert_eq!(written, read);
+
+        let text = toml::to_string(&defaults).unwrap();
+        assert_eq!(Config::from_toml_str(&text).unwrap(), defaults);
+        for (key, value) in &table {
+            let mut one = toml::Table::new();
+            one.insert(key.clone(), value.clone());
+            let text = toml::to_string(&one).unwrap();
+            assert_eq!(Config::from_toml_str(&text).unwrap(), defaults, "{text}");
+            let mut config = Config::default();
+            config.set(key, &text_of(value)).unwrap();
+            assert_eq!(config, defaults, "--set {key}={value}");
+        }
+    }
+
+    /// The text a `--set` override would give for `value`.
+    fn text_of(value: &toml::Value) -> String {
+        match value {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Float(x) => format!("{x:e}"),
+            other => other.to_string(),
+        }
+    }
+
+    #[test]
+    fn unknown_key_is_refused_naming_it_in_a_file_and_in_set() {
+        let known = all_keys().join(", ");
+        let path = temp_path("unknown.toml");
+        std::fs::write(&path, "viscosity = 30\nviscosityy = 5\n").unwrap();
+        let from_file = Config::from_file(&path);
+        let loaded = Config::load(Some(&path), &["slope=0.05"]);
+        std::fs::remove_file(&path).unwrap();
+        let errors = [
+            from_file.unwrap_err(),
+            loaded.unwrap_err(),
+            Config::from_toml_str("viscosityy = 5").unwrap_err(),
+            Config::load(None, &["viscosityy=5"]).unwrap_err(),
+            Config::default()
+                .apply_override("viscosityy=5")
+                .unwrap_err(),
+            Config::default()
+                .with_values([("viscosityy".to_string(), toml::Value::Integer(5))])
+                .unwrap_err(),
+        ];
+        for error in errors {
+            match &error {
+                ConfigError::UnknownKey { key, known: listed } => {
+                    assert_eq!(key, "viscosityy");
+                    assert_eq!(listed, &known);
+                }
+                other => panic!("expected UnknownKey, got {other:?}"),
+            }
+            assert!(error.to_string().contains("`viscosityy`"), "{error}");
+        }
+    }
+
+    /// A finite literal that an f64 cannot hold is refused naming the key, not read as 0 or infinity.
+    #[test]
+    fn numbers_out_of_f64_range_are_refused_not_rounded() {
+        for assignment in [
+            "viscosity=1e-400",
+            "viscosity=1e400",
+            "viscosity=-1e400",
+            "hub_inertia=0.00001e-330",
+        ] {
+            let error = Config::default().apply_override(assignment).unwrap_err();
+            assert!(
+                matches!(error, ConfigError::InvalidValue { .. }),
+                "{assignment}: {error}"
+            );
+            let (key, value) = assignment.split_once('=').unwrap();
+            assert_eq!(key_of(&error), Some(key), "{assignment}: {error}");
+            assert!(error.to_string().contains(value), "{assignment}: {error}");
+        }
+        for text in [
+            "viscosity = 1e-400",
+            "viscosity = -1e400",
+            "viscosity = 1_0e-400",
+        ] {
+            let error = Config::from_toml_str(text).unwrap_err();
+            assert!(
+                matches!(error, ConfigError::InvalidValue { .. }),
+                "{text}: {error}"
+            );
+            assert_eq!(key_of(&error), Some("viscosity"), "{text}: {error}");
+        }
+        // Zero written as zero, subnormal numbers and the non-finite spellings are read as written (the
+        // last are refused by validation, naming the key).
+        for (assignment, value) in [
+            ("viscosity=0e-400", 0.0),
+            ("viscosity=0.000", 0.0),
+            ("hub_inertia=1e-310", 1e-310),
+        ] {
+            let mut config = Config::default();
+            config.apply_override(assignment).unwrap();
+            let key = assignment.split_once('=').unwrap().0;
+            assert_eq!(config.get_numeric(key).unwrap(), value, "{assignment}");
+        }
+        assert_eq!(
+            Config::from_toml_str("viscosity = 0.0e-400")
+                .unwrap()
+                .params
+                .viscosity,
+            0.0
+        );
+        let error = Config::load(None, &["viscosity=-inf"]).unwrap_err();
+        assert_eq!(key_of(&error), Some("viscosity"), "{error}");
+        assert!(error.to_string().contains("must be finite"), "{error}");
+    }
+
+    /// Overrides are merged before validation: they may repair a file, and a rule between two keys names the
+    /// key the user gave.
+    #[test]
+    fn overrides_are_validated_with_the_file() {
+        let path = temp_path("stopper.toml");
+        std::fs::write(&path, "stopper_length = 2\n").unwrap();
+        let alone = Config::from_file(&path);
+        let repaired = Config::load(Some(&path), &["spring_natural_length=2.5"]);
+        let still_bad = Config::load(Some(&path), &["viscosity=10"]);
+        std::fs::remove_file(&path).unwrap();
+
+        let repaired = repaired.unwrap();
+        assert_eq!(repaired.params.stopper_length, 2.0);
+        assert_eq!(repaired.params.spring_natural_length, 2.5);
+
+        for error in [alone.unwrap_err(), still_bad.unwrap_err()] {
+            assert_eq!(key_of(&error), Some("stopper_length"), "{error}");
+            assert_eq!(
+                error.to_string(),
+                "invalid value 2 for `stopper_length`: must be <= spring_natural_length (1.02)"
+            );
+        }
+        // Given both, or only the other key, the rule names the key it always named.
+        let error =
+            Config::load(None, &["stopper_length=2", "spring_natural_length=1.5"]).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "invalid value 1.5 for `spring_natural_length`: must be >= stopper_length (2)"
+        );
+        let error = Config::load(None, &["stopper_length=0.2"]).unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "invalid value 0.2 for `stopper_length`: must be > leg_mass_offset (0.3)"
+        );
+        let error = Config::default()
+            .with_values([("stopper_length".to_string(), toml::Value::Float(0.25))])
+            .unwrap_err();
+        assert_eq!(key_of(&error), Some("stopper_length"), "{error}");
+        let error = Config::load(None, &["hub_mass=1e-7"]).unwrap_err();
+        assert_eq!(key_of(&error), Some("hub_mass"), "{error}");
+        assert!(error.to_string().contains("leg_mass / hub_mass"), "{error}");
+    }
+
+    /// Keys holding an integer take integers only, from a file, `--set` and typed fronts alike.
+    #[test]
+    fn integer_keys_take_integers_only() {
+        for value in ["8.0", "8e0", "8.5", "true", "\"8\""] {
+            let error = Config::from_toml_str(&format!("legs = {value}")).unwrap_err();
+            assert!(
+                matches!(error, ConfigError::WrongType { .. }),
+                "{value}: {error}"
+            );
+        }
+        for value in ["8.0", "8e0", "0x8", "true"] {
+            let error = Config::default()
+                .apply_override(&format!("legs={value}"))
+                .unwrap_err();
+            assert!(
+                matches!(error, ConfigError::WrongType { .. }),
+                "{value}: {error}"
+            );
+            assert!(
+                error.to_string().contains("a non-negative integer"),
+                "{error}"
+            );
+        }
+        let error = Config::default()
+            .with_values([("legs".to_string(), toml::Value::Float(8.0))])
+            .unwrap_err();
+        assert_eq!(
+            error.to_string(),
+            "wrong type for `legs`: expected a non-negative integer, found the float 8"
+        );
     }
 }
