@@ -91,17 +91,15 @@ fn toml_value(key: &str, value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     )))
 }
 
-/// Apply `keys` (keyword arguments or a state dict) to `config`, then validate, as the command line does.
-fn apply_keys(mut config: Config, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
-    if let Some(keys) = keys {
-        for (key, value) in keys.iter() {
-            let key: String = key.extract()?;
-            let value = toml_value(&key, &value)?;
-            config.set_value(&key, &value).map_err(config_error)?;
-        }
+/// Apply `keys` (keyword arguments or a state dict) to `config`, then validate once, as the command line does.
+fn apply_keys(config: Config, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Config> {
+    let mut values = Vec::new();
+    for (key, value) in keys.into_iter().flat_map(|d| d.iter()) {
+        let key: String = key.extract()?;
+        let value = toml_value(&key, &value)?;
+        values.push((key, value));
     }
-    config.validate().map_err(config_error)?;
-    Ok(config)
+    config.with_values(values).map_err(config_error)
 }
 
 /// The model's parameters and the solver's settings: every key of a vrw TOML file.

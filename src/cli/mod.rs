@@ -66,15 +66,7 @@ struct ModelArgs {
 
 impl ModelArgs {
     fn load(&self) -> Result<Config> {
-        let mut config = match &self.config {
-            Some(path) => Config::from_file(path)?,
-            None => Config::default(),
-        };
-        for assignment in &self.set {
-            config.apply_override(assignment)?;
-        }
-        config.validate()?;
-        Ok(config)
+        Ok(Config::load(self.config.as_deref(), &self.set)?)
     }
 }
 

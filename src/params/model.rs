@@ -1,0 +1,214 @@
+//! The physical model's parameters: [`Params`], the wheel and the slope (`docs/model.md` sections 1, 2
+//! and 7, defaults from the paper's Table 1), with the rules a valid model obeys.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use super::solver::{ContactInconsistency, ImpactModel};
+use super::{finite, invalid, non_negative, ordered, positive, ConfigError, Order::*};
+use crate::fmt::short;
+
+/// Physical parameters of the wheel and the slope (`docs/model.md` sections 1, 2 and 7).
+///
+/// Defaults are the paper's Table 1; the viscosity `c` is the parameter the paper sweeps. Check a value
+/// built by hand with [`Params::validate`].
+///
+/// Each field is a key of a configuration file, read by serde ([`super::load`]); absent keys keep their
+/// defaults and unknown keys are refused.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Params {
+    /// Number of legs `N` \[-\]. Default 8, i.e. the inter-leg angle `alpha = 2 pi / N = pi/4` of Table 1
+    /// (see [`Params::alpha`]). From 3 to [`MAX_LEGS`]. `docs/model.md` section 1.
+    pub legs: usize,
+    /// Hub mass `mH` \[kg\]. Default 10 (Table 1). Positive. `docs/model.md` section 2.
+    pub hub_mass: f64,
+    /// Rotational inertia `IH` of the hub about its centre \[kg m^2\]. Default 0: the paper gives none, so
+    /// this is an **assumption** (`docs/model.md` section 2). Non-negative.
+    pub hub_inertia: f64,
+    /// Leg mass `m` \[kg\], a point mass on the sliding part of each leg. Default 1 (Table 1). Positive.
+    /// `docs/model.md` section 2.
+    pub leg_mass: f64,
+    /// Distance `a` of the leg mass from the leg's tip \[m\]. Default 0.3 (Table 1). In
+    /// `[0, stopper_length)`. `docs/model.md` section 2.
+    pub leg_mass_offset: f64,
+    /// Stopper length `L0` \[m\]: the longest a leg can be (hub to tip); legs other than Leg 1 and Leg 2
+    /// are locked at it. Default 1.0 (Table 1). Positive. `docs/model.md` section 2.
+    pub stopper_length: f64,
+    /// Natural length `Lstar` of the leg spring \[m\]. Default 1.02 (Table 1). At least `stopper_length`:
+    /// the spring is preloaded by `k (Lstar - L0)` (10 N by default) so that an unloaded leg rests on its
+    /// stopper. `docs/model.md` section 2.
+    pub spring_natural_length: f64,
+    /// Spring stiffness `k` of Legs 1 and 2 \[N/m\]. Default 500 (Table 1). Positive. `docs/model.md` section 2.
+    pub stiffness: f64,
+    /// Damper viscosity `c` of Legs 1 and 2 \[N s/m\]: the force along a leg is
+    /// `k (Lstar - L) - c dL/dt`. Default 50; the paper sweeps it (thresholds near 4.0 and 220).
+    /// Non-negative. `docs/model.md` sections 2 and 6.
+    pub viscosity: f64,
+    /// Slope angle `phi` \[rad\]; the wheel walks down a slope with `phi > 0`. Default 0.10 (Table 1).
+    /// `|phi| < pi/2`. `docs/model.md` section 1.
+    pub slope: f64,
+    /// Gravitational acceleration `g` \[m/s^2\]. Default 9.81. Positive. `docs/model.md` section 1.
+    pub gravity: f64,
+    /// Impact law at touchdown. Default [`ImpactModel::Dlsi`]. `docs/model.md` section 5.
+    pub impact: ImpactModel,
+    /// Rigid special case: when `true`, every leg stays locked at `stopper_length` (the stopper acts both
+    /// ways, through impacts too) and the exchange is the traditional one, which makes the model the
+    /// classical rigid rimless wheel with a closed-form step map. Default `false`. `docs/model.md` section 7.
+    pub rigid_legs: bool,
+    /// What happens when no no-slip contact state is consistent (a lift-off with a non-zero tangential
+    /// contact force). Default [`ContactInconsistency::Slide`]. `docs/model.md` sections 3-4.
+    pub inconsistent_contact: ContactInconsistency,
+}
+
+impl Default for Params {
+    /// The paper's Table 1, with `c = 50 N s/m`, `g = 9.81 m/s^2`, `IH = 0`, the DLS-indicator impact and
+    /// frictionless sliding at an inconsistent contact.
+    fn default() -> Self {
+        Params {
+            legs: 8,
+            hub_mass: 10.0,
+            hub_inertia: 0.0,
+            leg_mass: 1.0,
+            leg_mass_offset: 0.3,
+            stopper_length: 1.0,
+            spring_natural_length: 1.02,
+            stiffness: 500.0,
+            viscosity: 50.0,
+            slope: 0.10,
+            gravity: 9.81,
+            impact: ImpactModel::Dlsi,
+            rigid_legs: false,
+            inconsistent_contact: ContactInconsistency::Slide,
+        }
+    }
+}
+
+impl Params {
+    /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`docs/model.md` section 1); `pi/4` by default.
+    pub fn alpha(&self) -> f64 {
+        2.0 * PI / self.legs as f64
+    }
+
+    /// Checks every rule on the physical parameters; the error names the first offending key.
+    ///
+    /// Rules: `3 <= legs <=` [`MAX_LEGS`]; every real value finite; `hub_mass`, `leg_mass`, `gravity`, `stopper_length`,
+    /// `stiffness > 0`; `hub_inertia`, `viscosity >= 0`; `|slope| < pi/2`;
+    /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length`;
+    /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.check(&|_| true)
+    }
+
+    /// [`Params::validate`], where a rule between two keys names the one the user gave (`given(key)`): a file
+    /// that sets only `stopper_length = 2` is told that `stopper_length` must be `<= spring_natural_length`,
+    /// not that the default `spring_natural_length` is wrong. When both or neither were given, the rule
+    /// names the key [`Params::validate`] names.
+    pub(crate) fn check(&self, given: &dyn Fn(&str) -> bool) -> Result<(), ConfigError> {
+        if !(3..=MAX_LEGS).contains(&self.legs) {
+            return Err(invalid(
+                "legs",
+                self.legs,
+                format!("must be between 3 and {MAX_LEGS}"),
+            ));
+        }
+        positive("hub_mass", self.hub_mass)?;
+        non_negative("hub_inertia", self.hub_inertia)?;
+        positive("leg_mass", self.leg_mass)?;
+        non_negative("leg_mass_offset", self.leg_mass_offset)?;
+        positive("stopper_length", self.stopper_length)?;
+        finite("spring_natural_length", self.spring_natural_length)?;
+        positive("stiffness", self.stiffness)?;
+        non_negative("viscosity", self.viscosity)?;
+        finite("slope", self.slope)?;
+        if self.slope.abs() >= FRAC_PI_2 {
+            return Err(invalid(
+                "slope",
+                short(self.slope),
+                "must satisfy |slope| < pi/2 (a slope angle in radians)",
+            ));
+        }
+        positive("gravity", self.gravity)?;
+        let ratio = self.leg_mass / self.hub_mass;
+        if !(1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio) {
+            let (key, value) = if !given("leg_mass") && given("hub_mass") {
+                ("hub_mass", self.hub_mass)
+            } else {
+                ("leg_mass", self.leg_mass)
+            };
+            return Err(invalid(
+                key,
+                short(value),
+                format!(
+                    "leg_mass / hub_mass = {} is outside [{}, {}]: the mass matrix would be singular to rounding",
+                    short(ratio),
+                    short(1.0 / MASS_RATIO_LIMIT),
+                    short(MASS_RATIO_LIMIT)
+                ),
+            ));
+        }
+        let stopper = ("stopper_length", self.stopper_length);
+        ordered(
+            ("leg_mass_offset", self.leg_mass_offset),
+            Below,
+            stopper,
+            given,
+        )?;
+        ordered(
+            ("spring_natural_length", self.spring_natural_length),
+            AtLeast,
+            stopper,
+            given,
+        )
+    }
+}
+
+/// `leg_mass / hub_mass` must lie in `[1 / MASS_RATIO_LIMIT, MASS_RATIO_LIMIT]`: beyond it `M(q)` is singular
+/// to rounding and the constraint solves fail.
+pub const MASS_RATIO_LIMIT: f64 = 1e6;
+
+/// The largest accepted number of legs.
+pub const MAX_LEGS: usize = 1000;
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::PI;
+
+    use crate::params::*;
+
+    #[test]
+    fn defaults_equal_table_1() {
+        let p = Params::default();
+        assert_eq!(p.legs, 8);
+        assert_eq!(p.alpha(), PI / 4.0);
+        assert_eq!(p.hub_mass, 10.0);
+        assert_eq!(p.hub_inertia, 0.0);
+        assert_eq!(p.leg_mass, 1.0);
+        assert_eq!(p.leg_mass_offset, 0.3);
+        assert_eq!(p.stopper_length, 1.0);
+        assert_eq!(p.spring_natural_length, 1.02);
+        assert_eq!(p.stiffness, 500.0);
+        assert_eq!(p.viscosity, 50.0);
+        assert_eq!(p.slope, 0.10);
+        assert_eq!(p.gravity, 9.81);
+        assert_eq!(p.impact, ImpactModel::Dlsi);
+        assert!(!p.rigid_legs);
+        assert_eq!(p.inconsistent_contact, ContactInconsistency::Slide);
+        // The preload k (Lstar - L0) = 10 N exceeds the leg weight m g (docs/model.md section 2).
+        let preload = p.stiffness * (p.spring_natural_length - p.stopper_length);
+        assert!(preload > p.leg_mass * p.gravity);
+
+        let s = SolverOptions::default();
+        assert_eq!(s.rtol, 1e-10);
+        assert_eq!(s.atol, 1e-12);
+        assert_eq!(s.max_step, 0.04);
+        assert_eq!(s.event_time_tol, 1e-13);
+        assert_eq!(s.recontact_gap, 1e-11);
+        assert_eq!(s.stopper_gap, 1e-9);
+        assert_eq!(s.fall_hub_height, 0.3);
+        assert_eq!(s.max_step_time, 60.0);
+        assert_eq!(s.max_events_per_step, 200);
+
+        Config::default().validate().unwrap();
+        assert_eq!(Config::from_toml_str("").unwrap(), Config::default());
+    }
+}
