@@ -7,7 +7,7 @@
 //!
 //! | event | function crossing zero from above |
 //! |---|---|
-//! | touchdown | height of the next leg's tip (length `L0`) |
+//! | touchdown | height of the lowest tip of the legs not in `q` (the next leg's in a walk, see [`touchdown_leg`]) |
 //! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (to [`FORCE_EVENT_MARGIN`] below 0) |
 //! | landing / rear re-contact of an airborne tip | its height (armed once above `recontact_gap`, see below) |
 //! | stopper unlock | the stopper's inward reaction (to [`FORCE_EVENT_MARGIN`] below 0) |
@@ -52,7 +52,7 @@ use crate::params::SolverOptions;
 pub use error::WalkError;
 use impact::{
     bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
-    touchdown_impact, Candidate, Unit, COMPLEMENTARITY_TOL,
+    touchdown_impact, touchdown_leg, Candidate, Unit, COMPLEMENTARITY_TOL,
 };
 pub use impact::{Branch, DlsIndicators};
 pub use report::{ContactAudit, EnergyAudit, StepReport};
@@ -412,7 +412,7 @@ impl<'a> EventSet<'a> {
     ) -> f64 {
         let force = |f: &dyn Fn(&ConstrainedDynamics) -> f64| dynamics.as_ref().map_or(f64::NAN, f);
         match kind {
-            EventKind::Touchdown => self.model.tip_height(q, self.model.front_leg()),
+            EventKind::Touchdown => self.model.tip_height(q, touchdown_leg(self.model, q)),
             EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
             EventKind::RollBack => qd[THETA],
             EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)),
@@ -504,10 +504,13 @@ impl ContactAudit {
         self.pull_force = self.pull_force.max(pull);
     }
 
-    /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`).
+    /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`),
+    /// and the farthest Leg 1 or 2 is past its stopper.
     fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
+        let l0 = model.params().stopper_length;
+        self.stopper_overrun = self.stopper_overrun.max(q[L1].max(q[L2]) - l0);
     }
 
     /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).
@@ -867,7 +870,8 @@ impl<'m> Walker<'m> {
         let e_end = model.energy(&q, &qd);
         let damper = y[2 * NQ];
         let loss = e_start - e_end;
-        let front = model.tip(&q, &qd, model.front_leg());
+        let touching = touchdown_leg(model, &q);
+        let front = model.tip(&q, &qd, touching);
         let step_length = front.position.x - start.q[X];
         let period = t - start.time;
         self.steps_done += 1;
@@ -897,7 +901,7 @@ impl<'m> Walker<'m> {
             },
             contact: tally.audit,
         };
-        match reindex(model, t, &q, &qd, active) {
+        match reindex(model, t, &q, &qd, active, touching) {
             Ok((q_new, qd_new, before)) => {
                 self.state = WalkState {
                     time: t,
@@ -905,7 +909,7 @@ impl<'m> Walker<'m> {
                     qd: qd_new,
                     active: before,
                     x_origin: start.x_origin + front.position.x,
-                    leg1: (start.leg1 + model.legs() - 1) % model.legs(),
+                    leg1: (start.leg1 + touching) % model.legs(),
                 };
             }
             Err(e) => self.blocked = Some(e),
@@ -914,36 +918,56 @@ impl<'m> Walker<'m> {
     }
 }
 
-/// Re-indexing at touchdown (paper Sec. 2.2, MODEL.md section 5): the touching leg becomes Leg 1, the old Leg 1
-/// becomes Leg 2, the old Leg 2 (which must be locked at `L0` and in the air) leaves `q`. The origin moves to
-/// the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
+/// Re-indexing at touchdown (paper Sec. 2.2, MODEL.md section 5): the touching leg `touching` (the front leg
+/// `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs that
+/// leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be locked at `L0` and in the air. The
+/// origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
 fn reindex(
     model: &Model,
     time: f64,
     q: &Coords,
     qd: &Coords,
     active: ActiveSet,
+    touching: usize,
 ) -> Result<(Coords, Coords, ActiveSet), WalkError> {
-    if active.contact2 {
-        return Err(WalkError::RearLegInContact { time });
+    // The touching leg is `shift` legs ahead of Leg 1; with `shift > 1` the new Leg 2 is a locked leg.
+    let shift = model.legs() - touching;
+    let leaving: &[Leg] = if shift == 1 { &[Leg::Two] } else { &Leg::BOTH };
+    for &leg in leaving {
+        if active.contact(leg) {
+            return Err(WalkError::RearLegInContact { time });
+        }
+        if !active.lock(leg) {
+            let i = leg.length_coordinate();
+            return Err(WalkError::RearLegNotLocked {
+                time,
+                length: q[i],
+                rate: qd[i],
+            });
+        }
     }
-    if !active.lock2 {
-        return Err(WalkError::RearLegNotLocked {
-            time,
-            length: q[L2],
-            rate: qd[L2],
-        });
-    }
-    let front = model.tip(q, qd, model.front_leg());
+    let front = model.tip(q, qd, touching);
     let v = front.velocity(qd);
     let l0 = model.params().stopper_length;
-    let q_new = Coords::new(0.0, front.position.y, q[THETA] - model.alpha(), l0, q[L1]);
-    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, qd[L1]);
+    let (l2, l2_dot) = if shift == 1 {
+        (q[L1], qd[L1])
+    } else {
+        (l0, 0.0)
+    };
+    let theta = if shift == 1 {
+        q[THETA] - model.alpha()
+    } else {
+        // psi of the touching leg, in [-pi, pi].
+        let psi = q[THETA] + touching as f64 * model.alpha();
+        psi - std::f64::consts::TAU * (psi / std::f64::consts::TAU).round()
+    };
+    let q_new = Coords::new(0.0, front.position.y, theta, l0, l2);
+    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot);
     let before = ActiveSet {
         contact1: false,
-        contact2: active.contact1,
+        contact2: shift == 1 && active.contact1,
         lock1: true,
-        lock2: active.lock1,
+        lock2: shift > 1 || active.lock1,
         ..Default::default()
     };
     Ok((q_new, qd_new, before))
