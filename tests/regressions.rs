@@ -116,8 +116,33 @@ fn stiff_legs_find_their_gait_from_the_default_start() {
     assert_eq!(table1.to_array(), TUNED_START.to_array());
 }
 
-/// One walk of the search: its number, `[legs, slope, k, c]`, steps walked, how it ended, its audit violations.
-type SearchResult = (usize, [f64; 4], usize, String, Vec<String>);
+/// One walk of the search: its number, `[legs, slope, k, c]`, steps walked, how it ended, its audit violations
+
+/// and the largest stopper overrun of its completed steps.
+type SearchResult = (usize, [f64; 4], usize, String, Vec<String>, f64);
+
+/// Stiff preloaded legs (`k = 3000 N/m`) bounce into flight, where both legs extend onto their stoppers. Each
+/// stopper impact is solved with the other stopper in the same complementarity problem, and stops its leg while
+/// kicking the other leg off its stopper with about 4 % of the speed (a Zeno sequence that would end within
+/// microseconds). But once a kicked leg's excursion falls below `stopper_gap`, its grazing guard lets it hit
+/// `stopper_gap` past where it left, and the spring's work over that gap keeps the sequence going at about
+/// 4e-4 m/s: the walk ends in `chatter ... in flight` (with a large event budget, the overrun grows to 2.5e-5 m
+/// and the walk ends in `rear_leg_not_locked`). Not fixed yet.
+#[test]
+#[ignore = "known defect: stopper chatter in flight with stiff preloaded legs (see the test's documentation)"]
+fn stiff_legs_do_not_chatter_in_flight() {
+    let config = config(&[("stiffness", 3000.0)]);
+    let run = walk(&config, &default_initial(&config), 10);
+    assert!(run.failure.is_none(), "{:?}", run.failure);
+    for s in &run.steps {
+        assert!(
+            s.contact.stopper_overrun <= 2e-9,
+            "step {}: {:?}",
+            s.step,
+            s.contact
+        );
+    }
+}
 
 /// A small deterministic generator (xorshift64*), so that the search needs no dependency and repeats.
 struct Rng(u64);
@@ -192,12 +217,18 @@ fn random_walks_audit_search() {
                 })
                 .collect();
             let end = run.failure.map_or("ok".to_string(), |e| e.to_string());
-            (i, [legs, slope, k, c], run.steps.len(), end, bad)
+            let overrun = run
+                .steps
+                .iter()
+                .map(|s| s.contact.stopper_overrun)
+                .fold(0.0, f64::max);
+            (i, [legs, slope, k, c], run.steps.len(), end, bad, overrun)
         })
         .collect();
     let mut flagged = 0;
     let mut ends = std::collections::BTreeMap::<String, usize>::new();
-    for (i, [legs, slope, k, c], steps, end, bad) in &results {
+    let worst_overrun = results.iter().map(|r| r.5).fold(0.0, f64::max);
+    for (i, [legs, slope, k, c], steps, end, bad, _) in &results {
         let kind = end.split(':').next().unwrap_or("").to_string();
         let kind = kind.split(" (t =").next().unwrap_or("").to_string();
         *ends.entry(kind).or_default() += 1;
@@ -210,6 +241,7 @@ fn random_walks_audit_search() {
         }
     }
     println!("endings: {ends:?}");
+    println!("largest stopper overrun of a completed step: {worst_overrun:e} m");
     println!("{flagged} of {walks} walks have an audit value above tolerance");
     assert_eq!(flagged, 0);
 }
