@@ -117,7 +117,6 @@ fn stiff_legs_find_their_gait_from_the_default_start() {
 }
 
 /// One walk of the search: its number, `[legs, slope, k, c]`, steps walked, how it ended, its audit violations
-
 /// and the largest stopper overrun of its completed steps.
 type SearchResult = (usize, [f64; 4], usize, String, Vec<String>, f64);
 
