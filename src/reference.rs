@@ -148,18 +148,40 @@ impl RigidRimlessWheel {
     }
 }
 
-/// The default starting point on the Poincare section (docs/model.md section 6): `(0.72, 1.0, 0.0)`, or, with
-/// `rigid_legs`, `(L0, omega*, 0.0)` with `omega*` the closed-form gait of the rigid rimless wheel
+/// The least default start length of Leg 2 as a fraction of `L0` (0.72 m with Table 1's `L0 = 1 m`): the start
+/// tuned for the paper's parameters (`k = 500 N/m`), where the static compression of [`default_initial`] would
+/// put Leg 2 lower (0.669 m). A softer leg is not started more compressed than this.
+pub const DEFAULT_START_LENGTH_FRACTION: f64 = 0.72;
+
+/// How far above `L0 cos(alpha)` (as a factor) the default start keeps Leg 2: at `L2 = L0 cos(alpha)` the section
+/// has `theta = -alpha`, and the tip of the leg behind Leg 2 touches the ground too (below, it starts in it).
+pub const VALID_START_MARGIN: f64 = 1.01;
+
+/// The default starting point on the Poincare section (docs/model.md section 6), derived from the parameters:
+///
+/// - `L2 = min(L0, max(0.72 L0, 1.01 L0 cos(alpha), Lstar - M g cos(phi) / k))`, with `M = mH + N m` the
+///   wheel's mass: Leg 2 at the length at which its spring alone carries the wheel's weight normal to the slope
+///   (its static compression), but no shorter than [`DEFAULT_START_LENGTH_FRACTION`] of `L0` (the start tuned
+///   for the paper's `k = 500 N/m`, where the static length is 0.669 m, so Table 1 starts at `(0.72, 1.0, 0.0)`
+///   as before), no shorter than [`VALID_START_MARGIN`] times `L0 cos(alpha)` (with many legs a shorter Leg 2
+///   would put the next leg's tip in the ground), and no longer than the stopper. A stiff leg (`k = 3000 N/m`,
+///   `Lstar = L0`: 0.941 m) thus starts near its stopper, where its gait is, instead of far inside the spring's
+///   range;
+/// - `dtheta/dt = sqrt(L2 / (0.72 L0))` rad/s: 1.0 rad/s where `L2` is at its floor (Table 1), faster for a
+///   leg that starts nearer its stopper. This is an empirical **choice**: a stiff wheel loses more energy per
+///   step (it tends to the rigid wheel, whose gait is faster), and started at 1 rad/s from its static length it
+///   rolls back within three steps (`k = 3000 N/m`, `Lstar = L0`: 1.14 rad/s walks to the gait, 1.0 does not);
+/// - `dL2/dt = 0`;
+///
+/// with `rigid_legs`, `(L0, omega*, 0.0)` with `omega*` the closed-form gait of the rigid rimless wheel
 /// ([`RigidRimlessWheel::fixed_point`]), since rigid legs stay at `L0` and a rigid wheel started much slower
 /// than its gait rolls back.
 pub fn default_initial(config: &Config) -> SectionState {
-    if config.params.rigid_legs {
-        let omega = RigidRimlessWheel {
-            params: config.params.clone(),
-        }
-        .fixed_point();
+    let p = &config.params;
+    if p.rigid_legs {
+        let omega = RigidRimlessWheel { params: p.clone() }.fixed_point();
         SectionState {
-            l2: config.params.stopper_length,
+            l2: p.stopper_length,
             theta_dot: if omega.is_finite() && omega > 0.0 {
                 omega
             } else {
@@ -168,9 +190,16 @@ pub fn default_initial(config: &Config) -> SectionState {
             l2_dot: 0.0,
         }
     } else {
+        let mass = p.hub_mass + p.legs as f64 * p.leg_mass;
+        let static_length =
+            p.spring_natural_length - mass * p.gravity * p.slope.cos() / p.stiffness;
+        let tuned = DEFAULT_START_LENGTH_FRACTION * p.stopper_length;
+        // Below L0 cos(alpha) the leg behind Leg 2 would start below the ground.
+        let floor = tuned.max(VALID_START_MARGIN * p.stopper_length * p.alpha().cos());
+        let l2 = static_length.max(floor).min(p.stopper_length);
         SectionState {
-            l2: 0.72,
-            theta_dot: 1.0,
+            l2,
+            theta_dot: (l2 / tuned).sqrt(),
             l2_dot: 0.0,
         }
     }

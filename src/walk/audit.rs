@@ -1,7 +1,8 @@
-//! The contact audit's per-step checks (docs/model.md section 7): the largest pulling force seen, and tips
-//! below the ground on the dense output ([`PENETRATION_SAMPLES`] points per integrator step).
+//! The contact audit's per-step checks (docs/model.md section 7): the largest pulling force seen, tips below
+//! the ground on the dense output ([`PENETRATION_SAMPLES`] points per integrator step), and legs past their
+//! stoppers.
 
-use crate::dynamics::Model;
+use crate::dynamics::{Model, L1, L2};
 use crate::integrate::DenseStep;
 
 use super::events::EVENT_SAMPLES;
@@ -19,10 +20,13 @@ impl ContactAudit {
         self.pull_force = self.pull_force.max(pull);
     }
 
-    /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`).
+    /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`),
+    /// and the farthest Leg 1 or 2 is past its stopper.
     pub(crate) fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
+        let l0 = model.params().stopper_length;
+        self.stopper_overrun = self.stopper_overrun.max(q[L1].max(q[L2]) - l0);
     }
 
     /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).

@@ -6,7 +6,7 @@ use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ConstrainedD
 use crate::dynamics::{Coords, Model, THETA};
 use crate::params::SolverOptions;
 
-use super::impact::COMPLEMENTARITY_TOL;
+use super::impact::{touchdown_leg, COMPLEMENTARITY_TOL};
 use super::phase::{unpack, WalkVector};
 
 /// A lift-off or stopper-unlock event fires when the force falls this far below zero \[N\] (or below its
@@ -145,7 +145,7 @@ impl<'a> EventSet<'a> {
     ) -> f64 {
         let force = |f: &dyn Fn(&ConstrainedDynamics) -> f64| dynamics.as_ref().map_or(f64::NAN, f);
         match kind {
-            EventKind::Touchdown => self.model.tip_height(q, self.model.front_leg()),
+            EventKind::Touchdown => self.model.tip_height(q, touchdown_leg(self.model, q)),
             EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
             EventKind::RollBack => qd[THETA],
             EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)),

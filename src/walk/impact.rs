@@ -14,13 +14,18 @@ use crate::contact::{
     constrained_dynamics, impulse, largest_pull, ActiveSet, ConstrainedDynamics, ContactError,
     ImpulseSolution, Leg, Multipliers,
 };
-use crate::dynamics::{Coords, Model};
+use crate::dynamics::{Coords, LegIndex, Model, THETA};
 use crate::params::{ContactInconsistency, ImpactModel};
 
 /// Tolerance of the complementarity checks (forces \[N\], impulses \[N s\], velocities \[m/s\], accelerations
 /// \[m/s^2\]): a value within this of zero counts as zero, so that an event located at a force or velocity
 /// zero is not undone by rounding.
 pub const COMPLEMENTARITY_TOL: f64 = 1e-9;
+
+/// Largest tangential speed of a tip that a no-slip contact may hold at force level \[m/s\]: a tip at rest up to
+/// the integration error (~1e-12 m/s, as `SECTION_TIP_SPEED_TOL` of the walk); a tip that slides faster (after a
+/// frictionless impulse) is not stuck by the force-level problem, which has no impulse to stop it.
+pub const STICK_SPEED_TOL: f64 = 1e-8;
 
 /// The three DLS indicators of the paper (Sec. 2.2): `lambda_I4` from (A1), `lambda_2+`, `lambda_4+` from (B1).
 /// `NaN` where the procedure does not define them (`lambda_2+`, `lambda_4+` after (A3), all three when the
@@ -324,6 +329,12 @@ pub fn consistent_active_set(
                 let tip = model.tip(q, qd, leg.index());
                 (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
             }
+            // A no-slip contact needs its tip at rest: one that slides (after a frictionless impulse) stays
+            // sliding or leaves; holding it would make the tangential force do work.
+            (Unit::Contact(leg), Mode::On) => {
+                dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL
+                    && model.tip(q, qd, leg.index()).velocity(qd).x.abs() <= STICK_SPEED_TOL
+            }
             (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
             (Unit::Stopper(leg), Mode::Off) => {
                 dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
@@ -367,13 +378,42 @@ pub struct TouchdownImpact {
     pub pull_impulse: f64,
 }
 
-/// Stoppers a touchdown impulse may need: Leg 1 (at `L0`, locked before touchdown) and Leg 2 if locked.
-fn stopper_candidates(before: &ActiveSet) -> Vec<Candidate> {
-    Leg::BOTH
-        .into_iter()
-        .filter(|leg| before.lock(*leg))
-        .map(|leg| Candidate::new(Unit::Stopper(leg), Mode::Off))
-        .collect()
+/// The leg whose touchdown ends the step: of the legs not in `q` (`j = 2..N`, all at `L0`), the one with the
+/// lowest tip (docs/model.md section 4). In a walk this is the front leg `j = -1` ([`Model::front_leg`], chosen
+/// on a tie); after a long flight the wheel may have turned by more than `alpha`, and then a leg further ahead
+/// (or behind) comes down first. Since every such leg has length `L0`, the lowest tip is the one whose angle
+/// `psi_j = theta + j alpha` is nearest to 0 modulo `2 pi`: the front leg, the leg `j = 2`, or the leg nearest
+/// to `j = -theta / alpha`.
+pub fn touchdown_leg(model: &Model, q: &Coords) -> LegIndex {
+    let n = model.legs();
+    let front = model.front_leg();
+    let nearest = (-q[THETA] / model.alpha()).round().rem_euclid(n as f64) as usize % n;
+    let mut best = (front, model.tip_height(q, front));
+    for j in [2, nearest] {
+        if (2..n).contains(&j) && j != front {
+            let h = model.tip_height(q, j);
+            if h < best.1 {
+                best = (j, h);
+            }
+        }
+    }
+    best.0
+}
+
+/// The candidates of a touchdown impulse: the new Leg 1's contact, closing (no-slip if its normal impulse
+/// pushes, else frictionless under [`ContactInconsistency::Slide`]), and the stoppers that may take an impulse:
+/// Leg 1's (at `L0`, locked before touchdown) and Leg 2's if locked, unless they act both ways (`rigid_legs`,
+/// then they are forced).
+fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
+    let bilateral = bilateral_stoppers(model);
+    let mut candidates = vec![Candidate::closing(Unit::Contact(Leg::One), model)];
+    candidates.extend(
+        Leg::BOTH
+            .into_iter()
+            .filter(|leg| before.lock(*leg) && !bilateral.lock(*leg))
+            .map(|leg| Candidate::new(Unit::Stopper(leg), Mode::Off)),
+    );
+    candidates
 }
 
 /// The touchdown impact at `(q_dagger, q'_dagger)` after re-indexing (MODEL.md section 5).
@@ -385,6 +425,11 @@ fn stopper_candidates(before: &ActiveSet) -> Vec<Candidate> {
 /// 2. (A3) if `lambda_I4 < 0`, the collision is recomputed with `J_SLS`.
 /// 3. (A4)/(B1) otherwise keep `q'+` of (A1) and solve Eqs. (6)-(7) for `lambda+`: `lambda_2+`, `lambda_4+`.
 /// 4. (B2) both non-negative: DLS; (B3) `lambda_4+ < 0`: SLS from the same `q'+`; `lambda_2+ < 0`: bounce.
+///
+/// Every collision is the impulse-level complementarity problem of [`plastic_impact`] in which Leg 2's
+/// contact is forced by the procedure (on in (A1), off in (A3)) and the new Leg 1 is the closing unit: it takes
+/// a no-slip impulse when that impulse pushes (the paper's `J_DLS`, `J_SLS`, and every regular touchdown), a
+/// frictionless one when a no-slip impulse would pull, as on a leg that lands behind the hub after a flight.
 ///
 /// With [`ImpactModel::Traditional`] the indicators are still computed and reported, but the collision is
 /// always the `J_SLS` one. With `rigid_legs` the stoppers act both ways and the exchange is the traditional
@@ -412,20 +457,20 @@ pub fn touchdown_impact(
         contact1: true,
         ..Default::default()
     };
-    let stoppers = stopper_candidates(&before);
+    let candidates = touchdown_candidates(model, &before);
+    // Leg 2's contact as the procedure forces it (off for the J_SLS collision, on for the J_DLS one).
+    let rear_off = bilateral_stoppers(model);
+    let rear_on = ActiveSet {
+        contact2: true,
+        ..rear_off
+    };
 
     if model.params().rigid_legs {
-        let set = ActiveSet {
-            contact1: true,
-            lock1: true,
-            lock2: true,
-            ..Default::default()
-        };
-        let sol = impulse(model, q, qd, &set)?;
+        let (set, sol) = plastic_impact(model, q, qd, rear_off, &candidates)?;
         return Ok(finish(set, sol, DlsIndicators::UNDEFINED, Branch::Sls, set));
     }
     if !before.contact2 {
-        let (set, sol) = plastic_impact(model, q, qd, sls, &stoppers)?;
+        let (set, sol) = plastic_impact(model, q, qd, rear_off, &candidates)?;
         return Ok(finish(
             set,
             sol,
@@ -440,7 +485,7 @@ pub fn touchdown_impact(
         contact2: true,
         ..sls
     };
-    let (dls_set, dls_sol) = plastic_impact(model, q, qd, dls, &stoppers)?;
+    let (dls_set, dls_sol) = plastic_impact(model, q, qd, rear_on, &candidates)?;
     let lambda_i4 = dls_sol.normal_impulse(Leg::Two);
     // (B1) forces just after the DLS collision, Eqs. (6)-(7).
     let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
@@ -457,7 +502,7 @@ pub fn touchdown_impact(
 
     if model.params().impact == ImpactModel::Traditional || lambda_i4 < 0.0 {
         // (A3), or the traditional exchange: the rear leg leaves at once.
-        let (set, sol) = plastic_impact(model, q, qd, sls, &stoppers)?;
+        let (set, sol) = plastic_impact(model, q, qd, rear_off, &candidates)?;
         return Ok(finish(set, sol, indicators, Branch::Sls, sls));
     }
     let (branch, preferred) = match (lambda_2_plus >= 0.0, lambda_4_plus >= 0.0) {

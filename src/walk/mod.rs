@@ -7,7 +7,7 @@
 //!
 //! | event | function crossing zero from above |
 //! |---|---|
-//! | touchdown | height of the next leg's tip (length `L0`) |
+//! | touchdown | height of the lowest tip of the legs not in `q` (the next leg's in a walk, see [`impact::touchdown_leg`]) |
 //! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (to [`FORCE_EVENT_MARGIN`] below 0) |
 //! | landing / rear re-contact of an airborne tip | its height (armed once above `recontact_gap`, see below) |
 //! | stopper unlock | the stopper's inward reaction (to [`FORCE_EVENT_MARGIN`] below 0) |

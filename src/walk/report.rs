@@ -39,6 +39,11 @@ pub struct ContactAudit {
     /// The deepest any tip went below the ground during the step \[m\] (checked on the dense output), 0 if
     /// none.
     pub penetration: f64,
+    /// The farthest Leg 1 or Leg 2 went past its stopper, `max(L - L0)` over the step \[m\] (checked where
+    /// `penetration` is), 0 if none: a free leg's stopper event fires `stopper_gap` past `L0` at most
+    /// (docs/model.md section 4). Not yet in the CSV and JSON outputs.
+    #[serde(skip)]
+    pub stopper_overrun: f64,
 }
 
 /// One step of the walk: from a touchdown to the next.

@@ -6,7 +6,7 @@
 use std::cell::Cell;
 
 use crate::contact::{ActiveSet, Leg, Phase};
-use crate::dynamics::{Coords, Model, L1, L2, NQ, THETA, X};
+use crate::dynamics::{Coords, Model, L1, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
 
@@ -14,7 +14,7 @@ use super::error::WalkError;
 use super::events::{EventKind, EventSet, EVENT_SAMPLES};
 use super::impact::{
     bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
-    touchdown_impact, Branch, Candidate, TouchdownImpact, Unit,
+    touchdown_impact, touchdown_leg, Branch, Candidate, TouchdownImpact, Unit,
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkVector, NY};
 use super::report::{ContactAudit, EnergyAudit, StepReport};
@@ -251,7 +251,8 @@ impl<'m> Walker<'m> {
         let e_end = model.energy(&q, &qd);
         let damper = y[2 * NQ];
         let loss = e_start - e_end;
-        let front = model.tip(&q, &qd, model.front_leg());
+        let touching = touchdown_leg(model, &q);
+        let front = model.tip(&q, &qd, touching);
         let step_length = front.position.x - start.q[X];
         let period = t - start.time;
         self.steps_done += 1;
@@ -281,7 +282,7 @@ impl<'m> Walker<'m> {
             },
             contact: tally.audit,
         };
-        match reindex(model, t, &q, &qd, active) {
+        match reindex(model, t, &q, &qd, active, touching) {
             Ok((q_new, qd_new, before)) => {
                 self.state = WalkState {
                     time: t,
@@ -289,7 +290,7 @@ impl<'m> Walker<'m> {
                     qd: qd_new,
                     active: before,
                     x_origin: start.x_origin + front.position.x,
-                    leg1: (start.leg1 + model.legs() - 1) % model.legs(),
+                    leg1: (start.leg1 + touching) % model.legs(),
                 };
             }
             Err(e) => self.blocked = Some(e),
@@ -635,36 +636,56 @@ fn release_contact(
     Ok(new_active)
 }
 
-/// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg becomes Leg 1, the old Leg 1
-/// becomes Leg 2, the old Leg 2 (which must be locked at `L0` and in the air) leaves `q`. The origin moves to
-/// the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
+/// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
+/// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
+/// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be locked at `L0` and in the air.
+/// The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
 fn reindex(
     model: &Model,
     time: f64,
     q: &Coords,
     qd: &Coords,
     active: ActiveSet,
+    touching: usize,
 ) -> Result<(Coords, Coords, ActiveSet), WalkError> {
-    if active.contact2 {
-        return Err(WalkError::RearLegInContact { time });
+    // The touching leg is `shift` legs ahead of Leg 1; with `shift > 1` the new Leg 2 is a locked leg.
+    let shift = model.legs() - touching;
+    let leaving: &[Leg] = if shift == 1 { &[Leg::Two] } else { &Leg::BOTH };
+    for &leg in leaving {
+        if active.contact(leg) {
+            return Err(WalkError::RearLegInContact { time });
+        }
+        if !active.lock(leg) {
+            let i = leg.length_coordinate();
+            return Err(WalkError::RearLegNotLocked {
+                time,
+                length: q[i],
+                rate: qd[i],
+            });
+        }
     }
-    if !active.lock2 {
-        return Err(WalkError::RearLegNotLocked {
-            time,
-            length: q[L2],
-            rate: qd[L2],
-        });
-    }
-    let front = model.tip(q, qd, model.front_leg());
+    let front = model.tip(q, qd, touching);
     let v = front.velocity(qd);
     let l0 = model.params().stopper_length;
-    let q_new = Coords::new(0.0, front.position.y, q[THETA] - model.alpha(), l0, q[L1]);
-    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, qd[L1]);
+    let (l2, l2_dot) = if shift == 1 {
+        (q[L1], qd[L1])
+    } else {
+        (l0, 0.0)
+    };
+    let theta = if shift == 1 {
+        q[THETA] - model.alpha()
+    } else {
+        // psi of the touching leg, in [-pi, pi].
+        let psi = q[THETA] + touching as f64 * model.alpha();
+        psi - std::f64::consts::TAU * (psi / std::f64::consts::TAU).round()
+    };
+    let q_new = Coords::new(0.0, front.position.y, theta, l0, l2);
+    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot);
     let before = ActiveSet {
         contact1: false,
-        contact2: active.contact1,
+        contact2: shift == 1 && active.contact1,
         lock1: true,
-        lock2: active.lock1,
+        lock2: shift > 1 || active.lock1,
         ..Default::default()
     };
     Ok((q_new, qd_new, before))
