@@ -1,4 +1,4 @@
-//! The basin of attraction of a gait on a slice of the Poincare section (issue 10 item 4).
+//! The basin of attraction of a gait on a slice of the Poincare section (docs/model.md section 6).
 //!
 //! Two of the section coordinates `(L2, thetadot, L2dot)` span a grid; the third is held at the gait's value.
 //! From every grid point the wheel walks until one of these happens, which is the point's outcome:

@@ -1,5 +1,5 @@
 //! Natural-parameter continuation of a gait family, verified from both sides, and the physical cause where a
-//! family ends (MODEL.md section 6).
+//! family ends (docs/model.md section 6).
 //!
 //! A continuation step from the gait `s0` at `v0` to `v1` is accepted only if Newton's method from `s0` converges
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within [`SAME_GAIT_TOL`]).

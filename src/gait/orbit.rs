@@ -1,4 +1,4 @@
-//! The orbit diagram (issue 10 item 3): along one parameter, the section states and DLS indicators the walk
+//! The orbit diagram (docs/model.md section 6): along one parameter, the section states and DLS indicators the walk
 //! visits once its transient has died out.
 //!
 //! At each parameter value the wheel walks `transient` steps, then `steps` more whose section states and step

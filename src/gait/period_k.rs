@@ -1,4 +1,4 @@
-//! Period-k gaits: fixed points of the iterated step map `P^k` (docs/model.md section 6, issue 10 item 2).
+//! Period-k gaits: fixed points of the iterated step map `P^k` (docs/model.md section 6).
 //!
 //! Where Newton's method on `P(s) - s` fails but the walk settles, the wheel may walk a gait that repeats every
 //! `k` steps (a period-doubled gait, `k = 2`, for example). The search:
