@@ -1,4 +1,4 @@
-//! The basin of attraction of a gait on a slice of the Poincare section (issue 10 item 4).
+//! The basin of attraction of a gait on a slice of the Poincare section (docs/model.md section 6).
 //!
 //! Two of the section coordinates `(L2, thetadot, L2dot)` span a grid; the third is held at the gait's value.
 //! From every grid point the wheel walks until one of these happens, which is the point's outcome:
@@ -16,10 +16,9 @@
 
 use serde::Serialize;
 
-use super::continuation::section_distance;
 use super::grid::{run_rows, Evaluated};
 use super::limit_cycle::Gait;
-use super::period_k::{least_period, MAX_PERIOD};
+use super::periodicity::{least_period, MAX_PERIOD};
 use crate::dynamics::Model;
 use crate::params::SolverOptions;
 use crate::walk::{SectionState, Walker};
@@ -174,7 +173,7 @@ pub fn classify(
             .iter()
             .map(|r| &r.section)
             .chain(std::iter::once(&gait.section))
-            .any(|g| section_distance(g, s) < tolerance)
+            .any(|g| g.distance(s) < tolerance)
     };
     if start.validate(model).is_err() {
         return Outcome::new("invalid_start", 0, None, None);

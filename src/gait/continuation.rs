@@ -1,5 +1,5 @@
 //! Natural-parameter continuation of a gait family, verified from both sides, and the physical cause where a
-//! family ends (MODEL.md section 6).
+//! family ends (docs/model.md section 6).
 //!
 //! A continuation step from the gait `s0` at `v0` to `v1` is accepted only if Newton's method from `s0` converges
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within [`SAME_GAIT_TOL`]).
@@ -22,19 +22,15 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::limit_cycle::{solve_fixed_point, FixedPoint, GaitOptions};
-use super::period_k::{least_period, MAX_PERIOD, RETURN_TOL};
+pub use super::periodicity::SAME_GAIT_TOL;
+use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
 use super::step_map::StepMap;
-use super::sweep::configured;
+use crate::dynamics::Model;
 use crate::params::Config;
 use crate::walk::{SectionState, Walker};
 
 /// Tolerance of every threshold in the swept parameter.
 pub const PARAM_TOL: f64 = 1e-6;
-
-/// Two fixed points closer than this (largest coordinate difference of `(L2, thetadot, L2dot)`) are the same
-/// gait. Newton converges to `1e-10` in the residual, so one gait found twice agrees to far better than this;
-/// distinct families differ by `1e-3` or more.
-pub const SAME_GAIT_TOL: f64 = 1e-6;
 
 /// Newton iterations allowed in one continuation step (a step that needs more is halved instead).
 pub const STEP_NEWTON_ITERATIONS: usize = 8;
@@ -72,12 +68,10 @@ pub const FOLD_TOL: f64 = 0.05;
 /// Steps walked from the last gait of a family just past its end, looking for the physical cause.
 pub const END_WALK_STEPS: usize = 300;
 
-/// Largest coordinate difference between two section states.
+/// Largest coordinate difference between two section states: [`SectionState::distance`], kept under this
+/// name for callers outside the crate.
 pub fn section_distance(a: &SectionState, b: &SectionState) -> f64 {
-    (a.l2 - b.l2)
-        .abs()
-        .max((a.theta_dot - b.theta_dot).abs())
-        .max((a.l2_dot - b.l2_dot).abs())
+    a.distance(b)
 }
 
 /// Follows gait families of one configuration along one parameter: fixed points of the step map `P`, or of
@@ -182,8 +176,13 @@ impl<'a> Continuation<'a> {
     }
 
     /// The configuration with the followed parameter at `value`, and its model.
-    fn configured_at(&self, value: f64) -> Result<(Config, crate::dynamics::Model), String> {
-        configured(self.config, self.param, value).map_err(|e| e.to_string())
+    fn configured_at(&self, value: f64) -> Result<(Config, Model), String> {
+        let c = self
+            .config
+            .with(self.param, value)
+            .map_err(|e| e.to_string())?;
+        let model = Model::new(&c.params).map_err(|e| e.to_string())?;
+        Ok((c, model))
     }
 
     /// The fixed point at `value` by Newton's method from `start` (no transient).
@@ -208,7 +207,7 @@ impl<'a> Continuation<'a> {
     ) -> Option<FamilyPoint> {
         let forward = self.solve(value, &from.section, guess).ok()?;
         let back = self.solve(from.value, &forward.section, guess).ok()?;
-        (section_distance(&back.section, &from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
+        (back.section.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
             value,
             section: forward.section,
         })
@@ -220,7 +219,7 @@ impl<'a> Continuation<'a> {
     pub fn walk_step(&self, from: &FamilyPoint, value: f64) -> Option<FamilyPoint> {
         let forward = self.settle(value, &from.section)?;
         let back = self.settle(from.value, &forward)?;
-        (section_distance(&back, &from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
+        (back.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
             value,
             section: forward,
         })
@@ -238,7 +237,7 @@ impl<'a> Continuation<'a> {
                 walker.step(None).ok()?;
             }
             let next = walker.section().ok()?;
-            if section_distance(&next, &previous) < SETTLE_TOL {
+            if next.distance(&previous) < SETTLE_TOL {
                 return Some(next);
             }
             previous = next;
@@ -423,7 +422,7 @@ impl<'a> Continuation<'a> {
 /// Is `s` within [`SAME_GAIT_TOL`] of a state of the period-`k` orbit through `orbit` (the orbit walked `k`
 /// steps with `map`)? The phases of a period-k gait are all fixed points of `P^k`.
 fn on_orbit(map: &StepMap, orbit: &SectionState, k: usize, s: &SectionState) -> bool {
-    if section_distance(orbit, s) <= SAME_GAIT_TOL {
+    if orbit.distance(s) <= SAME_GAIT_TOL {
         return true;
     }
     let Ok(mut walker) = Walker::new(map.model(), map.options(), orbit) else {
@@ -433,7 +432,7 @@ fn on_orbit(map: &StepMap, orbit: &SectionState, k: usize, s: &SectionState) -> 
         if walker.step(None).is_err() {
             return false;
         }
-        if section_distance(&walker.touchdown_coordinates(), s) <= SAME_GAIT_TOL {
+        if walker.touchdown_coordinates().distance(s) <= SAME_GAIT_TOL {
             return true;
         }
     }

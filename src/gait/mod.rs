@@ -9,6 +9,7 @@ pub mod limit_cycle;
 pub mod map;
 pub mod orbit;
 pub mod period_k;
+pub mod periodicity;
 pub mod step_map;
 pub mod sweep;
 pub mod thresholds;

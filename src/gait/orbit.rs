@@ -1,4 +1,4 @@
-//! The orbit diagram (issue 10 item 3): along one parameter, the section states and DLS indicators the walk
+//! The orbit diagram (docs/model.md section 6): along one parameter, the section states and DLS indicators the walk
 //! visits once its transient has died out.
 //!
 //! At each parameter value the wheel walks `transient` steps, then `steps` more whose section states and step
@@ -8,14 +8,15 @@
 //! instead of jumping between coexisting ones. The first value, and a value after a walk that failed, start
 //! from the job's initial state with [`FRESH_TRANSIENT_FACTOR`] times the transient.
 //!
-//! The period of the recorded returns ([`super::period_k::least_period`]) is reported per value: a period-1
+//! The period of the recorded returns ([`super::periodicity::least_period`]) is reported per value: a period-1
 //! gait shows as one point, a period-k gait as `k`, anything else as a cloud.
 
 use serde::Serialize;
 
 use super::grid::{run_rows, Evaluated};
-use super::period_k::{least_period, MAX_PERIOD};
-use super::sweep::{configured, SweepSpec};
+use super::periodicity::{least_period, MAX_PERIOD};
+use super::sweep::SweepSpec;
+use crate::dynamics::Model;
 use crate::params::{Config, ConfigError};
 use crate::walk::WalkError;
 use crate::walk::{SectionState, StepReport, Walker};
@@ -101,7 +102,10 @@ fn walk_column(
         period_k: None,
         continued_from: None,
     };
-    let (c, model) = match configured(config, param, value) {
+    let configured = config
+        .with(param, value)
+        .and_then(|c| Model::new(&c.params).map(|model| (c, model)));
+    let (c, model) = match configured {
         Ok(x) => x,
         Err(e) => {
             column.status = "invalid_parameter".to_string();

@@ -1,4 +1,4 @@
-//! Period-k gaits: fixed points of the iterated step map `P^k` (docs/model.md section 6, issue 10 item 2).
+//! Period-k gaits: fixed points of the iterated step map `P^k` (docs/model.md section 6).
 //!
 //! Where Newton's method on `P(s) - s` fails but the walk settles, the wheel may walk a gait that repeats every
 //! `k` steps (a period-doubled gait, `k = 2`, for example). The search:
@@ -25,48 +25,18 @@
 //! fixed point, and a multiple `k` would give a fixed point of `P^k` that the walk does not repeat: step 4
 //! refuses it.
 
-use super::continuation::{section_distance, SAME_GAIT_TOL};
 use super::limit_cycle::{
     find_gait, gait_at, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions,
+};
+use super::periodicity::SAME_GAIT_TOL;
+pub use super::periodicity::{
+    least_period, return_distances, MAX_PERIOD, RETURN_TOL, RETURN_WINDOW,
 };
 use super::step_map::StepMap;
 use crate::walk::{SectionState, Walker};
 
-/// The longest period searched by default (`vrw gait` and sweeps).
-pub const MAX_PERIOD: usize = 8;
-
 /// Steps walked after the transient before the period is looked for.
 pub const SETTLE_STEPS: usize = 64;
-
-/// Number of recent returns over which a period must hold.
-pub const RETURN_WINDOW: usize = 4;
-
-/// A period `k` is tried when the returns repeat with period `k` to within this (largest coordinate
-/// difference of `(L2, thetadot, L2dot)`; Newton's method then converges from there).
-pub const RETURN_TOL: f64 = 1e-3;
-
-/// `d_k` for `k = 1 ..= max_period`: the largest coordinate difference between `returns[n]` and
-/// `returns[n - k]` over the last [`RETURN_WINDOW`] returns `n` (`INFINITY` where there are too few returns).
-pub fn return_distances(returns: &[SectionState], max_period: usize) -> Vec<f64> {
-    (1..=max_period)
-        .map(|k| {
-            if returns.len() < k + RETURN_WINDOW {
-                return f64::INFINITY;
-            }
-            (returns.len() - RETURN_WINDOW..returns.len())
-                .map(|n| section_distance(&returns[n], &returns[n - k]))
-                .fold(0.0, f64::max)
-        })
-        .collect()
-}
-
-/// The least period of the returns: the smallest `k` whose return distance is below `tol`.
-pub fn least_period(returns: &[SectionState], max_period: usize, tol: f64) -> Option<usize> {
-    return_distances(returns, max_period)
-        .iter()
-        .position(|&d| d < tol)
-        .map(|i| i + 1)
-}
 
 /// The section states of `k` steps from `s` (`s` first), and the reports of those steps.
 fn walk_period(
@@ -163,7 +133,7 @@ pub fn periodic_gait_at(
     };
     // Two periods walked on: a periodic walk returns to s* after k and after 2k steps.
     let (states, reports) = walk_period(single, &fp.section, 2 * k).map_err(newton_error)?;
-    let distance = section_distance(&states[2 * k], &fp.section);
+    let distance = states[2 * k].distance(&fp.section);
     if distance > SAME_GAIT_TOL {
         return Err(GaitError::SectionIncomplete {
             period_k: k,
@@ -172,9 +142,7 @@ pub fn periodic_gait_at(
     }
     // The least period: P^j(s*) = s* for a divisor j of k.
     let least = (1..=k)
-        .find(|&j| {
-            k.is_multiple_of(j) && section_distance(&states[j], &fp.section) <= SAME_GAIT_TOL
-        })
+        .find(|&j| k.is_multiple_of(j) && states[j].distance(&fp.section) <= SAME_GAIT_TOL)
         .unwrap_or(k);
     let map_least = single.iterated(least);
     let (dp, error) = if options.refine_jacobian {
@@ -190,7 +158,7 @@ pub fn periodic_gait_at(
     gait.cycle = reports[..least].to_vec();
     if least < k {
         // The residual of the least period's map at the point.
-        gait.residual = section_distance(&states[least], &fp.section);
+        gait.residual = states[least].distance(&fp.section);
     }
     Ok(gait)
 }
@@ -213,40 +181,5 @@ pub fn find_gait_any_period(
             find_periodic_gait(map, initial, options, max_period)
         }
         result => result,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn s(l2: f64) -> SectionState {
-        SectionState {
-            l2,
-            theta_dot: 1.0,
-            l2_dot: 0.0,
-        }
-    }
-
-    #[test]
-    fn least_period_of_alternating_returns_is_two() {
-        let returns: Vec<SectionState> = (0..20)
-            .map(|i| s(if i % 2 == 0 { 0.7 } else { 0.8 }))
-            .collect();
-        assert_eq!(least_period(&returns, MAX_PERIOD, 1e-9), Some(2));
-        let d = return_distances(&returns, 4);
-        assert!((d[0] - 0.1).abs() < 1e-12 && d[1] == 0.0 && d[3] == 0.0);
-    }
-
-    #[test]
-    fn too_few_returns_have_no_period() {
-        let returns: Vec<SectionState> = (0..3).map(|_| s(0.7)).collect();
-        assert_eq!(least_period(&returns, MAX_PERIOD, 1e-9), None);
-    }
-
-    #[test]
-    fn period_three_is_found_before_six() {
-        let returns: Vec<SectionState> = (0..30).map(|i| s(0.7 + 0.01 * (i % 3) as f64)).collect();
-        assert_eq!(least_period(&returns, MAX_PERIOD, 1e-9), Some(3));
     }
 }

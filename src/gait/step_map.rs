@@ -76,8 +76,8 @@ impl<'m> StepMap<'m> {
         self.model
     }
 
-    /// Evaluate `P(s)` (`P^k(s)` for an iterated map). Fails with the reason the step could not be walked (fell, stalled, old rear leg not
-    /// relocked at the next touchdown, ...).
+    /// Evaluate `P(s)` (`P^k(s)` for an iterated map). Fails with the reason the step could not be walked
+    /// (fell, stalled, old rear leg not relocked at the next touchdown, ...).
     pub fn eval(&self, s: &SectionState) -> Result<StepOutcome, WalkError> {
         let mut walker = Walker::new(self.model, &self.opts, s)?;
         let report = walker.step(None)?;

@@ -16,10 +16,11 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::continuation::{section_distance, Continuation, FamilyPoint, Followed, SAME_GAIT_TOL};
+use super::continuation::{Continuation, FamilyPoint, Followed};
 use super::grid::{run_rows, Evaluated};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
-use super::period_k::{find_gait_any_period, periodic_gait_at, MAX_PERIOD};
+use super::period_k::{find_gait_any_period, periodic_gait_at};
+use super::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
 use crate::fmt::short;
@@ -139,17 +140,6 @@ impl SweepPoint {
     }
 }
 
-/// The configuration with the swept parameter set to `value`, validated, and its model.
-pub fn configured(
-    config: &Config,
-    param: &str,
-    value: f64,
-) -> Result<(Config, Model), ConfigError> {
-    let c = config.with(param, value)?;
-    let model = Model::new(&c.params)?;
-    Ok((c, model))
-}
-
 /// The gait at `value`, followed from `previous` (a neighbouring gait at another value, with its index) in
 /// verified continuation steps if given; if the family does not reach `value`, searched from `initial` with the
 /// full transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
@@ -161,7 +151,10 @@ pub fn gait_at_value(
     previous: Option<(usize, f64, &Gait)>,
     options: &GaitOptions,
 ) -> SweepPoint {
-    let (c, model) = match configured(config, param, value) {
+    let configured = config
+        .with(param, value)
+        .and_then(|c| Model::new(&c.params).map(|model| (c, model)));
+    let (c, model) = match configured {
         Ok(x) => x,
         Err(e) => {
             return SweepPoint {
@@ -244,7 +237,8 @@ fn follow_gait(
             }))
         }
     };
-    let (c, model) = configured(config, param, value).map_err(|_| None)?;
+    let c = config.with(param, value).map_err(|_| None)?;
+    let model = Model::new(&c.params).map_err(|_| None)?;
     let map = StepMap::new(&model, &c.solver);
     let opts = GaitOptions {
         transient_steps: 0,
@@ -338,7 +332,7 @@ pub(crate) fn number_families(
         let connected = Continuation::new(config, param, options)
             .with_period(ga.period_k)
             .step(&start, b.value, ga.jacobian_guess().as_ref())
-            .is_some_and(|p| section_distance(&p.section, &gb.section) <= SAME_GAIT_TOL);
+            .is_some_and(|p| p.section.distance(&gb.section) <= SAME_GAIT_TOL);
         if connected {
             for r in root.iter_mut().filter(|r| **r == Some(ri)) {
                 *r = Some(rl);

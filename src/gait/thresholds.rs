@@ -27,8 +27,10 @@ use serde::Serialize;
 pub use super::continuation::PARAM_TOL;
 use super::continuation::{Continuation, EndCause, FamilyPoint, Followed};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
+use super::periodicity::SAME_GAIT_TOL;
 use super::step_map::StepMap;
-use super::sweep::{configured, SweepPoint, SweepSpec};
+use super::sweep::{SweepPoint, SweepSpec};
+use crate::dynamics::Model;
 use crate::params::Config;
 use crate::walk::DlsIndicators;
 
@@ -242,7 +244,10 @@ fn vanishing_at_end(
     let Some(g) = from.gait.as_ref() else {
         return Vec::new();
     };
-    let Ok((c, model)) = configured(config, &spec.param, last.value) else {
+    let Ok(c) = config.with(&spec.param, last.value) else {
+        return Vec::new();
+    };
+    let Ok(model) = Model::new(&c.params) else {
         return Vec::new();
     };
     let map = StepMap::new(&model, &c.solver).iterated(g.period_k);
@@ -321,8 +326,7 @@ fn refine_end(
         }
         Followed::Reached(p) => {
             let same = toward.gait.as_ref().is_some_and(|gt| {
-                super::continuation::section_distance(&gt.section, &p.section)
-                    <= super::continuation::SAME_GAIT_TOL
+gt.section.distance(&p.section) <= SAME_GAIT_TOL
             });
             if same {
                 return Vec::new();
@@ -455,7 +459,8 @@ fn refine_root(
             return f64::NAN;
         }
         let value = (|| {
-            let (c, model) = configured(config, &spec.param, v).map_err(|e| e.to_string())?;
+            let c = config.with(&spec.param, v).map_err(|e| e.to_string())?;
+            let model = Model::new(&c.params).map_err(|e| e.to_string())?;
             // A period-k family's gaits are fixed points of P^k; the indicators are those of its first step.
             let map = StepMap::new(&model, &c.solver).iterated(start.period_k);
             let y = if q == Quantity::Stability {

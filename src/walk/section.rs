@@ -43,6 +43,15 @@ impl SectionState {
         }
     }
 
+    /// Largest coordinate difference between two section states, `max(|dL2|, |dthetadot|, |dL2dot|)`: the
+    /// distance every gait comparison uses (same gait, settled walk, period of the returns).
+    pub fn distance(&self, other: &SectionState) -> f64 {
+        (self.l2 - other.l2)
+            .abs()
+            .max((self.theta_dot - other.theta_dot).abs())
+            .max((self.l2_dot - other.l2_dot).abs())
+    }
+
     /// `theta` at which Leg 1 (length `L0`, tip at the origin) and Leg 2 (length `L2`) both touch the ground:
     /// `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2 sin(alpha))`.
     pub fn theta(&self, model: &Model) -> f64 {
