@@ -3,16 +3,13 @@
 
 use nalgebra::SVector;
 
-#[cfg(doc)]
-use super::{Dop853, Dopri5};
-
 /// One accepted step with its continuous extension (dense output), in the nested form of Hairer's codes.
 ///
 /// With `θ = (t - t0)/(t1 - t0)` the interpolant is
 /// `y(t) = c0 + θ (c1 + (1-θ) (c2 + θ (c3 + (1-θ) (c4 + θ (c5 + (1-θ) (c6 + θ c7))))))`, truncated after the
-/// last coefficient the method has: five for [`Dopri5`] (`c0 = y0`, `c1 = Δ = y1 - y0`, `c2 = h k1 - Δ`,
+/// last coefficient the method has: five for [`Dopri5`](super::Dopri5) (`c0 = y0`, `c1 = Δ = y1 - y0`, `c2 = h k1 - Δ`,
 /// `c3 = Δ - h k7 - c2`, `c4 = h Σ d_i k_i`: Shampine's 4th-order extension, `contd5` of `dopri5`), eight for
-/// [`Dop853`] (its 7th-order extension, `contd8` of `dop853`). It matches y0, y1, f0 and f1.
+/// [`Dop853`](super::Dop853) (its 7th-order extension, `contd8` of `dop853`). It matches y0, y1, f0 and f1.
 #[derive(Debug, Clone)]
 pub struct DenseStep<const N: usize> {
     t0: f64,
@@ -23,7 +20,7 @@ pub struct DenseStep<const N: usize> {
     terms: usize,
 }
 
-/// Most coefficients of a continuous extension ([`Dop853`] has eight).
+/// Most coefficients of a continuous extension ([`Dop853`](super::Dop853) has eight).
 const MAX_DENSE_TERMS: usize = 8;
 
 impl<const N: usize> DenseStep<N> {

@@ -3,10 +3,7 @@
 
 use nalgebra::SVector;
 
-#[cfg(doc)]
-use super::{Dopri5, IntegrationError};
-
-/// Error tolerances and step-size bounds of [`Dopri5`].
+/// Error tolerances and step-size bounds of [`Dopri5`](super::Dopri5).
 ///
 /// The local error estimate `e` of a step from `y0` to `y1` is accepted when
 /// `sqrt(mean_i (e_i / (atol + rtol * max(|y0_i|, |y1_i|)))^2) <= 1` (HNW I, Eq. II.4.11).

@@ -16,7 +16,7 @@ use std::fmt;
 use serde::de::{self, DeserializeOwned, DeserializeSeed, IntoDeserializer, MapAccess, Visitor};
 use serde::forward_to_deserialize_any;
 
-use super::{invalid, load, ConfigError};
+use super::{invalid, ConfigError};
 
 /// One key's value on its way into a configuration, with where it came from.
 #[derive(Debug, Clone)]
@@ -129,11 +129,12 @@ impl de::Error for ReadError {
         ReadError::Serde(message.to_string())
     }
 
-    /// `deny_unknown_fields` refuses a key: list every key of a configuration, not only the struct's.
+    /// `deny_unknown_fields` refuses a key. The message lists every key of a configuration, not only the
+    /// struct's: the reader of the whole table fills `known` in (`load.rs`, which knows both structs).
     fn unknown_field(field: &str, _expected: &'static [&'static str]) -> Self {
         ReadError::Config(ConfigError::UnknownKey {
             key: field.to_string(),
-            known: load::all_keys().join(", "),
+            known: String::new(),
         })
     }
 }

@@ -206,9 +206,17 @@ impl Config {
             .iter()
             .map(|(key, value)| (key.as_str(), value))
             .partition(|(key, _)| solver_keys.contains(key));
+        // An unknown key is refused by the struct that reads it; the message lists every key.
+        let listing_keys = |error| match error {
+            ConfigError::UnknownKey { key, .. } => ConfigError::UnknownKey {
+                key,
+                known: all_keys().join(", "),
+            },
+            other => other,
+        };
         Ok(Config {
-            params: de::read(&params)?,
-            solver: de::read(&solver)?,
+            params: de::read(&params).map_err(listing_keys)?,
+            solver: de::read(&solver).map_err(listing_keys)?,
         })
     }
 }

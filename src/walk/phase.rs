@@ -1,5 +1,6 @@
 //! The phase ODE (docs/model.md section 4): the integrated state `[q, q', E_damper]` ([`WalkVector`]), its
-//! packing, and the vector field of one phase of constrained motion ([`PhaseSystem`]).
+//! packing, the vector field of one phase of constrained motion ([`PhaseSystem`]), and the wheel's state
+//! between events ([`WalkState`]).
 
 use nalgebra::SVector;
 
@@ -49,4 +50,21 @@ impl OdeSystem<NY> for PhaseSystem<'_> {
             Err(_) => WalkVector::repeat(f64::NAN),
         }
     }
+}
+
+/// The wheel between events, in the frame of its current Leg 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkState {
+    /// Time \[s\].
+    pub time: f64,
+    /// `q` (with `x` relative to `x_origin`).
+    pub q: Coords,
+    /// `q'`.
+    pub qd: Coords,
+    /// Active contacts and stoppers (before the touchdown impact, when at the section).
+    pub active: ActiveSet,
+    /// Position along the slope of this frame's origin (the touchdown point of Leg 1) \[m\].
+    pub x_origin: f64,
+    /// Which physical leg (0..N) is Leg 1.
+    pub leg1: usize,
 }

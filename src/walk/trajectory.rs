@@ -5,8 +5,7 @@ use crate::contact::{constrained_dynamics, ActiveSet, Multipliers};
 use crate::dynamics::{Coords, Model, X};
 use crate::integrate::DenseStep;
 
-use super::phase::{unpack, WalkVector, NY};
-use super::walker::WalkState;
+use super::phase::{unpack, WalkState, WalkVector, NY};
 
 /// One sample of the trajectory, taken from the dense output.
 #[derive(Debug, Clone, PartialEq)]

@@ -16,7 +16,7 @@ use super::impact::{
     bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
     touchdown_impact, touchdown_leg, Branch, Candidate, TouchdownImpact, Unit,
 };
-use super::phase::{pack, unpack, PhaseSystem, WalkVector, NY};
+use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::report::{ContactAudit, EnergyAudit, StepReport};
 use super::section::SectionState;
 use super::trajectory::Trajectory;
@@ -25,23 +25,6 @@ use super::work::{add_to_total, WorkCounts};
 /// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
 /// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
 pub const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
-
-/// The wheel between events, in the frame of its current Leg 1.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WalkState {
-    /// Time \[s\].
-    pub time: f64,
-    /// `q` (with `x` relative to `x_origin`).
-    pub q: Coords,
-    /// `q'`.
-    pub qd: Coords,
-    /// Active contacts and stoppers (before the touchdown impact, when at the section).
-    pub active: ActiveSet,
-    /// Position along the slope of this frame's origin (the touchdown point of Leg 1) \[m\].
-    pub x_origin: f64,
-    /// Which physical leg (0..N) is Leg 1.
-    pub leg1: usize,
-}
 
 /// Bookkeeping of the step in progress.
 #[derive(Debug, Default, Clone, Copy)]
