@@ -47,6 +47,9 @@ pub struct GaitSummary {
     /// The gait, if found (its fields are also flattened into the top level of the JSON).
     #[serde(flatten)]
     pub gait: Option<Gait>,
+    /// What makes the gait untrustworthy: every audit value of its steps above its tolerance
+    /// ([`StepReport::audit_warnings`](crate::walk::StepReport::audit_warnings)); empty when every law holds.
+    pub warnings: Vec<String>,
 }
 
 /// The smallest Newton tolerance `vrw gait` accepts: the step map is computed to about 1e-13 (integration
@@ -106,6 +109,10 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
             .map_or_else(|e| e.kind(), |_| "found")
             .to_string(),
         message: result.as_ref().err().map(ToString::to_string),
+        warnings: result.as_ref().map_or_else(
+            |_| Vec::new(),
+            |g| g.cycle.iter().flat_map(|s| s.audit_warnings()).collect(),
+        ),
         gait: result.ok(),
     };
     Ok(summary)

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::dynamics::Model;
+use crate::fmt::short;
 use crate::gait::map::{LineThreshold, ThresholdCurve};
 use crate::gait::{map_curves, map_gaits, GaitMap, GaitOptions, MapSpec, SecondRoute, SweepPoint};
 use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
@@ -64,6 +65,8 @@ pub struct MapSummary {
     /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
     #[serde(skip)]
     pub second_route_seconds: f64,
+    /// Every audit value above its tolerance in the steps of the gaits found (empty when every law holds).
+    pub warnings: Vec<String>,
 }
 
 /// Run `vrw map`: the gaits (written to `map.csv` at once), the curves (`curves.json`) and the heat maps
@@ -113,6 +116,18 @@ pub fn run_map(
         thresholds,
         seconds: [gait_seconds, curve_seconds],
         second_route_seconds: 0.0,
+        warnings: super::gait_warnings(map.ys.iter().zip(&map.rows).flat_map(|(y, row)| {
+            row.iter().map(move |p| {
+                let at = format!(
+                    "{} = {}, {} = {}",
+                    job.spec.x.param,
+                    short(p.value),
+                    job.spec.y.param,
+                    short(*y)
+                );
+                (at, p)
+            })
+        })),
     };
     let curves_json = job.out_dir.join("curves.json");
     output::write_json(&curves_json, &summary)?;

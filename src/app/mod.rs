@@ -127,3 +127,21 @@ fn axis_label(param: &str) -> String {
         format!("{} [{unit}]", short_name(param))
     }
 }
+
+/// Audit warnings of the gaits of a sweep or a map ([`crate::walk::StepReport::audit_warnings`] of every
+/// step of every gait), each prefixed with where the gait is (`where_` names a point, e.g. `viscosity = 50`).
+/// A gait whose step breaks a law of the model is not to be trusted, so its numbers never go out unsaid.
+pub(crate) fn gait_warnings<'a>(
+    points: impl IntoIterator<Item = (String, &'a crate::gait::SweepPoint)>,
+) -> Vec<String> {
+    points
+        .into_iter()
+        .flat_map(|(at, point)| {
+            let steps = point.gait.iter().flat_map(|g| g.cycle.iter());
+            steps
+                .flat_map(|s| s.audit_warnings())
+                .map(move |w| format!("gait at {at}: {w}"))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}

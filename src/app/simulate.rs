@@ -17,9 +17,7 @@ use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
 
 use super::{remove_stale, AppError};
 
-/// A step whose energy audit leaves more than this unexplained \[J\] is reported as a warning (on stderr by the
-/// command line and in `summary.json`): the integration or an event is then not to be trusted.
-pub const ENERGY_RESIDUAL_WARNING: f64 = 1e-6;
+pub use crate::walk::ENERGY_RESIDUAL_WARNING;
 
 /// The smallest trajectory sampling interval `vrw simulate` accepts \[s\].
 pub const MIN_SAMPLE_DT: f64 = 1e-6;
@@ -117,8 +115,9 @@ impl SimulateSummary {
         }
     }
 
-    /// Account for one completed step; returns the warning it raises, if any.
-    fn add_step(&mut self, report: &StepReport, last: &mut VecDeque<StepReport>) -> Option<String> {
+    /// Account for one completed step; returns the warnings its audits raise ([`StepReport::audit_warnings`])
+    /// that are listed (the first [`SUMMARY_WARNINGS`] of the run; every one is counted).
+    fn add_step(&mut self, report: &StepReport, last: &mut VecDeque<StepReport>) -> Vec<String> {
         self.steps_completed += 1;
         let residual = report.energy.residual;
         self.max_abs_energy_residual = self.max_abs_energy_residual.max(residual.abs());
@@ -129,21 +128,15 @@ impl SimulateSummary {
             last.pop_front();
         }
         last.push_back(*report);
-        // A NaN residual is a warning too.
-        let within = residual.abs() <= ENERGY_RESIDUAL_WARNING;
-        let warning = (!within).then(|| {
-            format!(
-                "step {}: energy residual {} J exceeds {} J (the energy audit does not close)",
-                report.step,
-                short(residual),
-                short(ENERGY_RESIDUAL_WARNING)
-            )
-        })?;
-        self.warnings_total += 1;
-        (self.warnings.len() < SUMMARY_WARNINGS).then(|| {
-            self.warnings.push(warning.clone());
-            warning
-        })
+        let mut listed = Vec::new();
+        for warning in report.audit_warnings() {
+            self.warnings_total += 1;
+            if self.warnings.len() < SUMMARY_WARNINGS {
+                self.warnings.push(warning.clone());
+                listed.push(warning);
+            }
+        }
+        listed
     }
 
     /// Did the walk complete every requested step?
@@ -281,9 +274,9 @@ fn walk_job(
         job.interrupt.as_deref(),
         |report| -> Result<(), AppError> {
             on_step(report)?;
-            let warning = summary.add_step(report, &mut last);
+            let warnings = summary.add_step(report, &mut last);
             observe(SimulateEvent::Step(report));
-            if let Some(w) = &warning {
+            for w in &warnings {
                 observe(SimulateEvent::Warning(w));
             }
             Ok(())
@@ -384,14 +377,59 @@ mod tests {
         let mut summary =
             SimulateSummary::new(&job(dir.path(), 1, false), default_initial(&config));
         let mut last = VecDeque::new();
-        assert_eq!(summary.add_step(&report, &mut last), None);
+        assert_eq!(summary.add_step(&report, &mut last), Vec::<String>::new());
         report.energy.residual = 10.0 * ENERGY_RESIDUAL_WARNING;
-        let warning = summary.add_step(&report, &mut last).unwrap();
-        assert!(warning.contains("energy residual 1e-5 J"), "{warning}");
+        let warning = summary.add_step(&report, &mut last);
+        assert!(warning[0].contains("energy residual 1e-5 J"), "{warning:?}");
         report.energy.residual = f64::NAN;
-        assert!(summary.add_step(&report, &mut last).is_some());
+        assert_eq!(summary.add_step(&report, &mut last).len(), 1);
         assert_eq!(summary.warnings.len(), 2);
         assert_eq!(summary.warnings_total, 2);
+    }
+
+    /// Every contact audit value above its tolerance is a warning in `summary.json` and for the terminal, as
+    /// the energy residual is: a pulling impact after flight once went unsaid.
+    #[test]
+    fn contact_audit_above_its_tolerance_warns() {
+        use crate::walk::{
+            PENETRATION_WARNING, PULL_FORCE_WARNING, PULL_IMPULSE_WARNING, STOPPER_OVERRUN_WARNING,
+        };
+        let config = Config::default();
+        let model = Model::new(&config.params).unwrap();
+        let run = simulate(&model, &config.solver, &default_initial(&config), 1, None).unwrap();
+        let clean = run.steps[0];
+        assert!(
+            clean.audit_warnings().is_empty(),
+            "{:?}",
+            clean.audit_warnings()
+        );
+        let cases: [(&str, fn(&mut StepReport)); 5] = [
+            ("pulling force 2e-6 N exceeds 1e-6 N", |r| {
+                r.contact.pull_force = 2.0 * PULL_FORCE_WARNING
+            }),
+            ("pulling impulse 8.5 N s exceeds 1e-9 N s", |r| {
+                r.contact.pull_impulse = 8.5
+            }),
+            ("penetration 2e-9 m exceeds 1e-9 m", |r| {
+                r.contact.penetration = 2.0 * PENETRATION_WARNING
+            }),
+            ("stopper overrun 2e-8 m exceeds 1e-8 m", |r| {
+                r.contact.stopper_overrun = 2.0 * STOPPER_OVERRUN_WARNING
+            }),
+            ("pulling force NaN N", |r| r.contact.pull_force = f64::NAN),
+        ];
+        let _ = PULL_IMPULSE_WARNING;
+        let dir = tempfile::tempdir().unwrap();
+        for (expected, spoil) in cases {
+            let mut report = clean;
+            spoil(&mut report);
+            let mut summary =
+                SimulateSummary::new(&job(dir.path(), 1, false), default_initial(&config));
+            let listed = summary.add_step(&report, &mut VecDeque::new());
+            assert_eq!(listed.len(), 1, "{expected}: {listed:?}");
+            assert!(listed[0].contains(expected), "{expected}: {listed:?}");
+            assert_eq!(summary.warnings, listed);
+        }
     }
 
     /// A sink that collects the samples it is handed.

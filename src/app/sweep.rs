@@ -62,6 +62,8 @@ pub struct SweepSummary {
     /// The files this run wrote into the output directory (Fig. 2 only if some point has a gait; an earlier
     /// run's figure is removed rather than left beside this run's tables).
     pub files: Vec<String>,
+    /// Every audit value above its tolerance in the steps of the gaits found (empty when every law holds).
+    pub warnings: Vec<String>,
 }
 
 /// Run `vrw sweep`: the sweep, its thresholds, `sweep.csv`, `thresholds.json` and Fig. 2. `progress` is called
@@ -100,6 +102,12 @@ pub fn run_sweep(
         seconds: result.seconds,
         second_route_seconds: 0.0,
         files,
+        warnings: super::gait_warnings(
+            result
+                .points
+                .iter()
+                .map(|p| (format!("{} = {}", job.spec.param, short(p.value)), p)),
+        ),
     };
     let thresholds_json = job.out_dir.join("thresholds.json");
     output::write_json(&thresholds_json, &summary)?;

@@ -106,8 +106,8 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
     );
     let c = &g.contact;
     println!(
-        "contact audit: pull force {:.1e} N, pull impulse {:.1e} N s, penetration {:.1e} m; energy residual {:.1e} J",
-        c.pull_force, c.pull_impulse, c.penetration, g.energy_residual
+        "contact audit: pull force {:.1e} N, pull impulse {:.1e} N s, penetration {:.1e} m, stopper overrun {:.1e} m; energy residual {:.1e} J",
+        c.pull_force, c.pull_impulse, c.penetration, c.stopper_overrun, g.energy_residual
     );
     let multipliers: Vec<String> = g
         .floquet_multipliers
@@ -126,6 +126,9 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         g.jacobian_error,
         g.stability
     );
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
     println!("wrote {}/gait.json", args.out.display());
     Ok(())
 }

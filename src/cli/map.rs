@@ -10,7 +10,7 @@ use vrw::gait::{GaitOptions, MapSpec, SecondRoute, SweepSpec};
 use vrw::output::map_plot::MapMark;
 use vrw::walk::SectionState;
 
-use super::{confirmed_count, progress_bar, second_route_words, ModelArgs};
+use super::{confirmed_count, print_warnings, progress_bar, second_route_words, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct MapArgs {
@@ -197,6 +197,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
             }
         }
     }
+    print_warnings(&summary.warnings, "curves.json");
     println!(
         "wrote {}/{{map.csv, curves.json, map.svg, map.png}}",
         args.out.display()

@@ -161,3 +161,19 @@ fn confirmed_count<'a>(thresholds: impl Iterator<Item = &'a Threshold>) -> Strin
     }
     words
 }
+
+/// The most audit warnings a command prints; the file it names lists them all.
+const PRINTED_WARNINGS: usize = 20;
+
+/// Print audit warnings on stderr (the first [`PRINTED_WARNINGS`], then how many there are in `file`).
+fn print_warnings(warnings: &[String], file: &str) {
+    for w in warnings.iter().take(PRINTED_WARNINGS) {
+        eprintln!("warning: {w}");
+    }
+    if warnings.len() > PRINTED_WARNINGS {
+        eprintln!(
+            "warning: {} audit warnings in all, listed in {file}",
+            warnings.len()
+        );
+    }
+}

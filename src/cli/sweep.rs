@@ -10,7 +10,7 @@ use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
-use super::{confirmed_count, progress_bar, second_route_words, ModelArgs};
+use super::{confirmed_count, print_warnings, progress_bar, second_route_words, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct SweepArgs {
@@ -112,6 +112,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
             confirmed_count(summary.thresholds.iter())
         );
     }
+    print_warnings(&summary.warnings, "thresholds.json");
     println!(
         "wrote {}/{{{}}}",
         args.out.display(),

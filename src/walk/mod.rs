@@ -57,7 +57,10 @@ pub use error::WalkError;
 pub use events::{APPROACH_GAP, EVENT_SAMPLES, FORCE_EVENT_MARGIN};
 pub use impact::{Branch, DlsIndicators};
 pub use phase::{PhaseSystem, WalkState, WalkVector, NY};
-pub use report::{ContactAudit, EnergyAudit, StepReport};
+pub use report::{
+    ContactAudit, EnergyAudit, StepReport, ENERGY_RESIDUAL_WARNING, PENETRATION_WARNING,
+    PULL_FORCE_WARNING, PULL_IMPULSE_WARNING, STOPPER_OVERRUN_WARNING,
+};
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
 pub use section::SectionState;
 pub use trajectory::{Sample, SampleSink, Trajectory};

@@ -1,6 +1,9 @@
-//! What a step reports (issue: per-step report and energy audit; docs/model.md sections 5 and 7).
+//! What a step reports (docs/model.md sections 5 and 7): the indicators and durations, the energy audit and
+//! the contact audit, with the tolerances above which an audit value is a warning the user sees.
 
 use serde::Serialize;
+
+use crate::fmt::short;
 
 use super::impact::{Branch, DlsIndicators};
 use super::section::SectionState;
@@ -26,9 +29,32 @@ pub struct EnergyAudit {
     pub residual: f64,
 }
 
-/// Contact audit of one step (MODEL.md sections 3-4): the ground only pushes, stoppers only pull a leg inward,
-/// and no tip goes below the ground. Each field is 0 when the law holds exactly; a few 1e-10 come from event
-/// location and integration.
+/// A step whose energy audit leaves more than this unexplained \[J\] is a warning: the integration or an event
+/// is then not to be trusted.
+pub const ENERGY_RESIDUAL_WARNING: f64 = 1e-6;
+
+/// A pulling force (or outward stopper reaction) above this \[N\] is a warning. Forces of 100 N that cross zero
+/// at 1e4 to 1e5 N/s, located to `event_time_tol` (1e-13 s), overshoot by up to 1e-8 N; this is a hundred
+/// times that, and a millionth of the wheel's weight.
+pub const PULL_FORCE_WARNING: f64 = 1e-6;
+
+/// A pulling impulse above this \[N s\] is a warning. Impulses come from a linear solve with the active set
+/// fixed, so a law that holds gives 0 up to rounding (1e-15); the wrong active set gives 1e-2 to 10 N s.
+pub const PULL_IMPULSE_WARNING: f64 = 1e-9;
+
+/// A tip deeper than this below the ground \[m\] is a warning: a re-contact is armed `recontact_gap` (1e-11 m
+/// by default, at most 1e-6 m) above the ground and located to `event_time_tol`, so a law that holds stays
+/// within about 1e-11 m.
+pub const PENETRATION_WARNING: f64 = 1e-9;
+
+/// A leg farther than this past its stopper \[m\] is a warning: a free leg's stopper event fires at most
+/// `stopper_gap` (1e-9 m by default) past `L0`.
+pub const STOPPER_OVERRUN_WARNING: f64 = 1e-8;
+
+/// Contact audit of one step (docs/model.md sections 3, 4 and 7): the ground only pushes, stoppers only pull a
+/// leg inward, no tip goes below the ground and no leg past its stopper. Each field is 0 when the law holds
+/// exactly; a few 1e-10 come from event location and integration. A value above its tolerance
+/// ([`PULL_FORCE_WARNING`], ...) is a warning ([`StepReport::audit_warnings`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct ContactAudit {
     /// The largest pulling normal force or outward stopper reaction seen in the step \[N\] (at every accepted
@@ -41,8 +67,7 @@ pub struct ContactAudit {
     pub penetration: f64,
     /// The farthest Leg 1 or Leg 2 went past its stopper, `max(L - L0)` over the step \[m\] (checked where
     /// `penetration` is), 0 if none: a free leg's stopper event fires `stopper_gap` past `L0` at most
-    /// (docs/model.md section 4). Not yet in the CSV and JSON outputs.
-    #[serde(skip)]
+    /// (docs/model.md section 4).
     pub stopper_overrun: f64,
 }
 
@@ -83,4 +108,67 @@ pub struct StepReport {
     /// Contact audit (its fields are flattened into the step's JSON record).
     #[serde(flatten)]
     pub contact: ContactAudit,
+}
+
+impl StepReport {
+    /// What the step's audits say is wrong: one message per audit value above its tolerance (energy residual,
+    /// pulling force, pulling impulse, penetration, stopper overrun), naming the step, the value and the
+    /// tolerance. A NaN value is a warning too. Empty when every law holds.
+    pub fn audit_warnings(&self) -> Vec<String> {
+        let c = &self.contact;
+        let checks: [(&str, f64, f64, &str, &str); 5] = [
+            (
+                "energy residual",
+                self.energy.residual.abs(),
+                ENERGY_RESIDUAL_WARNING,
+                "J",
+                "the energy audit does not close",
+            ),
+            (
+                "pulling force",
+                c.pull_force,
+                PULL_FORCE_WARNING,
+                "N",
+                "the ground or a stopper pulled",
+            ),
+            (
+                "pulling impulse",
+                c.pull_impulse,
+                PULL_IMPULSE_WARNING,
+                "N s",
+                "an impact pulled",
+            ),
+            (
+                "penetration",
+                c.penetration,
+                PENETRATION_WARNING,
+                "m",
+                "a tip went below the ground",
+            ),
+            (
+                "stopper overrun",
+                c.stopper_overrun,
+                STOPPER_OVERRUN_WARNING,
+                "m",
+                "a leg went past its stopper",
+            ),
+        ];
+        checks
+            .iter()
+            .filter(|(_, value, limit, _, _)| !(*value <= *limit))
+            .map(|(name, value, limit, unit, meaning)| {
+                let shown = if *name == "energy residual" {
+                    self.energy.residual
+                } else {
+                    *value
+                };
+                format!(
+                    "step {}: {name} {} {unit} exceeds {} {unit} ({meaning})",
+                    self.step,
+                    short(shown),
+                    short(*limit)
+                )
+            })
+            .collect()
+    }
 }
