@@ -309,7 +309,8 @@ fn circle_points(at: (i32, i32), r: f64) -> Vec<Pt> {
         .collect()
 }
 
-/// The polyline `pts` split at every join sharper than plotters' mitre can draw (see [`SHARP_COS`]); the
+/// The polyline `pts` split at every join sharper than plotters' mitre can draw (an interior angle below
+/// 29 degrees, see the module comment); the
 /// parts share the point where they meet. A polyline without such a join comes back whole.
 pub fn split_sharp_turns(pts: &[(i32, i32)]) -> Vec<Vec<(i32, i32)>> {
     let mut out = vec![Vec::new()];
