@@ -1,17 +1,19 @@
 //! `vrw animate` and `vrw plot` end to end, on the directories `vrw simulate` and `vrw gait` write: the GIF
 //! decodes with the planned number of frames, the PNGs have their documented sizes, and bad input gets an
-//! error naming the problem. Only structure is checked (frame counts, sizes, files), never today's numbers.
+//! error naming the problem. Only structure is checked (frame counts, sizes, files), never today's numbers,
+//! except that a figure's curves stay inside its panels.
 
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use plotters::prelude::{BitMapBackend, IntoDrawingArea};
 use tempfile::TempDir;
 use vrw::output::animate::{plan_frames, AnimateOptions};
 use vrw::output::read::read_run;
-use vrw::output::run_plot::RUN_SIZE;
+use vrw::output::run_plot::{draw_run_figure, RUN_SIZE};
 use vrw::output::steps_plot::STEPS_SIZE;
-use vrw::output::style::png_size;
+use vrw::output::style::{png_size, COLOR_BLUE, COLOR_VERMILLION};
 
 fn vrw(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_vrw"))
@@ -184,6 +186,46 @@ fn plot_writes_run_and_steps_figures() {
     assert_png(&sim.join("steps.png"), STEPS_SIZE);
     assert_svg(&sim.join("run.svg"));
     assert_svg(&sim.join("steps.svg"));
+}
+
+/// The README's first walk (20 steps) has forces that jump at contact events; plotters joined such a jump and
+/// the one-pixel step back after it with a spike that crossed the panels below (t = 16.28 s and 31.35 s).
+/// No pixel of the panels' columns outside their plotting areas (2 px of frame allowed) has a curve colour.
+#[test]
+fn run_figure_lines_stay_inside_their_panels() {
+    let (_tmp, sim) = simulated("20");
+    let run = read_run(&sim).expect("the run reads back");
+    let (w, h) = RUN_SIZE;
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    let rects = {
+        let root = BitMapBackend::with_buffer(&mut buf, RUN_SIZE).into_drawing_area();
+        let rects = draw_run_figure(&run, &root).expect("the run figure draws");
+        root.present().expect("the bitmap is complete");
+        rects
+    };
+    assert_eq!(rects.len(), 5, "five panels");
+    let inside = |x: i32, y: i32| {
+        rects.iter().any(|(px, py)| {
+            (px.start - 2..px.end + 2).contains(&x) && (py.start - 2..py.end + 2).contains(&y)
+        })
+    };
+    let colours = [COLOR_BLUE, COLOR_VERMILLION].map(|c| [c.0, c.1, c.2]);
+    let (left, right) = (rects[0].0.start, rects[0].0.end);
+    let mut stray = Vec::new();
+    for y in 0..h as i32 {
+        for x in left..right {
+            let k = 3 * (y as usize * w as usize + x as usize);
+            if !inside(x, y) && colours.contains(&[buf[k], buf[k + 1], buf[k + 2]]) {
+                stray.push((x, y));
+            }
+        }
+    }
+    assert!(
+        stray.is_empty(),
+        "{} curve pixels outside the panels, e.g. {:?}",
+        stray.len(),
+        &stray[..stray.len().min(5)]
+    );
 }
 
 #[test]

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::chart::{
-    draw_axes_and_curves, draw_legend, titled, write_png, Axes, DrawResult, Figure, LEGEND_W,
+    draw_axes_and_curves, draw_legend, titled, write_png, Axes, Clip, DrawResult, Figure, LEGEND_W,
 };
 use super::style::{
     font, PlotError, COLOR_BLUE, COLOR_GREEN, COLOR_MARK, COLOR_ORANGE, COLOR_PURPLE,
@@ -127,11 +127,25 @@ impl Figure for BasinFigure {
             ],
             BLACK.stroke_width(2),
         ))?;
+        let clip = Clip::new(
+            px.start - base.0..px.end - base.0,
+            py.start - base.1..py.end - base.1,
+        );
         for &g in &self.gait {
             let p = to_px(g);
-            sub.draw(&Circle::new(p, 14, WHITE.filled()))?;
-            sub.draw(&Circle::new(p, 14, BLACK.stroke_width(3)))?;
-            sub.draw(&Cross::new(p, 8, BLACK.stroke_width(3)))?;
+            if !clip.contains(p) {
+                continue;
+            }
+            clip.draw_circle(&sub, p, 14, WHITE.filled())?;
+            clip.draw_circle(&sub, p, 14, BLACK.stroke_width(3))?;
+            if clip.contains((p.0 - 8, p.1 - 8)) && clip.contains((p.0 + 8, p.1 + 8)) {
+                sub.draw(&Cross::new(p, 8, BLACK.stroke_width(3)))?;
+            } else {
+                for arm in [[(-8, -8), (8, 8)], [(-8, 8), (8, -8)]] {
+                    let ends = arm.map(|(dx, dy)| (p.0 + dx, p.1 + dy));
+                    clip.draw_path(&sub, &ends, BLACK.stroke_width(3))?;
+                }
+            }
         }
         // Legend: the outcomes present, in a fixed order, then the gait marker.
         let mut kinds: Vec<&str> = Vec::new();

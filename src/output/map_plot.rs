@@ -18,7 +18,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::chart::{
-    dashed, titled, write_svg_png, DrawResult, Figure, AXIS_FONT, LEGEND_FONT, TICK_FONT,
+    dashed, titled, write_svg_png, Clip, DrawResult, Figure, AXIS_FONT, DASH_GAP, LEGEND_FONT,
+    TICK_FONT,
 };
 use super::style::{
     draw_box, font, house_mesh, tick_label, LegendLayout, PlotError, COLOR_BLACK, COLOR_BLUE,
@@ -249,6 +250,7 @@ impl MapFigure<'_> {
         }
         let (px, py) = chart.plotting_area().get_pixel_range();
         let plot = chart.plotting_area().strip_coord_spec();
+        let clip = Clip::of_area(&plot);
         let rel = |p: [f64; 2]| {
             let (a, b) = chart.backend_coord(&(p[0], p[1]));
             (a - px.start, b - py.start)
@@ -260,22 +262,25 @@ impl MapFigure<'_> {
                 pts.push(pts[0]);
             }
             if pts.len() == 1 {
-                plot.draw(&Circle::new(pts[0], 5, WHITE.filled()))?;
-                plot.draw(&Circle::new(pts[0], 3, color.filled()))?;
+                clip.draw_circle(&plot, pts[0], 5, WHITE.filled())?;
+                clip.draw_circle(&plot, pts[0], 3, color.filled())?;
                 continue;
             }
-            plot.draw(&PathElement::new(pts.clone(), WHITE.stroke_width(7)))?;
+            clip.draw_path(&plot, &pts, WHITE.stroke_width(7))?;
             if is_dashed {
-                dashed(&plot, &pts, color.stroke_width(3))?;
+                clip.draw_dashed(&plot, &pts, color.stroke_width(3), DASH_GAP)?;
             } else {
-                plot.draw(&PathElement::new(pts, color.stroke_width(3)))?;
+                clip.draw_path(&plot, &pts, color.stroke_width(3))?;
             }
         }
         for m in self.marks {
             let c = rel([m.x, m.y]);
-            plot.draw(&Circle::new(c, 10, WHITE.filled()))?;
-            plot.draw(&Circle::new(c, 10, COLOR_BLACK.stroke_width(3)))?;
-            plot.draw(&Circle::new(c, 3, COLOR_BLACK.filled()))?;
+            if !clip.contains(c) {
+                continue;
+            }
+            clip.draw_circle(&plot, c, 10, WHITE.filled())?;
+            clip.draw_circle(&plot, c, 10, COLOR_BLACK.stroke_width(3))?;
+            clip.draw_circle(&plot, c, 3, COLOR_BLACK.filled())?;
             let style = font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Bottom));
             let at = (c.0 + 14, c.1 - 8);
             let (tw, th) = plot.estimate_text_size(&m.label, &font(LEGEND_FONT))?;

@@ -9,8 +9,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::chart::{
-    draw_axes_and_curves, draw_legend, finite_range, titled, write_png, Axes, Band, Curve,
-    DrawResult, Figure, Stroke,
+    draw_axes_and_curves, draw_legend, finite_range, titled, write_png, Axes, Band, Clip, Curve,
+    DrawResult, Figure, Stroke, DASH_GAP,
 };
 use super::style::{padded, PlotError, COLOR_BLACK, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
 
@@ -183,17 +183,21 @@ impl Figure for OrbitFigure {
                     py.end - 1 - (fy * f64::from(py.end - py.start - 1)).round() as i32 - base.1,
                 )
             };
+            let clip = Clip::new(
+                px.start - base.0..px.end - base.0,
+                py.start - base.1..py.end - base.1,
+            );
             for &p in &panel.points {
                 if p.0.is_finite() && p.1.is_finite() && y.contains(&p.1) {
-                    sub.draw(&Circle::new(to_px(p), DOT, COLOR_BLUE.filled()))?;
+                    clip.draw_circle(&sub, to_px(p), DOT, COLOR_BLUE.filled())?;
                 }
             }
-            let plot = sub.clone();
             for c in &curves {
                 let pts: Vec<(i32, i32)> = c.points.iter().map(|&p| to_px(p)).collect();
+                let style = c.color.stroke_width(3);
                 match c.stroke {
-                    Stroke::Dashed => super::chart::dashed(&plot, &pts, c.color.stroke_width(3))?,
-                    _ => plot.draw(&PathElement::new(pts, c.color.stroke_width(3)))?,
+                    Stroke::Dashed => clip.draw_dashed(&sub, &pts, style, DASH_GAP)?,
+                    _ => clip.draw_path(&sub, &pts, style)?,
                 }
             }
             let mut legend = legend_curves(&curves);

@@ -12,8 +12,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::chart::{
-    dashed, draw_stack, titled, write_svg_png, Band, Curve, DrawResult, Figure, Panel, Stack,
-    Stroke,
+    dashed, draw_stack, titled, write_svg_png, Band, Curve, DrawResult, Figure, Panel, PixelRect,
+    Stack, Stroke,
 };
 use super::read::{RunData, TipState, TrajectoryRow};
 use super::style::{draw_box, PlotError, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
@@ -235,8 +235,12 @@ fn draw_phase_row<DB: DrawingBackend>(
     Ok(())
 }
 
-impl Figure for RunFigure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+impl RunFigure {
+    /// Draws the figure; returns the canvas pixels of the panels' plotting areas.
+    fn draw_panels<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<Vec<PixelRect>, DrawingAreaErrorKind<DB::ErrorType>> {
         let body = titled(root, &self.title)?;
         let mut kinds: Vec<PhaseKind> = Vec::new();
         for (_, k) in &self.bands {
@@ -260,9 +264,30 @@ impl Figure for RunFigure {
                 panels: &self.panels,
                 x_integer: false,
             },
-        )?;
-        Ok(())
+        )
     }
+}
+
+impl Figure for RunFigure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        self.draw_panels(root).map(|_| ())
+    }
+}
+
+/// Draws the run figure of `run` on `root` (of [`RUN_SIZE`]) and returns the canvas pixels of its five
+/// panels' plotting areas, top to bottom; whatever a panel shows stays inside its area.
+///
+/// # Errors
+/// [`PlotError::Empty`] if the trajectory spans no time; [`PlotError::Draw`] (naming `run.png`) if the
+/// backend fails.
+pub fn draw_run_figure<DB: DrawingBackend>(
+    run: &RunData,
+    root: &DrawingArea<DB, Shift>,
+) -> Result<Vec<PixelRect>, PlotError> {
+    super::style::require_font(&run.path("run.png"))?;
+    RunFigure::new(run)?
+        .draw_panels(root)
+        .map_err(|e| PlotError::draw_at(&run.path("run.png"))(e.to_string()))
 }
 
 /// Writes `run.png` and `run.svg` into the run directory and returns their paths.

@@ -1,5 +1,5 @@
 //! A chart's axes and plotting area: the mesh in a given [`AxisStyle`], then shading, vertical marks, curves
-//! and the frame drawn in data coordinates ([`PlotArea`]).
+//! and the frame drawn in data coordinates ([`PlotArea`]), each clipped to the plotting area ([`Clip`]).
 
 use std::ops::Range;
 
@@ -9,8 +9,8 @@ use plotters::prelude::*;
 
 use super::super::style::{house_mesh, tick_label, COLOR_MARK};
 use super::{
-    dashed, draw_marker, Band, Curve, DrawResult, Marker, PixelRect, Stroke, AXIS_FONT,
-    MIN_BAND_PX, TICK_FONT, X_LABEL_AREA, Y_LABEL_AREA,
+    Band, Clip, Curve, DrawResult, Marker, PixelRect, Stroke, AXIS_FONT, DASH_GAP, MIN_BAND_PX,
+    TICK_FONT, X_LABEL_AREA, Y_LABEL_AREA,
 };
 
 /// Proportions of a chart's axes \[px\]: fonts, the room for tick labels and descriptions, and how many
@@ -87,6 +87,8 @@ pub struct PlotArea<'a, DB: DrawingBackend> {
     pub px: Range<i32>,
     /// Its pixel rows on the canvas.
     pub py: Range<i32>,
+    /// The plotting area in the pixels of [`PlotArea::area`]: whatever is drawn there goes through it.
+    pub clip: Clip,
     x: Range<f64>,
     y: Range<f64>,
     min_band_px: i32,
@@ -139,6 +141,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
         let plot = chart.plotting_area().strip_coord_spec();
         Ok(PlotArea {
             chart,
+            clip: Clip::of_area(&plot),
             area: plot,
             px,
             py,
@@ -160,7 +163,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
         (a - self.px.start, b - self.py.start)
     }
 
-    /// Shades `bands` (clipped to the x range, at least [`AxisStyle::min_band_px`] wide).
+    /// Shades `bands` (at least [`AxisStyle::min_band_px`] wide, clipped to the plotting area).
     pub fn draw_bands(&self, bands: &[Band]) -> DrawResult<DB> {
         let (x, y) = (&self.x, &self.y);
         for b in bands {
@@ -168,7 +171,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
             if hi > lo {
                 let (mut a, c) = (self.rel((lo, y.end)), self.rel((hi, y.start)));
                 a.0 = a.0.min(c.0 - self.min_band_px);
-                self.area.draw(&Rectangle::new([a, c], b.color.filled()))?;
+                self.clip.draw_rect(&self.area, [a, c], b.color.filled())?;
             }
         }
         Ok(())
@@ -178,29 +181,33 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
     pub fn draw_marks(&self, marks: &[f64]) -> DrawResult<DB> {
         let (x, y) = (&self.x, &self.y);
         for &m in marks.iter().filter(|m| x.contains(m)) {
-            dashed(
+            self.clip.draw_dashed(
                 &self.area,
                 &[self.rel((m, y.end)), self.rel((m, y.start))],
                 COLOR_MARK.stroke_width(2),
+                DASH_GAP,
             )?;
         }
         Ok(())
     }
 
-    /// Draws `curves` (lines 3 px wide, markers of size 6), each broken where a value is not finite.
+    /// Draws `curves` (lines 3 px wide, markers of size 6), each broken where a value is not finite and
+    /// clipped to the plotting area.
     pub fn draw_curves(&self, curves: &[Curve]) -> DrawResult<DB> {
         for c in curves {
             for run in runs(&c.points) {
                 let pts: Vec<(i32, i32)> = run.iter().map(|&p| self.rel(p)).collect();
+                let style = c.color.stroke_width(3);
                 match c.stroke {
-                    Stroke::Dashed => dashed(&self.area, &pts, c.color.stroke_width(3))?,
-                    Stroke::Solid | Stroke::Markers => self
-                        .area
-                        .draw(&PathElement::new(pts.clone(), c.color.stroke_width(3)))?,
+                    Stroke::Dashed => self.clip.draw_dashed(&self.area, &pts, style, DASH_GAP)?,
+                    Stroke::Solid | Stroke::Markers => {
+                        self.clip.draw_path(&self.area, &pts, style)?
+                    }
                 }
                 if c.stroke == Stroke::Markers {
                     for p in pts {
-                        draw_marker(&self.area, p, Marker::Circle, c.color, false, 6)?;
+                        self.clip
+                            .draw_marker(&self.area, p, Marker::Circle, c.color, false, 6)?;
                     }
                 }
             }

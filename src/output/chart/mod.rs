@@ -1,6 +1,7 @@
 //! The panel, axis and legend drawing every figure shares: a chart's axes and plotting area ([`PlotArea`]:
 //! mesh, shading, vertical marks, curves, frame), markers, dashed lines, legend boxes ([`draw_legend_rows`]),
-//! titles, and panels of curves stacked on one x axis for the run figures (`run.png`, `steps.png`). Fig. 2
+//! titles, and panels of curves stacked on one x axis for the run figures (`run.png`, `steps.png`). What is
+//! drawn inside a plotting area is clipped to it ([`Clip`]). Fig. 2
 //! (`fig2.png`) draws with the same code at its own proportions ([`AxisStyle`]), and the run figures share
 //! its look (bundled font, units on every axis).
 
@@ -12,9 +13,11 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 mod axes;
+mod clip;
 mod legend;
 
 pub use axes::{draw_axes_and_curves, Axes, AxisStyle, PlotArea, RUN_AXES};
+pub use clip::{split_sharp_turns, Clip};
 pub use legend::{draw_legend, draw_legend_rows, draw_marker, Label, LegendRow, Marker, Sample};
 
 use super::style::{font, padded, PlotError};
@@ -184,11 +187,13 @@ pub fn dashed_with<DB: DrawingBackend>(
 }
 
 /// Draws the stack into `area`: the panels share the height equally and the x axis is labelled on the
-/// bottom panel only; each panel's legend stands right of it.
+/// bottom panel only; each panel's legend stands right of it. Returns the canvas pixels of each panel's
+/// plotting area, top to bottom: everything a panel shows is clipped to it.
 pub fn draw_stack<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     stack: &Stack,
-) -> DrawResult<DB> {
+) -> Result<Vec<PixelRect>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut rects = Vec::with_capacity(stack.panels.len());
     let (w, h) = area.dim_in_pixel();
     let (w, h) = (w as i32, h as i32);
     let n = stack.panels.len().max(1) as i32;
@@ -206,7 +211,8 @@ pub fn draw_stack<DB: DrawingBackend>(
             y_label: &panel.y_label,
             x_integer: stack.x_integer,
         };
-        let (_, y_px) = draw_axes_and_curves(&sub, &axes, &panel.curves, stack.bands, stack.marks)?;
+        let (x_px, y_px) =
+            draw_axes_and_curves(&sub, &axes, &panel.curves, stack.bands, stack.marks)?;
         let base = area.get_base_pixel();
         draw_legend(
             area,
@@ -214,8 +220,9 @@ pub fn draw_stack<DB: DrawingBackend>(
             &[],
             (w - LEGEND_W + 16, y_px.start - base.1 + 4),
         )?;
+        rects.push((x_px, y_px));
     }
-    Ok(())
+    Ok(rects)
 }
 
 /// The font size, at most `max`, at which `title` fits the width of `root` within [`MARGIN`] on each side.

@@ -8,8 +8,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::super::chart::{
-    dashed_with, draw_legend_rows, draw_marker, title_size, Axes, AxisStyle, Band, DrawResult,
-    Label, LegendRow, Marker, PixelRect, PlotArea, Sample, Stroke,
+    dashed_with, draw_legend_rows, title_size, Axes, AxisStyle, Band, DrawResult, Label, LegendRow,
+    Marker, PixelRect, PlotArea, Sample, Stroke,
 };
 use super::super::style::{draw_rich, font, rich_width, LegendLayout, Seg, COLOR_MARK};
 use super::data::{Prepared, Series};
@@ -150,13 +150,14 @@ fn draw_panel<DB: DrawingBackend>(
         .collect();
     plot.draw_bands(&no_gait)?;
     // Reference line.
-    plot.area.draw(&PathElement::new(
-        vec![
+    plot.clip.draw_path(
+        &plot.area,
+        &[
             plot.rel((x.start, panel.reference)),
             plot.rel((x.end, panel.reference)),
         ],
         BLACK.stroke_width(2),
-    ))?;
+    )?;
     if series.iter().all(|s| s.runs.is_empty()) {
         plot.area.draw(&Text::new(
             "not defined for these gaits (e.g. rigid legs)",
@@ -166,22 +167,22 @@ fn draw_panel<DB: DrawingBackend>(
     }
     // Thresholds inside the plot.
     for m in &data.marks {
-        dashed_vline(root, plot.to_px((m.value, 0.0)).0, py.start, py.end)?;
+        let at = plot.to_px((m.value, 0.0)).0;
+        if px.contains(&at) {
+            dashed_vline(root, at, py.start, py.end)?;
+        }
     }
     // Lines, then markers on top.
     for s in series {
         for run in &s.runs {
-            plot.area.draw(&PathElement::new(
-                run.iter()
-                    .map(|&(a, b, _)| plot.rel((a, b)))
-                    .collect::<Vec<_>>(),
-                s.color.stroke_width(2),
-            ))?;
+            let pts: Vec<(i32, i32)> = run.iter().map(|&(a, b, _)| plot.rel((a, b))).collect();
+            plot.clip
+                .draw_path(&plot.area, &pts, s.color.stroke_width(2))?;
         }
     }
     for s in series {
         for &(a, b, scuff) in s.samples() {
-            draw_marker(
+            plot.clip.draw_marker(
                 &plot.area,
                 plot.rel((a, b)),
                 s.shape,
