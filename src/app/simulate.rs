@@ -391,9 +391,7 @@ mod tests {
     /// the energy residual is: a pulling impact after flight once went unsaid.
     #[test]
     fn contact_audit_above_its_tolerance_warns() {
-        use crate::walk::{
-            PENETRATION_WARNING, PULL_FORCE_WARNING, PULL_IMPULSE_WARNING, STOPPER_OVERRUN_WARNING,
-        };
+        use crate::walk::{PENETRATION_WARNING, PULL_FORCE_WARNING, STOPPER_OVERRUN_WARNING};
         let config = Config::default();
         let model = Model::new(&config.params).unwrap();
         let run = simulate(&model, &config.solver, &default_initial(&config), 1, None).unwrap();
@@ -403,7 +401,8 @@ mod tests {
             "{:?}",
             clean.audit_warnings()
         );
-        let cases: [(&str, fn(&mut StepReport)); 5] = [
+        type Spoil = fn(&mut StepReport);
+        let cases: [(&str, Spoil); 5] = [
             ("pulling force 2e-6 N exceeds 1e-6 N", |r| {
                 r.contact.pull_force = 2.0 * PULL_FORCE_WARNING
             }),
@@ -418,7 +417,6 @@ mod tests {
             }),
             ("pulling force NaN N", |r| r.contact.pull_force = f64::NAN),
         ];
-        let _ = PULL_IMPULSE_WARNING;
         let dir = tempfile::tempdir().unwrap();
         for (expected, spoil) in cases {
             let mut report = clean;

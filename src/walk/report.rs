@@ -155,7 +155,7 @@ impl StepReport {
         ];
         checks
             .iter()
-            .filter(|(_, value, limit, _, _)| !(*value <= *limit))
+            .filter(|(_, value, limit, _, _)| value.is_nan() || value > limit)
             .map(|(name, value, limit, unit, meaning)| {
                 let shown = if *name == "energy residual" {
                     self.energy.residual
