@@ -13,7 +13,7 @@ use crate::fmt::short;
 use crate::output::{self, OutputError};
 use crate::params::Config;
 use crate::reference::default_initial;
-use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
+use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory, ZENO_IMPULSE_WARNING};
 
 use super::{remove_stale, AppError};
 
@@ -131,14 +131,26 @@ impl SimulateSummary {
         last.push_back(*report);
         // A NaN residual is a warning too.
         let within = residual.abs() <= ENERGY_RESIDUAL_WARNING;
-        let warning = (!within).then(|| {
+        let energy = (!within).then(|| {
             format!(
-                "step {}: energy residual {} J exceeds {} J (the energy audit does not close)",
-                report.step,
+                "energy residual {} J exceeds {} J (the energy audit does not close)",
                 short(residual),
                 short(ENERGY_RESIDUAL_WARNING)
             )
-        })?;
+        });
+        let zeno = report.contact.zeno_impulse;
+        let zeno = (zeno > ZENO_IMPULSE_WARNING).then(|| {
+            format!(
+                "a Zeno stopper lock took {} N s, above {} N s (docs/model.md section 5: lower stopper_gap)",
+                short(zeno),
+                short(ZENO_IMPULSE_WARNING)
+            )
+        });
+        let found: Vec<String> = energy.into_iter().chain(zeno).collect();
+        if found.is_empty() {
+            return None;
+        }
+        let warning = format!("step {}: {}", report.step, found.join("; "));
         self.warnings_total += 1;
         (self.warnings.len() < SUMMARY_WARNINGS).then(|| {
             self.warnings.push(warning.clone());
@@ -392,6 +404,14 @@ mod tests {
         assert!(summary.add_step(&report, &mut last).is_some());
         assert_eq!(summary.warnings.len(), 2);
         assert_eq!(summary.warnings_total, 2);
+        // A Zeno stopper lock above its tolerance is a warning too.
+        report.energy.residual = 0.0;
+        report.contact.zeno_impulse = 2.0 * crate::walk::ZENO_IMPULSE_WARNING;
+        let warning = summary.add_step(&report, &mut last).unwrap();
+        assert!(
+            warning.contains("Zeno stopper lock took 0.002 N s"),
+            "{warning}"
+        );
     }
 
     /// A sink that collects the samples it is handed.

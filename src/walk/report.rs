@@ -20,7 +20,8 @@ pub struct EnergyAudit {
     pub damper: f64,
     /// Kinetic energy lost in the touchdown collision and in ground re-contacts \[J\].
     pub impact: f64,
-    /// Kinetic energy lost when a sliding leg hits its stopper \[J\].
+    /// Kinetic energy lost when a sliding leg hits its stopper, and in Zeno locks (docs/model.md section 5)
+    /// \[J\].
     pub stopper: f64,
     /// `loss - (damper + impact + stopper)` \[J\]: zero up to the integration error.
     pub residual: f64,
@@ -40,10 +41,16 @@ pub struct ContactAudit {
     /// none.
     pub penetration: f64,
     /// The farthest Leg 1 or Leg 2 went past its stopper, `max(L - L0)` over the step \[m\] (checked where
-    /// `penetration` is), 0 if none: a free leg's stopper event fires `stopper_gap` past `L0` at most
-    /// (docs/model.md section 4). Not yet in the CSV and JSON outputs.
+    /// `penetration` is), 0 if none: a stopper lock is late by at most `APPROACH_GAP` per lock of a sequence,
+    /// and `stopper_gap` after a grazing unlock (docs/model.md section 4). Not yet in the CSV and JSON outputs.
     #[serde(skip)]
     pub stopper_overrun: f64,
+    /// The largest outward impulse of a stopper locked at the accumulation point of a Zeno sequence of stopper
+    /// impacts \[N s\], 0 if none (docs/model.md section 5): the small velocity the lock removes, at most about
+    /// `m sqrt(2 a_out stopper_gap)`; not a pull of the ground or a stopper, so it is not in `pull_impulse`.
+    /// Not yet in the CSV and JSON outputs.
+    #[serde(skip)]
+    pub zeno_impulse: f64,
 }
 
 /// One step of the walk: from a touchdown to the next.
