@@ -385,6 +385,14 @@ mod tests {
         assert_eq!(summary.add_step(&report, &mut last).len(), 1);
         assert_eq!(summary.warnings.len(), 2);
         assert_eq!(summary.warnings_total, 2);
+        // A Zeno stopper lock above its tolerance is a warning too.
+        report.energy.residual = 0.0;
+        report.contact.zeno_impulse = 2.0 * crate::walk::ZENO_IMPULSE_WARNING;
+        let warning = summary.add_step(&report, &mut last);
+        assert!(
+            warning[0].contains("Zeno stopper lock impulse 0.002 N s exceeds 0.001 N s"),
+            "{warning:?}"
+        );
     }
 
     /// Every contact audit value above its tolerance is a warning in `summary.json` and for the terminal, as

@@ -18,7 +18,10 @@ pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
 /// The grazing guard of a landing or stopper event whose tip (leg) starts at the ground (stopper) already moving
 /// into it \[m\]: such a contact is not grazing, so its event fires as soon as it moves this far (instead of
 /// `recontact_gap` / `stopper_gap`). It happens after the `traditional` exchange drives the rear tip into the
-/// ground, or when an impact's complementarity problem had no consistent solution.
+/// ground, or when an impact's complementarity problem had no consistent solution. A leg that starts at its
+/// stopper moving *away* from it (inward) is not grazing either (docs/model.md section 4): its stopper event
+/// fires this far past where it started, so a leg that comes back within one integrator step locks at `L0`
+/// instead of `stopper_gap` past it, and the overrun does not grow from lock to lock.
 pub const APPROACH_GAP: f64 = 1e-12;
 
 /// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
@@ -95,8 +98,10 @@ impl<'a> EventSet<'a> {
                 f0().min(0.0) - FORCE_EVENT_MARGIN
             } else if let Some(gap) = Self::guard(opts, kind) {
                 // Guarded events start disarmed unless their function already clears the gap. A tip (leg) that
-                // starts at the ground (stopper) already moving into it is not grazing: it fires at once.
-                let gap = if set.approaching(kind, &q, &qd) {
+                // starts at the ground (stopper) already moving into it is not grazing: it fires at once. Nor is
+                // a leg that leaves its stopper at a definite speed: the Zeno rule locked it if that speed could
+                // not take it `stopper_gap` away, so its stopper event fires at `L0`, not `stopper_gap` past it.
+                let gap = if set.approaching(kind, &q, &qd) || set.separating(kind, &qd) {
                     APPROACH_GAP
                 } else {
                     gap
@@ -131,6 +136,14 @@ impl<'a> EventSet<'a> {
                 self.model.tip(q, qd, leg.index()).velocity(qd).y < -COMPLEMENTARITY_TOL
             }
             EventKind::StopperHit(leg) => qd[leg.length_coordinate()] > COMPLEMENTARITY_TOL,
+            _ => false,
+        }
+    }
+
+    /// Does a free leg leave its stopper (move inward) faster than [`COMPLEMENTARITY_TOL`] at `q'`?
+    fn separating(&self, kind: EventKind, qd: &Coords) -> bool {
+        match kind {
+            EventKind::StopperHit(leg) => qd[leg.length_coordinate()] < -COMPLEMENTARITY_TOL,
             _ => false,
         }
     }

@@ -27,7 +27,9 @@
 //! **Impacts.** Every impact (touchdown, rear re-contact, stopper lock) is an impulse-level complementarity
 //! problem over every unilateral unit present (see [`impact::plastic_impact`]); only the closing unit (and at
 //! touchdown the paper's (A1)/(A3) choice for Leg 2) is forced. The force-level problem then picks the phase
-//! that follows.
+//! that follows. A leg that an impact kicks off its stopper too slowly to leave it by `stopper_gap` is locked at
+//! once (the Zeno rule of `zeno.rs`, docs/model.md section 5), and a leg that leaves its stopper faster has its
+//! stopper event fire at `L0` ([`APPROACH_GAP`]).
 //!
 //! **Audits.** Every step reports an energy audit and a contact audit ([`ContactAudit`]): the largest pulling
 //! force at the ends of the [`EVENT_SAMPLES`] parts of every accepted integrator step and at every event instant,
@@ -36,7 +38,8 @@
 //! per integrator step.
 //!
 //! **Layout.** `phase.rs` holds the phase ODE, `events.rs` the event functions and their guards,
-//! `audit.rs` the contact audit's per-step checks, `impact.rs` the impacts, `walker.rs` the step
+//! `audit.rs` the contact audit's per-step checks, `impact.rs` the impacts, `zeno.rs` the Zeno rule for
+//! sequences of stopper impacts, `walker.rs` the step
 //! ([`Walker`]), `run.rs` the walks of many steps ([`simulate`], [`simulate_streaming`]), `trajectory.rs`
 //! the sampled trajectory and `work.rs` the work counts ([`WorkCounts`]).
 
@@ -51,6 +54,7 @@ pub mod section;
 mod trajectory;
 mod walker;
 mod work;
+mod zeno;
 
 pub use audit::PENETRATION_SAMPLES;
 pub use error::WalkError;
@@ -66,3 +70,4 @@ pub use section::SectionState;
 pub use trajectory::{Sample, SampleSink, Trajectory};
 pub use walker::{Walker, SECTION_TIP_SPEED_TOL};
 pub use work::{total_work, EventCounts, WorkCounts};
+pub use zeno::ZENO_IMPULSE_WARNING;

@@ -7,6 +7,7 @@ use crate::fmt::short;
 
 use super::impact::{Branch, DlsIndicators};
 use super::section::SectionState;
+use super::zeno::ZENO_IMPULSE_WARNING;
 
 /// Energy bookkeeping of one step, from just before its touchdown to just before the next one
 /// (docs/model.md section 7): the loss of `T + V` must equal the damper dissipation plus the impact and stopper
@@ -23,7 +24,8 @@ pub struct EnergyAudit {
     pub damper: f64,
     /// Kinetic energy lost in the touchdown collision and in ground re-contacts \[J\].
     pub impact: f64,
-    /// Kinetic energy lost when a sliding leg hits its stopper \[J\].
+    /// Kinetic energy lost when a sliding leg hits its stopper, and in Zeno locks (docs/model.md section 5)
+    /// \[J\].
     pub stopper: f64,
     /// `loss - (damper + impact + stopper)` \[J\]: zero up to the integration error.
     pub residual: f64,
@@ -66,9 +68,13 @@ pub struct ContactAudit {
     /// none.
     pub penetration: f64,
     /// The farthest Leg 1 or Leg 2 went past its stopper, `max(L - L0)` over the step \[m\] (checked where
-    /// `penetration` is), 0 if none: a free leg's stopper event fires `stopper_gap` past `L0` at most
-    /// (docs/model.md section 4).
+    /// `penetration` is), 0 if none: a stopper lock is late by at most `APPROACH_GAP` per lock of a sequence,
+    /// and `stopper_gap` after a grazing unlock (docs/model.md section 4).
     pub stopper_overrun: f64,
+    /// The largest outward impulse of a stopper locked at the accumulation point of a Zeno sequence of stopper
+    /// impacts \[N s\], 0 if none (docs/model.md section 5): the small velocity the lock removes, at most about
+    /// `m sqrt(2 a_out stopper_gap)`; not a pull of the ground or a stopper, so it is not in `pull_impulse`.
+    pub zeno_impulse: f64,
 }
 
 /// One step of the walk: from a touchdown to the next.
@@ -116,7 +122,7 @@ impl StepReport {
     /// tolerance. A NaN value is a warning too. Empty when every law holds.
     pub fn audit_warnings(&self) -> Vec<String> {
         let c = &self.contact;
-        let checks: [(&str, f64, f64, &str, &str); 5] = [
+        let checks: [(&str, f64, f64, &str, &str); 6] = [
             (
                 "energy residual",
                 self.energy.residual.abs(),
@@ -151,6 +157,13 @@ impl StepReport {
                 STOPPER_OVERRUN_WARNING,
                 "m",
                 "a leg went past its stopper",
+            ),
+            (
+                "Zeno stopper lock impulse",
+                c.zeno_impulse,
+                ZENO_IMPULSE_WARNING,
+                "N s",
+                "docs/model.md section 5: lower stopper_gap",
             ),
         ];
         checks

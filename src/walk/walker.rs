@@ -21,6 +21,7 @@ use super::report::{ContactAudit, EnergyAudit, StepReport};
 use super::section::SectionState;
 use super::trajectory::Trajectory;
 use super::work::{add_to_total, WorkCounts};
+use super::zeno::{lock_zeno_stoppers, ZenoLock};
 
 /// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
 /// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
@@ -37,6 +38,17 @@ struct StepTally {
     impact_loss: f64,
     stopper_loss: f64,
     events: usize,
+}
+
+impl StepTally {
+    /// Account for a Zeno lock (docs/model.md section 5): its kinetic energy loss is a stopper loss, its impulse
+    /// goes to the contact audit as `zeno_impulse` (the other units' pulls as `pull_impulse`).
+    fn see_zeno(&mut self, lock: &ZenoLock) {
+        self.stopper_loss += lock.loss;
+        self.audit.zeno_impulse = self.audit.zeno_impulse.max(lock.impulse);
+        self.audit.pull_impulse = self.audit.pull_impulse.max(lock.pull_impulse);
+        self.scuffing |= lock.active.slide2;
+    }
 }
 
 /// Walks the wheel from touchdown to touchdown.
@@ -196,15 +208,30 @@ impl<'m> Walker<'m> {
             &present,
             &td.preferred,
         );
-        let (active, _) = consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
-            .map_err(WalkError::contact_at(t_start, td.preferred.phase()))?
-            .ok_or(WalkError::InconsistentContacts {
-                time: t_start,
-                phase: td.preferred.phase(),
-            })?;
+        let (mut active, _) =
+            consistent_active_set(model, &start.q, &td.qd_plus, forced, &candidates)
+                .map_err(WalkError::contact_at(t_start, td.preferred.phase()))?
+                .ok_or(WalkError::InconsistentContacts {
+                    time: t_start,
+                    phase: td.preferred.phase(),
+                })?;
         tally.scuffing |= active.slide2;
+        let mut qd_plus = td.qd_plus;
+        let zeno = lock_zeno_stoppers(
+            model,
+            &start.q,
+            &qd_plus,
+            active,
+            self.opts.stopper_gap,
+            t_start,
+        )?;
+        if let Some(lock) = zeno {
+            work.impacts += 1;
+            tally.see_zeno(&lock);
+            (qd_plus, active) = (lock.qd_plus, lock.active);
+        }
 
-        let y = pack(&start.q, &td.qd_plus, 0.0);
+        let y = pack(&start.q, &qd_plus, 0.0);
         let mut phases = Phases::start(self, start, trajectory, tally, active, y);
         let reached = phases.run();
         *work += phases.work();
@@ -555,8 +582,17 @@ impl<'a> Phases<'a> {
                 }
                 tally.scuffing |=
                     (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
-                self.active = closed.active;
-                self.y = pack(&q, &closed.qd_plus, self.y[2 * NQ]);
+                let (mut qd_plus, mut active) = (closed.qd_plus, closed.active);
+                let gap = self.opts.stopper_gap;
+                if let Some(lock) = lock_zeno_stoppers(model, &q, &qd_plus, active, gap, t)? {
+                    self.work.impacts += 1;
+                    self.tally.see_zeno(&lock);
+                    (qd_plus, active) = (lock.qd_plus, lock.active);
+                }
+                // Leg 1's tip may leave the ground at an impact (a stopper lock that lifts the wheel).
+                self.tally.bounce |= self.active.contact1 && !active.contact1;
+                self.active = active;
+                self.y = pack(&q, &qd_plus, self.y[2 * NQ]);
             }
         }
         self.tally.events += 1;

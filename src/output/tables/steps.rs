@@ -10,7 +10,7 @@ use crate::walk::StepReport;
 use Cell::{Count, Flag, Real, Text};
 
 /// The columns of `steps.csv` (docs/model.md sections 4-5 for the section state and the indicators).
-pub const STEPS: [Column<StepReport>; 29] = [
+pub const STEPS: [Column<StepReport>; 30] = [
     Column::new("step", "Step number, from 1.", |s| Count(s.step)),
     Column::new(
         "time",
@@ -146,10 +146,15 @@ pub const STEPS: [Column<StepReport>; 29] = [
         "Farthest Leg 1 or Leg 2 went past its stopper during the step, max(L - L0), 0 if none [m].",
         |s| Real(s.contact.stopper_overrun),
     ),
+    Column::new(
+        "zeno_impulse",
+        "Largest outward impulse of a stopper locked at the end of a Zeno sequence of stopper impacts, 0 if none [N s].",
+        |s| Real(s.contact.zeno_impulse),
+    ),
 ];
 
 /// Header of `steps.csv` (the names of [`STEPS`]).
-pub const STEPS_HEADER: [&str; 29] = fixed_names(&STEPS, 0);
+pub const STEPS_HEADER: [&str; 30] = fixed_names(&STEPS, 0);
 
 /// One row of `steps.csv`, in the order of [`STEPS_HEADER`].
 pub fn step_row(s: &StepReport) -> Vec<Cell> {
