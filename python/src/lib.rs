@@ -54,8 +54,15 @@ fn app_error(e: AppError) -> PyErr {
         AppError::Output(e) => PyOSError::new_err(e.to_string()),
         e @ AppError::InvalidOption { .. } => PyValueError::new_err(e.to_string()),
         // Reading run directories and drawing figures are command-line jobs, not reached from Python.
-        e @ (AppError::Read(_) | AppError::Animate(_) | AppError::Plot(_)) => {
-            PyOSError::new_err(e.to_string())
+        e @ (AppError::Read(_)
+        | AppError::Animate(_)
+        | AppError::Plot(_)
+        | AppError::Manifest(_)
+        | AppError::NotOneRun { .. }) => PyOSError::new_err(e.to_string()),
+        // Only reached when the interrupt flag was set without a signal (the watcher raises the signal's
+        // exception itself).
+        e @ AppError::Interrupted { .. } => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string())
         }
     }
 }
