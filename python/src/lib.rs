@@ -54,8 +54,15 @@ fn app_error(e: AppError) -> PyErr {
         AppError::Output(e) => PyOSError::new_err(e.to_string()),
         e @ AppError::InvalidOption { .. } => PyValueError::new_err(e.to_string()),
         // Reading run directories and drawing figures are command-line jobs, not reached from Python.
-        e @ (AppError::Read(_) | AppError::Animate(_) | AppError::Plot(_)) => {
-            PyOSError::new_err(e.to_string())
+        e @ (AppError::Read(_)
+        | AppError::Animate(_)
+        | AppError::Plot(_)
+        | AppError::Manifest(_)
+        | AppError::NotOneRun { .. }) => PyOSError::new_err(e.to_string()),
+        // Only reached when the interrupt flag was set without a signal (the watcher raises the signal's
+        // exception itself).
+        e @ AppError::Interrupted { .. } => {
+            pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string())
         }
     }
 }
@@ -357,19 +364,18 @@ fn sweep<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = gait_options(GaitOptions::for_sweeps(), options)?;
     let config = &params.config;
-    let result = py
-        .allow_threads(|| {
-            compute_sweep(
-                config,
-                param,
-                &values,
-                section(initial),
-                &options,
-                &|_| {},
-                &mut |_| Ok(()),
-            )
-        })
-        .map_err(app_error)?;
+    let result = interruptible(py, || {
+        compute_sweep(
+            config,
+            param,
+            &values,
+            section(initial),
+            &options,
+            &|_| {},
+            &mut |_| Ok(()),
+        )
+    })?
+    .map_err(app_error)?;
     let out = PyDict::new(py);
     out.set_item("param", param)?;
     let rows: Vec<Vec<Cell>> = result.points.iter().map(sweep_row).collect();
@@ -382,6 +388,41 @@ fn sweep<'py>(
     out.set_item("seconds", result.seconds.to_vec())?;
     Ok(out)
 }
+
+/// Run `work` with the GIL released on a thread of its own while this (the calling, main) thread checks
+/// Python's signals every [`SIGNAL_POLL`]: on Ctrl-C (`KeyboardInterrupt`, or any exception a signal handler
+/// raises) it sets the library's interrupt flag, so the grid runner stops between points, waits for `work` to
+/// return, discards its partial result and raises the signal's exception.
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    vrw::gait::grid::clear_interrupt();
+    py.allow_threads(|| {
+        std::thread::scope(|scope| {
+            let handle = scope.spawn(work);
+            let mut raised = None;
+            while !handle.is_finished() {
+                std::thread::sleep(SIGNAL_POLL);
+                if raised.is_none() {
+                    if let Err(e) = Python::with_gil(|py| py.check_signals()) {
+                        vrw::gait::grid::interrupt_flag()
+                            .store(true, std::sync::atomic::Ordering::SeqCst);
+                        raised = Some(e);
+                    }
+                }
+            }
+            let value = handle
+                .join()
+                .map_err(|_| PyRuntimeError::new_err("the computation panicked"));
+            vrw::gait::grid::clear_interrupt();
+            match raised {
+                Some(e) => Err(e),
+                None => value,
+            }
+        })
+    })
+}
+
+/// How often a long computation checks Python's signals.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
 /// The values `vrw sweep --from START --to STOP --points POINTS` visits (evenly spaced, ends included).
 #[pyfunction]

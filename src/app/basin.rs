@@ -14,7 +14,8 @@ use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{prepared, AppError};
+use super::{check_interrupted, in_run, prepared, AppError};
+use crate::output::manifest::RunDir;
 use crate::output::write_basin_csv;
 
 /// Default range of a coordinate on the basin slice around the gait's value `at`: `L2` from `L0 / 2` to `L0`,
@@ -161,15 +162,34 @@ pub fn run_basin(
         max_steps: job.max_steps,
         tolerance: job.tolerance,
     };
-    output::ensure_dir(&job.out_dir)?;
+    in_run(&job.out_dir, "basin", |run| {
+        basin_into(job, &model, gait, spec, run, progress).map(|s| (s, None))
+    })
+}
+
+/// The work of [`run_basin`] in its run directory.
+fn basin_into(
+    job: &BasinJob,
+    model: &crate::dynamics::Model,
+    gait: Gait,
+    spec: BasinSpec,
+    run: &mut RunDir,
+    progress: &(dyn Fn(&BasinPoint) + Sync),
+) -> Result<BasinSummary, AppError> {
     let clock = std::time::Instant::now();
-    let grid = basin(&model, &job.config.solver, &gait, &spec, progress);
+    let grid = basin(model, &job.config.solver, &gait, &spec, progress);
     let seconds = clock.elapsed().as_secs_f64();
     let mut outcomes = BTreeMap::new();
     for p in grid.iter().flatten() {
         *outcomes.entry(p.outcome.kind.clone()).or_insert(0) += 1;
     }
-    write_basin_csv(&job.out_dir.join("basin.csv"), &grid)?;
+    write_basin_csv(&run.path("basin.csv"), &grid)?;
+    run.add("basin.csv");
+    check_interrupted(
+        grid.iter().map(Vec::len).sum(),
+        spec.x.points * spec.y.points,
+        "basin.csv",
+    )?;
     let (cx, cy) = (spec.x.coordinate.index(), spec.y.coordinate.index());
     let figure = BasinFigure {
         title: format!(
@@ -180,7 +200,7 @@ pub fn run_basin(
                 String::new()
             },
             Coordinate::ALL[3 - cx - cy].name(),
-            through[3 - cx - cy],
+            spec.through.to_array()[3 - cx - cy],
             job.config.params.viscosity,
             job.config.params.slope,
             job.config.params.impact
@@ -202,7 +222,8 @@ pub fn run_basin(
             })
             .collect(),
     };
-    write_basin_figure(&figure, &job.out_dir.join("basin.png"))?;
+    write_basin_figure(&figure, &run.path("basin.png"))?;
+    run.add("basin.png");
     let summary = BasinSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
@@ -214,6 +235,7 @@ pub fn run_basin(
             .to_vec(),
         seconds,
     };
-    output::write_json(&job.out_dir.join("basin.json"), &summary)?;
+    output::write_json(&run.path("basin.json"), &summary)?;
+    run.add("basin.json");
     Ok(summary)
 }

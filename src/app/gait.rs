@@ -13,8 +13,9 @@ use crate::params::Config;
 use crate::reference::default_initial;
 use crate::walk::SectionState;
 
-use super::simulate::{run_simulate, SimulateJob, SimulateSummary, DEFAULT_SAMPLE_DT};
-use super::AppError;
+use super::simulate::{simulate_into, SimulateJob, SimulateSummary, DEFAULT_SAMPLE_DT};
+use super::{in_run, AppError};
+use crate::output::manifest::RunDir;
 
 /// What `vrw gait` runs.
 #[derive(Debug, Clone)]
@@ -63,12 +64,18 @@ pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 /// ([`write_gait_period`]).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let summary = compute_gait(job)?;
-    output::ensure_dir(&job.out_dir)?;
-    output::write_json(&job.out_dir.join("gait.json"), &summary)?;
-    if let Some(gait) = &summary.gait {
-        write_gait_period(job, gait)?;
-    }
-    Ok(summary)
+    in_run(&job.out_dir, "gait", |run| {
+        output::write_json(&run.path("gait.json"), &summary)?;
+        run.add("gait.json");
+        let mut interrupted = None;
+        if let Some(gait) = &summary.gait {
+            let period = write_gait_period(job, gait, run)?;
+            interrupted = (period.status == "interrupted")
+                .then_some(period.message)
+                .flatten();
+        }
+        Ok((summary, interrupted))
+    })
 }
 
 /// The search of [`run_gait`] without writing anything (`job.out_dir` is not used). A search that finds no
@@ -120,18 +127,21 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
 
 /// Walk one period (`period_k` steps) from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
 /// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
-/// `vrw plot` and `vrw animate` work on a gait directly.
-pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
-    run_simulate(
-        &SimulateJob {
-            config: job.config.clone(),
-            initial: Some(gait.section),
-            steps: gait.period_k,
-            sample_dt: DEFAULT_SAMPLE_DT,
-            trajectory: true,
-            out_dir: job.out_dir.clone(),
-            interrupt: None,
-        },
-        &mut |_| {},
-    )
+/// `vrw plot` and `vrw animate` work on a gait directly; the files are added to `run`'s manifest.
+pub fn write_gait_period(
+    job: &GaitJob,
+    gait: &Gait,
+    run: &mut RunDir,
+) -> Result<SimulateSummary, AppError> {
+    let period = SimulateJob {
+        config: job.config.clone(),
+        initial: Some(gait.section),
+        steps: gait.period_k,
+        sample_dt: DEFAULT_SAMPLE_DT,
+        trajectory: true,
+        out_dir: job.out_dir.clone(),
+        interrupt: None,
+    };
+    let model = Model::new(&job.config.params)?;
+    simulate_into(&period, &model, gait.section, run, &mut |_| {})
 }

@@ -14,7 +14,8 @@ use crate::output::{self, write_map_csv};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{axis_label, second_route_config, short_name, AppError};
+use super::{axis_label, check_interrupted, in_run, second_route_config, short_name, AppError};
+use crate::output::manifest::RunDir;
 use crate::reference::default_initial;
 
 /// What `vrw map` runs.
@@ -88,11 +89,25 @@ pub fn run_map(
             });
         }
     }
-    output::ensure_dir(&job.out_dir)?;
+    in_run(&job.out_dir, "map", |run| {
+        map_into(job, &initial, run, progress).map(|s| (s, None))
+    })
+}
+
+/// The work of [`run_map`] in its run directory.
+fn map_into(
+    job: &MapJob,
+    initial: &SectionState,
+    run: &mut RunDir,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<MapSummary, AppError> {
     let clock = std::time::Instant::now();
-    let map = map_gaits(&job.config, &job.spec, &initial, &job.options, progress)?;
+    let map = map_gaits(&job.config, &job.spec, initial, &job.options, progress)?;
     let gait_seconds = clock.elapsed().as_secs_f64();
-    write_map_csv(&job.out_dir.join("map.csv"), &map)?;
+    write_map_csv(&run.path("map.csv"), &map)?;
+    run.add("map.csv");
+    let points = map.xs.len() * map.ys.len();
+    check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;
     let clock = std::time::Instant::now();
     let (curves, thresholds) = if job.curves {
         let c = map_curves(&job.config, &map, &job.options, job.curve_columns);
@@ -111,7 +126,7 @@ pub fn run_map(
             .flatten()
             .filter(|p| p.gait.is_some())
             .count(),
-        points: map.xs.len() * map.ys.len(),
+        points,
         curves,
         thresholds,
         seconds: [gait_seconds, curve_seconds],
@@ -129,14 +144,22 @@ pub fn run_map(
             })
         })),
     };
-    let curves_json = job.out_dir.join("curves.json");
+    let curves_json = run.path("curves.json");
     output::write_json(&curves_json, &summary)?;
+    run.add("curves.json");
     write_figure(job, &map, &summary.curves)?;
+    run.add("map.svg");
+    run.add("map.png");
     if job.second_route && job.curves {
         // Everything of the first route is written: nothing is lost if this fails.
         let clock = std::time::Instant::now();
         let (second_config, route) = second_route_config(&job.config);
-        let second_map = map_gaits(&second_config, &job.spec, &initial, &job.options, progress)?;
+        let second_map = map_gaits(&second_config, &job.spec, initial, &job.options, progress)?;
+        check_interrupted(
+            second_map.rows.iter().map(Vec::len).sum(),
+            points,
+            "map.csv (first route; the second route is dropped)",
+        )?;
         let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
         for t in &mut summary.thresholds {
             let same_line = second

@@ -15,7 +15,9 @@ mod simulate;
 mod sweep;
 
 pub use basin::{default_basin_range, run_basin, BasinJob, BasinSummary};
-pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+pub use figures::{
+    checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
+};
 pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
 };
@@ -28,6 +30,7 @@ pub use simulate::{
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 
 use crate::dynamics::Model;
+use crate::output::manifest::{RunDir, RunStatus};
 use crate::output::OutputError;
 use crate::params::{Config, ConfigError};
 use crate::reference::default_initial;
@@ -54,6 +57,30 @@ pub enum AppError {
     /// A figure could not be drawn.
     #[error(transparent)]
     Plot(#[from] crate::output::style::PlotError),
+    /// The directory's manifest is missing or unreadable (`plot`, `animate`).
+    #[error(transparent)]
+    Manifest(#[from] crate::output::manifest::ManifestError),
+    /// The files of a directory do not all belong to one finished run of `simulate` or `gait`.
+    #[error("{dir}: {reason}")]
+    NotOneRun {
+        /// The directory.
+        dir: std::path::PathBuf,
+        /// What is wrong, and what to do.
+        reason: String,
+    },
+    /// The library's interrupt flag (Ctrl-C) stopped the job; what was complete is written.
+    #[error(
+        "interrupted (Ctrl-C) after {done} of {total} points; {kept} holds the complete ones \
+         (manifest.json: interrupted)"
+    )]
+    Interrupted {
+        /// Points computed.
+        done: usize,
+        /// Points asked for.
+        total: usize,
+        /// The file that holds them.
+        kept: &'static str,
+    },
     /// A bad command-line value that is not a model parameter.
     #[error("invalid {option}: {reason}")]
     InvalidOption {
@@ -77,14 +104,43 @@ fn prepared(
     Ok((model, initial))
 }
 
-/// Remove `path` if it exists (an output file of an earlier run that this run does not rewrite).
-fn remove_stale(path: &std::path::Path) -> Result<(), OutputError> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
-            path: path.to_path_buf(),
-            source: e,
-        }),
-        _ => Ok(()),
+/// Run `body` as a job `command` writing into `dir` ([`RunDir::start`]: the directory is checked and
+/// cleared, the manifest says `running`), then write the manifest's final status: `completed`, `interrupted`
+/// (when `body` returns an interruption reason, or [`AppError::Interrupted`]) or `failed` with the error.
+fn in_run<T>(
+    dir: &std::path::Path,
+    command: &str,
+    body: impl FnOnce(&mut RunDir) -> Result<(T, Option<String>), AppError>,
+) -> Result<T, AppError> {
+    let mut run = RunDir::start(dir, command)?;
+    match body(&mut run) {
+        Ok((value, None)) => {
+            run.finish(RunStatus::Completed, None)?;
+            Ok(value)
+        }
+        Ok((value, Some(reason))) => {
+            run.finish(RunStatus::Interrupted, Some(reason))?;
+            Ok(value)
+        }
+        Err(e) => {
+            let status = match e {
+                AppError::Interrupted { .. } => RunStatus::Interrupted,
+                _ => RunStatus::Failed,
+            };
+            // The job's own error says more than a failure to record it.
+            let _ = run.finish(status, Some(e.to_string()));
+            Err(e)
+        }
+    }
+}
+
+/// The error of a grid job cut short by the interrupt flag, once its complete points are in `kept`; `Ok` if it
+/// was not.
+fn check_interrupted(done: usize, total: usize, kept: &'static str) -> Result<(), AppError> {
+    if crate::gait::grid::interrupted() {
+        Err(AppError::Interrupted { done, total, kept })
+    } else {
+        Ok(())
     }
 }
 

@@ -14,7 +14,8 @@ use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, Or
 use crate::params::Config;
 use crate::walk::{SectionState, StepReport};
 
-use super::{axis_label, prepared, AppError};
+use super::{axis_label, check_interrupted, in_run, prepared, AppError};
+use crate::output::manifest::RunDir;
 use crate::output::{write_branch_csv, write_orbit_csv};
 
 /// What `vrw orbit` runs.
@@ -60,19 +61,33 @@ pub fn run_orbit(
 ) -> Result<OrbitSummary, AppError> {
     let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
-    output::ensure_dir(&job.out_dir)?;
+    in_run(&job.out_dir, "orbit", |run| {
+        orbit_into(job, &initial, run, progress).map(|s| (s, None))
+    })
+}
+
+/// The work of [`run_orbit`] in its run directory.
+fn orbit_into(
+    job: &OrbitJob,
+    initial: &SectionState,
+    run: &mut RunDir,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<OrbitSummary, AppError> {
     let clock = std::time::Instant::now();
-    let columns = orbit_diagram(&job.config, &job.spec, &initial, progress)?;
+    let columns = orbit_diagram(&job.config, &job.spec, initial, progress)?;
     let orbit_seconds = clock.elapsed().as_secs_f64();
     let param = &job.spec.range.param;
     let mut files = vec!["orbit.csv".to_string()];
-    write_orbit_csv(&job.out_dir.join("orbit.csv"), param, &columns)?;
+    write_orbit_csv(&run.path("orbit.csv"), param, &columns)?;
+    run.add("orbit.csv");
+    let total = job.spec.range.points;
+    check_interrupted(columns.len(), total, "orbit.csv")?;
     let clock = std::time::Instant::now();
     let branch: Vec<(f64, Option<Gait>)> = if job.branch {
         sweep(
             &job.config,
             &job.spec.range,
-            &initial,
+            initial,
             &GaitOptions::default(),
             &|_| {},
         )?
@@ -84,8 +99,10 @@ pub fn run_orbit(
     };
     let branch_seconds = clock.elapsed().as_secs_f64();
     if job.branch {
-        write_branch_csv(&job.out_dir.join("branch.csv"), param, &branch)?;
+        write_branch_csv(&run.path("branch.csv"), param, &branch)?;
         files.push("branch.csv".to_string());
+        run.add("branch.csv");
+        check_interrupted(branch.len(), total, "branch.csv (and orbit.csv, complete)")?;
     }
     let mut outcomes = BTreeMap::new();
     for c in &columns {
@@ -102,8 +119,11 @@ pub fn run_orbit(
         gaits.filter(|g| g.stability == Stability::Stable).count(),
     ];
     let figure = orbit_figure(job, &columns, &branch);
-    match write_orbit_figure(&figure, &job.out_dir.join("orbit.png")) {
-        Ok(()) => files.push("orbit.png".to_string()),
+    match write_orbit_figure(&figure, &run.path("orbit.png")) {
+        Ok(()) => {
+            files.push("orbit.png".to_string());
+            run.add("orbit.png");
+        }
         Err(crate::output::style::PlotError::Empty(_)) => {}
         Err(e) => return Err(e.into()),
     }
@@ -117,7 +137,8 @@ pub fn run_orbit(
         files,
         seconds: [orbit_seconds, branch_seconds],
     };
-    output::write_json(&job.out_dir.join("orbit.json"), &summary)?;
+    output::write_json(&run.path("orbit.json"), &summary)?;
+    run.add("orbit.json");
     Ok(summary)
 }
 

@@ -15,7 +15,8 @@ use crate::params::Config;
 use crate::reference::default_initial;
 use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
 
-use super::{remove_stale, AppError};
+use super::{in_run, AppError};
+use crate::output::manifest::RunDir;
 
 pub use crate::walk::ENERGY_RESIDUAL_WARNING;
 
@@ -42,7 +43,7 @@ pub struct SimulateJob {
     /// Trajectory sampling interval \[s\].
     pub sample_dt: f64,
     /// Write `trajectory.csv` (`false`: only `steps.csv` and `summary.json`; a `trajectory.csv` of an earlier
-    /// run in `out_dir` is removed, since it would not match).
+    /// run in `out_dir` is removed, as every file of an earlier run is).
     pub trajectory: bool,
     /// Where `steps.csv`, `trajectory.csv` and `summary.json` go.
     pub out_dir: PathBuf,
@@ -163,27 +164,45 @@ pub fn run_simulate(
     observe: &mut dyn FnMut(SimulateEvent),
 ) -> Result<SimulateSummary, AppError> {
     let (model, initial) = simulation_setup(job)?;
-    let dir = &job.out_dir;
-    output::ensure_dir(dir)?;
-    let mut steps_csv = output::StepsCsv::create(&dir.join("steps.csv"))?;
-    let trajectory_path = dir.join("trajectory.csv");
+    in_run(&job.out_dir, "simulate", |run| {
+        let summary = simulate_into(job, &model, initial, run, observe)?;
+        let interrupted = (summary.status == "interrupted").then(|| summary.message.clone());
+        Ok((summary, interrupted.flatten()))
+    })
+}
+
+/// The walk of [`run_simulate`] into the run directory `run` (also the period that `vrw gait` writes beside
+/// `gait.json`). `summary.json` is written first with the status `running` (so that the complete rows of a
+/// killed run can still be drawn, `vrw plot --partial`), then the streamed tables, listed in the manifest at
+/// once, then the final `summary.json`.
+pub(super) fn simulate_into(
+    job: &SimulateJob,
+    model: &Model,
+    initial: SectionState,
+    run: &mut RunDir,
+    observe: &mut dyn FnMut(SimulateEvent),
+) -> Result<SimulateSummary, AppError> {
+    let mut files = vec!["steps.csv".to_string()];
+    if job.trajectory {
+        files.push("trajectory.csv".to_string());
+    }
+    files.push("summary.json".to_string());
+    let mut running = SimulateSummary::new(job, initial);
+    running.status = "running".to_string();
+    running.files.clone_from(&files);
+    output::write_json(&run.path("summary.json"), &running)?;
+    let names: Vec<&str> = files.iter().map(String::as_str).collect();
+    run.add_streaming(&names)?;
+    let mut steps_csv = output::StepsCsv::create(&run.path("steps.csv"))?;
+    let trajectory_path = run.path("trajectory.csv");
     let mut trajectory = if job.trajectory {
         let sink = output::TrajectoryCsv::create(&trajectory_path)?;
         Some(Trajectory::streaming(job.sample_dt, Box::new(sink)))
     } else {
-        // A trajectory.csv left by an earlier run would not match the new steps.csv.
-        remove_stale(&trajectory_path)?;
         None
     };
     let write_row = |report: &StepReport| -> Result<(), AppError> { Ok(steps_csv.write(report)?) };
-    let mut summary = walk_job(
-        job,
-        &model,
-        initial,
-        trajectory.as_mut(),
-        write_row,
-        observe,
-    )?;
+    let mut summary = walk_job(job, model, initial, trajectory.as_mut(), write_row, observe)?;
     if let Some(source) = trajectory.as_mut().and_then(Trajectory::take_error) {
         return Err(OutputError::Io {
             path: trajectory_path,
@@ -191,12 +210,8 @@ pub fn run_simulate(
         }
         .into());
     }
-    summary.files.push("steps.csv".to_string());
-    if job.trajectory {
-        summary.files.push("trajectory.csv".to_string());
-    }
-    summary.files.push("summary.json".to_string());
-    output::write_json(&dir.join("summary.json"), &summary)?;
+    summary.files = files;
+    output::write_json(&run.path("summary.json"), &summary)?;
     Ok(summary)
 }
 

@@ -16,7 +16,10 @@ use crate::output::plot::{
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{axis_label, prepared, remove_stale, second_route_config, short_name, AppError};
+use super::{
+    axis_label, check_interrupted, in_run, prepared, second_route_config, short_name, AppError,
+};
+use crate::output::manifest::RunDir;
 
 /// What `vrw sweep` runs.
 #[derive(Debug, Clone)]
@@ -75,8 +78,19 @@ pub fn run_sweep(
 ) -> Result<SweepSummary, AppError> {
     let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
-    output::ensure_dir(&job.out_dir)?;
-    let csv = job.out_dir.join("sweep.csv");
+    in_run(&job.out_dir, "sweep", |run| {
+        sweep_into(job, initial, run, progress).map(|s| (s, None))
+    })
+}
+
+/// The work of [`run_sweep`] in its run directory.
+fn sweep_into(
+    job: &SweepJob,
+    initial: SectionState,
+    run: &mut RunDir,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<SweepSummary, AppError> {
+    let csv = run.path("sweep.csv");
     let result = compute_sweep(
         &job.config,
         &job.spec.param,
@@ -84,7 +98,11 @@ pub fn run_sweep(
         Some(initial),
         &job.options,
         progress,
-        &mut |points| Ok(output::write_sweep_csv(&csv, &job.spec.param, points)?),
+        &mut |points| {
+            output::write_sweep_csv(&csv, &job.spec.param, points)?;
+            run.add("sweep.csv");
+            Ok(())
+        },
     )?;
     let gaits_found = result.points.iter().filter(|p| p.gait.is_some()).count();
     let figures = ["fig2.svg", "fig2.png"];
@@ -109,14 +127,13 @@ pub fn run_sweep(
                 .map(|p| (format!("{} = {}", job.spec.param, short(p.value)), p)),
         ),
     };
-    let thresholds_json = job.out_dir.join("thresholds.json");
+    let thresholds_json = run.path("thresholds.json");
     output::write_json(&thresholds_json, &summary)?;
+    run.add("thresholds.json");
     if gaits_found > 0 {
         write_fig2(job, &result.points, &summary.thresholds)?;
-    } else {
-        // A figure of an earlier sweep must not stand beside this sweep's tables.
         for f in figures {
-            remove_stale(&job.out_dir.join(f))?;
+            run.add(f);
         }
     }
     if job.second_route {
@@ -155,7 +172,8 @@ pub struct SweepResult {
 /// The computation of [`run_sweep`] without writing anything: sweep `param` over `values` with continuation
 /// (starting at `initial`, `None`: [`default_initial`](crate::reference::default_initial)), then locate the
 /// thresholds between the points. `progress` is called after every point; `swept` receives the points before
-/// the thresholds are searched (where `vrw sweep` writes `sweep.csv`).
+/// the thresholds are searched (where `vrw sweep` writes `sweep.csv`). When the library's interrupt flag
+/// stops the sweep, `swept` receives the complete points and the result is [`AppError::Interrupted`].
 pub fn compute_sweep(
     config: &Config,
     param: &str,
@@ -170,6 +188,7 @@ pub fn compute_sweep(
     let points = sweep_values(config, param, values, &initial, options, progress)?;
     let sweep_seconds = clock.elapsed().as_secs_f64();
     swept(&points)?;
+    check_interrupted(points.len(), values.len(), "sweep.csv")?;
     // The thresholds read the parameter's name from the spec; the range is the values' span.
     let spec = SweepSpec {
         param: param.to_string(),

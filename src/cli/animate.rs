@@ -36,6 +36,9 @@ pub(super) struct AnimateArgs {
     /// Instead of the GIF, write the single frame at this time [s] as DIR/walk-frame.png.
     #[arg(long, value_name = "TIME", allow_hyphen_values = true)]
     still: Option<f64>,
+    /// Draw the complete rows of a run that did not finish (killed, or failed).
+    #[arg(long)]
+    partial: bool,
 }
 
 /// Run `vrw animate` and print its summary.
@@ -51,6 +54,7 @@ pub(super) fn run(args: AnimateArgs) -> Result<()> {
             height: args.height,
             horizontal: args.horizontal,
         },
+        partial: args.partial,
     };
     if let Some(time) = args.still {
         let path = run_still(&job, time).context("animate")?;
@@ -58,7 +62,11 @@ pub(super) fn run(args: AnimateArgs) -> Result<()> {
         return Ok(());
     }
     let started = std::time::Instant::now();
-    let report = run_animate(&job).context("animate")?;
+    let outcome = run_animate(&job).context("animate")?;
+    for w in &outcome.warnings {
+        eprintln!("warning: {w}");
+    }
+    let report = outcome.report;
     println!(
         "vrw animate: {} frames ({} in slow motion) of t = {:.3} .. {:.3} s, {:.1} s of playback, {:.2} MB in {:.2} s",
         report.frames,

@@ -9,7 +9,7 @@ use vrw::app::{run_basin, BasinJob};
 use vrw::gait::basin::Coordinate;
 use vrw::walk::SectionState;
 
-use super::{parse_range, progress_bar, ModelArgs};
+use super::{interrupt_flag, parse_range, progress_bar, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct BasinArgs {
@@ -60,6 +60,8 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
         tolerance: args.tolerance,
         out_dir: args.out.clone(),
     };
+    // Ctrl-C stops the grid between points; what is complete is written.
+    interrupt_flag();
     let bar = progress_bar(
         Some((args.nx * args.ny) as u64),
         "{bar:40} {pos}/{len} starts [{elapsed_precise}, eta {eta}]",

@@ -10,7 +10,9 @@ use vrw::gait::{GaitOptions, MapSpec, SecondRoute, SweepSpec};
 use vrw::output::map_plot::MapMark;
 use vrw::walk::SectionState;
 
-use super::{confirmed_count, print_warnings, progress_bar, second_route_words, ModelArgs};
+use super::{
+    confirmed_count, interrupt_flag, print_warnings, progress_bar, second_route_words, ModelArgs,
+};
 
 #[derive(Debug, Args)]
 pub(super) struct MapArgs {
@@ -120,6 +122,8 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     };
     let routes = if args.second_route { 2 } else { 1 };
     let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
+    // Ctrl-C stops the grid between points; what is complete is written.
+    interrupt_flag();
     let bar = progress_bar(
         Some(total as u64),
         "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",

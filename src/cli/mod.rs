@@ -95,14 +95,18 @@ fn progress_bar(len: Option<u64>, template: &str) -> ProgressBar {
     bar
 }
 
-/// A flag set by Ctrl-C (a second Ctrl-C exits at once with code 130).
+/// A flag set by Ctrl-C, which also sets the library's interrupt flag (the grid runner of `sweep`, `map`,
+/// `orbit` and `basin` then stops between points, and the job writes what is complete); a second Ctrl-C exits
+/// at once with code 130.
 fn interrupt_flag() -> Arc<AtomicBool> {
     let flag = Arc::new(AtomicBool::new(false));
     let handler_flag = Arc::clone(&flag);
     let installed = ctrlc::set_handler(move || {
+        vrw::gait::grid::interrupt_flag().store(true, Ordering::SeqCst);
         if handler_flag.swap(true, Ordering::SeqCst) {
             std::process::exit(130);
         }
+        eprintln!("\ninterrupted: finishing the work under way and writing what is complete (Ctrl-C again to quit at once)");
     });
     if let Err(e) = installed {
         eprintln!("warning: Ctrl-C will not stop the walk cleanly: {e}");

@@ -10,7 +10,7 @@ use vrw::gait::orbit::OrbitSpec;
 use vrw::gait::SweepSpec;
 use vrw::walk::SectionState;
 
-use super::{progress_bar, ModelArgs};
+use super::{interrupt_flag, progress_bar, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct OrbitArgs {
@@ -63,6 +63,8 @@ pub(super) fn run(args: OrbitArgs) -> Result<()> {
         branch: !args.no_branch,
         out_dir: args.out.clone(),
     };
+    // Ctrl-C stops the grid between points; what is complete is written.
+    interrupt_flag();
     let bar = progress_bar(
         Some(args.points as u64),
         "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",

@@ -10,7 +10,9 @@ use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
-use super::{confirmed_count, print_warnings, progress_bar, second_route_words, ModelArgs};
+use super::{
+    confirmed_count, interrupt_flag, print_warnings, progress_bar, second_route_words, ModelArgs,
+};
 
 #[derive(Debug, Args)]
 pub(super) struct SweepArgs {
@@ -64,6 +66,8 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         out_dir: args.out.clone(),
     };
     let routes = if args.second_route { 2 } else { 1 };
+    // Ctrl-C stops the grid between points; what is complete is written.
+    interrupt_flag();
     let bar = progress_bar(
         Some(routes * args.points as u64),
         "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",

@@ -21,6 +21,13 @@
 //! cell and on what it continues, so as long as `eval` is a deterministic function of its arguments the results
 //! do not depend on the number of threads or on the order in which rayon runs the work.
 //!
+//! **Interruption.** The runner checks the library's interrupt flag ([`interrupt_flag`], set by the command
+//! line's Ctrl-C handler and by the Python binding's signal watcher) before every point. Once it is set, no
+//! new point starts; the points under way finish, and every row is cut to its complete prefix (the points
+//! from its first up to the first one not evaluated), so what is returned is exactly what an uninterrupted
+//! run returns, minus the rows' tails. A job that sees [`interrupted`] after the runner keeps those points and
+//! says it was interrupted.
+//!
 //! ```
 //! use vrw::gait::grid::{run_rows, Cell, Evaluated};
 //!
@@ -33,7 +40,28 @@
 //! assert_eq!(rows[1][24], (Cell { row: 1, col: 24 }, 2800.0));
 //! ```
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
+
+/// The library's interrupt flag (see the module documentation): the grid runner stops starting points once it
+/// is set. Whoever sets it clears it before the next job ([`clear_interrupt`]).
+static INTERRUPT: AtomicBool = AtomicBool::new(false);
+
+/// The library's interrupt flag, for a signal handler to set.
+pub fn interrupt_flag() -> &'static AtomicBool {
+    &INTERRUPT
+}
+
+/// Has the interrupt flag been set (the last grid run may be cut short)?
+pub fn interrupted() -> bool {
+    INTERRUPT.load(Ordering::SeqCst)
+}
+
+/// Clear the interrupt flag (before a new job, in a process that outlives an interruption).
+pub fn clear_interrupt() {
+    INTERRUPT.store(false, Ordering::SeqCst);
+}
 
 /// Stride of the coarse continuation pass along a row.
 pub const COARSE_STRIDE: usize = 10;
@@ -57,31 +85,49 @@ pub struct Evaluated<P, C> {
 }
 
 /// Evaluate every point of a grid of `rows` rows of `cols` points each, continuing along rows (see the module
-/// documentation for the schedule). Returns the points row by row, in column order. `eval` must be a
-/// deterministic function of its arguments for the results to be the same for any number of threads.
+/// documentation for the schedule). Returns the points row by row, in column order; once the library's
+/// [`interrupt_flag`] is set, rows are cut to their complete prefix. `eval` must be a deterministic function of
+/// its arguments for the results to be the same for any number of threads.
 pub fn run_rows<P, C, F>(rows: usize, cols: usize, eval: F) -> Vec<Vec<P>>
 where
     P: Send,
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
+    run_rows_until(rows, cols, &INTERRUPT, eval)
+}
+
+/// [`run_rows`] stopped by `stop` instead of the library's interrupt flag.
+pub fn run_rows_until<P, C, F>(rows: usize, cols: usize, stop: &AtomicBool, eval: F) -> Vec<Vec<P>>
+where
+    P: Send,
+    C: Send + Sync,
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
+{
     if rows == 1 {
-        return vec![run_split_row(0, cols, &eval)];
+        return vec![run_split_row(0, cols, stop, &eval)];
     }
     (0..rows)
         .into_par_iter()
-        .map(|row| run_row_in_order(row, cols, &eval))
+        .map(|row| run_row_in_order(row, cols, stop, &eval))
         .collect()
 }
 
+fn stopped(stop: &AtomicBool) -> bool {
+    stop.load(Ordering::Relaxed)
+}
+
 /// One row in order, every point continuing the one before.
-fn run_row_in_order<P, C, F>(row: usize, cols: usize, eval: &F) -> Vec<P>
+fn run_row_in_order<P, C, F>(row: usize, cols: usize, stop: &AtomicBool, eval: &F) -> Vec<P>
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
     let mut points = Vec::with_capacity(cols);
     let mut last: Option<(usize, C)> = None;
     for col in 0..cols {
+        if stopped(stop) {
+            break;
+        }
         let e = eval(Cell { row, col }, last.as_ref().map(|(j, c)| (*j, c)));
         points.push(e.point);
         last = e.carry.map(|c| (col, c));
@@ -90,7 +136,7 @@ where
 }
 
 /// One row split for parallelism: the coarse pass, then the intervals between coarse points in parallel.
-fn run_split_row<P, C, F>(row: usize, cols: usize, eval: &F) -> Vec<P>
+fn run_split_row<P, C, F>(row: usize, cols: usize, stop: &AtomicBool, eval: &F) -> Vec<P>
 where
     P: Send,
     C: Send + Sync,
@@ -99,6 +145,9 @@ where
     let mut coarse_points: Vec<P> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
     let mut carries: Vec<Option<C>> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
     for col in (0..cols).step_by(COARSE_STRIDE) {
+        if stopped(stop) {
+            break;
+        }
         let from = carries
             .last()
             .and_then(|c| c.as_ref().map(|c| (col - COARSE_STRIDE, c)));
@@ -115,6 +164,9 @@ where
             let mut last: Option<(usize, Option<C>)> = None;
             let mut points = Vec::with_capacity(end - first - 1);
             for col in first + 1..end {
+                if stopped(stop) {
+                    break;
+                }
                 let from = match &last {
                     None => left.as_ref().map(|c| (first, c)),
                     Some((j, c)) => c.as_ref().map(|c| (*j, c)),
@@ -126,10 +178,18 @@ where
             points
         })
         .collect();
+    // The complete prefix: stop after the first interval whose fill was cut short (or before a coarse point
+    // that was never evaluated).
     let mut points = Vec::with_capacity(cols);
-    for (left, fill) in coarse_points.into_iter().zip(fills) {
+    for (k, (left, fill)) in coarse_points.into_iter().zip(fills).enumerate() {
+        let first = k * COARSE_STRIDE;
+        let full = (first + COARSE_STRIDE).min(cols) - first - 1;
+        let cut = fill.len() < full;
         points.push(left);
         points.extend(fill);
+        if cut {
+            break;
+        }
     }
     points
 }
@@ -169,6 +229,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A stop flag set during the run cuts every row to its complete prefix, for one row (split) and for
+    /// several.
+    #[test]
+    fn interrupted_grid_keeps_complete_prefixes() {
+        let cols = 3 * COARSE_STRIDE + 4;
+        for rows in [1, 3] {
+            let stop = AtomicBool::new(false);
+            let grid = run_rows_until(rows, cols, &stop, |cell: Cell, _: Option<(usize, &())>| {
+                if cell.col == 2 * COARSE_STRIDE + 5 {
+                    stop.store(true, Ordering::SeqCst);
+                }
+                Evaluated {
+                    point: cell.col,
+                    carry: Some(()),
+                }
+            });
+            for row in &grid {
+                assert!(row.len() < cols, "{rows} rows: {row:?}");
+                assert!(row.iter().copied().eq(0..row.len()), "{rows} rows: {row:?}");
+            }
+        }
+        let stop = AtomicBool::new(true);
+        let grid = run_rows_until(2, 5, &stop, |cell: Cell, _: Option<(usize, &())>| {
+            Evaluated {
+                point: cell,
+                carry: None,
+            }
+        });
+        assert!(grid.iter().all(Vec::is_empty));
     }
 
     /// Rows of one point, and an empty grid.

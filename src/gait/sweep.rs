@@ -366,7 +366,9 @@ pub struct GaitRow {
 /// continuation from the left neighbour on the [`super::grid`] runner's schedule, a search from `initial` where
 /// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in
 /// parallel, and the results are bitwise identical for any number of threads. `progress` is called after every
-/// point. A row's values that leave the valid domain give points with the status `invalid_parameter`.
+/// point. A row's values that leave the valid domain give points with the status `invalid_parameter`. Once the
+/// library's [`interrupt_flag`](super::grid::interrupt_flag) is set, each row is cut to its complete prefix,
+/// without the backward fill and the family numbers.
 pub fn gait_rows(
     rows: &[GaitRow],
     initial: &SectionState,
@@ -395,8 +397,11 @@ pub fn gait_rows(
         .zip(points.par_iter_mut())
         .map(|(row, points)| {
             let mut points: Vec<SweepPoint> = points.drain(..).flatten().collect();
-            backfill(&row.config, &row.param, &mut points, options);
-            number_families(&row.config, &row.param, &mut points, options);
+            // An interrupted row keeps its points as computed (no further searches).
+            if !super::grid::interrupted() {
+                backfill(&row.config, &row.param, &mut points, options);
+                number_families(&row.config, &row.param, &mut points, options);
+            }
             points
         })
         .collect()

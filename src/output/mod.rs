@@ -3,12 +3,18 @@
 //! This file holds the shared CSV and JSON writing; each table's columns and writer are declared once in
 //! [`tables`], each figure has its own file.
 //!
+//! Every file is written atomically ([`write_atomic`]: under a temporary name in the same directory, then
+//! renamed), so a reader never sees half a file under its real name; the tables that stream rows as a walk runs
+//! (`steps.csv`, `trajectory.csv`) are the exception, written in place, and the run's `manifest.json`
+//! ([`manifest`]) says whether they are complete.
+//!
 //! Numbers are written with Rust's shortest round-trip formatting, so a value read back is bit-identical;
 //! undefined values (e.g. `lambda_2+` after an (A3) exchange) are written as `NaN` in CSV and `null` in JSON.
 
 pub mod animate;
 pub mod basin_plot;
 pub mod chart;
+pub mod manifest;
 pub mod map_plot;
 pub mod orbit_plot;
 pub mod plot;
@@ -126,8 +132,55 @@ pub fn finish_csv(mut w: csv::Writer<File>, path: &Path) -> Result<(), OutputErr
     })
 }
 
-/// Write `value` as pretty JSON to `path`.
+/// The temporary name under which `path` is written before it is renamed: `.NAME.vrw-tmp.EXT` in the same
+/// directory (the extension is kept, since figure writers choose the format by it).
+pub fn temp_path(path: &Path) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let name = match path.extension() {
+        Some(ext) => format!(".{stem}{TEMP_MARK}.{}", ext.to_string_lossy()),
+        None => format!(".{stem}{TEMP_MARK}"),
+    };
+    path.with_file_name(name)
+}
+
+/// What marks a temporary file name ([`temp_path`]); a job removes such files left by a killed run.
+pub const TEMP_MARK: &str = ".vrw-tmp";
+
+/// Write `path` atomically: `write` writes the temporary file [`temp_path`]`(path)`, which is renamed to
+/// `path` when `write` succeeds and removed when it fails. A reader sees the old file or the whole new one,
+/// never a part.
+pub fn write_atomic<T, E: From<OutputError>>(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<T, E>,
+) -> Result<T, E> {
+    let temp = temp_path(path);
+    match write(&temp) {
+        Ok(value) => {
+            std::fs::rename(&temp, path).map_err(|source| {
+                let _ = std::fs::remove_file(&temp);
+                OutputError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
+            Ok(value)
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&temp);
+            Err(e)
+        }
+    }
+}
+
+/// Write `value` as pretty JSON to `path` (atomically).
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputError> {
+    write_atomic(path, |temp| write_json_in_place(temp, value))
+        .map_err(|e| e.renamed(temp_path(path).as_path(), path))
+}
+
+fn write_json_in_place<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputError> {
     let io = |source| OutputError::Io {
         path: path.to_path_buf(),
         source,
@@ -138,21 +191,47 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputErro
         source,
     })?;
     writeln!(w).map_err(io)?;
-    w.flush().map_err(io)
+    w.flush().map_err(io)?;
+    w.get_ref().sync_all().map_err(io)
 }
 
-/// Write a CSV table: the header, then one record per row.
+impl OutputError {
+    /// The same error, naming `to` where it named the temporary file `from`.
+    fn renamed(self, from: &Path, to: &Path) -> OutputError {
+        let fix = |p: PathBuf| if p == from { to.to_path_buf() } else { p };
+        match self {
+            OutputError::Io { path, source } => OutputError::Io {
+                path: fix(path),
+                source,
+            },
+            OutputError::Csv { path, source } => OutputError::Csv {
+                path: fix(path),
+                source,
+            },
+            OutputError::Json { path, source } => OutputError::Json {
+                path: fix(path),
+                source,
+            },
+            other => other,
+        }
+    }
+}
+
+/// Write a CSV table atomically: the header, then one record per row.
 pub fn write_table<H, R>(path: &Path, header: &[H], rows: R) -> Result<(), OutputError>
 where
     H: AsRef<[u8]>,
     R: IntoIterator<Item = Vec<Cell>>,
 {
-    let mut w = csv_writer(path)?;
-    write_record(&mut w, path, header)?;
-    for row in rows {
-        write_record(&mut w, path, row.iter().map(Cell::to_csv))?;
-    }
-    finish_csv(w, path)
+    write_atomic(path, |temp| {
+        let mut w = csv_writer(temp)?;
+        write_record(&mut w, temp, header)?;
+        for row in rows {
+            write_record(&mut w, temp, row.iter().map(Cell::to_csv))?;
+        }
+        finish_csv(w, temp)
+    })
+    .map_err(|e| e.renamed(temp_path(path).as_path(), path))
 }
 
 /// A CSV file written row by row: each row is flushed to the file as soon as it is written, so an

@@ -4,8 +4,12 @@
 //! Columns are found by their header name, never by position, and extra columns are ignored, so files from a
 //! newer vrw with more columns still read. Missing files or columns are errors that name the file and the
 //! column.
+//!
+//! A last row without its line end (what a run killed while writing leaves) is left out, with a warning in
+//! [`RunData::warnings`]. Values that cannot be (a non-finite or absurdly large number, `leg1` outside
+//! `0..N`, a leg length outside `(0, L0 + LENGTH_SLACK]`) are refused with an error naming the file, the row
+//! and the column.
 
-use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
@@ -70,6 +74,22 @@ pub enum ReadError {
         /// The file.
         path: PathBuf,
     },
+    /// A value that cannot be: not finite, absurdly large, or outside its range.
+    #[error("{path}: data row {row} (line {line}), column {column}: {value} {reason}")]
+    Implausible {
+        /// The file.
+        path: PathBuf,
+        /// Data row, from 1.
+        row: usize,
+        /// Line of the file (the header is line 1).
+        line: usize,
+        /// The column.
+        column: &'static str,
+        /// The value as read.
+        value: String,
+        /// Why it cannot be.
+        reason: String,
+    },
     /// The samples of `trajectory.csv` are not in time order, or a time is not finite.
     #[error("{path}: time {time} on data row {row} is not finite or goes backwards")]
     Unordered {
@@ -81,6 +101,14 @@ pub enum ReadError {
         time: f64,
     },
 }
+
+/// The largest magnitude a number of `trajectory.csv` or `steps.csv` may have: positions \[m\], angles
+/// \[rad\], velocities, forces \[N\] and energies \[J\] of a walking wheel are far below it.
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
+/// How far past the stopper length `L0` a leg length may read \[m\]: the largest `stopper_gap` accepted
+/// (docs/model.md section 4, grazing guards), by which a free leg's stopper event may fire past `L0`.
+pub const LENGTH_SLACK: f64 = 1e-6;
 
 /// A 0/1 (or true/false) flag column.
 fn flag<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
@@ -281,6 +309,8 @@ pub struct RunData {
     pub samples: Vec<TrajectoryRow>,
     /// The rows of `steps.csv`, in step order.
     pub steps: Vec<StepRow>,
+    /// What was left out while reading (an incomplete last row), for the user.
+    pub warnings: Vec<String>,
 }
 
 impl RunData {
@@ -306,15 +336,38 @@ impl RunData {
 
 /// Read the rows of a CSV file by header name (an empty table is an error unless `allow_empty`).
 pub fn read_csv<T: DeserializeOwned>(path: &Path, allow_empty: bool) -> Result<Vec<T>, ReadError> {
+    read_complete_rows(path, allow_empty).map(|(rows, _)| rows)
+}
+
+/// [`read_csv`], leaving out a last row without its line end (a run killed while writing it); the warning
+/// says so.
+pub fn read_complete_rows<T: DeserializeOwned>(
+    path: &Path,
+    allow_empty: bool,
+) -> Result<(Vec<T>, Option<String>), ReadError> {
     let csv_err = |source| ReadError::Csv {
         path: path.to_path_buf(),
         source,
     };
-    let file = File::open(path).map_err(|source| ReadError::Io {
+    let mut bytes = std::fs::read(path).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    let mut reader = csv::Reader::from_reader(std::io::BufReader::new(file));
+    let mut warning = None;
+    if bytes.last().is_some_and(|&b| b != b'\n') {
+        let end = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1);
+        // Only a data row can be left out; a header without its line end is read as it is.
+        if end > 0 {
+            let line = bytes[..end].iter().filter(|&&b| b == b'\n').count() + 1;
+            bytes.truncate(end);
+            warning = Some(format!(
+                "{}: the last row (line {line}) is incomplete (the run was killed while writing it?); it \
+                 is left out",
+                path.display()
+            ));
+        }
+    }
+    let mut reader = csv::Reader::from_reader(bytes.as_slice());
     let rows = reader
         .deserialize()
         .collect::<Result<Vec<T>, _>>()
@@ -324,7 +377,7 @@ pub fn read_csv<T: DeserializeOwned>(path: &Path, allow_empty: bool) -> Result<V
             path: path.to_path_buf(),
         });
     }
-    Ok(rows)
+    Ok((rows, warning))
 }
 
 fn parameter<T>(
@@ -405,7 +458,8 @@ pub fn read_run(dir: &Path) -> Result<RunData, ReadError> {
     let steps_path = file("steps.csv")?;
     let summary_path = file("summary.json")?;
     let (geometry, status) = read_summary(&summary_path)?;
-    let samples: Vec<TrajectoryRow> = read_csv(&trajectory_path, false)?;
+    let (samples, warning): (Vec<TrajectoryRow>, _) = read_complete_rows(&trajectory_path, false)?;
+    let mut warnings: Vec<String> = warning.into_iter().collect();
     let mut last = f64::NEG_INFINITY;
     for (k, s) in samples.iter().enumerate() {
         if !(s.time.is_finite() && s.time >= last) {
@@ -416,14 +470,129 @@ pub fn read_run(dir: &Path) -> Result<RunData, ReadError> {
             });
         }
         last = s.time;
+        check_sample(&trajectory_path, k + 1, s, &geometry)?;
     }
     // A walk that stopped during its first step has no step rows, but its trajectory can still be shown.
-    let steps: Vec<StepRow> = read_csv(&steps_path, true)?;
+    let (steps, warning): (Vec<StepRow>, _) = read_complete_rows(&steps_path, true)?;
+    warnings.extend(warning);
+    for (k, s) in steps.iter().enumerate() {
+        check_step(&steps_path, k + 1, s)?;
+    }
     Ok(RunData {
         dir: dir.to_path_buf(),
         geometry,
         status,
         samples,
         steps,
+        warnings,
     })
+}
+
+/// The error for `value` in `column` of data row `row` of `path`.
+fn implausible(
+    path: &Path,
+    row: usize,
+    column: &'static str,
+    value: String,
+    reason: String,
+) -> ReadError {
+    ReadError::Implausible {
+        path: path.to_path_buf(),
+        row,
+        line: row + 1,
+        column,
+        value,
+        reason,
+    }
+}
+
+/// A number that must be finite and at most [`MAX_MAGNITUDE`] in size.
+fn check_number(path: &Path, row: usize, column: &'static str, v: f64) -> Result<(), ReadError> {
+    if v.is_finite() && v.abs() <= MAX_MAGNITUDE {
+        Ok(())
+    } else {
+        Err(implausible(
+            path,
+            row,
+            column,
+            v.to_string(),
+            format!("is not a finite number of at most {MAX_MAGNITUDE:e} in size"),
+        ))
+    }
+}
+
+/// Check one row of `trajectory.csv` against what a state of the wheel `geometry` can be.
+fn check_sample(
+    path: &Path,
+    row: usize,
+    s: &TrajectoryRow,
+    geometry: &Geometry,
+) -> Result<(), ReadError> {
+    let numbers = [
+        ("x", s.x),
+        ("z", s.z),
+        ("theta", s.theta),
+        ("L1", s.l1),
+        ("L2", s.l2),
+        ("thetadot", s.theta_dot),
+        ("L1dot", s.l1_dot),
+        ("L2dot", s.l2_dot),
+        ("lambda_1", s.lambda_1),
+        ("lambda_2", s.lambda_2),
+        ("lambda_3", s.lambda_3),
+        ("lambda_4", s.lambda_4),
+    ];
+    for (column, v) in numbers {
+        check_number(path, row, column, v)?;
+    }
+    let longest = geometry.stopper_length + LENGTH_SLACK;
+    for (column, l) in [("L1", s.l1), ("L2", s.l2)] {
+        if !(l > 0.0 && l <= longest) {
+            return Err(implausible(
+                path,
+                row,
+                column,
+                l.to_string(),
+                format!("is not a leg length in (0, L0 + {LENGTH_SLACK:e}] = (0, {longest}] m"),
+            ));
+        }
+    }
+    if s.leg1 >= geometry.legs {
+        return Err(implausible(
+            path,
+            row,
+            "leg1",
+            s.leg1.to_string(),
+            format!(
+                "is not a leg of the {}-leg wheel (0 to {})",
+                geometry.legs,
+                geometry.legs - 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Check one row of `steps.csv`: the time is finite, every defined number (undefined ones are `NaN`) is at
+/// most [`MAX_MAGNITUDE`] in size.
+fn check_step(path: &Path, row: usize, s: &StepRow) -> Result<(), ReadError> {
+    check_number(path, row, "time", s.time)?;
+    let numbers = [
+        ("lambda_I4", s.lambda_i4),
+        ("lambda_2_plus", s.lambda_2_plus),
+        ("lambda_4_plus", s.lambda_4_plus),
+        ("dls_duration", s.dls_duration),
+        ("period", s.period),
+        ("energy_loss", s.energy_loss),
+        ("damper_loss", s.damper_loss),
+        ("impact_loss", s.impact_loss),
+        ("stopper_loss", s.stopper_loss),
+        ("energy_residual", s.energy_residual),
+    ];
+    for (column, v) in numbers {
+        if !v.is_nan() {
+            check_number(path, row, column, v)?;
+        }
+    }
+    Ok(())
 }

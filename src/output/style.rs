@@ -33,7 +33,35 @@ pub enum PlotError {
     Empty(String),
 }
 
+impl From<super::OutputError> for PlotError {
+    fn from(e: super::OutputError) -> PlotError {
+        let path = match &e {
+            super::OutputError::Io { path, .. }
+            | super::OutputError::Csv { path, .. }
+            | super::OutputError::Json { path, .. }
+            | super::OutputError::NotADirectory { path } => path.display().to_string(),
+        };
+        PlotError::Draw {
+            path,
+            message: e.to_string(),
+        }
+    }
+}
+
 impl PlotError {
+    /// The same error, naming the file `to` where it named its temporary file `from`.
+    pub(crate) fn renamed(self, from: &Path, to: &Path) -> PlotError {
+        match self {
+            PlotError::Draw { path, message } if path == from.display().to_string() => {
+                PlotError::Draw {
+                    path: to.display().to_string(),
+                    message,
+                }
+            }
+            other => other,
+        }
+    }
+
     /// A drawing failure at `path` (for `map_err`).
     pub fn draw_at(path: &Path) -> impl Fn(String) -> PlotError + '_ {
         move |message| PlotError::Draw {

@@ -262,7 +262,8 @@ pub trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB>;
 }
 
-/// Draws `figure` as an SVG and a PNG of `size` pixels.
+/// Draws `figure` as an SVG and a PNG of `size` pixels, each written atomically
+/// ([`write_atomic`](crate::output::write_atomic)).
 pub fn write_svg_png(
     figure: &impl Figure,
     svg: &Path,
@@ -270,24 +271,27 @@ pub fn write_svg_png(
     size: (u32, u32),
 ) -> Result<(), PlotError> {
     super::style::require_font(svg)?;
-    {
-        let root = SVGBackend::new(svg, size).into_drawing_area();
+    crate::output::write_atomic(svg, |temp| {
+        let root = SVGBackend::new(temp, size).into_drawing_area();
         figure
             .draw(&root)
             .map_err(|e| PlotError::draw_at(svg)(e.to_string()))?;
         root.present()
-            .map_err(|e| PlotError::draw_at(svg)(e.to_string()))?;
-    }
+            .map_err(|e| PlotError::draw_at(svg)(e.to_string()))
+    })?;
     write_png(figure, png, size)
 }
 
-/// Write `figure` as a PNG only (figures with tens of thousands of marks, whose SVG would be large).
+/// Write `figure` as a PNG only (figures with tens of thousands of marks, whose SVG would be large), atomically.
 pub fn write_png(figure: &impl Figure, png: &Path, size: (u32, u32)) -> Result<(), PlotError> {
     super::style::require_font(png)?;
-    let root = BitMapBackend::new(png, size).into_drawing_area();
-    figure
-        .draw(&root)
-        .map_err(|e| PlotError::draw_at(png)(e.to_string()))?;
-    root.present()
-        .map_err(|e| PlotError::draw_at(png)(e.to_string()))
+    crate::output::write_atomic(png, |temp| {
+        let root = BitMapBackend::new(temp, size).into_drawing_area();
+        figure
+            .draw(&root)
+            .map_err(|e| PlotError::draw_at(png)(e.to_string()))?;
+        root.present()
+            .map_err(|e| PlotError::draw_at(png)(e.to_string()))
+    })
+    .map_err(|e| e.renamed(&crate::output::temp_path(png), png))
 }
