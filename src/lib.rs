@@ -56,7 +56,7 @@
 //! each report to a callback as soon as its step is done and stops when an interrupt flag is set, and
 //! [`walk::Trajectory::streaming`] hands each sample to a [`walk::SampleSink`] (such as
 //! [`output::TrajectoryCsv`]). This is how `vrw simulate` runs in bounded memory ([`app::run_simulate`]).
-#![warn(missing_docs)]
+#![warn(missing_docs, unnameable_types)]
 
 pub mod app;
 pub mod contact;

@@ -57,7 +57,7 @@ pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 /// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
 /// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
 /// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
-/// ([`write_gait_period`]).
+/// (`write_gait_period`).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let summary = compute_gait(job)?;
     output::ensure_dir(&job.out_dir)?;

@@ -54,7 +54,7 @@ pub struct SimulateJob {
 }
 
 /// `summary.json`: the parameters used, how the run ended, aggregates over every step, and the records of the
-/// last [`SUMMARY_STEPS`] steps (`steps.csv` has every step).
+/// last `SUMMARY_STEPS` steps (`steps.csv` has every step).
 #[derive(Debug, Clone, Serialize)]
 pub struct SimulateSummary {
     /// Version of vrw that produced the file.
@@ -84,11 +84,11 @@ pub struct SimulateSummary {
     /// Files written to the output directory.
     pub files: Vec<String>,
     /// What may make the numbers untrustworthy (e.g. a step whose energy residual exceeds
-    /// [`ENERGY_RESIDUAL_WARNING`]); the first [`SUMMARY_WARNINGS`] of them.
+    /// `ENERGY_RESIDUAL_WARNING`); the first `SUMMARY_WARNINGS` of them.
     pub warnings: Vec<String>,
     /// Number of warnings, including those not listed.
     pub warnings_total: usize,
-    /// The most step records `steps` holds ([`SUMMARY_STEPS`]).
+    /// The most step records `steps` holds (`SUMMARY_STEPS`).
     pub steps_limit: usize,
     /// Records of the last `min(steps_completed, steps_limit)` steps, in order; `steps.csv` has every step.
     pub steps: Vec<StepReport>,
@@ -209,7 +209,7 @@ pub fn run_simulate(
 
 /// The walk of [`run_simulate`] without writing anything (`job.out_dir` and `job.trajectory` are not used),
 /// for other fronts (the Python binding): the summary with **every** step record (not only the last
-/// [`SUMMARY_STEPS`]), and the trajectory sampled every `job.sample_dt` if `record_trajectory`. It is held in
+/// `SUMMARY_STEPS`), and the trajectory sampled every `job.sample_dt` if `record_trajectory`. It is held in
 /// memory, so it suits runs of moderate length.
 pub fn compute_simulation(
     job: &SimulateJob,

@@ -224,7 +224,7 @@ impl std::fmt::Display for Stability {
 
 /// Newton stops after this many consecutive iterations with a freshly computed `DP` that fail to halve the
 /// residual.
-pub const MAX_POOR_ITERATIONS: usize = 3;
+pub(crate) const MAX_POOR_ITERATIONS: usize = 3;
 
 /// Largest entry of `|v|`.
 fn norm(v: &DVector<f64>) -> f64 {

@@ -9,7 +9,7 @@ use crate::walk::SectionState;
 /// Two fixed points closer than this (largest coordinate difference of `(L2, thetadot, L2dot)`) are the same
 /// gait. Newton converges to `1e-10` in the residual, so one gait found twice agrees to far better than this;
 /// distinct families differ by `1e-3` or more.
-pub const SAME_GAIT_TOL: f64 = 1e-6;
+pub(crate) const SAME_GAIT_TOL: f64 = 1e-6;
 
 /// The longest period searched by default (`vrw gait` and sweeps).
 pub const MAX_PERIOD: usize = 8;

@@ -1,31 +1,31 @@
 //! Output: tables a script can read (CSV, JSON) and figures a person can look at (STYLE.md point 12).
 //!
 //! This file holds the shared CSV and JSON writing; each table's columns and writer are declared once in
-//! [`tables`], each figure has its own file.
+//! `tables`, each figure has its own file.
 //!
 //! Numbers are written with Rust's shortest round-trip formatting, so a value read back is bit-identical;
 //! undefined values (e.g. `lambda_2+` after an (A3) exchange) are written as `NaN` in CSV and `null` in JSON.
 
 pub mod animate;
-pub mod basin_plot;
-pub mod chart;
+pub(crate) mod basin_plot;
+pub(crate) mod chart;
 pub mod map_plot;
-pub mod orbit_plot;
-pub mod plot;
+pub(crate) mod orbit_plot;
+pub(crate) mod plot;
 pub mod read;
 pub mod run_plot;
 pub mod steps_plot;
 pub mod style;
-pub mod tables;
+pub(crate) mod tables;
 
-pub use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv};
-pub use tables::map::write_map_csv;
+pub(crate) use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv};
+pub(crate) use tables::map::write_map_csv;
 pub use tables::steps::{step_row, write_steps_csv, StepsCsv, STEPS_HEADER};
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
 pub use tables::trajectory::{
     trajectory_row, write_trajectory_csv, TrajectoryCsv, TRAJECTORY_HEADER,
 };
-pub use tables::{Cell, Column};
+pub use tables::Cell;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -70,7 +70,7 @@ pub enum OutputError {
 
 /// A number as written in CSV: the shortest text that reads back to the same `f64`, in scientific notation
 /// when very small or very large; `NaN` for undefined values.
-pub fn num(v: f64) -> String {
+pub(crate) fn num(v: f64) -> String {
     let a = v.abs();
     if v == 0.0 {
         "0".to_string()
@@ -82,7 +82,7 @@ pub fn num(v: f64) -> String {
 }
 
 /// Create `dir` (and its parents) if needed; a `dir` that is an existing file is refused.
-pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
+pub(crate) fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
     if dir.exists() && !dir.is_dir() {
         return Err(OutputError::NotADirectory {
             path: dir.to_path_buf(),
@@ -95,7 +95,7 @@ pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
 }
 
 /// Open a CSV writer on `path`.
-pub fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
+pub(crate) fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
     csv::Writer::from_path(path).map_err(|source| OutputError::Csv {
         path: path.to_path_buf(),
         source,
@@ -103,7 +103,7 @@ pub fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
 }
 
 /// Write one CSV record, mapping errors to [`OutputError`].
-pub fn write_record<I, T>(
+pub(crate) fn write_record<I, T>(
     w: &mut csv::Writer<File>,
     path: &Path,
     record: I,
@@ -119,7 +119,7 @@ where
 }
 
 /// Flush a CSV writer.
-pub fn finish_csv(mut w: csv::Writer<File>, path: &Path) -> Result<(), OutputError> {
+pub(crate) fn finish_csv(mut w: csv::Writer<File>, path: &Path) -> Result<(), OutputError> {
     w.flush().map_err(|source| OutputError::Io {
         path: path.to_path_buf(),
         source,
@@ -127,7 +127,7 @@ pub fn finish_csv(mut w: csv::Writer<File>, path: &Path) -> Result<(), OutputErr
 }
 
 /// Write `value` as pretty JSON to `path`.
-pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputError> {
+pub(crate) fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputError> {
     let io = |source| OutputError::Io {
         path: path.to_path_buf(),
         source,
@@ -142,7 +142,7 @@ pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<(), OutputErro
 }
 
 /// Write a CSV table: the header, then one record per row.
-pub fn write_table<H, R>(path: &Path, header: &[H], rows: R) -> Result<(), OutputError>
+pub(crate) fn write_table<H, R>(path: &Path, header: &[H], rows: R) -> Result<(), OutputError>
 where
     H: AsRef<[u8]>,
     R: IntoIterator<Item = Vec<Cell>>,
@@ -157,14 +157,14 @@ where
 
 /// A CSV file written row by row: each row is flushed to the file as soon as it is written, so an
 /// interrupted or crashed run keeps every row it produced and memory does not grow with the rows.
-pub struct CsvStream {
+pub(crate) struct CsvStream {
     w: csv::Writer<File>,
     path: PathBuf,
 }
 
 impl CsvStream {
     /// Create (truncate) `path` and write `header`.
-    pub fn create<I, T>(path: &Path, header: I) -> Result<CsvStream, OutputError>
+    pub(crate) fn create<I, T>(path: &Path, header: I) -> Result<CsvStream, OutputError>
     where
         I: IntoIterator<Item = T>,
         T: AsRef<[u8]>,
@@ -187,7 +187,7 @@ impl CsvStream {
     }
 
     /// Write one row and flush it to the file.
-    pub fn write<I, T>(&mut self, record: I) -> Result<(), OutputError>
+    pub(crate) fn write<I, T>(&mut self, record: I) -> Result<(), OutputError>
     where
         I: IntoIterator<Item = T>,
         T: AsRef<[u8]>,
@@ -197,7 +197,7 @@ impl CsvStream {
     }
 
     /// Flush the rows written so far to the file.
-    pub fn flush(&mut self) -> Result<(), OutputError> {
+    pub(crate) fn flush(&mut self) -> Result<(), OutputError> {
         self.w.flush().map_err(|source| OutputError::Io {
             path: self.path.clone(),
             source,
@@ -205,7 +205,7 @@ impl CsvStream {
     }
 
     /// The file written.
-    pub fn path(&self) -> &Path {
+    pub(crate) fn path(&self) -> &Path {
         &self.path
     }
 }

@@ -15,7 +15,7 @@ use super::chart::{
 use super::style::{padded, PlotError, COLOR_BLACK, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
 
 /// Size of `orbit.png` \[px\].
-pub const ORBIT_SIZE: (u32, u32) = (2400, 1600);
+pub(crate) const ORBIT_SIZE: (u32, u32) = (2400, 1600);
 
 /// Radius of a point of the diagram \[px\].
 const DOT: i32 = 3;
@@ -29,7 +29,7 @@ const COLOR_FAILED: RGBColor = RGBColor(235, 235, 235);
 /// One point of the period-1 branch: the parameter value, the value drawn, and whether the gait is stable
 /// there (`None`: uncertain).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BranchPoint {
+pub(crate) struct BranchPoint {
     /// The parameter value.
     pub param: f64,
     /// The quantity drawn.
@@ -40,7 +40,7 @@ pub struct BranchPoint {
 
 /// One panel: one quantity against the parameter.
 #[derive(Debug, Clone)]
-pub struct OrbitPanel {
+pub(crate) struct OrbitPanel {
     /// Y axis description with unit.
     pub y_label: String,
     /// The points the walk visits `(parameter, value)`.
@@ -51,7 +51,7 @@ pub struct OrbitPanel {
 
 /// The whole figure.
 #[derive(Debug, Clone)]
-pub struct OrbitFigure {
+pub(crate) struct OrbitFigure {
     /// Title.
     pub title: String,
     /// X axis description with unit.
@@ -227,7 +227,7 @@ impl Figure for OrbitFigure {
 }
 
 /// Write the orbit diagram as a PNG at `png`.
-pub fn write_orbit_figure(figure: &OrbitFigure, png: &Path) -> Result<(), PlotError> {
+pub(crate) fn write_orbit_figure(figure: &OrbitFigure, png: &Path) -> Result<(), PlotError> {
     if figure
         .panels
         .iter()

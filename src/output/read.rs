@@ -152,7 +152,7 @@ pub struct TrajectoryRow {
 
 /// The contact state of a leg's tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TipState {
+pub(crate) enum TipState {
     /// On the ground, not slipping.
     Stuck,
     /// On the ground, sliding.
@@ -173,7 +173,7 @@ impl TipState {
 
 impl TrajectoryRow {
     /// Contact state of Leg 1's and Leg 2's tips.
-    pub fn tips(&self) -> [TipState; 2] {
+    pub(crate) fn tips(&self) -> [TipState; 2] {
         [
             TipState::of(self.contact1, self.slide1),
             TipState::of(self.contact2, self.slide2),
@@ -263,7 +263,7 @@ pub struct Geometry {
 
 impl Geometry {
     /// Inter-leg angle `alpha = 2 pi / N` \[rad\].
-    pub fn alpha(&self) -> f64 {
+    pub(crate) fn alpha(&self) -> f64 {
         std::f64::consts::TAU / self.legs as f64
     }
 }
@@ -285,7 +285,7 @@ pub struct RunData {
 
 impl RunData {
     /// Path of `name` inside the run directory.
-    pub fn path(&self, name: &str) -> PathBuf {
+    pub(crate) fn path(&self, name: &str) -> PathBuf {
         self.dir.join(name)
     }
 
@@ -298,14 +298,17 @@ impl RunData {
     }
 
     /// The step running at time `t` (the last touchdown at or before `t`), if any.
-    pub fn step_at(&self, t: f64) -> Option<&StepRow> {
+    pub(crate) fn step_at(&self, t: f64) -> Option<&StepRow> {
         let k = self.steps.partition_point(|s| s.time <= t);
         k.checked_sub(1).map(|k| &self.steps[k])
     }
 }
 
 /// Read the rows of a CSV file by header name (an empty table is an error unless `allow_empty`).
-pub fn read_csv<T: DeserializeOwned>(path: &Path, allow_empty: bool) -> Result<Vec<T>, ReadError> {
+pub(crate) fn read_csv<T: DeserializeOwned>(
+    path: &Path,
+    allow_empty: bool,
+) -> Result<Vec<T>, ReadError> {
     let csv_err = |source| ReadError::Csv {
         path: path.to_path_buf(),
         source,

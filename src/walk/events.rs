@@ -13,18 +13,18 @@ use super::phase::{unpack, WalkVector};
 /// value at the start of the phase, if the force-level problem accepted a slightly negative one within
 /// [`super::impact::COMPLEMENTARITY_TOL`]): small enough that the contact audit sees no pull above 1e-9 N, large
 /// enough that rounding of forces of ~100 N (~1e-12 N) cannot fire it.
-pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
+pub(crate) const FORCE_EVENT_MARGIN: f64 = 1e-10;
 
 /// The grazing guard of a landing or stopper event whose tip (leg) starts at the ground (stopper) already moving
 /// into it \[m\]: such a contact is not grazing, so its event fires as soon as it moves this far (instead of
 /// `recontact_gap` / `stopper_gap`). It happens after the `traditional` exchange drives the rear tip into the
 /// ground, or when an impact's complementarity problem had no consistent solution.
-pub const APPROACH_GAP: f64 = 1e-12;
+pub(crate) const APPROACH_GAP: f64 = 1e-12;
 
 /// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
 /// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
 /// however long the steps of a high-order integrator are.
-pub const EVENT_SAMPLES: usize = 4;
+pub(crate) const EVENT_SAMPLES: usize = 4;
 
 /// Kinds of events (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -109,7 +109,7 @@ impl<'m> Walker<'m> {
     /// The section coordinates `(L2, thetadot, L2dot)` at the current touchdown, without the check of
     /// [`Walker::section`]: what a return map or an orbit diagram records. Where the stance tip slides they do
     /// not hold the whole state, so they must not be used to start a walk there.
-    pub fn touchdown_coordinates(&self) -> SectionState {
+    pub(crate) fn touchdown_coordinates(&self) -> SectionState {
         SectionState::from_coords(&self.state.q, &self.state.qd)
     }
 

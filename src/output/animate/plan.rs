@@ -44,7 +44,7 @@ pub(super) fn window(run: &RunData, opts: &AnimateOptions) -> Result<(f64, f64),
 }
 
 /// The frame times: regular frames every `speed / fps` of simulated time over `[from, to]`, plus
-/// [`SLOW_FRAMES`] frames over every phase that no regular frame falls into (see the module doc).
+/// `SLOW_FRAMES` frames over every phase that no regular frame falls into (see the module doc).
 pub fn plan_frames(
     samples: &[TrajectoryRow],
     (from, to): (f64, f64),

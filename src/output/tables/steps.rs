@@ -10,7 +10,7 @@ use crate::walk::StepReport;
 use Cell::{Count, Flag, Real, Text};
 
 /// The columns of `steps.csv` (docs/model.md sections 4-5 for the section state and the indicators).
-pub const STEPS: [Column<StepReport>; 28] = [
+pub(crate) const STEPS: [Column<StepReport>; 28] = [
     Column::new("step", "Step number, from 1.", |s| Count(s.step)),
     Column::new(
         "time",
@@ -143,7 +143,7 @@ pub const STEPS: [Column<StepReport>; 28] = [
     ),
 ];
 
-/// Header of `steps.csv` (the names of [`STEPS`]).
+/// Header of `steps.csv` (the names of `STEPS`).
 pub const STEPS_HEADER: [&str; 28] = fixed_names(&STEPS, 0);
 
 /// One row of `steps.csv`, in the order of [`STEPS_HEADER`].
@@ -151,17 +151,17 @@ pub fn step_row(s: &StepReport) -> Vec<Cell> {
     row(&STEPS, s)
 }
 
-/// `steps.csv` written step by step ([`CsvStream`]).
+/// `steps.csv` written step by step (`CsvStream`).
 pub struct StepsCsv(CsvStream);
 
 impl StepsCsv {
     /// Create `path` with the header [`STEPS_HEADER`].
-    pub fn create(path: &Path) -> Result<StepsCsv, OutputError> {
+    pub(crate) fn create(path: &Path) -> Result<StepsCsv, OutputError> {
         CsvStream::create(path, STEPS_HEADER).map(StepsCsv)
     }
 
     /// Write the row of one step and flush it.
-    pub fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
+    pub(crate) fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
         self.0.write(step_row(step).iter().map(Cell::to_csv))
     }
 }
