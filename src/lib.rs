@@ -61,7 +61,7 @@
 pub mod app;
 pub mod contact;
 pub mod dynamics;
-pub mod fmt;
+pub(crate) mod fmt;
 pub mod gait;
 pub mod integrate;
 pub mod output;

@@ -52,7 +52,7 @@ pub struct GaitSummary {
 /// The smallest Newton tolerance `vrw gait` accepts: the step map is computed to about 1e-13 (integration
 /// and event-location tolerances, rounding over a step of thousands of solves), so a smaller
 /// `max |P(s) - s|` cannot be reached reliably.
-pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
+pub(crate) const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 
 /// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
 /// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
@@ -114,7 +114,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
 /// Walk one period (`period_k` steps) from the gait's fixed point, sampled every [`DEFAULT_SAMPLE_DT`], and write it beside
 /// `gait.json` in the format of `vrw simulate` (`steps.csv`, `trajectory.csv`, `summary.json`), so that
 /// `vrw plot` and `vrw animate` work on a gait directly.
-pub fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
+pub(crate) fn write_gait_period(job: &GaitJob, gait: &Gait) -> Result<SimulateSummary, AppError> {
     run_simulate(
         &SimulateJob {
             config: job.config.clone(),

@@ -19,16 +19,16 @@ use super::{remove_stale, AppError};
 
 /// A step whose energy audit leaves more than this unexplained \[J\] is reported as a warning (on stderr by the
 /// command line and in `summary.json`): the integration or an event is then not to be trusted.
-pub const ENERGY_RESIDUAL_WARNING: f64 = 1e-6;
+pub(crate) const ENERGY_RESIDUAL_WARNING: f64 = 1e-6;
 
 /// The smallest trajectory sampling interval `vrw simulate` accepts \[s\].
-pub const MIN_SAMPLE_DT: f64 = 1e-6;
+pub(crate) const MIN_SAMPLE_DT: f64 = 1e-6;
 
 /// `summary.json` keeps the records of the last this many steps; `steps.csv` has every step.
-pub const SUMMARY_STEPS: usize = 1000;
+pub(crate) const SUMMARY_STEPS: usize = 1000;
 
 /// `summary.json` keeps the first this many warnings and counts the rest.
-pub const SUMMARY_WARNINGS: usize = 100;
+pub(crate) const SUMMARY_WARNINGS: usize = 100;
 /// Default sampling interval of `trajectory.csv` \[s\].
 pub const DEFAULT_SAMPLE_DT: f64 = 0.005;
 

@@ -233,7 +233,7 @@ fn norm(v: &DVector<f64>) -> f64 {
 
 /// A fixed point of the step map, without its stability.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FixedPoint {
+pub(crate) struct FixedPoint {
     /// `s*`.
     pub section: SectionState,
     /// The step from `s*` (its report carries the DLS indicators).
@@ -278,7 +278,7 @@ pub fn find_gait(
 }
 
 /// The fixed point alone (no Jacobian at the end): what threshold searches need.
-pub fn solve_fixed_point(
+pub(crate) fn solve_fixed_point(
     map: &StepMap,
     initial: &SectionState,
     options: &GaitOptions,

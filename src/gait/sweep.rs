@@ -351,7 +351,7 @@ pub(crate) fn number_families(
 
 /// One row of gait points: a configuration and the values one of its parameters takes along the row.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GaitRow {
+pub(crate) struct GaitRow {
     /// Parameters and solver options (`param` is overridden point by point).
     pub config: Config,
     /// The numeric key that varies along the row ([`Config::numeric_keys`]).
@@ -365,7 +365,7 @@ pub struct GaitRow {
 /// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in
 /// parallel, and the results are bitwise identical for any number of threads. `progress` is called after every
 /// point. A row's values that leave the valid domain give points with the status `invalid_parameter`.
-pub fn gait_rows(
+pub(crate) fn gait_rows(
     rows: &[GaitRow],
     initial: &SectionState,
     options: &GaitOptions,
@@ -422,7 +422,7 @@ pub fn sweep(
 
 /// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
 /// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of [`gait_rows`].
-pub fn sweep_values(
+pub(crate) fn sweep_values(
     config: &Config,
     param: &str,
     values: &[f64],

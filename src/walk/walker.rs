@@ -24,7 +24,7 @@ use super::work::{add_to_total, WorkCounts};
 
 /// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
 /// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
-pub const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
+pub(crate) const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
 
 /// Bookkeeping of the step in progress.
 #[derive(Debug, Default, Clone, Copy)]

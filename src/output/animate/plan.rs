@@ -4,7 +4,7 @@
 use super::super::read::{RunData, TrajectoryRow};
 use super::{AnimateError, AnimateOptions};
 /// Extra frames given to a phase that no regular frame falls into.
-pub const SLOW_FRAMES: usize = 3;
+pub(crate) const SLOW_FRAMES: usize = 3;
 
 /// A short phase shown in slow motion.
 #[derive(Debug, Clone, PartialEq)]
