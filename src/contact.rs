@@ -250,7 +250,7 @@ impl ConstrainedDynamics {
 /// The largest pull among the unilateral units of `active` for multipliers (forces or impulses) in the fixed
 /// stacking: a negative normal multiplier (the ground pulling a tip down) or a positive stopper multiplier (a
 /// stopper pulling its leg outward), 0 if nothing pulls. Stoppers are skipped when `bilateral_stoppers` (rigid
-/// legs, where they act both ways). This is the contact audit of every step (MODEL.md section 4).
+/// legs, where they act both ways). This is the contact audit of every step (docs/model.md section 4).
 pub(crate) fn largest_pull(
     multipliers: &Multipliers,
     active: &ActiveSet,

@@ -205,8 +205,8 @@ pub fn default_initial(config: &Config) -> SectionState {
     }
 }
 
-/// A VRW with a period-2 gait (a fixed point of `P^2` that is not one of `P`, found by a parameter search,
-/// issue 10 item 2): a light hub (`mH = 2 kg`), weak damping (`c = 3 N s/m`), a soft spring (`k = 300 N/m`),
+/// A VRW with a period-2 gait (a fixed point of `P^2` that is not one of `P`, found by a parameter search;
+/// docs/model.md section 6, period-k gaits): a light hub (`mH = 2 kg`), weak damping (`c = 3 N s/m`), a soft spring (`k = 300 N/m`),
 /// slope 0.15 rad and the traditional impact; the other parameters are Table 1's. Its two steps alternate
 /// between `dtheta/dt` of about 1.09 and 1.66 rad/s just before touchdown; the period-1 search fails there. The
 /// walk settles on it from the default start. With `viscosity` from 1 to 10 N s/m it is the middle of a

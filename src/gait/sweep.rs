@@ -1,4 +1,4 @@
-//! Parameter sweeps with continuation (MODEL.md section 6, the paper's Fig. 2).
+//! Parameter sweeps with continuation (docs/model.md section 6, the paper's Fig. 2).
 //!
 //! Every point follows its neighbour's gait family in verified continuation steps (see
 //! [`super::continuation`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach

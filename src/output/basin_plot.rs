@@ -1,6 +1,6 @@
 //! The basin figure (`vrw basin`: `basin.png`): a slice of the Poincare section, every grid cell coloured by
 //! what the walk from it did (reached the gait, settled elsewhere, or failed, and how), with the gait marked
-//! (issue 10 item 4).
+//! (README, "Orbit diagram, basin of attraction, period-k gaits").
 
 use std::ops::Range;
 use std::path::Path;

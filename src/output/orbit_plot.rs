@@ -1,6 +1,7 @@
 //! The orbit diagram (`vrw orbit`: `orbit.png`): against one parameter, the section states and DLS indicators
 //! the walk visits after its transient, drawn as points, with the period-1 gait branch from continuation drawn
-//! as a line, solid where the gait is stable and dashed where it is not (issue 10 item 3).
+//! as a line, solid where the gait is stable and dashed where it is not (README,
+//! "Orbit diagram, basin of attraction, period-k gaits").
 
 use std::ops::Range;
 use std::path::Path;

@@ -94,7 +94,7 @@ fn flag<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
     }
 }
 
-/// One row of `trajectory.csv` (MODEL.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
+/// One row of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub struct TrajectoryRow {
     /// Time \[s\].

@@ -2,9 +2,9 @@
 //!
 //! Five panels share the time axis: the angle `theta` of Leg 1 from the slope normal, its rate, the leg
 //! lengths `L1`, `L2` with the stopper length `L0` dashed, the normal ground forces `lambda_2` (Leg 1) and
-//! `lambda_4` (Leg 2), and the tangential ones `lambda_1`, `lambda_3` (MODEL.md section 3). The background
+//! `lambda_4` (Leg 2), and the tangential ones `lambda_1`, `lambda_3` (docs/model.md section 3). The background
 //! is shaded by phase (DLS, a sliding tip, SLS, rear support, flight) and every touchdown is a dashed
-//! vertical line. Curves break at each touchdown, where the legs are re-indexed (MODEL.md section 5).
+//! vertical line. Curves break at each touchdown, where the legs are re-indexed (docs/model.md section 5).
 
 use std::path::PathBuf;
 

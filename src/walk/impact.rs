@@ -1,4 +1,4 @@
-//! Touchdown: re-indexing and the DLS-indicator impact procedure (MODEL.md section 5, paper Sec. 2.2,
+//! Touchdown: re-indexing and the DLS-indicator impact procedure (docs/model.md section 5, paper Sec. 2.2,
 //! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event.
 //!
 //! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward) are resolved by
@@ -273,7 +273,7 @@ fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
 }
 
 /// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
-/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (MODEL.md
+/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (docs/model.md
 /// section 4). Every candidate either takes a non-negative impulse and ends at zero relative normal velocity,
 /// or takes none and separates (normal velocity after the impact `>= 0`, a free leg not moving past its
 /// stopper). A no-slip contact's impulse has a tangential part; a sliding contact's is normal only. If no
@@ -416,7 +416,7 @@ fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
     candidates
 }
 
-/// The touchdown impact at `(q_dagger, q'_dagger)` after re-indexing (MODEL.md section 5).
+/// The touchdown impact at `(q_dagger, q'_dagger)` after re-indexing (docs/model.md section 5).
 ///
 /// `before` is the active set just before impact in the new indexing: `contact2` = the old Leg 1 was on the
 /// ground, `lock1` = true (the new leg arrives locked), `lock2` = the old Leg 1's stopper.
@@ -519,7 +519,7 @@ pub(crate) fn touchdown_impact(
     Ok(finish(dls_set, dls_sol, indicators, branch, preferred))
 }
 
-/// The stoppers that act both ways and are always active: both with `rigid_legs` (MODEL.md section 7), none
+/// The stoppers that act both ways and are always active: both with `rigid_legs` (docs/model.md section 7), none
 /// otherwise. Every active-set resolution starts from this set.
 pub(crate) fn bilateral_stoppers(model: &Model) -> ActiveSet {
     let rigid = model.params().rigid_legs;
@@ -597,7 +597,7 @@ pub struct UnitImpact {
 /// or sliding, and each locked stopper) is a candidate of the impulse-level complementarity problem of `plastic_impact`: it takes
 /// a non-negative impulse and ends at zero relative normal velocity, or takes none and separates. Nothing is
 /// held through the impact because it was active before: when Leg 2's stopper locks while its tip slides, the
-/// tip may leave the ground (MODEL.md section 4).
+/// tip may leave the ground (docs/model.md section 4).
 pub fn close_unit(
     model: &Model,
     q: &Coords,

@@ -1,4 +1,5 @@
-//! What a step reports (issue: per-step report and energy audit; docs/model.md sections 5 and 7).
+//! What a step reports (the per-step report and its energy and contact audits; docs/model.md sections 5
+//! and 7).
 
 use serde::Serialize;
 
@@ -26,7 +27,7 @@ pub struct EnergyAudit {
     pub residual: f64,
 }
 
-/// Contact audit of one step (MODEL.md sections 3-4): the ground only pushes, stoppers only pull a leg inward,
+/// Contact audit of one step (docs/model.md sections 3-4): the ground only pushes, stoppers only pull a leg inward,
 /// and no tip goes below the ground. Each field is 0 when the law holds exactly; a few 1e-10 come from event
 /// location and integration.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
