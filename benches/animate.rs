@@ -1,7 +1,7 @@
 //! Speed of `vrw animate` and `vrw plot` on the default run: 20 steps from the reference start on the
 //! paper's parameters (Table 1, c = 50 N s/m), about 52 s of motion.
 //!
-//! Run with `cargo bench --bench animate`. Target (issue 8): the GIF of 20 steps at the defaults (25
+//! Run with `cargo bench --bench animate`. Target (README, "Speed"): the GIF of 20 steps at the defaults (25
 //! frames/s, 640 x 360) in under 10 s and under 10 MB; the size is printed once before timing.
 //!
 //! - `animate_20_steps`: `write_animation` with the default options (reading the run directory excluded).

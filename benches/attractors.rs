@@ -1,4 +1,4 @@
-//! Speed of the orbit diagram and the basin (issue 10 item 7), scaled down so that criterion can repeat them;
+//! Speed of the orbit diagram and the basin (README, "Speed"), scaled down so that criterion can repeat them;
 //! the full sizes are timed by the commands themselves (README, "Speed"):
 //! `cargo run --release -- orbit --no-branch` (300 values x 64 steps) and
 //! `cargo run --release -- basin --nx 200 --ny 200`.

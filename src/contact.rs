@@ -20,14 +20,14 @@ use serde::Serialize;
 use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, NQ, X, Z};
 
 /// Number of constraint rows in the fixed stacking order.
-pub const NROWS: usize = 6;
+pub(crate) const NROWS: usize = 6;
 /// Multipliers `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]`.
-pub type Multipliers = SVector<f64, NROWS>;
+pub(crate) type Multipliers = SVector<f64, NROWS>;
 type Rows = SMatrix<f64, NROWS, NQ>;
 
 /// Relative size below which a pivot of the Schur complement `J M^-1 J^T` means the active constraints are
 /// redundant (linearly dependent rows).
-pub const REDUNDANCY_TOL: f64 = 1e-12;
+pub(crate) const REDUNDANCY_TOL: f64 = 1e-12;
 
 /// One of the two legs in `q`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -64,7 +64,7 @@ impl Leg {
     }
 
     /// Row of this leg's stopper in the multiplier vector.
-    pub fn stopper_row(self) -> usize {
+    pub(crate) fn stopper_row(self) -> usize {
         4 + self.index()
     }
 }
@@ -104,7 +104,7 @@ impl ActiveSet {
     }
 
     /// Does the contact of `leg` slide (normal constraint only)?
-    pub fn slide(&self, leg: Leg) -> bool {
+    pub(crate) fn slide(&self, leg: Leg) -> bool {
         match leg {
             Leg::One => self.slide1,
             Leg::Two => self.slide2,
@@ -112,7 +112,7 @@ impl ActiveSet {
     }
 
     /// Set the ground contact of `leg` as a no-slip contact (`on`) or open it.
-    pub fn set_contact(&mut self, leg: Leg, on: bool) {
+    pub(crate) fn set_contact(&mut self, leg: Leg, on: bool) {
         match leg {
             Leg::One => (self.contact1, self.slide1) = (on, false),
             Leg::Two => (self.contact2, self.slide2) = (on, false),
@@ -120,7 +120,7 @@ impl ActiveSet {
     }
 
     /// Make the contact of `leg` a sliding one (normal row only).
-    pub fn set_sliding(&mut self, leg: Leg) {
+    pub(crate) fn set_sliding(&mut self, leg: Leg) {
         match leg {
             Leg::One => (self.contact1, self.slide1) = (true, true),
             Leg::Two => (self.contact2, self.slide2) = (true, true),
@@ -128,7 +128,7 @@ impl ActiveSet {
     }
 
     /// Set the stopper of `leg`.
-    pub fn set_lock(&mut self, leg: Leg, on: bool) {
+    pub(crate) fn set_lock(&mut self, leg: Leg, on: bool) {
         match leg {
             Leg::One => self.lock1 = on,
             Leg::Two => self.lock2 = on,
@@ -136,7 +136,7 @@ impl ActiveSet {
     }
 
     /// Which rows of the fixed stacking are active.
-    pub fn row_mask(&self) -> [bool; NROWS] {
+    pub(crate) fn row_mask(&self) -> [bool; NROWS] {
         [
             self.contact1 && !self.slide1,
             self.contact1,
@@ -149,12 +149,12 @@ impl ActiveSet {
 
     /// Double-limb support in the paper's sense: (C1) and (C2) both hold, both tips on the ground without
     /// slipping.
-    pub fn double_support(&self) -> bool {
+    pub(crate) fn double_support(&self) -> bool {
         self.contact1 && self.contact2 && !self.slide1 && !self.slide2
     }
 
     /// The support phase named by its contacts (docs/model.md section 4).
-    pub fn phase(&self) -> Phase {
+    pub(crate) fn phase(&self) -> Phase {
         match (self.contact1, self.contact2) {
             (true, true) => Phase::DoubleSupport,
             (true, false) => Phase::SingleSupport,
@@ -237,12 +237,12 @@ pub struct ConstrainedDynamics {
 
 impl ConstrainedDynamics {
     /// Normal ground force on `leg` \[N\] (positive pushes up).
-    pub fn normal_force(&self, leg: Leg) -> f64 {
+    pub(crate) fn normal_force(&self, leg: Leg) -> f64 {
         self.multipliers[leg.normal_row()]
     }
 
     /// Stopper reaction on `leg` \[N\], positive when it pushes the leg inward (its only admissible direction).
-    pub fn stopper_reaction(&self, leg: Leg) -> f64 {
+    pub(crate) fn stopper_reaction(&self, leg: Leg) -> f64 {
         -self.multipliers[leg.stopper_row()]
     }
 }
@@ -250,8 +250,8 @@ impl ConstrainedDynamics {
 /// The largest pull among the unilateral units of `active` for multipliers (forces or impulses) in the fixed
 /// stacking: a negative normal multiplier (the ground pulling a tip down) or a positive stopper multiplier (a
 /// stopper pulling its leg outward), 0 if nothing pulls. Stoppers are skipped when `bilateral_stoppers` (rigid
-/// legs, where they act both ways). This is the contact audit of every step (MODEL.md section 4).
-pub fn largest_pull(
+/// legs, where they act both ways). This is the contact audit of every step (docs/model.md section 4).
+pub(crate) fn largest_pull(
     multipliers: &Multipliers,
     active: &ActiveSet,
     bilateral_stoppers: bool,
@@ -284,7 +284,7 @@ impl ImpulseSolution {
     }
 
     /// Stopper impulse on `leg` \[N s\], positive when inward.
-    pub fn stopper_impulse(&self, leg: Leg) -> f64 {
+    pub(crate) fn stopper_impulse(&self, leg: Leg) -> f64 {
         -self.impulses[leg.stopper_row()]
     }
 }

@@ -19,13 +19,13 @@ use nalgebra::{SMatrix, SVector, Vector2};
 use crate::params::{ConfigError, Params};
 
 /// Number of generalized coordinates.
-pub const NQ: usize = 5;
+pub(crate) const NQ: usize = 5;
 /// Generalized coordinates or velocities `[x, z, theta, L1, L2]`.
 pub type Coords = SVector<f64, NQ>;
 /// A 5x5 matrix over the generalized coordinates.
-pub type Mat5 = SMatrix<f64, NQ, NQ>;
+pub(crate) type Mat5 = SMatrix<f64, NQ, NQ>;
 /// Jacobian of a planar point with respect to `q`.
-pub type PointJacobian = SMatrix<f64, 2, NQ>;
+pub(crate) type PointJacobian = SMatrix<f64, 2, NQ>;
 
 /// Index of `x` in `q`.
 pub const X: usize = 0;
@@ -58,11 +58,11 @@ impl PointKinematics {
 
 /// Which leg of the wheel, counted from Leg 1 (`j = 0`) in the direction of Leg 2 (`j = 1`); the next leg to
 /// touch down is `j = N - 1` (docs/model.md section 1: `psi_j = theta + j alpha`).
-pub type LegIndex = usize;
+pub(crate) type LegIndex = usize;
 
 /// `M`, `h` and the tip of Leg 2 at one state, from [`Model::equations_of_motion`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EquationsOfMotion {
+pub(crate) struct EquationsOfMotion {
     /// Mass matrix `M(q)`.
     pub mass: Mat5,
     /// Bias vector `h(q, q')`: Coriolis/centrifugal terms, gravity, springs and dampers.
@@ -151,12 +151,12 @@ impl Model {
     }
 
     /// Number of legs `N`.
-    pub fn legs(&self) -> usize {
+    pub(crate) fn legs(&self) -> usize {
         self.offsets.len()
     }
 
     /// Index of the next leg to touch down (`j = -1`, i.e. `N - 1`).
-    pub fn front_leg(&self) -> LegIndex {
+    pub(crate) fn front_leg(&self) -> LegIndex {
         self.legs() - 1
     }
 
@@ -166,7 +166,7 @@ impl Model {
     }
 
     /// Length of leg `j`: `L1`, `L2` from `q`, the stopper length `L0` for the locked legs (docs/model.md section 2).
-    pub fn leg_length(&self, q: &Coords, j: LegIndex) -> (f64, Option<usize>) {
+    pub(crate) fn leg_length(&self, q: &Coords, j: LegIndex) -> (f64, Option<usize>) {
         match j {
             0 => (q[L1], Some(L1)),
             1 => (q[L2], Some(L2)),
@@ -175,7 +175,7 @@ impl Model {
     }
 
     /// Hub kinematics: `p_H = (x + L1 sin theta, z + L1 cos theta)` (docs/model.md section 1).
-    pub fn hub(&self, q: &Coords, qd: &Coords) -> PointKinematics {
+    pub(crate) fn hub(&self, q: &Coords, qd: &Coords) -> PointKinematics {
         let (s, c) = q[THETA].sin_cos();
         let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
         let mut jac = PointJacobian::zeros();
@@ -197,7 +197,7 @@ impl Model {
 
     /// A point on leg `j` at distance `from_tip` from its tip, `p = p_H + (L_j - from_tip) e(psi_j)` with
     /// `e(psi) = (-sin psi, -cos psi)`, given the hub kinematics `hub`.
-    pub fn leg_point_from_hub(
+    pub(crate) fn leg_point_from_hub(
         &self,
         hub: &PointKinematics,
         q: &Coords,
@@ -236,7 +236,7 @@ impl Model {
     }
 
     /// Height of the hub above the slope, `z + L1 cos(theta)` \[m\].
-    pub fn hub_height(&self, q: &Coords) -> f64 {
+    pub(crate) fn hub_height(&self, q: &Coords) -> f64 {
         q[Z] + q[L1] * q[THETA].cos()
     }
 
@@ -251,7 +251,7 @@ impl Model {
 
     /// Height of the lowest tip above the slope, over every leg \[m\]: the least [`Model::tip_height`], with one
     /// sine and cosine of `theta` for all legs (the penetration audit runs it several times per integrator step).
-    pub fn lowest_tip_height(&self, q: &Coords) -> f64 {
+    pub(crate) fn lowest_tip_height(&self, q: &Coords) -> f64 {
         let (st, ct) = q[THETA].sin_cos();
         let hub_height = q[Z] + q[L1] * ct;
         self.offsets
@@ -266,7 +266,7 @@ impl Model {
     ///
     /// See [`Model::equations_of_motion`] for how they are assembled; [`Model::mass_and_bias_reference`] is the
     /// plain formula the tests compare against.
-    pub fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+    pub(crate) fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
         let eom = self.equations_of_motion(q, qd);
         (eom.mass, eom.bias)
     }
@@ -281,7 +281,7 @@ impl Model {
     /// `f = m (a_H + g_n - d w^2 e(psi_j))` with the same `d = L0 - a` for all, and `|e'|^2 = 1`,
     /// `e . e' = 0`, so their sums need only `sum_j e(psi_j)` (and `sum_j e(psi_j)' `), a rotation by `theta` of
     /// the constant `sum_j (sin j alpha, cos j alpha)`. The cost is independent of `N`.
-    pub fn equations_of_motion(&self, q: &Coords, qd: &Coords) -> EquationsOfMotion {
+    pub(crate) fn equations_of_motion(&self, q: &Coords, qd: &Coords) -> EquationsOfMotion {
         let p = &self.params;
         let (st, ct) = q[THETA].sin_cos();
         let (l1, dl1, l2, dl2, w) = (q[L1], qd[L1], q[L2], qd[L2], qd[THETA]);
@@ -384,7 +384,8 @@ impl Model {
 
     /// `M` and `h` by the plain point-mass formula `sum m_i J_i^T J_i`, `sum m_i J_i^T (dJ_i/dt q' + g_n)`:
     /// slower than [`Model::mass_and_bias`], kept as its reference.
-    pub fn mass_and_bias_reference(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+    #[cfg(test)]
+    pub(crate) fn mass_and_bias_reference(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
         let p = &self.params;
         let hub = self.hub(q, qd);
         let mut m = p.hub_mass * hub.jacobian.transpose() * hub.jacobian;
@@ -402,18 +403,18 @@ impl Model {
     }
 
     /// Mass matrix `M(q)` alone.
-    pub fn mass_matrix(&self, q: &Coords) -> Mat5 {
+    pub(crate) fn mass_matrix(&self, q: &Coords) -> Mat5 {
         self.mass_and_bias(q, &Coords::zeros()).0
     }
 
     /// Kinetic energy `T = 1/2 q'^T M q'` \[J\].
-    pub fn kinetic_energy(&self, q: &Coords, qd: &Coords) -> f64 {
+    pub(crate) fn kinetic_energy(&self, q: &Coords, qd: &Coords) -> f64 {
         0.5 * qd.dot(&(self.mass_matrix(q) * qd))
     }
 
     /// Potential energy `V`: gravity of every body, `mass g (-p_x sin phi + p_z cos phi)`, plus the springs of
     /// Legs 1 and 2, `1/2 k (Lstar - L)^2` \[J\] (docs/model.md section 2).
-    pub fn potential_energy(&self, q: &Coords) -> f64 {
+    pub(crate) fn potential_energy(&self, q: &Coords) -> f64 {
         let p = &self.params;
         let zero = Coords::zeros();
         let hub = self.hub(q, &zero);

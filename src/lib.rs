@@ -7,21 +7,65 @@
 //!
 //! The model is written down in `docs/model.md` of the repository: coordinates, bodies, contacts, events,
 //! the impact procedure, the step map, the audits, the numerical settings and every choice vrw makes where
-//! the paper is silent. Every module cites the section of that file (a few comments still call it
-//! `MODEL.md`; the section numbers are the same) and the paper's equation it implements.
+//! the paper is silent. Every module cites the section of that file and the paper's equation it implements.
 //!
-//! The modules follow the pipeline:
+//! The modules follow the pipeline; each imports only the ones above it (`tests/layout.rs` checks this):
 //!
 //! | stage | module |
 //! |---|---|
+//! | numerical integration with event location | [`integrate`] |
 //! | parameters and options | [`params`] |
 //! | equations of motion, Eq. (1) | [`dynamics`] |
 //! | contacts, stoppers, KKT and impulse solves, Eqs. (2), (5) | [`contact`] |
-//! | integration with event location | [`integrate`] |
 //! | the hybrid walk: phases, events, the DLS-indicator impact procedure | [`walk`], [`walk::impact`] |
-//! | step map, gait, Floquet multipliers, sweeps, thresholds | [`gait`] |
+//! | reference problems with known answers, the default start | [`reference`](mod@reference) |
+//! | step map, gait, Floquet multipliers, sweeps, maps, orbits, basins, thresholds | [`gait`] |
 //! | tables and figures | [`output`] |
 //! | the command-line jobs | [`app`] |
+//!
+//! ## What the library promises
+//!
+//! These are the types and functions to build on, by stage. They are `pub`; so are the methods and fields
+//! of these types and the items of the public modules named here.
+//!
+//! - **Parameters**: [`params::Config`] (the physical [`params::Params`] and the numerical
+//!   [`params::SolverOptions`], read from TOML with [`params::Config::load`], changed with
+//!   [`params::Config::apply_override`], checked with [`params::Config::validate`]) and
+//!   [`params::ConfigError`].
+//! - **Model**: [`dynamics::Model`], the equations of motion built from [`params::Params`]; the contact and
+//!   impulse solves [`contact::constrained_dynamics`] and [`contact::impulse`].
+//! - **Integration**: the [`integrate::OdeSystem`] trait, the [`integrate::Dopri5`] solver with its
+//!   [`integrate::DenseStep`] and [`integrate::Tolerances`], and [`integrate::Method`].
+//! - **The walk**: [`walk::Walker`] (one step at a time), [`walk::simulate`] and [`walk::simulate_streaming`]
+//!   (many steps), each step's [`walk::StepReport`] (the DLS indicators, the energy and contact audits), the
+//!   Poincare section state [`walk::SectionState`], the sampled [`walk::Trajectory`] and its
+//!   [`walk::SampleSink`], [`walk::WorkCounts`], and [`walk::WalkError`] for a walk that fails.
+//! - **Reference problems**: [`reference::RigidRimlessWheel`] (closed-form step map),
+//!   [`reference::FallingPoint`], [`reference::HarmonicOscillator`], and the default start
+//!   [`reference::default_initial`].
+//! - **The gait**: the step map [`gait::StepMap`]; [`gait::find_gait`] with [`gait::GaitOptions`], giving a
+//!   [`gait::Gait`] (or a [`gait::GaitError`]); period-k gaits [`gait::find_periodic_gait`] and
+//!   [`gait::find_gait_any_period`]; parameter sweeps [`gait::sweep`] over a [`gait::SweepSpec`] and their
+//!   thresholds [`gait::find_thresholds`]; two-parameter maps [`gait::map_gaits`] and [`gait::map_curves`];
+//!   orbit diagrams [`gait::orbit::orbit_diagram`]; basins of attraction [`gait::basin::basin`]; families of
+//!   gaits [`gait::continuation`].
+//! - **Output**: the tables [`output::write_steps_csv`], [`output::write_trajectory_csv`] (and the streaming
+//!   [`output::StepsCsv`], [`output::TrajectoryCsv`]), [`output::write_sweep_csv`], their headers and rows;
+//!   reading a run directory back with [`output::read::read_run`]; the figures
+//!   [`output::run_plot::write_run_figure`], [`output::steps_plot::write_steps_figure`] and the animation
+//!   [`output::animate::write_animation`].
+//! - **Jobs** (what each `vrw` command runs, writing its files into a directory): [`app::run_simulate`],
+//!   [`app::run_gait`], [`app::run_sweep`], [`app::run_map`], [`app::run_orbit`], [`app::run_basin`],
+//!   [`app::run_plot`], [`app::run_animate`], [`app::run_still`], with their job structs
+//!   ([`app::SimulateJob`], ...) and [`app::AppError`]; and the jobs that return their results instead
+//!   ([`app::compute_simulation`], [`app::compute_gait`], [`app::compute_sweep`]), which the Python binding
+//!   uses.
+//!
+//! Everything else is internal to the crate (`pub(crate)`): the integrator driver and DOP853, the event
+//! functions and audits of a step, the grid runner behind sweeps and maps, continuation's tolerances, the
+//! table declarations, the charts of the other figures. Internal items may change in any release; the crate
+//! warns on a public item that cannot be named (`unnameable_types`), so every type in a public signature is
+//! reachable by a public path.
 //!
 //! ## From parameters to a gait
 //!
@@ -56,12 +100,12 @@
 //! each report to a callback as soon as its step is done and stops when an interrupt flag is set, and
 //! [`walk::Trajectory::streaming`] hands each sample to a [`walk::SampleSink`] (such as
 //! [`output::TrajectoryCsv`]). This is how `vrw simulate` runs in bounded memory ([`app::run_simulate`]).
-#![warn(missing_docs)]
+#![warn(missing_docs, unnameable_types)]
 
 pub mod app;
 pub mod contact;
 pub mod dynamics;
-pub mod fmt;
+pub(crate) mod fmt;
 pub mod gait;
 pub mod integrate;
 pub mod output;

@@ -105,7 +105,7 @@ impl RigidRimlessWheel {
     }
 
     /// Inertia about a leg tip, `I_P` \[kg m^2\].
-    pub fn inertia_about_tip(&self) -> f64 {
+    pub(crate) fn inertia_about_tip(&self) -> f64 {
         let p = &self.params;
         let r = p.stopper_length - p.leg_mass_offset;
         p.hub_inertia
@@ -151,19 +151,19 @@ impl RigidRimlessWheel {
 /// The least default start length of Leg 2 as a fraction of `L0` (0.72 m with Table 1's `L0 = 1 m`): the start
 /// tuned for the paper's parameters (`k = 500 N/m`), where the static compression of [`default_initial`] would
 /// put Leg 2 lower (0.669 m). A softer leg is not started more compressed than this.
-pub const DEFAULT_START_LENGTH_FRACTION: f64 = 0.72;
+pub(crate) const DEFAULT_START_LENGTH_FRACTION: f64 = 0.72;
 
 /// How far above `L0 cos(alpha)` (as a factor) the default start keeps Leg 2: at `L2 = L0 cos(alpha)` the section
 /// has `theta = -alpha`, and the tip of the leg behind Leg 2 touches the ground too (below, it starts in it).
-pub const VALID_START_MARGIN: f64 = 1.01;
+pub(crate) const VALID_START_MARGIN: f64 = 1.01;
 
 /// The default starting point on the Poincare section (docs/model.md section 6), derived from the parameters:
 ///
 /// - `L2 = min(L0, max(0.72 L0, 1.01 L0 cos(alpha), Lstar - M g cos(phi) / k))`, with `M = mH + N m` the
 ///   wheel's mass: Leg 2 at the length at which its spring alone carries the wheel's weight normal to the slope
-///   (its static compression), but no shorter than [`DEFAULT_START_LENGTH_FRACTION`] of `L0` (the start tuned
+///   (its static compression), but no shorter than `DEFAULT_START_LENGTH_FRACTION` of `L0` (the start tuned
 ///   for the paper's `k = 500 N/m`, where the static length is 0.669 m, so Table 1 starts at `(0.72, 1.0, 0.0)`
-///   as before), no shorter than [`VALID_START_MARGIN`] times `L0 cos(alpha)` (with many legs a shorter Leg 2
+///   as before), no shorter than `VALID_START_MARGIN` times `L0 cos(alpha)` (with many legs a shorter Leg 2
 ///   would put the next leg's tip in the ground), and no longer than the stopper. A stiff leg (`k = 3000 N/m`,
 ///   `Lstar = L0`: 0.941 m) thus starts near its stopper, where its gait is, instead of far inside the spring's
 ///   range;
@@ -205,8 +205,8 @@ pub fn default_initial(config: &Config) -> SectionState {
     }
 }
 
-/// A VRW with a period-2 gait (a fixed point of `P^2` that is not one of `P`, found by a parameter search,
-/// issue 10 item 2): a light hub (`mH = 2 kg`), weak damping (`c = 3 N s/m`), a soft spring (`k = 300 N/m`),
+/// A VRW with a period-2 gait (a fixed point of `P^2` that is not one of `P`, found by a parameter search;
+/// docs/model.md section 6, period-k gaits): a light hub (`mH = 2 kg`), weak damping (`c = 3 N s/m`), a soft spring (`k = 300 N/m`),
 /// slope 0.15 rad and the traditional impact; the other parameters are Table 1's. Its two steps alternate
 /// between `dtheta/dt` of about 1.09 and 1.66 rad/s just before touchdown; the period-1 search fails there. The
 /// walk settles on it from the default start. With `viscosity` from 1 to 10 N s/m it is the middle of a

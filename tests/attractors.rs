@@ -1,4 +1,5 @@
-//! The orbit diagram and the basin of attraction (issue 10 items 3, 4), checked by direct simulation.
+//! The orbit diagram and the basin of attraction (README, "Orbit diagram, basin of attraction,
+//! period-k gaits"), checked by direct simulation.
 
 use std::path::Path;
 

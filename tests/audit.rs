@@ -1,4 +1,4 @@
-//! The contact audit (MODEL.md sections 3-4) over wide parameter ranges: the ground never pulls, stoppers
+//! The contact audit (docs/model.md sections 3-4) over wide parameter ranges: the ground never pulls, stoppers
 //! never push a leg outward, no impulse pulls, and no tip goes below the ground, on every step of every walk.
 //! Also the regression test of the bilateral stopper-lock impact.
 
@@ -120,7 +120,7 @@ fn contact_audit_is_clean_over_viscosity_slope_and_stiffness() {
     assert!(worst.steps > 600, "only {} steps walked", worst.steps);
 }
 
-/// Every impact model and the assumptions' options. (`inconsistent_contact = rebound`, MODEL.md's (B3) rule
+/// Every impact model and the assumptions' options. (`inconsistent_contact = rebound`, docs/model.md's (B3) rule
 /// taken literally, is left out on purpose: it releases a contact whose tip is then driven into the ground, so
 /// its audit shows pull and penetration, see `rebound_option_is_flagged_by_the_audit`.)
 #[test]

@@ -3,7 +3,7 @@
 //!
 //! The import check reads every file under `src/`, strips comments, string literals and `#[cfg(test)]` items,
 //! and collects the paths each file uses: its `use` declarations and the `crate::`/`super::`/`self::` paths in
-//! its code (and `vrw::` in the binary, `main.rs` and `cli.rs`). A path is resolved to the module of the file
+//! its code (and `vrw::` in the binary, `main.rs` and `cli/`). A path is resolved to the module of the file
 //! that defines the item: through `mod.rs` (and `lib.rs`) re-exports where the item is re-exported by name,
 //! otherwise to the module named. Each edge `A -> B` between modules is then an edge between the two siblings
 //! under their deepest common directory: `gait::sweep -> walk::section` is the top-level edge `gait -> walk`,
@@ -41,7 +41,7 @@ const PIPELINE: &[&str] = &[
     BIN,
 ];
 
-/// The first segment of the binary's module paths (`main.rs` is the binary's root, `cli.rs` its child).
+/// The first segment of the binary's module paths (`main.rs` is the binary's root, `cli/` its child).
 const BIN: &str = "(bin)";
 
 /// The library's crate name, as the binary spells paths into it.

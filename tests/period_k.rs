@@ -1,4 +1,4 @@
-//! Period-k gaits (issue 10 item 2): fixed points of `P^k`, checked by evaluating the step map directly.
+//! Period-k gaits (docs/model.md section 6): fixed points of `P^k`, checked by evaluating the step map directly.
 
 use vrw::app::{run_gait, GaitJob};
 use vrw::dynamics::Model;

@@ -10,9 +10,10 @@ use vrw::params::{Config, ImpactModel, Params, SolverOptions};
 use vrw::reference::RigidRimlessWheel;
 use vrw::walk::{simulate, Branch, PhaseSystem, SectionState, WalkVector, Walker};
 
-/// Relative drift of `T + V` allowed over 2 s without damping (the requirement).
+/// Relative drift of `T + V` allowed over 2 s without damping: the walk then conserves `T + V` up to the
+/// integration error.
 const ENERGY_DRIFT_TOL: f64 = 1e-9;
-/// Largest energy-audit residual allowed per step [J] (the requirement).
+/// Largest energy-audit residual allowed per step [J] (docs/model.md section 7).
 const AUDIT_TOL: f64 = 1e-8;
 
 fn default_start() -> SectionState {

@@ -1,4 +1,4 @@
-"""Cost of the Python front (issue 9, point 5).
+"""Cost of the Python front: what calling vrw from Python adds to the Rust library's work.
 
     target/venv/bin/python python/bench/overhead.py [--rounds 3] [--repeat 15] [--skip-cargo]
 

@@ -394,7 +394,7 @@ fn sweep<'py>(
 /// raises) it sets the library's interrupt flag, so the grid runner stops between points, waits for `work` to
 /// return, discards its partial result and raises the signal's exception.
 fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    vrw::gait::grid::clear_interrupt();
+    vrw::gait::clear_interrupt();
     py.allow_threads(|| {
         std::thread::scope(|scope| {
             let handle = scope.spawn(work);
@@ -403,7 +403,7 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> Py
                 std::thread::sleep(SIGNAL_POLL);
                 if raised.is_none() {
                     if let Err(e) = Python::with_gil(|py| py.check_signals()) {
-                        vrw::gait::grid::interrupt_flag()
+                        vrw::gait::interrupt_flag()
                             .store(true, std::sync::atomic::Ordering::SeqCst);
                         raised = Some(e);
                     }
@@ -412,7 +412,7 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> Py
             let value = handle
                 .join()
                 .map_err(|_| PyRuntimeError::new_err("the computation panicked"));
-            vrw::gait::grid::clear_interrupt();
+            vrw::gait::clear_interrupt();
             match raised {
                 Some(e) => Err(e),
                 None => value,

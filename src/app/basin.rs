@@ -30,7 +30,7 @@ pub fn default_basin_range(config: &Config, coordinate: Coordinate, at: f64) -> 
 }
 
 /// The most grid points along one axis of a basin.
-pub const MAX_BASIN_POINTS: usize = 2000;
+pub(crate) const MAX_BASIN_POINTS: usize = 2000;
 
 /// What `vrw basin` runs.
 #[derive(Debug, Clone)]

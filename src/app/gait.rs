@@ -56,12 +56,12 @@ pub struct GaitSummary {
 /// The smallest Newton tolerance `vrw gait` accepts: the step map is computed to about 1e-13 (integration
 /// and event-location tolerances, rounding over a step of thousands of solves), so a smaller
 /// `max |P(s) - s|` cannot be reached reliably.
-pub const MIN_GAIT_TOLERANCE: f64 = 1e-13;
+pub(crate) const MIN_GAIT_TOLERANCE: f64 = 1e-13;
 
 /// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
 /// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
 /// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
-/// ([`write_gait_period`]).
+/// (`write_gait_period`).
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let summary = compute_gait(job)?;
     in_run(&job.out_dir, "gait", |run| {

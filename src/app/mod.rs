@@ -18,14 +18,12 @@ pub use basin::{default_basin_range, run_basin, BasinJob, BasinSummary};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
 };
-pub use gait::{
-    compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
-};
+pub use gait::{compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary};
 pub use map::{run_map, MapJob, MapSummary};
 pub use orbit::{run_orbit, OrbitJob, OrbitSummary};
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
-    DEFAULT_SAMPLE_DT, ENERGY_RESIDUAL_WARNING, MIN_SAMPLE_DT, SUMMARY_STEPS, SUMMARY_WARNINGS,
+    DEFAULT_SAMPLE_DT,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 
@@ -146,7 +144,7 @@ fn check_interrupted(done: usize, total: usize, kept: &'static str) -> Result<()
 
 /// The configuration of the second route for a result computed with `config`: the other integrator, and the
 /// route's name.
-pub fn second_route_config(config: &Config) -> (Config, String) {
+pub(crate) fn second_route_config(config: &Config) -> (Config, String) {
     let mut second = config.clone();
     second.solver.integrator = config.solver.integrator.other();
     let route = format!("integrator = {}", second.solver.integrator);

@@ -18,16 +18,14 @@ use crate::walk::{simulate_streaming, SectionState, StepReport, Trajectory};
 use super::{in_run, AppError};
 use crate::output::manifest::RunDir;
 
-pub use crate::walk::ENERGY_RESIDUAL_WARNING;
-
 /// The smallest trajectory sampling interval `vrw simulate` accepts \[s\].
-pub const MIN_SAMPLE_DT: f64 = 1e-6;
+pub(crate) const MIN_SAMPLE_DT: f64 = 1e-6;
 
 /// `summary.json` keeps the records of the last this many steps; `steps.csv` has every step.
-pub const SUMMARY_STEPS: usize = 1000;
+pub(crate) const SUMMARY_STEPS: usize = 1000;
 
 /// `summary.json` keeps the first this many warnings and counts the rest.
-pub const SUMMARY_WARNINGS: usize = 100;
+pub(crate) const SUMMARY_WARNINGS: usize = 100;
 /// Default sampling interval of `trajectory.csv` \[s\].
 pub const DEFAULT_SAMPLE_DT: f64 = 0.005;
 
@@ -53,7 +51,7 @@ pub struct SimulateJob {
 }
 
 /// `summary.json`: the parameters used, how the run ended, aggregates over every step, and the records of the
-/// last [`SUMMARY_STEPS`] steps (`steps.csv` has every step).
+/// last `SUMMARY_STEPS` steps (`steps.csv` has every step).
 #[derive(Debug, Clone, Serialize)]
 pub struct SimulateSummary {
     /// Version of vrw that produced the file.
@@ -83,11 +81,11 @@ pub struct SimulateSummary {
     /// Files written to the output directory.
     pub files: Vec<String>,
     /// What may make the numbers untrustworthy (e.g. a step whose energy residual exceeds
-    /// [`ENERGY_RESIDUAL_WARNING`]); the first [`SUMMARY_WARNINGS`] of them.
+    /// `ENERGY_RESIDUAL_WARNING`); the first `SUMMARY_WARNINGS` of them.
     pub warnings: Vec<String>,
     /// Number of warnings, including those not listed.
     pub warnings_total: usize,
-    /// The most step records `steps` holds ([`SUMMARY_STEPS`]).
+    /// The most step records `steps` holds (`SUMMARY_STEPS`).
     pub steps_limit: usize,
     /// Records of the last `min(steps_completed, steps_limit)` steps, in order; `steps.csv` has every step.
     pub steps: Vec<StepReport>,
@@ -217,7 +215,7 @@ pub(super) fn simulate_into(
 
 /// The walk of [`run_simulate`] without writing anything (`job.out_dir` and `job.trajectory` are not used),
 /// for other fronts (the Python binding): the summary with **every** step record (not only the last
-/// [`SUMMARY_STEPS`]), and the trajectory sampled every `job.sample_dt` if `record_trajectory`. It is held in
+/// `SUMMARY_STEPS`), and the trajectory sampled every `job.sample_dt` if `record_trajectory`. It is held in
 /// memory, so it suits runs of moderate length.
 pub fn compute_simulation(
     job: &SimulateJob,
@@ -393,7 +391,7 @@ mod tests {
             SimulateSummary::new(&job(dir.path(), 1, false), default_initial(&config));
         let mut last = VecDeque::new();
         assert_eq!(summary.add_step(&report, &mut last), Vec::<String>::new());
-        report.energy.residual = 10.0 * ENERGY_RESIDUAL_WARNING;
+        report.energy.residual = 10.0 * crate::walk::ENERGY_RESIDUAL_WARNING;
         let warning = summary.add_step(&report, &mut last);
         assert!(warning[0].contains("energy residual 1e-5 J"), "{warning:?}");
         report.energy.residual = f64::NAN;

@@ -102,7 +102,7 @@ fn interrupt_flag() -> Arc<AtomicBool> {
     let flag = Arc::new(AtomicBool::new(false));
     let handler_flag = Arc::clone(&flag);
     let installed = ctrlc::set_handler(move || {
-        vrw::gait::grid::interrupt_flag().store(true, Ordering::SeqCst);
+        vrw::gait::interrupt_flag().store(true, Ordering::SeqCst);
         if handler_flag.swap(true, Ordering::SeqCst) {
             std::process::exit(130);
         }

@@ -5,13 +5,13 @@
 //!
 //! - `gait`: a section state comes within `tolerance` of one of the gait's section states (largest coordinate
 //!   difference; for a period-k gait any of its `k` states);
-//! - `other`: the returns repeat with a period `k <= MAX_PERIOD` to [`SETTLED_TOL`] away from the gait: the
+//! - `other`: the returns repeat with a period `k <= MAX_PERIOD` to `SETTLED_TOL` away from the gait: the
 //!   walk settled on another attractor (its period is kept);
 //! - the walk fails: the failure kind (`rolled_back`, `fell`, `stalled`, `chatter`, `rear_leg_in_contact`, ...);
 //! - `invalid_start`: the point is not a section state (`L2` outside `(0, L0]`, `thetadot <= 0`, ...);
 //! - `undecided`: none of these within `max_steps` steps.
 //!
-//! The grid runs on the [`super::grid`] runner, one row per value of the second coordinate (every start is
+//! The grid runs on the `grid` runner, one row per value of the second coordinate (every start is
 //! independent, so nothing is handed along a row).
 
 use serde::Serialize;
@@ -24,7 +24,7 @@ use crate::params::SolverOptions;
 use crate::walk::{SectionState, Walker};
 
 /// Returns that repeat to within this (largest coordinate difference over the last returns) have settled.
-pub const SETTLED_TOL: f64 = 1e-7;
+pub(crate) const SETTLED_TOL: f64 = 1e-7;
 
 /// A section coordinate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -42,10 +42,11 @@ pub enum Coordinate {
 
 impl Coordinate {
     /// All three, in the section's order.
-    pub const ALL: [Coordinate; 3] = [Coordinate::L2, Coordinate::ThetaDot, Coordinate::L2Dot];
+    pub(crate) const ALL: [Coordinate; 3] =
+        [Coordinate::L2, Coordinate::ThetaDot, Coordinate::L2Dot];
 
     /// Index into `SectionState::to_array`.
-    pub fn index(self) -> usize {
+    pub(crate) fn index(self) -> usize {
         match self {
             Coordinate::L2 => 0,
             Coordinate::ThetaDot => 1,
@@ -63,7 +64,7 @@ impl Coordinate {
     }
 
     /// Axis label with its unit.
-    pub fn label(self) -> &'static str {
+    pub(crate) fn label(self) -> &'static str {
         match self {
             Coordinate::L2 => "L2 [m]",
             Coordinate::ThetaDot => "dθ/dt [rad/s]",
@@ -97,7 +98,7 @@ pub struct Axis {
 
 impl Axis {
     /// The `i`-th value.
-    pub fn value(&self, i: usize) -> f64 {
+    pub(crate) fn value(&self, i: usize) -> f64 {
         self.from + (self.to - self.from) * (i as f64 / (self.points - 1) as f64)
     }
 }
@@ -160,7 +161,7 @@ pub struct BasinPoint {
 }
 
 /// Walk from `start` until its outcome is known (see the module documentation).
-pub fn classify(
+pub(crate) fn classify(
     model: &Model,
     opts: &SolverOptions,
     gait: &Gait,

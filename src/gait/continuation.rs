@@ -2,18 +2,18 @@
 //! family ends (docs/model.md section 6).
 //!
 //! A continuation step from the gait `s0` at `v0` to `v1` is accepted only if Newton's method from `s0` converges
-//! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within [`SAME_GAIT_TOL`]).
+//! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within `SAME_GAIT_TOL`).
 //! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
 //! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved (and the
 //! step after a failure that works halves the next, which bisects toward an end), so a family is followed in
-//! shrinking steps until it is reached or its end is bracketed to [`PARAM_TOL`]. Where Newton's method fails at
-//! the finest step, or [`WALK_AFTER_FAILURES`] times in a row (and every [`WALK_AFTER_FAILURES`] failures after
+//! shrinking steps until it is reached or its end is bracketed to `PARAM_TOL`. Where Newton's method fails at
+//! the finest step, or `WALK_AFTER_FAILURES` times in a row (and every `WALK_AFTER_FAILURES` failures after
 //! that), steps are also tried by walking instead
-//! ([`Continuation::walk_step`]), since the step map is only piecewise smooth. A family of period-k gaits is
-//! followed the same way, as fixed points of `P^k` ([`Continuation::with_period`]).
+//! (`Continuation::walk_step`), since the step map is only piecewise smooth. A family of period-k gaits is
+//! followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
 //!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
-//! family at the first parameter value it does not reach ([`END_WALK_STEPS`] steps). The walk fails (falls,
+//! family at the first parameter value it does not reach (`END_WALK_STEPS` steps). The walk fails (falls,
 //! rolls back, stalls, the rear leg is not relocked, ...), settles on another gait of any period up to
 //! [`MAX_PERIOD`] (a branch switch), or does neither, in which case the end is reported as unconfirmed. Newton's
 //! method failing from a neighbour is never by itself taken for "no gait".
@@ -22,7 +22,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::limit_cycle::{solve_fixed_point, FixedPoint, GaitOptions};
-pub use super::periodicity::SAME_GAIT_TOL;
+pub(crate) use super::periodicity::SAME_GAIT_TOL;
 use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
@@ -30,27 +30,27 @@ use crate::params::Config;
 use crate::walk::{SectionState, Walker};
 
 /// Tolerance of every threshold in the swept parameter.
-pub const PARAM_TOL: f64 = 1e-6;
+pub(crate) const PARAM_TOL: f64 = 1e-6;
 
 /// Newton iterations allowed in one continuation step (a step that needs more is halved instead).
-pub const STEP_NEWTON_ITERATIONS: usize = 8;
+pub(crate) const STEP_NEWTON_ITERATIONS: usize = 8;
 
 /// Steps a walk may take to settle on a gait in a continuation step by walking.
-pub const SETTLE_STEPS: usize = 200;
+pub(crate) const SETTLE_STEPS: usize = 200;
 
 /// Most steps one [`Continuation::follow`] may try by walking (each walks up to twice [`SETTLE_STEPS`] steps):
 /// where only walking carries the family on, it is given up after these, as after [`MAX_FOLLOW_STEPS`].
-pub const MAX_FOLLOW_WALKS: usize = 60;
+pub(crate) const MAX_FOLLOW_WALKS: usize = 60;
 
 /// A walk has settled when two successive section states differ by less than this.
-pub const SETTLE_TOL: f64 = 1e-11;
+pub(crate) const SETTLE_TOL: f64 = 1e-11;
 /// Most continuation steps (verified or failed) one [`Continuation::follow`] may try. Following a family to a
 /// neighbouring value, or to its end bracketed to [`PARAM_TOL`], takes a few dozen; approaching an end where
 /// the steps Newton's method takes shrink with the distance to it (the wheel about to roll back, e.g. at
 /// `k = 761.311031 N/m` for `c = 50`) takes about four steps per halving, 100 to 150 from a grid interval of
 /// 20; a family that only advances in ever tinier steps without end is given up rather than followed for
 /// hours.
-pub const MAX_FOLLOW_STEPS: usize = 200;
+pub(crate) const MAX_FOLLOW_STEPS: usize = 200;
 
 /// After Newton's method fails this many continuation steps in a row (each half the one before), steps are
 /// also tried by walking ([`Continuation::walk_step`]): near a border of the map's smooth pieces (a DLS
@@ -60,13 +60,13 @@ pub const MAX_FOLLOW_STEPS: usize = 200;
 /// While walking has not yet carried the family on, a walk that fails is tried again only after as many more
 /// Newton failures (each halving the step): most ends (the wheel rolls back, a fold) cannot be walked past
 /// either, and a walk per bisection step was a fifth of a map's evaluations.
-pub const WALK_AFTER_FAILURES: usize = 3;
+pub(crate) const WALK_AFTER_FAILURES: usize = 3;
 
 /// A real Floquet multiplier this close to +1 at the last gait of a family marks a fold.
-pub const FOLD_TOL: f64 = 0.05;
+pub(crate) const FOLD_TOL: f64 = 0.05;
 
 /// Steps walked from the last gait of a family just past its end, looking for the physical cause.
-pub const END_WALK_STEPS: usize = 300;
+pub(crate) const END_WALK_STEPS: usize = 300;
 
 /// Largest coordinate difference between two section states: [`SectionState::distance`], kept under this
 /// name for callers outside the crate.
@@ -77,7 +77,7 @@ pub fn section_distance(a: &SectionState, b: &SectionState) -> f64 {
 /// Follows gait families of one configuration along one parameter: fixed points of the step map `P`, or of
 /// `P^k` for a family of period-k gaits ([`Continuation::with_period`]).
 #[derive(Debug, Clone)]
-pub struct Continuation<'a> {
+pub(crate) struct Continuation<'a> {
     config: &'a Config,
     param: &'a str,
     options: GaitOptions,
@@ -106,7 +106,7 @@ pub enum Followed {
         /// The first value it does not reach.
         beyond: f64,
     },
-    /// Neither within [`MAX_FOLLOW_STEPS`] steps (or [`MAX_FOLLOW_WALKS`] walking steps): the family was
+    /// Neither within `MAX_FOLLOW_STEPS` steps (or `MAX_FOLLOW_WALKS` walking steps): the family was
     /// followed to `last` and given up there.
     GaveUp {
         /// The last point of the family reached.
@@ -119,7 +119,7 @@ pub enum Followed {
 /// What happens just past the end of a family.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
-pub enum EndCause {
+pub(crate) enum EndCause {
     /// The walk from the family's last gait fails: `failure` is its kind (`rolled_back`, `fell`, ...).
     WalkFails {
         /// Failure kind.
@@ -153,7 +153,11 @@ pub enum EndCause {
 
 impl<'a> Continuation<'a> {
     /// Continuation of `param` in `config`, with Newton settings from `options`.
-    pub fn new(config: &'a Config, param: &'a str, options: &GaitOptions) -> Continuation<'a> {
+    pub(crate) fn new(
+        config: &'a Config,
+        param: &'a str,
+        options: &GaitOptions,
+    ) -> Continuation<'a> {
         Continuation {
             config,
             param,
@@ -168,7 +172,7 @@ impl<'a> Continuation<'a> {
     }
 
     /// The same continuation for a family of period-`k` gaits: fixed points of `P^k` (`k = 0` is taken as 1).
-    pub fn with_period(self, k: usize) -> Continuation<'a> {
+    pub(crate) fn with_period(self, k: usize) -> Continuation<'a> {
         Continuation {
             period: k.max(1),
             ..self
@@ -186,7 +190,7 @@ impl<'a> Continuation<'a> {
     }
 
     /// The fixed point at `value` by Newton's method from `start` (no transient).
-    pub fn solve(
+    pub(crate) fn solve(
         &self,
         value: f64,
         start: &SectionState,
@@ -199,7 +203,7 @@ impl<'a> Continuation<'a> {
 
     /// One verified continuation step from `from` to `value` by Newton's method, there and back (see the module
     /// documentation).
-    pub fn step(
+    pub(crate) fn step(
         &self,
         from: &FamilyPoint,
         value: f64,
@@ -216,7 +220,7 @@ impl<'a> Continuation<'a> {
     /// The same step by walking, where Newton's method fails (the step map is only piecewise smooth): the wheel
     /// walked from the gait at `value` settles on a gait, and walked from that one at `from.value` comes back to
     /// `from` (a stable family followed the way an experiment would).
-    pub fn walk_step(&self, from: &FamilyPoint, value: f64) -> Option<FamilyPoint> {
+    pub(crate) fn walk_step(&self, from: &FamilyPoint, value: f64) -> Option<FamilyPoint> {
         let forward = self.settle(value, &from.section)?;
         let back = self.settle(from.value, &forward)?;
         (back.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
@@ -258,7 +262,12 @@ impl<'a> Continuation<'a> {
     /// step that works lets the next one double, or halve right after a failure (bisecting toward the end). At
     /// most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
     /// ([`Followed::GaveUp`]).
-    pub fn follow(&self, from: FamilyPoint, target: f64, guess: Option<&DMatrix<f64>>) -> Followed {
+    pub(crate) fn follow(
+        &self,
+        from: FamilyPoint,
+        target: f64,
+        guess: Option<&DMatrix<f64>>,
+    ) -> Followed {
         let mut current = from;
         let mut steps = 0;
         // The Newton matrix and the parameter value where it was computed.
@@ -348,7 +357,7 @@ impl<'a> Continuation<'a> {
 
     /// What happens at `beyond`, just past the end of the family whose last gait is `last`: walk from it (see
     /// [`EndCause`]).
-    pub fn end_cause(&self, last: &FamilyPoint, beyond: f64) -> EndCause {
+    pub(crate) fn end_cause(&self, last: &FamilyPoint, beyond: f64) -> EndCause {
         let (c, model) = match self.configured_at(beyond) {
             Ok(x) => x,
             Err(message) => {

@@ -28,17 +28,8 @@
 //! run returns, minus the rows' tails. A job that sees [`interrupted`] after the runner keeps those points and
 //! says it was interrupted.
 //!
-//! ```
-//! use vrw::gait::grid::{run_rows, Cell, Evaluated};
-//!
-//! // A running sum along each row: the carry is the sum so far.
-//! let rows = run_rows(2, 25, |cell, from: Option<(usize, &f64)>| {
-//!     let sum = from.map_or(0.0, |(_, s)| *s) + (cell.row * 100 + cell.col) as f64;
-//!     Evaluated { point: (cell, sum), carry: Some(sum) }
-//! });
-//! assert_eq!(rows.len(), 2);
-//! assert_eq!(rows[1][24], (Cell { row: 1, col: 24 }, 2800.0));
-//! ```
+//! The example of a running sum along each row is the test `running_sum_along_rows` below (the runner is
+//! internal to the crate, so it is not a doc test).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -64,11 +55,11 @@ pub fn clear_interrupt() {
 }
 
 /// Stride of the coarse continuation pass along a row.
-pub const COARSE_STRIDE: usize = 10;
+pub(crate) const COARSE_STRIDE: usize = 10;
 
 /// A point's place in the grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Cell {
+pub(crate) struct Cell {
     /// Row index, from 0.
     pub row: usize,
     /// Column index along the row, from 0.
@@ -77,7 +68,7 @@ pub struct Cell {
 
 /// The result of one point's evaluation.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Evaluated<P, C> {
+pub(crate) struct Evaluated<P, C> {
     /// The point's result, returned by [`run_rows`].
     pub point: P,
     /// What later points of the row may continue from; `None` if nothing (they then start afresh).
@@ -275,5 +266,19 @@ mod tests {
         );
         assert!(run_rows(0, 5, eval).is_empty());
         assert_eq!(run_rows(1, 0, eval), vec![Vec::<Cell>::new()]);
+    }
+
+    #[test]
+    fn running_sum_along_rows() {
+        // A running sum along each row: the carry is the sum so far.
+        let rows = run_rows(2, 25, |cell, from: Option<(usize, &f64)>| {
+            let sum = from.map_or(0.0, |(_, s)| *s) + (cell.row * 100 + cell.col) as f64;
+            Evaluated {
+                point: (cell, sum),
+                carry: Some(sum),
+            }
+        });
+        assert_eq!(rows.len(), 2);
+        assert_eq!(rows[1][24], (Cell { row: 1, col: 24 }, 2800.0));
     }
 }

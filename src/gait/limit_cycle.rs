@@ -224,7 +224,7 @@ impl std::fmt::Display for Stability {
 
 /// Newton stops after this many consecutive iterations with a freshly computed `DP` that fail to halve the
 /// residual.
-pub const MAX_POOR_ITERATIONS: usize = 3;
+pub(crate) const MAX_POOR_ITERATIONS: usize = 3;
 
 /// Largest entry of `|v|`.
 fn norm(v: &DVector<f64>) -> f64 {
@@ -233,7 +233,7 @@ fn norm(v: &DVector<f64>) -> f64 {
 
 /// A fixed point of the step map, without its stability.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FixedPoint {
+pub(crate) struct FixedPoint {
     /// `s*`.
     pub section: SectionState,
     /// The step from `s*` (its report carries the DLS indicators).
@@ -278,7 +278,7 @@ pub fn find_gait(
 }
 
 /// The fixed point alone (no Jacobian at the end): what threshold searches need.
-pub fn solve_fixed_point(
+pub(crate) fn solve_fixed_point(
     map: &StepMap,
     initial: &SectionState,
     options: &GaitOptions,

@@ -1,17 +1,17 @@
 //! Maps over two parameters: the gait at every point of an `x` by `y` grid, and the threshold curves across
 //! the plane (docs/model.md section 6).
 //!
-//! **Gaits.** Every row (fixed `y`) is a sweep along `x` with the sweep's rules ([`super::sweep::gait_rows`] on
-//! the [`super::grid`] runner): continuation from the left neighbour, a search from the initial state where the
+//! **Gaits.** Every row (fixed `y`) is a sweep along `x` with the sweep's rules (`gait_rows` on
+//! the `grid` runner): continuation from the left neighbour, a search from the initial state where the
 //! family ends, backward fill and family numbers. Rows run in parallel and the map is bitwise identical for any
 //! number of threads. So row `j` of a map is exactly the sweep along `x` at `y_j`.
 //!
 //! **Curves.** The threshold curves (`lambda_4+ = 0`, `lambda_2+ = 0`, `lambda_I4 = 0`, loss of stability, the
 //! end of existence, branch switches, folds) are never read off the grid. Every row is searched for the 1-D
-//! thresholds of [`find_thresholds`] (refined to [`super::thresholds::PARAM_TOL`] in `x`; the family ends come
+//! thresholds of [`find_thresholds`] (refined to `PARAM_TOL` in `x`; the family ends come
 //! from the continuations that found the row's gaits, [`super::sweep::SweepPoint::attempts`]), and so are the
 //! columns [`curve_columns`] picks, at most `max_columns` of them, evenly spread with both ends (fixed `x`,
-//! refined to [`super::thresholds::PARAM_TOL`] in `y`; the column's gaits are those of the rows, and neighbours
+//! refined to `PARAM_TOL` in `y`; the column's gaits are those of the rows, and neighbours
 //! along the column belong to one family when a verified continuation step in `y` connects them). Each crossing
 //! lies on one edge of the grid. Within each cell between two neighbouring rows and two neighbouring refined
 //! columns, the crossings of one curve on its edges are joined (two crossings: one segment, as in marching
@@ -32,7 +32,7 @@ use crate::params::{Config, ConfigError};
 use crate::walk::SectionState;
 
 /// The most values along one axis of a map.
-pub const MAX_MAP_AXIS_POINTS: usize = 2000;
+pub(crate) const MAX_MAP_AXIS_POINTS: usize = 2000;
 
 /// What to map: two parameters and their ranges.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -47,7 +47,7 @@ impl MapSpec {
     /// Check the specification: each axis as a sweep ([`SweepSpec::validate`]), two different parameters, at
     /// most [`MAX_MAP_AXIS_POINTS`] values per axis, and a valid configuration at the four corners (the rules
     /// that join two keys are linear inequalities, so the whole rectangle is then valid).
-    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+    pub(crate) fn validate(&self, config: &Config) -> Result<(), ConfigError> {
         self.x.validate(config)?;
         self.y.validate(config)?;
         let invalid = |key: &str, value: String, reason: String| ConfigError::InvalidValue {
@@ -210,7 +210,7 @@ pub struct MapCurves {
 }
 
 /// The curve a 1-D threshold belongs to.
-pub fn curve_name(threshold: &str) -> &str {
+pub(crate) fn curve_name(threshold: &str) -> &str {
     match threshold {
         "gait_lost" | "gait_found" => "existence_end",
         other => other,

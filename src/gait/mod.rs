@@ -1,24 +1,24 @@
 //! Gait analysis (docs/model.md section 6): the step map, limit cycles and their stability, the grid runner
-//! ([`grid`]) behind parameter sweeps and maps with continuation, and the parameter values where the DLS
+//! (`grid`) behind parameter sweeps and maps with continuation, and the parameter values where the DLS
 //! indicators change sign or the gait is lost.
 
 pub mod basin;
 pub mod continuation;
-pub mod grid;
-pub mod limit_cycle;
+pub(crate) mod grid;
+pub(crate) mod limit_cycle;
 pub mod map;
 pub mod orbit;
 pub mod period_k;
-pub mod periodicity;
-pub mod step_map;
-pub mod sweep;
-pub mod thresholds;
+pub(crate) mod periodicity;
+pub(crate) mod step_map;
+pub(crate) mod sweep;
+pub(crate) mod thresholds;
 
-pub use limit_cycle::{
-    find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
-};
+pub use grid::{clear_interrupt, interrupt_flag, interrupted};
+pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions, Stability};
 pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
-pub use sweep::{gait_rows, sweep, sweep_values, FollowAttempt, GaitRow, SweepPoint, SweepSpec};
+pub(crate) use sweep::sweep_values;
+pub use sweep::{sweep, FollowAttempt, SweepPoint, SweepSpec};
 pub use thresholds::{find_thresholds, SecondRoute, Threshold, SECOND_ROUTE_TOL};

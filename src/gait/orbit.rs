@@ -3,10 +3,10 @@
 //!
 //! At each parameter value the wheel walks `transient` steps, then `steps` more whose section states and step
 //! reports are kept (the points of the diagram). Each value starts from where the walk at the value it continues
-//! ended, on the [`super::grid`] runner's schedule (every [`super::grid::COARSE_STRIDE`]-th value in order,
+//! ended, on the `grid` runner's schedule (every `COARSE_STRIDE`-th value in order,
 //! then the values between in parallel), so that the diagram follows an attractor as the parameter changes
 //! instead of jumping between coexisting ones. The first value, and a value after a walk that failed, start
-//! from the job's initial state with [`FRESH_TRANSIENT_FACTOR`] times the transient.
+//! from the job's initial state with `FRESH_TRANSIENT_FACTOR` times the transient.
 //!
 //! The period of the recorded returns ([`super::periodicity::least_period`]) is reported per value: a period-1
 //! gait shows as one point, a period-k gait as `k`, anything else as a cloud.
@@ -22,14 +22,14 @@ use crate::walk::WalkError;
 use crate::walk::{SectionState, StepReport, Walker};
 
 /// A value that does not continue another walks this many times the transient.
-pub const FRESH_TRANSIENT_FACTOR: usize = 4;
+pub(crate) const FRESH_TRANSIENT_FACTOR: usize = 4;
 
 /// The recorded returns repeat with period `k` to within this (largest coordinate difference) for a value to
 /// be reported as period `k`.
-pub const PERIOD_TOL: f64 = 1e-6;
+pub(crate) const PERIOD_TOL: f64 = 1e-6;
 
 /// The largest number of recorded steps per value.
-pub const MAX_ORBIT_STEPS: usize = 100_000;
+pub(crate) const MAX_ORBIT_STEPS: usize = 100_000;
 
 /// What to compute.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -44,7 +44,7 @@ pub struct OrbitSpec {
 
 impl OrbitSpec {
     /// Check the range against `config` (as a sweep's) and the step counts.
-    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+    pub(crate) fn validate(&self, config: &Config) -> Result<(), ConfigError> {
         self.range.validate(config)?;
         if !(1..=MAX_ORBIT_STEPS).contains(&self.steps) {
             return Err(ConfigError::InvalidValue {
@@ -77,7 +77,7 @@ pub struct OrbitColumn {
     /// The recorded steps (their section states, indicators and branches), in order; fewer than asked if the
     /// walk failed while recording.
     pub returns: Vec<StepReport>,
-    /// The least period of the recorded returns (to [`PERIOD_TOL`]), up to [`MAX_PERIOD`]; `None` if they do
+    /// The least period of the recorded returns (to `PERIOD_TOL`), up to [`MAX_PERIOD`]; `None` if they do
     /// not repeat (or the walk failed).
     pub period_k: Option<usize>,
     /// The value whose end state this walk started from (`None`: the initial state).

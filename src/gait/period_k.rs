@@ -3,11 +3,11 @@
 //! Where Newton's method on `P(s) - s` fails but the walk settles, the wheel may walk a gait that repeats every
 //! `k` steps (a period-doubled gait, `k = 2`, for example). The search:
 //!
-//! 1. walks the transient, then [`SETTLE_STEPS`] more steps, keeping their section states (the returns);
+//! 1. walks the transient, then `SETTLE_STEPS` more steps, keeping their section states (the returns);
 //! 2. for each `k = 1 ..= max_period` measures how far the returns are from repeating with period `k`
-//!    (the largest coordinate difference of `s_n` and `s_{n-k}` over the last [`RETURN_WINDOW`] returns);
-//! 3. for the smallest `k` whose distance is below [`RETURN_TOL`] (the walk's period), runs Newton's method
-//!    on `P^k(s) - s` from the last return ([`super::limit_cycle::solve_fixed_point`] on
+//!    (the largest coordinate difference of `s_n` and `s_{n-k}` over the last `RETURN_WINDOW` returns);
+//! 3. for the smallest `k` whose distance is below `RETURN_TOL` (the walk's period), runs Newton's method
+//!    on `P^k(s) - s` from the last return (`solve_fixed_point` on
 //!    [`StepMap::iterated`]);
 //! 4. walks two periods from the fixed point: a periodic walk is back at it after `2k` steps too, otherwise
 //!    the fixed point is an artefact of the section ([`GaitError::SectionIncomplete`], below);
@@ -29,14 +29,13 @@ use super::limit_cycle::{
     find_gait, gait_at, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions,
 };
 use super::periodicity::SAME_GAIT_TOL;
-pub use super::periodicity::{
-    least_period, return_distances, MAX_PERIOD, RETURN_TOL, RETURN_WINDOW,
-};
+pub use super::periodicity::{least_period, MAX_PERIOD};
+pub(crate) use super::periodicity::{return_distances, RETURN_TOL, RETURN_WINDOW};
 use super::step_map::StepMap;
 use crate::walk::{SectionState, Walker};
 
 /// Steps walked after the transient before the period is looked for.
-pub const SETTLE_STEPS: usize = 64;
+pub(crate) const SETTLE_STEPS: usize = 64;
 
 /// The section states of `k` steps from `s` (`s` first), and the reports of those steps.
 fn walk_period(
@@ -121,7 +120,7 @@ pub fn find_periodic_gait(
 /// The period-`k` gait at `fp`, a fixed point of `P^k` (`single` is `P`): steps 4 and 5 of the module
 /// documentation (two periods walked, the least period, `D(P^k)` with the settings of `options`). Also what a
 /// continuation of a period-k family completes its gaits with.
-pub fn periodic_gait_at(
+pub(crate) fn periodic_gait_at(
     single: &StepMap,
     fp: &FixedPoint,
     k: usize,

@@ -9,21 +9,21 @@ use crate::walk::SectionState;
 /// Two fixed points closer than this (largest coordinate difference of `(L2, thetadot, L2dot)`) are the same
 /// gait. Newton converges to `1e-10` in the residual, so one gait found twice agrees to far better than this;
 /// distinct families differ by `1e-3` or more.
-pub const SAME_GAIT_TOL: f64 = 1e-6;
+pub(crate) const SAME_GAIT_TOL: f64 = 1e-6;
 
 /// The longest period searched by default (`vrw gait` and sweeps).
 pub const MAX_PERIOD: usize = 8;
 
 /// Number of recent returns over which a period must hold.
-pub const RETURN_WINDOW: usize = 4;
+pub(crate) const RETURN_WINDOW: usize = 4;
 
 /// A period `k` is tried when the returns repeat with period `k` to within this (largest coordinate
 /// difference of `(L2, thetadot, L2dot)`; Newton's method then converges from there).
-pub const RETURN_TOL: f64 = 1e-3;
+pub(crate) const RETURN_TOL: f64 = 1e-3;
 
 /// `d_k` for `k = 1 ..= max_period`: the largest coordinate difference between `returns[n]` and
 /// `returns[n - k]` over the last [`RETURN_WINDOW`] returns `n` (`INFINITY` where there are too few returns).
-pub fn return_distances(returns: &[SectionState], max_period: usize) -> Vec<f64> {
+pub(crate) fn return_distances(returns: &[SectionState], max_period: usize) -> Vec<f64> {
     (1..=max_period)
         .map(|k| {
             if returns.len() < k + RETURN_WINDOW {

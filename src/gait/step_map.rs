@@ -62,7 +62,7 @@ impl<'m> StepMap<'m> {
     }
 
     /// The solver options.
-    pub fn options(&self) -> &SolverOptions {
+    pub(crate) fn options(&self) -> &SolverOptions {
         &self.opts
     }
 
@@ -72,7 +72,7 @@ impl<'m> StepMap<'m> {
     }
 
     /// The model.
-    pub fn model(&self) -> &'m Model {
+    pub(crate) fn model(&self) -> &'m Model {
         self.model
     }
 
@@ -89,7 +89,7 @@ impl<'m> StepMap<'m> {
     }
 
     /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.
-    pub fn free_coordinates(&self) -> &'static [usize] {
+    pub(crate) fn free_coordinates(&self) -> &'static [usize] {
         if self.model.params().rigid_legs {
             &[1]
         } else {
@@ -143,7 +143,11 @@ impl<'m> StepMap<'m> {
 
     /// Richardson-extrapolated Jacobian `(4 D(h/2) - D(h)) / 3` and an estimate of its error (the largest
     /// entry of `|extrapolated - D(h/2)|`).
-    pub fn jacobian(&self, s: &SectionState, h: f64) -> Result<(DMatrix<f64>, f64), WalkError> {
+    pub(crate) fn jacobian(
+        &self,
+        s: &SectionState,
+        h: f64,
+    ) -> Result<(DMatrix<f64>, f64), WalkError> {
         let coarse = self.central_jacobian(s, h)?;
         let fine = self.central_jacobian(s, h / 2.0)?;
         let extrapolated = (4.0 * &fine - coarse) / 3.0;

@@ -1,4 +1,4 @@
-//! Parameter sweeps with continuation (MODEL.md section 6, the paper's Fig. 2).
+//! Parameter sweeps with continuation (docs/model.md section 6, the paper's Fig. 2).
 //!
 //! Every point follows its neighbour's gait family in verified continuation steps (see
 //! [`super::continuation`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach
@@ -28,7 +28,7 @@ use crate::params::{Config, ConfigError, SolverOptions};
 use crate::walk::SectionState;
 
 /// The most points a sweep may have.
-pub const MAX_SWEEP_POINTS: usize = 100_000;
+pub(crate) const MAX_SWEEP_POINTS: usize = 100_000;
 
 /// What to sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -39,14 +39,14 @@ pub struct SweepSpec {
     pub from: f64,
     /// Last value.
     pub to: f64,
-    /// Number of values, evenly spaced, ends included (2 to [`MAX_SWEEP_POINTS`]).
+    /// Number of values, evenly spaced, ends included (2 to `MAX_SWEEP_POINTS`).
     pub points: usize,
 }
 
 impl SweepSpec {
     /// Check the specification against a configuration: a known numeric key, two different finite ends, at
     /// least 2 points, and a configuration that is valid with the parameter at either end.
-    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+    pub(crate) fn validate(&self, config: &Config) -> Result<(), ConfigError> {
         config.get_numeric(&self.param)?;
         let invalid = |value: String, reason: &str| ConfigError::InvalidValue {
             key: format!("sweep {}", self.param),
@@ -116,7 +116,7 @@ pub struct SweepPoint {
 }
 
 /// A continuation that did not reach its target: where it started, where it was going and where it led (the
-/// family's end bracketed to [`super::continuation::PARAM_TOL`], or given up). [`Continuation::follow`] is a
+/// family's end bracketed to `PARAM_TOL`, or given up). `Continuation::follow` is a
 /// deterministic function of its start, target and Newton matrix, so a threshold search that would follow the
 /// same family from the same start to the same target takes this result as it is.
 #[derive(Debug, Clone, PartialEq)]
@@ -132,7 +132,7 @@ pub struct FollowAttempt {
 impl SweepPoint {
     /// The recorded continuation toward this point from `from` (same value and bitwise the same section state),
     /// if there is one.
-    pub fn attempt_from(&self, from: &FamilyPoint) -> Option<&Followed> {
+    pub(crate) fn attempt_from(&self, from: &FamilyPoint) -> Option<&Followed> {
         self.attempts
             .iter()
             .find(|a| a.from == *from && a.target == self.value)
@@ -143,7 +143,7 @@ impl SweepPoint {
 /// The gait at `value`, followed from `previous` (a neighbouring gait at another value, with its index) in
 /// verified continuation steps if given; if the family does not reach `value`, searched from `initial` with the
 /// full transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
-pub fn gait_at_value(
+pub(crate) fn gait_at_value(
     config: &Config,
     param: &str,
     value: f64,
@@ -262,8 +262,6 @@ fn continuable(point: &SweepPoint) -> Option<&Gait> {
     point.gait.as_ref()
 }
 
-pub use super::grid::COARSE_STRIDE;
-
 /// Points without a gait just left of a gait (or of a stretch of gaits) may be misses of the search from the
 /// initial state: follow each such gait backwards, from right to left, and fill in the points its family
 /// reaches. Sequential and in a fixed order, so deterministic.
@@ -353,7 +351,7 @@ pub(crate) fn number_families(
 
 /// One row of gait points: a configuration and the values one of its parameters takes along the row.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GaitRow {
+pub(crate) struct GaitRow {
     /// Parameters and solver options (`param` is overridden point by point).
     pub config: Config,
     /// The numeric key that varies along the row ([`Config::numeric_keys`]).
@@ -408,7 +406,7 @@ pub fn gait_rows(
 }
 
 /// Sweep `spec.param` over its range with continuation, calling `progress` after each point: one row of
-/// [`gait_rows`].
+/// `gait_rows`.
 pub fn sweep(
     config: &Config,
     spec: &SweepSpec,
@@ -429,7 +427,7 @@ pub fn sweep(
 
 /// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
 /// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of [`gait_rows`].
-pub fn sweep_values(
+pub(crate) fn sweep_values(
     config: &Config,
     param: &str,
     values: &[f64],

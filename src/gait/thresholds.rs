@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 
-pub use super::continuation::PARAM_TOL;
+pub(crate) use super::continuation::PARAM_TOL;
 use super::continuation::{Continuation, EndCause, FamilyPoint, Followed};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::periodicity::SAME_GAIT_TOL;
@@ -61,7 +61,7 @@ pub struct Threshold {
 }
 
 /// Two routes agree on a threshold when their values differ by at most this: each value is the middle of a
-/// bracket at most [`PARAM_TOL`] wide.
+/// bracket at most `PARAM_TOL` wide.
 pub const SECOND_ROUTE_TOL: f64 = 2.0 * PARAM_TOL;
 
 /// A threshold searched again by a second route: the whole computation (gaits, continuation, thresholds) run
@@ -85,7 +85,7 @@ pub struct SecondRoute {
 impl SecondRoute {
     /// `threshold` checked against `found`, the thresholds the second route `route` found along the same line:
     /// the one between the same grid points closest in value (by name first) is its counterpart.
-    pub fn check<'a>(
+    pub(crate) fn check<'a>(
         threshold: &Threshold,
         found: impl IntoIterator<Item = &'a Threshold>,
         route: &str,

@@ -8,7 +8,7 @@ use nalgebra::SVector;
 use super::tolerances::scaled_rms;
 use super::{IntegrationError, OdeSystem, Tolerances};
 
-/// Work counters of a [`Dopri5`](super::Dopri5) or [`Dop853`](super::Dop853) solver, for benchmarks and snapshot tests.
+/// Work counters of a [`Dopri5`](super::Dopri5) or `Dop853` solver, for benchmarks and snapshot tests.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Stats {
     /// Accepted steps.

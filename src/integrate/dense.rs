@@ -9,7 +9,7 @@ use nalgebra::SVector;
 /// `y(t) = c0 + θ (c1 + (1-θ) (c2 + θ (c3 + (1-θ) (c4 + θ (c5 + (1-θ) (c6 + θ c7))))))`, truncated after the
 /// last coefficient the method has: five for [`Dopri5`](super::Dopri5) (`c0 = y0`, `c1 = Δ = y1 - y0`, `c2 = h k1 - Δ`,
 /// `c3 = Δ - h k7 - c2`, `c4 = h Σ d_i k_i`: Shampine's 4th-order extension, `contd5` of `dopri5`), eight for
-/// [`Dop853`](super::Dop853) (its 7th-order extension, `contd8` of `dop853`). It matches y0, y1, f0 and f1.
+/// `Dop853` (its 7th-order extension, `contd8` of `dop853`). It matches y0, y1, f0 and f1.
 #[derive(Debug, Clone)]
 pub struct DenseStep<const N: usize> {
     t0: f64,
@@ -48,7 +48,7 @@ impl<const N: usize> DenseStep<N> {
     ///
     /// Returns `y0` exactly at `t0` and `y1` exactly at `t1`. Outside the step the polynomial is
     /// extrapolated, which is not accurate.
-    pub fn eval(&self, t: f64) -> SVector<f64, N> {
+    pub(crate) fn eval(&self, t: f64) -> SVector<f64, N> {
         if t == self.t1 {
             return self.y1;
         }

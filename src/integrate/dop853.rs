@@ -87,13 +87,18 @@ fn tableau() -> &'static Tableau {
 /// Driven like [`super::Dopri5`]: [`step`](Self::step) returns a [`DenseStep`]; after an event,
 /// [`restart`](Self::restart). Its time, state and counters are read through [`super::Integrator`].
 #[derive(Debug, Clone)]
-pub struct Dop853<const N: usize> {
+pub(crate) struct Dop853<const N: usize> {
     core: Core<N>,
 }
 
 impl<const N: usize> Dop853<N> {
     /// Start at (t0, y0); computes f(t0, y0) and an initial step. Costs two right-hand-side evaluations.
-    pub fn new(sys: &impl OdeSystem<N>, t0: f64, y0: SVector<f64, N>, tol: Tolerances) -> Self {
+    pub(crate) fn new(
+        sys: &impl OdeSystem<N>,
+        t0: f64,
+        y0: SVector<f64, N>,
+        tol: Tolerances,
+    ) -> Self {
         Self {
             core: Core::new(sys, t0, y0, tol, HINIT_ORDER),
         }
@@ -101,7 +106,7 @@ impl<const N: usize> Dop853<N> {
 
     /// Restart at (t, y) with a possibly new vector field: recomputes f and keeps the last accepted step
     /// size as the first trial step (bounded by a fresh initial-step estimate). Two evaluations.
-    pub fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
+    pub(crate) fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
         self.core.restart(sys, t, y, HINIT_ORDER);
     }
 
@@ -117,7 +122,7 @@ impl<const N: usize> Dop853<N> {
     ///
     /// # Panics
     /// If `t_stop` is not after the current time.
-    pub fn step(
+    pub(crate) fn step(
         &mut self,
         sys: &impl OdeSystem<N>,
         t_stop: f64,

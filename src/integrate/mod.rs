@@ -1,8 +1,8 @@
 //! Adaptive Dormand–Prince integration with dense output and event-root location.
 //!
 //! Two explicit Runge–Kutta pairs, chosen by [`Method`] (the `integrator` key of a configuration) and driven
-//! through [`Integrator`]: [`Dop853`] (order 8, the default) and [`Dopri5`] (order 5). Both hand out each
-//! accepted step as a [`DenseStep`], on which the caller locates events ([`locate_root`]).
+//! through `Integrator`: `Dop853` (order 8, the default) and [`Dopri5`] (order 5). Both hand out each
+//! accepted step as a [`DenseStep`], on which the caller locates events (`locate_root`).
 //!
 //! [`Dopri5`] is the explicit Runge–Kutta pair of Dormand & Prince (1980) used in
 //! local extrapolation mode (the 5th-order solution is propagated, the embedded 4th-order one
@@ -12,14 +12,14 @@
 //! 4th-order continuous extension (the `contd5` dense output of `dopri5`, HNW Sec. II.6).
 //!
 //! # Layout
-//! - this file: the [`OdeSystem`] trait, [`IntegrationError`], the [`Method`] choice and the [`Integrator`]
+//! - this file: the [`OdeSystem`] trait, [`IntegrationError`], the [`Method`] choice and the `Integrator`
 //!   front over both pairs;
 //! - `tolerances`: [`Tolerances`] and the scaled error norm;
 //! - `core`: the stepping state and step-size control both pairs share (trial step, rejection,
 //!   acceptance, restart, starting step) and the work counters [`Stats`];
 //! - `dopri5`, `dop853`: each pair's tableau and step;
 //! - `dense`: the dense output [`DenseStep`] and its interpolation;
-//! - `roots`: [`locate_root`], root location on the dense output.
+//! - `roots`: `locate_root`, root location on the dense output.
 //!
 //! # Why hand-written
 //! The hybrid walk needs (i) fixed-size stack state (`SVector<f64, N>`, N = 11 and larger for
@@ -29,7 +29,7 @@
 //! change (no direction filter), re-reports a root right after a reset, and its problem must be
 //! rebuilt per phase. So this module only integrates one accepted step at a time
 //! ([`Dopri5::step`] returns a [`DenseStep`]); the caller evaluates its event functions on the
-//! dense output and refines a bracketed root with [`locate_root`], which uses Brent's method from
+//! dense output and refines a bracketed root with `locate_root`, which uses Brent's method from
 //! the `roots` crate.
 //!
 //! # References
@@ -57,9 +57,9 @@ mod tolerances;
 use self::core::Core;
 pub use self::core::Stats;
 pub use self::dense::DenseStep;
-pub use self::dop853::Dop853;
+pub(crate) use self::dop853::Dop853;
 pub use self::dopri5::Dopri5;
-pub use self::roots::locate_root;
+pub(crate) use self::roots::locate_root;
 pub use self::tolerances::Tolerances;
 
 /// A first-order system y' = f(t, y).
@@ -94,7 +94,7 @@ pub enum IntegrationError {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
-    /// [`Dop853`]: order 8 with a 7th-order dense output. Default.
+    /// `Dop853`: order 8 with a 7th-order dense output. Default.
     Dop853,
     /// [`Dopri5`]: order 5 with a 4th-order dense output.
     Dopri5,
@@ -102,7 +102,7 @@ pub enum Method {
 
 impl Method {
     /// The other method: the second route for a result computed with this one.
-    pub fn other(self) -> Method {
+    pub(crate) fn other(self) -> Method {
         match self {
             Method::Dop853 => Method::Dopri5,
             Method::Dopri5 => Method::Dop853,
@@ -110,7 +110,7 @@ impl Method {
     }
 
     /// The name of the method (`"dop853"` or `"dopri5"`), as in configurations.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Method::Dop853 => "dop853",
             Method::Dopri5 => "dopri5",
@@ -126,7 +126,7 @@ impl std::fmt::Display for Method {
 
 /// An adaptive integrator of either [`Method`], driven one accepted step at a time.
 #[derive(Debug, Clone)]
-pub enum Integrator<const N: usize> {
+pub(crate) enum Integrator<const N: usize> {
     /// DOP853.
     Dop853(Dop853<N>),
     /// DOPRI5.
@@ -143,7 +143,7 @@ impl<const N: usize> Integrator<N> {
     }
 
     /// Start `method` at (t0, y0) (see [`Dopri5::new`]).
-    pub fn new(
+    pub(crate) fn new(
         method: Method,
         sys: &impl OdeSystem<N>,
         t0: f64,
@@ -160,7 +160,7 @@ impl<const N: usize> Integrator<N> {
     ///
     /// # Errors
     /// As [`Dopri5::step`].
-    pub fn step(
+    pub(crate) fn step(
         &mut self,
         sys: &impl OdeSystem<N>,
         t_stop: f64,
@@ -172,7 +172,7 @@ impl<const N: usize> Integrator<N> {
     }
 
     /// Restart at (t, y), possibly with a new vector field (see [`Dopri5::restart`]).
-    pub fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
+    pub(crate) fn restart(&mut self, sys: &impl OdeSystem<N>, t: f64, y: SVector<f64, N>) {
         match self {
             Integrator::Dop853(s) => s.restart(sys, t, y),
             Integrator::Dopri5(s) => s.restart(sys, t, y),
@@ -180,22 +180,25 @@ impl<const N: usize> Integrator<N> {
     }
 
     /// Work counters.
-    pub fn stats(&self) -> Stats {
+    pub(crate) fn stats(&self) -> Stats {
         self.core().stats
     }
 
     /// Current time \[s\].
-    pub fn t(&self) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn t(&self) -> f64 {
         self.core().t
     }
 
     /// Current state.
-    pub fn y(&self) -> &SVector<f64, N> {
+    #[cfg(test)]
+    pub(crate) fn y(&self) -> &SVector<f64, N> {
         &self.core().y
     }
 
     /// Derivative f(t, y) at the current point (FSAL value).
-    pub fn dy(&self) -> &SVector<f64, N> {
+    #[cfg(test)]
+    pub(crate) fn dy(&self) -> &SVector<f64, N> {
         &self.core().dy
     }
 
@@ -203,7 +206,8 @@ impl<const N: usize> Integrator<N> {
     ///
     /// # Panics
     /// If `t` is outside `[step.t0(), step.t1()]`.
-    pub fn rewind(&mut self, sys: &impl OdeSystem<N>, step: &DenseStep<N>, t: f64) {
+    #[cfg(test)]
+    pub(crate) fn rewind(&mut self, sys: &impl OdeSystem<N>, step: &DenseStep<N>, t: f64) {
         self.restart(sys, t, step.eval_inside(t));
     }
 }

@@ -40,7 +40,7 @@ impl ::roots::Convergency<f64> for BracketWidth {
 /// returned. So the result is within about `t_tol` after the crossing and never before it.
 /// If `g_b == 0`, `t_b` is returned. If `g_a == 0` (not allowed by the precondition) `t_a`, an
 /// exact root, is returned.
-pub fn locate_root<const N: usize>(
+pub(crate) fn locate_root<const N: usize>(
     step: &DenseStep<N>,
     g: impl Fn(f64, &SVector<f64, N>) -> f64,
     t_a: f64,

@@ -1,6 +1,6 @@
 //! The basin figure (`vrw basin`: `basin.png`): a slice of the Poincare section, every grid cell coloured by
 //! what the walk from it did (reached the gait, settled elsewhere, or failed, and how), with the gait marked
-//! (issue 10 item 4).
+//! (README, "Orbit diagram, basin of attraction, period-k gaits").
 
 use std::ops::Range;
 use std::path::Path;
@@ -18,10 +18,10 @@ use super::style::{
 };
 
 /// Size of `basin.png` \[px\].
-pub const BASIN_SIZE: (u32, u32) = (2000, 1500);
+pub(crate) const BASIN_SIZE: (u32, u32) = (2000, 1500);
 
 /// The colour of an outcome (`gait`, `other`, `undecided`, `invalid_start` or a failure kind).
-pub fn outcome_color(outcome: &str) -> RGBColor {
+pub(crate) fn outcome_color(outcome: &str) -> RGBColor {
     match outcome {
         "gait" => COLOR_GREEN,
         "other" => COLOR_BLUE,
@@ -50,7 +50,7 @@ fn outcome_label(outcome: &str) -> String {
 
 /// The figure's data.
 #[derive(Debug, Clone)]
-pub struct BasinFigure {
+pub(crate) struct BasinFigure {
     /// Title.
     pub title: String,
     /// X axis description with unit.
@@ -185,7 +185,7 @@ impl Figure for BasinFigure {
 }
 
 /// Write the basin figure as a PNG at `png`.
-pub fn write_basin_figure(figure: &BasinFigure, png: &Path) -> Result<(), PlotError> {
+pub(crate) fn write_basin_figure(figure: &BasinFigure, png: &Path) -> Result<(), PlotError> {
     if figure.xs.is_empty() || figure.ys.is_empty() || figure.outcomes.is_empty() {
         return Err(PlotError::Empty("the basin has no grid points".to_string()));
     }

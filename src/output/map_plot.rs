@@ -8,7 +8,7 @@
 //! drawn with a white halo over every panel; marked points (e.g. the paper's thresholds) are white circles with a
 //! label.
 //!
-//! Text (the bundled DejaVu Sans), colours and axes come from [`super::style`] and [`super::chart`].
+//! Text (the bundled DejaVu Sans), colours and axes come from [`super::style`] and `chart`.
 
 use std::ops::Range;
 use std::path::Path;
@@ -40,7 +40,7 @@ pub struct MapMark {
 }
 
 /// What the map figure shows.
-pub struct MapFigure<'a> {
+pub(crate) struct MapFigure<'a> {
     /// The gaits.
     pub map: &'a GaitMap,
     /// The threshold curves.
@@ -56,7 +56,7 @@ pub struct MapFigure<'a> {
 }
 
 /// Size of the figure \[px\].
-pub const MAP_SIZE: (u32, u32) = (2600, 1900);
+pub(crate) const MAP_SIZE: (u32, u32) = (2600, 1900);
 /// Width right of the panels for the legends \[px\].
 const LEGEND_W: i32 = 430;
 /// Width of a colour bar with its tick labels and description \[px\].
@@ -65,13 +65,13 @@ const Y_LABEL_AREA: i32 = 130;
 const X_LABEL_AREA: i32 = 90;
 
 /// Grey of points without a gait.
-pub const COLOR_NO_GAIT: RGBColor = RGBColor(200, 200, 200);
+pub(crate) const COLOR_NO_GAIT: RGBColor = RGBColor(200, 200, 200);
 const NEGATIVE: RGBColor = RGBColor(33, 102, 172);
 const ZERO: RGBColor = RGBColor(247, 247, 247);
 const POSITIVE: RGBColor = RGBColor(178, 24, 43);
 
 /// The colour of `v` on the diverging scale of `range` (white at zero, each side scaled to its extreme).
-pub fn diverging(v: f64, range: &Range<f64>) -> RGBColor {
+pub(crate) fn diverging(v: f64, range: &Range<f64>) -> RGBColor {
     let mix = |a: RGBColor, b: RGBColor, t: f64| {
         let t = t.clamp(0.0, 1.0);
         let c = |x: u8, y: u8| (f64::from(x) + (f64::from(y) - f64::from(x)) * t).round() as u8;
@@ -94,7 +94,7 @@ fn bar_label(v: f64) -> String {
 }
 
 /// Colour of an impact branch on the existence panel.
-pub fn branch_color(b: Branch) -> RGBColor {
+pub(crate) fn branch_color(b: Branch) -> RGBColor {
     let light = |c: RGBColor| {
         let t = |x: u8| (255.0 - 0.55 * (255.0 - f64::from(x))).round() as u8;
         RGBColor(t(c.0), t(c.1), t(c.2))
@@ -117,7 +117,7 @@ const BRANCHES: [Branch; 5] = [
 ];
 
 /// How a curve is drawn: colour, dashed, legend text.
-pub fn curve_style(name: &str) -> (RGBColor, bool, &'static str) {
+pub(crate) fn curve_style(name: &str) -> (RGBColor, bool, &'static str) {
     match name {
         "existence_end" => (COLOR_BLACK, false, "end of the gait"),
         "lambda_4_plus = 0" => (COLOR_VERMILLION, false, "λ₄⁺ = 0"),
@@ -486,7 +486,11 @@ impl Figure for MapFigure<'_> {
 }
 
 /// Write the map figure as SVG and PNG ([`MAP_SIZE`]).
-pub fn write_map_figure(figure: &MapFigure, svg: &Path, png: &Path) -> Result<(), PlotError> {
+pub(crate) fn write_map_figure(
+    figure: &MapFigure,
+    svg: &Path,
+    png: &Path,
+) -> Result<(), PlotError> {
     if figure.map.xs.is_empty() || figure.map.ys.is_empty() {
         return Err(PlotError::Empty("the map has no points".to_string()));
     }

@@ -1,7 +1,7 @@
 //! Output: tables a script can read (CSV, JSON) and figures a person can look at (STYLE.md point 12).
 //!
 //! This file holds the shared CSV and JSON writing; each table's columns and writer are declared once in
-//! [`tables`], each figure has its own file.
+//! `tables`, each figure has its own file.
 //!
 //! Every file is written atomically ([`write_atomic`]: under a temporary name in the same directory, then
 //! renamed), so a reader never sees half a file under its real name; the tables that stream rows as a walk runs
@@ -12,26 +12,26 @@
 //! undefined values (e.g. `lambda_2+` after an (A3) exchange) are written as `NaN` in CSV and `null` in JSON.
 
 pub mod animate;
-pub mod basin_plot;
-pub mod chart;
+pub(crate) mod basin_plot;
+pub(crate) mod chart;
 pub mod manifest;
 pub mod map_plot;
-pub mod orbit_plot;
-pub mod plot;
+pub(crate) mod orbit_plot;
+pub(crate) mod plot;
 pub mod read;
 pub mod run_plot;
 pub mod steps_plot;
 pub mod style;
-pub mod tables;
+pub(crate) mod tables;
 
-pub use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv};
-pub use tables::map::write_map_csv;
+pub(crate) use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv};
+pub(crate) use tables::map::write_map_csv;
 pub use tables::steps::{step_row, write_steps_csv, StepsCsv, STEPS_HEADER};
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
 pub use tables::trajectory::{
     trajectory_row, write_trajectory_csv, TrajectoryCsv, TRAJECTORY_HEADER,
 };
-pub use tables::{Cell, Column};
+pub use tables::Cell;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -76,7 +76,7 @@ pub enum OutputError {
 
 /// A number as written in CSV: the shortest text that reads back to the same `f64`, in scientific notation
 /// when very small or very large; `NaN` for undefined values.
-pub fn num(v: f64) -> String {
+pub(crate) fn num(v: f64) -> String {
     let a = v.abs();
     if v == 0.0 {
         "0".to_string()
@@ -88,7 +88,7 @@ pub fn num(v: f64) -> String {
 }
 
 /// Create `dir` (and its parents) if needed; a `dir` that is an existing file is refused.
-pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
+pub(crate) fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
     if dir.exists() && !dir.is_dir() {
         return Err(OutputError::NotADirectory {
             path: dir.to_path_buf(),
@@ -101,7 +101,7 @@ pub fn ensure_dir(dir: &Path) -> Result<(), OutputError> {
 }
 
 /// Open a CSV writer on `path`.
-pub fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
+pub(crate) fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
     csv::Writer::from_path(path).map_err(|source| OutputError::Csv {
         path: path.to_path_buf(),
         source,
@@ -109,7 +109,7 @@ pub fn csv_writer(path: &Path) -> Result<csv::Writer<File>, OutputError> {
 }
 
 /// Write one CSV record, mapping errors to [`OutputError`].
-pub fn write_record<I, T>(
+pub(crate) fn write_record<I, T>(
     w: &mut csv::Writer<File>,
     path: &Path,
     record: I,
@@ -125,7 +125,7 @@ where
 }
 
 /// Flush a CSV writer.
-pub fn finish_csv(mut w: csv::Writer<File>, path: &Path) -> Result<(), OutputError> {
+pub(crate) fn finish_csv(mut w: csv::Writer<File>, path: &Path) -> Result<(), OutputError> {
     w.flush().map_err(|source| OutputError::Io {
         path: path.to_path_buf(),
         source,
@@ -236,14 +236,14 @@ where
 
 /// A CSV file written row by row: each row is flushed to the file as soon as it is written, so an
 /// interrupted or crashed run keeps every row it produced and memory does not grow with the rows.
-pub struct CsvStream {
+pub(crate) struct CsvStream {
     w: csv::Writer<File>,
     path: PathBuf,
 }
 
 impl CsvStream {
     /// Create (truncate) `path` and write `header`.
-    pub fn create<I, T>(path: &Path, header: I) -> Result<CsvStream, OutputError>
+    pub(crate) fn create<I, T>(path: &Path, header: I) -> Result<CsvStream, OutputError>
     where
         I: IntoIterator<Item = T>,
         T: AsRef<[u8]>,
@@ -266,7 +266,7 @@ impl CsvStream {
     }
 
     /// Write one row and flush it to the file.
-    pub fn write<I, T>(&mut self, record: I) -> Result<(), OutputError>
+    pub(crate) fn write<I, T>(&mut self, record: I) -> Result<(), OutputError>
     where
         I: IntoIterator<Item = T>,
         T: AsRef<[u8]>,
@@ -276,7 +276,7 @@ impl CsvStream {
     }
 
     /// Flush the rows written so far to the file.
-    pub fn flush(&mut self) -> Result<(), OutputError> {
+    pub(crate) fn flush(&mut self) -> Result<(), OutputError> {
         self.w.flush().map_err(|source| OutputError::Io {
             path: self.path.clone(),
             source,
@@ -284,7 +284,7 @@ impl CsvStream {
     }
 
     /// The file written.
-    pub fn path(&self) -> &Path {
+    pub(crate) fn path(&self) -> &Path {
         &self.path
     }
 }

@@ -1,6 +1,7 @@
 //! The orbit diagram (`vrw orbit`: `orbit.png`): against one parameter, the section states and DLS indicators
 //! the walk visits after its transient, drawn as points, with the period-1 gait branch from continuation drawn
-//! as a line, solid where the gait is stable and dashed where it is not (issue 10 item 3).
+//! as a line, solid where the gait is stable and dashed where it is not (README,
+//! "Orbit diagram, basin of attraction, period-k gaits").
 
 use std::ops::Range;
 use std::path::Path;
@@ -15,7 +16,7 @@ use super::chart::{
 use super::style::{padded, PlotError, COLOR_BLACK, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
 
 /// Size of `orbit.png` \[px\].
-pub const ORBIT_SIZE: (u32, u32) = (2400, 1600);
+pub(crate) const ORBIT_SIZE: (u32, u32) = (2400, 1600);
 
 /// Radius of a point of the diagram \[px\].
 const DOT: i32 = 3;
@@ -29,7 +30,7 @@ const COLOR_FAILED: RGBColor = RGBColor(235, 235, 235);
 /// One point of the period-1 branch: the parameter value, the value drawn, and whether the gait is stable
 /// there (`None`: uncertain).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BranchPoint {
+pub(crate) struct BranchPoint {
     /// The parameter value.
     pub param: f64,
     /// The quantity drawn.
@@ -40,7 +41,7 @@ pub struct BranchPoint {
 
 /// One panel: one quantity against the parameter.
 #[derive(Debug, Clone)]
-pub struct OrbitPanel {
+pub(crate) struct OrbitPanel {
     /// Y axis description with unit.
     pub y_label: String,
     /// The points the walk visits `(parameter, value)`.
@@ -51,7 +52,7 @@ pub struct OrbitPanel {
 
 /// The whole figure.
 #[derive(Debug, Clone)]
-pub struct OrbitFigure {
+pub(crate) struct OrbitFigure {
     /// Title.
     pub title: String,
     /// X axis description with unit.
@@ -231,7 +232,7 @@ impl Figure for OrbitFigure {
 }
 
 /// Write the orbit diagram as a PNG at `png`.
-pub fn write_orbit_figure(figure: &OrbitFigure, png: &Path) -> Result<(), PlotError> {
+pub(crate) fn write_orbit_figure(figure: &OrbitFigure, png: &Path) -> Result<(), PlotError> {
     if figure
         .panels
         .iter()

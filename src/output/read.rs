@@ -122,7 +122,7 @@ fn flag<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
     }
 }
 
-/// One row of `trajectory.csv` (MODEL.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
+/// One row of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub struct TrajectoryRow {
     /// Time \[s\].
@@ -180,7 +180,7 @@ pub struct TrajectoryRow {
 
 /// The contact state of a leg's tip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TipState {
+pub(crate) enum TipState {
     /// On the ground, not slipping.
     Stuck,
     /// On the ground, sliding.
@@ -201,7 +201,7 @@ impl TipState {
 
 impl TrajectoryRow {
     /// Contact state of Leg 1's and Leg 2's tips.
-    pub fn tips(&self) -> [TipState; 2] {
+    pub(crate) fn tips(&self) -> [TipState; 2] {
         [
             TipState::of(self.contact1, self.slide1),
             TipState::of(self.contact2, self.slide2),
@@ -291,7 +291,7 @@ pub struct Geometry {
 
 impl Geometry {
     /// Inter-leg angle `alpha = 2 pi / N` \[rad\].
-    pub fn alpha(&self) -> f64 {
+    pub(crate) fn alpha(&self) -> f64 {
         std::f64::consts::TAU / self.legs as f64
     }
 }
@@ -315,7 +315,7 @@ pub struct RunData {
 
 impl RunData {
     /// Path of `name` inside the run directory.
-    pub fn path(&self, name: &str) -> PathBuf {
+    pub(crate) fn path(&self, name: &str) -> PathBuf {
         self.dir.join(name)
     }
 
@@ -328,7 +328,7 @@ impl RunData {
     }
 
     /// The step running at time `t` (the last touchdown at or before `t`), if any.
-    pub fn step_at(&self, t: f64) -> Option<&StepRow> {
+    pub(crate) fn step_at(&self, t: f64) -> Option<&StepRow> {
         let k = self.steps.partition_point(|s| s.time <= t);
         k.checked_sub(1).map(|k| &self.steps[k])
     }

@@ -2,9 +2,9 @@
 //!
 //! Five panels share the time axis: the angle `theta` of Leg 1 from the slope normal, its rate, the leg
 //! lengths `L1`, `L2` with the stopper length `L0` dashed, the normal ground forces `lambda_2` (Leg 1) and
-//! `lambda_4` (Leg 2), and the tangential ones `lambda_1`, `lambda_3` (MODEL.md section 3). The background
+//! `lambda_4` (Leg 2), and the tangential ones `lambda_1`, `lambda_3` (docs/model.md section 3). The background
 //! is shaded by phase (DLS, a sliding tip, SLS, rear support, flight) and every touchdown is a dashed
-//! vertical line. Curves break at each touchdown, where the legs are re-indexed (MODEL.md section 5).
+//! vertical line. Curves break at each touchdown, where the legs are re-indexed (docs/model.md section 5).
 
 use std::path::PathBuf;
 
@@ -23,7 +23,7 @@ pub const RUN_SIZE: (u32, u32) = (1600, 2000);
 
 /// The phases the figures shade, by which tips are on the ground.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PhaseKind {
+pub(crate) enum PhaseKind {
     /// Both tips on the ground, neither sliding.
     DoubleSupport,
     /// A tip on the ground slides.
@@ -38,7 +38,7 @@ pub enum PhaseKind {
 
 impl PhaseKind {
     /// The phase of a sample.
-    pub fn of(s: &TrajectoryRow) -> PhaseKind {
+    pub(crate) fn of(s: &TrajectoryRow) -> PhaseKind {
         let [a, b] = s.tips();
         if a == TipState::Sliding || b == TipState::Sliding {
             return PhaseKind::Sliding;
@@ -52,7 +52,7 @@ impl PhaseKind {
     }
 
     /// Legend text.
-    pub fn label(self) -> &'static str {
+    pub(crate) fn label(self) -> &'static str {
         match self {
             PhaseKind::DoubleSupport => "DLS",
             PhaseKind::Sliding => "a tip slides",
@@ -63,7 +63,7 @@ impl PhaseKind {
     }
 
     /// Shading colour.
-    pub fn color(self) -> RGBColor {
+    pub(crate) fn color(self) -> RGBColor {
         match self {
             PhaseKind::DoubleSupport => RGBColor(222, 235, 247),
             PhaseKind::Sliding => RGBColor(253, 208, 162),
@@ -75,7 +75,7 @@ impl PhaseKind {
 }
 
 /// Shaded phase intervals: sample `k`'s phase holds until sample `k + 1`.
-pub fn phase_bands(samples: &[TrajectoryRow]) -> Vec<(Band, PhaseKind)> {
+pub(crate) fn phase_bands(samples: &[TrajectoryRow]) -> Vec<(Band, PhaseKind)> {
     let mut out: Vec<(Band, PhaseKind)> = Vec::new();
     for pair in samples.windows(2) {
         let kind = PhaseKind::of(&pair[0]);
@@ -95,7 +95,10 @@ pub fn phase_bands(samples: &[TrajectoryRow]) -> Vec<(Band, PhaseKind)> {
 }
 
 /// `(time, value)` points of the samples, with a break (NaN) wherever the legs are re-indexed.
-pub fn series(samples: &[TrajectoryRow], value: impl Fn(&TrajectoryRow) -> f64) -> Vec<(f64, f64)> {
+pub(crate) fn series(
+    samples: &[TrajectoryRow],
+    value: impl Fn(&TrajectoryRow) -> f64,
+) -> Vec<(f64, f64)> {
     let mut out = Vec::with_capacity(samples.len() + 64);
     for (k, s) in samples.iter().enumerate() {
         if k > 0 && samples[k - 1].leg1 != s.leg1 {

@@ -1,8 +1,8 @@
 //! The steps figure (`vrw plot`: `steps.png`, `steps.svg`): how the walk settles onto its gait.
 //!
 //! Left, against the step number: the three DLS indicators of each touchdown (`lambda_I4`, and `lambda_2+`,
-//! `lambda_4+`; MODEL.md section 5), the period and the DLS duration, the energy audit (loss of `T + V`
-//! against the damper, impact and stopper losses) and its residual (MODEL.md section 7). Right: the phase
+//! `lambda_4+`; docs/model.md section 5), the period and the DLS duration, the energy audit (loss of `T + V`
+//! against the damper, impact and stopper losses) and its residual (docs/model.md section 7). Right: the phase
 //! portrait of Leg 2 over the last step, `L2` against `dL2/dt`, coloured by the contact state of its tip,
 //! with `L0` dashed.
 

@@ -63,7 +63,7 @@ impl PlotError {
     }
 
     /// A drawing failure at `path` (for `map_err`).
-    pub fn draw_at(path: &Path) -> impl Fn(String) -> PlotError + '_ {
+    pub(crate) fn draw_at(path: &Path) -> impl Fn(String) -> PlotError + '_ {
         move |message| PlotError::Draw {
             path: path.display().to_string(),
             message,
@@ -73,7 +73,7 @@ impl PlotError {
 
 /// Font family name under which the bundled font is registered; it is also the CSS `font-family` list
 /// written into SVGs.
-pub const FAMILY: &str = "DejaVu Sans, sans-serif";
+pub(crate) const FAMILY: &str = "DejaVu Sans, sans-serif";
 static FONT_BYTES: &[u8] = include_bytes!(concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/assets/fonts/DejaVuSans.ttf"
@@ -82,7 +82,7 @@ static FONT_REGISTERED: OnceLock<bool> = OnceLock::new();
 
 /// Registers the bundled DejaVu Sans once per process, under [`FAMILY`] and under plotters' default
 /// `"sans-serif"`. Returns whether it succeeded.
-pub fn ensure_font() -> bool {
+pub(crate) fn ensure_font() -> bool {
     *FONT_REGISTERED.get_or_init(|| {
         register_font(FAMILY, FontStyle::Normal, FONT_BYTES).is_ok()
             && register_font("sans-serif", FontStyle::Normal, FONT_BYTES).is_ok()
@@ -90,7 +90,7 @@ pub fn ensure_font() -> bool {
 }
 
 /// Registers the bundled font, or fails naming the file that was to be drawn.
-pub fn require_font(path: &Path) -> Result<(), PlotError> {
+pub(crate) fn require_font(path: &Path) -> Result<(), PlotError> {
     if ensure_font() {
         Ok(())
     } else {
@@ -101,14 +101,14 @@ pub fn require_font(path: &Path) -> Result<(), PlotError> {
 }
 
 /// Black text in the bundled font at `size` pixels.
-pub fn font(size: f64) -> TextStyle<'static> {
+pub(crate) fn font(size: f64) -> TextStyle<'static> {
     (FontFamily::Name(FAMILY), size).into_font().color(&BLACK)
 }
 
 /// A run of rich text: text on the baseline, a subscript, or a stacked subscript/superscript pair (plotters
 /// has no rich text).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Seg {
+pub(crate) enum Seg {
     /// Text on the baseline.
     Text(&'static str),
     /// A subscript.
@@ -123,7 +123,7 @@ const SUB_DROP: f64 = 0.16;
 const SUP_RISE: f64 = 0.36;
 
 /// Width in pixels of rich text at font size `size`.
-pub fn rich_width<DB: DrawingBackend>(
+pub(crate) fn rich_width<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     segs: &[Seg],
     size: f64,
@@ -143,7 +143,7 @@ pub fn rich_width<DB: DrawingBackend>(
 /// Draws rich text whose first line box has its top-left corner at `at`
 /// (with `rotated`, the text runs upwards from `at`, its top facing left).
 /// Baselines follow plotters' ab_glyph rasteriser: `size / 2` below the top.
-pub fn draw_rich<DB: DrawingBackend>(
+pub(crate) fn draw_rich<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     segs: &[Seg],
     at: (i32, i32),
@@ -186,26 +186,26 @@ pub fn draw_rich<DB: DrawingBackend>(
 }
 
 /// Black (Fig. 2's `lambda_I4`, the first series of a panel).
-pub const COLOR_BLACK: RGBColor = RGBColor(0, 0, 0);
+pub(crate) const COLOR_BLACK: RGBColor = RGBColor(0, 0, 0);
 /// Blue (Okabe-Ito): Leg 1, `lambda_2`.
 pub const COLOR_BLUE: RGBColor = RGBColor(0, 114, 178);
 /// Vermillion (Okabe-Ito): Leg 2, `lambda_4`.
 pub const COLOR_VERMILLION: RGBColor = RGBColor(213, 94, 0);
 /// Bluish green (Okabe-Ito).
-pub const COLOR_GREEN: RGBColor = RGBColor(0, 158, 115);
+pub(crate) const COLOR_GREEN: RGBColor = RGBColor(0, 158, 115);
 /// Reddish purple (Okabe-Ito).
-pub const COLOR_PURPLE: RGBColor = RGBColor(204, 121, 167);
+pub(crate) const COLOR_PURPLE: RGBColor = RGBColor(204, 121, 167);
 /// Orange (Okabe-Ito).
-pub const COLOR_ORANGE: RGBColor = RGBColor(230, 159, 0);
+pub(crate) const COLOR_ORANGE: RGBColor = RGBColor(230, 159, 0);
 /// Grey of markers and reference lines.
-pub const COLOR_MARK: RGBColor = RGBColor(90, 90, 90);
+pub(crate) const COLOR_MARK: RGBColor = RGBColor(90, 90, 90);
 /// Grid lines.
-pub const COLOR_GRID: RGBColor = RGBColor(225, 225, 225);
+pub(crate) const COLOR_GRID: RGBColor = RGBColor(225, 225, 225);
 /// Border of legend boxes and colour swatches.
-pub const COLOR_FRAME: RGBColor = RGBColor(150, 150, 150);
+pub(crate) const COLOR_FRAME: RGBColor = RGBColor(150, 150, 150);
 
 /// Applies the house style to a chart's mesh: fonts, light grid, black axes, tick marks.
-pub fn house_mesh<DB: DrawingBackend>(
+pub(crate) fn house_mesh<DB: DrawingBackend>(
     mesh: &mut MeshStyle<'_, '_, RangedCoordf64, RangedCoordf64, DB>,
     tick_font: f64,
     axis_font: f64,
@@ -220,7 +220,7 @@ pub fn house_mesh<DB: DrawingBackend>(
 
 /// Proportions of a legend box \[px\]: rows of a sample (line, marker or swatch) and a text.
 #[derive(Debug, Clone, Copy)]
-pub struct LegendLayout {
+pub(crate) struct LegendLayout {
     /// Padding left and right inside the box.
     pub pad: i32,
     /// Width of a sample.
@@ -235,7 +235,13 @@ pub struct LegendLayout {
 
 impl LegendLayout {
     /// A layout from its padding, sample width, gap, row height and top padding \[px\].
-    pub const fn new(pad: i32, sample_w: i32, gap: i32, line: i32, top: i32) -> LegendLayout {
+    pub(crate) const fn new(
+        pad: i32,
+        sample_w: i32,
+        gap: i32,
+        line: i32,
+        top: i32,
+    ) -> LegendLayout {
         LegendLayout {
             pad,
             sample_w,
@@ -247,7 +253,7 @@ impl LegendLayout {
 
     /// Draws the white framed box of `rows` rows whose widest text is `text_w` at `(x0, y0)`; returns the x of
     /// the samples, the x of the texts and the centre y of the first row.
-    pub fn frame<DB: DrawingBackend>(
+    pub(crate) fn frame<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
         (x0, y0): (i32, i32),
@@ -267,7 +273,7 @@ impl LegendLayout {
 }
 
 /// Draws the rectangle `corners` filled with `fill` and framed in [`COLOR_FRAME`] (legend boxes, swatches).
-pub fn draw_box<DB: DrawingBackend>(
+pub(crate) fn draw_box<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     corners: [(i32, i32); 2],
     fill: RGBColor,
@@ -278,7 +284,7 @@ pub fn draw_box<DB: DrawingBackend>(
 
 /// Tick label of `v` on an axis spanning `range`: as many decimals as the tick step needs (plotters' default
 /// prints "100.0"), scientific notation on a very narrow or very wide axis, and a true minus sign.
-pub fn tick_label(v: f64, range: &Range<f64>) -> String {
+pub(crate) fn tick_label(v: f64, range: &Range<f64>) -> String {
     let span = (range.end - range.start).abs().max(f64::MIN_POSITIVE);
     // Smallest 1-2-5 step giving at most 10 ticks (plotters asks for <= 10).
     let mut step = 10f64.powf((span / 10.0).log10().floor());
@@ -307,7 +313,7 @@ pub fn tick_label(v: f64, range: &Range<f64>) -> String {
 }
 
 /// `(lo, hi)` widened by `frac` of its span on both sides (a unit span around a single value).
-pub fn padded(lo: f64, hi: f64, frac: f64) -> Range<f64> {
+pub(crate) fn padded(lo: f64, hi: f64, frac: f64) -> Range<f64> {
     let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
     (lo - frac * span)..(hi + frac * span)
 }

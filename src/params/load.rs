@@ -144,7 +144,7 @@ impl Config {
     }
 
     /// The value of the real-valued key `key` (one of [`Config::numeric_keys`]).
-    pub fn get_numeric(&self, key: &str) -> Result<f64, ConfigError> {
+    pub(crate) fn get_numeric(&self, key: &str) -> Result<f64, ConfigError> {
         if !Config::numeric_keys().contains(&key) {
             return Err(unknown_numeric_key(key));
         }

@@ -1,11 +1,11 @@
 //! Parameters and configuration: the first stage of the pipeline.
 //!
 //! [`Params`] holds the physical model of the viscoelastic-legged rimless wheel (`docs/model.md` sections 1, 2
-//! and 7, defaults from the paper's Table 1; in [`model`]), [`SolverOptions`] the numerical settings, including
-//! every tolerance that guards grazing and chatter (`docs/model.md` section 4; in [`solver`], with the named
+//! and 7, defaults from the paper's Table 1; in `model`), [`SolverOptions`] the numerical settings, including
+//! every tolerance that guards grazing and chatter (`docs/model.md` section 4; in `solver`, with the named
 //! choices [`ImpactModel`] and [`ContactInconsistency`]), and [`Config`] both of them together. Reading a
 //! configuration (a TOML file, `--set key=value` overrides, typed values from the Python binding) is in
-//! [`load`].
+//! `load`.
 //!
 //! A configuration file is a *flat* TOML file whose keys are the field names of both structs; keys that
 //! are absent keep their defaults:
@@ -29,14 +29,16 @@ use std::fmt;
 use crate::fmt::short;
 
 mod de;
-pub mod load;
-pub mod model;
-pub mod solver;
+pub(crate) mod load;
+pub(crate) mod model;
+pub(crate) mod solver;
 
-pub use model::{Params, MASS_RATIO_LIMIT, MAX_LEGS};
+pub use model::Params;
+pub use model::{MASS_RATIO_LIMIT, MAX_LEGS};
+pub use solver::{ContactInconsistency, ImpactModel, SolverOptions};
 pub use solver::{
-    ContactInconsistency, ImpactModel, SolverOptions, ATOL_RANGE, EVENT_TIME_TOL_RANGE, GAP_RANGE,
-    MAX_EVENTS_PER_STEP_LIMIT, MAX_STEP_RANGE, MAX_STEP_TIME_RANGE, RTOL_RANGE,
+    ATOL_RANGE, EVENT_TIME_TOL_RANGE, GAP_RANGE, MAX_EVENTS_PER_STEP_LIMIT, MAX_STEP_RANGE,
+    MAX_STEP_TIME_RANGE, RTOL_RANGE,
 };
 
 /// Everything a run needs: physics ([`Params`]) and numerics ([`SolverOptions`]).
@@ -45,7 +47,7 @@ pub use solver::{
 /// (e.g. `viscosity = 50.0`, `impact = "traditional"`, `rigid_legs = true`,
 /// `inconsistent_contact = "rebound"`, `rtol = 1e-11`).
 ///
-/// It is read by serde, one struct at a time ([`load`] says why not through `#[serde(flatten)]`).
+/// It is read by serde, one struct at a time (`load` says why not through `#[serde(flatten)]`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Config {
     /// Physical parameters (`docs/model.md` sections 1, 2 and 7). Default: the paper's Table 1.
@@ -65,7 +67,7 @@ impl Config {
 
     /// A copy with the real-valued key `key` set to `value` and validated: the configuration at one point of a
     /// sweep, a map or a continuation.
-    pub fn with(&self, key: &str, value: f64) -> Result<Config, ConfigError> {
+    pub(crate) fn with(&self, key: &str, value: f64) -> Result<Config, ConfigError> {
         let mut c = self.clone();
         c.set_numeric(key, value)?;
         c.validate()?;

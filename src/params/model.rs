@@ -12,7 +12,7 @@ use crate::fmt::short;
 /// Defaults are the paper's Table 1; the viscosity `c` is the parameter the paper sweeps. Check a value
 /// built by hand with [`Params::validate`].
 ///
-/// Each field is a key of a configuration file, read by serde ([`super::load`]); absent keys keep their
+/// Each field is a key of a configuration file, read by serde (`load`); absent keys keep their
 /// defaults and unknown keys are refused.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -29,7 +29,7 @@ pub enum ImpactModel {
 
 impl ImpactModel {
     /// The name of this law, as in TOML and on the command line (serde's name of the variant).
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             ImpactModel::Dlsi => "dlsi",
             ImpactModel::Traditional => "traditional",
@@ -63,7 +63,7 @@ pub enum ContactInconsistency {
 
 impl ContactInconsistency {
     /// The name of this treatment, as in TOML and on the command line (serde's name of the variant).
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             ContactInconsistency::Slide => "slide",
             ContactInconsistency::Rebound => "rebound",
@@ -82,7 +82,7 @@ impl fmt::Display for ContactInconsistency {
 /// Every tolerance that guards grazing or chatter is a named field here. Check a value built by hand
 /// with [`SolverOptions::validate`] (and [`Config::validate`](super::Config::validate) for the rule that involves [`Params`](super::Params)).
 ///
-/// Each field is a key of a configuration file, read by serde ([`super::load`]); absent keys keep their
+/// Each field is a key of a configuration file, read by serde (`load`); absent keys keep their
 /// defaults and unknown keys are refused.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -12,7 +12,7 @@ use super::report::ContactAudit;
 /// Number of points per integrator step (besides its start) at which the dense output is checked for tips
 /// below the ground: the event search's points, whose states the audit reuses (up to an event, the part of
 /// the step before it is sampled the same way).
-pub const PENETRATION_SAMPLES: usize = EVENT_SAMPLES;
+pub(crate) const PENETRATION_SAMPLES: usize = EVENT_SAMPLES;
 
 impl ContactAudit {
     /// A pulling force (or reaction) seen at some instant of the step.

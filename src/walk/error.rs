@@ -117,7 +117,7 @@ pub enum WalkError {
 
 impl WalkError {
     /// Wraps a failed constraint solve at `time` in `phase` (for `map_err`).
-    pub fn contact_at(time: f64, phase: Phase) -> impl Fn(ContactError) -> WalkError + Copy {
+    pub(crate) fn contact_at(time: f64, phase: Phase) -> impl Fn(ContactError) -> WalkError + Copy {
         move |source| WalkError::Contact {
             time,
             phase,
@@ -126,7 +126,7 @@ impl WalkError {
     }
 
     /// The time the walk stopped at \[s\], if the failure has one (every failure of a step has).
-    pub fn time(&self) -> Option<f64> {
+    pub(crate) fn time(&self) -> Option<f64> {
         match self {
             WalkError::Fell { time, .. }
             | WalkError::RolledBack { time, .. }

@@ -13,7 +13,7 @@ use super::phase::{unpack, WalkVector};
 /// value at the start of the phase, if the force-level problem accepted a slightly negative one within
 /// [`super::impact::COMPLEMENTARITY_TOL`]): small enough that the contact audit sees no pull above 1e-9 N, large
 /// enough that rounding of forces of ~100 N (~1e-12 N) cannot fire it.
-pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
+pub(crate) const FORCE_EVENT_MARGIN: f64 = 1e-10;
 
 /// The grazing guard of a landing or stopper event whose tip (leg) starts at the ground (stopper) already moving
 /// into it \[m\]: such a contact is not grazing, so its event fires as soon as it moves this far (instead of
@@ -22,12 +22,12 @@ pub const FORCE_EVENT_MARGIN: f64 = 1e-10;
 /// stopper moving *away* from it (inward) is not grazing either (docs/model.md section 4): its stopper event
 /// fires this far past where it started, so a leg that comes back within one integrator step locks at `L0`
 /// instead of `stopper_gap` past it, and the overrun does not grow from lock to lock.
-pub const APPROACH_GAP: f64 = 1e-12;
+pub(crate) const APPROACH_GAP: f64 = 1e-12;
 
 /// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
 /// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
 /// however long the steps of a high-order integrator are.
-pub const EVENT_SAMPLES: usize = 4;
+pub(crate) const EVENT_SAMPLES: usize = 4;
 
 /// Kinds of events (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

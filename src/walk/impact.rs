@@ -1,4 +1,4 @@
-//! Touchdown: re-indexing and the DLS-indicator impact procedure (MODEL.md section 5, paper Sec. 2.2,
+//! Touchdown: re-indexing and the DLS-indicator impact procedure (docs/model.md section 5, paper Sec. 2.2,
 //! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event.
 //!
 //! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward) are resolved by
@@ -20,12 +20,12 @@ use crate::params::{ContactInconsistency, ImpactModel};
 /// Tolerance of the complementarity checks (forces \[N\], impulses \[N s\], velocities \[m/s\], accelerations
 /// \[m/s^2\]): a value within this of zero counts as zero, so that an event located at a force or velocity
 /// zero is not undone by rounding.
-pub const COMPLEMENTARITY_TOL: f64 = 1e-9;
+pub(crate) const COMPLEMENTARITY_TOL: f64 = 1e-9;
 
 /// Largest tangential speed of a tip that a no-slip contact may hold at force level \[m/s\]: a tip at rest up to
 /// the integration error (~1e-12 m/s, as `SECTION_TIP_SPEED_TOL` of the walk); a tip that slides faster (after a
 /// frictionless impulse) is not stuck by the force-level problem, which has no impulse to stop it.
-pub const STICK_SPEED_TOL: f64 = 1e-8;
+pub(crate) const STICK_SPEED_TOL: f64 = 1e-8;
 
 /// The three DLS indicators of the paper (Sec. 2.2): `lambda_I4` from (A1), `lambda_2+`, `lambda_4+` from (B1).
 /// `NaN` where the procedure does not define them (`lambda_2+`, `lambda_4+` after (A3), all three when the
@@ -43,7 +43,7 @@ pub struct DlsIndicators {
 
 impl DlsIndicators {
     /// All three undefined.
-    pub const UNDEFINED: DlsIndicators = DlsIndicators {
+    pub(crate) const UNDEFINED: DlsIndicators = DlsIndicators {
         lambda_i4: f64::NAN,
         lambda_2_plus: f64::NAN,
         lambda_4_plus: f64::NAN,
@@ -89,7 +89,7 @@ pub enum Unit {
 
 /// State of a unit in an active set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
+pub(crate) enum Mode {
     /// Inactive: the tip is free / the leg is free of its stopper.
     Off,
     /// Active: a no-slip contact, or a locked stopper.
@@ -101,7 +101,7 @@ pub enum Mode {
 
 impl Unit {
     /// Put the unit in `mode` in `active`.
-    pub fn apply(self, active: &mut ActiveSet, mode: Mode) {
+    pub(crate) fn apply(self, active: &mut ActiveSet, mode: Mode) {
         match (self, mode) {
             (Unit::Contact(leg), Mode::Slide) => active.set_sliding(leg),
             (Unit::Contact(leg), m) => active.set_contact(leg, m == Mode::On),
@@ -110,7 +110,7 @@ impl Unit {
     }
 
     /// The unit's mode in `active`.
-    pub fn mode(self, active: &ActiveSet) -> Mode {
+    pub(crate) fn mode(self, active: &ActiveSet) -> Mode {
         match self {
             Unit::Contact(leg) if active.slide(leg) => Mode::Slide,
             Unit::Contact(leg) if active.contact(leg) => Mode::On,
@@ -122,7 +122,7 @@ impl Unit {
 
 /// What a candidate unit is doing at the moment its mode is resolved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Role {
+pub(crate) enum Role {
     /// Present before (or touching after an impact): any mode its kind allows.
     Keep,
     /// Its normal force has just fallen through zero (a lift-off event): it may leave the ground or slide, but
@@ -138,7 +138,7 @@ pub enum Role {
 
 /// An optional unit and the mode the caller prefers for it when several are consistent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Candidate {
+pub(crate) struct Candidate {
     /// The unit.
     pub unit: Unit,
     /// Preferred mode.
@@ -149,12 +149,12 @@ pub struct Candidate {
 
 impl Candidate {
     /// The candidate `unit` preferring the mode it has in `active`.
-    pub fn keep(unit: Unit, active: &ActiveSet) -> Candidate {
+    pub(crate) fn keep(unit: Unit, active: &ActiveSet) -> Candidate {
         Candidate::new(unit, unit.mode(active))
     }
 
     /// The candidate `unit` preferring `preferred`.
-    pub fn new(unit: Unit, preferred: Mode) -> Candidate {
+    pub(crate) fn new(unit: Unit, preferred: Mode) -> Candidate {
         Candidate {
             unit,
             preferred,
@@ -164,7 +164,7 @@ impl Candidate {
 
     /// A contact whose normal force has just reached zero: preferably it leaves; it may slide (under
     /// [`ContactInconsistency::Slide`]), but it cannot stay a no-slip contact.
-    pub fn releasing(leg: Leg) -> Candidate {
+    pub(crate) fn releasing(leg: Leg) -> Candidate {
         Candidate {
             unit: Unit::Contact(leg),
             preferred: Mode::Off,
@@ -173,7 +173,7 @@ impl Candidate {
     }
 
     /// The unit an impact closes, preferably no-slip (see [`Role::Closing`]).
-    pub fn closing(unit: Unit, model: &Model) -> Candidate {
+    pub(crate) fn closing(unit: Unit, model: &Model) -> Candidate {
         Candidate {
             unit,
             preferred: Mode::On,
@@ -273,13 +273,13 @@ fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
 }
 
 /// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
-/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (MODEL.md
+/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (docs/model.md
 /// section 4). Every candidate either takes a non-negative impulse and ends at zero relative normal velocity,
 /// or takes none and separates (normal velocity after the impact `>= 0`, a free leg not moving past its
 /// stopper). A no-slip contact's impulse has a tangential part; a sliding contact's is normal only. If no
 /// combination is consistent the preferred one is used, and the step's contact audit
 /// ([`largest_pull`]) shows the pulling impulse.
-pub fn plastic_impact(
+pub(crate) fn plastic_impact(
     model: &Model,
     q: &Coords,
     qd: &Coords,
@@ -313,7 +313,7 @@ pub fn plastic_impact(
 /// penetrates (tip accelerating into the ground, leg accelerating past its stopper). Sliding contacts are
 /// tried only under [`ContactInconsistency::Slide`]; under [`ContactInconsistency::Rebound`], when no set is
 /// consistent, the paper's (B2)/(B3) rule decides: contacts with a pulling normal force are released.
-pub fn consistent_active_set(
+pub(crate) fn consistent_active_set(
     model: &Model,
     q: &Coords,
     qd: &Coords,
@@ -361,7 +361,7 @@ pub fn consistent_active_set(
 
 /// What the touchdown impact produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TouchdownImpact {
+pub(crate) struct TouchdownImpact {
     /// `q'+`.
     pub qd_plus: Coords,
     /// DLS indicators of this touchdown.
@@ -384,7 +384,7 @@ pub struct TouchdownImpact {
 /// (or behind) comes down first. Since every such leg has length `L0`, the lowest tip is the one whose angle
 /// `psi_j = theta + j alpha` is nearest to 0 modulo `2 pi`: the front leg, the leg `j = 2`, or the leg nearest
 /// to `j = -theta / alpha`.
-pub fn touchdown_leg(model: &Model, q: &Coords) -> LegIndex {
+pub(crate) fn touchdown_leg(model: &Model, q: &Coords) -> LegIndex {
     let n = model.legs();
     let front = model.front_leg();
     let nearest = (-q[THETA] / model.alpha()).round().rem_euclid(n as f64) as usize % n;
@@ -416,7 +416,7 @@ fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
     candidates
 }
 
-/// The touchdown impact at `(q_dagger, q'_dagger)` after re-indexing (MODEL.md section 5).
+/// The touchdown impact at `(q_dagger, q'_dagger)` after re-indexing (docs/model.md section 5).
 ///
 /// `before` is the active set just before impact in the new indexing: `contact2` = the old Leg 1 was on the
 /// ground, `lock1` = true (the new leg arrives locked), `lock2` = the old Leg 1's stopper.
@@ -434,7 +434,7 @@ fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
 /// With [`ImpactModel::Traditional`] the indicators are still computed and reported, but the collision is
 /// always the `J_SLS` one. With `rigid_legs` the stoppers act both ways and the exchange is the traditional
 /// one; the indicators are undefined (a DLS collision of two locked legs is statically indeterminate).
-pub fn touchdown_impact(
+pub(crate) fn touchdown_impact(
     model: &Model,
     q: &Coords,
     qd: &Coords,
@@ -519,9 +519,9 @@ pub fn touchdown_impact(
     Ok(finish(dls_set, dls_sol, indicators, branch, preferred))
 }
 
-/// The stoppers that act both ways and are always active: both with `rigid_legs` (MODEL.md section 7), none
+/// The stoppers that act both ways and are always active: both with `rigid_legs` (docs/model.md section 7), none
 /// otherwise. Every active-set resolution starts from this set.
-pub fn bilateral_stoppers(model: &Model) -> ActiveSet {
+pub(crate) fn bilateral_stoppers(model: &Model) -> ActiveSet {
     let rigid = model.params().rigid_legs;
     ActiveSet {
         lock1: rigid,
@@ -537,7 +537,7 @@ pub fn bilateral_stoppers(model: &Model) -> ActiveSet {
 /// `traditional` exchange does that) stays free, and its landing event fires at once. `preferred` gives the modes
 /// the procedure wants (the paper's branch at a touchdown). With `rigid_legs` the stoppers are bilateral and
 /// forced.
-pub fn post_impact_candidates(
+pub(crate) fn post_impact_candidates(
     model: &Model,
     q: &Coords,
     qd_plus: &Coords,
@@ -594,10 +594,10 @@ pub struct UnitImpact {
 /// Only the closing unit must take an impulse (no-slip if that impulse pushes, else, under
 /// [`ContactInconsistency::Slide`], a frictionless one: a no-slip impact can demand a pulling normal impulse,
 /// the impulsive form of the lift-off inconsistency). Every other unit present (each ground contact, no-slip
-/// or sliding, and each locked stopper) is a candidate of the impulse-level complementarity problem of [`plastic_impact`]: it takes
+/// or sliding, and each locked stopper) is a candidate of the impulse-level complementarity problem of `plastic_impact`: it takes
 /// a non-negative impulse and ends at zero relative normal velocity, or takes none and separates. Nothing is
 /// held through the impact because it was active before: when Leg 2's stopper locks while its tip slides, the
-/// tip may leave the ground (MODEL.md section 4).
+/// tip may leave the ground (docs/model.md section 4).
 pub fn close_unit(
     model: &Model,
     q: &Coords,

@@ -2,15 +2,15 @@
 //!
 //! A [`Walker`] holds the wheel at the Poincare section (just before a touchdown, after re-indexing) and
 //! [`Walker::step`] advances it to the next one: the touchdown impact of [`impact`], then phases of constrained
-//! motion, each integrated by an [`Integrator`](crate::integrate::Integrator) (DOP853 by default) until the earliest event, located on the dense
-//! output (every event function is evaluated at the ends of [`EVENT_SAMPLES`] equal parts of each step):
+//! motion, each integrated by an `Integrator` (DOP853 by default) until the earliest event, located on the dense
+//! output (every event function is evaluated at the ends of `EVENT_SAMPLES` equal parts of each step):
 //!
 //! | event | function crossing zero from above |
 //! |---|---|
-//! | touchdown | height of the lowest tip of the legs not in `q` (the next leg's in a walk, see [`impact::touchdown_leg`]) |
-//! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (to [`FORCE_EVENT_MARGIN`] below 0) |
+//! | touchdown | height of the lowest tip of the legs not in `q` (the next leg's in a walk, see `impact::touchdown_leg`) |
+//! | lift-off of an active contact | normal force `lambda_2` or `lambda_4` (to `FORCE_EVENT_MARGIN` below 0) |
 //! | landing / rear re-contact of an airborne tip | its height (armed once above `recontact_gap`, see below) |
-//! | stopper unlock | the stopper's inward reaction (to [`FORCE_EVENT_MARGIN`] below 0) |
+//! | stopper unlock | the stopper's inward reaction (to `FORCE_EVENT_MARGIN` below 0) |
 //! | stopper hit of a free leg | `L0 - L` (armed once below `L0 - stopper_gap`) |
 //! | fall | hub height minus `fall_hub_height` |
 //! | rolling back | `dtheta/dt` |
@@ -25,16 +25,16 @@
 //! never fire, letting the tip sink.)
 //!
 //! **Impacts.** Every impact (touchdown, rear re-contact, stopper lock) is an impulse-level complementarity
-//! problem over every unilateral unit present (see [`impact::plastic_impact`]); only the closing unit (and at
+//! problem over every unilateral unit present (see `impact::plastic_impact`); only the closing unit (and at
 //! touchdown the paper's (A1)/(A3) choice for Leg 2) is forced. The force-level problem then picks the phase
 //! that follows. A leg that an impact kicks off its stopper too slowly to leave it by `stopper_gap` is locked at
 //! once (the Zeno rule of `zeno.rs`, docs/model.md section 5), and a leg that leaves its stopper faster has its
-//! stopper event fire at `L0` ([`APPROACH_GAP`]).
+//! stopper event fire at `L0` (`APPROACH_GAP`).
 //!
 //! **Audits.** Every step reports an energy audit and a contact audit ([`ContactAudit`]): the largest pulling
-//! force at the ends of the [`EVENT_SAMPLES`] parts of every accepted integrator step and at every event instant,
+//! force at the ends of the `EVENT_SAMPLES` parts of every accepted integrator step and at every event instant,
 //! the largest pulling impulse of its impacts, and
-//! the deepest any tip went below the ground, checked on the dense output at [`PENETRATION_SAMPLES`] points
+//! the deepest any tip went below the ground, checked on the dense output at `PENETRATION_SAMPLES` points
 //! per integrator step.
 //!
 //! **Layout.** `phase.rs` holds the phase ODE, `events.rs` the event functions and their guards,
@@ -48,26 +48,24 @@ mod error;
 mod events;
 pub mod impact;
 mod phase;
-pub mod report;
+pub(crate) mod report;
 mod run;
-pub mod section;
+pub(crate) mod section;
 mod trajectory;
 mod walker;
 mod work;
 mod zeno;
 
-pub use audit::PENETRATION_SAMPLES;
 pub use error::WalkError;
-pub use events::{APPROACH_GAP, EVENT_SAMPLES, FORCE_EVENT_MARGIN};
 pub use impact::{Branch, DlsIndicators};
-pub use phase::{PhaseSystem, WalkState, WalkVector, NY};
+pub use phase::{PhaseSystem, WalkState, WalkVector};
 pub use report::{
     ContactAudit, EnergyAudit, StepReport, ENERGY_RESIDUAL_WARNING, PENETRATION_WARNING,
     PULL_FORCE_WARNING, PULL_IMPULSE_WARNING, STOPPER_OVERRUN_WARNING,
 };
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
-pub use section::SectionState;
+pub use section::{ParseSectionError, SectionState};
 pub use trajectory::{Sample, SampleSink, Trajectory};
-pub use walker::{Walker, SECTION_TIP_SPEED_TOL};
+pub use walker::Walker;
 pub use work::{total_work, EventCounts, WorkCounts};
 pub use zeno::ZENO_IMPULSE_WARNING;

@@ -9,7 +9,7 @@ use crate::dynamics::{Coords, Model, L1, L2, NQ};
 use crate::integrate::OdeSystem;
 
 /// Size of the integrated state `[q, q', E_damper]`.
-pub const NY: usize = 2 * NQ + 1;
+pub(crate) const NY: usize = 2 * NQ + 1;
 /// The integrated state: coordinates, velocities and the energy dissipated by the dampers so far in the step.
 pub type WalkVector = SVector<f64, NY>;
 

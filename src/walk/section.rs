@@ -12,7 +12,7 @@ use crate::dynamics::{Coords, Model, L2, THETA, X, Z};
 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
 /// by rounding only \[m, m/s\].
-pub const RIGID_SECTION_TOL: f64 = 1e-9;
+pub(crate) const RIGID_SECTION_TOL: f64 = 1e-9;
 
 /// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -54,7 +54,7 @@ impl SectionState {
 
     /// `theta` at which Leg 1 (length `L0`, tip at the origin) and Leg 2 (length `L2`) both touch the ground:
     /// `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2 sin(alpha))`.
-    pub fn theta(&self, model: &Model) -> f64 {
+    pub(crate) fn theta(&self, model: &Model) -> f64 {
         let alpha = model.alpha();
         let l0 = model.params().stopper_length;
         ((self.l2 * alpha.cos() - l0) / (self.l2 * alpha.sin())).atan()

@@ -109,7 +109,7 @@ impl Trajectory {
     }
 
     /// Flush the sink, if any (a failure is kept for [`Trajectory::take_error`]).
-    pub fn flush(&mut self) {
+    pub(crate) fn flush(&mut self) {
         if let (Some(sink), None) = (&mut self.sink, &self.error) {
             if let Err(e) = sink.flush() {
                 self.error = Some(e);

@@ -25,7 +25,7 @@ use super::zeno::{lock_zeno_stoppers, ZenoLock};
 
 /// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
 /// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
-pub const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
+pub(crate) const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
 
 /// Bookkeeping of the step in progress.
 #[derive(Debug, Default, Clone, Copy)]
@@ -121,7 +121,7 @@ impl<'m> Walker<'m> {
     /// The section coordinates `(L2, thetadot, L2dot)` at the current touchdown, without the check of
     /// [`Walker::section`]: what a return map or an orbit diagram records. Where the stance tip slides they do
     /// not hold the whole state, so they must not be used to start a walk there.
-    pub fn touchdown_coordinates(&self) -> SectionState {
+    pub(crate) fn touchdown_coordinates(&self) -> SectionState {
         SectionState::from_coords(&self.state.q, &self.state.qd)
     }
 

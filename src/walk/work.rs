@@ -36,7 +36,7 @@ pub struct EventCounts {
 
 impl EventCounts {
     /// No event.
-    pub const ZERO: EventCounts = EventCounts {
+    pub(crate) const ZERO: EventCounts = EventCounts {
         touchdown: 0,
         lift_off: 0,
         unlock: 0,
@@ -98,7 +98,7 @@ pub struct WorkCounts {
 
 impl WorkCounts {
     /// No work.
-    pub const ZERO: WorkCounts = WorkCounts {
+    pub(crate) const ZERO: WorkCounts = WorkCounts {
         steps: 0,
         accepted: 0,
         rejected: 0,

@@ -21,7 +21,7 @@
 //! frame time, so a frame never shows a phase that has not started. The trajectory holds a sample right
 //! after every event, so every phase (every interval between changes of contacts, slides or stoppers) is
 //! known exactly; a phase that no regular frame falls into (say a slide of 0.03 s at 25 frames/s) gets
-//! [`SLOW_FRAMES`] extra frames spread over it, starting at its first instant, and those frames say "slow
+//! `SLOW_FRAMES` extra frames spread over it, starting at its first instant, and those frames say "slow
 //! motion" with the phase's real duration.
 //!
 //! **Encoding.** Frames are drawn with plotters into an RGB buffer and mapped to a fixed palette (the few
@@ -41,18 +41,18 @@ use plotters::prelude::*;
 use super::read::RunData;
 use super::style::{require_font, PlotError};
 use draw::Renderer;
-pub use plan::{plan_frames, FrameTime, SlowMotion, SLOW_FRAMES};
+pub use plan::{plan_frames, FrameTime, SlowMotion};
 
 /// Largest frame rate: GIF delays are whole hundredths of a second and viewers slow down delays below
 /// 0.02 s, so faster frame rates would not play at their speed.
-pub const MAX_FPS: u32 = 50;
+pub(crate) const MAX_FPS: u32 = 50;
 /// Smallest and largest frame side \[px\].
-pub const FRAME_SIDE: std::ops::RangeInclusive<u32> = 160..=4000;
+pub(crate) const FRAME_SIDE: std::ops::RangeInclusive<u32> = 160..=4000;
 
 /// What `vrw animate` draws.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnimateOptions {
-    /// Frames per second of playback. Default 25; at most [`MAX_FPS`].
+    /// Frames per second of playback. Default 25; at most `MAX_FPS`.
     pub fps: u32,
     /// Playback speed: simulated seconds per second of playback. Default 1.
     pub speed: f64,
@@ -124,7 +124,7 @@ pub enum AnimateError {
 
 impl AnimateOptions {
     /// Check every option; the error names the option and the value.
-    pub fn validate(&self) -> Result<(), AnimateError> {
+    pub(crate) fn validate(&self) -> Result<(), AnimateError> {
         let bad = |option, reason: String| Err(AnimateError::InvalidOption { option, reason });
         if !(1..=MAX_FPS).contains(&self.fps) {
             return bad(
@@ -225,7 +225,7 @@ pub fn write_animation(
 ///
 /// # Errors
 /// As [`write_animation`]; a `time` outside the trajectory is an [`AnimateError::EmptyWindow`].
-pub fn write_still(
+pub(crate) fn write_still(
     run: &RunData,
     opts: &AnimateOptions,
     time: f64,

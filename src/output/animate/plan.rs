@@ -4,7 +4,7 @@
 use super::super::read::{RunData, TrajectoryRow};
 use super::{AnimateError, AnimateOptions};
 /// Extra frames given to a phase that no regular frame falls into.
-pub const SLOW_FRAMES: usize = 3;
+pub(crate) const SLOW_FRAMES: usize = 3;
 
 /// A short phase shown in slow motion.
 #[derive(Debug, Clone, PartialEq)]
@@ -44,7 +44,7 @@ pub(super) fn window(run: &RunData, opts: &AnimateOptions) -> Result<(f64, f64),
 }
 
 /// The frame times: regular frames every `speed / fps` of simulated time over `[from, to]`, plus
-/// [`SLOW_FRAMES`] frames over every phase that no regular frame falls into (see the module doc).
+/// `SLOW_FRAMES` frames over every phase that no regular frame falls into (see the module doc).
 pub fn plan_frames(
     samples: &[TrajectoryRow],
     (from, to): (f64, f64),

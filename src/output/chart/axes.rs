@@ -16,7 +16,7 @@ use super::{
 /// Proportions of a chart's axes \[px\]: fonts, the room for tick labels and descriptions, and how many
 /// ticks to label.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AxisStyle {
+pub(crate) struct AxisStyle {
     /// Tick label font size.
     pub tick_font: f64,
     /// Axis description font size.
@@ -36,7 +36,7 @@ pub struct AxisStyle {
 }
 
 /// The axes of the run figures (`run.png`, `steps.png`) and the orbit and basin figures.
-pub const RUN_AXES: AxisStyle = AxisStyle {
+pub(crate) const RUN_AXES: AxisStyle = AxisStyle {
     tick_font: TICK_FONT,
     axis_font: AXIS_FONT,
     y_label_area: Y_LABEL_AREA,
@@ -65,7 +65,7 @@ fn runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
 
 /// The axes of one chart.
 #[derive(Debug, Clone)]
-pub struct Axes<'a> {
+pub(crate) struct Axes<'a> {
     /// X range.
     pub x: Range<f64>,
     /// Y range.
@@ -79,7 +79,7 @@ pub struct Axes<'a> {
 }
 
 /// A chart whose axes are drawn: its plotting area and the map from data to pixels.
-pub struct PlotArea<'a, DB: DrawingBackend> {
+pub(crate) struct PlotArea<'a, DB: DrawingBackend> {
     chart: ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     /// The plotting area; it is drawn on in pixels from its top left corner ([`PlotArea::rel`]).
     pub area: DrawingArea<DB, Shift>,
@@ -100,7 +100,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
     ///
     /// # Errors
     /// When the backend fails.
-    pub fn new(
+    pub(crate) fn new(
         area: &'a DrawingArea<DB, Shift>,
         axes: &Axes,
         style: &AxisStyle,
@@ -152,13 +152,13 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
     }
 
     /// The canvas pixel of the data point `p`.
-    pub fn to_px(&self, p: (f64, f64)) -> (i32, i32) {
+    pub(crate) fn to_px(&self, p: (f64, f64)) -> (i32, i32) {
         self.chart.backend_coord(&p)
     }
 
     /// The pixel of the data point `p` relative to the plotting area (what drawing on [`PlotArea::area`]
     /// takes).
-    pub fn rel(&self, p: (f64, f64)) -> (i32, i32) {
+    pub(crate) fn rel(&self, p: (f64, f64)) -> (i32, i32) {
         let (a, b) = self.to_px(p);
         (a - self.px.start, b - self.py.start)
     }
@@ -178,7 +178,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
     }
 
     /// Draws dashed grey vertical lines at the x values `marks` inside the range.
-    pub fn draw_marks(&self, marks: &[f64]) -> DrawResult<DB> {
+    pub(crate) fn draw_marks(&self, marks: &[f64]) -> DrawResult<DB> {
         let (x, y) = (&self.x, &self.y);
         for &m in marks.iter().filter(|m| x.contains(m)) {
             self.clip.draw_dashed(
@@ -216,7 +216,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
     }
 
     /// Frames the plotting area in black (the axes cover its left and bottom sides).
-    pub fn draw_outline(&self) -> DrawResult<DB> {
+    pub(crate) fn draw_outline(&self) -> DrawResult<DB> {
         let (px, py) = (&self.px, &self.py);
         self.area.draw(&Rectangle::new(
             [(0, 0), (px.end - px.start - 1, py.end - py.start - 1)],
@@ -227,7 +227,7 @@ impl<'a, DB: DrawingBackend> PlotArea<'a, DB> {
 
 /// Draws `curves` over `bands` and the dashed vertical `marks` on one chart area; returns the plot's pixel
 /// rectangle.
-pub fn draw_axes_and_curves<DB: DrawingBackend>(
+pub(crate) fn draw_axes_and_curves<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     axes: &Axes,
     curves: &[Curve],

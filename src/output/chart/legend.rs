@@ -10,7 +10,7 @@ use super::{dashed, Curve, DrawResult, Stroke, LEGEND_FONT};
 
 /// The shape of a marker.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Marker {
+pub(crate) enum Marker {
     /// A disc.
     Circle,
     /// A triangle pointing up.
@@ -18,7 +18,7 @@ pub enum Marker {
 }
 
 /// Draws a marker of size `r` at `at`, filled with `color` or (`hollow`) white with a `color` outline.
-pub fn draw_marker<DB: DrawingBackend>(
+pub(crate) fn draw_marker<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     at: (i32, i32),
     shape: Marker,
@@ -58,7 +58,7 @@ pub fn draw_marker<DB: DrawingBackend>(
 
 /// What a legend row shows left of its text.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Sample {
+pub(crate) enum Sample {
     /// A line of `width` pixels in `stroke`, with a filled marker `(shape, size)` in its middle if any.
     Line {
         /// Colour.
@@ -83,7 +83,7 @@ pub enum Sample {
 
 /// The text of a legend row.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Label<'a> {
+pub(crate) enum Label<'a> {
     /// Plain text, centred on the row.
     Plain(&'a str),
     /// Rich text (subscripts), its line box centred on the row.
@@ -106,7 +106,7 @@ impl Label<'_> {
 
 /// One row of a legend: a sample and its text.
 #[derive(Debug, Clone, PartialEq)]
-pub struct LegendRow<'a> {
+pub(crate) struct LegendRow<'a> {
     /// What stands left of the text.
     pub sample: Sample,
     /// The text.
@@ -114,7 +114,7 @@ pub struct LegendRow<'a> {
 }
 
 /// Draws a legend box at `(x0, y0)` with `rows` in `layout`, texts at font size `size`.
-pub fn draw_legend_rows<DB: DrawingBackend>(
+pub(crate) fn draw_legend_rows<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rows: &[LegendRow],
     layout: &LegendLayout,
@@ -180,7 +180,7 @@ pub fn draw_legend_rows<DB: DrawingBackend>(
 }
 
 /// Draws a legend box with one entry per curve (and extra `(label, colour)` swatches) at `(x0, y0)`.
-pub fn draw_legend<DB: DrawingBackend>(
+pub(crate) fn draw_legend<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     curves: &[Curve],
     swatches: &[(String, RGBColor)],

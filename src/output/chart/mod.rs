@@ -16,24 +16,26 @@ mod axes;
 mod clip;
 mod legend;
 
-pub use axes::{draw_axes_and_curves, Axes, AxisStyle, PlotArea, RUN_AXES};
-pub use clip::{split_sharp_turns, Clip};
-pub use legend::{draw_legend, draw_legend_rows, draw_marker, Label, LegendRow, Marker, Sample};
+pub(crate) use axes::{draw_axes_and_curves, Axes, AxisStyle, PlotArea};
+pub(crate) use clip::Clip;
+pub(crate) use legend::{
+    draw_legend, draw_legend_rows, draw_marker, Label, LegendRow, Marker, Sample,
+};
 
 use super::style::{font, padded, PlotError};
 
 /// Font sizes and layout of the run figures \[px\].
-pub const TITLE_FONT: f64 = 38.0;
+pub(crate) const TITLE_FONT: f64 = 38.0;
 /// Axis descriptions.
-pub const AXIS_FONT: f64 = 30.0;
+pub(crate) const AXIS_FONT: f64 = 30.0;
 /// Tick labels.
-pub const TICK_FONT: f64 = 24.0;
+pub(crate) const TICK_FONT: f64 = 24.0;
 /// Legend entries.
-pub const LEGEND_FONT: f64 = 24.0;
+pub(crate) const LEGEND_FONT: f64 = 24.0;
 /// Outer margin.
-pub const MARGIN: i32 = 24;
+pub(crate) const MARGIN: i32 = 24;
 /// Width reserved right of each panel for its legend.
-pub const LEGEND_W: i32 = 280;
+pub(crate) const LEGEND_W: i32 = 280;
 const Y_LABEL_AREA: i32 = 150;
 const X_LABEL_AREA: i32 = 90;
 const BOTTOM_PAD: i32 = 12;
@@ -41,11 +43,11 @@ const BOTTOM_PAD: i32 = 12;
 const MIN_BAND_PX: i32 = 3;
 
 /// Dash and gap lengths of [`dashed`] lines \[px\].
-pub const DASH_GAP: (f64, f64) = (12.0, 8.0);
+pub(crate) const DASH_GAP: (f64, f64) = (12.0, 8.0);
 
 /// How a curve is drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Stroke {
+pub(crate) enum Stroke {
     /// A solid line.
     Solid,
     /// A dashed line.
@@ -56,7 +58,7 @@ pub enum Stroke {
 
 /// One curve; a non-finite value breaks the line.
 #[derive(Debug, Clone)]
-pub struct Curve {
+pub(crate) struct Curve {
     /// Legend text.
     pub label: String,
     /// Colour.
@@ -69,7 +71,7 @@ pub struct Curve {
 
 /// A shaded stretch of the x axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Band {
+pub(crate) struct Band {
     /// Start.
     pub from: f64,
     /// End.
@@ -80,7 +82,7 @@ pub struct Band {
 
 /// One panel: curves against the shared x.
 #[derive(Debug, Clone)]
-pub struct Panel {
+pub(crate) struct Panel {
     /// Y axis description with unit, e.g. `"θ [rad]"`.
     pub y_label: String,
     /// The curves.
@@ -89,7 +91,7 @@ pub struct Panel {
 
 /// Panels stacked on a shared x axis.
 #[derive(Debug, Clone)]
-pub struct Stack<'a> {
+pub(crate) struct Stack<'a> {
     /// X axis description with unit.
     pub x_label: &'a str,
     /// X range.
@@ -105,10 +107,11 @@ pub struct Stack<'a> {
 }
 
 /// Pixel ranges (x, y) of a plotting area on the canvas.
-pub type PixelRect = (Range<i32>, Range<i32>);
+pub(crate) type PixelRect = (Range<i32>, Range<i32>);
 
 /// The result of a drawing call on backend `DB`.
-pub type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+pub(crate) type DrawResult<DB> =
+    Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
 /// The finite range of the curves' y values, padded.
 fn y_range(curves: &[Curve]) -> Range<f64> {
@@ -131,7 +134,7 @@ fn y_range(curves: &[Curve]) -> Range<f64> {
 }
 
 /// The finite range of `values` (`None` if there is none).
-pub fn finite_range(values: impl Iterator<Item = f64>) -> Option<Range<f64>> {
+pub(crate) fn finite_range(values: impl Iterator<Item = f64>) -> Option<Range<f64>> {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -141,7 +144,7 @@ pub fn finite_range(values: impl Iterator<Item = f64>) -> Option<Range<f64>> {
 }
 
 /// Draws a dashed polyline in pixel coordinates of `area` ([`DASH_GAP`] pattern).
-pub fn dashed<DB: DrawingBackend>(
+pub(crate) fn dashed<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     pts: &[(i32, i32)],
     style: ShapeStyle,
@@ -150,7 +153,7 @@ pub fn dashed<DB: DrawingBackend>(
 }
 
 /// Draws a dashed polyline in pixel coordinates of `area`, with dashes of `dash` and gaps of `gap` pixels.
-pub fn dashed_with<DB: DrawingBackend>(
+pub(crate) fn dashed_with<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     pts: &[(i32, i32)],
     style: ShapeStyle,
@@ -226,7 +229,7 @@ pub fn draw_stack<DB: DrawingBackend>(
 }
 
 /// The font size, at most `max`, at which `title` fits the width of `root` within [`MARGIN`] on each side.
-pub fn title_size<DB: DrawingBackend>(
+pub(crate) fn title_size<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
     max: f64,
@@ -237,7 +240,7 @@ pub fn title_size<DB: DrawingBackend>(
 }
 
 /// Draws `title` centred at the top of `root` and returns the area below it.
-pub fn titled<DB: DrawingBackend>(
+pub(crate) fn titled<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
 ) -> Result<DrawingArea<DB, Shift>, DrawingAreaErrorKind<DB::ErrorType>> {
@@ -257,7 +260,7 @@ pub fn titled<DB: DrawingBackend>(
 }
 
 /// A figure that can be drawn on any plotters backend.
-pub trait Figure {
+pub(crate) trait Figure {
     /// Draws the whole figure on `root`.
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB>;
 }

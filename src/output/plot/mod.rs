@@ -22,7 +22,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::chart::{write_svg_png, DrawResult, Figure};
-pub use super::style::PlotError;
+pub(crate) use super::style::PlotError;
 #[cfg(test)]
 use super::style::{png_size, FAMILY};
 use data::Prepared;
@@ -30,7 +30,7 @@ use draw::draw_fig2;
 
 /// One gait on the sweep: the parameter value and its DLS indicators (docs/model.md section 5).
 #[derive(Debug, Clone, PartialEq)]
-pub struct IndicatorPoint {
+pub(crate) struct IndicatorPoint {
     /// Swept parameter value, e.g. the leg viscosity `c` \[N s/m\].
     pub param: f64,
     /// Impulse indicator `lambda_I4` \[N s\]; NaN when there is no gait.
@@ -51,7 +51,7 @@ pub struct IndicatorPoint {
 
 /// A vertical annotated marker.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ThresholdMark {
+pub(crate) struct ThresholdMark {
     /// Text drawn verbatim beside the line, e.g. `"λ₄⁺ = 0 at c = 220.1"` or `"c = 220.1"`.
     pub label: String,
     /// Parameter value where the line is drawn (same unit as [`IndicatorPoint::param`]).
@@ -60,7 +60,7 @@ pub struct ThresholdMark {
 }
 
 /// What to draw in Fig. 2.
-pub struct Fig2Spec<'a> {
+pub(crate) struct Fig2Spec<'a> {
     /// The sweep; may contain NaN indicators for points without a gait: those are skipped.
     pub points: &'a [IndicatorPoint],
     /// Vertical dashed lines with labels (thresholds, loss of the gait).
@@ -76,7 +76,7 @@ pub struct Fig2Spec<'a> {
 }
 
 /// Size of both the SVG and the PNG, in pixels.
-pub const FIG2_SIZE: (u32, u32) = (1600, 1600);
+pub(crate) const FIG2_SIZE: (u32, u32) = (1600, 1600);
 
 /// Writes Fig. 2 (DLS indicators against the swept parameter) to `svg_path`
 /// and `png_path`, both [`FIG2_SIZE`] pixels.
@@ -91,7 +91,11 @@ pub const FIG2_SIZE: (u32, u32) = (1600, 1600);
 /// [`PlotError::Empty`] if there are no points or no point has a finite
 /// parameter and indicator (nothing is written then); [`PlotError::Draw`] if a
 /// file cannot be drawn or written.
-pub fn write_fig2(spec: &Fig2Spec, svg_path: &Path, png_path: &Path) -> Result<(), PlotError> {
+pub(crate) fn write_fig2(
+    spec: &Fig2Spec,
+    svg_path: &Path,
+    png_path: &Path,
+) -> Result<(), PlotError> {
     let data = Prepared::new(spec)?;
     write_svg_png(&Fig2 { spec, data: &data }, svg_path, png_path, FIG2_SIZE)
 }

@@ -15,7 +15,7 @@ use Cell::{Count, Empty, Real, Text};
 
 /// One row of `orbit.csv`: a value of the diagram and one of its recorded steps (its number from 1 after the
 /// transient), or no step for a value whose walk failed before recording anything.
-pub struct OrbitRow<'a> {
+pub(crate) struct OrbitRow<'a> {
     /// The value's column of the diagram.
     pub column: &'a OrbitColumn,
     /// The step number and the step.
@@ -29,7 +29,7 @@ fn of_step(r: &OrbitRow, cell: impl Fn(&StepReport) -> Cell) -> Cell {
 
 /// The columns of `orbit.csv`: the parameter (named after its config key), the outcome of its walk, and per
 /// recorded step the section state, the DLS indicators and the branch (docs/model.md sections 4-5).
-pub fn orbit_columns<'a>() -> [Column<OrbitRow<'a>>; 12] {
+pub(crate) fn orbit_columns<'a>() -> [Column<OrbitRow<'a>>; 12] {
     [
         Column::param(0, "The parameter's value (its config key's unit).", |r| {
             Real(r.column.value)
@@ -86,7 +86,7 @@ pub fn orbit_columns<'a>() -> [Column<OrbitRow<'a>>; 12] {
 
 /// Write `orbit.csv` for a diagram along `param`: one row per recorded step; a value whose walk failed
 /// before recording anything has one row with empty step fields.
-pub fn write_orbit_csv(
+pub(crate) fn write_orbit_csv(
     path: &Path,
     param: &str,
     columns: &[OrbitColumn],
@@ -112,7 +112,7 @@ fn of_gait(b: &(f64, Option<Gait>), cell: impl Fn(&Gait) -> Cell) -> Cell {
 
 /// The columns of `branch.csv`: the parameter (named after its config key) and the period-1 gait's section
 /// state, DLS indicators and stability (empty where there is no gait).
-pub const BRANCH: [Column<(f64, Option<Gait>)>; 9] = [
+pub(crate) const BRANCH: [Column<(f64, Option<Gait>)>; 9] = [
     Column::param(0, "The parameter's value (its config key's unit).", |b| {
         Real(b.0)
     }),
@@ -153,7 +153,7 @@ pub const BRANCH: [Column<(f64, Option<Gait>)>; 9] = [
 ];
 
 /// Write `branch.csv` for a branch along `param`: the period-1 gait at each value (empty where there is none).
-pub fn write_branch_csv(
+pub(crate) fn write_branch_csv(
     path: &Path,
     param: &str,
     branch: &[(f64, Option<Gait>)],
@@ -174,7 +174,7 @@ fn of_end(p: &BasinPoint, coordinate: impl Fn(&SectionState) -> f64) -> Cell {
 }
 
 /// The columns of `basin.csv`: the grid point, its start on the section, and what the walk from it did.
-pub const BASIN: [Column<BasinPoint>; 11] = [
+pub(crate) const BASIN: [Column<BasinPoint>; 11] = [
     Column::new("ix", "Grid column (x index, from 0).", |p| Count(p.ix)),
     Column::new("iy", "Grid row (y index, from 0).", |p| Count(p.iy)),
     Column::new("L2", "Start: length of Leg 2 [m].", |p| Real(p.start.l2)),
@@ -217,7 +217,7 @@ pub const BASIN: [Column<BasinPoint>; 11] = [
 ];
 
 /// Write `basin.csv`: one row per grid point, row by row.
-pub fn write_basin_csv(path: &Path, grid: &[Vec<BasinPoint>]) -> Result<(), OutputError> {
+pub(crate) fn write_basin_csv(path: &Path, grid: &[Vec<BasinPoint>]) -> Result<(), OutputError> {
     write_table(
         path,
         &header(&BASIN, &[]),

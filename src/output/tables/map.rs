@@ -11,7 +11,7 @@ use crate::output::{write_table, OutputError};
 use Cell::{Count, Empty, Flag, Real, Text};
 
 /// One row of `map.csv`: a point of the map and the `y` value of its row (its `value` is the `x` value).
-pub struct MapPoint<'a> {
+pub(crate) struct MapPoint<'a> {
     /// The `y` value.
     pub y: f64,
     /// The point.
@@ -21,7 +21,7 @@ pub struct MapPoint<'a> {
 /// The columns of `map.csv`: both parameters (named after their config keys), the status (the stability
 /// verdict, or why no gait was found), the gait's scalars (empty where no gait was found) and the failure
 /// message.
-pub fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
+pub(crate) fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
     [
         Column::param(0, "The x parameter's value (its config key's unit).", |m| {
             Real(m.point.value)
@@ -86,7 +86,7 @@ pub fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
 /// (the stability verdict, or why no gait was found), the impact branch, the gait family (numbered within the
 /// row), `period_k`, the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
 /// verdict; empty gait fields where no gait was found.
-pub fn write_map_csv(path: &Path, map: &GaitMap) -> Result<(), OutputError> {
+pub(crate) fn write_map_csv(path: &Path, map: &GaitMap) -> Result<(), OutputError> {
     let columns = map_columns();
     let params = [map.spec.x.param.as_str(), map.spec.y.param.as_str()];
     let points = map

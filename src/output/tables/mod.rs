@@ -7,11 +7,11 @@
 //! `map.csv`, and the attractor tables `orbit.csv`, `branch.csv` and `basin.csv`. Each file holds the
 //! declaration and the writer of its tables.
 
-pub mod attractors;
-pub mod map;
-pub mod steps;
-pub mod sweep;
-pub mod trajectory;
+pub(crate) mod attractors;
+pub(crate) mod map;
+pub(crate) mod steps;
+pub(crate) mod sweep;
+pub(crate) mod trajectory;
 
 use super::num;
 
@@ -19,7 +19,7 @@ use super::num;
 /// Python binding turns each column into an array of its type).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Cell {
-    /// A real number, written with [`num`].
+    /// A real number, written with `num`.
     Real(f64),
     /// A count or an index (also the `0`/`1` flags of `trajectory.csv`).
     Count(usize),
@@ -47,7 +47,7 @@ impl Cell {
 /// The name of a column: fixed, or the name of a swept parameter known only at run time (the leading
 /// columns of `sweep.csv`, `map.csv`, `orbit.csv` and `branch.csv`, named after the parameter's config key).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Name {
+pub(crate) enum Name {
     /// A fixed name.
     Fixed(&'static str),
     /// The name of the `k`-th swept parameter (from 0), given when the table is written.
@@ -55,18 +55,23 @@ pub enum Name {
 }
 
 /// One column of a table whose rows are `T`s.
-pub struct Column<T> {
+pub(crate) struct Column<T> {
     /// The header name.
-    pub name: Name,
-    /// Unit and meaning.
-    pub doc: &'static str,
+    pub(crate) name: Name,
+    /// Unit and meaning (read by the tables' tests, which require every column to have one).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) doc: &'static str,
     /// The cell of a row.
-    pub get: fn(&T) -> Cell,
+    pub(crate) get: fn(&T) -> Cell,
 }
 
 impl<T> Column<T> {
     /// A column with a fixed name.
-    pub const fn new(name: &'static str, doc: &'static str, get: fn(&T) -> Cell) -> Column<T> {
+    pub(crate) const fn new(
+        name: &'static str,
+        doc: &'static str,
+        get: fn(&T) -> Cell,
+    ) -> Column<T> {
         Column {
             name: Name::Fixed(name),
             doc,
@@ -75,7 +80,7 @@ impl<T> Column<T> {
     }
 
     /// A column named after the `k`-th swept parameter.
-    pub const fn param(k: usize, doc: &'static str, get: fn(&T) -> Cell) -> Column<T> {
+    pub(crate) const fn param(k: usize, doc: &'static str, get: fn(&T) -> Cell) -> Column<T> {
         Column {
             name: Name::Param(k),
             doc,
@@ -87,7 +92,7 @@ impl<T> Column<T> {
     ///
     /// # Panics
     /// If the column names a parameter beyond `params` (a table written with too few parameter names).
-    pub fn header_name<'a>(&self, params: &[&'a str]) -> &'a str {
+    pub(crate) fn header_name<'a>(&self, params: &[&'a str]) -> &'a str {
         match self.name {
             Name::Fixed(name) => name,
             Name::Param(k) => params[k],
@@ -96,12 +101,12 @@ impl<T> Column<T> {
 }
 
 /// The header of a table, with `params` the names of its swept parameters.
-pub fn header<'a, T>(columns: &[Column<T>], params: &[&'a str]) -> Vec<&'a str> {
+pub(crate) fn header<'a, T>(columns: &[Column<T>], params: &[&'a str]) -> Vec<&'a str> {
     columns.iter().map(|c| c.header_name(params)).collect()
 }
 
 /// One row of a table: the cell of every column, in order.
-pub fn row<T>(columns: &[Column<T>], item: &T) -> Vec<Cell> {
+pub(crate) fn row<T>(columns: &[Column<T>], item: &T) -> Vec<Cell> {
     columns.iter().map(|c| (c.get)(item)).collect()
 }
 
@@ -109,7 +114,7 @@ pub fn row<T>(columns: &[Column<T>], item: &T) -> Vec<Cell> {
 ///
 /// # Panics
 /// At compile time, if one of them names a swept parameter or `M != N - skip`.
-pub const fn fixed_names<T, const N: usize, const M: usize>(
+pub(crate) const fn fixed_names<T, const N: usize, const M: usize>(
     columns: &[Column<T>; N],
     skip: usize,
 ) -> [&'static str; M] {

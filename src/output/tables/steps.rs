@@ -153,7 +153,7 @@ pub const STEPS: [Column<StepReport>; 30] = [
     ),
 ];
 
-/// Header of `steps.csv` (the names of [`STEPS`]).
+/// Header of `steps.csv` (the names of `STEPS`).
 pub const STEPS_HEADER: [&str; 30] = fixed_names(&STEPS, 0);
 
 /// One row of `steps.csv`, in the order of [`STEPS_HEADER`].
@@ -161,17 +161,17 @@ pub fn step_row(s: &StepReport) -> Vec<Cell> {
     row(&STEPS, s)
 }
 
-/// `steps.csv` written step by step ([`CsvStream`]).
+/// `steps.csv` written step by step (`CsvStream`).
 pub struct StepsCsv(CsvStream);
 
 impl StepsCsv {
     /// Create `path` with the header [`STEPS_HEADER`].
-    pub fn create(path: &Path) -> Result<StepsCsv, OutputError> {
+    pub(crate) fn create(path: &Path) -> Result<StepsCsv, OutputError> {
         CsvStream::create(path, STEPS_HEADER).map(StepsCsv)
     }
 
     /// Write the row of one step and flush it.
-    pub fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
+    pub(crate) fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
         self.0.write(step_row(step).iter().map(Cell::to_csv))
     }
 }

@@ -16,7 +16,7 @@ pub(crate) fn of_gait(p: &SweepPoint, cell: impl Fn(&Gait) -> Cell) -> Cell {
 
 /// The columns of `sweep.csv`: the swept parameter (named after its config key), the status, the gait's
 /// scalars (empty where no gait was found) and the failure message.
-pub const SWEEP: [Column<SweepPoint>; 25] = [
+pub(crate) const SWEEP: [Column<SweepPoint>; 25] = [
     Column::param(
         0,
         "The swept parameter's value (its config key's unit).",

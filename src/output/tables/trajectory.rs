@@ -15,7 +15,7 @@ fn bit(b: bool) -> Cell {
 }
 
 /// The columns of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
-pub const TRAJECTORY: [Column<Sample>; 24] = [
+pub(crate) const TRAJECTORY: [Column<Sample>; 24] = [
     Column::new("time", "Time [s].", |s| Real(s.time)),
     Column::new(
         "x",
@@ -82,7 +82,7 @@ pub const TRAJECTORY: [Column<Sample>; 24] = [
     }),
 ];
 
-/// Header of `trajectory.csv` (the names of [`TRAJECTORY`]).
+/// Header of `trajectory.csv` (the names of `TRAJECTORY`).
 pub const TRAJECTORY_HEADER: [&str; 24] = fixed_names(&TRAJECTORY, 0);
 
 /// One row of `trajectory.csv`, in the order of [`TRAJECTORY_HEADER`]: time, the ten states (`x` from the
@@ -99,7 +99,7 @@ pub struct TrajectoryCsv(CsvStream);
 
 impl TrajectoryCsv {
     /// Create `path` with the header [`TRAJECTORY_HEADER`].
-    pub fn create(path: &Path) -> Result<TrajectoryCsv, OutputError> {
+    pub(crate) fn create(path: &Path) -> Result<TrajectoryCsv, OutputError> {
         CsvStream::create(path, TRAJECTORY_HEADER).map(TrajectoryCsv)
     }
 
