@@ -15,7 +15,7 @@ mod simulate;
 mod sweep;
 
 pub use basin::{default_basin_range, run_basin, BasinJob, BasinSummary};
-pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport};
+pub use figures::{run_animate, run_plot, run_still, AnimateJob, PlotReport, MAX_ANIMATION_FRAMES};
 pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
 };
@@ -23,7 +23,8 @@ pub use map::{run_map, MapJob, MapSummary};
 pub use orbit::{run_orbit, OrbitJob, OrbitSummary};
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
-    DEFAULT_SAMPLE_DT, ENERGY_RESIDUAL_WARNING, MIN_SAMPLE_DT, SUMMARY_STEPS, SUMMARY_WARNINGS,
+    DEFAULT_SAMPLE_DT, ENERGY_RESIDUAL_WARNING, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
+    SUMMARY_STEPS, SUMMARY_WARNINGS,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 
@@ -54,10 +55,11 @@ pub enum AppError {
     /// A figure could not be drawn.
     #[error(transparent)]
     Plot(#[from] crate::output::style::PlotError),
-    /// A bad command-line value that is not a model parameter.
+    /// A bad job setting that is not a model parameter.
     #[error("invalid {option}: {reason}")]
     InvalidOption {
-        /// The option.
+        /// The setting: the job's field, which is the Python keyword (`sample_dt`); the command line shows
+        /// its flag instead (`--sample-dt`).
         option: &'static str,
         /// Why.
         reason: String,

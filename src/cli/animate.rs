@@ -8,6 +8,8 @@ use clap::Args;
 use vrw::app::{run_animate, run_still, AnimateJob};
 use vrw::output::animate::AnimateOptions;
 
+use super::flagged;
+
 #[derive(Debug, Args)]
 pub(super) struct AnimateArgs {
     /// Output directory of `vrw simulate` or `vrw gait` (walk.gif is written there).
@@ -53,12 +55,12 @@ pub(super) fn run(args: AnimateArgs) -> Result<()> {
         },
     };
     if let Some(time) = args.still {
-        let path = run_still(&job, time).context("animate")?;
+        let path = run_still(&job, time).map_err(flagged).context("animate")?;
         println!("wrote {}", path.display());
         return Ok(());
     }
     let started = std::time::Instant::now();
-    let report = run_animate(&job).context("animate")?;
+    let report = run_animate(&job).map_err(flagged).context("animate")?;
     println!(
         "vrw animate: {} frames ({} in slow motion) of t = {:.3} .. {:.3} s, {:.1} s of playback, {:.2} MB in {:.2} s",
         report.frames,

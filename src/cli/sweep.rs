@@ -10,7 +10,7 @@ use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::params::Config;
 use vrw::walk::SectionState;
 
-use super::{confirmed_count, progress_bar, second_route_words, ModelArgs};
+use super::{confirmed_count, flagged, progress_bar, second_route_words, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct SweepArgs {
@@ -73,6 +73,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         bar.set_message(format!("{} = {:.4}: {}", args.param, p.value, p.status));
         bar.inc(1);
     })
+    .map_err(flagged)
     .context("sweep")?;
     bar.finish_and_clear();
     println!(

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::limit_cycle::GaitOptions;
-use super::sweep::{gait_rows, number_families, GaitRow, SweepPoint, SweepSpec};
+use super::sweep::{gait_rows, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec};
 use super::thresholds::{find_thresholds, Threshold};
 use crate::fmt::short;
 use crate::params::{Config, ConfigError};
@@ -33,6 +33,24 @@ use crate::walk::SectionState;
 
 /// The most values along one axis of a map.
 pub const MAX_MAP_AXIS_POINTS: usize = 2000;
+
+/// `vrw map`'s horizontal axis: `--x-from`, `--x-to`, `--nx` (at most [`MAX_MAP_AXIS_POINTS`]).
+pub const MAP_X_RANGE: RangeNames = RangeNames {
+    command: "map x",
+    from: "--x-from",
+    to: "--x-to",
+    points: "--nx",
+    max_points: MAX_MAP_AXIS_POINTS,
+};
+
+/// `vrw map`'s vertical axis: `--y-from`, `--y-to`, `--ny` (at most [`MAX_MAP_AXIS_POINTS`]).
+pub const MAP_Y_RANGE: RangeNames = RangeNames {
+    command: "map y",
+    from: "--y-from",
+    to: "--y-to",
+    points: "--ny",
+    max_points: MAX_MAP_AXIS_POINTS,
+};
 
 /// What to map: two parameters and their ranges.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -48,8 +66,8 @@ impl MapSpec {
     /// most [`MAX_MAP_AXIS_POINTS`] values per axis, and a valid configuration at the four corners (the rules
     /// that join two keys are linear inequalities, so the whole rectangle is then valid).
     pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
-        self.x.validate(config)?;
-        self.y.validate(config)?;
+        self.x.validate_as(config, &MAP_X_RANGE)?;
+        self.y.validate_as(config, &MAP_Y_RANGE)?;
         let invalid = |key: &str, value: String, reason: String| ConfigError::InvalidValue {
             key: key.to_string(),
             value,
@@ -61,15 +79,6 @@ impl MapSpec {
                 format!("--x {} --y {}", self.x.param, self.y.param),
                 "the two axes must be different parameters".to_string(),
             ));
-        }
-        for axis in [&self.x, &self.y] {
-            if axis.points > MAX_MAP_AXIS_POINTS {
-                return Err(invalid(
-                    &format!("map {}", axis.param),
-                    axis.points.to_string(),
-                    format!("at most {MAX_MAP_AXIS_POINTS} values per axis"),
-                ));
-            }
         }
         for x in [self.x.from, self.x.to] {
             for y in [self.y.from, self.y.to] {
@@ -134,6 +143,7 @@ pub fn map_gaits(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<GaitMap, ConfigError> {
     spec.validate(config)?;
+    options.validate()?;
     let xs = spec.x.values();
     let ys = spec.y.values();
     let rows: Vec<GaitRow> = ys

@@ -7,6 +7,7 @@ pub mod continuation;
 pub mod grid;
 pub mod limit_cycle;
 pub mod map;
+pub mod options;
 pub mod orbit;
 pub mod period_k;
 pub mod periodicity;
@@ -18,7 +19,11 @@ pub use limit_cycle::{
     find_gait, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions, Stability,
 };
 pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
+pub use options::{FD_STEP_RANGE, MAX_NEWTON_ITERATIONS, MAX_TRANSIENT_STEPS, TOLERANCE_RANGE};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
-pub use sweep::{gait_rows, sweep, sweep_values, FollowAttempt, GaitRow, SweepPoint, SweepSpec};
+pub use sweep::{
+    check_values, gait_rows, sweep, sweep_values, FollowAttempt, GaitRow, RangeNames, SweepPoint,
+    SweepSpec, SWEEP_RANGE,
+};
 pub use thresholds::{find_thresholds, SecondRoute, Threshold, SECOND_ROUTE_TOL};
