@@ -461,7 +461,7 @@ fn linspace(start: f64, stop: f64, points: &Bound<'_, PyAny>) -> PyResult<Vec<f6
     if !(2..=MAX_SWEEP_POINTS).contains(&points) {
         return Err(invalid(
             format!("points {points}"),
-            format!("a sweep takes 2 to {MAX_SWEEP_POINTS} values"),
+            format!("a sweep takes between 2 and {MAX_SWEEP_POINTS} values"),
         ));
     }
     let spec = SweepSpec {

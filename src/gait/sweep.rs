@@ -102,7 +102,7 @@ impl SweepSpec {
             return Err(invalid(
                 format!("{} {}", names.points, self.points),
                 &format!(
-                    "{} takes 2 to {} values per axis",
+                    "{} takes between 2 and {} values per axis",
                     names.command, names.max_points
                 ),
             ));
@@ -481,7 +481,7 @@ pub fn check_values(
     if !(1..=max_points).contains(&n) {
         return Err(invalid(
             format!("{n} values"),
-            format!("{command} takes 1 to {max_points} values"),
+            format!("{command} takes between 1 and {max_points} values"),
         ));
     }
     if let Some(i) = values.iter().position(|v| !v.is_finite()) {

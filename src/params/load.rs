@@ -806,15 +806,19 @@ mod tests {
             error.to_string(),
             "invalid value 1.5 for `spring_natural_length`: must be >= stopper_length (2)"
         );
+        // Every rule it breaks is listed, each naming the key given.
         let error = Config::load(None, &["stopper_length=0.2"]).unwrap_err();
         assert_eq!(
             error.to_string(),
-            "invalid value 0.2 for `stopper_length`: must be > leg_mass_offset (0.3)"
+            "2 problems: 1) invalid value 0.2 for `stopper_length`: must be > leg_mass_offset (0.3); \
+             2) invalid value 0.2 for `stopper_length`: must be > fall_hub_height (0.3)"
         );
         let error = Config::default()
             .with_values([("stopper_length".to_string(), toml::Value::Float(0.25))])
             .unwrap_err();
-        assert_eq!(key_of(&error), Some("stopper_length"), "{error}");
+        for problem in error.problems() {
+            assert_eq!(key_of(problem), Some("stopper_length"), "{error}");
+        }
         let error = Config::load(None, &["hub_mass=1e-7"]).unwrap_err();
         assert_eq!(key_of(&error), Some("hub_mass"), "{error}");
         assert!(error.to_string().contains("leg_mass / hub_mass"), "{error}");

@@ -178,9 +178,12 @@ impl Params {
                 given,
             )
         });
-        if !["leg_mass", "hub_mass", "viscosity", "stiffness"]
-            .iter()
-            .any(|key| rules.failed(key))
+        // The time scale needs sound masses: not when the mass ratio is already refused.
+        let ratio = self.leg_mass / self.hub_mass;
+        if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)
+            && !["leg_mass", "hub_mass", "viscosity", "stiffness"]
+                .iter()
+                .any(|key| rules.failed(key))
         {
             let result = self.stiff_legs_rule(&|key| rules.given(key));
             rules.between(["viscosity", "stiffness"], |_| result);

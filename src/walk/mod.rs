@@ -61,5 +61,5 @@ pub use report::{ContactAudit, EnergyAudit, StepReport};
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
 pub use section::SectionState;
 pub use trajectory::{Sample, SampleSink, Trajectory};
-pub use walker::{Walker, SECTION_TIP_SPEED_TOL};
+pub use walker::{Walker, INTERRUPT_CHECK_STEPS, SECTION_TIP_SPEED_TOL};
 pub use work::{total_work, EventCounts, WorkCounts};

@@ -4,6 +4,7 @@
 //! re-indexing of the legs.
 
 use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::contact::{ActiveSet, Leg, Phase};
 use crate::dynamics::{Coords, Model, L1, NQ, THETA, X};
@@ -51,7 +52,13 @@ pub struct Walker<'m> {
     blocked: Option<WalkError>,
     /// The work of every step taken so far.
     work: WorkCounts,
+    /// Stops a step in progress when set ([`Walker::with_interrupt`]).
+    interrupt: Option<&'m AtomicBool>,
 }
+
+/// A walker with an interrupt flag reads it every this many accepted integrator steps (and before the
+/// first): stiff legs take millions of integrator steps per walking step, so touchdowns alone are too rare.
+pub const INTERRUPT_CHECK_STEPS: usize = 1000;
 
 /// Where the phases of a step end: the touchdown event, with what the step's report needs.
 struct Touchdown {
@@ -96,6 +103,7 @@ impl<'m> Walker<'m> {
             opts: opts.clone(),
             state,
             steps_done: 0,
+            interrupt: None,
             blocked: None,
             work: WorkCounts::ZERO,
         })
@@ -158,6 +166,13 @@ impl<'m> Walker<'m> {
         self.work += work;
         add_to_total(work);
         reached.map(|touchdown| self.finish_step(&start, touchdown))
+    }
+
+    /// Stops a step in progress when `flag` is set (e.g. by Ctrl-C): the flag is read every
+    /// [`INTERRUPT_CHECK_STEPS`] integrator steps, and the step then fails with [`WalkError::Interrupted`].
+    pub fn with_interrupt(mut self, flag: Option<&'m AtomicBool>) -> Walker<'m> {
+        self.interrupt = flag;
+        self
     }
 
     /// The work of every step this walker took, failed ones included.
@@ -299,6 +314,8 @@ struct Phases<'a> {
     active: ActiveSet,
     /// A step that has not reached its touchdown by then stalls.
     t_limit: f64,
+    /// The walker's interrupt flag ([`Walker::with_interrupt`]).
+    interrupt: Option<&'a AtomicBool>,
     solver: Integrator<NY>,
     events: EventSet<'a>,
     /// Event values at the integrator's current point.
@@ -366,6 +383,7 @@ impl<'a> Phases<'a> {
             y,
             active,
             t_limit,
+            interrupt: walker.interrupt,
             solver,
             events,
             g_prev,
@@ -407,6 +425,16 @@ impl<'a> Phases<'a> {
                 time: self.t,
                 phase,
                 limit: self.opts.max_step_time,
+            });
+        }
+        if self.solver.stats().accepted % INTERRUPT_CHECK_STEPS == 0
+            && self
+                .interrupt
+                .is_some_and(|flag| flag.load(Ordering::Relaxed))
+        {
+            return Err(WalkError::Interrupted {
+                time: self.t,
+                phase,
             });
         }
         let sys = PhaseSystem { model, active };
