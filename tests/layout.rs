@@ -681,7 +681,7 @@ fn test_only_files(files: &[(String, String)]) -> BTreeSet<String> {
     for (rel, text) in files {
         // The directory a file's `mod name;` children live in.
         let dir = match rel.rsplit_once('/') {
-            Some((dir, file)) if file == "mod.rs" => format!("{dir}/"),
+            Some((dir, "mod.rs")) => format!("{dir}/"),
             None if rel == "lib.rs" || rel == "main.rs" => String::new(),
             _ => format!("{}/", rel.trim_end_matches(".rs")),
         };

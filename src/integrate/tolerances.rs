@@ -14,10 +14,10 @@ pub struct Tolerances {
     /// Absolute tolerance \[state units\], default 1e-12.
     pub atol: f64,
     /// Largest step \[s\], default 0.02 (a step may be stretched by up to 1% to land exactly
-    /// on `t_stop`, see [`Dopri5::step`]).
+    /// on `t_stop`, see [`Dopri5::step`](super::Dopri5::step)).
     pub h_max: f64,
     /// Smallest step \[s\]: a controller proposal below it ends the integration with
-    /// [`IntegrationError::StepSizeTooSmall`] (or [`IntegrationError::NonFinite`] if the last
+    /// [`IntegrationError::StepSizeTooSmall`](super::IntegrationError::StepSizeTooSmall) (or [`IntegrationError::NonFinite`](super::IntegrationError::NonFinite) if the last
     /// trial produced non-finite values), default 1e-14. Steps shortened to land on `t_stop`
     /// are not subject to it.
     pub h_min: f64,

@@ -226,7 +226,7 @@ impl Params {
         let Some(scale) = self.leg_time_scale() else {
             return Ok(());
         };
-        if !(scale.seconds < MIN_LEG_TIME_SCALE) {
+        if scale.seconds >= MIN_LEG_TIME_SCALE {
             return Ok(());
         }
         // Name the key the user gave, preferring the one that sets the time scale.

@@ -29,7 +29,7 @@ pub enum WalkError {
         phase: Phase,
     },
     /// The interrupt flag was set during the step (e.g. Ctrl-C); it is read every
-    /// [`INTERRUPT_CHECK_STEPS`](super::walker::INTERRUPT_CHECK_STEPS) integrator steps.
+    /// [`INTERRUPT_CHECK_STEPS`](super::INTERRUPT_CHECK_STEPS) integrator steps.
     #[error("interrupted at t = {time:.6} s in {phase}")]
     Interrupted {
         /// Time \[s\].

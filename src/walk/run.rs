@@ -68,7 +68,7 @@ pub struct WalkEnd {
 /// The walk stops early when a step fails (the failure and its time are in the [`WalkEnd`]), when `on_step`
 /// returns an error (returned as is), when the trajectory's sink fails (find its error with
 /// [`Trajectory::take_error`]), or when `interrupt` is set; the flag is checked before every step and, inside a
-/// step, every [`INTERRUPT_CHECK_STEPS`](super::walker::INTERRUPT_CHECK_STEPS) integrator steps (a step with
+/// step, every [`INTERRUPT_CHECK_STEPS`](super::INTERRUPT_CHECK_STEPS) integrator steps (a step with
 /// stiff legs can take millions), so an interrupted walk ends soon with every completed step reported (the
 /// step in progress is dropped).
 pub fn simulate_streaming<E: From<WalkError>>(

@@ -427,7 +427,11 @@ impl<'a> Phases<'a> {
                 limit: self.opts.max_step_time,
             });
         }
-        if self.solver.stats().accepted % INTERRUPT_CHECK_STEPS == 0
+        if self
+            .solver
+            .stats()
+            .accepted
+            .is_multiple_of(INTERRUPT_CHECK_STEPS)
             && self
                 .interrupt
                 .is_some_and(|flag| flag.load(Ordering::Relaxed))
