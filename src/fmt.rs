@@ -2,7 +2,7 @@
 
 /// A number in short form for messages: up to 6 significant digits, scientific notation when very small or
 /// very large.
-pub(crate) fn short(v: f64) -> String {
+pub fn short(v: f64) -> String {
     let a = v.abs();
     if v == 0.0 || !v.is_finite() || (1e-3..1e6).contains(&a) {
         let text = format!("{v:.6}");

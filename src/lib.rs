@@ -105,7 +105,7 @@
 pub mod app;
 pub mod contact;
 pub mod dynamics;
-pub(crate) mod fmt;
+pub mod fmt;
 pub mod gait;
 pub mod integrate;
 pub mod output;

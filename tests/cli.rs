@@ -610,7 +610,7 @@ fn interrupted_run_keeps_what_was_computed() {
     let dir = temp_dir_with(&[]);
     let out = dir.path().join("out");
     let mut child = Command::new(env!("CARGO_BIN_EXE_vrw"))
-        .args(["simulate", "--steps", "100000000", "--out"])
+        .args(["simulate", "--steps", "10000000", "--out"])
         .arg(&out)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())

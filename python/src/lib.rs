@@ -16,6 +16,8 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
 use vrw::app::{compute_gait, compute_simulation, compute_sweep, AppError, GaitJob, SimulateJob};
+use vrw::fmt::short;
+use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::output::{
     step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
@@ -106,7 +108,16 @@ fn apply_keys(config: Config, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Conf
         let value = toml_value(&key, &value)?;
         values.push((key, value));
     }
-    config.with_values(values).map_err(config_error)
+    let config = config.with_values(values).map_err(config_error)?;
+    // Legs stiff enough to make a run slow: a RuntimeWarning, as the command line warns on stderr.
+    if let Some(warning) = config.params.leg_time_scale().and_then(|s| s.warning()) {
+        let py = keys.map(|d| d.py());
+        if let Some(py) = py {
+            let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+            PyErr::warn(py, category.as_any(), &std::ffi::CString::new(warning)?, 1)?;
+        }
+    }
+    Ok(config)
 }
 
 /// The model's parameters and the solver's settings: every key of a vrw TOML file.
@@ -249,10 +260,10 @@ fn gait_options(
     for (key, value) in options.into_iter().flat_map(|d| d.iter()) {
         let key: String = key.extract()?;
         match key.as_str() {
-            "transient_steps" => o.transient_steps = value.extract()?,
-            "max_iterations" => o.max_iterations = value.extract()?,
-            "tolerance" => o.tolerance = value.extract()?,
-            "fd_step" => o.fd_step = value.extract()?,
+            "transient_steps" => o.transient_steps = count(&key, &value)?,
+            "max_iterations" => o.max_iterations = count(&key, &value)?,
+            "tolerance" => o.tolerance = real(&key, &value)?,
+            "fd_step" => o.fd_step = real(&key, &value)?,
             "refine_jacobian" => o.refine_jacobian = value.extract()?,
             _ => {
                 return Err(PyTypeError::new_err(format!(
@@ -262,14 +273,60 @@ fn gait_options(
             }
         }
     }
-    for (name, v) in [("tolerance", o.tolerance), ("fd_step", o.fd_step)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(PyValueError::new_err(format!(
-                "invalid {name} {v}: must be a positive number"
-            )));
-        }
-    }
+    // The library's ranges, with its message naming the keyword.
+    o.validate().map_err(config_error)?;
     Ok(o)
+}
+
+/// The keyword argument `name` as a count: a non-negative integer that fits the platform's `usize`
+/// (never a bare `OverflowError`: the error names the argument).
+fn count(name: &str, value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    if value.is_instance_of::<PyBool>() || !value.is_instance_of::<PyInt>() {
+        // numpy integers: their Python value.
+        if value.hasattr("dtype")? && value.getattr("ndim")?.extract::<usize>()? == 0 {
+            return count(name, &value.call_method0("item")?);
+        }
+        return Err(PyTypeError::new_err(format!(
+            "`{name}`: expected a non-negative integer, got {}",
+            value.get_type().name()?
+        )));
+    }
+    value.extract::<usize>().map_err(|_| {
+        let shown = value
+            .str()
+            .map_or_else(|_| "?".to_string(), |s| s.to_string());
+        config_error(LibConfigError::InvalidValue {
+            key: name.to_string(),
+            value: shown,
+            reason: "must be a non-negative integer of at most 64 bits".to_string(),
+        })
+    })
+}
+
+/// The keyword argument `name` as a real number (an int or a float; ranges are checked by the library).
+fn real(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    if value.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!(
+            "`{name}`: expected a number, got bool"
+        )));
+    }
+    value.extract::<f64>().map_err(|_| {
+        let kind = value
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_string(), |n| n.to_string());
+        PyTypeError::new_err(format!("`{name}`: expected a number, got {kind}"))
+    })
+}
+
+/// `simulate`'s `steps`, named in its errors.
+fn steps_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("steps", value)
+}
+
+/// `simulate`'s `sample_dt`, named in its errors.
+fn sample_dt_arg(value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    real("sample_dt", value)
 }
 
 /// Walk `steps` steps from `initial` (`vrw simulate`).
@@ -283,10 +340,10 @@ fn gait_options(
 fn simulate<'py>(
     py: Python<'py>,
     params: &Params,
-    steps: usize,
+    #[pyo3(from_py_with = steps_arg)] steps: usize,
     initial: Option<[f64; 3]>,
     trajectory: bool,
-    sample_dt: f64,
+    #[pyo3(from_py_with = sample_dt_arg)] sample_dt: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let job = SimulateJob {
         config: params.config.clone(),
@@ -424,13 +481,29 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> Py
 /// How often a long computation checks Python's signals.
 const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
-/// The values `vrw sweep --from START --to STOP --points POINTS` visits (evenly spaced, ends included).
+/// The values `vrw sweep --from START --to STOP --points POINTS` visits (evenly spaced, ends included), checked
+/// as the command line checks them (2 to `MAX_SWEEP_POINTS` points) before any is made.
 #[pyfunction]
-fn linspace(start: f64, stop: f64, points: usize) -> PyResult<Vec<f64>> {
-    if !(start.is_finite() && stop.is_finite()) || start == stop || points < 2 {
-        return Err(PyValueError::new_err(format!(
-            "linspace({start}, {stop}, {points}): needs two different finite ends and at least 2 points"
-        )));
+fn linspace(start: f64, stop: f64, points: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let points = count("points", points)?;
+    let invalid = |value: String, reason: String| {
+        config_error(LibConfigError::InvalidValue {
+            key: "linspace".to_string(),
+            value,
+            reason,
+        })
+    };
+    if !(start.is_finite() && stop.is_finite()) || start == stop {
+        return Err(invalid(
+            format!("start {} stop {}", short(start), short(stop)),
+            "needs two different finite ends".to_string(),
+        ));
+    }
+    if !(2..=MAX_SWEEP_POINTS).contains(&points) {
+        return Err(invalid(
+            format!("points {points}"),
+            format!("a sweep takes between 2 and {MAX_SWEEP_POINTS} values"),
+        ));
     }
     let spec = SweepSpec {
         param: String::new(),

@@ -15,14 +15,15 @@ Section = Union[Tuple[float, float, float], Sequence[float]]
 class GaitOptions(TypedDict, total=False):
     """Search settings (the library's ``GaitOptions``; ``gait.json``'s ``options``), as keyword arguments."""
 
-    transient_steps: int  # steps walked before Newton's method starts (default 30)
-    max_iterations: int  # Newton iterations allowed (default 20)
-    tolerance: float  # convergence: max |P(s) - s| below this (default 1e-10)
-    fd_step: float  # relative finite-difference step of the Jacobian (default 1e-4)
+    transient_steps: int  # steps walked before Newton's method starts (default 30; 0 to 100000)
+    max_iterations: int  # Newton iterations allowed (default 20; 1 to 1000)
+    tolerance: float  # convergence: max |P(s) - s| below this (default 1e-10; 1e-13 to 1e-6)
+    fd_step: float  # relative finite-difference step of the Jacobian (default 1e-4; 1e-6 to 1e-2)
     refine_jacobian: bool  # Richardson-refined final Jacobian (default True; False in sweeps)
 
 class ConfigError(ValueError):
-    """Invalid parameters (unknown key, wrong type, broken rule, bad TOML file); the command line's message."""
+    """Invalid parameters (unknown key, wrong type, broken rule, bad TOML file), or a search setting, a sweep
+    value or a count out of its range; the command line's message, naming the keyword."""
 
 class WalkError(RuntimeError):
     """A walk that cannot start (e.g. an invalid initial section state); the command line's message."""
@@ -98,4 +99,5 @@ def sweep(
     """
 
 def linspace(start: float, stop: float, points: int) -> List[float]:
-    """The values ``vrw sweep --from START --to STOP --points POINTS`` visits (bit for bit)."""
+    """The values ``vrw sweep --from START --to STOP --points POINTS`` visits (bit for bit); 2 to 100000
+    points, else ``ConfigError``."""

@@ -6,8 +6,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::dynamics::Model;
-use crate::fmt::short;
-use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD, TOLERANCE_RANGE};
 use crate::output;
 use crate::params::Config;
 use crate::reference::default_initial;
@@ -24,7 +23,7 @@ pub struct GaitJob {
     pub config: Config,
     /// Where the search starts (`None`: [`default_initial`]).
     pub initial: Option<SectionState>,
-    /// Search settings.
+    /// Search settings (checked by [`GaitOptions::validate`]).
     pub options: GaitOptions,
     /// Where `gait.json` goes, and one period of the gait in the files of `vrw simulate`.
     pub out_dir: PathBuf,
@@ -53,10 +52,8 @@ pub struct GaitSummary {
     pub warnings: Vec<String>,
 }
 
-/// The smallest Newton tolerance `vrw gait` accepts: the step map is computed to about 1e-13 (integration
-/// and event-location tolerances, rounding over a step of thousands of solves), so a smaller
-/// `max |P(s) - s|` cannot be reached reliably.
-pub(crate) const MIN_GAIT_TOLERANCE: f64 = 1e-13;
+/// The smallest Newton tolerance `vrw gait` accepts: the lower end of [`TOLERANCE_RANGE`], which says why.
+pub const MIN_GAIT_TOLERANCE: f64 = TOLERANCE_RANGE[0];
 
 /// Run `vrw gait`: search the gait (period 1, or if Newton's method fails there and the walk settles, period
 /// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
@@ -81,25 +78,7 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
 /// The search of [`run_gait`] without writing anything (`job.out_dir` is not used). A search that finds no
 /// gait is a summary with its status and message, not an error.
 pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
-    let tolerance = job.options.tolerance;
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(AppError::InvalidOption {
-            option: "--tolerance",
-            reason: format!("{} is not a positive number", short(tolerance)),
-        });
-    }
-    if tolerance < MIN_GAIT_TOLERANCE {
-        return Err(AppError::InvalidOption {
-            option: "--tolerance",
-            reason: format!(
-                "{} is below what the step map can reach (about {}, set by rtol, atol and \
-                 event_time_tol and by rounding); use --tolerance {} or more",
-                short(tolerance),
-                short(MIN_GAIT_TOLERANCE),
-                short(MIN_GAIT_TOLERANCE)
-            ),
-        });
-    }
+    job.options.validate()?;
     job.config.validate()?;
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));

@@ -17,13 +17,16 @@ mod sweep;
 pub use basin::{default_basin_range, run_basin, BasinJob, BasinSummary};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
+    MAX_ANIMATION_FRAMES,
 };
-pub use gait::{compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary};
+pub use gait::{
+    compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
+};
 pub use map::{run_map, MapJob, MapSummary};
 pub use orbit::{run_orbit, OrbitJob, OrbitSummary};
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
-    DEFAULT_SAMPLE_DT,
+    DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 
@@ -79,10 +82,11 @@ pub enum AppError {
         /// The file that holds them.
         kept: &'static str,
     },
-    /// A bad command-line value that is not a model parameter.
+    /// A bad job setting that is not a model parameter.
     #[error("invalid {option}: {reason}")]
     InvalidOption {
-        /// The option.
+        /// The setting: the job's field, which is the Python keyword (`sample_dt`); the command line shows
+        /// its flag instead (`--sample-dt`).
         option: &'static str,
         /// Why.
         reason: String,

@@ -19,7 +19,15 @@ use super::{in_run, AppError};
 use crate::output::manifest::RunDir;
 
 /// The smallest trajectory sampling interval `vrw simulate` accepts \[s\].
-pub(crate) const MIN_SAMPLE_DT: f64 = 1e-6;
+pub const MIN_SAMPLE_DT: f64 = 1e-6;
+
+/// Accepted range of the trajectory sampling interval `sample_dt` \[s\]: from [`MIN_SAMPLE_DT`] to 100 s
+/// (longer than any step, so at most one sample per step besides the events).
+pub const SAMPLE_DT_RANGE: [f64; 2] = [MIN_SAMPLE_DT, 100.0];
+
+/// The most steps `vrw simulate` walks (`steps`): `steps.csv` streams, but at about a millisecond a step
+/// this is already many minutes.
+pub const MAX_SIMULATE_STEPS: usize = 10_000_000;
 
 /// `summary.json` keeps the records of the last this many steps; `steps.csv` has every step.
 pub(crate) const SUMMARY_STEPS: usize = 1000;
@@ -48,6 +56,36 @@ pub struct SimulateJob {
     /// Set it (e.g. from a Ctrl-C handler) to stop the walk at the next touchdown; the results so far are
     /// written with the status `interrupted`.
     pub interrupt: Option<Arc<AtomicBool>>,
+}
+
+impl SimulateJob {
+    /// Checks the job's own settings (the configuration is checked by [`Config::validate`]): `steps` from 1
+    /// to [`MAX_SIMULATE_STEPS`], `sample_dt` in [`SAMPLE_DT_RANGE`]. The error names the setting by its
+    /// field (the Python keyword; the command line renames it to its flag).
+    pub fn validate(&self) -> Result<(), AppError> {
+        if !(1..=MAX_SIMULATE_STEPS).contains(&self.steps) {
+            return Err(AppError::InvalidOption {
+                option: "steps",
+                reason: format!(
+                    "{} steps is not between 1 and {MAX_SIMULATE_STEPS}",
+                    self.steps
+                ),
+            });
+        }
+        let [lo, hi] = SAMPLE_DT_RANGE;
+        if !(self.sample_dt.is_finite() && (lo..=hi).contains(&self.sample_dt)) {
+            return Err(AppError::InvalidOption {
+                option: "sample_dt",
+                reason: format!(
+                    "{} s is not between {} s (a million samples per simulated second) and {} s",
+                    short(self.sample_dt),
+                    short(lo),
+                    short(hi)
+                ),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// `summary.json`: the parameters used, how the run ended, aggregates over every step, and the records of the
@@ -242,23 +280,8 @@ pub fn compute_simulation(
 
 /// Validate a simulate job: its configuration, its sampling interval, its model and its start.
 fn simulation_setup(job: &SimulateJob) -> Result<(Model, SectionState), AppError> {
+    job.validate()?;
     job.config.validate()?;
-    if !(job.sample_dt.is_finite() && job.sample_dt > 0.0) {
-        return Err(AppError::InvalidOption {
-            option: "--sample-dt",
-            reason: format!("{} is not a positive time step", short(job.sample_dt)),
-        });
-    }
-    if job.sample_dt < MIN_SAMPLE_DT {
-        return Err(AppError::InvalidOption {
-            option: "--sample-dt",
-            reason: format!(
-                "{} s is below {} s (a million samples per simulated second)",
-                short(job.sample_dt),
-                short(MIN_SAMPLE_DT)
-            ),
-        });
-    }
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
     initial.validate(&model)?;

@@ -9,7 +9,7 @@ use vrw::app::{run_gait, GaitJob};
 use vrw::gait::GaitOptions;
 use vrw::walk::SectionState;
 
-use super::{progress_bar, ModelArgs};
+use super::{flagged, progress_bar, ModelArgs};
 
 /// `GaitOptions::default().tolerance` as `--help` shows it (a test checks that they agree).
 const DEFAULT_TOLERANCE: &str = "1e-10";
@@ -55,7 +55,7 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let result = run_gait(&job);
     bar.finish_and_clear();
-    let summary = result.context("gait")?;
+    let summary = result.map_err(flagged).context("gait")?;
     let p = &job.config.params;
     println!(
         "vrw gait: c = {} N s/m, slope = {} rad, impact = {}",

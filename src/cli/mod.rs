@@ -20,8 +20,9 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use vrw::app::AppError;
 use vrw::gait::{SecondRoute, Threshold, SECOND_ROUTE_TOL};
-use vrw::params::Config;
+use vrw::params::{Config, ConfigError};
 
 /// Passive dynamic walking of a viscoelastic-legged rimless wheel, with the DLS indicators.
 #[derive(Debug, Parser)]
@@ -65,8 +66,50 @@ struct ModelArgs {
 }
 
 impl ModelArgs {
+    /// The configuration; legs stiff enough to make a run slow draw a warning on stderr before it starts
+    /// (`docs/model.md` section 2, "Stiff legs").
     fn load(&self) -> Result<Config> {
-        Ok(Config::load(self.config.as_deref(), &self.set)?)
+        let config = Config::load(self.config.as_deref(), &self.set)?;
+        if let Some(warning) = config.params.leg_time_scale().and_then(|s| s.warning()) {
+            eprintln!("warning: {warning}");
+        }
+        Ok(config)
+    }
+}
+
+/// The flag of each job setting that the library names by its field (the Python keyword).
+const FLAGS: [(&str, &str); 5] = [
+    ("transient_steps", "--transient"),
+    ("tolerance", "--tolerance"),
+    ("steps", "--steps"),
+    ("sample_dt", "--sample-dt"),
+    ("speed", "--speed"),
+];
+
+/// A job's error with its settings named by their flags: the rule is the library's, the name the command
+/// line's (`invalid value 1 for `--tolerance`` instead of `tolerance`).
+fn flagged(error: AppError) -> AppError {
+    let flag = |name: &str| FLAGS.iter().find(|(field, _)| *field == name).map(|f| f.1);
+    fn renamed(error: ConfigError, flag: &dyn Fn(&str) -> Option<&'static str>) -> ConfigError {
+        match error {
+            ConfigError::InvalidValue { key, value, reason } => ConfigError::InvalidValue {
+                key: flag(&key).map_or(key, str::to_string),
+                value,
+                reason,
+            },
+            ConfigError::Several { errors } => ConfigError::Several {
+                errors: errors.into_iter().map(|e| renamed(e, flag)).collect(),
+            },
+            other => other,
+        }
+    }
+    match error {
+        AppError::InvalidOption { option, reason } => AppError::InvalidOption {
+            option: flag(option).unwrap_or(option),
+            reason,
+        },
+        AppError::Config(e) => AppError::Config(renamed(e, &flag)),
+        other => other,
     }
 }
 

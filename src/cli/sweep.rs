@@ -11,7 +11,8 @@ use vrw::params::Config;
 use vrw::walk::SectionState;
 
 use super::{
-    confirmed_count, interrupt_flag, print_warnings, progress_bar, second_route_words, ModelArgs,
+    confirmed_count, flagged, interrupt_flag, print_warnings, progress_bar, second_route_words,
+    ModelArgs,
 };
 
 #[derive(Debug, Args)]
@@ -77,6 +78,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         bar.set_message(format!("{} = {:.4}: {}", args.param, p.value, p.status));
         bar.inc(1);
     })
+    .map_err(flagged)
     .context("sweep")?;
     bar.finish_and_clear();
     println!(

@@ -8,7 +8,8 @@ use super::step_map::{StepMap, StepOutcome};
 use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport, Walker};
 
-/// How a gait is searched for.
+/// How a gait is searched for. Each setting has a valid range, checked by [`GaitOptions::validate`]
+/// (`gait/options.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct GaitOptions {
     /// Steps walked from the initial state before Newton's method starts (default 30).
@@ -97,6 +98,12 @@ pub enum GaitError {
         /// Distance from the fixed point after `2 period_k` steps.
         distance: f64,
     },
+    /// The search settings break a rule of [`GaitOptions::validate`] (the search does not start).
+    #[error("invalid search settings: {message}")]
+    InvalidOptions {
+        /// The rule broken, naming the setting.
+        message: String,
+    },
     /// `DP - I` is singular (a multiplier at 1: a fold of the gait).
     #[error("DP - I is singular (a Floquet multiplier at 1), residual {residual:e}")]
     SingularJacobian {
@@ -114,6 +121,7 @@ impl GaitError {
             GaitError::Unsettled { .. } => "unsettled",
             GaitError::SectionIncomplete { .. } => "section_incomplete",
             GaitError::SingularJacobian { .. } => "singular_jacobian",
+            GaitError::InvalidOptions { .. } => "invalid_options",
         }
     }
 }
@@ -284,6 +292,9 @@ pub(crate) fn solve_fixed_point(
     options: &GaitOptions,
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<FixedPoint, GaitError> {
+    options.validate().map_err(|e| GaitError::InvalidOptions {
+        message: e.to_string(),
+    })?;
     // The transient is one continuous walk (touchdowns on the way may be off the section, see
     // `WalkError::OffSection`); only where it ends must be on the section.
     let mut s = *initial;

@@ -25,14 +25,32 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::limit_cycle::GaitOptions;
-use super::sweep::{gait_rows, number_families, GaitRow, SweepPoint, SweepSpec};
+use super::sweep::{gait_rows, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec};
 use super::thresholds::{find_thresholds, Threshold};
 use crate::fmt::short;
 use crate::params::{Config, ConfigError};
 use crate::walk::SectionState;
 
 /// The most values along one axis of a map.
-pub(crate) const MAX_MAP_AXIS_POINTS: usize = 2000;
+pub const MAX_MAP_AXIS_POINTS: usize = 2000;
+
+/// `vrw map`'s horizontal axis: `--x-from`, `--x-to`, `--nx` (at most [`MAX_MAP_AXIS_POINTS`]).
+pub const MAP_X_RANGE: RangeNames = RangeNames {
+    command: "map x",
+    from: "--x-from",
+    to: "--x-to",
+    points: "--nx",
+    max_points: MAX_MAP_AXIS_POINTS,
+};
+
+/// `vrw map`'s vertical axis: `--y-from`, `--y-to`, `--ny` (at most [`MAX_MAP_AXIS_POINTS`]).
+pub const MAP_Y_RANGE: RangeNames = RangeNames {
+    command: "map y",
+    from: "--y-from",
+    to: "--y-to",
+    points: "--ny",
+    max_points: MAX_MAP_AXIS_POINTS,
+};
 
 /// What to map: two parameters and their ranges.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -47,9 +65,9 @@ impl MapSpec {
     /// Check the specification: each axis as a sweep ([`SweepSpec::validate`]), two different parameters, at
     /// most [`MAX_MAP_AXIS_POINTS`] values per axis, and a valid configuration at the four corners (the rules
     /// that join two keys are linear inequalities, so the whole rectangle is then valid).
-    pub(crate) fn validate(&self, config: &Config) -> Result<(), ConfigError> {
-        self.x.validate(config)?;
-        self.y.validate(config)?;
+    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+        self.x.validate_as(config, &MAP_X_RANGE)?;
+        self.y.validate_as(config, &MAP_Y_RANGE)?;
         let invalid = |key: &str, value: String, reason: String| ConfigError::InvalidValue {
             key: key.to_string(),
             value,
@@ -61,15 +79,6 @@ impl MapSpec {
                 format!("--x {} --y {}", self.x.param, self.y.param),
                 "the two axes must be different parameters".to_string(),
             ));
-        }
-        for axis in [&self.x, &self.y] {
-            if axis.points > MAX_MAP_AXIS_POINTS {
-                return Err(invalid(
-                    &format!("map {}", axis.param),
-                    axis.points.to_string(),
-                    format!("at most {MAX_MAP_AXIS_POINTS} values per axis"),
-                ));
-            }
         }
         for x in [self.x.from, self.x.to] {
             for y in [self.y.from, self.y.to] {
@@ -134,6 +143,7 @@ pub fn map_gaits(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<GaitMap, ConfigError> {
     spec.validate(config)?;
+    options.validate()?;
     let xs = spec.x.values();
     let ys = spec.y.values();
     let rows: Vec<GaitRow> = ys

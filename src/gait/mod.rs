@@ -7,6 +7,7 @@ pub mod continuation;
 pub(crate) mod grid;
 pub(crate) mod limit_cycle;
 pub mod map;
+pub mod options;
 pub mod orbit;
 pub mod period_k;
 pub(crate) mod periodicity;
@@ -17,8 +18,11 @@ pub(crate) mod thresholds;
 pub use grid::{clear_interrupt, interrupt_flag, interrupted};
 pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions, Stability};
 pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
+pub use options::{FD_STEP_RANGE, MAX_NEWTON_ITERATIONS, MAX_TRANSIENT_STEPS, TOLERANCE_RANGE};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{StepMap, StepOutcome};
-pub(crate) use sweep::sweep_values;
-pub use sweep::{sweep, FollowAttempt, SweepPoint, SweepSpec};
+pub use sweep::{
+    check_values, sweep, sweep_values, FollowAttempt, RangeNames, SweepPoint, SweepSpec,
+    MAX_SWEEP_POINTS, SWEEP_RANGE,
+};
 pub use thresholds::{find_thresholds, SecondRoute, Threshold, SECOND_ROUTE_TOL};

@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use super::grid::{run_rows, Evaluated};
 use super::periodicity::{least_period, MAX_PERIOD};
-use super::sweep::SweepSpec;
+use super::sweep::{RangeNames, SweepSpec};
 use crate::dynamics::Model;
 use crate::params::{Config, ConfigError};
 use crate::walk::WalkError;
@@ -29,7 +29,23 @@ pub(crate) const FRESH_TRANSIENT_FACTOR: usize = 4;
 pub(crate) const PERIOD_TOL: f64 = 1e-6;
 
 /// The largest number of recorded steps per value.
-pub(crate) const MAX_ORBIT_STEPS: usize = 100_000;
+pub const MAX_ORBIT_STEPS: usize = 100_000;
+
+/// The most values an orbit diagram takes (`--points`).
+pub const MAX_ORBIT_VALUES: usize = 10_000;
+
+/// The most steps an orbit diagram walks in all, `points x (transient + steps)` (about a millisecond each):
+/// the recorded returns are held in memory, and this is already hours of computing.
+pub const MAX_ORBIT_WALKED_STEPS: usize = 10_000_000;
+
+/// `vrw orbit`'s range: `--from`, `--to`, `--points` (at most [`MAX_ORBIT_VALUES`]).
+pub const ORBIT_RANGE: RangeNames = RangeNames {
+    command: "orbit",
+    from: "--from",
+    to: "--to",
+    points: "--points",
+    max_points: MAX_ORBIT_VALUES,
+};
 
 /// What to compute.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,9 +59,27 @@ pub struct OrbitSpec {
 }
 
 impl OrbitSpec {
-    /// Check the range against `config` (as a sweep's) and the step counts.
-    pub(crate) fn validate(&self, config: &Config) -> Result<(), ConfigError> {
-        self.range.validate(config)?;
+    /// Check the range against `config` (as a sweep's, with [`ORBIT_RANGE`]) and the step counts (each at
+    /// most [`MAX_ORBIT_STEPS`], all values together at most [`MAX_ORBIT_WALKED_STEPS`]).
+    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+        self.range.validate_as(config, &ORBIT_RANGE)?;
+        let walked = self
+            .range
+            .points
+            .saturating_mul(self.transient.saturating_add(self.steps));
+        if walked > MAX_ORBIT_WALKED_STEPS {
+            return Err(ConfigError::InvalidValue {
+                key: "orbit --points".to_string(),
+                value: format!(
+                    "{} (with --transient {} --steps {})",
+                    self.range.points, self.transient, self.steps
+                ),
+                reason: format!(
+                    "points x (transient + steps) = {walked} steps to walk; orbit walks at most \
+                     {MAX_ORBIT_WALKED_STEPS}"
+                ),
+            });
+        }
         if !(1..=MAX_ORBIT_STEPS).contains(&self.steps) {
             return Err(ConfigError::InvalidValue {
                 key: "orbit --steps".to_string(),

@@ -67,6 +67,9 @@ pub fn find_periodic_gait(
     options: &GaitOptions,
     max_period: usize,
 ) -> Result<Gait, GaitError> {
+    options.validate().map_err(|e| GaitError::InvalidOptions {
+        message: e.to_string(),
+    })?;
     let max_period = max_period.max(1);
     let single = map.iterated(1);
     let walked = options.transient_steps + SETTLE_STEPS.max(max_period + RETURN_WINDOW);
@@ -174,7 +177,10 @@ pub fn find_gait_any_period(
         // A transient that ends off the section (the walk's cycle has touchdowns where the stance tip slides)
         // is not a failure of the walk: look for a longer period.
         Err(e)
-            if (!matches!(e, GaitError::Transient { .. }) || e.kind() == "off_section")
+            if (!matches!(
+                e,
+                GaitError::Transient { .. } | GaitError::InvalidOptions { .. }
+            ) || e.kind() == "off_section")
                 && max_period > 1 =>
         {
             find_periodic_gait(map, initial, options, max_period)

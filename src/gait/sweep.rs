@@ -28,7 +28,7 @@ use crate::params::{Config, ConfigError, SolverOptions};
 use crate::walk::SectionState;
 
 /// The most points a sweep may have.
-pub(crate) const MAX_SWEEP_POINTS: usize = 100_000;
+pub const MAX_SWEEP_POINTS: usize = 100_000;
 
 /// What to sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,36 +43,74 @@ pub struct SweepSpec {
     pub points: usize,
 }
 
+/// How a command names a range of parameter values in its errors (its flags), and the most values it takes:
+/// each command states its own limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RangeNames {
+    /// The command and axis, e.g. `sweep` or `map y`.
+    pub command: &'static str,
+    /// The first value's flag, e.g. `--from` or `--y-from`.
+    pub from: &'static str,
+    /// The last value's flag.
+    pub to: &'static str,
+    /// The number of values' flag, e.g. `--points` or `--ny`.
+    pub points: &'static str,
+    /// The most values.
+    pub max_points: usize,
+}
+
+/// `vrw sweep`'s range: `--from`, `--to`, `--points` (at most [`MAX_SWEEP_POINTS`]).
+pub const SWEEP_RANGE: RangeNames = RangeNames {
+    command: "sweep",
+    from: "--from",
+    to: "--to",
+    points: "--points",
+    max_points: MAX_SWEEP_POINTS,
+};
+
 impl SweepSpec {
-    /// Check the specification against a configuration: a known numeric key, two different finite ends, at
-    /// least 2 points, and a configuration that is valid with the parameter at either end.
-    pub(crate) fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+    /// Check the specification against a configuration as `vrw sweep`'s ([`SWEEP_RANGE`]); see
+    /// [`SweepSpec::validate_as`].
+    pub fn validate(&self, config: &Config) -> Result<(), ConfigError> {
+        self.validate_as(config, &SWEEP_RANGE)
+    }
+
+    /// Check the specification against a configuration: a known numeric key, two different finite ends,
+    /// 2 to `names.max_points` points, and a configuration that is valid with the parameter at either end
+    /// (the rules on one key are intervals, so the whole range is then valid), before anything is computed.
+    /// Errors name the command and its flags (`names`).
+    pub fn validate_as(&self, config: &Config, names: &RangeNames) -> Result<(), ConfigError> {
         config.get_numeric(&self.param)?;
         let invalid = |value: String, reason: &str| ConfigError::InvalidValue {
-            key: format!("sweep {}", self.param),
+            key: format!("{} {}", names.command, self.param),
             value,
             reason: reason.to_string(),
         };
         if !(self.from.is_finite() && self.to.is_finite()) || self.from == self.to {
             return Err(invalid(
-                format!("{}..{}", short(self.from), short(self.to)),
+                format!(
+                    "{} {} {} {}",
+                    names.from,
+                    short(self.from),
+                    names.to,
+                    short(self.to)
+                ),
                 "the range must have two different finite ends",
             ));
         }
-        if !(2..=MAX_SWEEP_POINTS).contains(&self.points) {
+        if !(2..=names.max_points).contains(&self.points) {
             return Err(invalid(
-                self.points.to_string(),
-                &format!("the number of points must be between 2 and {MAX_SWEEP_POINTS}"),
+                format!("{} {}", names.points, self.points),
+                &format!(
+                    "{} takes between 2 and {} values per axis",
+                    names.command, names.max_points
+                ),
             ));
         }
-        // Every rule of the configuration must hold at both ends (the rules on one key are intervals, so the
-        // whole range is then valid), before anything is computed.
-        for (end, value) in [("from", self.from), ("to", self.to)] {
-            let mut at_end = config.clone();
-            at_end.set_numeric(&self.param, value)?;
-            if let Err(e) = at_end.validate() {
+        for (flag, value) in [(names.from, self.from), (names.to, self.to)] {
+            if let Err(e) = config.with(&self.param, value) {
                 return Err(invalid(
-                    format!("--{end} {}", short(value)),
+                    format!("{flag} {}", short(value)),
                     &format!("the range leaves the valid domain: {e}"),
                 ));
             }
@@ -425,9 +463,64 @@ pub fn sweep(
     )
 }
 
+/// Checks a list of values of the real-valued key `param` before a `command` (`sweep`, ...) computes
+/// anything: 1 to `max_points` of them, each finite, and the configuration valid at the smallest and the
+/// largest (the rules on one key are intervals, so it is then valid at every value). The error names the
+/// command, the key, the value, its position in the list, and the rule it breaks.
+pub fn check_values(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    command: &str,
+    max_points: usize,
+) -> Result<(), ConfigError> {
+    config.get_numeric(param)?;
+    let invalid = |value: String, reason: String| ConfigError::InvalidValue {
+        key: format!("{command} {param}"),
+        value,
+        reason,
+    };
+    let n = values.len();
+    if !(1..=max_points).contains(&n) {
+        return Err(invalid(
+            format!("{n} values"),
+            format!("{command} takes between 1 and {max_points} values"),
+        ));
+    }
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(invalid(
+            short(values[i]),
+            format!("value {} of {n} is not a finite number", i + 1),
+        ));
+    }
+    let by_value = |a: &&f64, b: &&f64| a.total_cmp(b);
+    let ends = [
+        values.iter().min_by(by_value),
+        values.iter().max_by(by_value),
+    ];
+    for &value in ends.into_iter().flatten() {
+        if let Err(e) = config.with(param, value) {
+            let i = values.iter().position(|v| *v == value).unwrap_or(0);
+            let rule = match &e {
+                ConfigError::InvalidValue { key, reason, .. } if key == param => reason.clone(),
+                other => other.to_string(),
+            };
+            return Err(invalid(
+                short(value),
+                format!("value {} of {n} is outside the valid domain: {rule}", i + 1),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
-/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of [`gait_rows`].
-pub(crate) fn sweep_values(
+/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of `gait_rows`.
+///
+/// Before anything is computed, the values are checked against the parameter's domain ([`check_values`])
+/// and the settings against their ranges ([`GaitOptions::validate`]): a value outside the domain is an error
+/// naming it and the rule, never a point without a gait (whose edge would pass for a threshold).
+pub fn sweep_values(
     config: &Config,
     param: &str,
     values: &[f64],
@@ -435,7 +528,8 @@ pub(crate) fn sweep_values(
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, ConfigError> {
-    config.get_numeric(param)?;
+    check_values(config, param, values, "sweep", MAX_SWEEP_POINTS)?;
+    options.validate()?;
     let row = GaitRow {
         config: config.clone(),
         param: param.to_string(),

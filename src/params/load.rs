@@ -18,7 +18,7 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use super::de::{self, Entry, Raw, Table};
-use super::{Config, ConfigError, Params, SolverOptions};
+use super::{Config, ConfigError, Params, SolverOptions, MAX_CONFIG_BYTES};
 
 /// The keys of a configuration, found once from the structs.
 struct Keys {
@@ -193,8 +193,27 @@ impl Config {
 
     /// Reads `table` over the defaults and validates the result; a rule between two keys names the key whose
     /// value the user gave.
+    ///
+    /// Every problem is reported at once: the values that cannot be read (each given key read alone over the
+    /// defaults, so that one bad value does not hide the next), or else every broken rule.
     fn read_validated(table: &Table) -> Result<Config, ConfigError> {
-        let config = Config::read(table)?;
+        let config = match Config::read(table) {
+            Ok(config) => config,
+            Err(first) => {
+                let errors: Vec<ConfigError> = table
+                    .iter()
+                    .filter(|(_, value)| value.is_given())
+                    .filter_map(|(key, value)| {
+                        let alone = Table::from([(key.clone(), value.clone())]);
+                        Config::read(&alone).err()
+                    })
+                    .collect();
+                return Err(match ConfigError::all(errors) {
+                    Err(all) => all,
+                    Ok(()) => first,
+                });
+            }
+        };
         config.check(&|key| table.get(key).is_some_and(Raw::is_given))?;
         Ok(config)
     }
@@ -232,12 +251,44 @@ fn split_override(assignment: &str) -> Result<(&str, &str), ConfigError> {
 }
 
 /// The keys and values of the flat TOML file at `path`; errors carry the path.
+///
+/// Only a regular file (or a link to one) is read, and at most [`MAX_CONFIG_BYTES`] of it: a device such as
+/// `/dev/zero` or a pipe would be read forever.
 fn file_table(path: &Path) -> Result<Table, ConfigError> {
+    use std::io::Read;
+
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+    let io = |source| ConfigError::Io {
         path: shown.clone(),
         source,
-    })?;
+    };
+    let refused = |reason: String| ConfigError::NotAConfigFile {
+        path: shown.clone(),
+        reason,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let kind = file.metadata().map_err(io)?.file_type();
+    if !kind.is_file() {
+        return Err(refused(format!(
+            "it is not a regular file (it is {})",
+            if kind.is_dir() {
+                "a directory"
+            } else {
+                "a device, a pipe or a socket"
+            }
+        )));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_CONFIG_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_CONFIG_BYTES {
+        return Err(refused(format!(
+            "it is larger than {MAX_CONFIG_BYTES} bytes (a configuration is a flat file of a few dozen keys)"
+        )));
+    }
+    let text =
+        String::from_utf8(bytes).map_err(|e| refused(format!("it is not UTF-8 text ({e})")))?;
     document(&text, &shown)
 }
 
@@ -755,15 +806,19 @@ mod tests {
             error.to_string(),
             "invalid value 1.5 for `spring_natural_length`: must be >= stopper_length (2)"
         );
+        // Every rule it breaks is listed, each naming the key given.
         let error = Config::load(None, &["stopper_length=0.2"]).unwrap_err();
         assert_eq!(
             error.to_string(),
-            "invalid value 0.2 for `stopper_length`: must be > leg_mass_offset (0.3)"
+            "2 problems: 1) invalid value 0.2 for `stopper_length`: must be > leg_mass_offset (0.3); \
+             2) invalid value 0.2 for `stopper_length`: must be > fall_hub_height (0.3)"
         );
         let error = Config::default()
             .with_values([("stopper_length".to_string(), toml::Value::Float(0.25))])
             .unwrap_err();
-        assert_eq!(key_of(&error), Some("stopper_length"), "{error}");
+        for problem in error.problems() {
+            assert_eq!(key_of(problem), Some("stopper_length"), "{error}");
+        }
         let error = Config::load(None, &["hub_mass=1e-7"]).unwrap_err();
         assert_eq!(key_of(&error), Some("hub_mass"), "{error}");
         assert!(error.to_string().contains("leg_mass / hub_mass"), "{error}");

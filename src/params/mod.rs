@@ -33,8 +33,9 @@ pub(crate) mod load;
 pub(crate) mod model;
 pub(crate) mod solver;
 
-pub use model::Params;
-pub use model::{MASS_RATIO_LIMIT, MAX_LEGS};
+pub use model::{
+    LegTimeScale, Params, MASS_RATIO_LIMIT, MAX_LEGS, MIN_LEG_TIME_SCALE, SLOW_LEG_TIME_SCALE,
+};
 pub use solver::{ContactInconsistency, ImpactModel, SolverOptions};
 pub use solver::{
     ATOL_RANGE, EVENT_TIME_TOL_RANGE, GAP_RANGE, MAX_EVENTS_PER_STEP_LIMIT, MAX_STEP_RANGE,
@@ -60,7 +61,8 @@ pub struct Config {
 
 impl Config {
     /// Checks every rule: [`Params::validate`], [`SolverOptions::validate`] and
-    /// `fall_hub_height < stopper_length`. The error names the first offending key.
+    /// `fall_hub_height < stopper_length`. Every broken rule is reported: one error names its key, several
+    /// are [`ConfigError::Several`].
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.check(&|_| true)
     }
@@ -77,14 +79,77 @@ impl Config {
     /// [`Config::validate`], where a rule between two keys names the one the user gave (`given(key)`, see
     /// [`Params::check`]).
     pub(crate) fn check(&self, given: &dyn Fn(&str) -> bool) -> Result<(), ConfigError> {
-        self.params.check(given)?;
-        self.solver.validate()?;
-        ordered(
-            ("fall_hub_height", self.solver.fall_hub_height),
-            Order::Below,
-            ("stopper_length", self.params.stopper_length),
+        let mut rules = Rules::new(given);
+        self.params.collect(&mut rules);
+        self.solver.collect(&mut rules);
+        rules.between(["fall_hub_height", "stopper_length"], |given| {
+            ordered(
+                ("fall_hub_height", self.solver.fall_hub_height),
+                Order::Below,
+                ("stopper_length", self.params.stopper_length),
+                given,
+            )
+        });
+        rules.finish()
+    }
+}
+
+/// The rules of one input checked together: every broken rule is kept, so that the user sees all of them at
+/// once. A rule between two keys is checked only when both keys passed their own rules (a NaN
+/// `stopper_length` is reported once, not again by every rule that compares with it).
+pub(crate) struct Rules<'a> {
+    /// Whether the user gave a key (see [`ordered`]).
+    given: &'a dyn Fn(&str) -> bool,
+    /// The broken rules so far.
+    errors: Vec<ConfigError>,
+    /// The keys that broke a rule of their own (not a rule between two keys).
+    failed: Vec<String>,
+}
+
+impl<'a> Rules<'a> {
+    /// No rule checked yet.
+    pub(crate) fn new(given: &'a dyn Fn(&str) -> bool) -> Rules<'a> {
+        Rules {
             given,
-        )
+            errors: Vec::new(),
+            failed: Vec::new(),
+        }
+    }
+
+    /// Keeps the error of a rule on one key.
+    pub(crate) fn single(&mut self, result: Result<(), ConfigError>) {
+        if let Err(error) = result {
+            self.failed.extend(error.key().map(str::to_string));
+            self.errors.push(error);
+        }
+    }
+
+    /// Checks a rule between `keys`, unless one of them already broke a rule of its own.
+    pub(crate) fn between(
+        &mut self,
+        keys: [&str; 2],
+        rule: impl FnOnce(&dyn Fn(&str) -> bool) -> Result<(), ConfigError>,
+    ) {
+        if !keys.iter().any(|key| self.failed(key)) {
+            if let Err(error) = rule(self.given) {
+                self.errors.push(error);
+            }
+        }
+    }
+
+    /// Whether `key` broke a rule of its own so far.
+    pub(crate) fn failed(&self, key: &str) -> bool {
+        self.failed.iter().any(|k| k == key)
+    }
+
+    /// Whether the user gave `key`.
+    pub(crate) fn given(&self, key: &str) -> bool {
+        (self.given)(key)
+    }
+
+    /// Nothing broken, the one error, or [`ConfigError::Several`].
+    pub(crate) fn finish(self) -> Result<(), ConfigError> {
+        ConfigError::all(self.errors)
     }
 }
 
@@ -141,6 +206,66 @@ pub enum ConfigError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// A configuration file that is not one: larger than [`MAX_CONFIG_BYTES`], or not a regular file (a
+    /// device such as `/dev/zero`, a directory).
+    #[error("cannot read configuration file {path}: {reason}")]
+    NotAConfigFile {
+        /// The file.
+        path: String,
+        /// Why, e.g. "it is larger than 1048576 bytes".
+        reason: String,
+    },
+    /// Several problems with one input (a file, the `--set` overrides, keyword arguments), each naming its
+    /// key, in the order of the keys' declaration.
+    #[error("{} problems: {}", errors.len(), numbered(errors))]
+    Several {
+        /// The problems, each a single error (never `Several`).
+        errors: Vec<ConfigError>,
+    },
+}
+
+/// The largest configuration file read \[bytes\]: a flat file of every key is about 600 bytes; a larger one
+/// is not a configuration (and a device like `/dev/zero` would be read forever).
+pub const MAX_CONFIG_BYTES: u64 = 1 << 20;
+
+/// "1) first; 2) second".
+fn numbered(errors: &[ConfigError]) -> String {
+    errors
+        .iter()
+        .enumerate()
+        .map(|(i, e)| format!("{}) {e}", i + 1))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+impl ConfigError {
+    /// The key the error names, for the errors that name one (not for [`ConfigError::Several`], which names
+    /// one per problem: see [`ConfigError::problems`]).
+    pub fn key(&self) -> Option<&str> {
+        match self {
+            ConfigError::UnknownKey { key, .. }
+            | ConfigError::InvalidValue { key, .. }
+            | ConfigError::WrongType { key, .. } => Some(key),
+            _ => None,
+        }
+    }
+
+    /// The single problems: the list of [`ConfigError::Several`], or this error alone.
+    pub fn problems(&self) -> Vec<&ConfigError> {
+        match self {
+            ConfigError::Several { errors } => errors.iter().collect(),
+            other => vec![other],
+        }
+    }
+
+    /// `Ok` without errors, the error alone, or [`ConfigError::Several`].
+    pub(crate) fn all(mut errors: Vec<ConfigError>) -> Result<(), ConfigError> {
+        match errors.len() {
+            0 => Ok(()),
+            1 => Err(errors.remove(0)),
+            _ => Err(ConfigError::Several { errors }),
+        }
+    }
 }
 
 /// A [`ConfigError::InvalidValue`] for `key`.
@@ -246,12 +371,7 @@ pub(crate) mod test_support {
 
     /// The key named by an error, for the errors that name one.
     pub(crate) fn key_of(error: &ConfigError) -> Option<&str> {
-        match error {
-            ConfigError::UnknownKey { key, .. }
-            | ConfigError::InvalidValue { key, .. }
-            | ConfigError::WrongType { key, .. } => Some(key),
-            _ => None,
-        }
+        error.key()
     }
 
     /// A temporary file path unique to this test process and `name`.

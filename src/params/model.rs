@@ -4,7 +4,7 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use super::solver::{ContactInconsistency, ImpactModel};
-use super::{finite, invalid, non_negative, ordered, positive, ConfigError, Order::*};
+use super::{finite, invalid, non_negative, ordered, positive, ConfigError, Order::*, Rules};
 use crate::fmt::short;
 
 /// Physical parameters of the wheel and the slope (`docs/model.md` sections 1, 2 and 7).
@@ -89,12 +89,14 @@ impl Params {
         2.0 * PI / self.legs as f64
     }
 
-    /// Checks every rule on the physical parameters; the error names the first offending key.
+    /// Checks every rule on the physical parameters; every broken rule is reported (one error names its key,
+    /// several are [`ConfigError::Several`]).
     ///
     /// Rules: `3 <= legs <=` [`MAX_LEGS`]; every real value finite; `hub_mass`, `leg_mass`, `gravity`, `stopper_length`,
     /// `stiffness > 0`; `hub_inertia`, `viscosity >= 0`; `|slope| < pi/2`;
     /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length`;
-    /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1.
+    /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1; legs not too stiff to integrate (the time scale
+    /// of [`Params::leg_time_scale`] at least [`MIN_LEG_TIME_SCALE`]).
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.check(&|_| true)
     }
@@ -104,38 +106,51 @@ impl Params {
     /// not that the default `spring_natural_length` is wrong. When both or neither were given, the rule
     /// names the key [`Params::validate`] names.
     pub(crate) fn check(&self, given: &dyn Fn(&str) -> bool) -> Result<(), ConfigError> {
+        let mut rules = Rules::new(given);
+        self.collect(&mut rules);
+        rules.finish()
+    }
+
+    /// Checks every rule into `rules` (see [`Params::check`]).
+    pub(crate) fn collect(&self, rules: &mut Rules<'_>) {
         if !(3..=MAX_LEGS).contains(&self.legs) {
-            return Err(invalid(
+            rules.single(Err(invalid(
                 "legs",
                 self.legs,
                 format!("must be between 3 and {MAX_LEGS}"),
-            ));
+            )));
         }
-        positive("hub_mass", self.hub_mass)?;
-        non_negative("hub_inertia", self.hub_inertia)?;
-        positive("leg_mass", self.leg_mass)?;
-        non_negative("leg_mass_offset", self.leg_mass_offset)?;
-        positive("stopper_length", self.stopper_length)?;
-        finite("spring_natural_length", self.spring_natural_length)?;
-        positive("stiffness", self.stiffness)?;
-        non_negative("viscosity", self.viscosity)?;
-        finite("slope", self.slope)?;
-        if self.slope.abs() >= FRAC_PI_2 {
-            return Err(invalid(
-                "slope",
-                short(self.slope),
-                "must satisfy |slope| < pi/2 (a slope angle in radians)",
-            ));
-        }
-        positive("gravity", self.gravity)?;
-        let ratio = self.leg_mass / self.hub_mass;
-        if !(1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio) {
+        rules.single(positive("hub_mass", self.hub_mass));
+        rules.single(non_negative("hub_inertia", self.hub_inertia));
+        rules.single(positive("leg_mass", self.leg_mass));
+        rules.single(non_negative("leg_mass_offset", self.leg_mass_offset));
+        rules.single(positive("stopper_length", self.stopper_length));
+        rules.single(finite("spring_natural_length", self.spring_natural_length));
+        rules.single(positive("stiffness", self.stiffness));
+        rules.single(non_negative("viscosity", self.viscosity));
+        rules.single(finite("slope", self.slope).and_then(|()| {
+            if self.slope.abs() < FRAC_PI_2 {
+                Ok(())
+            } else {
+                Err(invalid(
+                    "slope",
+                    short(self.slope),
+                    "must satisfy |slope| < pi/2 (a slope angle in radians)",
+                ))
+            }
+        }));
+        rules.single(positive("gravity", self.gravity));
+        rules.between(["leg_mass", "hub_mass"], |given| {
+            let ratio = self.leg_mass / self.hub_mass;
+            if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio) {
+                return Ok(());
+            }
             let (key, value) = if !given("leg_mass") && given("hub_mass") {
                 ("hub_mass", self.hub_mass)
             } else {
                 ("leg_mass", self.leg_mass)
             };
-            return Err(invalid(
+            Err(invalid(
                 key,
                 short(value),
                 format!(
@@ -144,23 +159,151 @@ impl Params {
                     short(1.0 / MASS_RATIO_LIMIT),
                     short(MASS_RATIO_LIMIT)
                 ),
-            ));
-        }
+            ))
+        });
         let stopper = ("stopper_length", self.stopper_length);
-        ordered(
-            ("leg_mass_offset", self.leg_mass_offset),
-            Below,
-            stopper,
-            given,
-        )?;
-        ordered(
-            ("spring_natural_length", self.spring_natural_length),
-            AtLeast,
-            stopper,
-            given,
-        )
+        rules.between(["leg_mass_offset", "stopper_length"], |given| {
+            ordered(
+                ("leg_mass_offset", self.leg_mass_offset),
+                Below,
+                stopper,
+                given,
+            )
+        });
+        rules.between(["spring_natural_length", "stopper_length"], |given| {
+            ordered(
+                ("spring_natural_length", self.spring_natural_length),
+                AtLeast,
+                stopper,
+                given,
+            )
+        });
+        // The time scale needs sound masses: not when the mass ratio is already refused.
+        let ratio = self.leg_mass / self.hub_mass;
+        if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)
+            && !["leg_mass", "hub_mass", "viscosity", "stiffness"]
+                .iter()
+                .any(|key| rules.failed(key))
+        {
+            let result = self.stiff_legs_rule(&|key| rules.given(key));
+            rules.between(["viscosity", "stiffness"], |_| result);
+        }
+    }
+
+    /// The fastest time scale of the leg dynamics \[s\] (`docs/model.md` section 2, "Stiff legs"), `None`
+    /// with rigid legs: the smaller of the damper's time constant `m / c` and the spring's `sqrt(m / k)`
+    /// (its period over 2 pi), with `m` the reduced mass `leg_mass hub_mass / (leg_mass + hub_mass)` of the
+    /// two bodies a leg's spring and damper push apart. An explicit integrator needs steps of about this
+    /// size while a leg is free, whatever `max_step` says: see [`LegTimeScale`].
+    pub fn leg_time_scale(&self) -> Option<LegTimeScale> {
+        if self.rigid_legs {
+            return None;
+        }
+        let mass = self.leg_mass * self.hub_mass / (self.leg_mass + self.hub_mass);
+        let damper = if self.viscosity > 0.0 {
+            mass / self.viscosity
+        } else {
+            f64::INFINITY
+        };
+        let spring = (mass / self.stiffness).sqrt();
+        Some(if damper <= spring {
+            LegTimeScale {
+                seconds: damper,
+                key: "viscosity",
+                cause: "the damper's time constant m / c",
+            }
+        } else {
+            LegTimeScale {
+                seconds: spring,
+                key: "stiffness",
+                cause: "the spring's time scale sqrt(m / k)",
+            }
+        })
+    }
+
+    /// Refuses legs so stiff that a walk could not finish in reasonable time ([`MIN_LEG_TIME_SCALE`]).
+    fn stiff_legs_rule(&self, given: &dyn Fn(&str) -> bool) -> Result<(), ConfigError> {
+        let Some(scale) = self.leg_time_scale() else {
+            return Ok(());
+        };
+        if scale.seconds >= MIN_LEG_TIME_SCALE {
+            return Ok(());
+        }
+        // Name the key the user gave, preferring the one that sets the time scale.
+        let key = [scale.key, "leg_mass", "hub_mass"]
+            .into_iter()
+            .find(|key| given(key))
+            .unwrap_or(scale.key);
+        let value = match key {
+            "viscosity" => self.viscosity,
+            "stiffness" => self.stiffness,
+            "leg_mass" => self.leg_mass,
+            _ => self.hub_mass,
+        };
+        Err(invalid(
+            key,
+            short(value),
+            format!(
+                "makes the legs too stiff to integrate: {} is {} s, below {} s (about {} integrator steps \
+                 per simulated second; a step of the gait lasts seconds)",
+                scale.cause,
+                short(scale.seconds),
+                short(MIN_LEG_TIME_SCALE),
+                scale.steps_shown()
+            ),
+        ))
     }
 }
+
+/// The fastest time scale of the leg dynamics ([`Params::leg_time_scale`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegTimeScale {
+    /// The time scale \[s\].
+    pub seconds: f64,
+    /// The key that sets it (`viscosity` or `stiffness`).
+    pub key: &'static str,
+    /// What it is, in words.
+    pub cause: &'static str,
+}
+
+impl LegTimeScale {
+    /// A rough count of integrator steps per simulated second while a leg is free: an explicit
+    /// Dormand-Prince method is stable for steps up to about 3 time scales.
+    pub fn steps_per_second(&self) -> f64 {
+        1.0 / (3.0 * self.seconds)
+    }
+
+    /// [`LegTimeScale::steps_per_second`] to one significant digit, for messages (`4e4`).
+    fn steps_shown(&self) -> String {
+        format!("{:.0e}", self.steps_per_second())
+    }
+
+    /// A warning when the legs are stiff enough to slow a walk down ([`SLOW_LEG_TIME_SCALE`]), `None`
+    /// otherwise.
+    pub fn warning(&self) -> Option<String> {
+        (self.seconds < SLOW_LEG_TIME_SCALE).then(|| {
+            format!(
+                "stiff legs: {} is {} s (set by `{}`), so the integrator needs about {} steps per simulated \
+                 second; runs will be slow (they are refused below {} s)",
+                self.cause,
+                short(self.seconds),
+                self.key,
+                self.steps_shown(),
+                short(MIN_LEG_TIME_SCALE)
+            )
+        })
+    }
+}
+
+/// Legs faster than this \[s\] ([`Params::leg_time_scale`]) are refused: about 3e5 integrator steps per
+/// simulated second, seconds of computing for each simulated second (measured: `viscosity = 1e7`, a time
+/// scale of 9e-8 s, computes about 12 s per simulated second; `1e8`, ten times that), so a gait search of
+/// a hundred steps would take many minutes.
+pub const MIN_LEG_TIME_SCALE: f64 = 1e-6;
+
+/// Legs faster than this \[s\] ([`Params::leg_time_scale`]) draw a warning before a run: about 3e4
+/// integrator steps per simulated second (the defaults' time scale is 0.018 s).
+pub const SLOW_LEG_TIME_SCALE: f64 = 1e-5;
 
 /// `leg_mass / hub_mass` must lie in `[1 / MASS_RATIO_LIMIT, MASS_RATIO_LIMIT]`: beyond it `M(q)` is singular
 /// to rounding and the constraint solves fail.

@@ -9,7 +9,7 @@
 
 use std::fmt;
 
-use super::{invalid, non_negative, within, ConfigError};
+use super::{invalid, non_negative, within, ConfigError, Rules};
 use crate::integrate::Method;
 
 /// Impact law at touchdown (`docs/model.md` section 5).
@@ -153,22 +153,36 @@ impl SolverOptions {
     /// `fall_hub_height < stopper_length` needs the [`Params`](super::Params) and is checked by
     /// [`Config::validate`](super::Config::validate).
     pub fn validate(&self) -> Result<(), ConfigError> {
-        within("rtol", self.rtol, RTOL_RANGE)?;
-        within("atol", self.atol, ATOL_RANGE)?;
-        within("max_step", self.max_step, MAX_STEP_RANGE)?;
-        within("event_time_tol", self.event_time_tol, EVENT_TIME_TOL_RANGE)?;
-        within("recontact_gap", self.recontact_gap, GAP_RANGE)?;
-        within("stopper_gap", self.stopper_gap, GAP_RANGE)?;
-        non_negative("fall_hub_height", self.fall_hub_height)?;
-        within("max_step_time", self.max_step_time, MAX_STEP_TIME_RANGE)?;
+        let mut rules = Rules::new(&|_| true);
+        self.collect(&mut rules);
+        rules.finish()
+    }
+
+    /// Checks every rule into `rules` (see [`SolverOptions::validate`]).
+    pub(crate) fn collect(&self, rules: &mut Rules<'_>) {
+        rules.single(within("rtol", self.rtol, RTOL_RANGE));
+        rules.single(within("atol", self.atol, ATOL_RANGE));
+        rules.single(within("max_step", self.max_step, MAX_STEP_RANGE));
+        rules.single(within(
+            "event_time_tol",
+            self.event_time_tol,
+            EVENT_TIME_TOL_RANGE,
+        ));
+        rules.single(within("recontact_gap", self.recontact_gap, GAP_RANGE));
+        rules.single(within("stopper_gap", self.stopper_gap, GAP_RANGE));
+        rules.single(non_negative("fall_hub_height", self.fall_hub_height));
+        rules.single(within(
+            "max_step_time",
+            self.max_step_time,
+            MAX_STEP_TIME_RANGE,
+        ));
         if !(1..=MAX_EVENTS_PER_STEP_LIMIT).contains(&self.max_events_per_step) {
-            return Err(invalid(
+            rules.single(Err(invalid(
                 "max_events_per_step",
                 self.max_events_per_step,
                 format!("must be between 1 and {MAX_EVENTS_PER_STEP_LIMIT}"),
-            ));
+            )));
         }
-        Ok(())
     }
 }
 

@@ -28,6 +28,15 @@ pub enum WalkError {
         /// Phase.
         phase: Phase,
     },
+    /// The interrupt flag was set during the step (e.g. Ctrl-C); it is read every
+    /// [`INTERRUPT_CHECK_STEPS`](super::INTERRUPT_CHECK_STEPS) integrator steps.
+    #[error("interrupted at t = {time:.6} s in {phase}")]
+    Interrupted {
+        /// Time \[s\].
+        time: f64,
+        /// Phase.
+        phase: Phase,
+    },
     /// No touchdown within `max_step_time`.
     #[error("stalled: no touchdown within {limit} s (t = {time:.6} s, in {phase})")]
     Stalled {
@@ -130,6 +139,7 @@ impl WalkError {
         match self {
             WalkError::Fell { time, .. }
             | WalkError::RolledBack { time, .. }
+            | WalkError::Interrupted { time, .. }
             | WalkError::Stalled { time, .. }
             | WalkError::Chatter { time, .. }
             | WalkError::RearLegNotLocked { time, .. }
@@ -150,6 +160,7 @@ impl WalkError {
         match self {
             WalkError::Fell { .. } => "fell",
             WalkError::RolledBack { .. } => "rolled_back",
+            WalkError::Interrupted { .. } => "interrupted",
             WalkError::Stalled { .. } => "stalled",
             WalkError::Chatter { .. } => "chatter",
             WalkError::RearLegNotLocked { .. } => "rear_leg_not_locked",

@@ -48,6 +48,7 @@ mod error;
 mod events;
 pub mod impact;
 mod phase;
+mod reindex;
 pub(crate) mod report;
 mod run;
 pub(crate) mod section;
@@ -66,6 +67,6 @@ pub use report::{
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
 pub use section::{ParseSectionError, SectionState};
 pub use trajectory::{Sample, SampleSink, Trajectory};
-pub use walker::Walker;
+pub use walker::{Walker, INTERRUPT_CHECK_STEPS};
 pub use work::{total_work, EventCounts, WorkCounts};
 pub use zeno::ZENO_IMPULSE_WARNING;

@@ -67,8 +67,10 @@ pub struct WalkEnd {
 ///
 /// The walk stops early when a step fails (the failure and its time are in the [`WalkEnd`]), when `on_step`
 /// returns an error (returned as is), when the trajectory's sink fails (find its error with
-/// [`Trajectory::take_error`]), or when `interrupt` is set; the flag is checked before every step, so an
-/// interrupted walk ends at a touchdown with every completed step reported.
+/// [`Trajectory::take_error`]), or when `interrupt` is set; the flag is checked before every step and, inside a
+/// step, every [`INTERRUPT_CHECK_STEPS`](super::INTERRUPT_CHECK_STEPS) integrator steps (a step with
+/// stiff legs can take millions), so an interrupted walk ends soon with every completed step reported (the
+/// step in progress is dropped).
 pub fn simulate_streaming<E: From<WalkError>>(
     model: &Model,
     opts: &SolverOptions,
@@ -78,7 +80,7 @@ pub fn simulate_streaming<E: From<WalkError>>(
     interrupt: Option<&std::sync::atomic::AtomicBool>,
     mut on_step: impl FnMut(&StepReport) -> Result<(), E>,
 ) -> Result<WalkEnd, E> {
-    let mut walker = Walker::new(model, opts, initial)?;
+    let mut walker = Walker::new(model, opts, initial)?.with_interrupt(interrupt);
     let mut end = WalkEnd {
         steps: 0,
         failure: None,
@@ -104,6 +106,10 @@ pub fn simulate_streaming<E: From<WalkError>>(
                 end.steps += 1;
                 end.time = walker.state().time;
                 on_step(&report)?;
+            }
+            Err(WalkError::Interrupted { .. }) => {
+                end.interrupted = true;
+                break;
             }
             Err(e) => {
                 end.time = e.time().unwrap_or(end.time);

@@ -4,9 +4,10 @@
 //! re-indexing of the legs.
 
 use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::contact::{ActiveSet, Leg, Phase};
-use crate::dynamics::{Coords, Model, L1, NQ, THETA, X};
+use crate::dynamics::{Coords, Model, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
 
@@ -17,6 +18,7 @@ use super::impact::{
     touchdown_impact, touchdown_leg, Branch, Candidate, TouchdownImpact, Unit,
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
+use super::reindex::reindex;
 use super::report::{ContactAudit, EnergyAudit, StepReport};
 use super::section::SectionState;
 use super::trajectory::Trajectory;
@@ -63,7 +65,13 @@ pub struct Walker<'m> {
     blocked: Option<WalkError>,
     /// The work of every step taken so far.
     work: WorkCounts,
+    /// Stops a step in progress when set ([`Walker::with_interrupt`]).
+    interrupt: Option<&'m AtomicBool>,
 }
+
+/// A walker with an interrupt flag reads it every this many accepted integrator steps (and before the
+/// first): stiff legs take millions of integrator steps per walking step, so touchdowns alone are too rare.
+pub const INTERRUPT_CHECK_STEPS: usize = 1000;
 
 /// Where the phases of a step end: the touchdown event, with what the step's report needs.
 struct Touchdown {
@@ -108,6 +116,7 @@ impl<'m> Walker<'m> {
             opts: opts.clone(),
             state,
             steps_done: 0,
+            interrupt: None,
             blocked: None,
             work: WorkCounts::ZERO,
         })
@@ -170,6 +179,13 @@ impl<'m> Walker<'m> {
         self.work += work;
         add_to_total(work);
         reached.map(|touchdown| self.finish_step(&start, touchdown))
+    }
+
+    /// Stops a step in progress when `flag` is set (e.g. by Ctrl-C): the flag is read every
+    /// [`INTERRUPT_CHECK_STEPS`] integrator steps, and the step then fails with [`WalkError::Interrupted`].
+    pub fn with_interrupt(mut self, flag: Option<&'m AtomicBool>) -> Walker<'m> {
+        self.interrupt = flag;
+        self
     }
 
     /// The work of every step this walker took, failed ones included.
@@ -326,6 +342,8 @@ struct Phases<'a> {
     active: ActiveSet,
     /// A step that has not reached its touchdown by then stalls.
     t_limit: f64,
+    /// The walker's interrupt flag ([`Walker::with_interrupt`]).
+    interrupt: Option<&'a AtomicBool>,
     solver: Integrator<NY>,
     events: EventSet<'a>,
     /// Event values at the integrator's current point.
@@ -393,6 +411,7 @@ impl<'a> Phases<'a> {
             y,
             active,
             t_limit,
+            interrupt: walker.interrupt,
             solver,
             events,
             g_prev,
@@ -434,6 +453,20 @@ impl<'a> Phases<'a> {
                 time: self.t,
                 phase,
                 limit: self.opts.max_step_time,
+            });
+        }
+        if self
+            .solver
+            .stats()
+            .accepted
+            .is_multiple_of(INTERRUPT_CHECK_STEPS)
+            && self
+                .interrupt
+                .is_some_and(|flag| flag.load(Ordering::Relaxed))
+        {
+            return Err(WalkError::Interrupted {
+                time: self.t,
+                phase,
             });
         }
         let sys = PhaseSystem { model, active };
@@ -653,59 +686,4 @@ fn release_contact(
         .map_err(WalkError::contact_at(time, phase))?
         .ok_or(WalkError::InconsistentContacts { time, phase })?;
     Ok(new_active)
-}
-
-/// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
-/// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
-/// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be locked at `L0` and in the air.
-/// The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
-fn reindex(
-    model: &Model,
-    time: f64,
-    q: &Coords,
-    qd: &Coords,
-    active: ActiveSet,
-    touching: usize,
-) -> Result<(Coords, Coords, ActiveSet), WalkError> {
-    // The touching leg is `shift` legs ahead of Leg 1; with `shift > 1` the new Leg 2 is a locked leg.
-    let shift = model.legs() - touching;
-    let leaving: &[Leg] = if shift == 1 { &[Leg::Two] } else { &Leg::BOTH };
-    for &leg in leaving {
-        if active.contact(leg) {
-            return Err(WalkError::RearLegInContact { time });
-        }
-        if !active.lock(leg) {
-            let i = leg.length_coordinate();
-            return Err(WalkError::RearLegNotLocked {
-                time,
-                length: q[i],
-                rate: qd[i],
-            });
-        }
-    }
-    let front = model.tip(q, qd, touching);
-    let v = front.velocity(qd);
-    let l0 = model.params().stopper_length;
-    let (l2, l2_dot) = if shift == 1 {
-        (q[L1], qd[L1])
-    } else {
-        (l0, 0.0)
-    };
-    let theta = if shift == 1 {
-        q[THETA] - model.alpha()
-    } else {
-        // psi of the touching leg, in [-pi, pi].
-        let psi = q[THETA] + touching as f64 * model.alpha();
-        psi - std::f64::consts::TAU * (psi / std::f64::consts::TAU).round()
-    };
-    let q_new = Coords::new(0.0, front.position.y, theta, l0, l2);
-    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot);
-    let before = ActiveSet {
-        contact1: false,
-        contact2: shift == 1 && active.contact1,
-        lock1: true,
-        lock2: shift > 1 || active.lock1,
-        ..Default::default()
-    };
-    Ok((q_new, qd_new, before))
 }

@@ -1,0 +1,62 @@
+//! Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg becomes Leg 1, the legs
+//! behind it shift, and the legs that leave `q` must be locked and in the air.
+
+use crate::contact::{ActiveSet, Leg};
+use crate::dynamics::{Coords, Model, L1, THETA};
+
+use super::error::WalkError;
+
+/// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
+/// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
+/// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be locked at `L0` and in the air.
+/// The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
+pub(super) fn reindex(
+    model: &Model,
+    time: f64,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+    touching: usize,
+) -> Result<(Coords, Coords, ActiveSet), WalkError> {
+    // The touching leg is `shift` legs ahead of Leg 1; with `shift > 1` the new Leg 2 is a locked leg.
+    let shift = model.legs() - touching;
+    let leaving: &[Leg] = if shift == 1 { &[Leg::Two] } else { &Leg::BOTH };
+    for &leg in leaving {
+        if active.contact(leg) {
+            return Err(WalkError::RearLegInContact { time });
+        }
+        if !active.lock(leg) {
+            let i = leg.length_coordinate();
+            return Err(WalkError::RearLegNotLocked {
+                time,
+                length: q[i],
+                rate: qd[i],
+            });
+        }
+    }
+    let front = model.tip(q, qd, touching);
+    let v = front.velocity(qd);
+    let l0 = model.params().stopper_length;
+    let (l2, l2_dot) = if shift == 1 {
+        (q[L1], qd[L1])
+    } else {
+        (l0, 0.0)
+    };
+    let theta = if shift == 1 {
+        q[THETA] - model.alpha()
+    } else {
+        // psi of the touching leg, in [-pi, pi].
+        let psi = q[THETA] + touching as f64 * model.alpha();
+        psi - std::f64::consts::TAU * (psi / std::f64::consts::TAU).round()
+    };
+    let q_new = Coords::new(0.0, front.position.y, theta, l0, l2);
+    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot);
+    let before = ActiveSet {
+        contact1: false,
+        contact2: shift == 1 && active.contact1,
+        lock1: true,
+        lock2: shift > 1 || active.lock1,
+        ..Default::default()
+    };
+    Ok((q_new, qd_new, before))
+}
