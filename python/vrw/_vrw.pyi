@@ -60,7 +60,8 @@ def simulate(
     """Walk ``steps`` steps from ``initial`` (``vrw simulate``).
 
     ``initial`` is the Poincare-section state ``(L2, thetadot, L2dot)``; ``None`` is the command line's
-    default ``(0.72, 1.0, 0.0)`` (``(L0, 1.0, 0.0)`` with ``rigid_legs``). Returns the fields of
+    default, derived from the parameters (``(0.72, 1.0, 0.0)`` for Table 1, the rigid gait with
+    ``rigid_legs``; see ``docs/model.md`` section 6). Returns the fields of
     ``summary.json`` (``status``: ``completed`` or the failure kind, ``message``, ``steps_completed``,
     ``end_time``, ``config``, ...) with ``steps`` replaced by a dict of numpy arrays keyed like the columns
     of ``steps.csv`` and ``trajectory`` a dict of numpy arrays keyed like ``trajectory.csv`` (``None`` if

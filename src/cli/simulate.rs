@@ -17,7 +17,8 @@ pub(super) struct SimulateArgs {
     /// Number of steps (touchdowns) to walk.
     #[arg(long, default_value_t = 20)]
     steps: usize,
-    /// Initial Poincare-section state `L2,thetadot,L2dot` (m, rad/s, m/s); default 0.72,1.0,0.0
+    /// Initial Poincare-section state `L2,thetadot,L2dot` (m, rad/s, m/s); default: derived from the parameters
+    /// (0.72,1.0,0.0 for Table 1; docs/model.md section 6)
     /// (with rigid_legs: L0 and the rigid wheel's gait speed, from its closed form).
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
