@@ -326,3 +326,53 @@ pub fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
     let be = |s: &[u8]| u32::from_be_bytes([s[0], s[1], s[2], s[3]]);
     Some((be(&bytes[16..20]), be(&bytes[20..24])))
 }
+
+/// Encode an RGB bitmap of `size` pixels as the PNG file `path`, with the encoder plotters uses (the same
+/// bytes as its `BitMapBackend::new(path, ..)`), but encoded in memory and written with `std::fs::write`: a
+/// failed write (a full disk) is an error that says what happened (`No space left on device`), where plotters
+/// prints debug text, and it is never lost in a buffered writer's drop.
+pub(crate) fn save_png(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<(), PlotError> {
+    use image::ImageEncoder;
+    let fail = |message: String| PlotError::Draw {
+        path: path.display().to_string(),
+        message,
+    };
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(rgb, size.0, size.1, image::ColorType::Rgb8)
+        .map_err(|e| fail(e.to_string()))?;
+    std::fs::write(path, bytes).map_err(|e| fail(e.to_string()))
+}
+
+impl PlotError {
+    /// The same error, naming `path` (the file the user asked for, not its temporary name).
+    pub(crate) fn at(self, path: &Path) -> PlotError {
+        match self {
+            PlotError::Draw { message, .. } => PlotError::Draw {
+                path: path.display().to_string(),
+                message,
+            },
+            other => other,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A full disk is reported as the OS says it, not as plotters' debug text
+    /// (`ImageError(IoError(Custom {...}))`).
+    #[test]
+    fn full_disk_error_is_readable() {
+        let full = Path::new("/dev/full");
+        if !full.exists() {
+            return; // not a Linux machine
+        }
+        let e = save_png(full, &[255; 3 * 4 * 4], (4, 4))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("No space left on device"), "{e}");
+        assert!(!e.contains("Custom") && !e.contains("IoError"), "{e}");
+    }
+}

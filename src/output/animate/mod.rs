@@ -39,7 +39,7 @@ use std::path::{Path, PathBuf};
 use plotters::prelude::*;
 
 use super::read::RunData;
-use super::style::{require_font, PlotError};
+use super::style::{require_font, save_png, PlotError};
 use draw::Renderer;
 pub use plan::{plan_frames, FrameTime, SlowMotion};
 
@@ -243,9 +243,14 @@ pub(crate) fn write_still(
         });
     }
     require_font(path)?;
-    let root = BitMapBackend::new(path, (opts.width, opts.height)).into_drawing_area();
-    let frame = FrameTime { time, slow: None };
-    Ok(Renderer::new(run, opts).draw(&root, &frame, path)?)
+    let size = (opts.width, opts.height);
+    let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        let frame = FrameTime { time, slow: None };
+        Renderer::new(run, opts).draw(&root, &frame, path)?;
+    }
+    Ok(save_png(path, &rgb, size)?)
 }
 
 #[cfg(test)]

@@ -289,12 +289,16 @@ pub fn write_svg_png(
 pub fn write_png(figure: &impl Figure, png: &Path, size: (u32, u32)) -> Result<(), PlotError> {
     super::style::require_font(png)?;
     crate::output::write_atomic(png, |temp| {
-        let root = BitMapBackend::new(temp, size).into_drawing_area();
-        figure
-            .draw(&root)
-            .map_err(|e| PlotError::draw_at(png)(e.to_string()))?;
-        root.present()
-            .map_err(|e| PlotError::draw_at(png)(e.to_string()))
+        let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+            figure
+                .draw(&root)
+                .map_err(|e| PlotError::draw_at(png)(e.to_string()))?;
+            root.present()
+                .map_err(|e| PlotError::draw_at(png)(e.to_string()))?;
+        }
+        super::style::save_png(temp, &rgb, size).map_err(|e| e.at(png))
     })
     .map_err(|e| e.renamed(&crate::output::temp_path(png), png))
 }
