@@ -5,21 +5,15 @@
 //! new counts (`cargo insta review`, or `INSTA_UPDATE=always cargo test --release --test work_counts`) and
 //! commit the updated `tests/snapshots/`.
 
-use std::sync::Mutex;
-
 use vrw::dynamics::Model;
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::integrate::Method;
 use vrw::params::Config;
 use vrw::reference::default_initial;
-use vrw::walk::{simulate, total_work, WorkCounts};
+use vrw::walk::{simulate, WorkCounts};
 
 /// Steps of the paper's walk (the default of `vrw simulate`).
 const WALK_STEPS: usize = 20;
-
-/// The gait search's work is read from the process-wide tally, which every walker in this test binary adds
-/// to: the tests take turns.
-static TURN: Mutex<()> = Mutex::new(());
 
 fn config(method: Method) -> Config {
     let mut config = Config::default();
@@ -29,7 +23,6 @@ fn config(method: Method) -> Config {
 
 /// The work of the paper's walk: `WALK_STEPS` steps from the default start.
 fn walk_work(method: Method) -> WorkCounts {
-    let _turn = TURN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let config = config(method);
     let model = Model::new(&config.params).unwrap();
     let run = simulate(
@@ -49,11 +42,9 @@ fn walk_work(method: Method) -> WorkCounts {
 
 /// The work of the paper's gait search (transient, Newton, Jacobian) from the default start.
 fn gait_work(method: Method) -> WorkCounts {
-    let _turn = TURN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let config = config(method);
     let model = Model::new(&config.params).unwrap();
     let map = StepMap::new(&model, &config.solver);
-    let before = total_work();
     let gait = find_gait(
         &map,
         &default_initial(&config),
@@ -61,9 +52,8 @@ fn gait_work(method: Method) -> WorkCounts {
         None,
     )
     .unwrap();
-    let work = total_work().since(&before);
     assert!(gait.stable, "{gait:?}");
-    work
+    map.work()
 }
 
 #[test]
@@ -89,7 +79,6 @@ fn paper_gait_work_dopri5() {
 /// A walk's counts are its steps' counts: the same walk split in two gives the same total.
 #[test]
 fn work_adds_up_over_steps() {
-    let _turn = TURN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let config = Config::default();
     let model = Model::new(&config.params).unwrap();
     let start = default_initial(&config);

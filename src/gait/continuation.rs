@@ -434,7 +434,7 @@ fn on_orbit(map: &StepMap, orbit: &SectionState, k: usize, s: &SectionState) -> 
     if orbit.distance(s) <= SAME_GAIT_TOL {
         return true;
     }
-    let Ok(mut walker) = Walker::new(map.model(), map.options(), orbit) else {
+    let Ok(mut walker) = map.walker(orbit) else {
         return false;
     };
     for _ in 1..k {

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::step_map::{StepMap, StepOutcome};
 use crate::walk::WalkError;
-use crate::walk::{Branch, ContactAudit, SectionState, StepReport, Walker};
+use crate::walk::{Branch, ContactAudit, SectionState, StepReport};
 
 /// How a gait is searched for. Each setting has a valid range, checked by [`GaitOptions::validate`]
 /// (`gait/options.rs`).
@@ -300,7 +300,7 @@ pub(crate) fn solve_fixed_point(
     let mut s = *initial;
     if options.transient_steps > 0 {
         let transient = |step: usize| move |source| GaitError::Transient { step, source };
-        let mut walker = Walker::new(map.model(), map.options(), initial).map_err(transient(1))?;
+        let mut walker = map.walker(initial).map_err(transient(1))?;
         for step in 1..=options.transient_steps {
             walker.step(None).map_err(transient(step))?;
         }

@@ -32,7 +32,7 @@ use super::periodicity::SAME_GAIT_TOL;
 pub use super::periodicity::{least_period, MAX_PERIOD};
 pub(crate) use super::periodicity::{return_distances, RETURN_TOL, RETURN_WINDOW};
 use super::step_map::StepMap;
-use crate::walk::{SectionState, Walker};
+use crate::walk::SectionState;
 
 /// Steps walked after the transient before the period is looked for.
 pub(crate) const SETTLE_STEPS: usize = 64;
@@ -43,7 +43,7 @@ fn walk_period(
     s: &SectionState,
     k: usize,
 ) -> Result<(Vec<SectionState>, Vec<crate::walk::StepReport>), crate::walk::WalkError> {
-    let mut walker = Walker::new(map.model(), map.options(), s)?;
+    let mut walker = map.walker(s)?;
     let mut states = vec![*s];
     let mut reports = Vec::with_capacity(k);
     for i in 0..k {
@@ -73,7 +73,8 @@ pub fn find_periodic_gait(
     let max_period = max_period.max(1);
     let single = map.iterated(1);
     let walked = options.transient_steps + SETTLE_STEPS.max(max_period + RETURN_WINDOW);
-    let mut walker = Walker::new(single.model(), single.options(), initial)
+    let mut walker = single
+        .walker(initial)
         .map_err(|source| GaitError::Transient { step: 1, source })?;
     // The returns' coordinates, and the last return on the section (where Newton's method on P^k may start:
     // touchdowns off the section, where the stance tip slides, can be inside the cycle but not start it).

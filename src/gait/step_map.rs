@@ -16,13 +16,16 @@
 //! checked against the closed-form Floquet multiplier of the rigid rimless wheel instead (tests), where they
 //! agree to about 1e-9.
 
+use std::ops::{Deref, DerefMut};
+use std::sync::{Arc, Mutex};
+
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::dynamics::Model;
 use crate::params::SolverOptions;
 use crate::walk::WalkError;
-use crate::walk::{SectionState, StepReport, Walker};
+use crate::walk::{SectionState, StepReport, Walker, WorkCounts};
 
 /// One evaluation of the step map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,6 +43,8 @@ pub struct StepMap<'m> {
     opts: SolverOptions,
     /// Steps per evaluation: 1 for `P`, `k` for `P^k`.
     iterate: usize,
+    /// The work of every walker this map (and its iterates) made, added once per walker when it is dropped.
+    work: Arc<Mutex<WorkCounts>>,
 }
 
 impl<'m> StepMap<'m> {
@@ -49,6 +54,7 @@ impl<'m> StepMap<'m> {
             model,
             opts: opts.clone(),
             iterate: 1,
+            work: Arc::default(),
         }
     }
 
@@ -61,25 +67,33 @@ impl<'m> StepMap<'m> {
         }
     }
 
-    /// The solver options.
-    pub(crate) fn options(&self) -> &SolverOptions {
-        &self.opts
-    }
-
     /// Steps walked per evaluation (`k` of `P^k`).
     pub fn steps_per_eval(&self) -> usize {
         self.iterate
     }
 
-    /// The model.
-    pub(crate) fn model(&self) -> &'m Model {
-        self.model
+    /// The work of every walker this map and its iterates ([`StepMap::iterated`]) have made so far: the
+    /// evaluations, and the walks of a gait search (transient, settling, orbit checks), failed steps included.
+    pub fn work(&self) -> WorkCounts {
+        *self
+            .work
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// A walker of this map's model and options from `s`, whose work is added to [`StepMap::work`] when it is
+    /// dropped (once per walker, not per step: evaluations run in parallel).
+    pub(crate) fn walker(&self, s: &SectionState) -> Result<CountedWalker<'_, 'm>, WalkError> {
+        Ok(CountedWalker {
+            walker: Walker::new(self.model, &self.opts, s)?,
+            tally: &self.work,
+        })
     }
 
     /// Evaluate `P(s)` (`P^k(s)` for an iterated map). Fails with the reason the step could not be walked
     /// (fell, stalled, old rear leg not relocked at the next touchdown, ...).
     pub fn eval(&self, s: &SectionState) -> Result<StepOutcome, WalkError> {
-        let mut walker = Walker::new(self.model, &self.opts, s)?;
+        let mut walker = self.walker(s)?;
         let report = walker.step(None)?;
         for _ in 1..self.iterate {
             walker.step(None)?;
@@ -153,5 +167,35 @@ impl<'m> StepMap<'m> {
         let extrapolated = (4.0 * &fine - coarse) / 3.0;
         let error = (&extrapolated - fine).abs().max();
         Ok((extrapolated, error))
+    }
+}
+
+/// A walker made by a [`StepMap`], which adds its work to the map's tally when it is dropped (on every path,
+/// failures included). Not `Clone`, so no work is counted twice.
+pub(crate) struct CountedWalker<'a, 'm> {
+    walker: Walker<'m>,
+    tally: &'a Mutex<WorkCounts>,
+}
+
+impl<'m> Deref for CountedWalker<'_, 'm> {
+    type Target = Walker<'m>;
+
+    fn deref(&self) -> &Walker<'m> {
+        &self.walker
+    }
+}
+
+impl DerefMut for CountedWalker<'_, '_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.walker
+    }
+}
+
+impl Drop for CountedWalker<'_, '_> {
+    fn drop(&mut self) {
+        *self
+            .tally
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner()) += self.walker.work();
     }
 }

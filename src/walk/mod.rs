@@ -68,5 +68,5 @@ pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
 pub use section::{ParseSectionError, SectionState};
 pub use trajectory::{Sample, SampleSink, Trajectory};
 pub use walker::{Walker, INTERRUPT_CHECK_STEPS};
-pub use work::{total_work, EventCounts, WorkCounts};
+pub use work::{EventCounts, WorkCounts};
 pub use zeno::ZENO_IMPULSE_WARNING;

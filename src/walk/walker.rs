@@ -22,7 +22,7 @@ use super::reindex::reindex;
 use super::report::{ContactAudit, EnergyAudit, StepReport};
 use super::section::SectionState;
 use super::trajectory::Trajectory;
-use super::work::{add_to_total, WorkCounts};
+use super::work::WorkCounts;
 use super::zeno::{lock_zeno_stoppers, ZenoLock};
 
 /// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
@@ -177,7 +177,6 @@ impl<'m> Walker<'m> {
         };
         let reached = self.walk_to_touchdown(&start, trajectory, &mut work);
         self.work += work;
-        add_to_total(work);
         reached.map(|touchdown| self.finish_step(&start, touchdown))
     }
 

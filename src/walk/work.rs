@@ -4,12 +4,10 @@
 //! `tests/work_counts.rs`) and give benchmarks a measure of work that does not depend on the machine.
 //!
 //! Every [`super::Walker`] counts its own work ([`super::Walker::work`]), and [`super::WalkRun`] /
-//! [`super::WalkEnd`] report a walk's. Work done by walkers that a caller does not see (the step map's, in a
-//! gait search) is also added to a process-wide tally, [`total_work`]: the difference of two readings is the
-//! work done in between, by every thread (so it is exact only when nothing else walks meanwhile).
+//! [`super::WalkEnd`] report a walk's. The walkers a gait search makes are counted by the step map they
+//! belong to (`StepMap::work` in `gait`).
 
 use std::ops::AddAssign;
-use std::sync::Mutex;
 
 use serde::Serialize;
 
@@ -144,22 +142,4 @@ impl AddAssign for WorkCounts {
         self.events += o.events;
         self.impacts += o.impacts;
     }
-}
-
-/// The work of every walker step in this process so far.
-static TOTAL: Mutex<WorkCounts> = Mutex::new(WorkCounts::ZERO);
-
-/// The work of every walker step taken in this process so far, on every thread (see the module
-/// documentation). Counts only grow; take the difference of two readings with [`WorkCounts::since`].
-pub fn total_work() -> WorkCounts {
-    *TOTAL
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
-}
-
-/// Add one step's work to the process-wide tally.
-pub(crate) fn add_to_total(work: WorkCounts) {
-    *TOTAL
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner()) += work;
 }
