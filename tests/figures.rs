@@ -3,67 +3,19 @@
 //! error naming the problem. Only structure is checked (frame counts, sizes, files), never today's numbers,
 //! except that a figure's curves stay inside its panels.
 
+mod common;
+
+use common::{assert_error, ok, simulated, vrw};
+
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use plotters::prelude::{BitMapBackend, IntoDrawingArea};
-use tempfile::TempDir;
 use vrw::output::animate::{plan_frames, AnimateOptions};
 use vrw::output::read::read_run;
 use vrw::output::run_plot::{draw_run_figure, RUN_SIZE};
 use vrw::output::steps_plot::STEPS_SIZE;
 use vrw::output::style::{png_size, COLOR_BLUE, COLOR_VERMILLION};
-
-fn vrw(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vrw"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("cannot run the vrw binary")
-}
-
-fn ok(output: &Output) -> String {
-    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
-    assert!(
-        output.status.success(),
-        "vrw failed:\n{}\nstdout:\n{stdout}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    stdout
-}
-
-/// The run failed with exit code 1, without a panic, and its `Error:` line names every one of `needles`.
-fn assert_error(output: &Output, needles: &[&str]) {
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!stderr.contains("panicked"), "vrw panicked:\n{stderr}");
-    assert_eq!(
-        output.status.code(),
-        Some(1),
-        "exit code; stderr:\n{stderr}"
-    );
-    let line = stderr
-        .lines()
-        .find(|l| l.starts_with("Error:"))
-        .unwrap_or_else(|| panic!("no `Error:` line:\n{stderr}"));
-    for needle in needles {
-        assert!(
-            line.contains(needle),
-            "the error does not name {needle:?}: {line}"
-        );
-    }
-}
-
-/// A temporary directory holding a `vrw simulate --steps N` run in `sim/`.
-fn simulated(steps: &str) -> (TempDir, PathBuf) {
-    let tmp = tempfile::tempdir().expect("temporary directory");
-    let out = tmp.path().join("sim");
-    ok(&vrw(
-        &["simulate", "--steps", steps, "--out", out.to_str().unwrap()],
-        tmp.path(),
-    ));
-    (tmp, out)
-}
 
 /// Frames of a GIF and the sum of their delays \[1/100 s\].
 fn decode_gif(path: &Path) -> (usize, u64, (u16, u16)) {

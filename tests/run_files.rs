@@ -2,59 +2,18 @@
 //! finished), an earlier run's files are removed, a killed or interrupted run is recognised, and damaged or
 //! impossible data is refused by `vrw plot` / `vrw animate` with the file, row and column.
 
+mod common;
+
+use common::{assert_error, ok, simulated, stderr, vrw};
+
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Command;
 
 use serde_json::Value;
-use tempfile::TempDir;
-
-fn vrw(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_vrw"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("cannot run the vrw binary")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn ok(output: &Output) {
-    assert!(output.status.success(), "vrw failed:\n{}", stderr(output));
-}
-
-/// Exit code 1, no panic, and an `Error:` line naming every needle.
-fn assert_error(output: &Output, needles: &[&str]) {
-    let err = stderr(output);
-    assert!(!err.contains("panicked"), "vrw panicked:\n{err}");
-    assert_eq!(output.status.code(), Some(1), "exit code; stderr:\n{err}");
-    let line = err
-        .lines()
-        .find(|l| l.starts_with("Error:"))
-        .unwrap_or_else(|| panic!("no `Error:` line:\n{err}"));
-    for needle in needles {
-        assert!(
-            line.contains(needle),
-            "the error does not name {needle:?}: {line}"
-        );
-    }
-}
 
 fn manifest(dir: &Path) -> Value {
     serde_json::from_str(&fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap()
-}
-
-/// A temporary directory with `vrw simulate --steps N` in `sim/`.
-fn simulated(steps: &str) -> (TempDir, PathBuf) {
-    let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("sim");
-    ok(&vrw(
-        &["simulate", "--steps", steps, "--out", out.to_str().unwrap()],
-        tmp.path(),
-    ));
-    (tmp, out)
 }
 
 /// Make `dir` look like a simulate killed with kill -9: the manifest still says `running`, and the
