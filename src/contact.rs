@@ -301,7 +301,7 @@ fn constraint_rows(
     let hub = model.hub(q, qd);
     for leg in Leg::BOTH {
         if active.contact(leg) {
-            let tip = model.leg_point_from_hub(&hub, q, qd, leg.index(), 0.0);
+            let tip = model.leg_point_from_hub(model.mechanics(), &hub, (q, qd), leg.index(), 0.0);
             let r = 2 * leg.index();
             rows.fixed_view_mut::<2, NQ>(r, 0).copy_from(&tip.jacobian);
             jdq.fixed_rows_mut::<2>(r).copy_from(&tip.velocity_product);

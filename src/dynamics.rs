@@ -14,18 +14,32 @@
 //! equations for the energies of docs/model.md section 2 (the tests check it against finite differences of `T` and
 //! `V`).
 
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{RealField, SMatrix, SVector, Vector2};
 
 use crate::params::{ConfigError, Params};
+
+/// A real scalar the kinematics and the equations of motion are written for: `f64` for the walk, and the dual
+/// numbers of [`crate::variational`] that carry derivatives through the very same code (forward-mode automatic
+/// differentiation, docs/model.md section 8). STYLE.md asks for concrete `f64`; this is the one exception, so
+/// that the exact derivatives differentiate the equations the walk integrates rather than a copy of them.
+pub trait Real: RealField + Copy {}
+impl<T: RealField + Copy> Real for T {}
+
+/// The constant `x` as a [`Real`] (exact: every `Real` holds an `f64`).
+pub(crate) fn lit<T: Real>(x: f64) -> T {
+    nalgebra::convert(x)
+}
 
 /// Number of generalized coordinates.
 pub(crate) const NQ: usize = 5;
 /// Generalized coordinates or velocities `[x, z, theta, L1, L2]`.
 pub type Coords = SVector<f64, NQ>;
+/// Generalized coordinates or velocities over any [`Real`].
+pub(crate) type CoordsOf<T> = SVector<T, NQ>;
 /// A 5x5 matrix over the generalized coordinates.
 pub(crate) type Mat5 = SMatrix<f64, NQ, NQ>;
 /// Jacobian of a planar point with respect to `q`.
-pub(crate) type PointJacobian = SMatrix<f64, 2, NQ>;
+pub(crate) type PointJacobian<T = f64> = SMatrix<T, 2, NQ>;
 
 /// Index of `x` in `q`.
 pub const X: usize = 0;
@@ -40,18 +54,18 @@ pub const L2: usize = 4;
 
 /// Position, Jacobian and velocity-product acceleration of one point of the wheel.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PointKinematics {
+pub struct PointKinematics<T: Real = f64> {
     /// Position in the slope frame \[m\].
-    pub position: Vector2<f64>,
+    pub position: Vector2<T>,
     /// `J = dp/dq`.
-    pub jacobian: PointJacobian,
+    pub jacobian: PointJacobian<T>,
     /// `dJ/dt q'`: the acceleration of the point when `q'' = 0` \[m/s^2\].
-    pub velocity_product: Vector2<f64>,
+    pub velocity_product: Vector2<T>,
 }
 
-impl PointKinematics {
+impl<T: Real> PointKinematics<T> {
     /// Velocity `J q'` of the point \[m/s\].
-    pub fn velocity(&self, qd: &Coords) -> Vector2<f64> {
+    pub fn velocity(&self, qd: &CoordsOf<T>) -> Vector2<T> {
         self.jacobian * qd
     }
 }
@@ -62,39 +76,110 @@ pub(crate) type LegIndex = usize;
 
 /// `M`, `h` and the tip of Leg 2 at one state, from [`Model::equations_of_motion`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct EquationsOfMotion {
+pub(crate) struct EquationsOfMotion<T: Real = f64> {
     /// Mass matrix `M(q)`.
-    pub mass: Mat5,
+    pub mass: SMatrix<T, NQ, NQ>,
     /// Bias vector `h(q, q')`: Coriolis/centrifugal terms, gravity, springs and dampers.
-    pub bias: Coords,
+    pub bias: CoordsOf<T>,
     /// Kinematics of the tip of Leg 2 (the rows of (C2)), as [`Model::tip`] gives them.
-    pub rear_tip: PointKinematics,
+    pub rear_tip: PointKinematics<T>,
+}
+
+/// The physical constants the equations of motion use, as [`Real`]s: the [`Params`] values (as `f64` for the
+/// walk, or with one of them carrying a derivative, see [`Mechanics::seeded`]) and the gravity vector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Mechanics<T: Real = f64> {
+    /// `mH` \[kg\].
+    pub hub_mass: T,
+    /// `IH` \[kg m^2\].
+    pub hub_inertia: T,
+    /// `m` \[kg\].
+    pub leg_mass: T,
+    /// `a` \[m\].
+    pub leg_mass_offset: T,
+    /// `L0` \[m\].
+    pub stopper_length: T,
+    /// `Lstar` \[m\].
+    pub spring_natural_length: T,
+    /// `k` \[N/m\].
+    pub stiffness: T,
+    /// `c` \[N s/m\].
+    pub viscosity: T,
+    /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame \[m/s^2\].
+    pub up: Vector2<T>,
+}
+
+/// The numeric keys of [`Params`] the equations of motion depend on smoothly: the parameters `dP/dp` can be
+/// taken for ([`Mechanics::seeded`]).
+pub const DIFFERENTIABLE_KEYS: [&str; 10] = [
+    "hub_mass",
+    "hub_inertia",
+    "leg_mass",
+    "leg_mass_offset",
+    "stopper_length",
+    "spring_natural_length",
+    "stiffness",
+    "viscosity",
+    "slope",
+    "gravity",
+];
+
+impl<T: Real> Mechanics<T> {
+    /// The constants of `params`, each made a `T` by `value(key, value)` (the key as in a configuration file).
+    pub(crate) fn seeded(params: &Params, value: impl Fn(&'static str, f64) -> T) -> Mechanics<T> {
+        let (slope, gravity) = (
+            value("slope", params.slope),
+            value("gravity", params.gravity),
+        );
+        Mechanics {
+            hub_mass: value("hub_mass", params.hub_mass),
+            hub_inertia: value("hub_inertia", params.hub_inertia),
+            leg_mass: value("leg_mass", params.leg_mass),
+            leg_mass_offset: value("leg_mass_offset", params.leg_mass_offset),
+            stopper_length: value("stopper_length", params.stopper_length),
+            spring_natural_length: value("spring_natural_length", params.spring_natural_length),
+            stiffness: value("stiffness", params.stiffness),
+            viscosity: value("viscosity", params.viscosity),
+            up: Vector2::new(-slope.sin(), slope.cos()) * gravity,
+        }
+    }
 }
 
 /// Sums over point masses `m_i` with Jacobian columns `b_i = [b_theta, b_L1, b_L2]` (the `x`, `z` columns
 /// being the identity) and forces `f_i = m_i (dJ_i/dt q' + g_n)`, from which `M` and `h` are assembled.
-#[derive(Debug, Default)]
-struct PointSums {
+#[derive(Debug)]
+struct PointSums<T: Real> {
     /// `sum m_i`.
-    mass: f64,
+    mass: T,
     /// `sum m_i b_ik`.
-    b: [Vector2<f64>; 3],
+    b: [Vector2<T>; 3],
     /// `sum m_i b_ik . b_il` for `k <= l`.
-    bb: [[f64; 3]; 3],
+    bb: [[T; 3]; 3],
     /// `sum f_i`.
-    f: Vector2<f64>,
+    f: Vector2<T>,
     /// `sum b_ik . f_i`.
-    bf: [f64; 3],
+    bf: [T; 3],
 }
 
-impl PointSums {
+impl<T: Real> PointSums<T> {
+    fn zero() -> Self {
+        let (z, v) = (T::zero(), Vector2::zeros());
+        PointSums {
+            mass: z,
+            b: [v; 3],
+            bb: [[z; 3]; 3],
+            f: v,
+            bf: [z; 3],
+        }
+    }
+
     /// Add a point of mass `m`, Jacobian columns `b` and acceleration `a = dJ/dt q' + g_n`.
-    fn add(&mut self, m: f64, b: &[Vector2<f64>; 3], a: Vector2<f64>) {
-        let f = m * a;
+    fn add(&mut self, m: T, b: &[Vector2<T>; 3], a: Vector2<T>) {
+        let f = a * m;
         self.mass += m;
         self.f += f;
         for k in 0..3 {
-            self.b[k] += m * b[k];
+            self.b[k] += b[k] * m;
             self.bf[k] += b[k].dot(&f);
             for l in k..3 {
                 self.bb[k][l] += m * b[k].dot(&b[l]);
@@ -112,8 +197,8 @@ pub struct Model {
     offsets: Vec<(f64, f64)>,
     /// `sum_j (sin j alpha, cos j alpha)` over the locked legs `j = 2..N`.
     locked_offsets: (f64, f64),
-    /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame \[m/s^2\].
-    up: Vector2<f64>,
+    /// The physical constants as `f64`.
+    mech: Mechanics,
 }
 
 impl Model {
@@ -130,19 +215,23 @@ impl Model {
         // The N-th roots of unity sum to zero, so the locked legs' sum is minus that of legs 0 and 1 (exact,
         // without the rounding of a sum over up to `MAX_LEGS` terms).
         let locked_offsets = (-alpha.sin(), -1.0 - alpha.cos());
-        let up = params.gravity * Vector2::new(-params.slope.sin(), params.slope.cos());
         Ok(Model {
             params: params.clone(),
             alpha,
             offsets,
             locked_offsets,
-            up,
+            mech: Mechanics::seeded(params, |_, value| value),
         })
     }
 
     /// The parameters this model was built from.
     pub fn params(&self) -> &Params {
         &self.params
+    }
+
+    /// The physical constants as `f64`.
+    pub(crate) fn mechanics(&self) -> &Mechanics {
+        &self.mech
     }
 
     /// Inter-leg angle `alpha = 2 pi / N` \[rad\].
@@ -166,21 +255,26 @@ impl Model {
     }
 
     /// Length of leg `j`: `L1`, `L2` from `q`, the stopper length `L0` for the locked legs (docs/model.md section 2).
-    pub(crate) fn leg_length(&self, q: &Coords, j: LegIndex) -> (f64, Option<usize>) {
+    fn leg_length<T: Real>(
+        mech: &Mechanics<T>,
+        q: &CoordsOf<T>,
+        j: LegIndex,
+    ) -> (T, Option<usize>) {
         match j {
             0 => (q[L1], Some(L1)),
             1 => (q[L2], Some(L2)),
-            _ => (self.params.stopper_length, None),
+            _ => (mech.stopper_length, None),
         }
     }
 
     /// Hub kinematics: `p_H = (x + L1 sin theta, z + L1 cos theta)` (docs/model.md section 1).
-    pub(crate) fn hub(&self, q: &Coords, qd: &Coords) -> PointKinematics {
+    pub(crate) fn hub<T: Real>(&self, q: &CoordsOf<T>, qd: &CoordsOf<T>) -> PointKinematics<T> {
         let (s, c) = q[THETA].sin_cos();
         let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
-        let mut jac = PointJacobian::zeros();
-        jac[(0, X)] = 1.0;
-        jac[(1, Z)] = 1.0;
+        let two = lit::<T>(2.0);
+        let mut jac = PointJacobian::<T>::zeros();
+        jac[(0, X)] = T::one();
+        jac[(1, Z)] = T::one();
         jac[(0, THETA)] = l1 * c;
         jac[(1, THETA)] = -l1 * s;
         jac[(0, L1)] = s;
@@ -189,31 +283,32 @@ impl Model {
             position: Vector2::new(q[X] + l1 * s, q[Z] + l1 * c),
             jacobian: jac,
             velocity_product: Vector2::new(
-                2.0 * dl1 * c * w - l1 * s * w * w,
-                -2.0 * dl1 * s * w - l1 * c * w * w,
+                two * dl1 * c * w - l1 * s * w * w,
+                -two * dl1 * s * w - l1 * c * w * w,
             ),
         }
     }
 
     /// A point on leg `j` at distance `from_tip` from its tip, `p = p_H + (L_j - from_tip) e(psi_j)` with
-    /// `e(psi) = (-sin psi, -cos psi)`, given the hub kinematics `hub`.
-    pub(crate) fn leg_point_from_hub(
+    /// `e(psi) = (-sin psi, -cos psi)`, given the hub kinematics `hub` and the constants `mech`.
+    pub(crate) fn leg_point_from_hub<T: Real>(
         &self,
-        hub: &PointKinematics,
-        q: &Coords,
-        qd: &Coords,
+        mech: &Mechanics<T>,
+        hub: &PointKinematics<T>,
+        (q, qd): (&CoordsOf<T>, &CoordsOf<T>),
         j: LegIndex,
-        from_tip: f64,
-    ) -> PointKinematics {
+        from_tip: T,
+    ) -> PointKinematics<T> {
         let (sj, cj) = self.offsets[j];
+        let (sj, cj) = (lit::<T>(sj), lit::<T>(cj));
         let (st, ct) = q[THETA].sin_cos();
         // psi = theta + j alpha
         let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
         let e = Vector2::new(-sp, -cp);
         let e_psi = Vector2::new(-cp, sp);
-        let (length, length_index) = self.leg_length(q, j);
+        let (length, length_index) = Self::leg_length(mech, q, j);
         let d = length - from_tip;
-        let dd = length_index.map_or(0.0, |i| qd[i]);
+        let dd = length_index.map_or(T::zero(), |i| qd[i]);
         let w = qd[THETA];
         let mut jac = hub.jacobian;
         if let Some(i) = length_index {
@@ -223,16 +318,28 @@ impl Model {
         jac[(0, THETA)] += d * e_psi.x;
         jac[(1, THETA)] += d * e_psi.y;
         PointKinematics {
-            position: hub.position + d * e,
+            position: hub.position + e * d,
             jacobian: jac,
-            velocity_product: hub.velocity_product + 2.0 * dd * w * e_psi - d * w * w * e,
+            velocity_product: hub.velocity_product + e_psi * (lit::<T>(2.0) * dd * w)
+                - e * (d * w * w),
         }
     }
 
     /// The tip of leg `j`.
     pub fn tip(&self, q: &Coords, qd: &Coords, j: LegIndex) -> PointKinematics {
+        self.tip_with(&self.mech, q, qd, j)
+    }
+
+    /// The tip of leg `j` over any [`Real`], with the constants `mech`.
+    pub(crate) fn tip_with<T: Real>(
+        &self,
+        mech: &Mechanics<T>,
+        q: &CoordsOf<T>,
+        qd: &CoordsOf<T>,
+        j: LegIndex,
+    ) -> PointKinematics<T> {
         let hub = self.hub(q, qd);
-        self.leg_point_from_hub(&hub, q, qd, j, 0.0)
+        self.leg_point_from_hub(mech, &hub, (q, qd), j, T::zero())
     }
 
     /// Height of the hub above the slope, `z + L1 cos(theta)` \[m\].
@@ -242,10 +349,20 @@ impl Model {
 
     /// Height of the tip of leg `j` above the slope \[m\] (no Jacobian; cheap, for event functions).
     pub fn tip_height(&self, q: &Coords, j: LegIndex) -> f64 {
+        self.tip_height_with(&self.mech, q, j)
+    }
+
+    /// [`Model::tip_height`] over any [`Real`], with the constants `mech`.
+    pub(crate) fn tip_height_with<T: Real>(
+        &self,
+        mech: &Mechanics<T>,
+        q: &CoordsOf<T>,
+        j: LegIndex,
+    ) -> T {
         let (sj, cj) = self.offsets[j];
         let (st, ct) = q[THETA].sin_cos();
-        let cp = ct * cj - st * sj;
-        let (length, _) = self.leg_length(q, j);
+        let cp = ct * lit::<T>(cj) - st * lit::<T>(sj);
+        let (length, _) = Self::leg_length(mech, q, j);
         q[Z] + q[L1] * ct - length * cp
     }
 
@@ -257,7 +374,9 @@ impl Model {
         self.offsets
             .iter()
             .enumerate()
-            .map(|(j, &(sj, cj))| hub_height - self.leg_length(q, j).0 * (ct * cj - st * sj))
+            .map(|(j, &(sj, cj))| {
+                hub_height - Self::leg_length(&self.mech, q, j).0 * (ct * cj - st * sj)
+            })
             .fold(f64::INFINITY, f64::min)
     }
 
@@ -273,6 +392,11 @@ impl Model {
 
     /// `M(q)` and `h(q, q')` of Eq. (1) (as [`Model::mass_and_bias`]) together with the kinematics of Leg 2's tip,
     /// which share the sine and cosine of `theta` and the hub terms (docs/model.md sections 2-3).
+    pub(crate) fn equations_of_motion(&self, q: &Coords, qd: &Coords) -> EquationsOfMotion {
+        self.equations_of_motion_with(&self.mech, q, qd)
+    }
+
+    /// [`Model::equations_of_motion`] over any [`Real`], with the constants `mech`.
     ///
     /// Every point Jacobian has the form `J_i = [I_2 | b_theta | b_L1 | b_L2]` (the `x`, `z` columns are the
     /// identity), so `M = sum m_i J_i^T J_i` and `h = sum m_i J_i^T f_i` are accumulated from the three
@@ -281,8 +405,14 @@ impl Model {
     /// `f = m (a_H + g_n - d w^2 e(psi_j))` with the same `d = L0 - a` for all, and `|e'|^2 = 1`,
     /// `e . e' = 0`, so their sums need only `sum_j e(psi_j)` (and `sum_j e(psi_j)' `), a rotation by `theta` of
     /// the constant `sum_j (sin j alpha, cos j alpha)`. The cost is independent of `N`.
-    pub(crate) fn equations_of_motion(&self, q: &Coords, qd: &Coords) -> EquationsOfMotion {
-        let p = &self.params;
+    pub(crate) fn equations_of_motion_with<T: Real>(
+        &self,
+        mech: &Mechanics<T>,
+        q: &CoordsOf<T>,
+        qd: &CoordsOf<T>,
+    ) -> EquationsOfMotion<T> {
+        let p = mech;
+        let two = lit::<T>(2.0);
         let (st, ct) = q[THETA].sin_cos();
         let (l1, dl1, l2, dl2, w) = (q[L1], qd[L1], q[L2], qd[L2], qd[THETA]);
         // Hub: b_theta = (L1 c, -L1 s), b_L1 = (s, c), b_L2 = 0; dJ/dt q' as in `hub`.
@@ -292,58 +422,60 @@ impl Model {
             Vector2::zeros(),
         ];
         let hub_vp = Vector2::new(
-            2.0 * dl1 * ct * w - l1 * st * w * w,
-            -2.0 * dl1 * st * w - l1 * ct * w * w,
+            two * dl1 * ct * w - l1 * st * w * w,
+            -two * dl1 * st * w - l1 * ct * w * w,
         );
         // psi = theta + j alpha; e = (-sin psi, -cos psi), e_psi = de/dpsi = (-cos psi, sin psi)
         let directions = |(sj, cj): (f64, f64)| {
+            let (sj, cj) = (lit::<T>(sj), lit::<T>(cj));
             let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
             (Vector2::new(-sp, -cp), Vector2::new(-cp, sp))
         };
         let hub_position = Vector2::new(q[X] + l1 * st, q[Z] + l1 * ct);
         // Leg j with length L and rate dL/dt, its length column b_L in `slot`: a point of it at distance
         // `from_tip` from its tip, as Jacobian columns b, dJ/dt q' and position.
-        let leg = |j: usize, length: f64, dlength: f64, slot: usize| {
+        let leg = |j: usize, length: T, dlength: T, slot: usize| {
             let (e, e_psi) = directions(self.offsets[j]);
-            move |from_tip: f64| {
+            move |from_tip: T| {
                 let d = length - from_tip;
                 let mut b = hub_b;
-                b[0] += d * e_psi;
+                b[0] += e_psi * d;
                 b[slot] += e;
-                let vp = hub_vp + 2.0 * dlength * w * e_psi - d * w * w * e;
-                (b, vp, hub_position + d * e)
+                let vp = hub_vp + e_psi * (two * dlength * w) - e * (d * w * w);
+                (b, vp, hub_position + e * d)
             }
         };
         let (leg_one, leg_two) = (leg(0, l1, dl1, 1), leg(1, l2, dl2, 2));
-        let mut sums = PointSums::default();
-        sums.add(p.hub_mass, &hub_b, hub_vp + self.up);
+        let mut sums = PointSums::zero();
+        sums.add(p.hub_mass, &hub_b, hub_vp + p.up);
         for point in [leg_one, leg_two] {
             let (b, vp, _) = point(p.leg_mass_offset);
-            sums.add(p.leg_mass, &b, vp + self.up);
+            sums.add(p.leg_mass, &b, vp + p.up);
         }
         // The locked legs j = 2..N, all of length L0 (see above).
-        let n = (self.legs() - 2) as f64;
+        let n = lit::<T>((self.legs() - 2) as f64);
         let d = p.stopper_length - p.leg_mass_offset;
         let (ss, sc) = self.locked_offsets;
+        let (ss, sc) = (lit::<T>(ss), lit::<T>(sc));
         let (sum_sin, sum_cos) = (st * sc + ct * ss, ct * sc - st * ss);
         let sum_e = Vector2::new(-sum_sin, -sum_cos);
         let sum_e_psi = Vector2::new(-sum_cos, sum_sin);
-        let a = hub_vp + self.up;
+        let a = hub_vp + p.up;
         let m = p.leg_mass;
         sums.mass += n * m;
-        sums.f += m * (n * a - d * w * w * sum_e);
-        sums.b[0] += m * (n * hub_b[0] + d * sum_e_psi);
-        sums.b[1] += m * n * hub_b[1];
+        sums.f += (a * n - sum_e * (d * w * w)) * m;
+        sums.b[0] += (hub_b[0] * n + sum_e_psi * d) * m;
+        sums.b[1] += hub_b[1] * (m * n);
         sums.bb[0][0] +=
-            m * (n * hub_b[0].norm_squared() + 2.0 * d * hub_b[0].dot(&sum_e_psi) + n * d * d);
+            m * (n * hub_b[0].norm_squared() + two * d * hub_b[0].dot(&sum_e_psi) + n * d * d);
         sums.bb[0][1] += m * (n * hub_b[0].dot(&hub_b[1]) + d * hub_b[1].dot(&sum_e_psi));
         sums.bb[1][1] += m * n * hub_b[1].norm_squared();
         sums.bf[0] +=
             m * (n * hub_b[0].dot(&a) - d * w * w * hub_b[0].dot(&sum_e) + d * sum_e_psi.dot(&a));
         sums.bf[1] += m * (n * hub_b[1].dot(&a) - d * w * w * hub_b[1].dot(&sum_e));
 
-        let mut mass = Mat5::zeros();
-        let mut bias = Coords::zeros();
+        let mut mass = SMatrix::<T, NQ, NQ>::zeros();
+        let mut bias = CoordsOf::<T>::zeros();
         mass[(X, X)] = sums.mass;
         mass[(Z, Z)] = sums.mass;
         bias[X] = sums.f.x;
@@ -364,10 +496,10 @@ impl Model {
         bias[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
         bias[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
 
-        let (b, velocity_product, position) = leg_two(0.0);
-        let mut jacobian = PointJacobian::zeros();
-        jacobian[(0, X)] = 1.0;
-        jacobian[(1, Z)] = 1.0;
+        let (b, velocity_product, position) = leg_two(T::zero());
+        let mut jacobian = PointJacobian::<T>::zeros();
+        jacobian[(0, X)] = T::one();
+        jacobian[(1, Z)] = T::one();
         for (k, column) in b.iter().enumerate() {
             jacobian.set_column(THETA + k, column);
         }
@@ -387,15 +519,16 @@ impl Model {
     #[cfg(test)]
     pub(crate) fn mass_and_bias_reference(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
         let p = &self.params;
+        let up = self.mech.up;
         let hub = self.hub(q, qd);
         let mut m = p.hub_mass * hub.jacobian.transpose() * hub.jacobian;
-        let mut h = p.hub_mass * hub.jacobian.transpose() * (hub.velocity_product + self.up);
+        let mut h = p.hub_mass * hub.jacobian.transpose() * (hub.velocity_product + up);
         m[(THETA, THETA)] += p.hub_inertia;
         for j in 0..self.legs() {
-            let leg = self.leg_point_from_hub(&hub, q, qd, j, p.leg_mass_offset);
+            let leg = self.leg_point_from_hub(&self.mech, &hub, (q, qd), j, p.leg_mass_offset);
             let jt = leg.jacobian.transpose();
             m += p.leg_mass * jt * leg.jacobian;
-            h += p.leg_mass * jt * (leg.velocity_product + self.up);
+            h += p.leg_mass * jt * (leg.velocity_product + up);
         }
         h[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
         h[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
@@ -417,11 +550,12 @@ impl Model {
     pub(crate) fn potential_energy(&self, q: &Coords) -> f64 {
         let p = &self.params;
         let zero = Coords::zeros();
+        let up = self.mech.up;
         let hub = self.hub(q, &zero);
-        let mut v = p.hub_mass * hub.position.dot(&self.up);
+        let mut v = p.hub_mass * hub.position.dot(&up);
         for j in 0..self.legs() {
-            let leg = self.leg_point_from_hub(&hub, q, &zero, j, p.leg_mass_offset);
-            v += p.leg_mass * leg.position.dot(&self.up);
+            let leg = self.leg_point_from_hub(&self.mech, &hub, (q, &zero), j, p.leg_mass_offset);
+            v += p.leg_mass * leg.position.dot(&up);
         }
         let spring = |l: f64| 0.5 * p.stiffness * (p.spring_natural_length - l).powi(2);
         v + spring(q[L1]) + spring(q[L2])

@@ -133,21 +133,11 @@ impl<const N: usize> Dop853<N> {
         let y0 = self.core.y;
         let mut k = [SVector::<f64, N>::zeros(); DENSE_STAGES];
         k[0] = self.core.dy;
-        let stage_state = |k: &[SVector<f64, N>], i: usize, h: f64| {
-            let mut sum = SVector::<f64, N>::zeros();
-            for &(j, a) in &tab.a[i] {
-                sum += k[j] * a;
-            }
-            y0 + sum * h
-        };
         let mut rejected_before = false;
         let mut last_non_finite = false;
         loop {
             let (h, t1) = self.core.trial(t_stop, last_non_finite)?;
-            for i in 1..STAGES {
-                let yi = stage_state(&k, i, h);
-                k[i] = sys.rhs(t + tab.c[i] * h, &yi);
-            }
+            trial_stages(sys, t, &y0, &mut k, h);
             self.core.stats.rhs_evals += STAGES - 1;
             let mut yseg = SVector::<f64, N>::zeros();
             let mut e5 = SVector::<f64, N>::zeros();
@@ -192,37 +182,101 @@ impl<const N: usize> Dop853<N> {
             };
             let fac = (fac11 / SAFE).clamp(FAC_GROW_MAX, FAC_SHRINK_MAX);
             self.core.accept(h, (t1, y1, k13), h / fac, rejected_before);
-
-            // The dense output: f(t1, y1) and three more stages.
             k[STAGES] = k13;
-            for i in STAGES + 1..DENSE_STAGES {
-                let yi = stage_state(&k, i, h);
-                k[i] = sys.rhs(t + tab.c[i] * h, &yi);
-            }
             self.core.stats.rhs_evals += DENSE_STAGES - STAGES - 1;
-            let delta = y1 - y0;
-            let bspl = k[0] * h - delta;
-            let mut cont = [
-                y0,
-                delta,
-                bspl,
-                delta - k13 * h - bspl,
-                SVector::zeros(),
-                SVector::zeros(),
-                SVector::zeros(),
-                SVector::zeros(),
-            ];
-            for (row, c) in tab.d.iter().zip(cont[4..].iter_mut()) {
-                for (ki, &d) in k.iter().zip(row) {
-                    if d != 0.0 {
-                        *c += ki * d;
-                    }
-                }
-                *c *= h;
-            }
-            return Ok(DenseStep::from_coefficients(t, t1, y1, &cont));
+            return Ok(dense_step(sys, (t, t1, h), &y0, y1, &mut k));
         }
     }
+}
+
+/// The state of stage `i` of a step of size `h` from `y0`, from the stages `k[..i]` before it.
+fn stage_state<const N: usize>(
+    y0: &SVector<f64, N>,
+    k: &[SVector<f64, N>],
+    i: usize,
+    h: f64,
+) -> SVector<f64, N> {
+    let mut sum = SVector::<f64, N>::zeros();
+    for &(j, a) in &tableau().a[i] {
+        sum += k[j] * a;
+    }
+    y0 + sum * h
+}
+
+/// Stages `2 ..= STAGES` of a step of size `h` from `(t, y0)`, given `k[0] = f(t, y0)`.
+fn trial_stages<const N: usize>(
+    sys: &impl OdeSystem<N>,
+    t: f64,
+    y0: &SVector<f64, N>,
+    k: &mut [SVector<f64, N>; DENSE_STAGES],
+    h: f64,
+) {
+    let tab = tableau();
+    for i in 1..STAGES {
+        let yi = stage_state(y0, k, i, h);
+        k[i] = sys.rhs(t + tab.c[i] * h, &yi);
+    }
+}
+
+/// The dense output of an accepted step `(t, t1, h)` from `y0` to `y1`, given its stages `k[..=STAGES]`
+/// (`k[STAGES] = f(t1, y1)`): the three extra stages of the 7th-order extension (`contd8` of `dop853`).
+fn dense_step<const N: usize>(
+    sys: &impl OdeSystem<N>,
+    (t, t1, h): (f64, f64, f64),
+    y0: &SVector<f64, N>,
+    y1: SVector<f64, N>,
+    k: &mut [SVector<f64, N>; DENSE_STAGES],
+) -> DenseStep<N> {
+    let tab = tableau();
+    for i in STAGES + 1..DENSE_STAGES {
+        let yi = stage_state(y0, k, i, h);
+        k[i] = sys.rhs(t + tab.c[i] * h, &yi);
+    }
+    let delta = y1 - y0;
+    let bspl = k[0] * h - delta;
+    let mut cont = [
+        *y0,
+        delta,
+        bspl,
+        delta - k[STAGES] * h - bspl,
+        SVector::zeros(),
+        SVector::zeros(),
+        SVector::zeros(),
+        SVector::zeros(),
+    ];
+    for (row, c) in tab.d.iter().zip(cont[4..].iter_mut()) {
+        for (ki, &d) in k.iter().zip(row) {
+            if d != 0.0 {
+                *c += ki * d;
+            }
+        }
+        *c *= h;
+    }
+    DenseStep::from_coefficients(t, t1, y1, &cont)
+}
+
+/// One DOP853 step of the given size `h` from `(t, y0)` to `t1` (`t + h`, or the `t_stop` it landed on), with
+/// no error control: the step an adaptive run accepted, taken again on another system (the variational
+/// equations, see `crate::variational`). The same arithmetic as [`Dop853::step`], so a system whose first
+/// components are the original one's reproduces its states bit for bit.
+pub(crate) fn fixed_step<const N: usize>(
+    sys: &impl OdeSystem<N>,
+    t: f64,
+    y0: &SVector<f64, N>,
+    h: f64,
+    t1: f64,
+) -> DenseStep<N> {
+    let tab = tableau();
+    let mut k = [SVector::<f64, N>::zeros(); DENSE_STAGES];
+    k[0] = sys.rhs(t, y0);
+    trial_stages(sys, t, y0, &mut k, h);
+    let mut yseg = SVector::<f64, N>::zeros();
+    for (i, ki) in k.iter().take(STAGES).enumerate() {
+        yseg += ki * tab.b[i];
+    }
+    let y1 = y0 + yseg * h;
+    k[STAGES] = sys.rhs(t1, &y1);
+    dense_step(sys, (t, t1, h), y0, y1, &mut k)
 }
 
 #[cfg(test)]

@@ -175,19 +175,8 @@ impl<const N: usize> Dopri5<N> {
         let mut last_non_finite = false;
         loop {
             let (h, t1) = self.core.trial(t_stop, last_non_finite)?;
-            let k2 = sys.rhs(t + C2 * h, &(y0 + k1 * (h * A21)));
-            let k3 = sys.rhs(t + C3 * h, &(y0 + (k1 * A31 + k2 * A32) * h));
-            let k4 = sys.rhs(t + C4 * h, &(y0 + (k1 * A41 + k2 * A42 + k3 * A43) * h));
-            let k5 = sys.rhs(
-                t + C5 * h,
-                &(y0 + (k1 * A51 + k2 * A52 + k3 * A53 + k4 * A54) * h),
-            );
-            let k6 = sys.rhs(
-                t1,
-                &(y0 + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h),
-            );
-            let y1 = y0 + (k1 * A71 + k3 * A73 + k4 * A74 + k5 * A75 + k6 * A76) * h;
-            let k7 = sys.rhs(t1, &y1);
+            let Stages { k, y1 } = stages(sys, t, &y0, k1, h, t1);
+            let [_, _, k3, k4, k5, k6, k7] = k;
             self.core.stats.rhs_evals += 6;
 
             let e = (k1 * E1 + k3 * E3 + k4 * E4 + k5 * E5 + k6 * E6 + k7 * E7) * h;
@@ -207,23 +196,82 @@ impl<const N: usize> Dopri5<N> {
                     (fac11 / self.err_old.powf(BETA) / SAFE).clamp(FAC_GROW_MAX, FAC_SHRINK_MAX);
                 self.err_old = err.max(ERR_OLD_MIN);
                 self.core.accept(h, (t1, y1, k7), h / fac, rejected_before);
-                let delta = y1 - y0;
-                let bspl = k1 * h - delta;
-                return Ok(DenseStep::from_coefficients(
-                    t,
-                    t1,
-                    y1,
-                    &[
-                        y0,
-                        delta,
-                        bspl,
-                        delta - k7 * h - bspl,
-                        (k1 * D1 + k3 * D3 + k4 * D4 + k5 * D5 + k6 * D6 + k7 * D7) * h,
-                    ],
-                ));
+                return Ok(dense_step((t, t1, h), &y0, y1, &k));
             }
             rejected_before = true;
             self.core.reject(h, FAC_SHRINK_MAX.min(fac11 / SAFE));
         }
     }
+}
+
+/// The seven stages `k1 .. k7` of a step of size `h` from `(t, y0)` to `t1` (`k1 = f(t, y0)` given, `k7 =
+/// f(t1, y1)`), and the 5th-order solution `y1`.
+struct Stages<const N: usize> {
+    k: [SVector<f64, N>; 7],
+    y1: SVector<f64, N>,
+}
+
+fn stages<const N: usize>(
+    sys: &impl OdeSystem<N>,
+    t: f64,
+    y0: &SVector<f64, N>,
+    k1: SVector<f64, N>,
+    h: f64,
+    t1: f64,
+) -> Stages<N> {
+    let y0 = *y0;
+    let k2 = sys.rhs(t + C2 * h, &(y0 + k1 * (h * A21)));
+    let k3 = sys.rhs(t + C3 * h, &(y0 + (k1 * A31 + k2 * A32) * h));
+    let k4 = sys.rhs(t + C4 * h, &(y0 + (k1 * A41 + k2 * A42 + k3 * A43) * h));
+    let k5 = sys.rhs(
+        t + C5 * h,
+        &(y0 + (k1 * A51 + k2 * A52 + k3 * A53 + k4 * A54) * h),
+    );
+    let k6 = sys.rhs(
+        t1,
+        &(y0 + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h),
+    );
+    let y1 = y0 + (k1 * A71 + k3 * A73 + k4 * A74 + k5 * A75 + k6 * A76) * h;
+    let k7 = sys.rhs(t1, &y1);
+    Stages {
+        k: [k1, k2, k3, k4, k5, k6, k7],
+        y1,
+    }
+}
+
+/// Shampine's 4th-order dense output of the step `(t, t1, h)` from `y0` to `y1` with stages `k`.
+fn dense_step<const N: usize>(
+    (t, t1, h): (f64, f64, f64),
+    y0: &SVector<f64, N>,
+    y1: SVector<f64, N>,
+    k: &[SVector<f64, N>; 7],
+) -> DenseStep<N> {
+    let [k1, _, k3, k4, k5, k6, k7] = *k;
+    let delta = y1 - y0;
+    let bspl = k1 * h - delta;
+    DenseStep::from_coefficients(
+        t,
+        t1,
+        y1,
+        &[
+            *y0,
+            delta,
+            bspl,
+            delta - k7 * h - bspl,
+            (k1 * D1 + k3 * D3 + k4 * D4 + k5 * D5 + k6 * D6 + k7 * D7) * h,
+        ],
+    )
+}
+
+/// One DOPRI5 step of the given size `h` from `(t, y0)` to `t1`, with no error control: the step an adaptive
+/// run accepted, taken again on another system (see `super::dop853::fixed_step`).
+pub(crate) fn fixed_step<const N: usize>(
+    sys: &impl OdeSystem<N>,
+    t: f64,
+    y0: &SVector<f64, N>,
+    h: f64,
+    t1: f64,
+) -> DenseStep<N> {
+    let Stages { k, y1 } = stages(sys, t, y0, sys.rhs(t, y0), h, t1);
+    dense_step((t, t1, h), y0, y1, &k)
 }

@@ -179,6 +179,23 @@ impl<const N: usize> Integrator<N> {
         }
     }
 
+    /// One step of `method` of the given size `h` from `(t, y0)` to `t1`, with no error control: an accepted step
+    /// of an adaptive run taken again on another system whose first components are the original one's (the
+    /// variational equations of `crate::variational`, which thereby see the original run's steps, states and
+    /// dense output bit for bit).
+    pub(crate) fn fixed_step(
+        method: Method,
+        sys: &impl OdeSystem<N>,
+        t: f64,
+        y0: &SVector<f64, N>,
+        (h, t1): (f64, f64),
+    ) -> DenseStep<N> {
+        match method {
+            Method::Dop853 => dop853::fixed_step(sys, t, y0, h, t1),
+            Method::Dopri5 => dopri5::fixed_step(sys, t, y0, h, t1),
+        }
+    }
+
     /// Work counters.
     pub(crate) fn stats(&self) -> Stats {
         self.core().stats
