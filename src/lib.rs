@@ -111,4 +111,5 @@ pub mod integrate;
 pub mod output;
 pub mod params;
 pub mod reference;
+pub mod variational;
 pub mod walk;

@@ -34,6 +34,7 @@ const PIPELINE: &[&str] = &[
     "dynamics",
     "contact",
     "walk",
+    "variational",
     "reference",
     "gait",
     "output",

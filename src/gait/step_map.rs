@@ -22,8 +22,13 @@ use std::sync::{Arc, Mutex};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use crate::dynamics::Model;
+use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, NQ, THETA};
 use crate::params::SolverOptions;
+use crate::variational::{
+    replay_step, seeded, sensitivity, Dual, NotDifferentiable, Sensitivity, NDIR, PARAM,
+};
+use crate::walk::section::section_coords;
+use crate::walk::tape::StepTape;
 use crate::walk::WalkError;
 use crate::walk::{SectionState, StepReport, Walker, WorkCounts};
 
@@ -34,6 +39,35 @@ pub struct StepOutcome {
     pub next: SectionState,
     /// The (first) step's report (DLS indicators, period, energy audit, ...).
     pub report: StepReport,
+}
+
+/// One evaluation of the step map with its exact derivatives ([`StepMap::eval_with_derivatives`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepDerivatives {
+    /// `P(s)` and the (first) step's report, exactly as [`StepMap::eval`] gives them.
+    pub outcome: StepOutcome,
+    /// `DP`: the Jacobian of the map over its free coordinates ([`StepMap::reduce`]; `D(P^k)` for an iterated
+    /// map).
+    pub jacobian: DMatrix<f64>,
+    /// `dP/dp` over the free coordinates for the chosen parameter, if one was chosen.
+    pub dparam: Option<DVector<f64>>,
+}
+
+/// Why [`StepMap::eval_with_derivatives`] gave no derivatives.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DerivativeError {
+    /// The step could not be walked.
+    #[error(transparent)]
+    Walk(#[from] WalkError),
+    /// The map is not differentiable there (or the replay failed).
+    #[error(transparent)]
+    NotDifferentiable(#[from] NotDifferentiable),
+    /// The parameter is not a key the equations of motion depend on smoothly.
+    #[error("no derivative with respect to {key:?}: the parameter must be one of {keys}", keys = DIFFERENTIABLE_KEYS.join(", "))]
+    UnknownParameter {
+        /// The key given.
+        key: String,
+    },
 }
 
 /// The step map of one parameter set.
@@ -100,6 +134,69 @@ impl<'m> StepMap<'m> {
         }
         let next = walker.section()?;
         Ok(StepOutcome { next, report })
+    }
+
+    /// Evaluate `P(s)` (`P^k(s)`) with its exact derivatives (docs/model.md section 8): `DP` over the free
+    /// coordinates and, if `param` names one of [`DIFFERENTIABLE_KEYS`], `dP/dp`. The walk is the one
+    /// [`StepMap::eval`] takes (same outcome, bit for bit); the derivatives come from the variational equations
+    /// over its steps and the saltation matrix of each of its events ([`crate::variational`]). `D(P^k)` is the
+    /// chain of the `k` steps' derivatives.
+    pub fn eval_with_derivatives(
+        &self,
+        s: &SectionState,
+        param: Option<&str>,
+    ) -> Result<StepDerivatives, DerivativeError> {
+        if let Some(key) = param.filter(|key| !DIFFERENTIABLE_KEYS.contains(key)) {
+            return Err(DerivativeError::UnknownParameter {
+                key: key.to_string(),
+            });
+        }
+        let model = self.model;
+        let mut walker = self.walker(s)?;
+        // The section's own constraint, differentiated: (q, q') as functions of (s, p).
+        let mech = seeded::<NDIR>(model, param, PARAM);
+        let unit = |i: usize, value: f64| {
+            let mut e = nalgebra::SVector::<f64, NDIR>::zeros();
+            e[i] = 1.0;
+            crate::variational::dual_of(value, e)
+        };
+        let (q, qd) = section_coords::<Dual>(
+            model,
+            &mech,
+            (unit(0, s.l2), unit(1, s.theta_dot), unit(2, s.l2_dot)),
+        );
+        let mut sens: Sensitivity = sensitivity(&q, &qd);
+        let mut report = None;
+        for _ in 0..self.iterate {
+            let start = walker.state().clone();
+            let mut tape = StepTape::default();
+            let step = walker.step_taped(&mut tape)?;
+            report.get_or_insert(step);
+            sens = replay_step(
+                model,
+                &self.opts,
+                param,
+                (&start.q, &start.qd),
+                &sens,
+                &tape,
+            )?
+            .sensitivity;
+        }
+        let next = walker.section()?;
+        let report = report.expect("at least one step is walked");
+        // Rows of the next section state (L2, dtheta/dt, dL2/dt) in (q, q').
+        let rows = [L2, NQ + THETA, NQ + L2];
+        let free = self.free_coordinates();
+        let jacobian = DMatrix::from_fn(free.len(), free.len(), |i, j| {
+            sens[(rows[free[i]], free[j])]
+        });
+        let dparam =
+            param.map(|_| DVector::from_fn(free.len(), |i, _| sens[(rows[free[i]], PARAM)]));
+        Ok(StepDerivatives {
+            outcome: StepOutcome { next, report },
+            jacobian,
+            dparam,
+        })
     }
 
     /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.

@@ -14,6 +14,8 @@ use nalgebra::SVector;
 pub struct DenseStep<const N: usize> {
     t0: f64,
     t1: f64,
+    /// The step size the method used (`t1 - t0` up to rounding; exactly the `h` of its stages).
+    h: f64,
     y1: SVector<f64, N>,
     /// `c0 .. c7`; only the first `terms` are used.
     cont: [SVector<f64, N>; MAX_DENSE_TERMS],
@@ -32,6 +34,12 @@ impl<const N: usize> DenseStep<N> {
     /// End time of the step \[s\].
     pub fn t1(&self) -> f64 {
         self.t1
+    }
+
+    /// The step size the method used: `t1 - t0` up to rounding, exactly the `h` of its stages (what a fixed
+    /// step needs to take the same step again, `Integrator::fixed_step`).
+    pub(crate) fn h(&self) -> f64 {
+        self.h
     }
 
     /// State at [`t0`](Self::t0).
@@ -79,8 +87,7 @@ impl<const N: usize> DenseStep<N> {
 
     /// A dense step from its coefficients `c0 ..` (see the type's documentation).
     pub(super) fn from_coefficients(
-        t0: f64,
-        t1: f64,
+        (t0, t1, h): (f64, f64, f64),
         y1: SVector<f64, N>,
         coefficients: &[SVector<f64, N>],
     ) -> Self {
@@ -89,6 +96,7 @@ impl<const N: usize> DenseStep<N> {
         DenseStep {
             t0,
             t1,
+            h,
             y1,
             cont,
             terms: coefficients.len(),

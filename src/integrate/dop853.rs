@@ -252,7 +252,7 @@ fn dense_step<const N: usize>(
         }
         *c *= h;
     }
-    DenseStep::from_coefficients(t, t1, y1, &cont)
+    DenseStep::from_coefficients((t, t1, h), y1, &cont)
 }
 
 /// One DOP853 step of the given size `h` from `(t, y0)` to `t1` (`t + h`, or the `t_stop` it landed on), with

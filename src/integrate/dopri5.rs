@@ -250,8 +250,7 @@ fn dense_step<const N: usize>(
     let delta = y1 - y0;
     let bspl = k1 * h - delta;
     DenseStep::from_coefficients(
-        t,
-        t1,
+        (t, t1, h),
         y1,
         &[
             *y0,

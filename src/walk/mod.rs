@@ -52,13 +52,16 @@ mod reindex;
 pub(crate) mod report;
 mod run;
 pub(crate) mod section;
+pub(crate) mod tape;
 mod trajectory;
 mod walker;
 mod work;
 mod zeno;
 
 pub use error::WalkError;
+pub(crate) use events::EventKind;
 pub use impact::{Branch, DlsIndicators};
+pub(crate) use phase::pack;
 pub use phase::{PhaseSystem, WalkState, WalkVector};
 pub use report::{
     ContactAudit, EnergyAudit, StepReport, ENERGY_RESIDUAL_WARNING, PENETRATION_WARNING,

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::WalkError;
 use crate::contact::Leg;
-use crate::dynamics::{Coords, Model, L2, THETA, X, Z};
+use crate::dynamics::{lit, Coords, CoordsOf, Mechanics, Model, Real, L2, THETA, X, Z};
 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
 /// by rounding only \[m, m/s\].
@@ -50,14 +50,6 @@ impl SectionState {
             .abs()
             .max((self.theta_dot - other.theta_dot).abs())
             .max((self.l2_dot - other.l2_dot).abs())
-    }
-
-    /// `theta` at which Leg 1 (length `L0`, tip at the origin) and Leg 2 (length `L2`) both touch the ground:
-    /// `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2 sin(alpha))`.
-    pub(crate) fn theta(&self, model: &Model) -> f64 {
-        let alpha = model.alpha();
-        let l0 = model.params().stopper_length;
-        ((self.l2 * alpha.cos() - l0) / (self.l2 * alpha.sin())).atan()
     }
 
     /// Check that this is a state the wheel can be in at touchdown.
@@ -104,24 +96,11 @@ impl SectionState {
     /// Generalized coordinates and velocities `(q_dagger, q'_dagger)` of this section state (with
     /// `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly).
     pub fn to_coords(&self, model: &Model) -> (Coords, Coords) {
-        let l0 = model.params().stopper_length;
-        let s = if model.params().rigid_legs {
-            SectionState {
-                l2: l0,
-                l2_dot: 0.0,
-                ..*self
-            }
-        } else {
-            *self
-        };
-        let q = Coords::new(0.0, 0.0, s.theta(model), l0, s.l2);
-        let mut qd = Coords::new(0.0, 0.0, s.theta_dot, 0.0, s.l2_dot);
-        // Leg 2's tip at rest: J_C2 q' = 0, and its x/z columns are the identity.
-        let tip = model.tip(&q, &qd, Leg::Two.index());
-        let v = tip.velocity(&qd);
-        qd[X] = -v.x;
-        qd[Z] = -v.y;
-        (q, qd)
+        section_coords(
+            model,
+            model.mechanics(),
+            (self.l2, self.theta_dot, self.l2_dot),
+        )
     }
 
     /// The section state of generalized coordinates at the section.
@@ -132,6 +111,35 @@ impl SectionState {
             l2_dot: qd[L2],
         }
     }
+}
+
+/// The state `(q_dagger, q'_dagger)` at the section state `(L2, dtheta/dt, dL2/dt)` over any [`Real`] (the
+/// section's own constraint, docs/model.md section 6): `x = z = 0`, `L1 = L0`, `dL1/dt = 0`; `theta` puts Leg 2's
+/// tip on the ground, `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2
+/// sin(alpha))`; `(dx, dz)` hold Leg 2's tip at rest (`J_C2 q' = 0`, whose `x`, `z` columns are the identity).
+/// With `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly.
+pub(crate) fn section_coords<T: Real>(
+    model: &Model,
+    mech: &Mechanics<T>,
+    (l2, theta_dot, l2_dot): (T, T, T),
+) -> (CoordsOf<T>, CoordsOf<T>) {
+    let l0 = mech.stopper_length;
+    let (l2, l2_dot) = if model.params().rigid_legs {
+        (l0, T::zero())
+    } else {
+        (l2, l2_dot)
+    };
+    let alpha = lit::<T>(model.alpha());
+    let theta = ((l2 * alpha.cos() - l0) / (l2 * alpha.sin())).atan();
+    let zero = T::zero();
+    let q = CoordsOf::<T>::new(zero, zero, theta, l0, l2);
+    let mut qd = CoordsOf::<T>::new(zero, zero, theta_dot, zero, l2_dot);
+    let v = model
+        .tip_with(mech, &q, &qd, Leg::Two.index())
+        .velocity(&qd);
+    qd[X] = -v.x;
+    qd[Z] = -v.y;
+    (q, qd)
 }
 
 /// A section state written as `L2,thetadot,L2dot` could not be read.

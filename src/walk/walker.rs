@@ -21,6 +21,7 @@ use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::reindex::reindex;
 use super::report::{ContactAudit, EnergyAudit, StepReport};
 use super::section::SectionState;
+use super::tape::StepTape;
 use super::trajectory::Trajectory;
 use super::work::WorkCounts;
 use super::zeno::{lock_zeno_stoppers, ZenoLock};
@@ -167,6 +168,19 @@ impl<'m> Walker<'m> {
     /// until the next touchdown), then `finish_step` (the report and the re-indexing). The step's work, failed
     /// or not, is added to [`Walker::work`].
     pub fn step(&mut self, trajectory: Option<&mut Trajectory>) -> Result<StepReport, WalkError> {
+        self.step_recorded(trajectory, None)
+    }
+
+    /// [`Walker::step`], recording the step in `tape` (which must be empty) for the exact derivatives.
+    pub(crate) fn step_taped(&mut self, tape: &mut StepTape) -> Result<StepReport, WalkError> {
+        self.step_recorded(None, Some(tape))
+    }
+
+    fn step_recorded(
+        &mut self,
+        trajectory: Option<&mut Trajectory>,
+        tape: Option<&mut StepTape>,
+    ) -> Result<StepReport, WalkError> {
         if let Some(e) = &self.blocked {
             return Err(e.clone());
         }
@@ -175,7 +189,7 @@ impl<'m> Walker<'m> {
             steps: 1,
             ..WorkCounts::ZERO
         };
-        let reached = self.walk_to_touchdown(&start, trajectory, &mut work);
+        let reached = self.walk_to_touchdown(&start, trajectory, tape, &mut work);
         self.work += work;
         reached.map(|touchdown| self.finish_step(&start, touchdown))
     }
@@ -198,6 +212,7 @@ impl<'m> Walker<'m> {
         &self,
         start: &WalkState,
         trajectory: Option<&mut Trajectory>,
+        mut tape: Option<&mut StepTape>,
         work: &mut WorkCounts,
     ) -> Result<Touchdown, WalkError> {
         let model = self.model;
@@ -207,6 +222,9 @@ impl<'m> Walker<'m> {
         let td = touchdown_impact(model, &start.q, &start.qd, start.active)
             .map_err(WalkError::contact_at(t_start, Phase::SingleSupport))?;
         work.impacts += 1;
+        if let Some(tape) = tape.as_deref_mut() {
+            tape.impact(td.impulse_set);
+        }
         let mut tally = StepTally {
             impact_loss: td.loss,
             bounce: td.branch == Branch::Bounce,
@@ -243,11 +261,14 @@ impl<'m> Walker<'m> {
         if let Some(lock) = zeno {
             work.impacts += 1;
             tally.see_zeno(&lock);
+            if let Some(tape) = tape.as_deref_mut() {
+                lock.impulse_sets.iter().for_each(|set| tape.impact(*set));
+            }
             (qd_plus, active) = (lock.qd_plus, lock.active);
         }
 
         let y = pack(&start.q, &qd_plus, 0.0);
-        let mut phases = Phases::start(self, start, trajectory, tally, active, y);
+        let mut phases = Phases::start(self, start, (trajectory, tape), tally, active, y);
         let reached = phases.run();
         *work += phases.work();
         let (t, y) = reached?;
@@ -333,6 +354,8 @@ struct Phases<'a> {
     /// The section state the step started from (its frame and time).
     start: &'a WalkState,
     trajectory: Option<&'a mut Trajectory>,
+    /// The record of the step for the exact derivatives, if asked for.
+    tape: Option<&'a mut StepTape>,
     tally: StepTally,
     /// Time of the integrator's current point \[s\].
     t: f64,
@@ -378,7 +401,7 @@ impl<'a> Phases<'a> {
     fn start(
         walker: &'a Walker<'_>,
         start: &'a WalkState,
-        mut trajectory: Option<&'a mut Trajectory>,
+        (mut trajectory, mut tape): (Option<&'a mut Trajectory>, Option<&'a mut StepTape>),
         mut tally: StepTally,
         active: ActiveSet,
         y: WalkVector,
@@ -387,6 +410,9 @@ impl<'a> Phases<'a> {
         let t = start.time;
         if let Some(tr) = trajectory.as_deref_mut() {
             tr.push(model, t, &y, active, start);
+        }
+        if let Some(tape) = tape.as_deref_mut() {
+            tape.begin(active, t, y);
         }
         let t_limit = start.time + opts.max_step_time;
         let solver = Integrator::new(
@@ -405,6 +431,7 @@ impl<'a> Phases<'a> {
             opts,
             start,
             trajectory,
+            tape,
             tally,
             t,
             y,
@@ -473,6 +500,9 @@ impl<'a> Phases<'a> {
             .solver
             .step(&sys, self.t_limit)
             .map_err(|source| WalkError::Integration { phase, source })?;
+        if let Some(tape) = self.tape.as_deref_mut() {
+            tape.step(step.h(), step.t1());
+        }
         let StepSearch {
             hit,
             mut g_next,
@@ -581,6 +611,9 @@ impl<'a> Phases<'a> {
         self.tally.audit.see_force(self.events.values(&self.y).1);
         let kind = self.events.events[hit.index].kind;
         self.work.events.count(kind);
+        if let Some(tape) = self.tape.as_deref_mut() {
+            tape.end(t, kind, self.y);
+        }
         match kind {
             EventKind::Touchdown => return Ok(Some((t, self.y))),
             EventKind::Fall => {
@@ -606,6 +639,9 @@ impl<'a> Phases<'a> {
                     .map_err(WalkError::contact_at(t, phase))?
                     .ok_or(WalkError::InconsistentContacts { time: t, phase })?;
                 self.work.impacts += 1;
+                if let Some(tape) = self.tape.as_deref_mut() {
+                    tape.impact(closed.impulse_set);
+                }
                 let tally = &mut self.tally;
                 tally.audit.pull_impulse = tally.audit.pull_impulse.max(closed.pull_impulse);
                 match unit {
@@ -619,6 +655,9 @@ impl<'a> Phases<'a> {
                 if let Some(lock) = lock_zeno_stoppers(model, &q, &qd_plus, active, gap, t)? {
                     self.work.impacts += 1;
                     self.tally.see_zeno(&lock);
+                    if let Some(tape) = self.tape.as_deref_mut() {
+                        lock.impulse_sets.iter().for_each(|set| tape.impact(*set));
+                    }
                     (qd_plus, active) = (lock.qd_plus, lock.active);
                 }
                 // Leg 1's tip may leave the ground at an impact (a stopper lock that lifts the wheel).
@@ -651,6 +690,9 @@ impl<'a> Phases<'a> {
         self.tally.audit.see_force(pull);
         if let Some(tr) = self.trajectory.as_deref_mut() {
             tr.push(model, self.t, &self.y, active, self.start);
+        }
+        if let Some(tape) = self.tape.as_deref_mut() {
+            tape.begin(active, self.t, self.y);
         }
     }
 }

@@ -29,7 +29,7 @@ use super::impact::{
 pub const ZENO_IMPULSE_WARNING: f64 = 1e-3;
 
 /// What [`lock_zeno_stoppers`] did to the state after an impact.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ZenoLock {
     /// The stoppers locked at the accumulation point.
     pub locked: ActiveSet,
@@ -44,6 +44,9 @@ pub struct ZenoLock {
     pub impulse: f64,
     /// The largest pulling impulse of the other units that took an impulse in the locks \[N s\] (contact audit).
     pub pull_impulse: f64,
+    /// The units that took an impulse in each of the locks' plastic impacts, in order (at most one per leg):
+    /// what the exact derivatives replay (`crate::variational`).
+    pub impulse_sets: Vec<ActiveSet>,
 }
 
 /// The free legs at `(q, q')` under `active` that the Zeno rule locks: at their stopper (`L0 - L <=
@@ -105,6 +108,7 @@ pub fn lock_zeno_stoppers(
     let (mut qd_now, mut active_now) = (*qd, active);
     let mut pull_impulse: f64 = 0.0;
     let mut zeno_impulse: f64 = 0.0;
+    let mut impulse_sets = Vec::new();
     loop {
         let legs = zeno_legs(model, q, &qd_now, &active_now, stopper_gap, &locked)
             .map_err(contact_error)?;
@@ -126,6 +130,7 @@ pub fn lock_zeno_stoppers(
         }
         let (impulse_set, sol) =
             plastic_impact(model, q, &qd_now, forced, &candidates).map_err(contact_error)?;
+        impulse_sets.push(impulse_set);
         let mut others = impulse_set;
         for leg in Leg::BOTH {
             if legs.lock(leg) {
@@ -158,6 +163,7 @@ pub fn lock_zeno_stoppers(
         loss: model.kinetic_energy(q, qd) - model.kinetic_energy(q, &qd_now),
         impulse: zeno_impulse,
         pull_impulse,
+        impulse_sets,
     }))
 }
 

@@ -1,0 +1,59 @@
+//! Exact derivatives of the step map (docs/model.md section 8): `DP = dP/ds` and `dP/dp` for one chosen
+//! parameter, from the variational equations of every phase (the KKT solve differentiated with its active set
+//! fixed) composed with the saltation matrix of every event, replayed over the step the walk took.
+//!
+//! The walker records its step ([`crate::walk::tape::StepTape`]: the impulse sets of its impacts, the active
+//! set and accepted integrator steps of each phase, the event that ended it); `replay` integrates the
+//! augmented system `[y, S]` over the same steps and crosses each event with its time's sensitivity. The
+//! derivatives of the equations of motion, the KKT solution, the guards, the collisions, the re-indexing and
+//! the section's own constraint come from forward-mode automatic differentiation (`num-dual` dual numbers
+//! through the same generic code the walk runs, [`crate::dynamics::Real`]). Where the map has no derivative (a
+//! grazing event, two events at one instant) the replay says so ([`NotDifferentiable`]) instead of returning
+//! a number.
+//!
+//! `kkt.rs` holds the constrained dynamics and collision over any `Real`, `replay.rs` the variational
+//! equations and the events.
+
+mod kkt;
+mod replay;
+
+pub(crate) use replay::{
+    dual as dual_of, replay_step, seeded, sensitivity, Dual, Sensitivity, NDIR, PARAM,
+};
+pub use replay::{COINCIDENT_EVENTS, GRAZING_RATE};
+
+/// Why a step has no derivative (or the replay could not give it).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotDifferentiable {
+    /// An event met the flow tangentially (its rate along the flow vanishes against its derivatives, see
+    /// [`GRAZING_RATE`]): the step map is not differentiable there.
+    #[error("grazing {event} event at t = {time} s: the step map is not differentiable there")]
+    Grazing {
+        /// Time of the event \[s\].
+        time: f64,
+        /// Which event.
+        event: String,
+    },
+    /// Two events within [`COINCIDENT_EVENTS`] of each other (e.g. a lift-off at a stopper lock): the step map
+    /// has a corner there.
+    #[error("two events at t = {time} s: the step map has a corner there and no derivative")]
+    CoincidentEvents {
+        /// Time of the second event \[s\].
+        time: f64,
+    },
+    /// A KKT or collision solve in the replay was singular.
+    #[error("singular constraint solve at t = {time} s in the derivative replay")]
+    Singular {
+        /// Time \[s\].
+        time: f64,
+    },
+    /// The replay's state left the walk's (an internal error: it takes the walk's steps bit for bit).
+    #[error("the derivative replay diverged from the walk at t = {time} s")]
+    Diverged {
+        /// Time \[s\].
+        time: f64,
+    },
+    /// The recorded step is incomplete (it did not reach its touchdown).
+    #[error("the step was not recorded to its touchdown")]
+    Incomplete,
+}

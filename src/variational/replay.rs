@@ -1,0 +1,363 @@
+//! The variational equations of each phase and the saltation matrix of each event, replayed over a walked step
+//! ([`StepTape`]): docs/model.md section 8.
+//!
+//! **Phases.** The sensitivity `S = d(q, q')/d(s, p)` (10 rows, [`NDIR`] columns) obeys `S' = F_y S + F_p`, with
+//! `F` the phase's vector field `(q', q'')`, `q''` from the KKT system with the active set fixed. Both products
+//! come from one evaluation of `F` on dual numbers whose derivative parts are the rows of `S` (and the
+//! parameter's unit direction): forward-mode automatic differentiation (`num-dual`). The augmented state
+//! `[y, S]` is integrated with the very steps the walk accepted (`Integrator::fixed_step`, the same stages and
+//! dense output): internal numerical differentiation (Bock), so the state part reproduces the walk bit for bit
+//! and its error control is the walk's, untouched; `S` is the exact derivative of that discretization.
+//!
+//! **Events.** An event with guard `g(y, p) = 0`, reset `R` and vector fields `f-`, `f+` before and after moves
+//! the time of the event by `dt = -(g_y S + g_p) / (g_y f-)`; the sensitivity after it is
+//! `S+ = R_y (S- + f- dt) + R_p - f+ dt`, which for `p = 0` is the saltation matrix
+//! `S+ = [R_y + (f+ - R_y f-) g_y^T / (g_y f-)] S-`. `g_y S` and `g_y f-` come from one evaluation of `g` on
+//! duals carrying `S` and `f-` (`DualSVec64<NDIR + 1>`): so the force guards (a normal force or a stopper
+//! reaction reaching zero, from the KKT solution) are differentiated through the KKT solve like the rest. `R` is
+//! the identity for a change of active set (lift-off, unlock, slide) and the collision equation (5) with the
+//! recorded units for an impact (touchdown, landing, stopper hit, Zeno locks), differentiated in duals.
+
+use nalgebra::{Const, SMatrix, SVector};
+use num_dual::{Derivative, DualSVec64};
+
+use crate::contact::ActiveSet;
+use crate::dynamics::{CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA};
+use crate::integrate::{Integrator, OdeSystem};
+use crate::params::SolverOptions;
+use crate::walk::impact::touchdown_leg;
+use crate::walk::tape::{Segment, StepTape};
+use crate::walk::{EventKind, PhaseSystem, WalkVector};
+
+use super::kkt::{constrained_dynamics_with, impulse_with};
+use super::NotDifferentiable;
+
+/// Directions of the derivatives: the three section coordinates `(L2, dtheta/dt, dL2/dt)` and one parameter.
+pub(crate) const NDIR: usize = 4;
+/// Column of the parameter in a sensitivity.
+pub(crate) const PARAM: usize = 3;
+/// Rows of a sensitivity: `q` and `q'`.
+pub(crate) const NS: usize = 2 * NQ;
+/// `d(q, q')/d(L2, dtheta/dt, dL2/dt, p)`.
+pub(crate) type Sensitivity = SMatrix<f64, NS, NDIR>;
+/// A number with its derivatives along the [`NDIR`] directions.
+pub(crate) type Dual = DualSVec64<NDIR>;
+/// A number with its derivatives along the [`NDIR`] directions and along the flow (the event's rate).
+type Dual5 = DualSVec64<{ NDIR + 1 }>;
+
+/// Size of the walk's state `[q, q', E_damper]`.
+const NY: usize = 2 * NQ + 1;
+/// Size of the augmented state `[y, S]` (`S` column by column).
+const NAUG: usize = NY + NS * NDIR;
+type Augmented = SVector<f64, NAUG>;
+
+/// A grazing event: the guard's rate along the flow `g_y f-` is at most this times its largest derivative
+/// `|g_y S + g_p|` (the event time would move by more than `1 / GRAZING_RATE` seconds per unit of the section
+/// state or parameter): the flow touches the guard tangentially and the event time is not a smooth function.
+pub const GRAZING_RATE: f64 = 1e-7;
+
+/// Two events less than this apart \[s\] are taken as coincident (e.g. a lift-off at a stopper lock): the
+/// step map has a corner there and no derivative.
+pub const COINCIDENT_EVENTS: f64 = 1e-9;
+
+/// The dual number `re + eps . e`.
+pub(crate) fn dual<const D: usize>(re: f64, eps: SVector<f64, D>) -> DualSVec64<D> {
+    DualSVec64::new(re, Derivative::some(eps))
+}
+
+/// The derivative part of a dual number.
+pub(crate) fn eps<const D: usize>(x: &DualSVec64<D>) -> SVector<f64, D> {
+    x.eps.clone().unwrap_generic(Const::<D>, Const::<1>)
+}
+
+/// The constants of `model` with the parameter `param` (if any) carrying the unit derivative in direction
+/// `index` of `D`.
+pub(crate) fn seeded<const D: usize>(
+    model: &Model,
+    param: Option<&str>,
+    index: usize,
+) -> Mechanics<DualSVec64<D>> {
+    Mechanics::seeded(model.params(), |key, value| {
+        let mut e = SVector::<f64, D>::zeros();
+        if param == Some(key) {
+            e[index] = 1.0;
+        }
+        dual(value, e)
+    })
+}
+
+/// `(q, q')` as duals: real parts from `y`, derivative parts from the rows of `s`.
+fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual>, CoordsOf<Dual>) {
+    let at = |i: usize| dual(y[i], s.row(i).transpose());
+    (
+        CoordsOf::from_fn(|i, _| at(i)),
+        CoordsOf::from_fn(|i, _| at(NQ + i)),
+    )
+}
+
+/// `(q, q')` as duals whose first [`NDIR`] directions are the rows of `s` and whose last one is the rate `f`.
+fn with_rate(
+    y: &WalkVector,
+    s: &Sensitivity,
+    f: &WalkVector,
+) -> (CoordsOf<Dual5>, CoordsOf<Dual5>) {
+    let at = |i: usize| {
+        let mut e = SVector::<f64, { NDIR + 1 }>::zeros();
+        e.fixed_rows_mut::<NDIR>(0).copy_from(&s.row(i).transpose());
+        e[NDIR] = f[i];
+        dual(y[i], e)
+    };
+    (
+        CoordsOf::from_fn(|i, _| at(i)),
+        CoordsOf::from_fn(|i, _| at(NQ + i)),
+    )
+}
+
+/// The sensitivity carried by duals `(q, q')`.
+pub(crate) fn sensitivity(q: &CoordsOf<Dual>, qd: &CoordsOf<Dual>) -> Sensitivity {
+    Sensitivity::from_fn(|i, c| {
+        let x = if i < NQ { &q[i] } else { &qd[i - NQ] };
+        eps(x)[c]
+    })
+}
+
+/// The phase's vector field with its variational equation, on the augmented state `[y, S]`.
+struct Variational<'a> {
+    model: &'a Model,
+    mech: &'a Mechanics<Dual>,
+    active: ActiveSet,
+}
+
+impl Variational<'_> {
+    fn split(a: &Augmented) -> (WalkVector, Sensitivity) {
+        let y = a.fixed_rows::<NY>(0).into_owned();
+        let s = Sensitivity::from_column_slice(&a.as_slice()[NY..]);
+        (y, s)
+    }
+
+    fn join(y: &WalkVector, s: &Sensitivity) -> Augmented {
+        let mut a = Augmented::zeros();
+        a.fixed_rows_mut::<NY>(0).copy_from(y);
+        a.as_mut_slice()[NY..].copy_from_slice(s.as_slice());
+        a
+    }
+}
+
+impl OdeSystem<NAUG> for Variational<'_> {
+    fn rhs(&self, t: f64, a: &Augmented) -> Augmented {
+        let (y, s) = Self::split(a);
+        // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
+        let fy = PhaseSystem {
+            model: self.model,
+            active: self.active,
+        }
+        .rhs(t, &y);
+        let (q, qd) = duals(&y, &s);
+        let Some((qdd, _)) =
+            constrained_dynamics_with(self.model, self.mech, &q, &qd, &self.active)
+        else {
+            return Augmented::repeat(f64::NAN);
+        };
+        let ds = Sensitivity::from_fn(|i, c| {
+            let x = if i < NQ { &qd[i] } else { &qdd[i - NQ] };
+            eps(x)[c]
+        });
+        Self::join(&fy, &ds)
+    }
+}
+
+/// The derivatives of one step: the sensitivity of the state after the re-indexing at the next touchdown (the
+/// next section), and the state itself.
+pub(crate) struct StepDerivative {
+    /// `d(q, q')/d(s, p)` just after re-indexing.
+    pub(crate) sensitivity: Sensitivity,
+}
+
+/// Replays `tape`, a step walked from the state `(q, q')` (at the section, before the touchdown impact) with
+/// sensitivity `s0`: the sensitivity after the re-indexing at the next touchdown. `opts` are the walk's.
+pub(crate) fn replay_step(
+    model: &Model,
+    opts: &SolverOptions,
+    param: Option<&str>,
+    (q0, qd0): (&CoordsOf<f64>, &CoordsOf<f64>),
+    s0: &Sensitivity,
+    tape: &StepTape,
+) -> Result<StepDerivative, NotDifferentiable> {
+    let mech = seeded::<NDIR>(model, param, PARAM);
+    let mech5 = seeded::<{ NDIR + 1 }>(model, param, PARAM);
+    // The touchdown impact at the section: the recorded collision, then any Zeno locks (no time shift: the
+    // section is the touchdown instant).
+    let mut y0 = crate::walk::pack(q0, qd0, 0.0);
+    let (q, mut qd) = duals(&y0, s0);
+    for set in &tape.impacts {
+        qd = impulse_with(model, &mech, &q, &qd, set).ok_or(NotDifferentiable::Singular {
+            time: tape.segments.first().map_or(0.0, |s| s.t0),
+        })?;
+    }
+    let mut s = sensitivity(&q, &qd);
+    let Some(first) = tape.segments.first() else {
+        return Err(NotDifferentiable::Incomplete);
+    };
+    y0 = first.y0;
+    let mut last_event: Option<f64> = None;
+    for (k, segment) in tape.segments.iter().enumerate() {
+        let (y_minus, s_minus) = integrate_segment(model, opts, &mech, segment, &y0, &s)?;
+        let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
+        if last_event.is_some_and(|t| (end.time - t).abs() < COINCIDENT_EVENTS) {
+            return Err(NotDifferentiable::CoincidentEvents { time: end.time });
+        }
+        last_event = Some(end.time);
+        let (s_event, dt) = cross_guard(model, &mech5, segment, &y_minus, &s_minus)?;
+        if end.kind == EventKind::Touchdown {
+            let (q, qd) = duals(&y_minus, &s_event);
+            let (q, qd) = reindex_duals(model, &mech, &q, &qd);
+            return Ok(StepDerivative {
+                sensitivity: sensitivity(&q, &qd),
+            });
+        }
+        let next = tape
+            .segments
+            .get(k + 1)
+            .ok_or(NotDifferentiable::Incomplete)?;
+        // The reset: the recorded impacts, in duals.
+        let (q, mut qd) = duals(&y_minus, &s_event);
+        for set in &end.impacts {
+            qd = impulse_with(model, &mech, &q, &qd, set)
+                .ok_or(NotDifferentiable::Singular { time: end.time })?;
+        }
+        let f_plus = PhaseSystem {
+            model,
+            active: next.active,
+        }
+        .rhs(end.time, &next.y0);
+        s = sensitivity(&q, &qd) - rate_outer(&f_plus, &dt);
+        y0 = next.y0;
+    }
+    Err(NotDifferentiable::Incomplete)
+}
+
+/// `f dt^T` over the rows `(q, q')` of the state's rate `f`.
+fn rate_outer(f: &WalkVector, dt: &SVector<f64, NDIR>) -> Sensitivity {
+    Sensitivity::from_fn(|i, c| f[i] * dt[c])
+}
+
+/// Integrate the variational equations over the recorded steps of `segment` from `(y0, s0)`: the state and
+/// sensitivity at the event that ends it.
+fn integrate_segment(
+    model: &Model,
+    opts: &SolverOptions,
+    mech: &Mechanics<Dual>,
+    segment: &Segment,
+    y0: &WalkVector,
+    s0: &Sensitivity,
+) -> Result<(WalkVector, Sensitivity), NotDifferentiable> {
+    let sys = Variational {
+        model,
+        mech,
+        active: segment.active,
+    };
+    let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
+    let mut t = segment.t0;
+    let mut a = Variational::join(y0, s0);
+    let mut at_event = None;
+    for &(h, t1) in &segment.steps {
+        let step = Integrator::fixed_step(opts.integrator, &sys, t, &a, (h, t1));
+        if end.time <= t1 {
+            at_event = Some(step.eval(end.time));
+            break;
+        }
+        a = *step.y1();
+        t = t1;
+    }
+    let (y, s) = Variational::split(&at_event.ok_or(NotDifferentiable::Incomplete)?);
+    // The replay takes the walk's steps with the walk's arithmetic: its state is the walk's, bit for bit.
+    if y != end.y || !s.iter().all(|v| v.is_finite()) {
+        return Err(NotDifferentiable::Diverged { time: end.time });
+    }
+    Ok((y, s))
+}
+
+/// The event that ends `segment`, crossed: its time's derivative `dt = -(g_y S + g_p) / (g_y f-)` and the
+/// sensitivity at the event `S- + f- dt` (before its reset).
+fn cross_guard(
+    model: &Model,
+    mech: &Mechanics<Dual5>,
+    segment: &Segment,
+    y: &WalkVector,
+    s: &Sensitivity,
+) -> Result<(Sensitivity, SVector<f64, NDIR>), NotDifferentiable> {
+    let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
+    let f = PhaseSystem {
+        model,
+        active: segment.active,
+    }
+    .rhs(end.time, y);
+    let (q, qd) = with_rate(y, s, &f);
+    let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
+    let guard = guard(model, mech, (end.kind, touching), segment.active, &q, &qd)
+        .ok_or(NotDifferentiable::Singular { time: end.time })?;
+    let d = eps(&guard);
+    let rate = d[NDIR];
+    if !(rate.abs() > GRAZING_RATE * d.fixed_rows::<NDIR>(0).amax()) {
+        return Err(NotDifferentiable::Grazing {
+            time: end.time,
+            event: format!("{:?}", end.kind),
+        });
+    }
+    let dt: SVector<f64, NDIR> = -d.fixed_rows::<NDIR>(0) / rate;
+    Ok((s + rate_outer(&f, &dt), dt))
+}
+
+/// The guard of an event at `(q, q')` over any [`Real`]: the function whose zero is the event (the unshifted
+/// event function of `crate::walk`'s event table; its guards' numerical offsets are constants).
+fn guard<T: Real>(
+    model: &Model,
+    mech: &Mechanics<T>,
+    (kind, touching): (EventKind, LegIndex),
+    active: ActiveSet,
+    q: &CoordsOf<T>,
+    qd: &CoordsOf<T>,
+) -> Option<T> {
+    let forces = || constrained_dynamics_with(model, mech, q, qd, &active).map(|(_, lam)| lam);
+    match kind {
+        EventKind::Touchdown => Some(model.tip_height_with(mech, q, touching)),
+        EventKind::LiftOff(leg) => forces().map(|lam| lam[leg.normal_row()]),
+        EventKind::Unlock(leg) => forces().map(|lam| -lam[leg.stopper_row()]),
+        EventKind::Landing(leg) => Some(model.tip_height_with(mech, q, leg.index())),
+        EventKind::StopperHit(leg) => Some(mech.stopper_length - q[leg.length_coordinate()]),
+        EventKind::Fall | EventKind::RollBack => None,
+    }
+}
+
+/// Re-indexing at touchdown in duals (as `crate::walk`'s `reindex`): the touching leg becomes Leg 1, the old Leg
+/// 1 Leg 2 (or, after a long flight, a locked leg at `L0`), the origin moves to the new tip.
+fn reindex_duals(
+    model: &Model,
+    mech: &Mechanics<Dual>,
+    q: &CoordsOf<Dual>,
+    qd: &CoordsOf<Dual>,
+) -> (CoordsOf<Dual>, CoordsOf<Dual>) {
+    let real_q = q.map(|x| x.re);
+    let touching = touchdown_leg(model, &real_q);
+    let shift = model.legs() - touching;
+    let front = model.tip_with(mech, q, qd, touching);
+    let v = front.velocity(qd);
+    let l0 = mech.stopper_length;
+    let zero = Dual::from(0.0);
+    let (l2, l2_dot) = if shift == 1 {
+        (q[L1], qd[L1])
+    } else {
+        (l0, zero)
+    };
+    let alpha = model.alpha();
+    let theta = if shift == 1 {
+        q[THETA] - Dual::from(alpha)
+    } else {
+        let psi = q[THETA] + Dual::from(touching as f64 * alpha);
+        let turns = (psi.re / std::f64::consts::TAU).round();
+        psi - Dual::from(std::f64::consts::TAU * turns)
+    };
+    let q_new = CoordsOf::<Dual>::new(zero, front.position.y, theta, l0, l2);
+    let qd_new = CoordsOf::<Dual>::new(v.x, v.y, qd[THETA], zero, l2_dot);
+    (q_new, qd_new)
+}

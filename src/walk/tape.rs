@@ -1,0 +1,93 @@
+//! The record of one walked step that the exact derivatives replay (docs/model.md section 8): the impulse sets
+//! of its impacts, the active set, start and accepted integrator steps of each phase, and the event that ended
+//! each phase. With it, `crate::variational` integrates the variational equations over the very steps the walk
+//! took and composes the saltation matrix of every event, without deciding anything again.
+
+use crate::contact::ActiveSet;
+
+use super::events::EventKind;
+use super::phase::WalkVector;
+
+/// One step as the walker took it ([`super::Walker::step_taped`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct StepTape {
+    /// The units that took an impulse at the touchdown impact: the collision the procedure applied, then the
+    /// Zeno locks that followed it, in order.
+    pub(crate) impacts: Vec<ActiveSet>,
+    /// The phases of the step, in order; the last ends at the next touchdown.
+    pub(crate) segments: Vec<Segment>,
+}
+
+/// One phase of constrained motion.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Segment {
+    /// Its active contacts and stoppers.
+    pub(crate) active: ActiveSet,
+    /// Start time \[s\].
+    pub(crate) t0: f64,
+    /// The state at the start (after the event's reset).
+    pub(crate) y0: WalkVector,
+    /// The accepted integrator steps, `(h, t1)` each, every one starting where the one before ended.
+    pub(crate) steps: Vec<(f64, f64)>,
+    /// The event that ended it (located inside the last step).
+    pub(crate) end: Option<SegmentEnd>,
+}
+
+/// The event that ended a phase.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SegmentEnd {
+    /// When \[s\].
+    pub(crate) time: f64,
+    /// Which event.
+    pub(crate) kind: EventKind,
+    /// The state then, on the last step's dense output (before any reset).
+    pub(crate) y: WalkVector,
+    /// The units that took an impulse at the event's impacts (a landing or stopper hit, then its Zeno locks),
+    /// in order; empty when the event only changes the active set.
+    pub(crate) impacts: Vec<ActiveSet>,
+}
+
+impl StepTape {
+    /// Start a phase at `(t0, y0)` with `active`.
+    pub(crate) fn begin(&mut self, active: ActiveSet, t0: f64, y0: WalkVector) {
+        self.segments.push(Segment {
+            active,
+            t0,
+            y0,
+            steps: Vec::new(),
+            end: None,
+        });
+    }
+
+    /// The phase in progress.
+    fn current(&mut self) -> Option<&mut Segment> {
+        self.segments.last_mut()
+    }
+
+    /// An accepted integrator step of size `h` ending at `t1`.
+    pub(crate) fn step(&mut self, h: f64, t1: f64) {
+        if let Some(segment) = self.current() {
+            segment.steps.push((h, t1));
+        }
+    }
+
+    /// The phase in progress ends with `kind` at `(time, y)`.
+    pub(crate) fn end(&mut self, time: f64, kind: EventKind, y: WalkVector) {
+        if let Some(segment) = self.current() {
+            segment.end = Some(SegmentEnd {
+                time,
+                kind,
+                y,
+                impacts: Vec::new(),
+            });
+        }
+    }
+
+    /// The units of an impact at the end of the phase in progress (or, before any phase, at the touchdown).
+    pub(crate) fn impact(&mut self, set: ActiveSet) {
+        match self.segments.last_mut().and_then(|s| s.end.as_mut()) {
+            Some(end) => end.impacts.push(set),
+            None => self.impacts.push(set),
+        }
+    }
+}
