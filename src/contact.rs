@@ -574,19 +574,19 @@ fn solve_active_rows<const N: usize, const K: usize>(
 /// factorizations and solves of size 1 to 5, where nalgebra's generic code (column views, `axpy`, square roots)
 /// costs several times these plain loops; [`solve_saddle`] keeps the nalgebra version as the reference. The
 /// factorization works in place (fill `l` with `A`, then [`Ldl::factor`]) so that no matrix is moved around.
-struct Ldl<const N: usize> {
+pub(crate) struct Ldl<const N: usize> {
     /// `A` before [`Ldl::factor`] (its lower triangle is read), `L` below the diagonal after.
-    l: [[f64; N]; N],
+    pub(crate) l: [[f64; N]; N],
     /// The pivots `D` (the squares of the diagonal of the Cholesky factor).
-    d: [f64; N],
+    pub(crate) d: [f64; N],
     /// `1 / D`, so that the solves multiply rather than divide.
-    d_inv: [f64; N],
+    pub(crate) d_inv: [f64; N],
     n: usize,
 }
 
 impl<const N: usize> Ldl<N> {
     /// An `n x n` matrix of zeros to fill in before [`Ldl::factor`].
-    fn zeros(n: usize) -> Self {
+    pub(crate) fn zeros(n: usize) -> Self {
         Ldl {
             l: [[0.0; N]; N],
             d: [0.0; N],
@@ -597,7 +597,7 @@ impl<const N: usize> Ldl<N> {
 
     /// Factor in place; `false` when a pivot is not positive (or not a number), as nalgebra's
     /// `Cholesky::new` fails.
-    fn factor(&mut self) -> bool {
+    pub(crate) fn factor(&mut self) -> bool {
         let (l, d, d_inv) = (&mut self.l, &mut self.d, &mut self.d_inv);
         for j in 0..self.n {
             let mut pivot = l[j][j];
@@ -621,7 +621,7 @@ impl<const N: usize> Ldl<N> {
     }
 
     /// `b <- L^-1 b`.
-    fn forward(&self, b: &mut [f64; N]) {
+    pub(crate) fn forward(&self, b: &mut [f64; N]) {
         for i in 0..self.n {
             for k in 0..i {
                 b[i] -= self.l[i][k] * b[k];
@@ -630,7 +630,7 @@ impl<const N: usize> Ldl<N> {
     }
 
     /// `y <- L^-T D^-1 y`, so that `forward` then `backward_scaled` solve `A x = b`.
-    fn backward_scaled(&self, y: &mut [f64; N]) {
+    pub(crate) fn backward_scaled(&self, y: &mut [f64; N]) {
         for i in (0..self.n).rev() {
             y[i] *= self.d_inv[i];
             for k in i + 1..self.n {

@@ -57,3 +57,40 @@ fn paper_gait_jacobian_matches_richardson_differences() {
     assert!((&exact.jacobian - &fd).abs().max() < 10.0 * gait.jacobian_error.max(1e-9));
     let _ = DIFFERENTIABLE_KEYS;
 }
+
+#[test]
+#[ignore]
+fn timing_scratch() {
+    let config = Config::default();
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let gait = find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None,
+    )
+    .unwrap();
+    let n = 50;
+    let t = std::time::Instant::now();
+    for _ in 0..n {
+        map.eval(&gait.section).unwrap();
+    }
+    let e = t.elapsed().as_secs_f64() / n as f64;
+    let t = std::time::Instant::now();
+    for _ in 0..n {
+        map.eval_with_derivatives(&gait.section, Some("viscosity"))
+            .unwrap();
+    }
+    let d = t.elapsed().as_secs_f64() / n as f64;
+    let t = std::time::Instant::now();
+    for _ in 0..n {
+        map.eval_with_derivatives(&gait.section, None).unwrap();
+    }
+    let d0 = t.elapsed().as_secs_f64() / n as f64;
+    eprintln!(
+        "eval {e:e} s, with derivatives {d:e} s ({:.2}x), no param {d0:e} ({:.2}x)",
+        d / e,
+        d0 / e
+    );
+}

@@ -21,6 +21,7 @@
 use nalgebra::DMatrix;
 use serde::Serialize;
 
+use super::derivative::newton_jacobian;
 use super::limit_cycle::{solve_fixed_point, FixedPoint, GaitOptions};
 pub(crate) use super::periodicity::SAME_GAIT_TOL;
 use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
@@ -249,11 +250,12 @@ impl<'a> Continuation<'a> {
         None
     }
 
-    /// `DP` (`D(P^k)` for a period-k family; central differences) of the gait `at`.
+    /// `DP` (`D(P^k)` for a period-k family; exact, or a central difference where the map is not
+    /// differentiable) of the gait `at`.
     fn jacobian(&self, at: &FamilyPoint) -> Option<DMatrix<f64>> {
         let (c, model) = self.configured_at(at.value).ok()?;
         let map = StepMap::new(&model, &c.solver).iterated(self.period);
-        map.central_jacobian(&at.section, self.options.fd_step).ok()
+        newton_jacobian(&map, &at.section, self.options.fd_step).ok()
     }
 
     /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's

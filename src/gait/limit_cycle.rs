@@ -4,6 +4,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
+use super::derivative::{gait_jacobian, newton_jacobian, ParamDerivative};
 use super::step_map::{StepMap, StepOutcome};
 use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport};
@@ -18,11 +19,16 @@ pub struct GaitOptions {
     pub max_iterations: usize,
     /// Convergence: `max |P(s) - s| <` this (default 1e-10; units of the section coordinates).
     pub tolerance: f64,
-    /// Relative finite-difference step of the Jacobian (default 1e-4).
+    /// Relative finite-difference step of the Jacobian where finite differences are used: Newton's matrix where
+    /// the map is not differentiable, and the check of the exact `DP` (default 1e-4).
     pub fd_step: f64,
-    /// Compute the final `DP` with Richardson extrapolation and an error estimate (default true); otherwise
-    /// one central difference (half the cost, used inside sweeps).
+    /// Estimate the error of the final `DP` (default true): the exact `DP` computed again at tolerances
+    /// [`super::derivative::DERIVATIVE_CHECK_TIGHTENING`] times tighter, the difference being the estimate that
+    /// the stability verdict uses; otherwise no estimate (about half the cost, used inside continuation).
     pub refine_jacobian: bool,
+    /// Also compute `dP/dp` of the gait for this parameter (one of
+    /// [`DIFFERENTIABLE_KEYS`](crate::dynamics::DIFFERENTIABLE_KEYS); `gait.json`'s `dP_dparam`). Default none.
+    pub parameter: Option<&'static str>,
 }
 
 impl Default for GaitOptions {
@@ -33,6 +39,7 @@ impl Default for GaitOptions {
             tolerance: 1e-10,
             fd_step: 1e-4,
             refine_jacobian: true,
+            parameter: None,
         }
     }
 }
@@ -173,18 +180,23 @@ pub struct Gait {
     /// Every step of one period, in order (`period_k` records; each carries its section state, DLS
     /// indicators and branch).
     pub cycle: Vec<StepReport>,
-    /// `DP(s*)` (`D(P^k)(s*)` for a period-k gait) on the free coordinates, row-major.
+    /// `DP(s*)` (`D(P^k)(s*)` for a period-k gait) on the free coordinates, row-major: exact derivatives
+    /// (variational equations and saltation matrices, docs/model.md section 8).
     pub jacobian: Vec<Vec<f64>>,
-    /// Estimated error of the Jacobian entries (Richardson), or `NaN` if not refined.
+    /// Estimated error of the Jacobian entries: the largest difference to the exact `DP` at tolerances
+    /// [`super::derivative::DERIVATIVE_CHECK_TIGHTENING`] times tighter, or `NaN` if not estimated.
     pub jacobian_error: f64,
+    /// `dP/dp` for the parameter of [`GaitOptions::parameter`], if one was chosen (`dP_dparam` in JSON).
+    pub dp_dparam: Option<ParamDerivative>,
     /// Eigenvalues of `DP(s*)` (of `D(P^k)(s*)` for a period-k gait) as `[re, im]`, largest modulus first.
     pub floquet_multipliers: Vec<[f64; 2]>,
     /// Largest modulus of the multipliers.
     pub max_floquet: f64,
     /// What the multipliers and their error estimate show (see [`Stability`]).
     pub stability: Stability,
-    /// Why `DP` could not be computed (a perturbed state of the finite differences did not walk, e.g. at the
-    /// edge of existence); `None` when it was. Then the multipliers are unknown and the stability uncertain.
+    /// Why `DP` could not be computed (the map is not differentiable at the gait, e.g. a grazing event or two
+    /// events at one instant, or the walk failed); `None` when it was. Then the multipliers are unknown and the
+    /// stability uncertain.
     pub jacobian_failure: Option<String>,
     /// `stability == Stability::Stable`: all multipliers inside the unit circle by more than the error
     /// estimate.
@@ -264,25 +276,26 @@ pub fn find_gait(
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<Gait, GaitError> {
     let fp = solve_fixed_point(map, initial, options, jacobian_guess)?;
-    // Near the edge of existence a perturbed state may fail to walk (e.g. roll back): retry with smaller
-    // differences; if none works, the gait is reported without multipliers (stability uncertain).
-    let mut last_error = None;
-    for shrink in [1.0, 0.1, 0.01] {
-        let h = options.fd_step * shrink;
-        let dp = if options.refine_jacobian {
-            map.jacobian(&fp.section, h)
-        } else {
-            map.central_jacobian(&fp.section, h).map(|j| (j, f64::NAN))
-        };
-        match dp {
-            Ok((dp, jacobian_error)) => return Ok(gait_at(&fp, dp, jacobian_error)),
-            Err(e) => last_error = Some(e),
+    Ok(gait_with_jacobian(map, &fp, options))
+}
+
+/// The gait at the fixed point `fp` of `map` with its exact `DP` (and `dP/dp` if asked for) and the error
+/// estimate of [`super::derivative::gait_jacobian`]; where the map is not differentiable at `fp` (or a
+/// perturbed walk fails), the gait without multipliers and the reason in [`Gait::jacobian_failure`].
+pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitOptions) -> Gait {
+    match gait_jacobian(map, &fp.section, options.parameter, options.refine_jacobian) {
+        Ok(j) => {
+            let mut gait = gait_at(fp, j.jacobian, j.error);
+            gait.dp_dparam = j.dparam;
+            gait
+        }
+        Err(e) => {
+            let n = map.free_coordinates().len();
+            let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
+            gait.jacobian_failure = Some(e.to_string());
+            gait
         }
     }
-    let n = map.free_coordinates().len();
-    let mut gait = gait_at(&fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
-    gait.jacobian_failure = last_error.map(|e| e.to_string());
-    Ok(gait)
 }
 
 /// The fixed point alone (no Jacobian at the end): what threshold searches need.
@@ -337,12 +350,12 @@ pub(crate) fn solve_fixed_point(
         let a = match &newton_matrix {
             Some(a) => a.clone(),
             None => {
-                let dp = map
-                    .central_jacobian(&s, options.fd_step)
-                    .map_err(|source| GaitError::Newton {
+                let dp = newton_jacobian(map, &s, options.fd_step).map_err(|source| {
+                    GaitError::Newton {
                         iteration: iterations,
                         source,
-                    })?;
+                    }
+                })?;
                 let a = dp - DMatrix::identity(n, n);
                 newton_matrix = Some(a.clone());
                 fresh = true;
@@ -452,6 +465,7 @@ pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) ->
             .map(|row| row.iter().copied().collect())
             .collect(),
         jacobian_error,
+        dp_dparam: None,
         floquet_multipliers: multipliers.iter().map(|z| [z.re, z.im]).collect(),
         max_floquet,
         stability: Stability::judge(max_floquet, jacobian_error),
@@ -493,6 +507,8 @@ struct GaitRecord {
     cycle: Vec<StepReport>,
     jacobian: Vec<Vec<f64>>,
     jacobian_error: f64,
+    #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
+    dp_dparam: Option<ParamDerivative>,
     floquet_multipliers: Vec<[f64; 2]>,
     max_floquet: f64,
     stability: Stability,
@@ -527,6 +543,7 @@ impl From<Gait> for GaitRecord {
             cycle: g.cycle,
             jacobian: g.jacobian,
             jacobian_error: g.jacobian_error,
+            dp_dparam: g.dp_dparam,
             floquet_multipliers: g.floquet_multipliers,
             max_floquet: g.max_floquet,
             stability: g.stability,

@@ -4,6 +4,7 @@
 
 pub mod basin;
 pub mod continuation;
+pub(crate) mod derivative;
 pub(crate) mod grid;
 pub(crate) mod limit_cycle;
 pub mod map;
@@ -15,6 +16,7 @@ pub(crate) mod step_map;
 pub(crate) mod sweep;
 pub(crate) mod thresholds;
 
+pub use derivative::{check_jacobian, JacobianCheck, ParamDerivative, DERIVATIVE_CHECK_TIGHTENING};
 pub use grid::{clear_interrupt, interrupt_flag, interrupted};
 pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions, Stability};
 pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};

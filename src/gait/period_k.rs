@@ -26,7 +26,7 @@
 //! refuses it.
 
 use super::limit_cycle::{
-    find_gait, gait_at, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions,
+    find_gait, gait_with_jacobian, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions,
 };
 use super::periodicity::SAME_GAIT_TOL;
 pub use super::periodicity::{least_period, MAX_PERIOD};
@@ -148,15 +148,7 @@ pub(crate) fn periodic_gait_at(
         .find(|&j| k.is_multiple_of(j) && states[j].distance(&fp.section) <= SAME_GAIT_TOL)
         .unwrap_or(k);
     let map_least = single.iterated(least);
-    let (dp, error) = if options.refine_jacobian {
-        map_least.jacobian(&fp.section, options.fd_step)
-    } else {
-        map_least
-            .central_jacobian(&fp.section, options.fd_step)
-            .map(|j| (j, f64::NAN))
-    }
-    .map_err(newton_error)?;
-    let mut gait = gait_at(fp, dp, error);
+    let mut gait = gait_with_jacobian(&map_least, fp, options);
     gait.period_k = least;
     gait.cycle = reports[..least].to_vec();
     if least < k {

@@ -101,6 +101,23 @@ impl<'m> StepMap<'m> {
         }
     }
 
+    /// The solver options the map integrates with.
+    pub(crate) fn options(&self) -> &SolverOptions {
+        &self.opts
+    }
+
+    /// The same map integrated with `rtol` and `atol` multiplied by `factor` (the error estimate of the exact
+    /// derivatives, [`super::derivative`]); its work joins this map's.
+    pub(crate) fn with_tolerances_scaled(&self, factor: f64) -> StepMap<'m> {
+        let mut opts = self.opts.clone();
+        opts.rtol *= factor;
+        opts.atol *= factor;
+        StepMap {
+            opts,
+            ..self.clone()
+        }
+    }
+
     /// Steps walked per evaluation (`k` of `P^k`).
     pub fn steps_per_eval(&self) -> usize {
         self.iterate

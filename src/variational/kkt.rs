@@ -1,31 +1,35 @@
-//! The constrained dynamics and the collision equation over any [`Real`] (docs/model.md sections 3 and 5),
-//! for the dual numbers that carry the derivatives: the KKT system and Eq. (5) with the active set fixed, solved
-//! through the Schur complement `J M^-1 J^T` with nalgebra's Cholesky factorization.
+//! Derivatives of the constrained dynamics and of the collision equation with their active set fixed
+//! (docs/model.md sections 3, 5 and 8).
 //!
-//! The walk's own solves ([`crate::contact::constrained_dynamics`], [`crate::contact::impulse`]) are faster,
-//! hand-tuned `f64` code (active rows only, a reduced system when Leg 1 is held); these are the plain form of
-//! the same equations, which the tests check against them at `f64`. Differentiating a linear solve with the
-//! active set fixed is exactly what forward-mode differentiation of this code does: `d lam` and `d q''` solve
-//! the same KKT matrix with the differentiated right-hand side.
+//! Both are linear solves `K(y) z = r(y)` with the KKT matrix `K = [M -J^T; J 0]` (inactive rows as identity
+//! rows): Eq. (1) with the constraints, `z = (q'', lam)`, and Eq. (5), `z = (q'+ - q'-, lam_I)`. Written as a
+//! residual `R(y, z) = 0`, the solution's derivative along a direction of `y` is `dz = -K^-1 (dR/dy)`, the
+//! residual differentiated with `z` held at its value. So the walk's own `f64` solve gives `z`, one evaluation
+//! of the residual on dual numbers gives `dR/dy` along every direction at once (the equations of motion and
+//! the rows of (C2) differentiated by [`crate::dynamics::Real`]), and one `f64` factorization of `K` solves for
+//! all directions. This is the KKT solve differentiated, without running a factorization on dual numbers.
 
 use nalgebra::{SMatrix, SVector};
+use num_dual::DualSVec64;
 
-use crate::contact::{ActiveSet, NROWS};
-use crate::dynamics::{CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z};
+use crate::contact::{ActiveSet, Ldl, NROWS};
+use crate::dynamics::{
+    lit, Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z,
+};
 
-/// Constraint rows in the fixed stacking of [`crate::contact`].
-type RowsOf<T> = SMatrix<T, NROWS, NQ>;
-/// Multipliers `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]`.
-pub(crate) type MultipliersOf<T> = SVector<T, NROWS>;
+use super::dual::eps;
 
-/// The rows `J` of the active units of `active` and `-dJ/dt q'` (zero where inactive).
+/// Multipliers `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]` over any [`Real`].
+type MultipliersOf<T> = SVector<T, NROWS>;
+
+/// The constraint rows `J` of the active units of `active` (zero where inactive) and `dJ/dt q'`.
 fn constraint_rows<T: Real>(
     eom: &EquationsOfMotion<T>,
     active: &ActiveSet,
-) -> (RowsOf<T>, MultipliersOf<T>) {
+) -> (SMatrix<T, NROWS, NQ>, MultipliersOf<T>) {
     let mask = active.row_mask();
-    let mut rows = RowsOf::<T>::zeros();
-    let mut rhs = MultipliersOf::<T>::zeros();
+    let mut rows = SMatrix::<T, NROWS, NQ>::zeros();
+    let mut jdq = MultipliersOf::<T>::zeros();
     for (row, column) in [(0, X), (1, Z), (4, L1), (5, L2)] {
         if mask[row] {
             rows[(row, column)] = T::one();
@@ -34,73 +38,178 @@ fn constraint_rows<T: Real>(
     for axis in 0..2 {
         if mask[2 + axis] {
             rows.set_row(2 + axis, &eom.rear_tip.jacobian.row(axis));
-            rhs[2 + axis] = -eom.rear_tip.velocity_product[axis];
+            jdq[2 + axis] = eom.rear_tip.velocity_product[axis];
         }
     }
-    (rows, rhs)
+    (rows, jdq)
 }
 
-/// Solve `[M -J^T; J 0] [x; lam] = [f; b]`, the inactive rows of `active` being identity rows of the Schur
-/// complement with zero right-hand side (their `lam` is 0). `None` if `M` or the Schur complement is singular.
-fn solve_saddle<T: Real>(
-    mass: &SMatrix<T, NQ, NQ>,
-    rows: &RowsOf<T>,
-    active: &ActiveSet,
-    f: &CoordsOf<T>,
-    b: &MultipliersOf<T>,
-) -> Option<(CoordsOf<T>, MultipliersOf<T>)> {
-    let chol = mass.cholesky()?;
-    let x_free = chol.solve(f);
-    let minv_jt = chol.solve(&rows.transpose());
-    let mut schur = rows * minv_jt;
-    let mut rhs = b - rows * x_free;
-    for (i, on) in active.row_mask().into_iter().enumerate() {
-        if !on {
-            schur[(i, i)] = T::one();
-            rhs[i] = T::zero();
+/// The KKT matrix `[M -J^T; J 0]` of the active rows of `active` at one configuration, factored in `f64`
+/// through the Schur complement `J M^-1 J^T` (the walk's `LDL^T`, [`Ldl`]): solves for many right-hand sides.
+pub(crate) struct Kkt {
+    /// `M = L D L^T`.
+    mass: Ldl<NQ>,
+    /// `W_i = L^-1 a_i` for the active rows `a_i`.
+    w: [[f64; NQ]; NROWS],
+    /// Positions of the active rows in the stacking.
+    stacked: [usize; NROWS],
+    /// Number of active rows.
+    k: usize,
+    /// `S = W^T D^-1 W = L_S D_S L_S^T`.
+    schur: Ldl<NROWS>,
+}
+
+impl Kkt {
+    /// Factor the KKT matrix of `active` with `M` and the rows of `eom`; `None` if singular.
+    fn new(eom: &EquationsOfMotion<f64>, active: &ActiveSet) -> Option<Kkt> {
+        let (rows, _) = constraint_rows(eom, active);
+        let mut mass = Ldl::<NQ>::zeros(NQ);
+        for i in 0..NQ {
+            for j in 0..=i {
+                mass.l[i][j] = eom.mass[(i, j)];
+            }
         }
+        if !mass.factor() {
+            return None;
+        }
+        let (mut w, mut stacked, mut k) = ([[0.0; NQ]; NROWS], [0; NROWS], 0);
+        for (i, on) in active.row_mask().into_iter().enumerate() {
+            if on {
+                w[k] = std::array::from_fn(|l| rows[(i, l)]);
+                mass.forward(&mut w[k]);
+                stacked[k] = i;
+                k += 1;
+            }
+        }
+        let scaled_dot = |u: &[f64; NQ], v: &[f64; NQ]| {
+            (0..NQ).map(|l| u[l] * v[l] * mass.d_inv[l]).sum::<f64>()
+        };
+        let mut schur = Ldl::<NROWS>::zeros(k);
+        for i in 0..k {
+            for j in 0..=i {
+                schur.l[i][j] = scaled_dot(&w[i], &w[j]);
+            }
+        }
+        if !schur.factor() {
+            return None;
+        }
+        Some(Kkt {
+            mass,
+            w,
+            stacked,
+            k,
+            schur,
+        })
     }
-    let lam = schur.cholesky()?.solve(&rhs);
-    Some((x_free + minv_jt * lam, lam))
+
+    /// Solve `[M -J^T; J 0] [x; lam] = [f; b]` for `D` right-hand sides (inactive rows of `b` are ignored; their
+    /// `lam` is 0).
+    fn solve<const D: usize>(
+        &self,
+        f: &SMatrix<f64, NQ, D>,
+        b: &SMatrix<f64, NROWS, D>,
+    ) -> (SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>) {
+        let (mut x, mut lam) = (
+            SMatrix::<f64, NQ, D>::zeros(),
+            SMatrix::<f64, NROWS, D>::zeros(),
+        );
+        let d_inv = &self.mass.d_inv;
+        for c in 0..D {
+            let mut g: [f64; NQ] = std::array::from_fn(|l| f[(l, c)]);
+            self.mass.forward(&mut g);
+            let mut l_c = [0.0; NROWS];
+            for i in 0..self.k {
+                let wg: f64 = (0..NQ).map(|l| self.w[i][l] * g[l] * d_inv[l]).sum();
+                l_c[i] = b[(self.stacked[i], c)] - wg;
+            }
+            self.schur.forward(&mut l_c);
+            self.schur.backward_scaled(&mut l_c);
+            let mut x_c = g;
+            for i in 0..self.k {
+                for (x_l, w_l) in x_c.iter_mut().zip(&self.w[i]) {
+                    *x_l += l_c[i] * w_l;
+                }
+                lam[(self.stacked[i], c)] = l_c[i];
+            }
+            self.mass.backward_scaled(&mut x_c);
+            x.set_column(c, &SVector::from(x_c));
+        }
+        (x, lam)
+    }
 }
 
-/// `q''` and the multipliers of Eq. (1) with the constraints of `active` (as
-/// [`crate::contact::constrained_dynamics`]), with the constants `mech`.
-pub(crate) fn constrained_dynamics_with<T: Real>(
+/// Duals over the configuration `(q, q')` and the constants `mech`, `D` directions each.
+type Duals<const D: usize> = (
+    CoordsOf<DualSVec64<D>>,
+    CoordsOf<DualSVec64<D>>,
+    Mechanics<DualSVec64<D>>,
+);
+
+/// The derivatives of `q''` and of the multipliers of the constrained dynamics with `active` (Eq. (1) with
+/// the KKT system of docs/model.md section 3) along the `D` directions of the duals, at the solution
+/// `(qdd, lam)` the walk's solve gave at their real parts. `None` if the KKT matrix is singular.
+pub(crate) fn dynamics_derivative<const D: usize>(
     model: &Model,
-    mech: &Mechanics<T>,
-    q: &CoordsOf<T>,
-    qd: &CoordsOf<T>,
+    (q, qd, mech): &Duals<D>,
     active: &ActiveSet,
-) -> Option<(CoordsOf<T>, MultipliersOf<T>)> {
+    (qdd, lam): (&Coords, &SVector<f64, NROWS>),
+) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
     let eom = model.equations_of_motion_with(mech, q, qd);
-    let (rows, rhs) = constraint_rows(&eom, active);
-    solve_saddle(&eom.mass, &rows, active, &(-eom.bias), &rhs)
+    let (rows, jdq) = constraint_rows(&eom, active);
+    // R = [M q'' + h - J^T lam; J q'' + dJ/dt q'] with (q'', lam) held.
+    let (qdd_d, lam_d) = (qdd.map(lit), lam.map(lit));
+    let r1 = eom.mass * qdd_d + eom.bias - rows.transpose() * lam_d;
+    let r2 = rows * qdd_d + jdq;
+    let kkt = Kkt::new(&real_eom(&eom), active)?;
+    Some(kkt.solve(&-derivatives(&r1), &-derivatives(&r2)))
 }
 
-/// `q'+` of the collision equation (5), `M (q'+ - q'-) = J^T lambda_I`, `J q'+ = 0`, with the units of `active`
-/// (as [`crate::contact::impulse`]).
-pub(crate) fn impulse_with<T: Real>(
+/// The derivative of `q'+` of the collision equation (5) with the units of `active` along the `D` directions
+/// of the duals `(q, q'-)`, at the solution `(q'+ - q'-, lam_I)` the walk's solve gave. `None` if singular.
+pub(crate) fn impulse_derivative<const D: usize>(
     model: &Model,
-    mech: &Mechanics<T>,
-    q: &CoordsOf<T>,
-    qd_minus: &CoordsOf<T>,
+    (q, qd_minus, mech): &Duals<D>,
     active: &ActiveSet,
-) -> Option<CoordsOf<T>> {
-    let eom = model.equations_of_motion_with(mech, q, &CoordsOf::<T>::zeros());
+    (dqd, impulses): (&Coords, &SVector<f64, NROWS>),
+) -> Option<SMatrix<f64, NQ, D>> {
+    let eom = model.equations_of_motion_with(mech, q, &CoordsOf::zeros());
     let (rows, _) = constraint_rows(&eom, active);
-    let b = -(rows * qd_minus);
-    let (dqd, _) = solve_saddle(&eom.mass, &rows, active, &CoordsOf::<T>::zeros(), &b)?;
-    Some(qd_minus + dqd)
+    // R = [M dq' - J^T lam_I; J (q'- + dq')] with (dq', lam_I) held.
+    let (dqd_d, lam_d) = (dqd.map(lit), impulses.map(lit));
+    let r1 = eom.mass * dqd_d - rows.transpose() * lam_d;
+    let r2 = rows * (qd_minus + dqd_d);
+    let kkt = Kkt::new(&real_eom(&eom), active)?;
+    let (ddqd, _) = kkt.solve(&-derivatives(&r1), &-derivatives(&r2));
+    Some(derivatives(qd_minus) + ddqd)
+}
+
+/// The derivative parts of a vector of duals, one row per entry.
+fn derivatives<const R: usize, const D: usize>(
+    v: &SVector<DualSVec64<D>, R>,
+) -> SMatrix<f64, R, D> {
+    SMatrix::from_fn(|i, c| eps(&v[i])[c])
+}
+
+/// The real parts of the equations of motion.
+fn real_eom<const D: usize>(eom: &EquationsOfMotion<DualSVec64<D>>) -> EquationsOfMotion<f64> {
+    let re = |x: &DualSVec64<D>| x.re;
+    EquationsOfMotion {
+        mass: eom.mass.map(|x| re(&x)),
+        bias: eom.bias.map(|x| re(&x)),
+        rear_tip: crate::dynamics::PointKinematics {
+            position: eom.rear_tip.position.map(|x| re(&x)),
+            jacobian: eom.rear_tip.jacobian.map(|x| re(&x)),
+            velocity_product: eom.rear_tip.velocity_product.map(|x| re(&x)),
+        },
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::contact::{constrained_dynamics, impulse};
-    use crate::dynamics::Coords;
     use crate::params::Params;
-    use approx::assert_relative_eq;
+    use crate::variational::dual::{dual, seeded};
 
     /// Every active set (the six flags in all combinations).
     fn all_active_sets() -> impl Iterator<Item = ActiveSet> {
@@ -117,28 +226,56 @@ mod tests {
         })
     }
 
-    /// At `f64`, the plain solves equal the walk's hand-tuned ones for every active set that both solve.
+    /// The derivatives of `q''`, the multipliers and `q'+` along a direction in `(q, q', k)` equal central
+    /// differences of the walk's own solves, for every active set they solve.
     #[test]
-    fn plain_solves_equal_the_walks_solves() {
-        let model = Model::new(&Params {
+    fn solve_derivatives_match_finite_differences_for_every_active_set() {
+        let params = Params {
             hub_inertia: 0.2,
             ..Params::default()
-        })
-        .unwrap();
+        };
+        let model = Model::new(&params).unwrap();
         let q = Coords::new(0.01, -0.02, -0.3, 0.97, 0.93);
         let qd = Coords::new(0.2, -0.1, 1.0, -0.2, 0.1);
+        let dir_q = Coords::new(0.3, -0.2, 0.5, 0.1, -0.4);
+        let dir_qd = Coords::new(-0.5, 0.2, 0.3, 0.6, 0.1);
+        let h = 1e-6;
         let mut compared = 0;
         for active in all_active_sets() {
-            let fast = constrained_dynamics(&model, &q, &qd, &active);
-            let plain = constrained_dynamics_with(&model, model.mechanics(), &q, &qd, &active);
-            if let (Ok(fast), Some((qdd, lam))) = (fast, plain) {
-                assert_relative_eq!(fast.qdd, qdd, epsilon = 1e-9, max_relative = 1e-10);
-                assert_relative_eq!(fast.multipliers, lam, epsilon = 1e-8, max_relative = 1e-10);
-                let fast = impulse(&model, &q, &qd, &active).unwrap();
-                let plain = impulse_with(&model, model.mechanics(), &q, &qd, &active).unwrap();
-                assert_relative_eq!(fast.qd_plus, plain, epsilon = 1e-12, max_relative = 1e-12);
-                compared += 1;
-            }
+            let at = |s: f64| {
+                let mut p = params.clone();
+                p.stiffness += s;
+                let m = Model::new(&p).unwrap();
+                let (q, qd) = (q + dir_q * s, qd + dir_qd * s);
+                (
+                    constrained_dynamics(&m, &q, &qd, &active),
+                    impulse(&m, &q, &qd, &active),
+                )
+            };
+            let (Ok(d0), Ok(i0)) = at(0.0) else { continue };
+            let (Ok(dp), Ok(ip)) = at(h) else { continue };
+            let (Ok(dm), Ok(im)) = at(-h) else { continue };
+            let mech = seeded::<1>(&model, Some("stiffness"), 0);
+            let one = |x: f64, e: f64| dual(x, SVector::<f64, 1>::new(e));
+            let qd_ = CoordsOf::from_fn(|i, _| one(q[i], dir_q[i]));
+            let qdd_ = CoordsOf::from_fn(|i, _| one(qd[i], dir_qd[i]));
+            let duals = (qd_, qdd_, mech);
+            let (dqdd, dlam) =
+                dynamics_derivative(&model, &duals, &active, (&d0.qdd, &d0.multipliers)).unwrap();
+            let fd_qdd = (dp.qdd - dm.qdd) / (2.0 * h);
+            let fd_lam = (dp.multipliers - dm.multipliers) / (2.0 * h);
+            let scale = 1.0 + fd_qdd.amax() + fd_lam.amax();
+            assert!((dqdd.column(0) - fd_qdd).amax() < 1e-6 * scale, "{active}");
+            assert!((dlam.column(0) - fd_lam).amax() < 1e-6 * scale, "{active}");
+            let dqd_plus =
+                impulse_derivative(&model, &duals, &active, (&(i0.qd_plus - qd), &i0.impulses))
+                    .unwrap();
+            let fd_plus = (ip.qd_plus - im.qd_plus) / (2.0 * h);
+            assert!(
+                (dqd_plus.column(0) - fd_plus).amax() < 1e-6 * (1.0 + fd_plus.amax()),
+                "{active}"
+            );
+            compared += 1;
         }
         assert!(compared > 20, "only {compared} active sets compared");
     }

@@ -11,15 +11,15 @@
 //! grazing event, two events at one instant) the replay says so ([`NotDifferentiable`]) instead of returning
 //! a number.
 //!
-//! `kkt.rs` holds the constrained dynamics and collision over any `Real`, `replay.rs` the variational
-//! equations and the events.
+//! `dual.rs` holds the dual numbers, `kkt.rs` the derivatives of the constrained dynamics and of the
+//! collision, `replay.rs` the variational equations and the events.
 
+mod dual;
 mod kkt;
 mod replay;
 
-pub(crate) use replay::{
-    dual as dual_of, replay_step, seeded, sensitivity, Dual, Sensitivity, NDIR, PARAM,
-};
+pub(crate) use dual::{dual as dual_of, seeded, Dual, NDIR};
+pub(crate) use replay::{replay_step, sensitivity, Sensitivity, PARAM};
 pub use replay::{COINCIDENT_EVENTS, GRAZING_RATE};
 
 /// Why a step has no derivative (or the replay could not give it).

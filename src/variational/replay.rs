@@ -18,32 +18,26 @@
 //! the identity for a change of active set (lift-off, unlock, slide) and the collision equation (5) with the
 //! recorded units for an impact (touchdown, landing, stopper hit, Zeno locks), differentiated in duals.
 
-use nalgebra::{Const, SMatrix, SVector};
-use num_dual::{Derivative, DualSVec64};
+use nalgebra::{SMatrix, SVector};
 
-use crate::contact::ActiveSet;
-use crate::dynamics::{CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA};
+use crate::contact::{impulse, ActiveSet};
+use crate::dynamics::{Coords, CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA};
 use crate::integrate::{Integrator, OdeSystem};
 use crate::params::SolverOptions;
 use crate::walk::impact::touchdown_leg;
 use crate::walk::tape::{Segment, StepTape};
 use crate::walk::{EventKind, PhaseSystem, WalkVector};
 
-use super::kkt::{constrained_dynamics_with, impulse_with};
+use super::dual::{dual, eps, seeded, Dual, Dual5, NDIR};
+use super::kkt::{dynamics_derivative, impulse_derivative};
 use super::NotDifferentiable;
 
-/// Directions of the derivatives: the three section coordinates `(L2, dtheta/dt, dL2/dt)` and one parameter.
-pub(crate) const NDIR: usize = 4;
 /// Column of the parameter in a sensitivity.
 pub(crate) const PARAM: usize = 3;
 /// Rows of a sensitivity: `q` and `q'`.
 pub(crate) const NS: usize = 2 * NQ;
 /// `d(q, q')/d(L2, dtheta/dt, dL2/dt, p)`.
 pub(crate) type Sensitivity = SMatrix<f64, NS, NDIR>;
-/// A number with its derivatives along the [`NDIR`] directions.
-pub(crate) type Dual = DualSVec64<NDIR>;
-/// A number with its derivatives along the [`NDIR`] directions and along the flow (the event's rate).
-type Dual5 = DualSVec64<{ NDIR + 1 }>;
 
 /// Size of the walk's state `[q, q', E_damper]`.
 const NY: usize = 2 * NQ + 1;
@@ -59,32 +53,6 @@ pub const GRAZING_RATE: f64 = 1e-7;
 /// Two events less than this apart \[s\] are taken as coincident (e.g. a lift-off at a stopper lock): the
 /// step map has a corner there and no derivative.
 pub const COINCIDENT_EVENTS: f64 = 1e-9;
-
-/// The dual number `re + eps . e`.
-pub(crate) fn dual<const D: usize>(re: f64, eps: SVector<f64, D>) -> DualSVec64<D> {
-    DualSVec64::new(re, Derivative::some(eps))
-}
-
-/// The derivative part of a dual number.
-pub(crate) fn eps<const D: usize>(x: &DualSVec64<D>) -> SVector<f64, D> {
-    x.eps.clone().unwrap_generic(Const::<D>, Const::<1>)
-}
-
-/// The constants of `model` with the parameter `param` (if any) carrying the unit derivative in direction
-/// `index` of `D`.
-pub(crate) fn seeded<const D: usize>(
-    model: &Model,
-    param: Option<&str>,
-    index: usize,
-) -> Mechanics<DualSVec64<D>> {
-    Mechanics::seeded(model.params(), |key, value| {
-        let mut e = SVector::<f64, D>::zeros();
-        if param == Some(key) {
-            e[index] = 1.0;
-        }
-        dual(value, e)
-    })
-}
 
 /// `(q, q')` as duals: real parts from `y`, derivative parts from the rows of `s`.
 fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual>, CoordsOf<Dual>) {
@@ -144,26 +112,57 @@ impl Variational<'_> {
 }
 
 impl OdeSystem<NAUG> for Variational<'_> {
-    fn rhs(&self, t: f64, a: &Augmented) -> Augmented {
+    fn rhs(&self, _t: f64, a: &Augmented) -> Augmented {
         let (y, s) = Self::split(a);
         // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
-        let fy = PhaseSystem {
+        let phase = PhaseSystem {
             model: self.model,
             active: self.active,
-        }
-        .rhs(t, &y);
+        };
+        let (fy, dynamics) = phase.rhs_and_dynamics(&y);
         let (q, qd) = duals(&y, &s);
-        let Some((qdd, _)) =
-            constrained_dynamics_with(self.model, self.mech, &q, &qd, &self.active)
-        else {
+        let derivative = dynamics.and_then(|d| {
+            let duals = (q, qd, *self.mech);
+            dynamics_derivative(self.model, &duals, &self.active, (&d.qdd, &d.multipliers))
+        });
+        let Some((dqdd, _)) = derivative else {
             return Augmented::repeat(f64::NAN);
         };
-        let ds = Sensitivity::from_fn(|i, c| {
-            let x = if i < NQ { &qd[i] } else { &qdd[i - NQ] };
-            eps(x)[c]
-        });
+        let mut ds = Sensitivity::zeros();
+        ds.fixed_rows_mut::<NQ>(0)
+            .copy_from(&s.fixed_rows::<NQ>(NQ));
+        ds.fixed_rows_mut::<NQ>(NQ).copy_from(&dqdd);
         Self::join(&fy, &ds)
     }
+}
+
+/// The impacts `sets` applied in order at `q` to `q'` with sensitivity rows `s` (the collision equation (5)
+/// with the recorded units, differentiated): the velocity after them and the sensitivity.
+fn apply_impacts(
+    model: &Model,
+    mech: &Mechanics<Dual>,
+    y: &WalkVector,
+    s: &Sensitivity,
+    sets: &[ActiveSet],
+    time: f64,
+) -> Result<(Coords, Sensitivity), NotDifferentiable> {
+    let (q, mut qd) = crate::walk::unpack(y);
+    let mut s = *s;
+    for set in sets {
+        let singular = NotDifferentiable::Singular { time };
+        let sol = impulse(model, &q, &qd, set).map_err(|_| singular.clone())?;
+        let (q_d, qd_d) = duals(&crate::walk::pack(&q, &qd, 0.0), &s);
+        let dqd_plus = impulse_derivative(
+            model,
+            &(q_d, qd_d, *mech),
+            set,
+            (&(sol.qd_plus - qd), &sol.impulses),
+        )
+        .ok_or(singular)?;
+        s.fixed_rows_mut::<NQ>(NQ).copy_from(&dqd_plus);
+        qd = sol.qd_plus;
+    }
+    Ok((qd, s))
 }
 
 /// The derivatives of one step: the sensitivity of the state after the re-indexing at the next touchdown (the
@@ -187,18 +186,13 @@ pub(crate) fn replay_step(
     let mech5 = seeded::<{ NDIR + 1 }>(model, param, PARAM);
     // The touchdown impact at the section: the recorded collision, then any Zeno locks (no time shift: the
     // section is the touchdown instant).
-    let mut y0 = crate::walk::pack(q0, qd0, 0.0);
-    let (q, mut qd) = duals(&y0, s0);
-    for set in &tape.impacts {
-        qd = impulse_with(model, &mech, &q, &qd, set).ok_or(NotDifferentiable::Singular {
-            time: tape.segments.first().map_or(0.0, |s| s.t0),
-        })?;
-    }
-    let mut s = sensitivity(&q, &qd);
-    let Some(first) = tape.segments.first() else {
+    let (Some(first), Some(t0)) = (tape.segments.first(), tape.segments.first().map(|s| s.t0))
+    else {
         return Err(NotDifferentiable::Incomplete);
     };
-    y0 = first.y0;
+    let y_section = crate::walk::pack(q0, qd0, 0.0);
+    let (_, mut s) = apply_impacts(model, &mech, &y_section, s0, &tape.impacts, t0)?;
+    let mut y0 = first.y0;
     let mut last_event: Option<f64> = None;
     for (k, segment) in tape.segments.iter().enumerate() {
         let (y_minus, s_minus) = integrate_segment(model, opts, &mech, segment, &y0, &s)?;
@@ -219,18 +213,14 @@ pub(crate) fn replay_step(
             .segments
             .get(k + 1)
             .ok_or(NotDifferentiable::Incomplete)?;
-        // The reset: the recorded impacts, in duals.
-        let (q, mut qd) = duals(&y_minus, &s_event);
-        for set in &end.impacts {
-            qd = impulse_with(model, &mech, &q, &qd, set)
-                .ok_or(NotDifferentiable::Singular { time: end.time })?;
-        }
+        // The reset: the recorded impacts, differentiated.
+        let (_, s_reset) = apply_impacts(model, &mech, &y_minus, &s_event, &end.impacts, end.time)?;
         let f_plus = PhaseSystem {
             model,
             active: next.active,
         }
         .rhs(end.time, &next.y0);
-        s = sensitivity(&q, &qd) - rate_outer(&f_plus, &dt);
+        s = s_reset - rate_outer(&f_plus, &dt);
         y0 = next.y0;
     }
     Err(NotDifferentiable::Incomplete)
@@ -294,11 +284,33 @@ fn cross_guard(
     .rhs(end.time, y);
     let (q, qd) = with_rate(y, s, &f);
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
-    let guard = guard(model, mech, (end.kind, touching), segment.active, &q, &qd)
-        .ok_or(NotDifferentiable::Singular { time: end.time })?;
+    let singular = NotDifferentiable::Singular { time: end.time };
+    let guard = match end.kind {
+        EventKind::LiftOff(_) | EventKind::Unlock(_) => {
+            // A force guard: the multiplier's derivative through the KKT solve.
+            let (q_real, qd_real) = crate::walk::unpack(y);
+            let d = crate::contact::constrained_dynamics(model, &q_real, &qd_real, &segment.active)
+                .map_err(|_| singular.clone())?;
+            let (_, dlam) = dynamics_derivative(
+                model,
+                &(q, qd, *mech),
+                &segment.active,
+                (&d.qdd, &d.multipliers),
+            )
+            .ok_or(singular.clone())?;
+            let (row, sign) = match end.kind {
+                EventKind::LiftOff(leg) => (leg.normal_row(), 1.0),
+                EventKind::Unlock(leg) => (leg.stopper_row(), -1.0),
+                _ => unreachable!("a force guard"),
+            };
+            dual(sign * d.multipliers[row], dlam.row(row).transpose() * sign)
+        }
+        kind => guard(model, mech, (kind, touching), &q).ok_or(singular)?,
+    };
     let d = eps(&guard);
     let rate = d[NDIR];
-    if !(rate.abs() > GRAZING_RATE * d.fixed_rows::<NDIR>(0).amax()) {
+    let grazing = rate.abs() <= GRAZING_RATE * d.fixed_rows::<NDIR>(0).amax();
+    if grazing || !rate.is_finite() || rate == 0.0 {
         return Err(NotDifferentiable::Grazing {
             time: end.time,
             event: format!("{:?}", end.kind),
@@ -308,24 +320,22 @@ fn cross_guard(
     Ok((s + rate_outer(&f, &dt), dt))
 }
 
-/// The guard of an event at `(q, q')` over any [`Real`]: the function whose zero is the event (the unshifted
-/// event function of `crate::walk`'s event table; its guards' numerical offsets are constants).
+/// The guard of a kinematic event at `q` over any [`Real`]: the function whose zero is the event (the unshifted
+/// event function of `crate::walk`'s event table; its guards' numerical offsets are constants). Force guards
+/// are differentiated through the KKT solve in [`cross_guard`].
 fn guard<T: Real>(
     model: &Model,
     mech: &Mechanics<T>,
     (kind, touching): (EventKind, LegIndex),
-    active: ActiveSet,
     q: &CoordsOf<T>,
-    qd: &CoordsOf<T>,
 ) -> Option<T> {
-    let forces = || constrained_dynamics_with(model, mech, q, qd, &active).map(|(_, lam)| lam);
     match kind {
         EventKind::Touchdown => Some(model.tip_height_with(mech, q, touching)),
-        EventKind::LiftOff(leg) => forces().map(|lam| lam[leg.normal_row()]),
-        EventKind::Unlock(leg) => forces().map(|lam| -lam[leg.stopper_row()]),
         EventKind::Landing(leg) => Some(model.tip_height_with(mech, q, leg.index())),
         EventKind::StopperHit(leg) => Some(mech.stopper_length - q[leg.length_coordinate()]),
-        EventKind::Fall | EventKind::RollBack => None,
+        EventKind::LiftOff(_) | EventKind::Unlock(_) | EventKind::Fall | EventKind::RollBack => {
+            None
+        }
     }
 }
 

@@ -52,6 +52,7 @@ mod reindex;
 pub(crate) mod report;
 mod run;
 pub(crate) mod section;
+mod tally;
 pub(crate) mod tape;
 mod trajectory;
 mod walker;
@@ -61,7 +62,7 @@ mod zeno;
 pub use error::WalkError;
 pub(crate) use events::EventKind;
 pub use impact::{Branch, DlsIndicators};
-pub(crate) use phase::pack;
+pub(crate) use phase::{pack, unpack};
 pub use phase::{PhaseSystem, WalkState, WalkVector};
 pub use report::{
     ContactAudit, EnergyAudit, StepReport, ENERGY_RESIDUAL_WARNING, PENETRATION_WARNING,

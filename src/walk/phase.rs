@@ -4,7 +4,7 @@
 
 use nalgebra::SVector;
 
-use crate::contact::{constrained_dynamics, ActiveSet};
+use crate::contact::{constrained_dynamics, ActiveSet, ConstrainedDynamics};
 use crate::dynamics::{Coords, Model, L1, L2, NQ};
 use crate::integrate::OdeSystem;
 
@@ -38,17 +38,29 @@ pub struct PhaseSystem<'a> {
     pub active: ActiveSet,
 }
 
-impl OdeSystem<NY> for PhaseSystem<'_> {
-    fn rhs(&self, _t: f64, y: &WalkVector) -> WalkVector {
+impl PhaseSystem<'_> {
+    /// The vector field at `y` and the constrained dynamics it came from (`None` where the KKT system is
+    /// singular; the field is then `NaN`).
+    pub(crate) fn rhs_and_dynamics(
+        &self,
+        y: &WalkVector,
+    ) -> (WalkVector, Option<ConstrainedDynamics>) {
         let (q, qd) = unpack(y);
         match constrained_dynamics(self.model, &q, &qd, &self.active) {
             Ok(d) => {
                 let c = self.model.params().viscosity;
-                pack(&qd, &d.qdd, c * (qd[L1] * qd[L1] + qd[L2] * qd[L2]))
+                let f = pack(&qd, &d.qdd, c * (qd[L1] * qd[L1] + qd[L2] * qd[L2]));
+                (f, Some(d))
             }
             // The integrator reports a non-finite derivative as an error with its time.
-            Err(_) => WalkVector::repeat(f64::NAN),
+            Err(_) => (WalkVector::repeat(f64::NAN), None),
         }
+    }
+}
+
+impl OdeSystem<NY> for PhaseSystem<'_> {
+    fn rhs(&self, _t: f64, y: &WalkVector) -> WalkVector {
+        self.rhs_and_dynamics(y).0
     }
 }
 

@@ -19,40 +19,17 @@ use super::impact::{
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::reindex::reindex;
-use super::report::{ContactAudit, EnergyAudit, StepReport};
+use super::report::{EnergyAudit, StepReport};
 use super::section::SectionState;
+use super::tally::StepTally;
 use super::tape::StepTape;
 use super::trajectory::Trajectory;
 use super::work::WorkCounts;
-use super::zeno::{lock_zeno_stoppers, ZenoLock};
+use super::zeno::lock_zeno_stoppers;
 
 /// Largest speed of Leg 2's tip at a touchdown for the wheel to count as on the Poincare section \[m/s\]: the
 /// no-slip constraint holds it at rest up to the integration error (~1e-12 m/s).
 pub(crate) const SECTION_TIP_SPEED_TOL: f64 = 1e-8;
-
-/// Bookkeeping of the step in progress.
-#[derive(Debug, Default, Clone, Copy)]
-struct StepTally {
-    dls_duration: f64,
-    rear_contact_duration: f64,
-    audit: ContactAudit,
-    scuffing: bool,
-    bounce: bool,
-    impact_loss: f64,
-    stopper_loss: f64,
-    events: usize,
-}
-
-impl StepTally {
-    /// Account for a Zeno lock (docs/model.md section 5): its kinetic energy loss is a stopper loss, its impulse
-    /// goes to the contact audit as `zeno_impulse` (the other units' pulls as `pull_impulse`).
-    fn see_zeno(&mut self, lock: &ZenoLock) {
-        self.stopper_loss += lock.loss;
-        self.audit.zeno_impulse = self.audit.zeno_impulse.max(lock.impulse);
-        self.audit.pull_impulse = self.audit.pull_impulse.max(lock.pull_impulse);
-        self.scuffing |= lock.active.slide2;
-    }
-}
 
 /// Walks the wheel from touchdown to touchdown.
 #[derive(Debug, Clone)]

@@ -1,0 +1,142 @@
+//! The Jacobian of a gait (docs/model.md sections 6 and 8): the exact `DP` (and `dP/dp`) of
+//! [`StepMap::eval_with_derivatives`] with an error estimate that comes from the computation, and the
+//! finite-difference route kept as its independent check ([`check_jacobian`], `vrw gait --check-jacobian`).
+//!
+//! **Error estimate.** The exact derivatives are exact for the discretized step map, which differs from the
+//! model's by the integration error; so the estimate is the largest difference between `DP` at the run's
+//! tolerances and `DP` at tolerances [`DERIVATIVE_CHECK_TIGHTENING`] times tighter (or looser, where the
+//! tighter ones would pass the smallest `rtol` the integrator resolves). The stability verdict
+//! ([`super::Stability`]) is built on it.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use super::step_map::{DerivativeError, StepMap};
+use crate::walk::SectionState;
+
+/// The factor between the run's integration tolerances and those of the second computation of `DP` whose
+/// difference is the error estimate.
+pub const DERIVATIVE_CHECK_TIGHTENING: f64 = 100.0;
+
+/// The smallest relative tolerance the error estimate tightens to: below it the integration is at rounding
+/// level, and the estimate loosens the tolerances instead.
+const TIGHTEST_RTOL: f64 = 1e-14;
+
+/// `dP/dp` of a gait for one parameter (`gait.json`'s `dP_dparam`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ParamDerivative {
+    /// The parameter's key.
+    pub parameter: &'static str,
+    /// `dP/dp` over the free section coordinates.
+    pub values: Vec<f64>,
+    /// Its error estimate, as that of `DP`.
+    pub error: f64,
+}
+
+/// `DP` at a point with its error estimate, and `dP/dp` if asked for.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct GaitJacobian {
+    /// `DP` over the free coordinates.
+    pub(crate) jacobian: DMatrix<f64>,
+    /// The largest difference to `DP` at tightened tolerances (`NaN` if not estimated).
+    pub(crate) error: f64,
+    /// `dP/dp`.
+    pub(crate) dparam: Option<ParamDerivative>,
+}
+
+/// The exact `DP` of `map` at `s` (and `dP/dp` for `param`), with the error estimate when `estimate_error`.
+pub(crate) fn gait_jacobian(
+    map: &StepMap,
+    s: &SectionState,
+    param: Option<&'static str>,
+    estimate_error: bool,
+) -> Result<GaitJacobian, DerivativeError> {
+    let at = map.eval_with_derivatives(s, param)?;
+    let (error, dparam_error) = if estimate_error {
+        let rtol = map.options().rtol;
+        let factor = if rtol / DERIVATIVE_CHECK_TIGHTENING >= TIGHTEST_RTOL {
+            1.0 / DERIVATIVE_CHECK_TIGHTENING
+        } else {
+            DERIVATIVE_CHECK_TIGHTENING
+        };
+        let other = map
+            .with_tolerances_scaled(factor)
+            .eval_with_derivatives(s, param)?;
+        let dparam_error = match (&at.dparam, &other.dparam) {
+            (Some(a), Some(b)) => (a - b).amax(),
+            _ => f64::NAN,
+        };
+        ((&at.jacobian - &other.jacobian).amax(), dparam_error)
+    } else {
+        (f64::NAN, f64::NAN)
+    };
+    Ok(GaitJacobian {
+        jacobian: at.jacobian,
+        error,
+        dparam: param
+            .zip(at.dparam)
+            .map(|(parameter, values)| ParamDerivative {
+                parameter,
+                values: values.iter().copied().collect(),
+                error: dparam_error,
+            }),
+    })
+}
+
+/// `DP` at `s` for Newton's method: exact where the map is differentiable, else one central difference with
+/// relative step `fd_step` (a Newton matrix need not be exact).
+pub(crate) fn newton_jacobian(
+    map: &StepMap,
+    s: &SectionState,
+    fd_step: f64,
+) -> Result<DMatrix<f64>, crate::walk::WalkError> {
+    match map.eval_with_derivatives(s, None) {
+        Ok(d) => Ok(d.jacobian),
+        Err(DerivativeError::Walk(e)) => Err(e),
+        Err(_) => map.central_jacobian(s, fd_step),
+    }
+}
+
+/// The exact `DP` against the finite-difference one (`vrw gait --check-jacobian`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct JacobianCheck {
+    /// The exact `DP`, row-major.
+    pub exact: Vec<Vec<f64>>,
+    /// Its error estimate (tightened tolerances).
+    pub exact_error: f64,
+    /// `DP` by central differences with Richardson extrapolation, row-major.
+    pub finite_difference: Vec<Vec<f64>>,
+    /// The finite difference's own error estimate (extrapolated against the plain difference).
+    pub finite_difference_error: f64,
+    /// The largest entry of `|exact - finite_difference|`.
+    pub difference: f64,
+    /// `difference <= exact_error + finite_difference_error`: the two routes agree within their errors.
+    pub agree: bool,
+}
+
+/// Compare the exact `DP` of `map` at `s` with central differences of relative step `fd_step` extrapolated
+/// by Richardson.
+pub fn check_jacobian(
+    map: &StepMap,
+    s: &SectionState,
+    fd_step: f64,
+) -> Result<JacobianCheck, DerivativeError> {
+    let exact = gait_jacobian(map, s, None, true)?;
+    let (fd, fd_error) = map.jacobian(s, fd_step)?;
+    let difference = (&exact.jacobian - &fd).amax();
+    let rows = |m: &DMatrix<f64>| m.row_iter().map(|r| r.iter().copied().collect()).collect();
+    Ok(JacobianCheck {
+        exact: rows(&exact.jacobian),
+        exact_error: exact.error,
+        finite_difference: rows(&fd),
+        finite_difference_error: fd_error,
+        difference,
+        agree: difference <= exact.error + fd_error,
+    })
+}
+
+/// `dP/dp` as a vector, for tests and the Python binding.
+#[allow(dead_code)]
+pub(crate) fn as_vector(d: &ParamDerivative) -> DVector<f64> {
+    DVector::from_vec(d.values.clone())
+}
