@@ -180,6 +180,7 @@ fn gait_job(c: &mut Criterion) {
         initial: None,
         options: GaitOptions::default(),
         out_dir: Default::default(),
+        check_jacobian: false,
     };
     let mut group = c.benchmark_group("gait");
     group.sample_size(10);

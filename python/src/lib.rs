@@ -388,6 +388,7 @@ fn find_gait<'py>(
         initial: section(initial),
         options: gait_options(GaitOptions::default(), options)?,
         out_dir: PathBuf::new(),
+        check_jacobian: false,
     };
     let summary = py.allow_threads(|| compute_gait(&job)).map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;

@@ -6,7 +6,10 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::dynamics::Model;
-use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD, TOLERANCE_RANGE};
+use crate::gait::{
+    check_jacobian, find_gait_any_period, Gait, GaitOptions, JacobianCheck, StepMap, MAX_PERIOD,
+    TOLERANCE_RANGE,
+};
 use crate::output;
 use crate::params::Config;
 use crate::reference::default_initial;
@@ -27,6 +30,8 @@ pub struct GaitJob {
     pub options: GaitOptions,
     /// Where `gait.json` goes, and one period of the gait in the files of `vrw simulate`.
     pub out_dir: PathBuf,
+    /// Check the exact `DP` of the gait found against finite differences ([`check_jacobian`]).
+    pub check_jacobian: bool,
 }
 
 /// `gait.json`: the parameters, and the gait or why none was found.
@@ -47,6 +52,9 @@ pub struct GaitSummary {
     /// The gait, if found (its fields are also flattened into the top level of the JSON).
     #[serde(flatten)]
     pub gait: Option<Gait>,
+    /// The exact `DP` against finite differences, if asked for ([`GaitJob::check_jacobian`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian_check: Option<JacobianCheck>,
     /// What makes the gait untrustworthy: every audit value of its steps above its tolerance
     /// ([`StepReport::audit_warnings`](crate::walk::StepReport::audit_warnings)); empty when every law holds.
     pub warnings: Vec<String>,
@@ -85,6 +93,17 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     initial.validate(&model)?;
     let map = StepMap::new(&model, &job.config.solver);
     let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
+    let jacobian_check = match (&result, job.check_jacobian) {
+        (Ok(gait), true) => Some(
+            check_jacobian(
+                &map.iterated(gait.period_k),
+                &gait.section,
+                job.options.fd_step,
+            )
+            .unwrap_or_else(|e| JacobianCheck::failed(e.to_string())),
+        ),
+        _ => None,
+    };
     let summary = GaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
@@ -100,6 +119,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
             |g| g.cycle.iter().flat_map(|s| s.audit_warnings()).collect(),
         ),
         gait: result.ok(),
+        jacobian_check,
     };
     Ok(summary)
 }

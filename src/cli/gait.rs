@@ -6,7 +6,8 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use vrw::app::{run_gait, GaitJob};
-use vrw::gait::GaitOptions;
+use vrw::dynamics::DIFFERENTIABLE_KEYS;
+use vrw::gait::{GaitOptions, JacobianCheck};
 use vrw::walk::SectionState;
 
 use super::{flagged, progress_bar, ModelArgs};
@@ -27,9 +28,32 @@ pub(super) struct GaitArgs {
     /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
     #[arg(long, default_value = DEFAULT_TOLERANCE)]
     tolerance: f64,
+    /// Also compute dP/dp of the gait for this parameter (gait.json's dP_dparam): one of hub_mass,
+    /// hub_inertia, leg_mass, leg_mass_offset, stopper_length, spring_natural_length, stiffness, viscosity,
+    /// slope, gravity.
+    #[arg(long, value_name = "KEY", value_parser = parse_parameter)]
+    parameter: Option<&'static str>,
+    /// Check the exact Jacobian against central differences with Richardson extrapolation: print both and their
+    /// difference, and fail if they disagree beyond the two error estimates.
+    #[arg(long)]
+    check_jacobian: bool,
     /// Output directory for gait.json and one period of the gait (steps.csv, trajectory.csv, summary.json).
     #[arg(long, default_value = "out/gait")]
     out: PathBuf,
+}
+
+/// A parameter `dP/dp` can be taken for ([`DIFFERENTIABLE_KEYS`]).
+fn parse_parameter(key: &str) -> Result<&'static str, String> {
+    DIFFERENTIABLE_KEYS
+        .iter()
+        .find(|k| **k == key)
+        .copied()
+        .ok_or_else(|| {
+            format!(
+                "no derivative with respect to {key:?}: the parameter must be one of {}",
+                DIFFERENTIABLE_KEYS.join(", ")
+            )
+        })
 }
 
 /// Run `vrw gait` and print its summary.
@@ -40,9 +64,11 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         options: GaitOptions {
             transient_steps: args.transient,
             tolerance: args.tolerance,
+            parameter: args.parameter,
             ..GaitOptions::default()
         },
         out_dir: args.out.clone(),
+        check_jacobian: args.check_jacobian,
     };
     let bar = progress_bar(
         None,
@@ -121,15 +147,61 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         })
         .collect();
     println!(
-        "Floquet multipliers [{}] (Jacobian error ~{:.0e}): {}",
+        "Floquet multipliers [{}] (exact Jacobian, error ~{:.0e}): {}",
         multipliers.join(", "),
         g.jacobian_error,
         g.stability
     );
+    if let Some(failure) = &g.jacobian_failure {
+        println!("no Jacobian: {failure}");
+    }
+    if let Some(d) = &g.dp_dparam {
+        let values: Vec<String> = d.values.iter().map(|v| format!("{v:.9e}")).collect();
+        println!(
+            "dP/d{} = [{}] (error ~{:.0e})",
+            d.parameter,
+            values.join(", "),
+            d.error
+        );
+    }
+    let check = summary.jacobian_check.as_ref().map(print_check).transpose();
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
     println!("wrote {}/gait.json", args.out.display());
+    check.map(|_| ())
+}
+
+/// Print the Jacobian check of `--check-jacobian`; an error if the two routes disagree.
+fn print_check(check: &JacobianCheck) -> Result<()> {
+    if let Some(failure) = &check.failure {
+        bail!("Jacobian check failed: {failure}");
+    }
+    let show = |name: &str, m: &[Vec<f64>]| {
+        println!("{name}:");
+        for row in m {
+            let row: Vec<String> = row.iter().map(|v| format!("{v:+.12e}")).collect();
+            println!("  [{}]", row.join(", "));
+        }
+    };
+    show("exact DP", &check.exact);
+    show(
+        "finite-difference DP (Richardson)",
+        &check.finite_difference,
+    );
+    println!(
+        "largest difference {:.1e}; error estimates: exact {:.1e}, finite difference {:.1e}: {}",
+        check.difference,
+        check.exact_error,
+        check.finite_difference_error,
+        if check.agree { "agree" } else { "DISAGREE" }
+    );
+    if !check.agree {
+        bail!(
+            "the exact Jacobian and the finite differences disagree by {:.1e}, beyond their error estimates",
+            check.difference
+        );
+    }
     Ok(())
 }
 

@@ -8,7 +8,7 @@
 //! tighter ones would pass the smallest `rtol` the integrator resolves). The stability verdict
 //! ([`super::Stability`]) is built on it.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::step_map::{DerivativeError, StepMap};
@@ -112,6 +112,25 @@ pub struct JacobianCheck {
     pub difference: f64,
     /// `difference <= exact_error + finite_difference_error`: the two routes agree within their errors.
     pub agree: bool,
+    /// Why the check could not be made (the map is not differentiable at the point, or a perturbed walk of the
+    /// finite differences failed); `agree` is then false.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
+}
+
+impl JacobianCheck {
+    /// A check that could not be made, and why.
+    pub fn failed(failure: String) -> JacobianCheck {
+        JacobianCheck {
+            exact: Vec::new(),
+            exact_error: f64::NAN,
+            finite_difference: Vec::new(),
+            finite_difference_error: f64::NAN,
+            difference: f64::NAN,
+            agree: false,
+            failure: Some(failure),
+        }
+    }
 }
 
 /// Compare the exact `DP` of `map` at `s` with central differences of relative step `fd_step` extrapolated
@@ -132,11 +151,6 @@ pub fn check_jacobian(
         finite_difference_error: fd_error,
         difference,
         agree: difference <= exact.error + fd_error,
+        failure: None,
     })
-}
-
-/// `dP/dp` as a vector, for tests and the Python binding.
-#[allow(dead_code)]
-pub(crate) fn as_vector(d: &ParamDerivative) -> DVector<f64> {
-    DVector::from_vec(d.values.clone())
 }

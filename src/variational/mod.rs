@@ -57,3 +57,6 @@ pub enum NotDifferentiable {
     #[error("the step was not recorded to its touchdown")]
     Incomplete,
 }
+
+#[cfg(test)]
+mod tests;

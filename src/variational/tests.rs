@@ -1,0 +1,185 @@
+//! The saltation-based derivatives against finite differences of the whole step map, over walks that meet
+//! every kind of event (the anchors' lesson: saltation code fails silently, so this cross-check stays in the
+//! suite), and `dP/dp` against finite differences in every differentiable parameter.
+
+use std::collections::BTreeSet;
+
+use nalgebra::DMatrix;
+
+use crate::contact::{ActiveSet, Leg};
+use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
+use crate::gait::StepMap;
+use crate::params::Config;
+use crate::walk::tape::StepTape;
+use crate::walk::{EventKind, SectionState, Walker};
+
+/// Relative step of the central differences.
+const FD_STEP: f64 = 1e-5;
+/// Agreement required of the exact derivatives with the central differences, relative to the largest entry
+/// of the column: the differences' truncation (~FD_STEP^2) and noise (~1e-12 / FD_STEP) are well below it; a
+/// missing or wrong saltation term is of the order of the entries.
+const FD_AGREEMENT: f64 = 2e-5;
+
+/// The walks: `(overrides, start)`. Together they meet every kind of event (asserted below).
+fn cases() -> Vec<(Vec<&'static str>, SectionState)> {
+    let s = |l2, theta_dot, l2_dot| SectionState {
+        l2,
+        theta_dot,
+        l2_dot,
+    };
+    vec![
+        // The paper's gait: DLS, rear lift-off into a slide, stopper lock of the rear leg.
+        (vec![], s(0.714888348, 0.964139462, -0.423466119)),
+        // Leg 1 bounces: fore lift-off, landing.
+        (vec!["viscosity=4", "stiffness=640"], s(0.72, 1.0, 0.0)),
+        // The traditional exchange: the rear leg leaves at once and lands again (re-contact).
+        (vec!["impact=traditional"], s(0.72, 1.0, 0.0)),
+        // Stiff legs from a fast start: Leg 1 lifts off, the wheel flies, Zeno locks of the stoppers.
+        (
+            vec!["stiffness=6000", "spring_natural_length=1.0"],
+            s(0.995, 1.8, 0.0),
+        ),
+        // The (B3) branch.
+        (vec!["viscosity=80", "stiffness=1450"], s(0.93, 1.2, 0.0)),
+        // A start far from the gait: the rear tip lands again.
+        (vec!["stiffness=300"], s(0.9, 1.3, 0.3)),
+    ]
+}
+
+fn config_of(overrides: &[&str]) -> Config {
+    let mut config = Config::default();
+    for o in overrides {
+        config.apply_override(o).unwrap();
+    }
+    config
+}
+
+/// The kinds of event (and of reset) a tape holds, named.
+fn kinds(tape: &StepTape) -> BTreeSet<String> {
+    let mut kinds = BTreeSet::new();
+    if tape.impacts.len() > 1 {
+        kinds.insert("zeno lock at touchdown".to_string());
+    }
+    for segment in &tape.segments {
+        let ActiveSet { slide1, slide2, .. } = segment.active;
+        if slide1 || slide2 {
+            kinds.insert("slide".to_string());
+        }
+        if let Some(end) = &segment.end {
+            let name = match end.kind {
+                EventKind::LiftOff(Leg::One) => "fore lift-off",
+                EventKind::LiftOff(Leg::Two) => "rear lift-off",
+                EventKind::Unlock(_) => "stopper unlock",
+                EventKind::Landing(Leg::One) => "landing of Leg 1",
+                EventKind::Landing(Leg::Two) => "rear re-contact",
+                EventKind::StopperHit(_) => "stopper lock",
+                EventKind::Touchdown => "touchdown",
+                EventKind::Fall | EventKind::RollBack => "failure",
+            };
+            kinds.insert(name.to_string());
+            if end.impacts.len() > 1 {
+                kinds.insert("zeno lock".to_string());
+            }
+        }
+    }
+    kinds
+}
+
+/// Central differences of the reduced map at `s`, column by column.
+fn central(map: &StepMap, s: &SectionState) -> DMatrix<f64> {
+    map.central_jacobian(s, FD_STEP).unwrap()
+}
+
+fn assert_columns_agree(exact: &DMatrix<f64>, fd: &DMatrix<f64>, context: &str) {
+    for j in 0..exact.ncols() {
+        let scale = fd.column(j).amax().max(1e-3);
+        let diff = (exact.column(j) - fd.column(j)).amax();
+        assert!(
+            diff <= FD_AGREEMENT * scale,
+            "{context}, column {j}: exact {}, finite differences {}, difference {diff:e}",
+            exact.column(j).transpose(),
+            fd.column(j).transpose()
+        );
+    }
+}
+
+/// A stopper unlock is crossed by the code of a lift-off (a force guard differentiated through the KKT solve,
+/// then an identity reset); the stopper rows of that derivative are checked for every active set in
+/// `kkt.rs`. No walk here meets one: after an impact the complementarity problem frees a loaded leg at once.
+#[test]
+fn saltation_based_jacobian_matches_finite_differences_at_every_event_kind() {
+    let mut covered = BTreeSet::new();
+    for (overrides, s) in cases() {
+        let config = config_of(&overrides);
+        let model = Model::new(&config.params).unwrap();
+        let map = StepMap::new(&model, &config.solver);
+        let mut tape = StepTape::default();
+        Walker::new(&model, &config.solver, &s)
+            .unwrap()
+            .step_taped(&mut tape)
+            .unwrap();
+        let seen = kinds(&tape);
+        let exact = map.eval_with_derivatives(&s, None).unwrap();
+        assert_columns_agree(
+            &exact.jacobian,
+            &central(&map, &s),
+            &format!("{overrides:?} from {s:?} ({seen:?})"),
+        );
+        covered.extend(seen);
+    }
+    for kind in [
+        "touchdown",
+        "rear lift-off",
+        "fore lift-off",
+        "slide",
+        "stopper lock",
+        "landing of Leg 1",
+        "rear re-contact",
+        "zeno lock",
+    ] {
+        assert!(
+            covered.contains(kind),
+            "no walk meets a {kind}: {covered:?}"
+        );
+    }
+}
+
+#[test]
+fn parameter_derivatives_match_finite_differences_for_every_key() {
+    for (overrides, s) in cases().into_iter().take(2) {
+        // A hub inertia inside its domain, so that both differences exist.
+        let mut config = config_of(&overrides);
+        config.params.hub_inertia = 0.2;
+        let model = Model::new(&config.params).unwrap();
+        let map = StepMap::new(&model, &config.solver);
+        for key in DIFFERENTIABLE_KEYS {
+            let exact = map.eval_with_derivatives(&s, Some(key)).unwrap();
+            let value = |c: &Config| match key {
+                "hub_mass" => c.params.hub_mass,
+                "hub_inertia" => c.params.hub_inertia,
+                "leg_mass" => c.params.leg_mass,
+                "leg_mass_offset" => c.params.leg_mass_offset,
+                "stopper_length" => c.params.stopper_length,
+                "spring_natural_length" => c.params.spring_natural_length,
+                "stiffness" => c.params.stiffness,
+                "viscosity" => c.params.viscosity,
+                "slope" => c.params.slope,
+                "gravity" => c.params.gravity,
+                _ => unreachable!(),
+            };
+            let p0 = value(&config);
+            let h = FD_STEP * p0.abs().max(1.0);
+            let at = |p: f64| {
+                let c = config.with(key, p).unwrap();
+                let model = Model::new(&c.params).unwrap();
+                let map = StepMap::new(&model, &c.solver);
+                map.reduce(&map.eval(&s).unwrap().next)
+            };
+            let fd = (at(p0 + h) - at(p0 - h)) / (2.0 * h);
+            let exact = exact.dparam.unwrap();
+            let fd = DMatrix::from_column_slice(fd.len(), 1, fd.as_slice());
+            let exact = DMatrix::from_column_slice(exact.len(), 1, exact.as_slice());
+            assert_columns_agree(&exact, &fd, &format!("dP/d{key} at {overrides:?}"));
+        }
+    }
+}
