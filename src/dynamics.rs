@@ -14,7 +14,12 @@
 //! equations for the energies of docs/model.md section 2 (the tests check it against finite differences of `T` and
 //! `V`).
 
-use nalgebra::{RealField, SMatrix, SVector, Vector2};
+use std::ops::Neg;
+
+use nalgebra::{
+    ClosedAddAssign, ClosedDivAssign, ClosedMulAssign, ClosedSubAssign, SMatrix, SVector, Vector2,
+};
+use num_traits::{One, Zero};
 
 use crate::params::{ConfigError, Params};
 
@@ -22,12 +27,53 @@ use crate::params::{ConfigError, Params};
 /// numbers of [`crate::variational`] that carry derivatives through the very same code (forward-mode automatic
 /// differentiation, docs/model.md section 8). STYLE.md asks for concrete `f64`; this is the one exception, so
 /// that the exact derivatives differentiate the equations the walk integrates rather than a copy of them.
-pub trait Real: RealField + Copy {}
-impl<T: RealField + Copy> Real for T {}
+///
+/// The trait asks only for what the kinematics use (field arithmetic, the sine, cosine and arctangent), so that
+/// a plain dual number (`crate::variational`'s) can implement it.
+pub trait Real:
+    nalgebra::Scalar
+    + Copy
+    + Zero
+    + One
+    + ClosedAddAssign
+    + ClosedSubAssign
+    + ClosedMulAssign
+    + ClosedDivAssign
+    + Neg<Output = Self>
+{
+    /// The constant `x` (exact: every `Real` holds an `f64`).
+    fn lit(x: f64) -> Self;
+    /// `sin(self)`.
+    fn sin(self) -> Self;
+    /// `cos(self)`.
+    fn cos(self) -> Self;
+    /// `(sin(self), cos(self))`.
+    fn sin_cos(self) -> (Self, Self);
+    /// `atan(self)`.
+    fn atan(self) -> Self;
+}
 
-/// The constant `x` as a [`Real`] (exact: every `Real` holds an `f64`).
+impl Real for f64 {
+    fn lit(x: f64) -> f64 {
+        x
+    }
+    fn sin(self) -> f64 {
+        f64::sin(self)
+    }
+    fn cos(self) -> f64 {
+        f64::cos(self)
+    }
+    fn sin_cos(self) -> (f64, f64) {
+        f64::sin_cos(self)
+    }
+    fn atan(self) -> f64 {
+        f64::atan(self)
+    }
+}
+
+/// The constant `x` as a [`Real`].
 pub(crate) fn lit<T: Real>(x: f64) -> T {
-    nalgebra::convert(x)
+    T::lit(x)
 }
 
 /// Number of generalized coordinates.
@@ -467,9 +513,9 @@ impl Model {
         sums.b[0] += (hub_b[0] * n + sum_e_psi * d) * m;
         sums.b[1] += hub_b[1] * (m * n);
         sums.bb[0][0] +=
-            m * (n * hub_b[0].norm_squared() + two * d * hub_b[0].dot(&sum_e_psi) + n * d * d);
+            m * (n * hub_b[0].dot(&hub_b[0]) + two * d * hub_b[0].dot(&sum_e_psi) + n * d * d);
         sums.bb[0][1] += m * (n * hub_b[0].dot(&hub_b[1]) + d * hub_b[1].dot(&sum_e_psi));
-        sums.bb[1][1] += m * n * hub_b[1].norm_squared();
+        sums.bb[1][1] += m * n * hub_b[1].dot(&hub_b[1]);
         sums.bf[0] +=
             m * (n * hub_b[0].dot(&a) - d * w * w * hub_b[0].dot(&sum_e) + d * sum_e_psi.dot(&a));
         sums.bf[1] += m * (n * hub_b[1].dot(&a) - d * w * w * hub_b[1].dot(&sum_e));

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, NQ, THETA};
 use crate::params::SolverOptions;
 use crate::variational::{
-    replay_step, seeded, sensitivity, Dual, NotDifferentiable, Sensitivity, NDIR, PARAM,
+    replay_step, seeded, sensitivity, Dual4, NotDifferentiable, Sensitivity, NDIR, PARAM,
 };
 use crate::walk::section::section_coords;
 use crate::walk::tape::StepTape;
@@ -177,7 +177,7 @@ impl<'m> StepMap<'m> {
             e[i] = 1.0;
             crate::variational::dual_of(value, e)
         };
-        let (q, qd) = section_coords::<Dual>(
+        let (q, qd) = section_coords::<Dual4>(
             model,
             &mech,
             (unit(0, s.l2), unit(1, s.theta_dot), unit(2, s.l2_dot)),

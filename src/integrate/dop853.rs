@@ -23,7 +23,7 @@ use nalgebra::SVector;
 
 use super::core::{all_finite, Core};
 use super::tolerances::scaled_rms;
-use super::{DenseStep, IntegrationError, OdeSystem, Tolerances};
+use super::{DenseStep, FixedStep, IntegrationError, OdeSystem, Tolerances};
 
 /// Stages of one step.
 const STAGES: usize = 12;
@@ -255,20 +255,21 @@ fn dense_step<const N: usize>(
     DenseStep::from_coefficients((t, t1, h), y1, &cont)
 }
 
-/// One DOP853 step of the given size `h` from `(t, y0)` to `t1` (`t + h`, or the `t_stop` it landed on), with
-/// no error control: the step an adaptive run accepted, taken again on another system (the variational
-/// equations, see `crate::variational`). The same arithmetic as [`Dop853::step`], so a system whose first
-/// components are the original one's reproduces its states bit for bit.
+/// One DOP853 step of the given size `h` from `(t, y0)` with `f0 = f(t, y0)` to `t1` (`t + h`, or the `t_stop`
+/// it landed on), with no error control: the step an adaptive run accepted, taken again on another system (the
+/// variational equations, see `crate::variational`). The same arithmetic as [`Dop853::step`], so a system whose
+/// first components are the original one's reproduces its states bit for bit. Returns `y1`, `f(t1, y1)` and,
+/// if `dense`, the dense output (three more stages).
 pub(crate) fn fixed_step<const N: usize>(
     sys: &impl OdeSystem<N>,
-    t: f64,
-    y0: &SVector<f64, N>,
+    (t, y0, f0): (f64, &SVector<f64, N>, &SVector<f64, N>),
     h: f64,
     t1: f64,
-) -> DenseStep<N> {
+    dense: bool,
+) -> FixedStep<N> {
     let tab = tableau();
     let mut k = [SVector::<f64, N>::zeros(); DENSE_STAGES];
-    k[0] = sys.rhs(t, y0);
+    k[0] = *f0;
     trial_stages(sys, t, y0, &mut k, h);
     let mut yseg = SVector::<f64, N>::zeros();
     for (i, ki) in k.iter().take(STAGES).enumerate() {
@@ -276,7 +277,12 @@ pub(crate) fn fixed_step<const N: usize>(
     }
     let y1 = y0 + yseg * h;
     k[STAGES] = sys.rhs(t1, &y1);
-    dense_step(sys, (t, t1, h), y0, y1, &mut k)
+    let f1 = k[STAGES];
+    FixedStep {
+        y1,
+        f1,
+        dense: dense.then(|| dense_step(sys, (t, t1, h), y0, y1, &mut k)),
+    }
 }
 
 #[cfg(test)]

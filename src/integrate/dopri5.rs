@@ -16,7 +16,7 @@ use nalgebra::SVector;
 
 use super::core::{all_finite, Core, Stats};
 use super::tolerances::scaled_rms;
-use super::{DenseStep, IntegrationError, OdeSystem, Tolerances};
+use super::{DenseStep, FixedStep, IntegrationError, OdeSystem, Tolerances};
 
 // Dormand–Prince 5(4) tableau (HNW I, Table II.5.2).
 const C2: f64 = 1.0 / 5.0;
@@ -262,15 +262,19 @@ fn dense_step<const N: usize>(
     )
 }
 
-/// One DOPRI5 step of the given size `h` from `(t, y0)` to `t1`, with no error control: the step an adaptive
-/// run accepted, taken again on another system (see `super::dop853::fixed_step`).
+/// One DOPRI5 step of the given size `h` from `(t, y0)` with `f0 = f(t, y0)` to `t1`, with no error control: the
+/// step an adaptive run accepted, taken again on another system (see `super::dop853::fixed_step`).
 pub(crate) fn fixed_step<const N: usize>(
     sys: &impl OdeSystem<N>,
-    t: f64,
-    y0: &SVector<f64, N>,
+    (t, y0, f0): (f64, &SVector<f64, N>, &SVector<f64, N>),
     h: f64,
     t1: f64,
-) -> DenseStep<N> {
-    let Stages { k, y1 } = stages(sys, t, y0, sys.rhs(t, y0), h, t1);
-    dense_step((t, t1, h), y0, y1, &k)
+    dense: bool,
+) -> FixedStep<N> {
+    let Stages { k, y1 } = stages(sys, t, y0, *f0, h, t1);
+    FixedStep {
+        y1,
+        f1: k[6],
+        dense: dense.then(|| dense_step((t, t1, h), y0, y1, &k)),
+    }
 }

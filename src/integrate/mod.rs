@@ -68,6 +68,18 @@ pub trait OdeSystem<const N: usize> {
     fn rhs(&self, t: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
 }
 
+/// A step of given size without error control (`Integrator::fixed_step`): its end, the vector field there, and
+/// its dense output if asked for.
+#[derive(Debug, Clone)]
+pub(crate) struct FixedStep<const N: usize> {
+    /// The state at the end.
+    pub(crate) y1: SVector<f64, N>,
+    /// `f(t1, y1)` (the next step's first stage).
+    pub(crate) f1: SVector<f64, N>,
+    /// The dense output over the step.
+    pub(crate) dense: Option<DenseStep<N>>,
+}
+
 /// Why [`Dopri5::step`] could not take a step.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
 pub enum IntegrationError {
@@ -179,20 +191,20 @@ impl<const N: usize> Integrator<N> {
         }
     }
 
-    /// One step of `method` of the given size `h` from `(t, y0)` to `t1`, with no error control: an accepted step
-    /// of an adaptive run taken again on another system whose first components are the original one's (the
-    /// variational equations of `crate::variational`, which thereby see the original run's steps, states and
-    /// dense output bit for bit).
+    /// One step of `method` of the given size `h` from `(t, y0)` (with `f0 = f(t, y0)`) to `t1`, with no error
+    /// control: an accepted step of an adaptive run taken again on another system whose first components are
+    /// the original one's (the variational equations of `crate::variational`, which thereby see the original
+    /// run's steps, states and dense output bit for bit). The dense output only if `dense`.
     pub(crate) fn fixed_step(
         method: Method,
         sys: &impl OdeSystem<N>,
-        t: f64,
-        y0: &SVector<f64, N>,
+        start: (f64, &SVector<f64, N>, &SVector<f64, N>),
         (h, t1): (f64, f64),
-    ) -> DenseStep<N> {
+        dense: bool,
+    ) -> FixedStep<N> {
         match method {
-            Method::Dop853 => dop853::fixed_step(sys, t, y0, h, t1),
-            Method::Dopri5 => dopri5::fixed_step(sys, t, y0, h, t1),
+            Method::Dop853 => dop853::fixed_step(sys, start, h, t1, dense),
+            Method::Dopri5 => dopri5::fixed_step(sys, start, h, t1, dense),
         }
     }
 

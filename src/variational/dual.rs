@@ -1,28 +1,186 @@
-//! The dual numbers that carry the derivatives (forward-mode automatic differentiation, `num-dual`): a number
-//! with its derivatives along the [`NDIR`] directions of a sensitivity, and the physical constants with one
-//! parameter seeded.
+//! The dual numbers that carry the derivatives (forward-mode automatic differentiation): a number with its
+//! derivatives along `N` directions ([`Dual`]), and the physical constants with one parameter seeded.
+//!
+//! Hand-written rather than `num-dual`'s `DualVec`: the variational equations evaluate the equations of motion
+//! on duals at every stage of every integrator step (about a thousand times per walking step), and `DualVec`
+//! keeps its derivative as an optional nalgebra vector, so that every operation branches and copies; a plain
+//! array of `N` derivatives is several times faster, and the few operations the kinematics need
+//! ([`Real`]) are a page of code.
 
-use nalgebra::{Const, SVector};
-use num_dual::{Derivative, DualSVec64};
+use std::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
-use crate::dynamics::{Mechanics, Model};
+use nalgebra::SVector;
+use num_traits::{One, Zero};
+
+use crate::dynamics::{Mechanics, Model, Real};
 
 /// Directions of the derivatives: the three section coordinates `(L2, dtheta/dt, dL2/dt)` and one parameter.
 pub(crate) const NDIR: usize = 4;
 
+/// `re + sum_i eps_i e_i` with `e_i e_j = 0`: a number and its derivatives along `N` directions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Dual<const N: usize> {
+    /// The value.
+    pub(crate) re: f64,
+    /// Its derivatives.
+    pub(crate) eps: [f64; N],
+}
+
 /// A number with its derivatives along the [`NDIR`] directions.
-pub(crate) type Dual = DualSVec64<NDIR>;
+pub(crate) type Dual4 = Dual<NDIR>;
 /// A number with its derivatives along the [`NDIR`] directions and along the flow (the event's rate).
-pub(crate) type Dual5 = DualSVec64<{ NDIR + 1 }>;
+pub(crate) type Dual5 = Dual<{ NDIR + 1 }>;
+
+impl<const N: usize> Dual<N> {
+    /// `re` with the derivatives `eps`.
+    pub(crate) fn new(re: f64, eps: SVector<f64, N>) -> Self {
+        Dual {
+            re,
+            eps: eps.into(),
+        }
+    }
+
+    /// The derivatives as a vector.
+    pub(crate) fn derivative(&self) -> SVector<f64, N> {
+        SVector::from(self.eps)
+    }
+
+    /// The chain rule for `f(self)` with `f(re) = value`, `f'(re) = slope`.
+    fn chain(self, value: f64, slope: f64) -> Self {
+        Dual {
+            re: value,
+            eps: self.eps.map(|e| slope * e),
+        }
+    }
+}
+
+impl<const N: usize> Add for Dual<N> {
+    type Output = Self;
+    fn add(self, b: Self) -> Self {
+        Dual {
+            re: self.re + b.re,
+            eps: std::array::from_fn(|i| self.eps[i] + b.eps[i]),
+        }
+    }
+}
+
+impl<const N: usize> Sub for Dual<N> {
+    type Output = Self;
+    fn sub(self, b: Self) -> Self {
+        Dual {
+            re: self.re - b.re,
+            eps: std::array::from_fn(|i| self.eps[i] - b.eps[i]),
+        }
+    }
+}
+
+impl<const N: usize> Mul for Dual<N> {
+    type Output = Self;
+    fn mul(self, b: Self) -> Self {
+        Dual {
+            re: self.re * b.re,
+            eps: std::array::from_fn(|i| self.re * b.eps[i] + b.re * self.eps[i]),
+        }
+    }
+}
+
+impl<const N: usize> Div for Dual<N> {
+    type Output = Self;
+    fn div(self, b: Self) -> Self {
+        let inv = 1.0 / b.re;
+        let re = self.re * inv;
+        Dual {
+            re,
+            eps: std::array::from_fn(|i| (self.eps[i] - re * b.eps[i]) * inv),
+        }
+    }
+}
+
+impl<const N: usize> Neg for Dual<N> {
+    type Output = Self;
+    fn neg(self) -> Self {
+        Dual {
+            re: -self.re,
+            eps: self.eps.map(|e| -e),
+        }
+    }
+}
+
+impl<const N: usize> AddAssign for Dual<N> {
+    fn add_assign(&mut self, b: Self) {
+        *self = *self + b;
+    }
+}
+
+impl<const N: usize> SubAssign for Dual<N> {
+    fn sub_assign(&mut self, b: Self) {
+        *self = *self - b;
+    }
+}
+
+impl<const N: usize> MulAssign for Dual<N> {
+    fn mul_assign(&mut self, b: Self) {
+        *self = *self * b;
+    }
+}
+
+impl<const N: usize> DivAssign for Dual<N> {
+    fn div_assign(&mut self, b: Self) {
+        *self = *self / b;
+    }
+}
+
+impl<const N: usize> Zero for Dual<N> {
+    fn zero() -> Self {
+        Dual {
+            re: 0.0,
+            eps: [0.0; N],
+        }
+    }
+    fn is_zero(&self) -> bool {
+        self.re == 0.0 && self.eps.iter().all(|e| *e == 0.0)
+    }
+}
+
+impl<const N: usize> One for Dual<N> {
+    fn one() -> Self {
+        Dual {
+            re: 1.0,
+            eps: [0.0; N],
+        }
+    }
+}
+
+impl<const N: usize> Real for Dual<N> {
+    fn lit(x: f64) -> Self {
+        Dual {
+            re: x,
+            eps: [0.0; N],
+        }
+    }
+    fn sin(self) -> Self {
+        self.chain(self.re.sin(), self.re.cos())
+    }
+    fn cos(self) -> Self {
+        self.chain(self.re.cos(), -self.re.sin())
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.re.sin_cos();
+        (self.chain(s, c), self.chain(c, -s))
+    }
+    fn atan(self) -> Self {
+        self.chain(self.re.atan(), 1.0 / (1.0 + self.re * self.re))
+    }
+}
 
 /// The dual number `re + eps . e`.
-pub(crate) fn dual<const D: usize>(re: f64, eps: SVector<f64, D>) -> DualSVec64<D> {
-    DualSVec64::new(re, Derivative::some(eps))
+pub(crate) fn dual<const D: usize>(re: f64, eps: SVector<f64, D>) -> Dual<D> {
+    Dual::new(re, eps)
 }
 
 /// The derivative part of a dual number.
-pub(crate) fn eps<const D: usize>(x: &DualSVec64<D>) -> SVector<f64, D> {
-    x.eps.unwrap_generic(Const::<D>, Const::<1>)
+pub(crate) fn eps<const D: usize>(x: &Dual<D>) -> SVector<f64, D> {
+    x.derivative()
 }
 
 /// The constants of `model` with the parameter `param` (if any) carrying the unit derivative in direction
@@ -31,7 +189,7 @@ pub(crate) fn seeded<const D: usize>(
     model: &Model,
     param: Option<&str>,
     index: usize,
-) -> Mechanics<DualSVec64<D>> {
+) -> Mechanics<Dual<D>> {
     Mechanics::seeded(model.params(), |key, value| {
         let mut e = SVector::<f64, D>::zeros();
         if param == Some(key) {
@@ -39,4 +197,43 @@ pub(crate) fn seeded<const D: usize>(
         }
         dual(value, e)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each operation's derivative against a central difference of the same operation on `f64`.
+    #[test]
+    fn operations_differentiate_like_finite_differences() {
+        let h = 1e-6;
+        let x = 0.7;
+        let at = |x: f64| Dual::<1>::new(x, SVector::<f64, 1>::new(1.0));
+        let ops: [(&str, fn(Dual<1>) -> Dual<1>, fn(f64) -> f64); 6] = [
+            ("sin", |d| d.sin(), f64::sin),
+            ("cos", |d| d.cos(), f64::cos),
+            ("atan", |d| d.atan(), f64::atan),
+            (
+                "x / (1 + x^2)",
+                |d| d / (Dual::one() + d * d),
+                |x| x / (1.0 + x * x),
+            ),
+            (
+                "-x^3 + 2",
+                |d| -(d * d * d) + Dual::lit(2.0),
+                |x| -(x * x * x) + 2.0,
+            ),
+            (
+                "sin cos",
+                |d| d.sin_cos().0 * d.sin_cos().1,
+                |x| x.sin() * x.cos(),
+            ),
+        ];
+        for (name, f, g) in ops {
+            let d = f(at(x));
+            let fd = (g(x + h) - g(x - h)) / (2.0 * h);
+            assert!((d.re - g(x)).abs() < 1e-15, "{name}");
+            assert!((d.eps[0] - fd).abs() < 1e-9, "{name}: {} vs {fd}", d.eps[0]);
+        }
+    }
 }

@@ -10,14 +10,13 @@
 //! all directions. This is the KKT solve differentiated, without running a factorization on dual numbers.
 
 use nalgebra::{SMatrix, SVector};
-use num_dual::DualSVec64;
 
 use crate::contact::{ActiveSet, Ldl, NROWS};
 use crate::dynamics::{
-    lit, Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z,
+    Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z,
 };
 
-use super::dual::eps;
+use super::dual::Dual;
 
 /// Multipliers `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]` over any [`Real`].
 type MultipliersOf<T> = SVector<T, NROWS>;
@@ -139,11 +138,63 @@ impl Kkt {
 }
 
 /// Duals over the configuration `(q, q')` and the constants `mech`, `D` directions each.
-type Duals<const D: usize> = (
-    CoordsOf<DualSVec64<D>>,
-    CoordsOf<DualSVec64<D>>,
-    Mechanics<DualSVec64<D>>,
-);
+type Duals<const D: usize> = (CoordsOf<Dual<D>>, CoordsOf<Dual<D>>, Mechanics<Dual<D>>);
+
+/// The parts of `dR/dy` that come from the configuration: `dM z1` (for a vector `z1` held fixed) and the
+/// derivatives of the rows of (C2), `dJ_C2^T lam_C2` and `dJ_C2 z2`, on the derivative parts only (the rows of
+/// (C1) and of the stoppers are constant).
+struct ResidualParts<const D: usize> {
+    /// `M` and the rows, real parts.
+    eom: EquationsOfMotion<f64>,
+    /// `dR1 = dM z1 - dJ^T lam` (and `dh` where the caller adds it), `NQ x D`.
+    r1: SMatrix<f64, NQ, D>,
+    /// `dR2 = dJ z2` on the active rows of (C2), `NROWS x D`.
+    r2: SMatrix<f64, NROWS, D>,
+}
+
+fn residual_parts<const D: usize>(
+    eom: &EquationsOfMotion<Dual<D>>,
+    active: &ActiveSet,
+    z1: &Coords,
+    z2: &Coords,
+    lam: &SVector<f64, NROWS>,
+) -> ResidualParts<D> {
+    let mask = active.row_mask();
+    let mut r1 = SMatrix::<f64, NQ, D>::zeros();
+    let mut r2 = SMatrix::<f64, NROWS, D>::zeros();
+    for i in 0..NQ {
+        for j in 0..NQ {
+            let (m, z) = (&eom.mass[(i, j)].eps, z1[j]);
+            for c in 0..D {
+                r1[(i, c)] += m[c] * z;
+            }
+        }
+    }
+    for axis in 0..2 {
+        let row = 2 + axis;
+        if !mask[row] {
+            continue;
+        }
+        for j in 0..NQ {
+            let dj = &eom.rear_tip.jacobian[(axis, j)].eps;
+            for c in 0..D {
+                r1[(j, c)] -= dj[c] * lam[row];
+                r2[(row, c)] += dj[c] * z2[j];
+            }
+        }
+    }
+    let re = |x: &Dual<D>| x.re;
+    let eom = EquationsOfMotion {
+        mass: eom.mass.map(|x| re(&x)),
+        bias: eom.bias.map(|x| re(&x)),
+        rear_tip: crate::dynamics::PointKinematics {
+            position: eom.rear_tip.position.map(|x| re(&x)),
+            jacobian: eom.rear_tip.jacobian.map(|x| re(&x)),
+            velocity_product: eom.rear_tip.velocity_product.map(|x| re(&x)),
+        },
+    };
+    ResidualParts { eom, r1, r2 }
+}
 
 /// The derivatives of `q''` and of the multipliers of the constrained dynamics with `active` (Eq. (1) with
 /// the KKT system of docs/model.md section 3) along the `D` directions of the duals, at the solution
@@ -155,13 +206,27 @@ pub(crate) fn dynamics_derivative<const D: usize>(
     (qdd, lam): (&Coords, &SVector<f64, NROWS>),
 ) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
     let eom = model.equations_of_motion_with(mech, q, qd);
-    let (rows, jdq) = constraint_rows(&eom, active);
     // R = [M q'' + h - J^T lam; J q'' + dJ/dt q'] with (q'', lam) held.
-    let (qdd_d, lam_d) = (qdd.map(lit), lam.map(lit));
-    let r1 = eom.mass * qdd_d + eom.bias - rows.transpose() * lam_d;
-    let r2 = rows * qdd_d + jdq;
-    let kkt = Kkt::new(&real_eom(&eom), active)?;
-    Some(kkt.solve(&-derivatives(&r1), &-derivatives(&r2)))
+    let ResidualParts {
+        eom: real,
+        mut r1,
+        mut r2,
+    } = residual_parts(&eom, active, qdd, qdd, lam);
+    let mask = active.row_mask();
+    for i in 0..NQ {
+        for c in 0..D {
+            r1[(i, c)] += eom.bias[i].eps[c];
+        }
+    }
+    for axis in 0..2 {
+        if mask[2 + axis] {
+            for c in 0..D {
+                r2[(2 + axis, c)] += eom.rear_tip.velocity_product[axis].eps[c];
+            }
+        }
+    }
+    let kkt = Kkt::new(&real, active)?;
+    Some(kkt.solve(&-r1, &-r2))
 }
 
 /// The derivative of `q'+` of the collision equation (5) with the units of `active` along the `D` directions
@@ -173,35 +238,28 @@ pub(crate) fn impulse_derivative<const D: usize>(
     (dqd, impulses): (&Coords, &SVector<f64, NROWS>),
 ) -> Option<SMatrix<f64, NQ, D>> {
     let eom = model.equations_of_motion_with(mech, q, &CoordsOf::zeros());
-    let (rows, _) = constraint_rows(&eom, active);
-    // R = [M dq' - J^T lam_I; J (q'- + dq')] with (dq', lam_I) held.
-    let (dqd_d, lam_d) = (dqd.map(lit), impulses.map(lit));
-    let r1 = eom.mass * dqd_d - rows.transpose() * lam_d;
-    let r2 = rows * (qd_minus + dqd_d);
-    let kkt = Kkt::new(&real_eom(&eom), active)?;
-    let (ddqd, _) = kkt.solve(&-derivatives(&r1), &-derivatives(&r2));
-    Some(derivatives(qd_minus) + ddqd)
-}
-
-/// The derivative parts of a vector of duals, one row per entry.
-fn derivatives<const R: usize, const D: usize>(
-    v: &SVector<DualSVec64<D>, R>,
-) -> SMatrix<f64, R, D> {
-    SMatrix::from_fn(|i, c| eps(&v[i])[c])
-}
-
-/// The real parts of the equations of motion.
-fn real_eom<const D: usize>(eom: &EquationsOfMotion<DualSVec64<D>>) -> EquationsOfMotion<f64> {
-    let re = |x: &DualSVec64<D>| x.re;
-    EquationsOfMotion {
-        mass: eom.mass.map(|x| re(&x)),
-        bias: eom.bias.map(|x| re(&x)),
-        rear_tip: crate::dynamics::PointKinematics {
-            position: eom.rear_tip.position.map(|x| re(&x)),
-            jacobian: eom.rear_tip.jacobian.map(|x| re(&x)),
-            velocity_product: eom.rear_tip.velocity_product.map(|x| re(&x)),
-        },
+    let qd_real = qd_minus.map(|x| x.re);
+    // R = [M dq' - J^T lam_I; J (q'- + dq')] with (dq', lam_I) held; J dq'- enters through q'-'s derivatives.
+    let qd_plus = qd_real + dqd;
+    let ResidualParts {
+        eom: real,
+        r1,
+        mut r2,
+    } = residual_parts(&eom, active, dqd, &qd_plus, impulses);
+    let (rows, _) = constraint_rows(&real, active);
+    let dqd_minus = SMatrix::<f64, NQ, D>::from_fn(|i, c| qd_minus[i].eps[c]);
+    let mask = active.row_mask();
+    let j_dqd = rows * dqd_minus;
+    for (r, on) in mask.into_iter().enumerate() {
+        if on {
+            for c in 0..D {
+                r2[(r, c)] += j_dqd[(r, c)];
+            }
+        }
     }
+    let kkt = Kkt::new(&real, active)?;
+    let (ddqd, _) = kkt.solve(&-r1, &-r2);
+    Some(dqd_minus + ddqd)
 }
 
 #[cfg(test)]

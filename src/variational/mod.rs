@@ -18,7 +18,7 @@ mod dual;
 mod kkt;
 mod replay;
 
-pub(crate) use dual::{dual as dual_of, seeded, Dual, NDIR};
+pub(crate) use dual::{dual as dual_of, seeded, Dual4, NDIR};
 pub(crate) use replay::{replay_step, sensitivity, Sensitivity, PARAM};
 pub use replay::{COINCIDENT_EVENTS, GRAZING_RATE};
 

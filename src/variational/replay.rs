@@ -28,7 +28,7 @@ use crate::walk::impact::touchdown_leg;
 use crate::walk::tape::{Segment, StepTape};
 use crate::walk::{EventKind, PhaseSystem, WalkVector};
 
-use super::dual::{dual, eps, seeded, Dual, Dual5, NDIR};
+use super::dual::{dual, eps, seeded, Dual4, Dual5, NDIR};
 use super::kkt::{dynamics_derivative, impulse_derivative};
 use super::NotDifferentiable;
 
@@ -55,7 +55,7 @@ pub const GRAZING_RATE: f64 = 1e-7;
 pub const COINCIDENT_EVENTS: f64 = 1e-9;
 
 /// `(q, q')` as duals: real parts from `y`, derivative parts from the rows of `s`.
-fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual>, CoordsOf<Dual>) {
+fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual4>, CoordsOf<Dual4>) {
     let at = |i: usize| dual(y[i], s.row(i).transpose());
     (
         CoordsOf::from_fn(|i, _| at(i)),
@@ -82,7 +82,7 @@ fn with_rate(
 }
 
 /// The sensitivity carried by duals `(q, q')`.
-pub(crate) fn sensitivity(q: &CoordsOf<Dual>, qd: &CoordsOf<Dual>) -> Sensitivity {
+pub(crate) fn sensitivity(q: &CoordsOf<Dual4>, qd: &CoordsOf<Dual4>) -> Sensitivity {
     Sensitivity::from_fn(|i, c| {
         let x = if i < NQ { &q[i] } else { &qd[i - NQ] };
         eps(x)[c]
@@ -92,7 +92,7 @@ pub(crate) fn sensitivity(q: &CoordsOf<Dual>, qd: &CoordsOf<Dual>) -> Sensitivit
 /// The phase's vector field with its variational equation, on the augmented state `[y, S]`.
 struct Variational<'a> {
     model: &'a Model,
-    mech: &'a Mechanics<Dual>,
+    mech: &'a Mechanics<Dual4>,
     active: ActiveSet,
 }
 
@@ -140,7 +140,7 @@ impl OdeSystem<NAUG> for Variational<'_> {
 /// with the recorded units, differentiated): the velocity after them and the sensitivity.
 fn apply_impacts(
     model: &Model,
-    mech: &Mechanics<Dual>,
+    mech: &Mechanics<Dual4>,
     y: &WalkVector,
     s: &Sensitivity,
     sets: &[ActiveSet],
@@ -236,7 +236,7 @@ fn rate_outer(f: &WalkVector, dt: &SVector<f64, NDIR>) -> Sensitivity {
 fn integrate_segment(
     model: &Model,
     opts: &SolverOptions,
-    mech: &Mechanics<Dual>,
+    mech: &Mechanics<Dual4>,
     segment: &Segment,
     y0: &WalkVector,
     s0: &Sensitivity,
@@ -249,15 +249,16 @@ fn integrate_segment(
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
     let mut t = segment.t0;
     let mut a = Variational::join(y0, s0);
+    let mut f = sys.rhs(t, &a);
     let mut at_event = None;
     for &(h, t1) in &segment.steps {
-        let step = Integrator::fixed_step(opts.integrator, &sys, t, &a, (h, t1));
-        if end.time <= t1 {
-            at_event = Some(step.eval(end.time));
+        let last = end.time <= t1;
+        let step = Integrator::fixed_step(opts.integrator, &sys, (t, &a, &f), (h, t1), last);
+        if let Some(dense) = step.dense {
+            at_event = Some(dense.eval(end.time));
             break;
         }
-        a = *step.y1();
-        t = t1;
+        (a, f, t) = (step.y1, step.f1, t1);
     }
     let (y, s) = Variational::split(&at_event.ok_or(NotDifferentiable::Incomplete)?);
     // The replay takes the walk's steps with the walk's arithmetic: its state is the walk's, bit for bit.
@@ -343,17 +344,17 @@ fn guard<T: Real>(
 /// 1 Leg 2 (or, after a long flight, a locked leg at `L0`), the origin moves to the new tip.
 fn reindex_duals(
     model: &Model,
-    mech: &Mechanics<Dual>,
-    q: &CoordsOf<Dual>,
-    qd: &CoordsOf<Dual>,
-) -> (CoordsOf<Dual>, CoordsOf<Dual>) {
+    mech: &Mechanics<Dual4>,
+    q: &CoordsOf<Dual4>,
+    qd: &CoordsOf<Dual4>,
+) -> (CoordsOf<Dual4>, CoordsOf<Dual4>) {
     let real_q = q.map(|x| x.re);
     let touching = touchdown_leg(model, &real_q);
     let shift = model.legs() - touching;
     let front = model.tip_with(mech, q, qd, touching);
     let v = front.velocity(qd);
     let l0 = mech.stopper_length;
-    let zero = Dual::from(0.0);
+    let zero = Dual4::lit(0.0);
     let (l2, l2_dot) = if shift == 1 {
         (q[L1], qd[L1])
     } else {
@@ -361,13 +362,13 @@ fn reindex_duals(
     };
     let alpha = model.alpha();
     let theta = if shift == 1 {
-        q[THETA] - Dual::from(alpha)
+        q[THETA] - Dual4::lit(alpha)
     } else {
-        let psi = q[THETA] + Dual::from(touching as f64 * alpha);
+        let psi = q[THETA] + Dual4::lit(touching as f64 * alpha);
         let turns = (psi.re / std::f64::consts::TAU).round();
-        psi - Dual::from(std::f64::consts::TAU * turns)
+        psi - Dual4::lit(std::f64::consts::TAU * turns)
     };
-    let q_new = CoordsOf::<Dual>::new(zero, front.position.y, theta, l0, l2);
-    let qd_new = CoordsOf::<Dual>::new(v.x, v.y, qd[THETA], zero, l2_dot);
+    let q_new = CoordsOf::<Dual4>::new(zero, front.position.y, theta, l0, l2);
+    let qd_new = CoordsOf::<Dual4>::new(v.x, v.y, qd[THETA], zero, l2_dot);
     (q_new, qd_new)
 }

@@ -129,8 +129,9 @@ pub(crate) fn section_coords<T: Real>(
     } else {
         (l2, l2_dot)
     };
-    let alpha = lit::<T>(model.alpha());
-    let theta = ((l2 * alpha.cos() - l0) / (l2 * alpha.sin())).atan();
+    let alpha = model.alpha();
+    let (cos_alpha, sin_alpha) = (lit::<T>(alpha.cos()), lit::<T>(alpha.sin()));
+    let theta = ((l2 * cos_alpha - l0) / (l2 * sin_alpha)).atan();
     let zero = T::zero();
     let q = CoordsOf::<T>::new(zero, zero, theta, l0, l2);
     let mut qd = CoordsOf::<T>::new(zero, zero, theta_dot, zero, l2_dot);
