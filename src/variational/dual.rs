@@ -76,6 +76,8 @@ impl<const N: usize> Sub for Dual<N> {
 
 impl<const N: usize> Mul for Dual<N> {
     type Output = Self;
+    // The product rule: (a + a' e)(b + b' e) = ab + (a b' + b a') e.
+    #[allow(clippy::suspicious_arithmetic_impl)]
     fn mul(self, b: Self) -> Self {
         Dual {
             re: self.re * b.re,
@@ -209,7 +211,8 @@ mod tests {
         let h = 1e-6;
         let x = 0.7;
         let at = |x: f64| Dual::<1>::new(x, SVector::<f64, 1>::new(1.0));
-        let ops: [(&str, fn(Dual<1>) -> Dual<1>, fn(f64) -> f64); 6] = [
+        type Case = (&'static str, fn(Dual<1>) -> Dual<1>, fn(f64) -> f64);
+        let ops: [Case; 6] = [
             ("sin", |d| d.sin(), f64::sin),
             ("cos", |d| d.cos(), f64::cos),
             ("atan", |d| d.atan(), f64::atan),
