@@ -157,7 +157,9 @@ fn gait_after_transient(c: &mut Criterion) {
     let mut group = c.benchmark_group("gait");
     group.sample_size(20);
     group.measurement_time(Duration::from_secs(5));
-    for (name, refine_jacobian) in [("central", false), ("refined", true)] {
+    // The exact Jacobian without and with its error estimate (a second exact Jacobian at 100x tighter
+    // tolerances).
+    for (name, refine_jacobian) in [("exact", false), ("exact_with_error", true)] {
         let options = GaitOptions {
             transient_steps: 0,
             refine_jacobian,
@@ -171,6 +173,34 @@ fn gait_after_transient(c: &mut Criterion) {
             })
         });
     }
+    group.finish();
+}
+
+/// One gait's `DP` by each route, in the units of the goal (step-map evaluations): `eval` is one step of
+/// the map, `exact` the step with its exact `DP` and `dP/dp`, `central` and `richardson` the finite differences
+/// (6 and 12 evaluations).
+fn jacobian_routes(c: &mut Criterion) {
+    let config = Config::default();
+    let model = Model::new(&config.params).expect("the paper's parameters are valid");
+    let map = StepMap::new(&model, &config.solver);
+    let gait = find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None,
+    )
+    .expect("the gait");
+    let s = gait.section;
+    let mut group = c.benchmark_group("jacobian");
+    group.sample_size(20);
+    group.measurement_time(Duration::from_secs(4));
+    group.bench_function("eval", |b| b.iter(|| black_box(map.eval(black_box(&s)))));
+    group.bench_function("exact", |b| {
+        b.iter(|| black_box(map.eval_with_derivatives(black_box(&s), Some("viscosity"))))
+    });
+    group.bench_function("central", |b| {
+        b.iter(|| black_box(map.central_jacobian(black_box(&s), 1e-4)))
+    });
     group.finish();
 }
 
@@ -201,6 +231,7 @@ criterion_group!(
     rhs,
     twenty_steps,
     gait_after_transient,
+    jacobian_routes,
     gait_job
 );
 criterion_main!(benches);

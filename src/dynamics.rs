@@ -25,7 +25,7 @@ use crate::params::{ConfigError, Params};
 
 /// A real scalar the kinematics and the equations of motion are written for: `f64` for the walk, and the dual
 /// numbers of [`crate::variational`] that carry derivatives through the very same code (forward-mode automatic
-/// differentiation, docs/model.md section 8). STYLE.md asks for concrete `f64`; this is the one exception, so
+/// differentiation, docs/model.md section 10). STYLE.md asks for concrete `f64`; this is the one exception, so
 /// that the exact derivatives differentiate the equations the walk integrates rather than a copy of them.
 ///
 /// The trait asks only for what the kinematics use (field arithmetic, the sine, cosine and arctangent), so that
@@ -156,7 +156,7 @@ pub(crate) struct Mechanics<T: Real = f64> {
 }
 
 /// The numeric keys of [`Params`] the equations of motion depend on smoothly: the parameters `dP/dp` can be
-/// taken for ([`Mechanics::seeded`]).
+/// taken for (`gait::StepMap::eval_with_derivatives`, `vrw gait --parameter`).
 pub const DIFFERENTIABLE_KEYS: [&str; 10] = [
     "hub_mass",
     "hub_inertia",

@@ -18,6 +18,7 @@
 //! | equations of motion, Eq. (1) | [`dynamics`] |
 //! | contacts, stoppers, KKT and impulse solves, Eqs. (2), (5) | [`contact`] |
 //! | the hybrid walk: phases, events, the DLS-indicator impact procedure | [`walk`], [`walk::impact`] |
+//! | exact derivatives of the step map: variational equations, saltation matrices | [`variational`] |
 //! | reference problems with known answers, the default start | [`reference`](mod@reference) |
 //! | step map, gait, Floquet multipliers, sweeps, maps, orbits, basins, thresholds | [`gait`] |
 //! | tables and figures | [`output`] |

@@ -1,4 +1,4 @@
-//! The Jacobian of a gait (docs/model.md sections 6 and 8): the exact `DP` (and `dP/dp`) of
+//! The Jacobian of a gait (docs/model.md sections 6 and 10): the exact `DP` (and `dP/dp`) of
 //! [`StepMap::eval_with_derivatives`] with an error estimate that comes from the computation, and the
 //! finite-difference route kept as its independent check ([`check_jacobian`], `vrw gait --check-jacobian`).
 //!

@@ -181,7 +181,7 @@ pub struct Gait {
     /// indicators and branch).
     pub cycle: Vec<StepReport>,
     /// `DP(s*)` (`D(P^k)(s*)` for a period-k gait) on the free coordinates, row-major: exact derivatives
-    /// (variational equations and saltation matrices, docs/model.md section 8).
+    /// (variational equations and saltation matrices, docs/model.md section 10).
     pub jacobian: Vec<Vec<f64>>,
     /// Estimated error of the Jacobian entries: the largest difference to the exact `DP` at tolerances
     /// [`super::derivative::DERIVATIVE_CHECK_TIGHTENING`] times tighter, or `NaN` if not estimated.

@@ -8,13 +8,12 @@
 //! are the period-k gaits ([`super::period_k`]); everything below (Jacobian, Newton's method) works on it
 //! unchanged.
 //!
-//! **Jacobian.** `DP` is computed by central differences of the whole map with Richardson extrapolation:
-//! `D(h) = (P(s + h e_i) - P(s - h e_i)) / 2h` has an error `c2 h^2 + c4 h^4 + noise/h`, and
-//! `(4 D(h/2) - D(h)) / 3` removes the `h^2` term. The difference between the extrapolated and the plain
-//! `D(h/2)` estimates the error, which is reported with every gait. Forward sensitivities through the events
-//! (variational equations with saltation matrices) would avoid the `noise/h` term; the finite differences are
-//! checked against the closed-form Floquet multiplier of the rigid rimless wheel instead (tests), where they
-//! agree to about 1e-9.
+//! **Jacobian.** `DP` (and `dP/dp`) is exact: [`StepMap::eval_with_derivatives`] walks the step with a record of
+//! it and replays that record with the variational equations and the saltation matrix of every event
+//! ([`crate::variational`], docs/model.md section 10). The finite-difference route stays as its independent
+//! check and as Newton's matrix where the map is not differentiable: [`StepMap::central_jacobian`],
+//! `D(h) = (P(s + h e_i) - P(s - h e_i)) / 2h`, with an error `c2 h^2 + c4 h^4 + noise/h`, and its Richardson
+//! extrapolation `(4 D(h/2) - D(h)) / 3`, whose difference to the plain `D(h/2)` estimates its error.
 
 use std::ops::{Deref, DerefMut};
 use std::sync::{Arc, Mutex};
@@ -153,7 +152,7 @@ impl<'m> StepMap<'m> {
         Ok(StepOutcome { next, report })
     }
 
-    /// Evaluate `P(s)` (`P^k(s)`) with its exact derivatives (docs/model.md section 8): `DP` over the free
+    /// Evaluate `P(s)` (`P^k(s)`) with its exact derivatives (docs/model.md section 10): `DP` over the free
     /// coordinates and, if `param` names one of [`DIFFERENTIABLE_KEYS`], `dP/dp`. The walk is the one
     /// [`StepMap::eval`] takes (same outcome, bit for bit); the derivatives come from the variational equations
     /// over its steps and the saltation matrix of each of its events ([`crate::variational`]). `D(P^k)` is the

@@ -1,5 +1,5 @@
 //! Derivatives of the constrained dynamics and of the collision equation with their active set fixed
-//! (docs/model.md sections 3, 5 and 8).
+//! (docs/model.md sections 3, 5 and 10).
 //!
 //! Both are linear solves `K(y) z = r(y)` with the KKT matrix `K = [M -J^T; J 0]` (inactive rows as identity
 //! rows): Eq. (1) with the constraints, `z = (q'', lam)`, and Eq. (5), `z = (q'+ - q'-, lam_I)`. Written as a

@@ -1,8 +1,8 @@
-//! Exact derivatives of the step map (docs/model.md section 8): `DP = dP/ds` and `dP/dp` for one chosen
+//! Exact derivatives of the step map (docs/model.md section 10): `DP = dP/ds` and `dP/dp` for one chosen
 //! parameter, from the variational equations of every phase (the KKT solve differentiated with its active set
 //! fixed) composed with the saltation matrix of every event, replayed over the step the walk took.
 //!
-//! The walker records its step ([`crate::walk::tape::StepTape`]: the impulse sets of its impacts, the active
+//! The walker records its step (`walk/tape.rs`: the impulse sets of its impacts, the active
 //! set and accepted integrator steps of each phase, the event that ended it); `replay` integrates the
 //! augmented system `[y, S]` over the same steps and crosses each event with its time's sensitivity. The
 //! derivatives of the equations of motion, the KKT solution, the guards, the collisions, the re-indexing and

@@ -1,5 +1,5 @@
 //! The variational equations of each phase and the saltation matrix of each event, replayed over a walked step
-//! ([`StepTape`]): docs/model.md section 8.
+//! ([`StepTape`]): docs/model.md section 10.
 //!
 //! **Phases.** The sensitivity `S = d(q, q')/d(s, p)` (10 rows, [`NDIR`] columns) obeys `S' = F_y S + F_p`, with
 //! `F` the phase's vector field `(q', q'')`, `q''` from the KKT system with the active set fixed. Both products

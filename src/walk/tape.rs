@@ -1,4 +1,4 @@
-//! The record of one walked step that the exact derivatives replay (docs/model.md section 8): the impulse sets
+//! The record of one walked step that the exact derivatives replay (docs/model.md section 10): the impulse sets
 //! of its impacts, the active set, start and accepted integrator steps of each phase, and the event that ended
 //! each phase. With it, `crate::variational` integrates the variational equations over the very steps the walk
 //! took and composes the saltation matrix of every event, without deciding anything again.
