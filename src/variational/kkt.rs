@@ -43,61 +43,122 @@ fn constraint_rows<T: Real>(
     (rows, jdq)
 }
 
-/// The KKT matrix `[M -J^T; J 0]` of the active rows of `active` at one configuration, factored in `f64`
-/// through the Schur complement `J M^-1 J^T` (the walk's `LDL^T`, [`Ldl`]): solves for many right-hand sides.
-pub(crate) struct Kkt {
-    /// `M = L D L^T`.
-    mass: Ldl<NQ>,
-    /// `W_i = L^-1 a_i` for the active rows `a_i`.
-    w: [[f64; NQ]; NROWS],
-    /// Positions of the active rows in the stacking.
-    stacked: [usize; NROWS],
-    /// Number of active rows.
+/// A saddle-point system `[A -B^T; B 0]` over `N` unknowns with up to [`NROWS`] rows `B`, factored through the
+/// Schur complement `B A^-1 B^T` with the walk's `LDL^T` ([`Ldl`]).
+struct Saddle<const N: usize> {
+    /// `A = L D L^T`.
+    a: Ldl<N>,
+    /// `W_i = L^-1 b_i` for the rows `b_i`.
+    w: [[f64; N]; NROWS],
+    /// Number of rows.
     k: usize,
     /// `S = W^T D^-1 W = L_S D_S L_S^T`.
     schur: Ldl<NROWS>,
+}
+
+impl<const N: usize> Saddle<N> {
+    /// Factor `A` (its lower triangle given by `entry(i, j)`, `j <= i`) with the rows `rows[..k]`.
+    fn new(entry: impl Fn(usize, usize) -> f64, rows: &[[f64; N]]) -> Option<Saddle<N>> {
+        let mut a = Ldl::<N>::zeros(N);
+        for i in 0..N {
+            for j in 0..=i {
+                a.l[i][j] = entry(i, j);
+            }
+        }
+        if !a.factor() {
+            return None;
+        }
+        let k = rows.len();
+        let mut w = [[0.0; N]; NROWS];
+        for (w_i, row) in w.iter_mut().zip(rows) {
+            *w_i = *row;
+            a.forward(w_i);
+        }
+        let mut schur = Ldl::<NROWS>::zeros(k);
+        for i in 0..k {
+            for j in 0..=i {
+                schur.l[i][j] = (0..N).map(|l| w[i][l] * w[j][l] * a.d_inv[l]).sum();
+            }
+        }
+        schur.factor().then_some(Saddle { a, w, k, schur })
+    }
+
+    /// Solve `[A -B^T; B 0] [x; lam] = [f; b]`.
+    fn solve(&self, f: [f64; N], b: &[f64; NROWS]) -> ([f64; N], [f64; NROWS]) {
+        let mut g = f;
+        self.a.forward(&mut g);
+        let mut lam = [0.0; NROWS];
+        for i in 0..self.k {
+            let wg: f64 = (0..N).map(|l| self.w[i][l] * g[l] * self.a.d_inv[l]).sum();
+            lam[i] = b[i] - wg;
+        }
+        self.schur.forward(&mut lam);
+        self.schur.backward_scaled(&mut lam);
+        for i in 0..self.k {
+            for (g_l, w_l) in g.iter_mut().zip(&self.w[i]) {
+                *g_l += lam[i] * w_l;
+            }
+        }
+        self.a.backward_scaled(&mut g);
+        (g, lam)
+    }
+}
+
+/// The KKT matrix `[M -J^T; J 0]` of the active rows of `active` at one configuration, factored in `f64`:
+/// solves for many right-hand sides. When Leg 1's tip is held (no-slip (C1), most of the walk) its rows `e_x`,
+/// `e_z` fix `x`, `z` and the system is reduced to `(theta, L1, L2)`, as the walk's own solve does.
+pub(crate) struct Kkt {
+    /// `M`.
+    mass: SMatrix<f64, NQ, NQ>,
+    /// The rows `J` in the fixed stacking (zero where inactive).
+    rows: SMatrix<f64, NROWS, NQ>,
+    /// The stacked positions of the rows of the saddle system (those of (C1) excluded when held).
+    stacked: [usize; NROWS],
+    /// The factored system: over all five coordinates, or over `(theta, L1, L2)` with (C1) held.
+    saddle: Reduced,
+}
+
+/// [`Kkt`]'s saddle system.
+enum Reduced {
+    /// Over `(x, z, theta, L1, L2)`.
+    General(Saddle<NQ>),
+    /// Over `(theta, L1, L2)`, with `x`, `z` fixed by (C1).
+    Held(Saddle<3>),
 }
 
 impl Kkt {
     /// Factor the KKT matrix of `active` with `M` and the rows of `eom`; `None` if singular.
     fn new(eom: &EquationsOfMotion<f64>, active: &ActiveSet) -> Option<Kkt> {
         let (rows, _) = constraint_rows(eom, active);
-        let mut mass = Ldl::<NQ>::zeros(NQ);
-        for i in 0..NQ {
-            for j in 0..=i {
-                mass.l[i][j] = eom.mass[(i, j)];
-            }
-        }
-        if !mass.factor() {
-            return None;
-        }
-        let (mut w, mut stacked, mut k) = ([[0.0; NQ]; NROWS], [0; NROWS], 0);
-        for (i, on) in active.row_mask().into_iter().enumerate() {
+        let held = active.contact1 && !active.slide1;
+        let first = if held { 2 } else { 0 };
+        let mut stacked = [0; NROWS];
+        let mut k = 0;
+        for (i, on) in active.row_mask().into_iter().enumerate().skip(first) {
             if on {
-                w[k] = std::array::from_fn(|l| rows[(i, l)]);
-                mass.forward(&mut w[k]);
                 stacked[k] = i;
                 k += 1;
             }
         }
-        let scaled_dot = |u: &[f64; NQ], v: &[f64; NQ]| {
-            (0..NQ).map(|l| u[l] * v[l] * mass.d_inv[l]).sum::<f64>()
+        let m = &eom.mass;
+        let saddle = if held {
+            let r: Vec<[f64; 3]> = stacked[..k]
+                .iter()
+                .map(|&i| std::array::from_fn(|l| rows[(i, 2 + l)]))
+                .collect();
+            Reduced::Held(Saddle::new(|i, j| m[(2 + i, 2 + j)], &r)?)
+        } else {
+            let r: Vec<[f64; NQ]> = stacked[..k]
+                .iter()
+                .map(|&i| std::array::from_fn(|l| rows[(i, l)]))
+                .collect();
+            Reduced::General(Saddle::new(|i, j| m[(i, j)], &r)?)
         };
-        let mut schur = Ldl::<NROWS>::zeros(k);
-        for i in 0..k {
-            for j in 0..=i {
-                schur.l[i][j] = scaled_dot(&w[i], &w[j]);
-            }
-        }
-        if !schur.factor() {
-            return None;
-        }
         Some(Kkt {
-            mass,
-            w,
+            mass: eom.mass,
+            rows,
             stacked,
-            k,
-            schur,
+            saddle,
         })
     }
 
@@ -108,30 +169,64 @@ impl Kkt {
         f: &SMatrix<f64, NQ, D>,
         b: &SMatrix<f64, NROWS, D>,
     ) -> (SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>) {
-        let (mut x, mut lam) = (
-            SMatrix::<f64, NQ, D>::zeros(),
-            SMatrix::<f64, NROWS, D>::zeros(),
-        );
-        let d_inv = &self.mass.d_inv;
+        let mut x = SMatrix::<f64, NQ, D>::zeros();
+        let mut lam = SMatrix::<f64, NROWS, D>::zeros();
         for c in 0..D {
-            let mut g: [f64; NQ] = std::array::from_fn(|l| f[(l, c)]);
-            self.mass.forward(&mut g);
-            let mut l_c = [0.0; NROWS];
-            for i in 0..self.k {
-                let wg: f64 = (0..NQ).map(|l| self.w[i][l] * g[l] * d_inv[l]).sum();
-                l_c[i] = b[(self.stacked[i], c)] - wg;
-            }
-            self.schur.forward(&mut l_c);
-            self.schur.backward_scaled(&mut l_c);
-            let mut x_c = g;
-            for i in 0..self.k {
-                for (x_l, w_l) in x_c.iter_mut().zip(&self.w[i]) {
-                    *x_l += l_c[i] * w_l;
+            match &self.saddle {
+                Reduced::General(saddle) => {
+                    let b_c = std::array::from_fn(|i| {
+                        if i < saddle.k {
+                            b[(self.stacked[i], c)]
+                        } else {
+                            0.0
+                        }
+                    });
+                    let (x_c, l_c) = saddle.solve(std::array::from_fn(|l| f[(l, c)]), &b_c);
+                    for l in 0..NQ {
+                        x[(l, c)] = x_c[l];
+                    }
+                    for i in 0..saddle.k {
+                        lam[(self.stacked[i], c)] = l_c[i];
+                    }
                 }
-                lam[(self.stacked[i], c)] = l_c[i];
+                Reduced::Held(saddle) => {
+                    // (C1): x'' = b_x, z'' = b_z; the rest on (theta, L1, L2).
+                    let xz = [b[(0, c)], b[(1, c)]];
+                    let f_r = std::array::from_fn(|l| {
+                        f[(2 + l, c)]
+                            - self.mass[(2 + l, 0)] * xz[0]
+                            - self.mass[(2 + l, 1)] * xz[1]
+                    });
+                    let b_c = std::array::from_fn(|i| {
+                        if i < saddle.k {
+                            let row = self.stacked[i];
+                            b[(row, c)] - self.rows[(row, 0)] * xz[0] - self.rows[(row, 1)] * xz[1]
+                        } else {
+                            0.0
+                        }
+                    });
+                    let (x_r, l_c) = saddle.solve(f_r, &b_c);
+                    x[(0, c)] = xz[0];
+                    x[(1, c)] = xz[1];
+                    for l in 0..3 {
+                        x[(2 + l, c)] = x_r[l];
+                    }
+                    for i in 0..saddle.k {
+                        lam[(self.stacked[i], c)] = l_c[i];
+                    }
+                    // lambda_1, lambda_2 from the x and z equations: (M x - f - J_o^T lam_o)_{x,z}.
+                    for axis in 0..2 {
+                        let mut v = -f[(axis, c)];
+                        for j in 0..NQ {
+                            v += self.mass[(axis, j)] * x[(j, c)];
+                        }
+                        for i in 0..saddle.k {
+                            v -= self.rows[(self.stacked[i], axis)] * l_c[i];
+                        }
+                        lam[(axis, c)] = v;
+                    }
+                }
             }
-            self.mass.backward_scaled(&mut x_c);
-            x.set_column(c, &SVector::from(x_c));
         }
         (x, lam)
     }
