@@ -51,24 +51,27 @@ pub(crate) fn gait_jacobian(
     param: Option<&'static str>,
     estimate_error: bool,
 ) -> Result<GaitJacobian, DerivativeError> {
-    let at = map.eval_with_derivatives(s, param)?;
-    let (error, dparam_error) = if estimate_error {
-        let rtol = map.options().rtol;
-        let factor = if rtol / DERIVATIVE_CHECK_TIGHTENING >= TIGHTEST_RTOL {
-            1.0 / DERIVATIVE_CHECK_TIGHTENING
-        } else {
-            DERIVATIVE_CHECK_TIGHTENING
-        };
-        let other = map
-            .with_tolerances_scaled(factor)
-            .eval_with_derivatives(s, param)?;
-        let dparam_error = match (&at.dparam, &other.dparam) {
-            (Some(a), Some(b)) => (a - b).amax(),
-            _ => f64::NAN,
-        };
-        ((&at.jacobian - &other.jacobian).amax(), dparam_error)
+    let factor = if map.options().rtol / DERIVATIVE_CHECK_TIGHTENING >= TIGHTEST_RTOL {
+        1.0 / DERIVATIVE_CHECK_TIGHTENING
     } else {
-        (f64::NAN, f64::NAN)
+        DERIVATIVE_CHECK_TIGHTENING
+    };
+    let other_map = map.with_tolerances_scaled(factor);
+    // The two computations are independent: both cores.
+    let (at, other) = rayon::join(
+        || map.eval_with_derivatives(s, param),
+        || estimate_error.then(|| other_map.eval_with_derivatives(s, param)),
+    );
+    let at = at?;
+    let (error, dparam_error) = match other.transpose()? {
+        Some(other) => {
+            let dparam_error = match (&at.dparam, &other.dparam) {
+                (Some(a), Some(b)) => (a - b).amax(),
+                _ => f64::NAN,
+            };
+            ((&at.jacobian - &other.jacobian).amax(), dparam_error)
+        }
+        None => (f64::NAN, f64::NAN),
     };
     Ok(GaitJacobian {
         jacobian: at.jacobian,

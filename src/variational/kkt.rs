@@ -94,9 +94,9 @@ impl<const N: usize> Saddle<N> {
         }
         self.schur.forward(&mut lam);
         self.schur.backward_scaled(&mut lam);
-        for i in 0..self.k {
-            for (g_l, w_l) in g.iter_mut().zip(&self.w[i]) {
-                *g_l += lam[i] * w_l;
+        for (lam_i, w_i) in lam.iter().zip(&self.w).take(self.k) {
+            for (g_l, w_l) in g.iter_mut().zip(w_i) {
+                *g_l += lam_i * w_l;
             }
         }
         self.a.backward_scaled(&mut g);
@@ -118,7 +118,8 @@ pub(crate) struct Kkt {
     saddle: Reduced,
 }
 
-/// [`Kkt`]'s saddle system.
+/// [`Kkt`]'s saddle system (the variants differ in size by two rows of `W`; one lives per solve).
+#[allow(clippy::large_enum_variant)]
 enum Reduced {
     /// Over `(x, z, theta, L1, L2)`.
     General(Saddle<NQ>),
