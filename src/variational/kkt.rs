@@ -221,8 +221,8 @@ impl Kkt {
                         for j in 0..NQ {
                             v += self.mass[(axis, j)] * x[(j, c)];
                         }
-                        for i in 0..saddle.k {
-                            v -= self.rows[(self.stacked[i], axis)] * l_c[i];
+                        for (&row, l_i) in self.stacked.iter().zip(&l_c).take(saddle.k) {
+                            v -= self.rows[(row, axis)] * l_i;
                         }
                         lam[(axis, c)] = v;
                     }
