@@ -18,8 +18,8 @@ class GaitOptions(TypedDict, total=False):
     transient_steps: int  # steps walked before Newton's method starts (default 30; 0 to 100000)
     max_iterations: int  # Newton iterations allowed (default 20; 1 to 1000)
     tolerance: float  # convergence: max |P(s) - s| below this (default 1e-10; 1e-13 to 1e-6)
-    fd_step: float  # relative finite-difference step of the Jacobian (default 1e-4; 1e-6 to 1e-2)
-    refine_jacobian: bool  # Richardson-refined final Jacobian (default True; False in sweeps)
+    fd_step: float  # relative finite-difference step where differences are used (default 1e-4; 1e-6 to 1e-2)
+    refine_jacobian: bool  # error estimate of the exact Jacobian (default True)
 
 class ConfigError(ValueError):
     """Invalid parameters (unknown key, wrong type, broken rule, bad TOML file), or a search setting, a sweep

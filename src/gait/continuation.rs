@@ -55,8 +55,8 @@ pub(crate) const MAX_FOLLOW_STEPS: usize = 200;
 
 /// After Newton's method fails this many continuation steps in a row (each half the one before), steps are
 /// also tried by walking ([`Continuation::walk_step`]): near a border of the map's smooth pieces (a DLS
-/// indicator near zero) the finite-difference `DP` straddles the border and Newton's method fails at every
-/// step length, while the walk follows the stable gait.
+/// indicator near zero) the map's pieces differ across the border and Newton's method fails at every step
+/// length, while the walk follows the stable gait.
 ///
 /// While walking has not yet carried the family on, a walk that fails is tried again only after as many more
 /// Newton failures (each halving the step): most ends (the wheel rolls back, a fold) cannot be walked past

@@ -10,8 +10,8 @@
 //! Parallelism (rayon) with results bitwise identical for any number of threads comes from the grid runner
 //! ([`super::grid`]): a sweep is one row of [`gait_rows`], which continues every [`COARSE_STRIDE`]-th point in
 //! order (the coarse pass) and then the points between two coarse points from the left one, all intervals in
-//! parallel; a map is many rows, run in parallel. Inside each point the step-map evaluations of the
-//! finite-difference Jacobian run in parallel as well.
+//! parallel; a map is many rows, run in parallel. Inside each point the exact Jacobian and the second one of
+//! its error estimate run in parallel as well.
 
 use rayon::prelude::*;
 use serde::Serialize;
