@@ -164,6 +164,25 @@ impl ActiveSet {
     }
 }
 
+#[cfg(test)]
+impl ActiveSet {
+    /// Every active set: the six flags in all combinations (a sliding flag without its contact is the same as no
+    /// contact), for tests that check a solve on all of them.
+    pub(crate) fn all() -> impl Iterator<Item = ActiveSet> {
+        (0..1u32 << 6).map(|bits| {
+            let on = |b: u32| bits & (1 << b) != 0;
+            ActiveSet {
+                contact1: on(0),
+                contact2: on(1),
+                lock1: on(2),
+                lock2: on(3),
+                slide1: on(4),
+                slide2: on(5),
+            }
+        })
+    }
+}
+
 /// Support phase, named by which tips are on the ground.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Phase {
@@ -706,22 +725,6 @@ mod tests {
         assert!(sol.qdd[THETA].is_finite());
     }
 
-    /// Every active set: the six flags in all combinations (a sliding flag without its contact is the same as
-    /// no contact).
-    fn all_active_sets() -> impl Iterator<Item = ActiveSet> {
-        (0..1u32 << 6).map(|bits| {
-            let on = |b: u32| bits & (1 << b) != 0;
-            ActiveSet {
-                contact1: on(0),
-                contact2: on(1),
-                lock1: on(2),
-                lock2: on(3),
-                slide1: on(4),
-                slide2: on(5),
-            }
-        })
-    }
-
     /// The solve on the active rows only (with Leg 1 held: reduced to `(theta, L1, L2)`) equals the general
     /// saddle-point solve on the full stacking, results and errors, for every active set, at a double-support
     /// state, a state with Leg 2 near its stopper and a lifted state, with and without hub inertia.
@@ -747,7 +750,7 @@ mod tests {
             ];
             let mut solved = 0;
             for (q, qd) in states {
-                for active in all_active_sets() {
+                for active in ActiveSet::all() {
                     let fast = constrained_dynamics(&model, &q, &qd, &active);
                     let (m, h) = model.mass_and_bias(&q, &qd);
                     let (rows, jdq) = constraint_rows(&model, &q, &qd, &active);

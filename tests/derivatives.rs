@@ -130,31 +130,3 @@ fn parameter_derivative_predicts_the_neighbouring_gait() {
     );
     assert!((ds - &fd).amax() < 1e-6 * (1.0 + fd.amax()));
 }
-
-#[test]
-#[ignore]
-fn timing_scratch() {
-    let config = Config::default();
-    let model = Model::new(&config.params).unwrap();
-    let map = StepMap::new(&model, &config.solver);
-    let gait = find_gait(
-        &map,
-        &default_initial(&config),
-        &GaitOptions::default(),
-        None,
-    )
-    .unwrap();
-    let n = 50;
-    let t = std::time::Instant::now();
-    for _ in 0..n {
-        map.eval(&gait.section).unwrap();
-    }
-    let e = t.elapsed().as_secs_f64() / n as f64;
-    let t = std::time::Instant::now();
-    for _ in 0..n {
-        map.eval_with_derivatives(&gait.section, Some("viscosity"))
-            .unwrap();
-    }
-    let d = t.elapsed().as_secs_f64() / n as f64;
-    eprintln!("eval {e:e} s, with derivatives {d:e} s ({:.2}x)", d / e);
-}

@@ -365,21 +365,6 @@ mod tests {
     use crate::params::Params;
     use crate::variational::dual::{dual, seeded};
 
-    /// Every active set (the six flags in all combinations).
-    fn all_active_sets() -> impl Iterator<Item = ActiveSet> {
-        (0..1u32 << 6).map(|bits| {
-            let on = |b: u32| bits & (1 << b) != 0;
-            ActiveSet {
-                contact1: on(0),
-                contact2: on(1),
-                lock1: on(2),
-                lock2: on(3),
-                slide1: on(4),
-                slide2: on(5),
-            }
-        })
-    }
-
     /// The derivatives of `q''`, the multipliers and `q'+` along a direction in `(q, q', k)` equal central
     /// differences of the walk's own solves, for every active set they solve.
     #[test]
@@ -395,7 +380,7 @@ mod tests {
         let dir_qd = Coords::new(-0.5, 0.2, 0.3, 0.6, 0.1);
         let h = 1e-6;
         let mut compared = 0;
-        for active in all_active_sets() {
+        for active in ActiveSet::all() {
             let at = |s: f64| {
                 let mut p = params.clone();
                 p.stiffness += s;
