@@ -130,3 +130,60 @@ fn parameter_derivative_predicts_the_neighbouring_gait() {
     );
     assert!((ds - &fd).amax() < 1e-6 * (1.0 + fd.amax()));
 }
+
+/// A gait exactly on a border collision (its `lambda_2+` zero to 1e-11: the DLS family at `c = 20` ends there,
+/// README) has no derivative: `gait.json` says so instead of giving multipliers.
+#[test]
+fn gait_on_a_border_collision_reports_no_derivative() {
+    let lambda_2_at = |k: f64, from: &SectionState| {
+        let config = config_of(&["viscosity=20", &format!("stiffness={k}")]);
+        let model = Model::new(&config.params).unwrap();
+        let map = StepMap::new(&model, &config.solver);
+        let options = GaitOptions {
+            transient_steps: 0,
+            ..GaitOptions::default()
+        };
+        let gait = find_gait(&map, from, &options, None).unwrap();
+        (gait.lambda_2_plus, gait)
+    };
+    let start = {
+        let config = config_of(&["viscosity=20", "stiffness=593.86"]);
+        let model = Model::new(&config.params).unwrap();
+        let map = StepMap::new(&model, &config.solver);
+        find_gait(
+            &map,
+            &default_initial(&config),
+            &GaitOptions::default(),
+            None,
+        )
+        .unwrap()
+        .section
+    };
+    // The secant method on lambda_2+(k), from the DLS side.
+    let (mut k0, mut k1) = (593.86, 593.866);
+    let (mut f0, _) = lambda_2_at(k0, &start);
+    let (mut f1, mut gait) = lambda_2_at(k1, &start);
+    for _ in 0..20 {
+        if f1.abs() < 1e-11 {
+            break;
+        }
+        let k2 = k1 - f1 * (k1 - k0) / (f1 - f0);
+        let (f2, g2) = lambda_2_at(k2, &gait.section);
+        (k0, f0, k1, f1, gait) = (k1, f1, k2, f2, g2);
+    }
+    eprintln!(
+        "lambda_2+ = {f1:e} at k = {k1}: {:?}",
+        gait.jacobian_failure
+    );
+    assert!(
+        f1.abs() < 1e-11,
+        "the secant did not reach the border: {f1:e} at {k1}"
+    );
+    let failure = gait.jacobian_failure.expect("no derivative on the border");
+    assert!(
+        failure.contains("lambda_2_plus") && failure.contains("border"),
+        "{failure}"
+    );
+    assert!(gait.floquet_multipliers.is_empty());
+    assert_eq!(gait.stability, vrw::gait::Stability::Uncertain);
+}

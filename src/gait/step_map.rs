@@ -22,14 +22,16 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, NQ, THETA};
+use crate::params::ImpactModel;
 use crate::params::SolverOptions;
 use crate::variational::{
-    replay_step, seeded, sensitivity, Dual4, NotDifferentiable, Sensitivity, NDIR, PARAM,
+    replay_step, seeded, sensitivity, Dual4, NotDifferentiable, Sensitivity, BORDER_TOL, NDIR,
+    PARAM,
 };
 use crate::walk::section::section_coords;
 use crate::walk::tape::StepTape;
 use crate::walk::WalkError;
-use crate::walk::{SectionState, StepReport, Walker, WorkCounts};
+use crate::walk::{Branch, SectionState, StepReport, Walker, WorkCounts};
 
 /// One evaluation of the step map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -187,6 +189,7 @@ impl<'m> StepMap<'m> {
             let start = walker.state().clone();
             let mut tape = StepTape::default();
             let step = walker.step_taped(&mut tape)?;
+            on_border(model, &step)?;
             report.get_or_insert(step);
             sens = replay_step(
                 model,
@@ -281,6 +284,32 @@ impl<'m> StepMap<'m> {
         let error = (&extrapolated - fine).abs().max();
         Ok((extrapolated, error))
     }
+}
+
+/// An error if the step's touchdown impact is on a border between two of its branches: the indicator that decides
+/// the branch (`lambda_I4` between (A1) and (A3), `lambda_2+` and `lambda_4+` between (B2), (B3) and the bounce)
+/// within [`BORDER_TOL`] of zero. Only the paper's procedure decides by the indicators (not `rigid_legs`, not the
+/// traditional exchange, not a landing with the rear leg in the air).
+fn on_border(model: &Model, step: &StepReport) -> Result<(), NotDifferentiable> {
+    let p = model.params();
+    if p.rigid_legs || p.impact != ImpactModel::Dlsi || step.branch == Branch::RearAirborne {
+        return Ok(());
+    }
+    let i = &step.indicators;
+    for (indicator, value) in [
+        ("lambda_I4", i.lambda_i4),
+        ("lambda_2_plus", i.lambda_2_plus),
+        ("lambda_4_plus", i.lambda_4_plus),
+    ] {
+        if value.abs() < BORDER_TOL {
+            return Err(NotDifferentiable::Border {
+                time: step.time,
+                indicator,
+                value,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A walker made by a [`StepMap`], which adds its work to the map's tally when it is dropped (on every path,

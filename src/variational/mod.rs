@@ -22,6 +22,11 @@ pub(crate) use dual::{dual as dual_of, seeded, Dual4, NDIR};
 pub(crate) use replay::{replay_step, sensitivity, Sensitivity, PARAM};
 pub use replay::{COINCIDENT_EVENTS, GRAZING_RATE};
 
+/// A DLS indicator closer to zero than this (\[N s\] for `lambda_I4`, \[N\] for `lambda_2+`, `lambda_4+`) puts
+/// the touchdown on the border between two branches of the impact procedure (the complementarity tolerance of
+/// the impact's own decisions).
+pub const BORDER_TOL: f64 = 1e-9;
+
 /// Why a step has no derivative (or the replay could not give it).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NotDifferentiable {
@@ -40,6 +45,18 @@ pub enum NotDifferentiable {
     CoincidentEvents {
         /// Time of the second event \[s\].
         time: f64,
+    },
+    /// The touchdown impact's branch is decided by a DLS indicator within [`BORDER_TOL`] of zero: the state is on
+    /// the border between two smooth pieces of the step map (a border collision), where it has only one-sided
+    /// derivatives.
+    #[error("{indicator} = {value:e} at the touchdown at t = {time} s: on the border between two impact branches, the step map is not differentiable there")]
+    Border {
+        /// Time of the touchdown \[s\].
+        time: f64,
+        /// The indicator (`lambda_I4`, `lambda_2_plus`, `lambda_4_plus`).
+        indicator: &'static str,
+        /// Its value.
+        value: f64,
     },
     /// A KKT or collision solve in the replay was singular.
     #[error("singular constraint solve at t = {time} s in the derivative replay")]
