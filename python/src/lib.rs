@@ -16,6 +16,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
 use vrw::app::{compute_gait, compute_simulation, compute_sweep, AppError, GaitJob, SimulateJob};
+use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
 use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, SweepSpec};
@@ -250,6 +251,25 @@ fn section(initial: Option<[f64; 3]>) -> Option<SectionState> {
     initial.map(SectionState::from_array)
 }
 
+/// The `parameter` keyword: `None`, or a key `dP/dp` can be taken for (the command line's `--parameter` rule
+/// and message).
+fn differentiable_key(value: &Bound<'_, PyAny>) -> PyResult<Option<&'static str>> {
+    if value.is_none() {
+        return Ok(None);
+    }
+    let key: String = value.extract()?;
+    DIFFERENTIABLE_KEYS
+        .iter()
+        .find(|k| **k == key)
+        .map(|k| Some(*k))
+        .ok_or_else(|| {
+            ConfigError::new_err(format!(
+                "invalid value {key:?} for `parameter`: no derivative with respect to it; the parameter must be one of {}",
+                DIFFERENTIABLE_KEYS.join(", ")
+            ))
+        })
+}
+
 /// The search settings: `defaults` with the keyword arguments `options` (the fields of the library's
 /// `GaitOptions`, as `gait.json` lists them under `options`).
 fn gait_options(
@@ -265,10 +285,11 @@ fn gait_options(
             "tolerance" => o.tolerance = real(&key, &value)?,
             "fd_step" => o.fd_step = real(&key, &value)?,
             "refine_jacobian" => o.refine_jacobian = value.extract()?,
+            "parameter" => o.parameter = differentiable_key(&value)?,
             _ => {
                 return Err(PyTypeError::new_err(format!(
                     "unexpected keyword argument `{key}` (search options: transient_steps, \
-                     max_iterations, tolerance, fd_step, refine_jacobian)"
+                     max_iterations, tolerance, fd_step, refine_jacobian, parameter)"
                 )))
             }
         }
@@ -374,7 +395,8 @@ fn simulate<'py>(
 ///
 /// `status` is `found` or why no gait was found (with `message`, as the command line reports it); a found
 /// gait adds its fields, `floquet_multipliers` as a complex numpy array and `jacobian` as a 2-D array.
-/// Keyword options: `transient_steps`, `max_iterations`, `tolerance`, `fd_step`, `refine_jacobian`.
+/// Keyword options: `transient_steps`, `max_iterations`, `tolerance`, `fd_step`, `refine_jacobian`,
+/// `parameter` (`dP/dp` of the gait for that key, as `dP_dparam`).
 #[pyfunction]
 #[pyo3(signature = (params, initial = None, **options))]
 fn find_gait<'py>(

@@ -58,6 +58,16 @@ def test_find_gait_equals_gait_json(cli, tmp_path):
     assert gait["jacobian"].shape == (len(gait["floquet_multipliers"]),) * 2
 
 
+def test_parameter_derivative_is_the_command_lines(cli, tmp_path):
+    cli("gait", "--parameter", "stiffness", "--out", tmp_path)
+    gait = vrw.find_gait(vrw.Params(), parameter="stiffness")
+    assert json_equal(gait, json.loads((tmp_path / "gait.json").read_text()))
+    assert gait["dP_dparam"]["parameter"] == "stiffness"
+    assert len(gait["dP_dparam"]["values"]) == 3
+    with pytest.raises(vrw.ConfigError, match="parameter"):
+        vrw.find_gait(vrw.Params(), parameter="legs")
+
+
 def test_search_options_are_the_command_lines(cli, tmp_path):
     cli("gait", "--transient", 12, "--tolerance", 1e-11, "--out", tmp_path)
     gait = vrw.find_gait(vrw.Params(), transient_steps=12, tolerance=1e-11)

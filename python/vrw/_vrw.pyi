@@ -20,6 +20,7 @@ class GaitOptions(TypedDict, total=False):
     tolerance: float  # convergence: max |P(s) - s| below this (default 1e-10; 1e-13 to 1e-6)
     fd_step: float  # relative finite-difference step where differences are used (default 1e-4; 1e-6 to 1e-2)
     refine_jacobian: bool  # error estimate of the exact Jacobian (default True)
+    parameter: Optional[str]  # also dP/dp of the gait for this key (``dP_dparam``; default None)
 
 class ConfigError(ValueError):
     """Invalid parameters (unknown key, wrong type, broken rule, bad TOML file), or a search setting, a sweep
