@@ -211,6 +211,7 @@ fn gait_job(c: &mut Criterion) {
         options: GaitOptions::default(),
         out_dir: Default::default(),
         check_jacobian: false,
+        interrupt: None,
     };
     let mut group = c.benchmark_group("gait");
     group.sample_size(10);

@@ -104,6 +104,7 @@ fn gait_job_writes_the_period_two_gait() {
         options: GaitOptions::default(),
         out_dir: dir.path().to_path_buf(),
         check_jacobian: false,
+        interrupt: None,
     })
     .unwrap();
     assert_eq!(summary.status, "found");

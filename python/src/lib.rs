@@ -7,6 +7,8 @@
 //! impls, through `pythonize`). Each library error becomes one Python exception with the same message.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use numpy::{Complex64, IntoPyArray, PyArray2};
 use pyo3::create_exception;
@@ -373,11 +375,11 @@ fn simulate<'py>(
         sample_dt,
         trajectory,
         out_dir: PathBuf::new(),
-        interrupt: None,
+        interrupt: Some(Arc::new(AtomicBool::new(false))),
     };
-    let (summary, samples) = py
-        .allow_threads(|| compute_simulation(&job, trajectory))
-        .map_err(app_error)?;
+    let flag = job.interrupt.clone().unwrap_or_default();
+    let (summary, samples) =
+        interruptible(py, &flag, || compute_simulation(&job, trajectory))?.map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
     let rows: Vec<Vec<Cell>> = summary.steps.iter().map(step_row).collect();
     result.set_item("steps", table(py, &STEPS_HEADER, &rows)?)?;
@@ -411,8 +413,10 @@ fn find_gait<'py>(
         options: gait_options(GaitOptions::default(), options)?,
         out_dir: PathBuf::new(),
         check_jacobian: false,
+        interrupt: Some(Arc::new(AtomicBool::new(false))),
     };
-    let summary = py.allow_threads(|| compute_gait(&job)).map_err(app_error)?;
+    let flag = job.interrupt.clone().unwrap_or_default();
+    let summary = interruptible(py, &flag, || compute_gait(&job))?.map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
     if let Some(g) = &summary.gait {
         let multipliers: Vec<Complex64> = g
@@ -444,7 +448,7 @@ fn sweep<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = gait_options(GaitOptions::for_sweeps(), options)?;
     let config = &params.config;
-    let result = interruptible(py, || {
+    let result = interruptible(py, vrw::gait::interrupt_flag(), || {
         compute_sweep(
             config,
             param,
@@ -471,10 +475,15 @@ fn sweep<'py>(
 
 /// Run `work` with the GIL released on a thread of its own while this (the calling, main) thread checks
 /// Python's signals every [`SIGNAL_POLL`]: on Ctrl-C (`KeyboardInterrupt`, or any exception a signal handler
-/// raises) it sets the library's interrupt flag, so the grid runner stops between points, waits for `work` to
-/// return, discards its partial result and raises the signal's exception.
-fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    vrw::gait::clear_interrupt();
+/// raises) it sets `flag`, the interrupt flag `work` reads (the library's own for grids, where the grid runner
+/// stops between points; a job's for a walk or a gait search, whose walker stops inside a step), waits for
+/// `work` to return, discards its partial result and raises the signal's exception.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    flag: &AtomicBool,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    flag.store(false, Ordering::SeqCst);
     py.allow_threads(|| {
         std::thread::scope(|scope| {
             let handle = scope.spawn(work);
@@ -483,8 +492,7 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> Py
                 std::thread::sleep(SIGNAL_POLL);
                 if raised.is_none() {
                     if let Err(e) = Python::with_gil(|py| py.check_signals()) {
-                        vrw::gait::interrupt_flag()
-                            .store(true, std::sync::atomic::Ordering::SeqCst);
+                        flag.store(true, Ordering::SeqCst);
                         raised = Some(e);
                     }
                 }
@@ -492,7 +500,7 @@ fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> Py
             let value = handle
                 .join()
                 .map_err(|_| PyRuntimeError::new_err("the computation panicked"));
-            vrw::gait::clear_interrupt();
+            flag.store(false, Ordering::SeqCst);
             match raised {
                 Some(e) => Err(e),
                 None => value,

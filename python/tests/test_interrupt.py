@@ -22,3 +22,25 @@ def test_ctrl_c_during_a_long_sweep_raises_keyboard_interrupt_within_a_second():
     # The library's interrupt flag is cleared: the next sweep is whole.
     result = vrw.sweep(vrw.Params(), "viscosity", vrw.linspace(40, 60, 3))
     assert len(result["sweep"]["viscosity"]) == 3
+
+
+@pytest.mark.parametrize(
+    "job",
+    [
+        # A walk of about ten seconds: Ctrl-C stops it inside a step.
+        lambda: vrw.simulate(vrw.Params(), steps=50000, trajectory=False),
+        # A gait search whose transient walks about ten seconds.
+        lambda: vrw.find_gait(vrw.Params(), transient_steps=50000),
+    ],
+    ids=["simulate", "find_gait"],
+)
+def test_ctrl_c_during_a_long_walk_or_gait_search_raises_within_a_second(job):
+    delay = 0.5
+    timer = threading.Timer(delay, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        job()
+    assert time.monotonic() - start < delay + 1.0
+    # The next call runs normally.
+    assert vrw.find_gait(vrw.Params())["status"] == "found"

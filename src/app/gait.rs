@@ -2,6 +2,8 @@
 //! walk in the files of `vrw simulate`.
 
 use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 use serde::Serialize;
 
@@ -32,6 +34,9 @@ pub struct GaitJob {
     pub out_dir: PathBuf,
     /// Check the exact `DP` of the gait found against finite differences ([`check_jacobian`]).
     pub check_jacobian: bool,
+    /// Stops the search inside a step when set (e.g. by Ctrl-C from Python); the search then ends with the
+    /// interruption as its failure.
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// `gait.json`: the parameters, and the gait or why none was found.
@@ -91,7 +96,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let model = Model::new(&job.config.params)?;
     let initial = job.initial.unwrap_or_else(|| default_initial(&job.config));
     initial.validate(&model)?;
-    let map = StepMap::new(&model, &job.config.solver);
+    let map = StepMap::new(&model, &job.config.solver).with_interrupt(job.interrupt.as_deref());
     let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
     let jacobian_check = match (&result, job.check_jacobian) {
         (Ok(gait), true) => Some(

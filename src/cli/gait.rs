@@ -69,6 +69,7 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         },
         out_dir: args.out.clone(),
         check_jacobian: args.check_jacobian,
+        interrupt: None,
     };
     let bar = progress_bar(
         None,

@@ -16,6 +16,7 @@
 //! extrapolation `(4 D(h/2) - D(h)) / 3`, whose difference to the plain `D(h/2)` estimates its error.
 
 use std::ops::{Deref, DerefMut};
+use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 use nalgebra::{DMatrix, DVector};
@@ -80,6 +81,8 @@ pub struct StepMap<'m> {
     iterate: usize,
     /// The work of every walker this map (and its iterates) made, added once per walker when it is dropped.
     work: Arc<Mutex<WorkCounts>>,
+    /// Stops its walks inside a step when set ([`StepMap::with_interrupt`]).
+    interrupt: Option<&'m AtomicBool>,
 }
 
 impl<'m> StepMap<'m> {
@@ -90,6 +93,16 @@ impl<'m> StepMap<'m> {
             opts: opts.clone(),
             iterate: 1,
             work: Arc::default(),
+            interrupt: None,
+        }
+    }
+
+    /// The same map, whose walks stop with [`WalkError::Interrupted`] when `flag` is set (read every
+    /// [`crate::walk::INTERRUPT_CHECK_STEPS`] integrator steps): what makes a gait search interruptible.
+    pub fn with_interrupt(self, flag: Option<&'m AtomicBool>) -> StepMap<'m> {
+        StepMap {
+            interrupt: flag,
+            ..self
         }
     }
 
@@ -137,7 +150,7 @@ impl<'m> StepMap<'m> {
     /// dropped (once per walker, not per step: evaluations run in parallel).
     pub(crate) fn walker(&self, s: &SectionState) -> Result<CountedWalker<'_, 'm>, WalkError> {
         Ok(CountedWalker {
-            walker: Walker::new(self.model, &self.opts, s)?,
+            walker: Walker::new(self.model, &self.opts, s)?.with_interrupt(self.interrupt),
             tally: &self.work,
         })
     }
