@@ -6,6 +6,7 @@
 
 use serde::Serialize;
 
+use super::report::PENETRATION_WARNING;
 use super::WalkError;
 use crate::contact::Leg;
 use crate::dynamics::{lit, Coords, CoordsOf, Mechanics, Model, Real, L2, THETA, X, Z};
@@ -79,6 +80,15 @@ impl SectionState {
                 "thetadot",
                 self.theta_dot,
                 "must be positive (the wheel rolls forward)",
+            );
+        }
+        let (q, _) = self.to_coords(model);
+        if (2..model.legs()).any(|j| model.tip_height(&q, j) < -PENETRATION_WARNING) {
+            return bad(
+                "L2",
+                self.l2,
+                "puts the tip of a leg behind Leg 2 below the ground: with Leg 1 at stopper_length, L2 must \
+                 exceed about stopper_length cos(2 pi / legs)",
             );
         }
         if model.params().rigid_legs

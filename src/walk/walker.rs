@@ -232,7 +232,7 @@ impl<'m> Walker<'m> {
             &start.q,
             &qd_plus,
             active,
-            self.opts.stopper_gap,
+            (self.opts.stopper_gap, self.opts.recontact_gap),
             t_start,
         )?;
         if let Some(lock) = zeno {
@@ -628,8 +628,8 @@ impl<'a> Phases<'a> {
                 tally.scuffing |=
                     (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
                 let (mut qd_plus, mut active) = (closed.qd_plus, closed.active);
-                let gap = self.opts.stopper_gap;
-                if let Some(lock) = lock_zeno_stoppers(model, &q, &qd_plus, active, gap, t)? {
+                let gaps = (self.opts.stopper_gap, self.opts.recontact_gap);
+                if let Some(lock) = lock_zeno_stoppers(model, &q, &qd_plus, active, gaps, t)? {
                     self.work.impacts += 1;
                     self.tally.see_zeno(&lock);
                     if let Some(tape) = self.tape.as_deref_mut() {

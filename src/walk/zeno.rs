@@ -1,4 +1,5 @@
-//! Zeno sequences of stopper impacts resolved at their accumulation point (docs/model.md sections 4-5).
+//! Zeno sequences of stopper impacts and of landings resolved at their accumulation point (docs/model.md
+//! sections 4-5).
 //!
 //! When one leg hits its stopper while the other rests on its own, the impact's complementarity problem stops
 //! the first leg and kicks the second a little off its stopper (inward, at a few percent of the speed); the
@@ -12,9 +13,21 @@
 //! and separates inward at a speed `v` with `v^2 < 2 a_out stopper_gap`, where `a_out > 0` is its outward
 //! acceleration as a free leg, is locked by a plastic stopper impact. The rule depends only on the state and on
 //! `stopper_gap`, not on the integrator's steps.
+//!
+//! **Landings.** The same happens with the two tips on the ground: when both tips touch a frictionless ground,
+//! the landing of one kicks the other up at about the speed it landed with (the impulse at one tip reaches the
+//! other through the mass matrix), the kicked tip comes back within microseconds and kicks the first, and the
+//! tips take turns carrying the wheel thousands of times per millisecond, sinking by the grazing guard
+//! `recontact_gap` at every landing (the short-leg starts of the default basin did this). A free tip at the
+//! ground (`height <= recontact_gap`) that separates at a speed `v` with `v^2 < 2 a_down recontact_gap`,
+//! where `a_down > 0` is its downward acceleration as a free tip, is closed by a plastic impact the same way,
+//! as its next landing would close it: held without slip, unless holding it would pull it down by more than
+//! [`ZENO_IMPULSE_WARNING`] (a tip sliding fast along the ground), then frictionless; the motion goes on with
+//! both tips on the ground.
 
 use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ContactError, Leg};
 use crate::dynamics::{Coords, Model};
+use crate::params::ContactInconsistency;
 
 use super::error::WalkError;
 
@@ -31,16 +44,16 @@ pub const ZENO_IMPULSE_WARNING: f64 = 1e-3;
 /// What [`lock_zeno_stoppers`] did to the state after an impact.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ZenoLock {
-    /// The stoppers locked at the accumulation point.
+    /// The stoppers locked and the contacts closed at the accumulation point.
     pub locked: ActiveSet,
     /// `q'` after the locks.
     pub qd_plus: Coords,
     /// The active set of the motion that follows.
     pub active: ActiveSet,
-    /// Kinetic energy the locks took away \[J\] (a stopper loss of the energy audit).
+    /// Kinetic energy the locks and closures took away \[J\] (a stopper loss of the energy audit).
     pub loss: f64,
-    /// The largest outward (pulling) impulse of a locked stopper \[N s\] (`ContactAudit::zeno_impulse`), at most
-    /// about `m sqrt(2 a_out stopper_gap)`.
+    /// The largest pulling impulse of a locked stopper (outward) or a closed tip (downward) \[N s\]
+    /// (`ContactAudit::zeno_impulse`), at most about `m sqrt(2 a gap)` with the unit's gap.
     pub impulse: f64,
     /// The largest pulling impulse of the other units that took an impulse in the locks \[N s\] (contact audit).
     pub pull_impulse: f64,
@@ -49,40 +62,91 @@ pub struct ZenoLock {
     pub impulse_sets: Vec<ActiveSet>,
 }
 
-/// The free legs at `(q, q')` under `active` that the Zeno rule locks: at their stopper (`L0 - L <=
-/// stopper_gap`), moving inward (`L' < -COMPLEMENTARITY_TOL`) slower than the speed that would take them more
-/// than `stopper_gap` inward against their outward acceleration `a_out = L''` before they return
-/// (`L'^2 < 2 a_out stopper_gap`).
-fn zeno_legs(
+/// The units at `(q, q')` under `active` that the Zeno rule closes (as flags of an [`ActiveSet`]): the free legs
+/// at their stopper (`L0 - L <= stopper_gap`), moving inward (`L' < -COMPLEMENTARITY_TOL`) slower than the speed
+/// that would take them more than `stopper_gap` inward against their outward acceleration `a_out = L''` before
+/// they return (`L'^2 < 2 a_out stopper_gap`), and the free tips at the ground (`height <= recontact_gap`: a
+/// tip that landed at the grazing guard is `recontact_gap` below it)
+/// rising (`v > COMPLEMENTARITY_TOL`) slower than the speed that would take them above `recontact_gap` against
+/// their downward acceleration (`v^2 < 2 a_down recontact_gap`); a tip closes as a no-slip contact here (see
+/// [`lock_zeno_stoppers`] for when it slides instead). Units in `exclude` were closed already.
+fn zeno_units(
     model: &Model,
-    q: &Coords,
-    qd: &Coords,
+    (q, qd): (&Coords, &Coords),
     active: &ActiveSet,
-    stopper_gap: f64,
+    (stopper_gap, recontact_gap): (f64, f64),
     exclude: &ActiveSet,
 ) -> Result<ActiveSet, ContactError> {
     let l0 = model.params().stopper_length;
     let bilateral = bilateral_stoppers(model);
-    let mut legs = ActiveSet::default();
+    let mut units = ActiveSet::default();
     let mut dynamics = None;
-    for leg in Leg::BOTH {
-        let i = leg.length_coordinate();
-        if active.lock(leg) || bilateral.lock(leg) || exclude.lock(leg) {
-            continue;
-        }
-        let v = qd[i];
-        if l0 - q[i] > stopper_gap || v >= -COMPLEMENTARITY_TOL {
-            continue;
-        }
+    let mut free_dynamics = || -> Result<_, ContactError> {
         if dynamics.is_none() {
             dynamics = Some(constrained_dynamics(model, q, qd, active)?);
         }
-        let a_out = dynamics.as_ref().map_or(0.0, |d| d.qdd[i]);
-        if a_out > 0.0 && v * v < 2.0 * a_out * stopper_gap {
-            legs.set_lock(leg, true);
+        Ok(dynamics.expect("just computed"))
+    };
+    for leg in Leg::BOTH {
+        let i = leg.length_coordinate();
+        let stopper_free = !(active.lock(leg) || bilateral.lock(leg) || exclude.lock(leg));
+        let v = qd[i];
+        if stopper_free && l0 - q[i] <= stopper_gap && v < -COMPLEMENTARITY_TOL {
+            let a_out = free_dynamics()?.qdd[i];
+            if a_out > 0.0 && v * v < 2.0 * a_out * stopper_gap {
+                units.set_lock(leg, true);
+            }
+        }
+        let tip_free = !(active.contact(leg) || exclude.contact(leg));
+        if tip_free && model.tip_height(q, leg.index()) <= recontact_gap {
+            let tip = model.tip(q, qd, leg.index());
+            let v = tip.velocity(qd).y;
+            if v > COMPLEMENTARITY_TOL {
+                let a_down = -(tip.jacobian * free_dynamics()?.qdd + tip.velocity_product).y;
+                if a_down > 0.0 && v * v < 2.0 * a_down * recontact_gap {
+                    units.set_contact(leg, true);
+                }
+            }
         }
     }
-    Ok(legs)
+    Ok(units)
+}
+
+/// The units of `a` and of `b` (a contact sliding in either slides).
+fn union(a: &ActiveSet, b: &ActiveSet) -> ActiveSet {
+    ActiveSet {
+        contact1: a.contact1 || b.contact1,
+        contact2: a.contact2 || b.contact2,
+        lock1: a.lock1 || b.lock1,
+        lock2: a.lock2 || b.lock2,
+        slide1: a.slide1 || b.slide1,
+        slide2: a.slide2 || b.slide2,
+    }
+}
+
+/// The units of a Zeno impact: the bilateral stoppers and the units `closing` closes, forced, and every other
+/// unit of `active` a candidate of the impulse-level complementarity problem.
+fn zeno_impact_units(
+    model: &Model,
+    closing: &ActiveSet,
+    active: &ActiveSet,
+) -> (ActiveSet, Vec<Candidate>) {
+    let mut forced = bilateral_stoppers(model);
+    let mut candidates = Vec::new();
+    for leg in Leg::BOTH {
+        if closing.lock(leg) {
+            forced.set_lock(leg, true);
+        }
+        if closing.contact(leg) {
+            Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(closing));
+        }
+        for unit in [Unit::Contact(leg), Unit::Stopper(leg)] {
+            if unit.mode(active) != Mode::Off && unit.mode(&forced) == Mode::Off {
+                candidates.push(Candidate::keep(unit, active));
+            }
+        }
+    }
+    (forced, candidates)
 }
 
 /// Right after an impact at `time`, at `(q, q')` whose motion would continue with `active`: lock every leg the
@@ -98,7 +162,7 @@ pub fn lock_zeno_stoppers(
     q: &Coords,
     qd: &Coords,
     active: ActiveSet,
-    stopper_gap: f64,
+    gaps: (f64, f64),
     time: f64,
 ) -> Result<Option<ZenoLock>, WalkError> {
     let phase = active.phase();
@@ -110,41 +174,62 @@ pub fn lock_zeno_stoppers(
     let mut zeno_impulse: f64 = 0.0;
     let mut impulse_sets = Vec::new();
     loop {
-        let legs = zeno_legs(model, q, &qd_now, &active_now, stopper_gap, &locked)
-            .map_err(contact_error)?;
+        let mut legs =
+            zeno_units(model, (q, &qd_now), &active_now, gaps, &locked).map_err(contact_error)?;
         if legs == ActiveSet::default() {
             break;
         }
-        let mut forced = bilateral_stoppers(model);
-        let mut candidates = Vec::new();
+        // One impact problem: a tip closes as a landing does, held (no slip) unless holding it would pull it down
+        // by more than a grazing correction, then sliding (where sliding is allowed); and a unit that the impact
+        // itself kicks off too slowly to clear its gap closes in the same impact (two tips that would take turns
+        // landing close together, the accumulation point of their sequence).
+        let (impulse_set, sol) = loop {
+            let (forced, candidates) = zeno_impact_units(model, &legs, &active_now);
+            let (set, sol) =
+                plastic_impact(model, q, &qd_now, forced, &candidates).map_err(contact_error)?;
+            let pulled = Leg::BOTH.into_iter().find(|&leg| {
+                legs.contact(leg)
+                    && !legs.slide(leg)
+                    && sol.normal_impulse(leg) < -ZENO_IMPULSE_WARNING
+            });
+            if let (Some(leg), ContactInconsistency::Slide) =
+                (pulled, model.params().inconsistent_contact)
+            {
+                legs.set_sliding(leg);
+                continue;
+            }
+            // The units that took an impulse hold; the others are free after the impact.
+            let kicked = zeno_units(model, (q, &sol.qd_plus), &set, gaps, &union(&legs, &locked))
+                .map_err(contact_error)?;
+            if kicked == ActiveSet::default() {
+                break (set, sol);
+            }
+            legs = union(&legs, &kicked);
+        };
         for leg in Leg::BOTH {
             if legs.lock(leg) {
-                forced.set_lock(leg, true);
                 locked.set_lock(leg, true);
             }
-            for unit in [Unit::Contact(leg), Unit::Stopper(leg)] {
-                if unit.mode(&active_now) != Mode::Off && unit.mode(&forced) == Mode::Off {
-                    candidates.push(Candidate::keep(unit, &active_now));
-                }
+            if legs.contact(leg) {
+                Unit::Contact(leg).apply(&mut locked, Unit::Contact(leg).mode(&legs));
             }
         }
-        let (impulse_set, sol) =
-            plastic_impact(model, q, &qd_now, forced, &candidates).map_err(contact_error)?;
         impulse_sets.push(impulse_set);
         let mut others = impulse_set;
-        for leg in Leg::BOTH {
-            if legs.lock(leg) {
-                others.set_lock(leg, false);
-                zeno_impulse = zeno_impulse.max(-sol.stopper_impulse(leg));
-            }
-        }
-        pull_impulse = pull_impulse.max(largest_pull(&sol.impulses, &others, rigid));
         let mut present = active_now;
         for leg in Leg::BOTH {
             if legs.lock(leg) {
+                others.set_lock(leg, false);
                 present.set_lock(leg, true);
+                zeno_impulse = zeno_impulse.max(-sol.stopper_impulse(leg));
+            }
+            if legs.contact(leg) {
+                others.set_contact(leg, false);
+                Unit::Contact(leg).apply(&mut present, Unit::Contact(leg).mode(&legs));
+                zeno_impulse = zeno_impulse.max(-sol.normal_impulse(leg));
             }
         }
+        pull_impulse = pull_impulse.max(largest_pull(&sol.impulses, &others, rigid));
         let (forced, candidates) =
             post_impact_candidates(model, q, &sol.qd_plus, &impulse_set, &present, &impulse_set);
         let (next, _) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)
@@ -202,7 +287,7 @@ mod tests {
         let (q, qd, active) = flight(&model, -1e-5);
         let a = constrained_dynamics(&model, &q, &qd, &active).unwrap().qdd[L2];
         assert!(a > 0.0);
-        let lock = lock_zeno_stoppers(&model, &q, &qd, active, gap, 0.0)
+        let lock = lock_zeno_stoppers(&model, &q, &qd, active, (gap, 1e-11), 0.0)
             .unwrap()
             .expect("locked");
         assert!(lock.locked.lock2 && lock.active.lock2 && lock.active.lock1);
@@ -213,9 +298,11 @@ mod tests {
         // The same state with a kick that clears the gap is left alone.
         let fast = -2.0 * (2.0 * a * gap).sqrt();
         let (q, qd, active) = flight(&model, fast);
-        assert!(lock_zeno_stoppers(&model, &q, &qd, active, gap, 0.0)
-            .unwrap()
-            .is_none());
+        assert!(
+            lock_zeno_stoppers(&model, &q, &qd, active, (gap, 1e-11), 0.0)
+                .unwrap()
+                .is_none()
+        );
     }
 
     /// A leg moving outward, a leg away from its stopper, and a leg already locked are not touched.
@@ -223,18 +310,75 @@ mod tests {
     fn only_legs_leaving_their_stopper_slowly_are_locked() {
         let model = stiff();
         let (q, qd, active) = flight(&model, 1e-6);
-        assert!(lock_zeno_stoppers(&model, &q, &qd, active, 1e-9, 0.0)
-            .unwrap()
-            .is_none());
+        assert!(
+            lock_zeno_stoppers(&model, &q, &qd, active, (1e-9, 1e-11), 0.0)
+                .unwrap()
+                .is_none()
+        );
         let (mut q, qd, active) = flight(&model, -1e-6);
         q[L2] -= 1e-6;
-        assert!(lock_zeno_stoppers(&model, &q, &qd, active, 1e-9, 0.0)
-            .unwrap()
-            .is_none());
+        assert!(
+            lock_zeno_stoppers(&model, &q, &qd, active, (1e-9, 1e-11), 0.0)
+                .unwrap()
+                .is_none()
+        );
         let (q, qd, mut active) = flight(&model, 0.0);
         active.lock2 = true;
-        assert!(lock_zeno_stoppers(&model, &q, &qd, active, 1e-9, 0.0)
+        assert!(
+            lock_zeno_stoppers(&model, &q, &qd, active, (1e-9, 1e-11), 0.0)
+                .unwrap()
+                .is_none()
+        );
+    }
+
+    /// Both tips at the ground, Leg 1 held, Leg 2's tip rising at `v` (kicked by Leg 1's landing): below the
+    /// speed that could lift it above `recontact_gap` it is closed (no slip, at rest along the ground), with
+    /// an impulse within the Zeno bound; above it, the tip is left to fly.
+    #[test]
+    fn a_tip_kicked_below_the_gap_is_closed_plastically() {
+        let model = Model::new(&Params::default()).unwrap();
+        let (l1, l2) = (0.95, 0.9);
+        let alpha = model.alpha();
+        let theta = ((l2 * alpha.cos() - l1) / (l2 * alpha.sin())).atan();
+        let q = Coords::new(0.0, 0.0, theta, l1, l2);
+        let active = ActiveSet {
+            contact1: true,
+            ..ActiveSet::default()
+        };
+        // Leg 2's tip velocity is J_2 q'; with Leg 1 held (x' = z' = 0), move L2 to lift it.
+        let with_tip_speed = |v: f64| {
+            let mut qd = Coords::new(0.0, 0.0, 0.8, -0.1, 0.0);
+            let tip = model.tip(&q, &qd, 1);
+            let (vx, vz) = (tip.velocity(&qd).x, tip.velocity(&qd).y);
+            // Solve for the theta' and L2' that give the tip velocity (0, v) with L1' fixed.
+            let j = tip.jacobian;
+            let m = nalgebra::Matrix2::new(j[(0, 2)], j[(0, 4)], j[(1, 2)], j[(1, 4)]);
+            let delta = m.lu().solve(&nalgebra::Vector2::new(-vx, v - vz)).unwrap();
+            qd[2] += delta[0];
+            qd[4] += delta[1];
+            qd
+        };
+        let gaps = (1e-9, 1e-11);
+        let qd = with_tip_speed(1e-7);
+        let tip = model.tip(&q, &qd, 1);
+        assert!((tip.velocity(&qd).y - 1e-7).abs() < 1e-15 && tip.velocity(&qd).x.abs() < 1e-15);
+        let lock = lock_zeno_stoppers(&model, &q, &qd, active, gaps, 0.0)
             .unwrap()
-            .is_none());
+            .expect("closed");
+        assert!(lock.locked.contact2 && !lock.locked.slide2, "{lock:?}");
+        assert!(lock.active.contact2, "{lock:?}");
+        let after = model.tip(&q, &lock.qd_plus, 1).velocity(&lock.qd_plus);
+        assert!(after.norm() < 1e-12, "the closed tip is at rest: {after}");
+        assert!(
+            lock.impulse < 1e-5,
+            "a grazing correction: {}",
+            lock.impulse
+        );
+        assert!(lock.loss >= 0.0);
+        assert!(
+            lock_zeno_stoppers(&model, &q, &with_tip_speed(1e-3), active, gaps, 0.0)
+                .unwrap()
+                .is_none()
+        );
     }
 }
