@@ -6,7 +6,6 @@
 
 use serde::Serialize;
 
-use super::report::PENETRATION_WARNING;
 use super::WalkError;
 use crate::contact::Leg;
 use crate::dynamics::{lit, Coords, CoordsOf, Mechanics, Model, Real, L2, THETA, X, Z};
@@ -14,6 +13,10 @@ use crate::dynamics::{lit, Coords, CoordsOf, Mechanics, Model, Real, L2, THETA, 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
 /// by rounding only \[m, m/s\].
 pub(crate) const RIGID_SECTION_TOL: f64 = 1e-9;
+
+/// How far below the ground the tip of a leg other than Legs 1 and 2 may be at a section state \[m\] (the
+/// penetration the contact audit tolerates): a section state deeper than that is not a state of the wheel.
+pub(crate) const SECTION_GROUND_TOL: f64 = 1e-9;
 
 /// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -83,7 +86,7 @@ impl SectionState {
             );
         }
         let (q, _) = self.to_coords(model);
-        if (2..model.legs()).any(|j| model.tip_height(&q, j) < -PENETRATION_WARNING) {
+        if (2..model.legs()).any(|j| model.tip_height(&q, j) < -SECTION_GROUND_TOL) {
             return bad(
                 "L2",
                 self.l2,
