@@ -5,9 +5,19 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
-from typing_extensions import TypedDict, Unpack
+from typing_extensions import TypedDict, Unpack, final
 
 __version__: str
+__all__ = [
+    "ConfigError",
+    "Params",
+    "WalkError",
+    "__version__",
+    "find_gait",
+    "linspace",
+    "simulate",
+    "sweep",
+]
 
 Value = Union[float, int, bool, str]
 Section = Union[Tuple[float, float, float], Sequence[float]]
@@ -29,6 +39,7 @@ class ConfigError(ValueError):
 class WalkError(RuntimeError):
     """A walk that cannot start (e.g. an invalid initial section state); the command line's message."""
 
+@final
 class Params:
     """The model's parameters and the solver's settings: every key of a vrw TOML file.
 
@@ -37,7 +48,7 @@ class Params:
     ``ConfigError`` (a ``ValueError``) with the command line's message. Immutable, comparable, picklable.
     """
 
-    def __init__(self, **keys: Value) -> None: ...
+    def __new__(cls, **keys: Value) -> "Params": ...
     @staticmethod
     def from_toml(path: Union[str, "PathLike[str]"]) -> "Params":
         """Read a flat TOML file of parameters (as ``vrw --config FILE``)."""
@@ -45,11 +56,13 @@ class Params:
         """Every key and its value, as a TOML file (or ``summary.json``'s ``config``) holds them."""
     def replace(self, **keys: Value) -> "Params":
         """A copy with the given keys changed (validated as in the constructor)."""
-    def __getitem__(self, key: str) -> Value: ...
+    def __getitem__(self, key: str, /) -> Value: ...
+    def __getnewargs_ex__(self) -> Tuple[Tuple[()], Dict[str, Value]]:
+        """Pickle as ``Params(**to_dict())``."""
     @staticmethod
     def numeric_keys() -> List[str]:
         """The keys holding a real number (what a sweep or a grid can vary)."""
-    def __eq__(self, other: object) -> bool: ...
+    def __eq__(self, other: object, /) -> bool: ...
 
 def simulate(
     params: Params,
