@@ -187,3 +187,39 @@ fn gait_on_a_border_collision_reports_no_derivative() {
     assert!(gait.floquet_multipliers.is_empty());
     assert_eq!(gait.stability, vrw::gait::Stability::Uncertain);
 }
+
+/// `dP/dp` of the rigid wheel against its closed-form step map (differentiated in the slope and the leg length
+/// by central differences of the formula itself, not of a simulation).
+#[test]
+fn rigid_wheel_parameter_derivatives_match_the_closed_form() {
+    let config = config_of(&["rigid_legs=true"]);
+    let wheel = RigidRimlessWheel {
+        params: config.params.clone(),
+    };
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let omega = 1.3;
+    let s = SectionState {
+        l2: config.params.stopper_length,
+        theta_dot: omega,
+        l2_dot: 0.0,
+    };
+    for (key, value) in [("slope", config.params.slope), ("stopper_length", 1.0)] {
+        let exact = map.eval_with_derivatives(&s, Some(key)).unwrap();
+        let h = 1e-6;
+        let closed = |v: f64| {
+            let c = config_of(&["rigid_legs=true", &format!("{key}={v}")]);
+            RigidRimlessWheel { params: c.params }.step_map(omega)
+        };
+        let fd = (closed(value + h) - closed(value - h)) / (2.0 * h);
+        let d = exact.dparam.unwrap()[0];
+        eprintln!("rigid wheel dP/d{key}: exact {d}, closed form {fd}");
+        assert_relative_eq!(d, fd, max_relative = 1e-7);
+        // And the value itself.
+        assert_relative_eq!(
+            exact.outcome.next.theta_dot,
+            wheel.step_map(omega),
+            max_relative = 1e-11
+        );
+    }
+}
