@@ -6,7 +6,8 @@
 //! set and accepted integrator steps of each phase, the event that ended it); `replay` integrates the
 //! augmented system `[y, S]` over the same steps and crosses each event with its time's sensitivity. The
 //! derivatives of the equations of motion, the KKT solution, the guards, the collisions, the re-indexing and
-//! the section's own constraint come from forward-mode automatic differentiation (`num-dual` dual numbers
+//! the section's own constraint come from forward-mode automatic differentiation (dual numbers,
+//! `dual.rs`,
 //! through the same generic code the walk runs, [`crate::dynamics::Real`]). Where the map has no derivative (a
 //! grazing event, two events at one instant) the replay says so ([`NotDifferentiable`]) instead of returning
 //! a number.

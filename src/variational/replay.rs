@@ -3,8 +3,9 @@
 //!
 //! **Phases.** The sensitivity `S = d(q, q')/d(s, p)` (10 rows, [`NDIR`] columns) obeys `S' = F_y S + F_p`, with
 //! `F` the phase's vector field `(q', q'')`, `q''` from the KKT system with the active set fixed. Both products
-//! come from one evaluation of `F` on dual numbers whose derivative parts are the rows of `S` (and the
-//! parameter's unit direction): forward-mode automatic differentiation (`num-dual`). The augmented state
+//! come from one evaluation of the KKT residual on dual numbers whose derivative parts are the rows of `S` (and
+//! the parameter's unit direction), forward-mode automatic differentiation, and one solve with the KKT matrix
+//! (`kkt.rs`). The augmented state
 //! `[y, S]` is integrated with the very steps the walk accepted (`Integrator::fixed_step`, the same stages and
 //! dense output): internal numerical differentiation (Bock), so the state part reproduces the walk bit for bit
 //! and its error control is the walk's, untouched; `S` is the exact derivative of that discretization.
@@ -13,7 +14,7 @@
 //! the time of the event by `dt = -(g_y S + g_p) / (g_y f-)`; the sensitivity after it is
 //! `S+ = R_y (S- + f- dt) + R_p - f+ dt`, which for `p = 0` is the saltation matrix
 //! `S+ = [R_y + (f+ - R_y f-) g_y^T / (g_y f-)] S-`. `g_y S` and `g_y f-` come from one evaluation of `g` on
-//! duals carrying `S` and `f-` (`DualSVec64<NDIR + 1>`): so the force guards (a normal force or a stopper
+//! duals carrying `S` and `f-` (`Dual<NDIR + 1>`): so the force guards (a normal force or a stopper
 //! reaction reaching zero, from the KKT solution) are differentiated through the KKT solve like the rest. `R` is
 //! the identity for a change of active set (lift-off, unlock, slide) and the collision equation (5) with the
 //! recorded units for an impact (touchdown, landing, stopper hit, Zeno locks), differentiated in duals.
@@ -166,7 +167,7 @@ fn apply_impacts(
 }
 
 /// The derivatives of one step: the sensitivity of the state after the re-indexing at the next touchdown (the
-/// next section), and the state itself.
+/// next section).
 pub(crate) struct StepDerivative {
     /// `d(q, q')/d(s, p)` just after re-indexing.
     pub(crate) sensitivity: Sensitivity,
