@@ -13,20 +13,65 @@ result pickle, so they travel to worker processes (see ``vrw.grid`` for grids of
 ('found', True, True)
 """
 
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _vrw
 from ._vrw import (
     ConfigError,
     Params,
     WalkError,
     __version__,
-    find_gait,
     linspace,
-    simulate,
-    sweep,
 )
+from .results import GaitResult, Grid, Result, Run, SweepResult, Table, wrap_tables
+
+
+def simulate(
+    params: Params,
+    steps: int = 20,
+    initial: Optional[Sequence[float]] = None,
+    trajectory: bool = True,
+    sample_dt: float = 0.005,
+) -> Run:
+    """Walk ``steps`` steps from ``initial`` (``vrw simulate``): a ``Run``, the fields of ``summary.json`` with
+    ``steps`` and ``trajectory`` as ``Table``s (``.to_pandas()``). See ``vrw._vrw.simulate``."""
+    run = Run(_vrw.simulate(params, steps, initial, trajectory, sample_dt))
+    wrap_tables(run, ["steps", "trajectory"])
+    return run
+
+
+def find_gait(params: Params, initial: Optional[Sequence[float]] = None, **options: Any) -> GaitResult:
+    """Find the gait (``vrw gait``): a ``GaitResult``, the fields of ``gait.json``. See
+    ``vrw._vrw.find_gait``."""
+    return GaitResult(_vrw.find_gait(params, initial, **options))
+
+
+def sweep(
+    params: Params,
+    param: str,
+    values: Union[Sequence[float], "np.ndarray"],
+    *,
+    initial: Optional[Sequence[float]] = None,
+    **options: Any,
+) -> SweepResult:
+    """Sweep ``param`` over ``values`` (``vrw sweep``): a ``SweepResult`` whose ``sweep`` is a ``Table``
+    (``.to_pandas()``). See ``vrw._vrw.sweep``."""
+    result = SweepResult(_vrw.sweep(params, param, values, initial=initial, **options))
+    wrap_tables(result, ["sweep"])
+    return result
+
 
 __all__ = [
     "ConfigError",
+    "GaitResult",
+    "Grid",
     "Params",
+    "Result",
+    "Run",
+    "SweepResult",
+    "Table",
     "WalkError",
     "__version__",
     "find_gait",

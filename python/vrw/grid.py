@@ -23,7 +23,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ._vrw import Params, sweep
+from ._vrw import Params
+from .results import Grid, Table
 
 Axis = Tuple[str, Sequence[float]]
 
@@ -37,6 +38,8 @@ def grid_row(
     options: Dict[str, Any],
 ) -> Dict[str, Any]:
     """One row of a grid: ``vrw.sweep(params, x, x_values, **options)`` (what a worker runs)."""
+    from . import sweep  # the package's, which returns result objects
+
     return sweep(params, x, list(x_values), **options)
 
 
@@ -48,7 +51,7 @@ def gait_grid(
     *,
     initial: Optional[Sequence[float]] = None,
     **options: Any,
-) -> Dict[str, Any]:
+) -> Grid:
     """The gaits on the grid ``x`` by ``y``: one ``vrw.sweep`` of ``x`` per value of ``y``.
 
     ``client`` is a ``dask.distributed.Client`` (each row is one task, submitted to its workers), or
@@ -56,7 +59,7 @@ def gait_grid(
     numeric ``Params`` keys (``vrw.Params.numeric_keys()``). ``initial`` and the other keyword arguments
     are passed to ``vrw.sweep`` (each row starts its continuation from ``initial``).
 
-    Returns a dict with ``x`` and ``y`` (the keys), ``x_values`` and ``y_values`` (float arrays),
+    Returns a ``Grid`` (a dict; ``.to_xarray()`` gives an ``xarray.Dataset``) with ``x`` and ``y`` (the keys), ``x_values`` and ``y_values`` (float arrays),
     ``sweep`` (every column of ``sweep.csv`` as an array of shape ``(len(y), len(x))``), ``thresholds``
     (one list of threshold dicts per row) and ``gaits_found`` (the number of grid points with a gait).
     An invalid ``y`` value raises ``vrw.ConfigError`` before anything is submitted.
@@ -81,12 +84,14 @@ def gait_grid(
         )
         results = client.gather(futures)
     columns = results[0]["sweep"].keys() if results else []
-    return {
-        "x": x_name,
-        "y": y_name,
-        "x_values": x_values,
-        "y_values": y_values,
-        "sweep": {c: np.stack([r["sweep"][c] for r in results]) for c in columns},
-        "thresholds": [r["thresholds"] for r in results],
-        "gaits_found": sum(r["gaits_found"] for r in results),
-    }
+    return Grid(
+        {
+            "x": x_name,
+            "y": y_name,
+            "x_values": x_values,
+            "y_values": y_values,
+            "sweep": Table({c: np.stack([r["sweep"][c] for r in results]) for c in columns}),
+            "thresholds": [r["thresholds"] for r in results],
+            "gaits_found": sum(r["gaits_found"] for r in results),
+        }
+    )

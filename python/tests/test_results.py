@@ -1,0 +1,66 @@
+"""Result objects: attribute access and dict access alike, readable reprs, tables as DataFrames with the CSV's
+column names and dtypes, grids as xarray Datasets over the two parameters, and pickling."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import vrw
+from vrw.grid import gait_grid
+
+pd = pytest.importorskip("pandas")
+xr = pytest.importorskip("xarray")
+
+
+def test_run_tables_convert_to_dataframes_like_the_csv_files(cli, tmp_path):
+    cli("simulate", "--steps", 3, "--out", tmp_path)
+    run = vrw.simulate(vrw.Params(), steps=3)
+    assert isinstance(run, dict) and run.status == run["status"] == "completed"
+    assert "Run(status='completed', 3 steps" in repr(run)
+    for name in ["steps", "trajectory"]:
+        frame = getattr(run, name).to_pandas()
+        csv = pd.read_csv(tmp_path / f"{name}.csv")
+        assert list(frame.columns) == list(csv.columns), name
+        assert frame.shape == csv.shape, name
+        for column in csv.columns:
+            if csv[column].dtype.kind in "fi":
+                # Numbers: the CSV's own dtype (float64, or int64 for counts), equal values.
+                assert frame[column].dtype.kind in "fi", column
+                assert np.allclose(frame[column], csv[column], rtol=1e-12, atol=0, equal_nan=True), column
+        # Words: the dtype pandas itself reads them with.
+        for column in frame.columns:
+            if frame[column].dtype.kind not in "fib":
+                assert frame[column].dtype == csv[column].dtype, column
+
+
+def test_gait_and_sweep_results_read_as_attributes():
+    gait = vrw.find_gait(vrw.Params())
+    assert gait.lambda_4_plus == gait["lambda_4_plus"]
+    assert repr(gait).startswith("GaitResult(found, period 1, branch DLS")
+    with pytest.raises(AttributeError, match="no field"):
+        gait.no_such_field
+    result = vrw.sweep(vrw.Params(), "viscosity", vrw.linspace(40, 60, 5))
+    frame = result.to_pandas()
+    assert frame.shape == (5, len(result.sweep))
+    assert frame["viscosity"].dtype == np.float64
+    assert frame["stability"].dtype == pd.Series(["stable"]).dtype  # pandas' own dtype for words
+    assert frame["scuffing"].dtype == bool and frame["period_k"].dtype == np.int64
+    assert "SweepResult(viscosity: 5 points" in repr(result)
+    for r in [gait, result]:
+        again = pickle.loads(pickle.dumps(r))
+        assert type(again) is type(r) and again.keys() == r.keys()
+
+
+def test_grid_converts_to_an_xarray_dataset_over_both_parameters():
+    x = ("viscosity", [40.0, 50.0, 60.0])
+    y = ("stiffness", [480.0, 520.0])
+    grid = gait_grid(None, vrw.Params(), x=x, y=y)
+    ds = grid.to_xarray()
+    assert dict(ds.sizes) == {"stiffness": 2, "viscosity": 3}
+    assert list(ds["viscosity"].values) == x[1] and list(ds["stiffness"].values) == y[1]
+    assert ds["lambda_4_plus"].dims == ("stiffness", "viscosity")
+    assert ds["lambda_4_plus"].dtype == np.float64
+    np.testing.assert_array_equal(ds["lambda_4_plus"].values, grid.sweep["lambda_4_plus"])
+    assert ds.attrs["gaits_found"] == grid.gaits_found
+    assert "Grid(stiffness (2) x viscosity (3)" in repr(grid)

@@ -1,0 +1,136 @@
+"""Result objects of the jobs: what ``vrw.simulate``, ``vrw.find_gait``, ``vrw.sweep`` and ``vrw.grid.gait_grid``
+return.
+
+Each is a ``dict`` (the keys of the job's JSON file, so ``result["status"]`` and every dict use keep
+working) with attribute access (``result.status``), a short ``repr`` that says what it holds, and
+conversions of its tables:
+
+- a ``Table`` (``run.steps``, ``run.trajectory``, ``sweep.sweep``) is a dict of numpy columns keyed like the
+  CSV file's header; ``Table.to_pandas()`` is the DataFrame with those column names and dtypes (float64,
+  int64, bool, and pandas' own dtype for words), the values ``pandas.read_csv`` of the file gives;
+- ``Grid.to_xarray()`` is an ``xarray.Dataset`` with one variable per column of ``sweep.csv`` over the two
+  parameters as coordinates.
+
+pandas and xarray are optional: they are imported when a conversion is asked for, and a clear
+``ImportError`` says which to install.
+"""
+
+from typing import Any, Dict, List
+
+import numpy as np
+
+__all__ = ["Result", "Table", "Run", "GaitResult", "SweepResult", "Grid"]
+
+
+def _optional(module: str) -> Any:
+    """Import an optional dependency, or say how to get it."""
+    try:
+        return __import__(module)
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError(f"this conversion needs {module}: pip install {module}") from e
+
+
+class Result(dict):
+    """A job's result: a dict with attribute access (``r.status`` is ``r["status"]``)."""
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(f"{type(self).__name__} has no field {name!r}") from None
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | {k for k in self if k.isidentifier()})
+
+    def _fields(self) -> str:
+        return ", ".join(self.keys())
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._fields()})"
+
+
+class Table(Result):
+    """Columns of a CSV file as numpy arrays, keyed like its header."""
+
+    def to_pandas(self) -> Any:
+        """The table as a ``pandas.DataFrame`` (the CSV's column names, in order, and dtypes)."""
+        pd = _optional("pandas")
+        return pd.DataFrame({name: np.asarray(column) for name, column in self.items()})
+
+    @property
+    def rows(self) -> int:
+        """Number of rows."""
+        return len(next(iter(self.values()))) if self else 0
+
+    def __repr__(self) -> str:
+        return f"Table({self.rows} rows: {self._fields()})"
+
+
+class Run(Result):
+    """``vrw.simulate``: the fields of ``summary.json``, with ``steps`` and ``trajectory`` as ``Table``s."""
+
+    def __repr__(self) -> str:
+        steps = self.get("steps")
+        n = steps.rows if isinstance(steps, Table) else 0
+        return f"Run(status={self.get('status')!r}, {n} steps, end_time={self.get('end_time')})"
+
+
+class GaitResult(Result):
+    """``vrw.find_gait``: the fields of ``gait.json``."""
+
+    def __repr__(self) -> str:
+        if self.get("status") != "found":
+            return f"GaitResult(status={self.get('status')!r}, message={self.get('message')!r})"
+        return (
+            f"GaitResult(found, period {self.get('period_k')}, branch {self.get('branch')}, "
+            f"lambda_I4={self.get('lambda_I4'):.6g}, lambda_2_plus={self.get('lambda_2_plus'):.6g}, "
+            f"lambda_4_plus={self.get('lambda_4_plus'):.6g}, {self.get('stability')}, "
+            f"max |multiplier| {self.get('max_floquet'):.6g})"
+        )
+
+
+class SweepResult(Result):
+    """``vrw.sweep``: ``sweep`` (the columns of ``sweep.csv``, a ``Table``) and ``thresholds``."""
+
+    def to_pandas(self) -> Any:
+        """``sweep.csv`` as a ``pandas.DataFrame``."""
+        return self["sweep"].to_pandas()
+
+    def __repr__(self) -> str:
+        return (
+            f"SweepResult({self.get('param')}: {self['sweep'].rows} points, {self.get('gaits_found')} "
+            f"gaits, {len(self.get('thresholds', []))} thresholds)"
+        )
+
+
+class Grid(Result):
+    """``vrw.grid.gait_grid``: every column of ``sweep.csv`` over the grid, ``(len(y), len(x))`` each."""
+
+    def to_xarray(self) -> Any:
+        """The grid as an ``xarray.Dataset``: one variable per column of ``sweep.csv`` (both parameters'
+        own columns excepted), over the coordinates ``y`` and ``x`` named by their parameters."""
+        xr = _optional("xarray")
+        x, y = self["x"], self["y"]
+        data = {
+            name: ((y, x), np.asarray(column))
+            for name, column in self["sweep"].items()
+            if name not in (x, y)
+        }
+        return xr.Dataset(
+            data,
+            coords={x: np.asarray(self["x_values"]), y: np.asarray(self["y_values"])},
+            attrs={"gaits_found": self["gaits_found"]},
+        )
+
+    def __repr__(self) -> str:
+        return (
+            f"Grid({self['y']} ({len(self['y_values'])}) x {self['x']} ({len(self['x_values'])}): "
+            f"{self['gaits_found']} gaits)"
+        )
+
+
+def wrap_tables(result: Dict[str, Any], names: List[str]) -> None:
+    """Make the named entries of ``result`` that are dicts of columns into ``Table``s (in place)."""
+    for name in names:
+        if isinstance(result.get(name), dict):
+            result[name] = Table(result[name])
