@@ -17,13 +17,18 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
-use vrw::app::{compute_gait, compute_simulation, compute_sweep, AppError, GaitJob, SimulateJob};
+use vrw::app::{
+    compute_basin, compute_gait, compute_simulation, compute_sweep, AppError, BasinJob, GaitJob,
+    SimulateJob,
+};
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
+use vrw::gait::basin::Coordinate;
 use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::output::{
-    step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
+    basin_header, basin_row, step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER,
+    TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -473,6 +478,73 @@ fn sweep<'py>(
     Ok(out)
 }
 
+/// The basin of the gait on a slice of the section (`vrw basin`, without the figure).
+///
+/// Returns the fields of `basin.json` (`spec`, `gait`, `outcomes`, ...) and `points`, the columns of
+/// `basin.csv` as numpy arrays (one row per grid point, row by row). Keyword arguments as the command line's
+/// options: `x`, `y` (`"L2"`, `"thetadot"`, `"L2dot"`), `x_range`, `y_range` (`(from, to)`, default the command
+/// line's), `nx`, `ny`, `max_steps`, `tolerance`, `initial` (where the gait search starts).
+#[pyfunction]
+#[pyo3(signature = (params, *, x = "L2", y = "thetadot", x_range = None, y_range = None, nx = 61, ny = 61, max_steps = 100, tolerance = 1e-3, initial = None))]
+#[allow(clippy::too_many_arguments)]
+fn basin<'py>(
+    py: Python<'py>,
+    params: &Params,
+    x: &str,
+    y: &str,
+    x_range: Option<(f64, f64)>,
+    y_range: Option<(f64, f64)>,
+    #[pyo3(from_py_with = nx_arg)] nx: usize,
+    #[pyo3(from_py_with = ny_arg)] ny: usize,
+    #[pyo3(from_py_with = max_steps_arg)] max_steps: usize,
+    #[pyo3(from_py_with = tolerance_arg)] tolerance: f64,
+    initial: Option<[f64; 3]>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let coordinate = |name: &str, value: &str| {
+        value
+            .parse::<Coordinate>()
+            .map_err(|e| ConfigError::new_err(format!("invalid value {value:?} for `{name}`: {e}")))
+    };
+    let job = BasinJob {
+        config: params.config.clone(),
+        initial: section(initial),
+        coordinates: [coordinate("x", x)?, coordinate("y", y)?],
+        ranges: [x_range, y_range],
+        points: [nx, ny],
+        max_steps,
+        tolerance,
+        out_dir: PathBuf::new(),
+    };
+    let (summary, grid) = interruptible(py, vrw::gait::interrupt_flag(), || {
+        compute_basin(&job, &|_| {})
+    })?
+    .map_err(app_error)?;
+    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
+    let rows: Vec<Vec<Cell>> = grid.iter().flatten().map(basin_row).collect();
+    result.set_item("points", table(py, &basin_header(), &rows)?)?;
+    Ok(result)
+}
+
+/// `basin`'s `nx`, named in its errors.
+fn nx_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("nx", value)
+}
+
+/// `basin`'s `ny`, named in its errors.
+fn ny_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("ny", value)
+}
+
+/// `basin`'s `max_steps`, named in its errors.
+fn max_steps_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("max_steps", value)
+}
+
+/// `basin`'s `tolerance`, named in its errors.
+fn tolerance_arg(value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    real("tolerance", value)
+}
+
 /// Run `work` with the GIL released on a thread of its own while this (the calling, main) thread checks
 /// Python's signals every [`SIGNAL_POLL`]: on Ctrl-C (`KeyboardInterrupt`, or any exception a signal handler
 /// raises) it sets `flag`, the interrupt flag `work` reads (the library's own for grids, where the grid runner
@@ -552,6 +624,7 @@ fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(find_gait, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(basin, m)?)?;
     m.add_function(wrap_pyfunction!(linspace, m)?)?;
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("WalkError", py.get_type::<WalkError>())?;

@@ -64,3 +64,21 @@ def test_grid_converts_to_an_xarray_dataset_over_both_parameters():
     np.testing.assert_array_equal(ds["lambda_4_plus"].values, grid.sweep["lambda_4_plus"])
     assert ds.attrs["gaits_found"] == grid.gaits_found
     assert "Grid(stiffness (2) x viscosity (3)" in repr(grid)
+
+
+def test_basin_equals_basin_csv_and_converts_to_a_grid(cli, tmp_path):
+    cli("basin", "--nx", 5, "--ny", 4, "--out", tmp_path)
+    result = vrw.basin(vrw.Params(), nx=5, ny=4)
+    csv = pd.read_csv(tmp_path / "basin.csv")
+    frame = result.to_pandas()
+    assert list(frame.columns) == list(csv.columns) and frame.shape == (20, len(csv.columns))
+    assert list(frame["outcome"]) == list(csv["outcome"])
+    assert np.allclose(frame["thetadot"], csv["thetadot"], rtol=1e-15, atol=0)
+    expected = __import__("json").loads((tmp_path / "basin.json").read_text())
+    assert result.outcomes == expected["outcomes"]
+    ds = result.to_xarray()
+    assert dict(ds.sizes) == {"thetadot": 4, "L2": 5}
+    assert ds["outcome"].dims == ("thetadot", "L2")
+    assert repr(result).startswith("BasinResult(20 starts")
+    with pytest.raises(vrw.ConfigError, match="`x`"):
+        vrw.basin(vrw.Params(), x="theta", nx=3, ny=3)

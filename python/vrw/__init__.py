@@ -25,7 +25,7 @@ from ._vrw import (
     __version__,
     linspace,
 )
-from .results import GaitResult, Grid, Result, Run, SweepResult, Table, wrap_tables
+from .results import BasinResult, GaitResult, Grid, Result, Run, SweepResult, Table, wrap_tables
 
 
 def simulate(
@@ -63,7 +63,17 @@ def sweep(
     return result
 
 
+def basin(params: Params, **options: Any) -> BasinResult:
+    """The basin of the gait on a slice of the section (``vrw basin``): a ``BasinResult``, the fields of
+    ``basin.json`` with ``points`` (the columns of ``basin.csv``) as a ``Table``; ``.to_xarray()`` gives the
+    grid over the slice's two coordinates. See ``vrw._vrw.basin`` for the options."""
+    result = BasinResult(_vrw.basin(params, **options))
+    wrap_tables(result, ["points"])
+    return result
+
+
 __all__ = [
+    "BasinResult",
     "ConfigError",
     "GaitResult",
     "Grid",
@@ -74,6 +84,7 @@ __all__ = [
     "Table",
     "WalkError",
     "__version__",
+    "basin",
     "find_gait",
     "linspace",
     "simulate",

@@ -13,6 +13,7 @@ __all__ = [
     "Params",
     "WalkError",
     "__version__",
+    "basin",
     "find_gait",
     "linspace",
     "simulate",
@@ -116,3 +117,25 @@ def sweep(
 def linspace(start: float, stop: float, points: int) -> List[float]:
     """The values ``vrw sweep --from START --to STOP --points POINTS`` visits (bit for bit); 2 to 100000
     points, else ``ConfigError``."""
+
+def basin(
+    params: Params,
+    *,
+    x: str = "L2",
+    y: str = "thetadot",
+    x_range: Optional[Tuple[float, float]] = None,
+    y_range: Optional[Tuple[float, float]] = None,
+    nx: int = 61,
+    ny: int = 61,
+    max_steps: int = 100,
+    tolerance: float = 1e-3,
+    initial: Optional[Section] = None,
+) -> Dict[str, Any]:
+    """The basin of the gait on a slice of the section (``vrw basin``, without the figure).
+
+    Returns the fields of ``basin.json`` (``spec``, ``gait``, ``outcomes``, ...) and ``points``: the columns
+    of ``basin.csv`` as numpy arrays, one row per grid point, row by row. The options are the command line's
+    (``x``, ``y``: ``"L2"``, ``"thetadot"``, ``"L2dot"``; ``x_range``, ``y_range``: ``(from, to)``, default
+    the command line's), validated as it validates them. Ctrl-C raises ``KeyboardInterrupt`` within about a
+    second.
+    """

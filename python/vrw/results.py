@@ -19,7 +19,7 @@ from typing import Any, Dict, List
 
 import numpy as np
 
-__all__ = ["Result", "Table", "Run", "GaitResult", "SweepResult", "Grid"]
+__all__ = ["Result", "Table", "Run", "GaitResult", "SweepResult", "Grid", "BasinResult"]
 
 
 def _optional(module: str) -> Any:
@@ -127,6 +127,37 @@ class Grid(Result):
             f"Grid({self['y']} ({len(self['y_values'])}) x {self['x']} ({len(self['x_values'])}): "
             f"{self['gaits_found']} gaits)"
         )
+
+
+class BasinResult(Result):
+    """``vrw.basin``: the fields of ``basin.json``, with ``points`` (the columns of ``basin.csv``) a ``Table``."""
+
+    def to_pandas(self) -> Any:
+        """``basin.csv`` as a ``pandas.DataFrame``."""
+        return self["points"].to_pandas()
+
+    def to_xarray(self) -> Any:
+        """The grid as an ``xarray.Dataset`` over the slice's two coordinates (``y`` by ``x``): the outcome,
+        the steps, the period and the end state of every start."""
+        xr = _optional("xarray")
+        spec, points = self["spec"], self["points"]
+        x, y = spec["x"]["coordinate"], spec["y"]["coordinate"]
+        nx, ny = spec["x"]["points"], spec["y"]["points"]
+        ix, iy = np.asarray(points["ix"]), np.asarray(points["iy"])
+        xs, ys = np.empty(nx), np.empty(ny)
+        xs[ix], ys[iy] = np.asarray(points[x]), np.asarray(points[y])
+        data = {}
+        for name, column in points.items():
+            if name in ("ix", "iy", x, y):
+                continue
+            column = np.asarray(column)
+            grid = np.empty((ny, nx), dtype=column.dtype)
+            grid[iy, ix] = column
+            data[name] = ((y, x), grid)
+        return xr.Dataset(data, coords={x: xs, y: ys}, attrs={"outcomes": str(self["outcomes"])})
+
+    def __repr__(self) -> str:
+        return f"BasinResult({self['points'].rows} starts: {dict(self['outcomes'])})"
 
 
 def wrap_tables(result: Dict[str, Any], names: List[str]) -> None:

@@ -133,6 +133,51 @@ pub fn run_basin(
     job: &BasinJob,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<BasinSummary, AppError> {
+    let (model, gait, spec) = prepare_basin(job)?;
+    in_run(&job.out_dir, "basin", |run| {
+        basin_into(job, &model, gait, spec, run, progress).map(|s| (s, None))
+    })
+}
+
+/// The basin of [`run_basin`] without writing anything (`job.out_dir` is not used): the summary of
+/// `basin.json` (with no files) and every grid point, row by row (what the Python binding returns). An
+/// interrupted grid (the library's interrupt flag) is an error, [`AppError::Interrupted`].
+pub fn compute_basin(
+    job: &BasinJob,
+    progress: &(dyn Fn(&BasinPoint) + Sync),
+) -> Result<(BasinSummary, Vec<Vec<BasinPoint>>), AppError> {
+    let (model, gait, spec) = prepare_basin(job)?;
+    let clock = std::time::Instant::now();
+    let grid = basin(&model, &job.config.solver, &gait, &spec, progress);
+    let seconds = clock.elapsed().as_secs_f64();
+    check_interrupted(
+        grid.iter().map(Vec::len).sum(),
+        spec.x.points * spec.y.points,
+        "no file",
+    )?;
+    let summary = BasinSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec,
+        gait,
+        outcomes: outcome_counts(&grid),
+        files: Vec::new(),
+        seconds,
+    };
+    Ok((summary, grid))
+}
+
+/// The number of grid points per outcome.
+fn outcome_counts(grid: &[Vec<BasinPoint>]) -> BTreeMap<String, usize> {
+    let mut outcomes = BTreeMap::new();
+    for p in grid.iter().flatten() {
+        *outcomes.entry(p.outcome.kind.clone()).or_insert(0) += 1;
+    }
+    outcomes
+}
+
+/// The checks and the gait of a basin job, and its slice.
+fn prepare_basin(job: &BasinJob) -> Result<(crate::dynamics::Model, Gait, BasinSpec), AppError> {
     job.validate()?;
     let (model, initial) = prepared(&job.config, job.initial)?;
     let map = StepMap::new(&model, &job.config.solver);
@@ -162,9 +207,7 @@ pub fn run_basin(
         max_steps: job.max_steps,
         tolerance: job.tolerance,
     };
-    in_run(&job.out_dir, "basin", |run| {
-        basin_into(job, &model, gait, spec, run, progress).map(|s| (s, None))
-    })
+    Ok((model, gait, spec))
 }
 
 /// The work of [`run_basin`] in its run directory.
@@ -179,10 +222,7 @@ fn basin_into(
     let clock = std::time::Instant::now();
     let grid = basin(model, &job.config.solver, &gait, &spec, progress);
     let seconds = clock.elapsed().as_secs_f64();
-    let mut outcomes = BTreeMap::new();
-    for p in grid.iter().flatten() {
-        *outcomes.entry(p.outcome.kind.clone()).or_insert(0) += 1;
-    }
+    let outcomes = outcome_counts(&grid);
     write_basin_csv(&run.path("basin.csv"), &grid)?;
     run.add("basin.csv");
     check_interrupted(

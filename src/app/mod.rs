@@ -14,7 +14,7 @@ mod orbit;
 mod simulate;
 mod sweep;
 
-pub use basin::{default_basin_range, run_basin, BasinJob, BasinSummary};
+pub use basin::{compute_basin, default_basin_range, run_basin, BasinJob, BasinSummary};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
     MAX_ANIMATION_FRAMES,

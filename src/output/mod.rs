@@ -24,6 +24,7 @@ pub mod steps_plot;
 pub mod style;
 pub(crate) mod tables;
 
+pub use tables::attractors::{basin_header, basin_row};
 pub(crate) use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv};
 pub(crate) use tables::map::write_map_csv;
 pub use tables::steps::{step_row, write_steps_csv, StepsCsv, STEPS_HEADER};

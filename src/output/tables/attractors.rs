@@ -216,6 +216,16 @@ pub(crate) const BASIN: [Column<BasinPoint>; 11] = [
     ),
 ];
 
+/// The header of `basin.csv`.
+pub fn basin_header() -> Vec<&'static str> {
+    header(&BASIN, &[])
+}
+
+/// One row of `basin.csv`.
+pub fn basin_row(p: &BasinPoint) -> Vec<Cell> {
+    row(&BASIN, p)
+}
+
 /// Write `basin.csv`: one row per grid point, row by row.
 pub(crate) fn write_basin_csv(path: &Path, grid: &[Vec<BasinPoint>]) -> Result<(), OutputError> {
     write_table(
