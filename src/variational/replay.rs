@@ -279,20 +279,18 @@ fn cross_guard(
     s: &Sensitivity,
 ) -> Result<(Sensitivity, SVector<f64, NDIR>), NotDifferentiable> {
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
-    let f = PhaseSystem {
+    let (f, dynamics) = PhaseSystem {
         model,
         active: segment.active,
     }
-    .rhs(end.time, y);
+    .rhs_and_dynamics(y);
     let (q, qd) = with_rate(y, s, &f);
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
     let singular = NotDifferentiable::Singular { time: end.time };
     let guard = match end.kind {
         EventKind::LiftOff(_) | EventKind::Unlock(_) => {
             // A force guard: the multiplier's derivative through the KKT solve.
-            let (q_real, qd_real) = crate::walk::unpack(y);
-            let d = crate::contact::constrained_dynamics(model, &q_real, &qd_real, &segment.active)
-                .map_err(|_| singular.clone())?;
+            let d = dynamics.ok_or(singular.clone())?;
             let (_, dlam) = dynamics_derivative(
                 model,
                 &(q, qd, *mech),
