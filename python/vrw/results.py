@@ -89,12 +89,20 @@ class GaitResult(Result):
         )
 
 
-class SweepResult(Result):
-    """``vrw.sweep``: ``sweep`` (the columns of ``sweep.csv``, a ``Table``) and ``thresholds``."""
+class _WithTable(Result):
+    """A result whose main table is its entry ``_table``; ``to_pandas()`` converts that table."""
+
+    _table = ""
 
     def to_pandas(self) -> Any:
-        """``sweep.csv`` as a ``pandas.DataFrame``."""
-        return self["sweep"].to_pandas()
+        """The result's table (its CSV file) as a ``pandas.DataFrame``."""
+        return self[self._table].to_pandas()
+
+
+class SweepResult(_WithTable):
+    """``vrw.sweep``: ``sweep`` (the columns of ``sweep.csv``, a ``Table``) and ``thresholds``."""
+
+    _table = "sweep"
 
     def __repr__(self) -> str:
         return (
@@ -129,12 +137,10 @@ class Grid(Result):
         )
 
 
-class BasinResult(Result):
+class BasinResult(_WithTable):
     """``vrw.basin``: the fields of ``basin.json``, with ``points`` (the columns of ``basin.csv``) a ``Table``."""
 
-    def to_pandas(self) -> Any:
-        """``basin.csv`` as a ``pandas.DataFrame``."""
-        return self["points"].to_pandas()
+    _table = "points"
 
     def to_xarray(self) -> Any:
         """The grid as an ``xarray.Dataset`` over the slice's two coordinates (``y`` by ``x``): the outcome,
