@@ -104,6 +104,7 @@
 #![warn(missing_docs, unnameable_types)]
 
 pub mod app;
+pub mod bifurcation;
 pub mod contact;
 pub mod dynamics;
 pub mod fmt;

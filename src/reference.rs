@@ -222,6 +222,69 @@ pub fn period_two_config() -> Config {
     config
 }
 
+/// A one-parameter family of maps of the plane with a fold and a period-doubling cascade in closed form: the
+/// quadratic map `x -> p - x^2` with a contracting companion coordinate,
+///
+/// `P(x, y; p) = (p - x^2, y / 2 + x / 10)`.
+///
+/// Its fixed points are `x = (-1 ± sqrt(1 + 4p)) / 2`, `y = x / 5`, with multipliers `-2x` and `1/2`: the two
+/// meet at the fold `p = -1/4` (`x = -1/2`, multiplier +1); the upper one loses stability by period doubling at
+/// `p = 3/4` (`x = 1/2`, multiplier -1), where the period-2 orbit `x = (1 ± sqrt(4p - 3)) / 2` is born, which
+/// doubles again at `p = 5/4` (the multiplier of `P^2` there is `4 x1 x2 = 4 (1 - p) = -1`). The reference
+/// of the continuation tests (`crate::bifurcation`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct QuadraticFamily;
+
+impl QuadraticFamily {
+    /// The fold: `(p, x)`.
+    pub const FOLD: (f64, f64) = (-0.25, -0.5);
+    /// The period doubling of the fixed points: `(p, x)`.
+    pub const PERIOD_DOUBLING: (f64, f64) = (0.75, 0.5);
+    /// The period doubling of the period-2 orbit: `p`.
+    pub const SECOND_PERIOD_DOUBLING: f64 = 1.25;
+
+    /// `P(x, y; p)`, its Jacobian `DP` (row-major) and `dP/dp`.
+    pub fn eval(&self, x: [f64; 2], p: f64) -> ([f64; 2], [[f64; 2]; 2], [f64; 2]) {
+        (
+            [p - x[0] * x[0], 0.5 * x[1] + 0.1 * x[0]],
+            [[-2.0 * x[0], 0.0], [0.1, 0.5]],
+            [1.0, 0.0],
+        )
+    }
+
+    /// The upper fixed point at `p >= -1/4`: `(x, y)`.
+    pub fn upper_fixed_point(&self, p: f64) -> [f64; 2] {
+        let x = 0.5 * (-1.0 + (1.0 + 4.0 * p).sqrt());
+        [x, 0.2 * x]
+    }
+}
+
+/// The delayed logistic map, a one-parameter family of maps of the plane with a Neimark-Sacker bifurcation in
+/// closed form: `P(x, y; p) = (p x (1 - y), x)`. Its fixed point `x = y = 1 - 1/p` has the Jacobian
+/// `[[1, 1 - p], [1, 0]]`, whose determinant `p - 1` is the squared modulus of its complex pair (for
+/// `5/4 < p < 5`): the pair crosses the unit circle at `p = 2`, with angle `pi / 3`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DelayedLogisticFamily;
+
+impl DelayedLogisticFamily {
+    /// The Neimark-Sacker point: `p`.
+    pub const NEIMARK_SACKER: f64 = 2.0;
+
+    /// `P(x, y; p)`, its Jacobian `DP` (row-major) and `dP/dp`.
+    pub fn eval(&self, x: [f64; 2], p: f64) -> ([f64; 2], [[f64; 2]; 2], [f64; 2]) {
+        (
+            [p * x[0] * (1.0 - x[1]), x[0]],
+            [[p * (1.0 - x[1]), -p * x[0]], [1.0, 0.0]],
+            [x[0] * (1.0 - x[1]), 0.0],
+        )
+    }
+
+    /// The fixed point `x = y = 1 - 1/p`.
+    pub fn fixed_point(&self, p: f64) -> [f64; 2] {
+        [1.0 - 1.0 / p, 1.0 - 1.0 / p]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

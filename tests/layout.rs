@@ -37,6 +37,7 @@ const PIPELINE: &[&str] = &[
     "variational",
     "reference",
     "gait",
+    "bifurcation",
     "output",
     "app",
     BIN,

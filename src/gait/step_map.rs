@@ -53,6 +53,8 @@ pub struct StepDerivatives {
     pub jacobian: DMatrix<f64>,
     /// `dP/dp` over the free coordinates for the chosen parameter, if one was chosen.
     pub dparam: Option<DVector<f64>>,
+    /// The event sequence of the walk (see [`StepMap::eval_signature`]).
+    pub signature: String,
 }
 
 /// Why [`StepMap::eval_with_derivatives`] gave no derivatives.
@@ -198,10 +200,12 @@ impl<'m> StepMap<'m> {
         );
         let mut sens: Sensitivity = sensitivity(&q, &qd);
         let mut report = None;
+        let mut words = Vec::with_capacity(self.iterate);
         for _ in 0..self.iterate {
             let start = walker.state().clone();
             let mut tape = StepTape::default();
             let step = walker.step_taped(&mut tape)?;
+            words.push(tape.signature(step.branch));
             on_border(model, &step)?;
             report.get_or_insert(step);
             sens = replay_step(
@@ -228,7 +232,26 @@ impl<'m> StepMap<'m> {
             outcome: StepOutcome { next, report },
             jacobian,
             dparam,
+            signature: words.join(" / "),
         })
+    }
+
+    /// Evaluate `P(s)` (`P^k(s)`) as [`StepMap::eval`] does, with the event sequence of its walk: the words of
+    /// each step's record (`TD DLS UNLOCK1 LIFT2 LOCK2`: the touchdown's branch, then the changes of contacts
+    /// and stoppers between its phases), the steps of an iterated map joined by ` / `.
+    pub fn eval_signature(&self, s: &SectionState) -> Result<(StepOutcome, String), WalkError> {
+        let mut walker = self.walker(s)?;
+        let mut report = None;
+        let mut words = Vec::with_capacity(self.iterate);
+        for _ in 0..self.iterate {
+            let mut tape = StepTape::default();
+            let step = walker.step_taped(&mut tape)?;
+            words.push(tape.signature(step.branch));
+            report.get_or_insert(step);
+        }
+        let next = walker.section()?;
+        let report = report.expect("at least one step is walked");
+        Ok((StepOutcome { next, report }, words.join(" / ")))
     }
 
     /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.

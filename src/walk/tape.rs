@@ -3,7 +3,7 @@
 //! each phase. With it, `crate::variational` integrates the variational equations over the very steps the walk
 //! took and composes the saltation matrix of every event, without deciding anything again.
 
-use crate::contact::ActiveSet;
+use crate::contact::{ActiveSet, Leg};
 
 use super::events::EventKind;
 use super::phase::WalkVector;
@@ -89,5 +89,51 @@ impl StepTape {
             Some(end) => end.impacts.push(set),
             None => self.impacts.push(set),
         }
+    }
+}
+
+impl StepTape {
+    /// The step's event sequence in words (`branch.csv`'s `signature`, docs/model.md section 11): the touchdown
+    /// and its branch (`TD DLS`), then one word per change of a unit between successive phases, in the order
+    /// the phases follow and, within one change, Leg 1 before Leg 2: `LIFT`/`LAND` (ground contact off/on),
+    /// `SLIDE`/`STICK` (a contact starts/stops sliding), `UNLOCK`/`LOCK` (stopper), each with the leg's number,
+    /// as `TD DLS UNLOCK1 LIFT2 LOCK2`. Two steps with the same signature took the same smooth piece of the
+    /// step map; a family whose signature changes crossed a border between pieces.
+    pub(crate) fn signature(&self, branch: impl std::fmt::Display) -> String {
+        let mut words = vec!["TD".to_string(), branch.to_string()];
+        for pair in self.segments.windows(2) {
+            let (a, b) = (pair[0].active, pair[1].active);
+            for leg in Leg::BOTH {
+                let n = match leg {
+                    Leg::One => 1,
+                    Leg::Two => 2,
+                };
+                let slide = |s: &ActiveSet| match leg {
+                    Leg::One => s.slide1,
+                    Leg::Two => s.slide2,
+                };
+                let changes = [
+                    (a.contact(leg), b.contact(leg), "LAND", "LIFT"),
+                    (
+                        a.contact(leg) && slide(&a),
+                        b.contact(leg) && slide(&b),
+                        "SLIDE",
+                        "STICK",
+                    ),
+                    (a.lock(leg), b.lock(leg), "LOCK", "UNLOCK"),
+                ];
+                for (before, after, on, off) in changes {
+                    if before != after {
+                        let word = if after { on } else { off };
+                        // A sliding contact that leaves is a lift-off, not a stick.
+                        if word == "STICK" && !b.contact(leg) {
+                            continue;
+                        }
+                        words.push(format!("{word}{n}"));
+                    }
+                }
+            }
+        }
+        words.join(" ")
     }
 }

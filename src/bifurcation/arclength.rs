@@ -1,0 +1,433 @@
+//! Pseudo-arclength continuation of a family of fixed points `P(x; p) = x` (docs/model.md section 11; Keller
+//! 1977, Allgower and Georg 1990 ch. 2, the predictor-corrector of AUTO, MatCont and BifurcationKit.jl).
+//!
+//! **Unknowns.** `z = (x, p / sigma)`: the state and the parameter divided by its scale `sigma`
+//! ([`ContinuationOptions::param_scale`]), so that a step of length `h` in `z` moves the state and the parameter
+//! by comparable amounts. `H(z) = P(x; p) - x` has the `n x (n + 1)` Jacobian `J = [DP - I, sigma dP/dp]`,
+//! exact from the variational equations.
+//!
+//! **Predictor.** The tangent `t` is the unit null vector of `J`, oriented as the previous one
+//! (`[J; t_prev^T] t = [0; 1]`); the prediction is `z + h t`.
+//!
+//! **Corrector.** Newton's method on `H(z) = 0` with the hyperplane `t . (z - z_pred) = 0`, the matrix
+//! `[J; t^T]` of the last point held (a chord method: one evaluation of `P` per iteration, no derivatives),
+//! until `max |H| <` [`ContinuationOptions::tolerance`]; it fails if the residual does not at least halve per
+//! iteration. Because the hyperplane is transversal to the family, the corrector passes folds, where
+//! natural-parameter continuation (fixed `p`) stops.
+//!
+//! **Step control.** A step is accepted only if its corrector converged, the corrected point is within
+//! `h / 2` of the prediction and the new tangent turned by less than [`MAX_TURN`] (a step that jumps to
+//! another family shows as a large turn or a large correction); otherwise it is halved. Accepted steps grow
+//! by [`GROW`] after a corrector of at most [`EASY_CORRECTOR`] iterations and shrink by [`SHRINK`] after one of more than
+//! [`HARD_CORRECTOR`]. The family ends where the step falls below [`ContinuationOptions::min_step`] (with the last
+//! failure: the walk falls, rolls back, ...), where it leaves the parameter range (its last point placed
+//! exactly on the bound), where it closes on itself, or after [`ContinuationOptions::max_points`] points.
+
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use super::corrector::{
+    augmented, bordered, correct, corrector_failure, point_at, split, start_point,
+    ContinuationOptions, FamilyPoint,
+};
+use super::special::{detect_between, SpecialPoint};
+use super::{FamilyMap, MapFailure};
+
+/// Largest angle between successive tangents of an accepted step (as its cosine).
+pub const MAX_TURN: f64 = 0.9;
+
+/// Growth of the step after an easy corrector (at most [`EASY_CORRECTOR`] iterations).
+pub const GROW: f64 = 1.6;
+
+/// Shrinkage of the step after a hard corrector (more than [`HARD_CORRECTOR`] iterations).
+pub const SHRINK: f64 = 0.6;
+
+/// A corrector of at most this many iterations lets the next step grow (the chord method from a good
+/// prediction takes three to 1e-11).
+pub const EASY_CORRECTOR: usize = 3;
+
+/// A corrector of more than this many iterations makes the next step shrink.
+pub const HARD_CORRECTOR: usize = 5;
+
+/// Why following a family stopped in one direction.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FamilyEnd {
+    /// The family reached the end of the parameter range (its last point lies on it).
+    LeftRange {
+        /// The bound.
+        bound: f64,
+    },
+    /// The family came back to its start: a closed loop.
+    Closed,
+    /// [`ContinuationOptions::max_points`] points were followed.
+    MaxPoints,
+    /// The step fell below [`ContinuationOptions::min_step`]: the family cannot be followed further. `failure`
+    /// is the last failure of the map (the walk rolls back, falls, ...), or of the corrector if the map never
+    /// failed. Where the map failed, the end is bracketed in the parameter to
+    /// [`ContinuationOptions::param_tolerance`] times `max(1, |p|)` by bisection at fixed parameter from the
+    /// last point (a border of the map's domain has no smooth test function to solve for).
+    Ended {
+        /// The parameter at the last point.
+        param: f64,
+        /// The nearest parameter beyond it where the map failed (`NaN` if it never did).
+        beyond: f64,
+        /// The failure's kind (`corrector` where the corrector did not converge without a failure of the map).
+        failure: String,
+        /// The last failure in words.
+        message: String,
+    },
+}
+
+/// A followed family: its points in order of arclength, its special points and how it ends either way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Family<I> {
+    /// Points in order of arclength (the start among them).
+    pub points: Vec<FamilyPoint<I>>,
+    /// Index of the start in `points`.
+    pub start: usize,
+    /// Special points, in order of arclength.
+    pub special: Vec<SpecialPoint<I>>,
+    /// How the family ends at its first point (`[0]`) and at its last (`[1]`).
+    pub ends: [FamilyEnd; 2],
+    /// Steps of `P` per evaluation of the map followed.
+    pub period: usize,
+    /// The options it was followed with.
+    pub options: ContinuationOptions,
+}
+
+/// Why a family could not be started.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ContinuationError {
+    /// The options are invalid.
+    #[error("invalid continuation options: {0}")]
+    Options(String),
+    /// The start is outside the range.
+    #[error("the start value {value} is outside the range [{from}, {to}]")]
+    StartOutsideRange {
+        /// The start.
+        value: f64,
+        /// The range.
+        from: f64,
+        /// The range.
+        to: f64,
+    },
+    /// No fixed point near the initial state at the start value.
+    #[error("no fixed point at the start value {value}: {reason}")]
+    NoStart {
+        /// The start value.
+        value: f64,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// Follow the family of fixed points of `map` through the state `x0` at the parameter `p0` (which need only
+/// be near a fixed point: it is corrected at fixed `p0` first) in both directions (see the module
+/// documentation).
+pub fn continue_family<M: FamilyMap>(
+    map: &M,
+    x0: &DVector<f64>,
+    p0: f64,
+    options: &ContinuationOptions,
+) -> Result<Family<M::Info>, ContinuationError> {
+    options.validate().map_err(ContinuationError::Options)?;
+    if !(options.from..=options.to).contains(&p0) {
+        return Err(ContinuationError::StartOutsideRange {
+            value: p0,
+            from: options.from,
+            to: options.to,
+        });
+    }
+    let start = start_point(map, x0, p0, options).map_err(|e| ContinuationError::NoStart {
+        value: p0,
+        reason: e.message,
+    })?;
+    let forward = follow(map, start.clone(), options);
+    let mut reversed = start.clone();
+    reversed.tangent.neg_mut();
+    let backward = follow(map, reversed, options);
+    Ok(assemble(start, forward, backward, map.period(), *options))
+}
+
+/// What following one direction found.
+pub(crate) struct Followed<I> {
+    points: Vec<FamilyPoint<I>>,
+    special: Vec<SpecialPoint<I>>,
+    end: FamilyEnd,
+}
+
+/// Follow the family from `start` along its tangent (see the module documentation); the points after the
+/// start, in order.
+fn follow<M: FamilyMap>(
+    map: &M,
+    start: FamilyPoint<M::Info>,
+    options: &ContinuationOptions,
+) -> Followed<M::Info> {
+    let sigma = options.param_scale;
+    let z_start = start.z(sigma);
+    let mut points: Vec<FamilyPoint<M::Info>> = Vec::new();
+    let mut special = Vec::new();
+    // `J` of the last point that has derivatives: the corrector's matrix.
+    let mut held = augmented(&start.jacobian, &start.dparam, sigma);
+    let mut current = start;
+    let mut h = options.initial_step;
+    let mut last_failure: Option<MapFailure> = None;
+    // The last failure of the map itself since the last accepted step, and the parameter it failed at.
+    let mut map_failure: Option<(MapFailure, f64)> = None;
+    let mut travelled = 0.0;
+    while points.len() < options.max_points {
+        if h < options.min_step {
+            let end = match map_failure {
+                Some((failure, at)) => {
+                    let (nearer, beyond, failure) =
+                        bracket_end(map, &current, &held, (at, failure), options);
+                    if let Some(nearer) = nearer {
+                        if options.detect {
+                            special.extend(detect_between(map, &current, &nearer, options));
+                        }
+                        points.push(nearer.clone());
+                        current = nearer;
+                    }
+                    FamilyEnd::Ended {
+                        param: current.param,
+                        beyond,
+                        failure: failure.kind,
+                        message: failure.message,
+                    }
+                }
+                None => {
+                    let failure = last_failure.unwrap_or_else(|| corrector_failure(0, f64::NAN));
+                    FamilyEnd::Ended {
+                        param: current.param,
+                        beyond: f64::NAN,
+                        failure: failure.kind,
+                        message: failure.message,
+                    }
+                }
+            };
+            return Followed {
+                points,
+                special,
+                end,
+            };
+        }
+        let z = current.z(sigma);
+        let z_pred = &z + h * &current.tangent;
+        if current.has_derivatives() {
+            held = augmented(&current.jacobian, &current.dparam, sigma);
+        }
+        let m = bordered(&held, &current.tangent);
+        let next = correct(map, &z_pred, &current.tangent, &m, options).and_then(|(zc, it)| {
+            let mut next = point_at(map, &zc, &current.tangent, options)?;
+            next.iterations = it;
+            Ok(next)
+        });
+        let mut next = match next {
+            Ok(next) => next,
+            Err(failure) => {
+                if failure.kind != "corrector" {
+                    map_failure = Some((failure.clone(), split(&z_pred, sigma).1));
+                }
+                last_failure = Some(failure);
+                h *= 0.5;
+                continue;
+            }
+        };
+        let z_next = next.z(sigma);
+        let jumped = (&z_next - &z_pred).norm() > 0.5 * h;
+        let turned = next.tangent.dot(&current.tangent) < MAX_TURN;
+        if (jumped || turned) && h > options.min_step {
+            last_failure = Some(MapFailure {
+                kind: "step".to_string(),
+                message: format!(
+                    "steps near p = {} turn or jump too far (the family turns sharply, or another is near)",
+                    current.param
+                ),
+            });
+            h *= 0.5;
+            continue;
+        }
+        let step = (&z_next - &z).norm();
+        travelled += step;
+        next.arclength = current.arclength + step;
+        // The end of the range: the last point is placed on the bound.
+        let bound = if next.param > options.to {
+            Some(options.to)
+        } else if next.param < options.from {
+            Some(options.from)
+        } else {
+            None
+        };
+        if let Some(bound) = bound {
+            if let Ok(on_bound) = point_on_bound(map, &current, &next, bound, options) {
+                if options.detect {
+                    special.extend(detect_between(map, &current, &on_bound, options));
+                }
+                points.push(on_bound);
+                return Followed {
+                    points,
+                    special,
+                    end: FamilyEnd::LeftRange { bound },
+                };
+            }
+        }
+        if options.detect {
+            special.extend(detect_between(map, &current, &next, options));
+        }
+        let iterations = next.iterations;
+        points.push(next.clone());
+        current = next;
+        // Back at the start after going round: a closed family.
+        if travelled > 4.0 * h && (&z_next - &z_start).norm() < 0.5 * h {
+            return Followed {
+                points,
+                special,
+                end: FamilyEnd::Closed,
+            };
+        }
+        if iterations <= EASY_CORRECTOR {
+            h = (h * GROW).min(options.max_step);
+        } else if iterations > HARD_CORRECTOR {
+            h = (h * SHRINK).max(options.min_step);
+        }
+        last_failure = None;
+        map_failure = None;
+    }
+    Followed {
+        points,
+        special,
+        end: FamilyEnd::MaxPoints,
+    }
+}
+
+/// The point of the family between `a` and `b` at the parameter `bound` (corrected at fixed `p`).
+fn point_on_bound<M: FamilyMap>(
+    map: &M,
+    a: &FamilyPoint<M::Info>,
+    b: &FamilyPoint<M::Info>,
+    bound: f64,
+    options: &ContinuationOptions,
+) -> Result<FamilyPoint<M::Info>, MapFailure> {
+    let sigma = options.param_scale;
+    let w = (bound - a.param) / (b.param - a.param);
+    let (za, zb) = (a.z(sigma), b.z(sigma));
+    let mut z_pred = &za + w * (&zb - &za);
+    let n = a.x.len();
+    z_pred[n] = bound / sigma;
+    let mut e_p = DVector::zeros(n + 1);
+    e_p[n] = 1.0;
+    if !a.has_derivatives() {
+        return Err(corrector_failure(0, f64::NAN));
+    }
+    let m = bordered(&augmented(&a.jacobian, &a.dparam, sigma), &e_p);
+    let (z, it) = correct(map, &z_pred, &e_p, &m, options)?;
+    let mut point = point_at(map, &z, &a.tangent, options)?;
+    point.iterations = it;
+    point.arclength = a.arclength + (&z - &za).norm();
+    Ok(point)
+}
+
+/// The end of a family whose map failed at the parameter `fail_at` just beyond the point `from`, bracketed by
+/// bisection in the parameter: each trial value is corrected at fixed parameter from the nearest point that
+/// worked (along its tangent), with the matrix of that point or, if that fails, of the trial itself. The
+/// point nearest the end (if nearer than `from`), the first parameter found to fail, and the last failure
+/// of the map.
+fn bracket_end<M: FamilyMap>(
+    map: &M,
+    from: &FamilyPoint<M::Info>,
+    held: &DMatrix<f64>,
+    (fail_at, failure): (f64, MapFailure),
+    options: &ContinuationOptions,
+) -> (Option<FamilyPoint<M::Info>>, f64, MapFailure) {
+    let sigma = options.param_scale;
+    let n = from.x.len();
+    let mut e_p = DVector::zeros(n + 1);
+    e_p[n] = 1.0;
+    let mut failure = failure;
+    let mut nearer: Option<FamilyPoint<M::Info>> = None;
+    let mut hi = fail_at;
+    let tol = options.param_tolerance * from.param.abs().max(1.0);
+    for _ in 0..MAX_END_BISECTIONS {
+        let base = nearer.as_ref().unwrap_or(from);
+        let t_p = base.tangent[n];
+        if (hi - base.param).abs() <= tol || t_p.abs() < 1e-12 {
+            break;
+        }
+        let mid = 0.5 * (base.param + hi);
+        let z_base = base.z(sigma);
+        let mut z_pred = &z_base + ((mid - base.param) / sigma / t_p) * &base.tangent;
+        z_pred[n] = mid / sigma;
+        let j = if base.has_derivatives() {
+            augmented(&base.jacobian, &base.dparam, sigma)
+        } else {
+            held.clone()
+        };
+        let trial = correct(map, &z_pred, &e_p, &bordered(&j, &e_p), options).or_else(|_| {
+            let (x, p) = split(&z_pred, sigma);
+            let ev = map.eval(&x, p)?;
+            let fresh = bordered(&augmented(&ev.jacobian, &ev.dparam, sigma), &e_p);
+            correct(map, &z_pred, &e_p, &fresh, options)
+        });
+        match trial.and_then(|(z, it)| {
+            let mut point = point_at(map, &z, &base.tangent, options)?;
+            point.iterations = it;
+            point.arclength = base.arclength + (&z - &z_base).norm();
+            Ok(point)
+        }) {
+            Ok(point) => nearer = Some(point),
+            Err(f) => {
+                hi = mid;
+                if f.kind != "corrector" {
+                    failure = f;
+                }
+            }
+        }
+    }
+    (nearer, hi, failure)
+}
+
+/// Bisections allowed to bracket the end of a family.
+const MAX_END_BISECTIONS: usize = 60;
+
+/// One family from the start and the two directions followed from it, in order of arclength.
+fn assemble<I: Clone>(
+    start: FamilyPoint<I>,
+    forward: Followed<I>,
+    backward: Followed<I>,
+    period: usize,
+    options: ContinuationOptions,
+) -> Family<I> {
+    let mut points: Vec<FamilyPoint<I>> = backward.points.into_iter().rev().collect();
+    let start_index = points.len();
+    points.push(start);
+    points.extend(forward.points);
+    // Arclength from the first point, and every tangent along the order of the points.
+    let total_back = points[start_index].arclength;
+    let back_lengths: Vec<f64> = points[..start_index].iter().map(|p| p.arclength).collect();
+    for (point, len) in points[..start_index].iter_mut().zip(back_lengths) {
+        point.arclength = -len;
+        point.tangent.neg_mut();
+    }
+    let offset = points.first().map_or(total_back, |p| p.arclength);
+    for point in &mut points {
+        point.arclength -= offset;
+    }
+    let mut special: Vec<SpecialPoint<I>> = backward.special;
+    for sp in &mut special {
+        sp.arclength = -sp.arclength;
+    }
+    special.extend(forward.special);
+    for sp in &mut special {
+        sp.arclength -= offset;
+    }
+    special.sort_by(|a, b| a.arclength.total_cmp(&b.arclength));
+    Family {
+        points,
+        start: start_index,
+        special,
+        ends: [backward.end, forward.end],
+        period,
+        options,
+    }
+}
