@@ -2,11 +2,15 @@
 //!
 //! One file per job: [`simulate`](run_simulate) (`simulate.rs`), [`gait`](run_gait) (`gait.rs`),
 //! [`sweep`](run_sweep) with its Fig. 2 (`sweep.rs`), [`map`](run_map) (`map.rs`), [`orbit`](run_orbit)
-//! (`orbit.rs`), [`basin`](run_basin) (`basin.rs`), and [`plot`](run_plot) / [`animate`](run_animate) of a run
+//! (`orbit.rs`), [`basin`](run_basin) (`basin.rs`), [`continue`](run_continuation)
+//! (`family.rs`, its records `family_records.rs`, its files `family_output.rs`), and [`plot`](run_plot) / [`animate`](run_animate) of a run
 //! directory (`figures.rs`); the tables they write are declared in `output::tables`. This file holds what they
 //! share: the error type, the start of every walk, and the names of parameters on figures.
 
 mod basin;
+mod family;
+mod family_output;
+mod family_records;
 mod figures;
 mod gait;
 mod map;
@@ -15,6 +19,12 @@ mod simulate;
 mod sweep;
 
 pub use basin::{compute_basin, default_basin_range, run_basin, BasinJob, BasinSummary};
+pub use family::{
+    compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
+    MAX_FAMILIES, MAX_FAMILY_POINTS, STABILITY_BAND,
+};
+pub use family_output::run_continuation;
+pub use family_records::{EndRecord, FamilyRecord, SectionRecord, SideRecord, SpecialRecord};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
     MAX_ANIMATION_FRAMES,

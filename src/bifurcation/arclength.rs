@@ -30,11 +30,16 @@ use super::corrector::{
     augmented, bordered, correct, corrector_failure, point_at, split, start_point,
     ContinuationOptions, FamilyPoint,
 };
-use super::special::{detect_between, SpecialPoint};
+use super::special::{border_at_end, detect_between, SpecialPoint};
 use super::{FamilyMap, MapFailure};
 
 /// Largest angle between successive tangents of an accepted step (as its cosine).
 pub const MAX_TURN: f64 = 0.9;
+
+/// Below this step length (in the scaled unknowns) a large turn of the tangent is accepted: the family has a
+/// corner there (a border of the map's pieces, where `DP` jumps; e.g. a nonsmooth fold), which no shorter
+/// step smooths out.
+pub const CORNER_STEP: f64 = 1e-5;
 
 /// Growth of the step after an easy corrector (at most [`EASY_CORRECTOR`] iterations).
 pub const GROW: f64 = 1.6;
@@ -197,10 +202,24 @@ fn follow<M: FamilyMap>(
                     }
                 }
                 None => {
+                    // No failure of the map: the family may end at a border of the map's pieces.
+                    let border = options
+                        .detect
+                        .then(|| {
+                            let previous = points.len().checked_sub(2).map(|i| &points[i]);
+                            border_at_end(map, previous, &current, options)
+                        })
+                        .flatten();
+                    // Just past the border, where the walk looks for what takes over.
+                    let beyond = border.as_ref().map_or(f64::NAN, |b| {
+                        let step = options.param_tolerance.max(1e-7) * b.param.abs().max(1.0);
+                        b.param + step.copysign(b.param - current.param)
+                    });
+                    special.extend(border);
                     let failure = last_failure.unwrap_or_else(|| corrector_failure(0, f64::NAN));
                     FamilyEnd::Ended {
                         param: current.param,
-                        beyond: f64::NAN,
+                        beyond,
                         failure: failure.kind,
                         message: failure.message,
                     }
@@ -236,7 +255,9 @@ fn follow<M: FamilyMap>(
         };
         let z_next = next.z(sigma);
         let jumped = (&z_next - &z_pred).norm() > 0.5 * h;
-        let turned = next.tangent.dot(&current.tangent) < MAX_TURN;
+        // A turn over a step this short is a corner of the family (it crosses a border where DP jumps), not
+        // a jump to another family.
+        let turned = next.tangent.dot(&current.tangent) < MAX_TURN && h > CORNER_STEP;
         if (jumped || turned) && h > options.min_step {
             last_failure = Some(MapFailure {
                 kind: "step".to_string(),

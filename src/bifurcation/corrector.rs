@@ -35,7 +35,8 @@ pub struct ContinuationOptions {
 }
 
 impl ContinuationOptions {
-    /// The defaults for the range `[from, to]`: `sigma` a tenth of its width, steps from `1e-7` to `0.1`
+    /// The defaults for the range `[from, to]`: `sigma` the power of two nearest a tenth of its
+    /// width, steps from `1e-7` to `0.1`
     /// (first `0.01`), 300 points each way, `tolerance = 1e-10` (as the gait search), eight corrector iterations, special points
     /// to `1e-10` in the parameter.
     pub fn for_range(from: f64, to: f64) -> ContinuationOptions {
@@ -49,7 +50,13 @@ impl ContinuationOptions {
             max_points: 300,
             tolerance: 1e-10,
             max_corrector_iterations: 8,
-            param_scale: if width > 0.0 { width / 10.0 } else { 1.0 },
+            // A power of two, so that `p / sigma * sigma` is `p` exactly (a family's last point lies exactly
+            // on the bound).
+            param_scale: if width > 0.0 {
+                (width / 10.0).log2().round().exp2()
+            } else {
+                1.0
+            },
             param_tolerance: 1e-10,
             detect: true,
         }

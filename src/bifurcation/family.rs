@@ -9,18 +9,48 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Evaluation, FamilyMap, MapFailure};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
-use crate::gait::{DerivativeError, StepMap};
+use crate::gait::{DerivativeError, StepMap, DERIVATIVE_CHECK_TIGHTENING, MAX_PERIOD};
 use crate::params::{Config, ImpactModel};
 use crate::walk::{Branch, SectionState, StepReport};
+
+/// The names of the border functions of each step of a period-k gait (up to [`MAX_PERIOD`] steps).
+const BORDER_NAMES: [[&str; 3]; MAX_PERIOD] = [
+    ["lambda_I4", "lambda_2_plus", "lambda_4_plus"],
+    ["lambda_I4@2", "lambda_2_plus@2", "lambda_4_plus@2"],
+    ["lambda_I4@3", "lambda_2_plus@3", "lambda_4_plus@3"],
+    ["lambda_I4@4", "lambda_2_plus@4", "lambda_4_plus@4"],
+    ["lambda_I4@5", "lambda_2_plus@5", "lambda_4_plus@5"],
+    ["lambda_I4@6", "lambda_2_plus@6", "lambda_4_plus@6"],
+    ["lambda_I4@7", "lambda_2_plus@7", "lambda_4_plus@7"],
+    ["lambda_I4@8", "lambda_2_plus@8", "lambda_4_plus@8"],
+];
 
 /// What a point of a gait family records: the (first) step's report and the event sequence of the walk.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GaitInfo {
     /// The report of the step from the point (of its first step for a period-k family).
     pub report: StepReport,
+    /// The reports of all its steps (`k` for a period-k family).
+    pub cycle: Vec<StepReport>,
     /// The event sequence ([`StepMap::eval_signature`]).
     pub signature: String,
 }
+
+impl GaitInfo {
+    /// The least period of the gait: the least `j` dividing the family's period `k` with the section state
+    /// before the `j+1`-th touchdown within [`LEAST_PERIOD_TOL`] of the first (a family of `P^k` passes
+    /// through gaits of any period dividing `k`).
+    pub fn least_period(&self) -> usize {
+        let k = self.cycle.len().max(1);
+        (1..k)
+            .filter(|j| k.is_multiple_of(*j))
+            .find(|&j| self.cycle[j].section.distance(&self.cycle[0].section) < LEAST_PERIOD_TOL)
+            .unwrap_or(k)
+    }
+}
+
+/// Section states closer than this are one gait's (for [`GaitInfo::least_period`]).
+pub const LEAST_PERIOD_TOL: f64 = 1e-6;
 
 /// The VRW's step map (or its `k`-th iterate) with one parameter free.
 #[derive(Debug, Clone, Copy)]
@@ -128,6 +158,22 @@ impl<'a> GaitFamily<'a> {
             .with_interrupt(self.interrupt)
     }
 
+    /// The error estimate of the exact `DP` at `(x, p)` (as a gait's, [`crate::gait::DERIVATIVE_CHECK_TIGHTENING`]):
+    /// the largest difference between `jacobian` and `DP` at tolerances that many times tighter; `NaN` where
+    /// it cannot be computed.
+    pub fn jacobian_error(&self, x: &DVector<f64>, p: f64, jacobian: &DMatrix<f64>) -> f64 {
+        let Ok((c, model)) = self.configured(p) else {
+            return f64::NAN;
+        };
+        let tighter = self
+            .step_map(&model, &c)
+            .with_tolerances_scaled(1.0 / DERIVATIVE_CHECK_TIGHTENING);
+        match tighter.eval_with_derivatives(&self.expand(x), None) {
+            Ok(d) if d.jacobian.shape() == jacobian.shape() => (&d.jacobian - jacobian).amax(),
+            _ => f64::NAN,
+        }
+    }
+
     /// `dP/dp` by central differences.
     fn dparam_by_difference(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
         let step = self.fd_step * p.abs().max(1.0);
@@ -175,6 +221,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
                     exact,
                     info: GaitInfo {
                         report: d.outcome.report,
+                        cycle: d.cycle,
                         signature: d.signature,
                     },
                 })
@@ -184,7 +231,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
             // derivatives where a perturbed walk fails (the point is within the difference step of the end of
             // the map's domain).
             Err(_) => {
-                let (out, signature) = map.eval_signature(&s).map_err(walk_failure)?;
+                let signed = map.eval_signature(&s).map_err(walk_failure)?;
                 let n = self.dim();
                 let jacobian = map
                     .central_jacobian(&s, self.fd_step)
@@ -193,13 +240,14 @@ impl<'a> FamilyMap for GaitFamily<'a> {
                     .dparam_by_difference(x, p)
                     .unwrap_or_else(|_| DVector::from_element(n, f64::NAN));
                 Ok(Evaluation {
-                    value: self.reduce(&out.next),
+                    value: self.reduce(&signed.outcome.next),
                     jacobian,
                     dparam,
                     exact: false,
                     info: GaitInfo {
-                        report: out.report,
-                        signature,
+                        report: signed.outcome.report,
+                        cycle: signed.cycle,
+                        signature: signed.signature,
                     },
                 })
             }
@@ -221,22 +269,29 @@ impl<'a> FamilyMap for GaitFamily<'a> {
         self.period
     }
 
-    /// The DLS indicators that decide the impact procedure's branch: `lambda_I4` (between (A1) and (A3)) and,
-    /// where it is not negative, `lambda_2+` and `lambda_4+` (between (B2), the bounce and (B3)); none for rigid
+    /// The DLS indicators that decide the impact procedure's branch at each step's touchdown: `lambda_I4`
+    /// (between (A1) and (A3)) and, where it is not negative, `lambda_2+` and `lambda_4+` (between (B2), the
+    /// bounce and (B3)); named with the step's number after the first (`lambda_2_plus@2`); none for rigid
     /// legs, the traditional impact or a landing with the rear leg in the air.
     fn borders(&self, info: &GaitInfo) -> Vec<(&'static str, f64)> {
         let p = &self.config.params;
-        let r = &info.report;
-        if p.rigid_legs || p.impact != ImpactModel::Dlsi || r.branch == Branch::RearAirborne {
+        if p.rigid_legs || p.impact != ImpactModel::Dlsi {
             return Vec::new();
         }
-        let i = &r.indicators;
-        let after = if i.lambda_i4 >= 0.0 { 1.0 } else { f64::NAN };
-        vec![
-            ("lambda_I4", i.lambda_i4),
-            ("lambda_2_plus", after * i.lambda_2_plus),
-            ("lambda_4_plus", after * i.lambda_4_plus),
-        ]
+        let mut borders = Vec::new();
+        for (r, names) in info.cycle.iter().zip(BORDER_NAMES) {
+            if r.branch == Branch::RearAirborne {
+                continue;
+            }
+            let i = &r.indicators;
+            let after = if i.lambda_i4 >= 0.0 { 1.0 } else { f64::NAN };
+            borders.extend([
+                (names[0], i.lambda_i4),
+                (names[1], after * i.lambda_2_plus),
+                (names[2], after * i.lambda_4_plus),
+            ]);
+        }
+        borders
     }
 
     fn piece(&self, info: &GaitInfo) -> String {

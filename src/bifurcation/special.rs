@@ -219,9 +219,16 @@ pub(crate) fn detect_between<M: FamilyMap>(
         };
         let mut sp = locate(map, a, b, (*ga, *gb), &test, options);
         sp.kind = SpecialKind::BorderCollision;
+        // DP does not exist on the border: the one-sided multipliers are in `sides`.
+        sp.multipliers = Vec::new();
         sp.method = format!("Newton on P(x) = x, {name} = 0: {}", sp.method);
         sp.border = Some(name.to_string());
-        sp.sides = sides(map, a, b, &sp, options);
+        sp.sides = sides(
+            map,
+            &(b.z(options.param_scale) - a.z(options.param_scale)),
+            &sp,
+            options,
+        );
         found.push(sp);
     }
     if !border_crossed && map.piece(&a.info) != map.piece(&b.info) {
@@ -365,11 +372,10 @@ fn newton_extended<M: FamilyMap>(
 }
 
 /// The multipliers of `DP` at [`SIDE_OFFSET`] before and after the located border collision `sp`, along the
-/// family from `a` to `b`.
+/// direction `d` in the scaled unknowns.
 fn sides<M: FamilyMap>(
     map: &M,
-    a: &FamilyPoint<M::Info>,
-    b: &FamilyPoint<M::Info>,
+    d: &DVector<f64>,
     sp: &SpecialPoint<M::Info>,
     options: &ContinuationOptions,
 ) -> Option<[Side; 2]> {
@@ -379,7 +385,7 @@ fn sides<M: FamilyMap>(
     let sigma = options.param_scale;
     let n = sp.x.len();
     let z = DVector::from_fn(n + 1, |i, _| if i < n { sp.x[i] } else { sp.param / sigma });
-    let d = (b.z(sigma) - a.z(sigma)).normalize();
+    let d = d.normalize();
     let side = |sign: f64| -> Option<Side> {
         let (x, p) = split(&(&z + sign * SIDE_OFFSET * &d), sigma);
         let ev = map.eval(&x, p).ok()?;
@@ -391,6 +397,191 @@ fn sides<M: FamilyMap>(
     };
     Some([side(-1.0)?, side(1.0)?])
 }
+
+/// Images of the two sides of a border (at [`SIDE_OFFSET`]) that differ by more than this show a jump of the
+/// step map.
+pub const JUMP_TOL: f64 = 1e-5;
+
+/// How far (in the scaled unknowns) from a family's last point a border at which the family ends may lie.
+pub const END_BORDER_REACH: f64 = 1e-3;
+
+/// Where a family ends without a failure of its map (the corrector fails at every step length just past its
+/// last point `last`, after `previous`): a border collision at which no fixed point continues the family on
+/// the other side. Each border function whose zero, extrapolated linearly from `previous` and `last`, lies
+/// ahead within [`END_BORDER_REACH`] is solved for along the family ([`approach_border`]); the nearest zero
+/// is the end, with the one-sided multipliers along the family's tangent.
+pub(crate) fn border_at_end<M: FamilyMap>(
+    map: &M,
+    previous: Option<&FamilyPoint<M::Info>>,
+    last: &FamilyPoint<M::Info>,
+    options: &ContinuationOptions,
+) -> Option<SpecialPoint<M::Info>> {
+    let sigma = options.param_scale;
+    let z_last = last.z(sigma);
+    let mut best: Option<(f64, SpecialPoint<M::Info>)> = None;
+    let before = previous.map(|p| map.borders(&p.info)).unwrap_or_default();
+    for (name, g) in map.borders(&last.info) {
+        if !g.is_finite() {
+            continue;
+        }
+        // Only a border the family is heading for.
+        if let (Some(prev), Some((_, g_prev))) =
+            (previous, before.iter().find(|(other, _)| *other == name))
+        {
+            let ds = (&z_last - prev.z(sigma)).norm();
+            let ahead = g * ds / (g_prev - g);
+            if !(ahead.is_finite() && ahead >= 0.0 && ahead <= END_BORDER_REACH.max(2.0 * ds)) {
+                continue;
+            }
+        }
+        let Some((point, iterations)) = approach_border(map, previous, last, name, options) else {
+            continue;
+        };
+        let z = point.z(sigma);
+        let distance = (&z - &z_last).norm();
+        if distance > END_BORDER_REACH || best.as_ref().is_some_and(|(d, _)| *d <= distance) {
+            continue;
+        }
+        let test = |info: &M::Info| {
+            map.borders(info)
+                .into_iter()
+                .find(|(other, _)| *other == name)
+                .map_or(f64::NAN, |(_, g)| g)
+        };
+        let ev = Evaluation {
+            value: point.x.clone(),
+            jacobian: point.jacobian.clone(),
+            dparam: point.dparam.clone(),
+            exact: point.exact,
+            info: point.info.clone(),
+        };
+        let iterations_note = format!(
+            "secant along the family on {name} from its last point: {iterations} iterations"
+        );
+        let test_value = test(&ev.info);
+        let residual = point.residual;
+        let (x, p) = split(&z, sigma);
+        let mut sp = SpecialPoint {
+            kind: SpecialKind::BorderCollision,
+            param: p,
+            residual,
+            x,
+            arclength: last.arclength + distance,
+            bracket: [last.param, p],
+            located: true,
+            method: iterations_note,
+            iterations,
+            test_value,
+            multipliers: multipliers(&ev.jacobian),
+            border: Some(name.to_string()),
+            sides: None,
+            info: Some(ev.info),
+            note: None,
+        };
+        sp.sides = sides(map, &last.tangent, &sp, options);
+        // The map at the border: continuous (a nonsmooth fold: no fixed point of the other piece nearby) or
+        // not (the other piece's image jumps away).
+        let jump = {
+            let d = last.tangent.normalize();
+            let at = |sign: f64| {
+                let (xs, ps) = split(&(&z + sign * SIDE_OFFSET * &d), sigma);
+                map.value(&xs, ps).ok()
+            };
+            match (at(-1.0), at(1.0)) {
+                (Some(a), Some(b)) => (a - b).amax(),
+                _ => f64::NAN,
+            }
+        };
+        sp.note = Some(if jump > JUMP_TOL {
+            format!(
+                "the family ends here: the step map jumps by {jump:.3e} across the border, and no fixed point \
+                 continues the family on the other side"
+            )
+        } else {
+            format!(
+                "the family ends here: the step map is continuous across the border (jump {jump:.1e}) but no \
+                 fixed point continues the family on the other side"
+            )
+        });
+        // DP does not exist on the border: the one-sided multipliers are in `sides`.
+        sp.multipliers = Vec::new();
+        best = Some((distance, sp));
+    }
+    best.map(|(_, sp)| sp)
+}
+
+/// The zero of the border function `name` ahead of the family's last point `last`, approached along the
+/// family from its side: secant steps in the arclength `s` along `last`'s tangent, each trial corrected onto
+/// the family (on the hyperplane normal to the tangent, with `last`'s matrix held); a trial whose corrector
+/// fails lies past the border (the family does not continue there) and is halved back toward the last point
+/// that worked. Stops when successive points differ by less than the parameter tolerance in `p` and
+/// `1e-9` in the state; the point nearest the border and the iterations.
+fn approach_border<M: FamilyMap>(
+    map: &M,
+    previous: Option<&FamilyPoint<M::Info>>,
+    last: &FamilyPoint<M::Info>,
+    name: &str,
+    options: &ContinuationOptions,
+) -> Option<(FamilyPoint<M::Info>, usize)> {
+    let sigma = options.param_scale;
+    let z0 = last.z(sigma);
+    let t = &last.tangent;
+    let g = |p: &FamilyPoint<M::Info>| {
+        map.borders(&p.info)
+            .into_iter()
+            .find(|(other, _)| *other == name)
+            .map_or(f64::NAN, |(_, g)| g)
+    };
+    let m = bordered(&augmented(&last.jacobian, &last.dparam, sigma), t);
+    let at = |s: f64| -> Option<FamilyPoint<M::Info>> {
+        let (z, _) = correct(map, &(&z0 + s * t), t, &m, options).ok()?;
+        point_at(map, &z, t, options).ok()
+    };
+    // Two points on this side: the last, and the previous (or one just behind the last).
+    let behind = match previous {
+        Some(p) => (t.dot(&(p.z(sigma) - &z0)), g(p)),
+        None => {
+            let s = -SIDE_OFFSET * 10.0;
+            (s, g(&at(s)?))
+        }
+    };
+    let (mut s_a, mut g_a, mut best) = (0.0, g(last), last.clone());
+    let (mut s_b, mut g_b) = behind;
+    let tol = options.param_tolerance * last.param.abs().max(1.0);
+    for iteration in 1..=MAX_APPROACH_ITERATIONS {
+        if !(g_a.is_finite() && g_b.is_finite()) || g_a == g_b {
+            return None;
+        }
+        let mut s_new = s_a - g_a * (s_a - s_b) / (g_a - g_b);
+        if !(s_new.is_finite() && s_new >= s_b.min(0.0) && s_new <= END_BORDER_REACH) {
+            return None;
+        }
+        let mut point = None;
+        for _ in 0..MAX_APPROACH_HALVINGS {
+            if let Some(p) = at(s_new) {
+                point = Some(p);
+                break;
+            }
+            s_new = 0.5 * (s_a + s_new);
+        }
+        let point = point?;
+        let converged =
+            (point.param - best.param).abs() < tol && (&point.x - &best.x).amax() < 1e-9;
+        (s_b, g_b) = (s_a, g_a);
+        (s_a, g_a) = (s_new, g(&point));
+        best = point;
+        if converged {
+            return Some((best, iteration));
+        }
+    }
+    None
+}
+
+/// Secant steps allowed to approach a border at a family's end.
+const MAX_APPROACH_ITERATIONS: usize = 60;
+
+/// Halvings of a secant step that lands past the border.
+const MAX_APPROACH_HALVINGS: usize = 40;
 
 /// The change of piece between `a` and `b` bracketed by bisection along the family: each midpoint of the
 /// bracket corrected onto the family on the hyperplane through it normal to the bracket, until the bracket's

@@ -4,6 +4,7 @@
 
 mod animate;
 mod basin;
+mod continuation;
 mod gait;
 mod map;
 mod orbit;
@@ -46,6 +47,10 @@ enum Command {
     Orbit(orbit::OrbitArgs),
     /// Basin of the gait on a slice of the Poincare section: what the walk from every grid point does.
     Basin(basin::BasinArgs),
+    /// Follow the gait family through folds by pseudo-arclength continuation in one parameter: its special
+    /// points (fold, period doubling, Neimark-Sacker, border collision) located by solving for them, the
+    /// period-2 family of every period doubling, branch.csv, special_points.json and a bifurcation diagram.
+    Continue(continuation::ContinueArgs),
     /// Map the gait over two parameters: map.csv, the threshold curves (curves.json) and heat maps (map.png).
     Map(map::MapArgs),
     /// Animate a run: DIR/walk.gif from the output directory of `simulate` or `gait`.
@@ -121,6 +126,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Sweep(args) => sweep::run(args),
         Command::Orbit(args) => orbit::run(args),
         Command::Basin(args) => basin::run(args),
+        Command::Continue(args) => continuation::run(args),
         Command::Map(args) => map::run(args),
         Command::Animate(args) => animate::run(args),
         Command::Plot(args) => plot::run(&args),

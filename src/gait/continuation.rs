@@ -120,7 +120,7 @@ pub enum Followed {
 /// What happens just past the end of a family.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
-pub(crate) enum EndCause {
+pub enum EndCause {
     /// The walk from the family's last gait fails: `failure` is its kind (`rolled_back`, `fell`, ...).
     WalkFails {
         /// Failure kind.
@@ -139,7 +139,7 @@ pub(crate) enum EndCause {
         /// Its period in steps (1 for a fixed point of `P`).
         period_k: usize,
     },
-    /// The family folds: the largest Floquet multiplier of its last gait is within [`FOLD_TOL`] of +1 (a
+    /// The family folds: the largest Floquet multiplier of its last gait is within `FOLD_TOL` (0.05) of +1 (a
     /// saddle-node, where the gait meets an unstable one and both vanish), and the walk drifts slowly.
     Fold {
         /// The multiplier closest to +1.

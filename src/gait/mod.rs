@@ -22,7 +22,7 @@ pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions, Stability};
 pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
 pub use options::{FD_STEP_RANGE, MAX_NEWTON_ITERATIONS, MAX_TRANSIENT_STEPS, TOLERANCE_RANGE};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
-pub use step_map::{DerivativeError, StepDerivatives, StepMap, StepOutcome};
+pub use step_map::{DerivativeError, SignedOutcome, StepDerivatives, StepMap, StepOutcome};
 pub use sweep::{
     check_values, sweep, sweep_values, FollowAttempt, RangeNames, SweepPoint, SweepSpec,
     MAX_SWEEP_POINTS, SWEEP_RANGE,

@@ -55,6 +55,19 @@ pub struct StepDerivatives {
     pub dparam: Option<DVector<f64>>,
     /// The event sequence of the walk (see [`StepMap::eval_signature`]).
     pub signature: String,
+    /// The report of every step walked (`k` of them for `P^k`; the first is `outcome.report`).
+    pub cycle: Vec<StepReport>,
+}
+
+/// One evaluation of the step map with the event sequence of its walk ([`StepMap::eval_signature`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SignedOutcome {
+    /// `P(s)` and the (first) step's report.
+    pub outcome: StepOutcome,
+    /// The event sequence.
+    pub signature: String,
+    /// The report of every step walked.
+    pub cycle: Vec<StepReport>,
 }
 
 /// Why [`StepMap::eval_with_derivatives`] gave no derivatives.
@@ -199,7 +212,7 @@ impl<'m> StepMap<'m> {
             (unit(0, s.l2), unit(1, s.theta_dot), unit(2, s.l2_dot)),
         );
         let mut sens: Sensitivity = sensitivity(&q, &qd);
-        let mut report = None;
+        let mut cycle = Vec::with_capacity(self.iterate);
         let mut words = Vec::with_capacity(self.iterate);
         for _ in 0..self.iterate {
             let start = walker.state().clone();
@@ -207,7 +220,7 @@ impl<'m> StepMap<'m> {
             let step = walker.step_taped(&mut tape)?;
             words.push(tape.signature(step.branch));
             on_border(model, &step)?;
-            report.get_or_insert(step);
+            cycle.push(step);
             sens = replay_step(
                 model,
                 &self.opts,
@@ -219,7 +232,7 @@ impl<'m> StepMap<'m> {
             .sensitivity;
         }
         let next = walker.section()?;
-        let report = report.expect("at least one step is walked");
+        let report = cycle[0];
         // Rows of the next section state (L2, dtheta/dt, dL2/dt) in (q, q').
         let rows = [L2, NQ + THETA, NQ + L2];
         let free = self.free_coordinates();
@@ -233,25 +246,32 @@ impl<'m> StepMap<'m> {
             jacobian,
             dparam,
             signature: words.join(" / "),
+            cycle,
         })
     }
 
     /// Evaluate `P(s)` (`P^k(s)`) as [`StepMap::eval`] does, with the event sequence of its walk: the words of
     /// each step's record (`TD DLS UNLOCK1 LIFT2 LOCK2`: the touchdown's branch, then the changes of contacts
     /// and stoppers between its phases), the steps of an iterated map joined by ` / `.
-    pub fn eval_signature(&self, s: &SectionState) -> Result<(StepOutcome, String), WalkError> {
+    pub fn eval_signature(&self, s: &SectionState) -> Result<SignedOutcome, WalkError> {
         let mut walker = self.walker(s)?;
-        let mut report = None;
+        let mut cycle = Vec::with_capacity(self.iterate);
         let mut words = Vec::with_capacity(self.iterate);
         for _ in 0..self.iterate {
             let mut tape = StepTape::default();
             let step = walker.step_taped(&mut tape)?;
             words.push(tape.signature(step.branch));
-            report.get_or_insert(step);
+            cycle.push(step);
         }
         let next = walker.section()?;
-        let report = report.expect("at least one step is walked");
-        Ok((StepOutcome { next, report }, words.join(" / ")))
+        Ok(SignedOutcome {
+            outcome: StepOutcome {
+                next,
+                report: cycle[0],
+            },
+            signature: words.join(" / "),
+            cycle,
+        })
     }
 
     /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.

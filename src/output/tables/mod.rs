@@ -4,10 +4,12 @@
 //! from that list.
 //!
 //! One file per table (or per job's tables): `steps.csv` and `trajectory.csv` of a walk, `sweep.csv`,
-//! `map.csv`, and the attractor tables `orbit.csv`, `branch.csv` and `basin.csv`. Each file holds the
+//! `map.csv`, the attractor tables `orbit.csv`, `branch.csv` and `basin.csv`, and the families of
+//! `vrw continue` (`branch.csv` too: its own directory). Each file holds the
 //! declaration and the writer of its tables.
 
 pub(crate) mod attractors;
+pub(crate) mod family;
 pub(crate) mod map;
 pub(crate) mod steps;
 pub(crate) mod sweep;

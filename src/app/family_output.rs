@@ -1,0 +1,177 @@
+//! The files of `vrw continue` (docs/model.md section 11): `branch.csv`, `special_points.json` and the
+//! bifurcation diagram `bifurcation.{svg,png}`.
+
+use super::family::{compute_continuation, ContinueJob, ContinueResult};
+use super::{axis_label, in_run, AppError};
+use crate::gait::Stability;
+use crate::output::bifurcation_plot::{
+    BifurcationFigure, DiagramFamily, DiagramSpecial, BIFURCATION_SIZE,
+};
+use crate::output::chart::write_svg_png;
+use crate::output::manifest::RunDir;
+use crate::output::{write_family_csv, write_json, FamilyRow};
+
+/// Run `vrw continue`: [`compute_continuation`], then write `branch.csv`, `special_points.json` and the
+/// diagram.
+pub fn run_continuation(job: &ContinueJob) -> Result<ContinueResult, AppError> {
+    let mut result = compute_continuation(job)?;
+    in_run(&job.out_dir, "continue", |run| {
+        write_continuation(job, &mut result, run)?;
+        Ok((result, None))
+    })
+}
+
+/// Write the files of a computed continuation into `run`.
+fn write_continuation(
+    job: &ContinueJob,
+    result: &mut ContinueResult,
+    run: &mut RunDir,
+) -> Result<(), AppError> {
+    let param = &job.param;
+    let rows: Vec<FamilyRow> = result
+        .families
+        .iter()
+        .zip(&result.stability)
+        .enumerate()
+        .flat_map(|(k, (family, verdicts))| {
+            family.points.iter().zip(verdicts).enumerate().map(
+                move |(index, (point, &stability))| FamilyRow {
+                    family: k + 1,
+                    period_k: family.period,
+                    index,
+                    point,
+                    stability,
+                },
+            )
+        })
+        .collect();
+    write_family_csv(&run.path("branch.csv"), param, &rows)?;
+    run.add("branch.csv");
+    let mut files = vec!["branch.csv".to_string()];
+    let figure = diagram(job, result);
+    write_svg_png(
+        &figure,
+        &run.path("bifurcation.svg"),
+        &run.path("bifurcation.png"),
+        BIFURCATION_SIZE,
+    )?;
+    for name in ["bifurcation.svg", "bifurcation.png"] {
+        run.add(name);
+        files.push(name.to_string());
+    }
+    files.insert(1, "special_points.json".to_string());
+    result.summary.files = files;
+    write_json(&run.path("special_points.json"), &result.summary)?;
+    run.add("special_points.json");
+    Ok(())
+}
+
+/// The bifurcation diagram of a computed continuation.
+fn diagram(job: &ContinueJob, result: &ContinueResult) -> BifurcationFigure {
+    let families: Vec<DiagramFamily> = result
+        .families
+        .iter()
+        .zip(&result.stability)
+        .enumerate()
+        .map(|(k, (f, verdicts))| {
+            // One line per step of the period (the multipliers are the orbit's: one line).
+            let phases = if job.plot == "max_floquet" {
+                1
+            } else {
+                f.period
+            };
+            DiagramFamily {
+                label: format!("family {} (period {})", k + 1, f.period),
+                phases: (0..phases)
+                    .map(|j| {
+                        f.points
+                            .iter()
+                            .zip(verdicts)
+                            .map(|(p, s)| {
+                                let stable = match s {
+                                    Stability::Stable => Some(true),
+                                    Stability::Unstable => Some(false),
+                                    Stability::Uncertain => None,
+                                };
+                                let value = match job.plot.as_str() {
+                                    "max_floquet" => p.max_multiplier(),
+                                    q => p
+                                        .info
+                                        .cycle
+                                        .get(j)
+                                        .map_or(f64::NAN, |r| quantity_of_report(r, q)),
+                                };
+                                (p.param, value, stable)
+                            })
+                            .collect()
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    let special = result
+        .families
+        .iter()
+        .enumerate()
+        .flat_map(|(k, f)| {
+            f.special.iter().map(move |s| DiagramSpecial {
+                family: k,
+                param: s.param,
+                value: match job.plot.as_str() {
+                    "max_floquet" => s.multipliers.first().map_or(f64::NAN, |m| m.norm()),
+                    q => s
+                        .info
+                        .as_ref()
+                        .map_or(f64::NAN, |i| quantity_of_report(&i.report, q)),
+                },
+                label: s.kind.label().to_string(),
+            })
+        })
+        .collect();
+    BifurcationFigure {
+        title: format!(
+            "Gait families in {} (period of the start: {})",
+            job.param,
+            result.families.first().map_or(1, |f| f.period)
+        ),
+        param_label: axis_label(&job.param),
+        y_label: quantity_label(&job.plot),
+        x: job.from..job.to,
+        families,
+        special,
+    }
+}
+
+/// The axis label of a quantity of [`super::DIAGRAM_QUANTITIES`], with its unit.
+fn quantity_label(quantity: &str) -> String {
+    match quantity {
+        "L2" => "L2 before touchdown [m]",
+        "thetadot" => "dθ/dt before touchdown [rad/s]",
+        "L2dot" => "dL2/dt before touchdown [m/s]",
+        "lambda_I4" => "λI4 [N s]",
+        "lambda_2_plus" => "λ2+ [N]",
+        "lambda_4_plus" => "λ4+ [N]",
+        "max_floquet" => "largest |Floquet multiplier|",
+        "period" => "step period [s]",
+        "speed" => "speed [m/s]",
+        "dls_duration" => "DLS duration [s]",
+        other => other,
+    }
+    .to_string()
+}
+
+/// The value of a report quantity (those of [`super::DIAGRAM_QUANTITIES`] other than `max_floquet`).
+fn quantity_of_report(r: &crate::walk::StepReport, quantity: &str) -> f64 {
+    match quantity {
+        "L2" => r.section.l2,
+        "thetadot" => r.section.theta_dot,
+        "L2dot" => r.section.l2_dot,
+        "lambda_I4" => r.indicators.lambda_i4,
+        "lambda_2_plus" => r.indicators.lambda_2_plus,
+        "lambda_4_plus" => r.indicators.lambda_4_plus,
+        "period" => r.period,
+        "speed" => r.speed,
+        "dls_duration" => r.dls_duration,
+        _ => f64::NAN,
+    }
+}

@@ -1,0 +1,140 @@
+//! The records `vrw continue` writes into `special_points.json` (docs/model.md section 11): families with
+//! their ends and causes, special points with their sides.
+
+use serde::Serialize;
+
+use crate::bifurcation::special::Side;
+use crate::bifurcation::{FamilyEnd, GaitInfo, SpecialKind, SpecialPoint};
+use crate::gait::continuation::EndCause;
+
+/// How a family ends at one side, with the physical cause found by walking just past it.
+#[derive(Debug, Clone, Serialize)]
+pub struct EndRecord {
+    /// How following it stopped.
+    #[serde(flatten)]
+    pub end: FamilyEnd,
+    /// What the walk from the last gait does just past the end (where the map failed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cause: Option<EndCause>,
+}
+
+/// One family in `special_points.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct FamilyRecord {
+    /// Its number (`family` in `branch.csv`), from 1.
+    pub family: usize,
+    /// Steps per period of its gaits.
+    pub period_k: usize,
+    /// Points in `branch.csv`.
+    pub points: usize,
+    /// Where it came from: `start`, or the special point (index into `special_points`) it was switched to
+    /// from.
+    pub origin: String,
+    /// How it ends at its first point and at its last.
+    pub ends: [EndRecord; 2],
+}
+
+/// The section state of a point, as written.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct SectionRecord {
+    /// `L2` \[m\].
+    #[serde(rename = "L2")]
+    pub l2: f64,
+    /// `dtheta/dt` \[rad/s\].
+    pub thetadot: f64,
+    /// `dL2/dt` \[m/s\].
+    #[serde(rename = "L2dot")]
+    pub l2dot: f64,
+}
+
+/// One side of a border collision, as written.
+#[derive(Debug, Clone, Serialize)]
+pub struct SideRecord {
+    /// Where its multipliers were taken.
+    pub param: f64,
+    /// The event sequence there.
+    pub signature: String,
+    /// Its multipliers `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+}
+
+/// One special point in `special_points.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpecialRecord {
+    /// The family it lies on.
+    pub family: usize,
+    /// `LP`, `PD`, `NS` or `BC`.
+    pub kind: SpecialKind,
+    /// The parameter.
+    pub param: f64,
+    /// The gait's section state there (`null` fields if unknown).
+    pub section: SectionRecord,
+    /// Arclength along its family.
+    pub arclength: f64,
+    /// The parameters of the two family points it was detected between.
+    pub bracket: [f64; 2],
+    /// Located by solving (false: detected only, see `note`).
+    pub located: bool,
+    /// How.
+    pub method: String,
+    /// `max |P(s) - s|` there.
+    pub residual: f64,
+    /// The test function there.
+    pub test_value: f64,
+    /// The multipliers there `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+    /// For a border collision: the indicator crossing zero, or `event sequence`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub border: Option<String>,
+    /// For a border collision: the two sides, in the order the family was followed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sides: Option<Vec<SideRecord>>,
+    /// The event sequence there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub signature: Option<String>,
+    /// Why it is not located, or what else is worth knowing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// A special point as written.
+pub(crate) fn special_record(family: usize, s: &SpecialPoint<GaitInfo>) -> SpecialRecord {
+    let pairs = |m: &[nalgebra::Complex<f64>]| m.iter().map(|z| [z.re, z.im]).collect();
+    let section = s.info.as_ref().map_or(
+        SectionRecord {
+            l2: f64::NAN,
+            thetadot: f64::NAN,
+            l2dot: f64::NAN,
+        },
+        |i| SectionRecord {
+            l2: i.report.section.l2,
+            thetadot: i.report.section.theta_dot,
+            l2dot: i.report.section.l2_dot,
+        },
+    );
+    let side = |side: &Side| SideRecord {
+        param: side.param,
+        signature: side.piece.clone(),
+        multipliers: pairs(&side.multipliers),
+    };
+    SpecialRecord {
+        family,
+        kind: s.kind,
+        param: s.param,
+        section,
+        arclength: s.arclength,
+        bracket: s.bracket,
+        located: s.located,
+        method: s.method.clone(),
+        residual: s.residual,
+        test_value: s.test_value,
+        multipliers: pairs(&s.multipliers),
+        border: s.border.clone(),
+        sides: s
+            .sides
+            .as_ref()
+            .map(|sides| sides.iter().map(side).collect()),
+        signature: s.info.as_ref().map(|i| i.signature.clone()),
+        note: s.note.clone(),
+    }
+}

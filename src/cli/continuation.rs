@@ -1,0 +1,156 @@
+//! The `vrw continue` command: its options and the summary it prints.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use vrw::app::{run_continuation, ContinueJob, DIAGRAM_QUANTITIES};
+use vrw::bifurcation::FamilyEnd;
+use vrw::walk::SectionState;
+
+use super::{flagged, interrupt_flag, print_warnings, ModelArgs};
+
+#[derive(Debug, Args)]
+pub(super) struct ContinueArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The parameter followed: one of the real-valued keys (as for sweep).
+    #[arg(long, default_value = "viscosity")]
+    param: String,
+    /// Where the first gait is searched: the parameter's value (default: its value in the configuration).
+    #[arg(long, allow_hyphen_values = true)]
+    start: Option<f64>,
+    /// Lower end of the range the families are followed in.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    from: f64,
+    /// Upper end of the range.
+    #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
+    to: f64,
+    /// Where the search for the first gait starts, `L2,thetadot,L2dot`; default as for simulate.
+    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    initial: Option<SectionState>,
+    /// Follow the family of period-k gaits (fixed points of P^k); default: the period the gait search finds.
+    #[arg(long)]
+    period: Option<usize>,
+    /// Most points of a family in each direction from its start.
+    #[arg(long, default_value_t = 300)]
+    max_points: usize,
+    /// Largest continuation step, in the scaled unknowns (section state, parameter / (range / 10)).
+    #[arg(long, default_value_t = 0.1)]
+    max_step: f64,
+    /// Do not follow the period-2 family born at each period doubling.
+    #[arg(long)]
+    no_switch: bool,
+    /// The quantity the diagram draws against the parameter.
+    #[arg(long, default_value = "thetadot", help = plot_help())]
+    plot: String,
+    /// Output directory for branch.csv, special_points.json and bifurcation.{svg,png}.
+    #[arg(long, default_value = "out/continue")]
+    out: PathBuf,
+}
+
+/// Help of `continue --plot`.
+fn plot_help() -> String {
+    format!(
+        "The quantity the diagram draws against the parameter, one of: {}",
+        DIAGRAM_QUANTITIES.join(", ")
+    )
+}
+
+/// How a family ends, in words.
+fn end_words(end: &FamilyEnd) -> String {
+    match end {
+        FamilyEnd::LeftRange { bound } => format!("reaches the end of the range at {bound}"),
+        FamilyEnd::Closed => "closes on itself".to_string(),
+        FamilyEnd::MaxPoints => "followed to --max-points".to_string(),
+        FamilyEnd::Ended {
+            param,
+            beyond,
+            failure,
+            message,
+        } if beyond.is_nan() => format!("ends at {param:.9} ({failure}: {message})"),
+        FamilyEnd::Ended {
+            param,
+            beyond,
+            failure,
+            ..
+        } => format!("ends at {param:.9} ({failure} at {beyond:.9})"),
+    }
+}
+
+/// Run `vrw continue` and print its summary.
+pub(super) fn run(args: ContinueArgs) -> Result<()> {
+    let flag = interrupt_flag();
+    let job = ContinueJob {
+        config: args.model.load()?,
+        param: args.param.clone(),
+        start: args.start,
+        from: args.from,
+        to: args.to,
+        initial: args.initial,
+        period: args.period,
+        max_points: args.max_points,
+        max_step: args.max_step,
+        switch: !args.no_switch,
+        plot: args.plot.clone(),
+        out_dir: args.out.clone(),
+        interrupt: Some(flag),
+    };
+    let result = run_continuation(&job)
+        .map_err(flagged)
+        .context("continue")?;
+    let s = &result.summary;
+    println!(
+        "vrw continue: {} from {} to {}, from the period-{} gait at {}: {} families, {} special points; {:.2} s",
+        s.param,
+        args.from,
+        args.to,
+        result.families.first().map_or(1, |f| f.period),
+        s.start,
+        s.families.len(),
+        s.special_points.len(),
+        s.seconds
+    );
+    for f in &s.families {
+        println!(
+            "  family {} (period {}, {} points, from {}): {}; {}",
+            f.family,
+            f.period_k,
+            f.points,
+            f.origin,
+            end_words(&f.ends[0].end),
+            end_words(&f.ends[1].end)
+        );
+    }
+    for sp in &s.special_points {
+        let located = if sp.located {
+            ""
+        } else {
+            " (detected, not located)"
+        };
+        let what = sp
+            .border
+            .as_deref()
+            .map(|b| format!(" {b}"))
+            .unwrap_or_default();
+        let modulus = sp
+            .multipliers
+            .first()
+            .map(|m| format!(", |mu| = {:.6}", m[0].hypot(m[1])))
+            .unwrap_or_default();
+        println!(
+            "  {} family {}: {} = {:.9}{what}{modulus}{located}",
+            serde_json::to_value(sp.kind)
+                .ok()
+                .and_then(|v| v.as_str().map(str::to_string))
+                .unwrap_or_default(),
+            sp.family,
+            s.param,
+            sp.param,
+        );
+    }
+    print_warnings(&s.warnings, "special_points.json");
+    println!("wrote {}/{{{}}}", args.out.display(), s.files.join(", "));
+    Ok(())
+}
