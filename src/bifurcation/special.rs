@@ -607,15 +607,25 @@ fn bisect_piece<M: FamilyMap>(
         let mid = (&zl + &zh) * 0.5;
         let d = (&zh - &zl).normalize();
         let m = bordered(&augmented(&lo.jacobian, &lo.dparam, sigma), &d);
+        // With the matrix of the bracket's end on the old piece, or (where `DP` jumps across the border and
+        // that fails) with the midpoint's own.
         let point = correct(map, &mid, &d, &m, options)
+            .or_else(|_| {
+                let (x, p) = split(&mid, sigma);
+                let ev = map.eval(&x, p)?;
+                let fresh = bordered(&augmented(&ev.jacobian, &ev.dparam, sigma), &d);
+                correct(map, &mid, &d, &fresh, options)
+            })
             .and_then(|(z, _)| point_at(map, &z, &lo.tangent, options));
         match point {
             Ok(point) if map.piece(&point.info) == piece_a => lo = point,
             Ok(point) => hi = point,
             Err(e) => {
                 note = Some(format!(
-                    "the bisection stopped after {steps} steps: {}",
-                    e.message
+                    "the bisection stopped after {steps} steps, the bracket [{}, {}] holding no fixed point \
+                     at its middle ({}): the family may jump across this border (a discontinuity of the step \
+                     map)",
+                    lo.param, hi.param, e.message
                 ));
                 break;
             }
