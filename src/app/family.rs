@@ -11,9 +11,10 @@ use serde::Serialize;
 
 use super::family_records::{special_record, EndRecord, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
+use crate::bifurcation::special::JUMP_TOL;
 use crate::bifurcation::{
-    continue_family, switch_at_period_doubling, ContinuationError, ContinuationOptions, Family,
-    FamilyEnd, FamilyMap, GaitFamily, GaitInfo, SpecialKind,
+    continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
+    ContinuationOptions, Family, FamilyEnd, FamilyMap, GaitFamily, GaitInfo, SpecialKind,
 };
 use crate::gait::continuation::{Continuation, EndCause, FamilyPoint as GaitPoint};
 use crate::gait::MAX_PERIOD;
@@ -328,7 +329,7 @@ struct Followed<'a> {
 }
 
 /// The families born from family `k` (branch switching): the period-2 family of each of its located period
-/// doublings, and the family of each gait that a walk past one of its `ends` settles on (unless a family
+/// doublings, the other piece's family at each border collision where it ends, and the family of each gait that a walk past one of its `ends` settles on (unless a family
 /// already followed passes through that gait). A family that cannot be started is a warning.
 fn switched_families<'a>(
     job: &ContinueJob,
@@ -358,6 +359,38 @@ fn switched_families<'a>(
                         k + 1,
                         job.param,
                         pd.param
+                    )
+                }),
+        );
+    }
+    for (i, bc) in parent.family.special.iter().enumerate() {
+        // Where the map jumps across the border, no fixed point of the other piece is near: the walk past
+        // the end (below) looks for what takes over.
+        if bc.kind != SpecialKind::BorderCollision
+            || !bc.ends_family
+            || !bc.located
+            || bc.jump.is_nan()
+            || bc.jump > JUMP_TOL
+        {
+            continue;
+        }
+        born.push(
+            switch_at_border(&parent.map, bc, options)
+                .map(|family| Followed {
+                    family,
+                    origin: format!(
+                        "family {} special point {i} (BC: the other piece's fixed points)",
+                        k + 1
+                    ),
+                    map: parent.map,
+                    ends: None,
+                })
+                .map_err(|e| {
+                    format!(
+                        "family {} BC at {} = {}: no family of the other piece followed: {e}",
+                        k + 1,
+                        job.param,
+                        bc.param
                     )
                 }),
         );

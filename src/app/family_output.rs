@@ -3,6 +3,7 @@
 
 use super::family::{compute_continuation, ContinueJob, ContinueResult};
 use super::{axis_label, in_run, AppError};
+use crate::bifurcation::FamilyEnd;
 use crate::gait::Stability;
 use crate::output::bifurcation_plot::{
     BifurcationFigure, DiagramFamily, DiagramSpecial, BIFURCATION_SIZE,
@@ -80,7 +81,23 @@ fn diagram(job: &ContinueJob, result: &ContinueResult) -> BifurcationFigure {
             } else {
                 f.period
             };
+            let ends = result.summary.families[k]
+                .ends
+                .iter()
+                .zip([f.points.first(), f.points.last()])
+                .filter_map(|(end, point)| match (&end.end, point) {
+                    (FamilyEnd::Ended { failure, .. }, Some(p)) => {
+                        let value = match job.plot.as_str() {
+                            "max_floquet" => p.max_multiplier(),
+                            q => quantity_of_report(&p.info.report, q),
+                        };
+                        Some((p.param, value, failure.clone()))
+                    }
+                    _ => None,
+                })
+                .collect();
             DiagramFamily {
+                ends,
                 label: format!("family {} (period {})", k + 1, f.period),
                 phases: (0..phases)
                     .map(|j| {

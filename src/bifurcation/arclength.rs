@@ -68,14 +68,16 @@ pub enum FamilyEnd {
     /// [`ContinuationOptions::max_points`] points were followed.
     MaxPoints,
     /// The step fell below [`ContinuationOptions::min_step`]: the family cannot be followed further. `failure`
-    /// is the last failure of the map (the walk rolls back, falls, ...), or of the corrector if the map never
-    /// failed. Where the map failed, the end is bracketed in the parameter to
+    /// is the last failure of the map (the walk rolls back, falls, ...); where the map never failed, `border`
+    /// if a border collision was found at the end (a special point), else the corrector's or the step
+    /// control's (`corrector`, `step`). Where the map failed, the end is bracketed in the parameter to
     /// [`ContinuationOptions::param_tolerance`] times `max(1, |p|)` by bisection at fixed parameter from the
     /// last point (a border of the map's domain has no smooth test function to solve for).
     Ended {
         /// The parameter at the last point.
         param: f64,
-        /// The nearest parameter beyond it where the map failed (`NaN` if it never did).
+        /// The nearest parameter beyond it where the map failed; just past the border at a `border` end;
+        /// `NaN` otherwise.
         beyond: f64,
         /// The failure's kind (`corrector` where the corrector did not converge without a failure of the map).
         failure: String,
@@ -215,8 +217,20 @@ fn follow<M: FamilyMap>(
                         let step = options.param_tolerance.max(1e-7) * b.param.abs().max(1.0);
                         b.param + step.copysign(b.param - current.param)
                     });
+                    // The border is the end's cause where one was found; else the corrector's last failure.
+                    let failure = match &border {
+                        Some(b) => MapFailure {
+                            kind: "border".to_string(),
+                            message: format!(
+                                "{} = 0 at {}: {}",
+                                b.border.as_deref().unwrap_or("a border"),
+                                b.param,
+                                b.note.as_deref().unwrap_or("the family ends there")
+                            ),
+                        },
+                        None => last_failure.unwrap_or_else(|| corrector_failure(0, f64::NAN)),
+                    };
                     special.extend(border);
-                    let failure = last_failure.unwrap_or_else(|| corrector_failure(0, f64::NAN));
                     FamilyEnd::Ended {
                         param: current.param,
                         beyond,

@@ -25,7 +25,7 @@ pub use arclength::{continue_family, ContinuationError, Family, FamilyEnd};
 pub use corrector::{ContinuationOptions, FamilyPoint};
 pub use family::{GaitFamily, GaitInfo};
 pub use special::{SpecialKind, SpecialPoint};
-pub use switch::switch_at_period_doubling;
+pub use switch::{switch_at_border, switch_at_period_doubling};
 
 /// One evaluation of a family's map: `P(x; p)`, `DP`, `dP/dp` and what the map records of the point.
 #[derive(Debug, Clone, PartialEq)]

@@ -113,6 +113,13 @@ pub struct SpecialPoint<I> {
     pub info: Option<I>,
     /// Why it is not located, or what else is worth knowing.
     pub note: Option<String>,
+    /// The direction the family was followed in at the point (unit, in the scaled unknowns).
+    pub direction: DVector<f64>,
+    /// The family ends here (a border collision past which no fixed point continues it).
+    pub ends_family: bool,
+    /// At a border collision where the family ends: how far the step map's images on the two sides of the
+    /// border differ ([`JUMP_TOL`] and more: the map is discontinuous there); `NaN` otherwise.
+    pub jump: f64,
 }
 
 /// `det(DP - I)`.
@@ -280,6 +287,9 @@ fn locate<M: FamilyMap>(
         sides: None,
         info: None,
         note: None,
+        direction: (&zb - &za).normalize(),
+        ends_family: false,
+        jump: f64::NAN,
     };
     match newton_extended(map, &z0, test, options) {
         Ok((z, ev, iterations)) => {
@@ -477,6 +487,9 @@ pub(crate) fn border_at_end<M: FamilyMap>(
             sides: None,
             info: Some(ev.info),
             note: None,
+            direction: last.tangent.normalize(),
+            ends_family: true,
+            jump: f64::NAN,
         };
         sp.sides = sides(map, &last.tangent, &sp, options);
         // The map at the border: continuous (a nonsmooth fold: no fixed point of the other piece nearby) or
@@ -492,6 +505,7 @@ pub(crate) fn border_at_end<M: FamilyMap>(
                 _ => f64::NAN,
             }
         };
+        sp.jump = jump;
         sp.note = Some(if jump > JUMP_TOL {
             format!(
                 "the family ends here: the step map jumps by {jump:.3e} across the border, and no fixed point \
@@ -656,5 +670,8 @@ fn bisect_piece<M: FamilyMap>(
         sides: Some([side(&lo), side(&hi)]),
         info: Some(lo.info.clone()),
         note,
+        direction: (hi.z(sigma) - lo.z(sigma)).normalize(),
+        ends_family: false,
+        jump: f64::NAN,
     }
 }

@@ -65,6 +65,9 @@ fn end_words(end: &FamilyEnd) -> String {
         FamilyEnd::Closed => "closes on itself".to_string(),
         FamilyEnd::MaxPoints => "followed to --max-points".to_string(),
         FamilyEnd::Ended {
+            failure, message, ..
+        } if failure == "border" => format!("ends at a border collision, {message}"),
+        FamilyEnd::Ended {
             param,
             beyond,
             failure,

@@ -48,6 +48,9 @@ pub(crate) struct DiagramFamily {
     /// One line per phase of its gaits (`k` for a period-k family, whose steps each have their own value),
     /// each of points in order of arclength: parameter, value drawn, stable (`None`: uncertain or unknown).
     pub phases: Vec<Vec<(f64, f64, Option<bool>)>>,
+    /// Where it ends without reaching the range's end or closing (the first phase's last value), and why
+    /// (`rolled_back`, `stalled`, ...): marked with a cross and the word.
+    pub ends: Vec<(f64, f64, String)>,
 }
 
 /// One special point of the diagram.
@@ -190,6 +193,37 @@ impl Figure for BifurcationFigure {
                 (at.0 + SPECIAL_R + 4, at.1 - SPECIAL_R - 4),
                 font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Bottom)),
             ))?;
+        }
+        for (k, family) in self.families.iter().enumerate() {
+            for (param, value, why) in &family.ends {
+                if !(param.is_finite() && value.is_finite() && self.x.contains(param)) {
+                    continue;
+                }
+                let at = to_px((*param, *value));
+                let style = family_color(k).stroke_width(3);
+                let r = SPECIAL_R;
+                panel.draw(&PathElement::new(
+                    vec![(at.0 - r, at.1 - r), (at.0 + r, at.1 + r)],
+                    style,
+                ))?;
+                panel.draw(&PathElement::new(
+                    vec![(at.0 - r, at.1 + r), (at.0 + r, at.1 - r)],
+                    style,
+                ))?;
+                // Right of the cross, or left of it where the word would leave the plot.
+                let style = font(LEGEND_FONT * 0.8);
+                let (tw, _) = panel.estimate_text_size(why, &style)?;
+                let (x, h_pos) = if at.0 + r + 4 + tw as i32 > px.end - base.0 {
+                    (at.0 - r - 4, HPos::Right)
+                } else {
+                    (at.0 + r + 4, HPos::Left)
+                };
+                panel.draw(&Text::new(
+                    why.clone(),
+                    (x, at.1 + r + 4),
+                    style.pos(Pos::new(h_pos, VPos::Top)),
+                ))?;
+            }
         }
         let mut legend: Vec<Curve> = self
             .families
