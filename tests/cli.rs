@@ -900,3 +900,69 @@ fn slope_sweep_figure_names_only_fixed_parameters_and_spans_the_range() {
         assert!(ticks.contains(&tick), "the x axis has a tick at {tick}");
     }
 }
+
+/// `vrw continue` writes its three kinds of files for one family, with the fold of the slope family.
+#[test]
+fn continue_writes_the_family_and_its_fold() {
+    let args = [
+        "--param",
+        "slope",
+        "--from",
+        "0.3",
+        "--to",
+        "0.34",
+        "--start",
+        "0.32",
+        "--no-switch",
+    ];
+    let run = command_in(temp_dir_with(&[]), "continue", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    assert!(
+        run.stdout().contains("LP family 1: slope = 0.33116292"),
+        "{}",
+        run.stdout()
+    );
+    let table = run.read("branch.csv");
+    assert!(table.starts_with("family,period_k,least_period,point,arclength,slope,L2,thetadot"));
+    assert!(table.contains(",unstable,") && table.contains(",stable,"));
+    let summary: Value = serde_json::from_str(&run.read("special_points.json")).unwrap();
+    assert_eq!(summary["special_points"][0]["kind"], "LP");
+    assert_eq!(summary["special_points"][0]["located"], true);
+    assert_eq!(
+        summary["files"],
+        serde_json::json!([
+            "branch.csv",
+            "special_points.json",
+            "bifurcation.svg",
+            "bifurcation.png"
+        ])
+    );
+    assert_eq!(
+        &fs::read(run.out.join("bifurcation.png")).unwrap()[..8],
+        b"\x89PNG\r\n\x1a\n"
+    );
+}
+
+/// Bad continuation options: an error naming the option, never a panic, and no files.
+#[test]
+fn continue_refuses_bad_options() {
+    for (args, needle) in [
+        (&["--start", "500"][..], "outside the range"),
+        (&["--plot", "colour"][..], "unknown quantity"),
+        (&["--param", "legs"][..], "unknown parameter"),
+        (&["--from", "10", "--to", "5"][..], "from < to"),
+        (&["--max-points", "0"][..], "--max-points"),
+        (&["--max-step=-1"][..], "--max-step"),
+        (&["--period", "9"][..], "--period"),
+        (
+            &[
+                "--param", "slope", "--from", "0.6", "--to", "0.7", "--start", "0.65",
+            ][..],
+            "no gait",
+        ),
+    ] {
+        let run = command_in(temp_dir_with(&[]), "continue", args);
+        assert_error(&run, &[needle]);
+        assert!(!run.out.join("branch.csv").exists());
+    }
+}

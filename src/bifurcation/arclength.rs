@@ -308,7 +308,36 @@ fn follow<M: FamilyMap>(
             }
         }
         if options.detect {
-            special.extend(detect_between(map, &current, &next, options));
+            let found = detect_between(map, &current, &next, options);
+            // A border between the two points with no fixed point at its middle: the step reached another
+            // family across a jump of the map. The family ends at the last point before the border.
+            if let Some(jump) = found.iter().find(|s| s.ends_family) {
+                let message = format!(
+                    "the family ends at the border between {} and {}: {}",
+                    current.param,
+                    next.param,
+                    jump.note
+                        .as_deref()
+                        .unwrap_or("no fixed point at its middle")
+                );
+                special.extend(
+                    found
+                        .iter()
+                        .filter(|s| s.arclength <= jump.arclength)
+                        .cloned(),
+                );
+                return Followed {
+                    points,
+                    special,
+                    end: FamilyEnd::Ended {
+                        param: current.param,
+                        beyond: next.param,
+                        failure: "border".to_string(),
+                        message,
+                    },
+                };
+            }
+            special.extend(found);
         }
         let iterations = next.iterations;
         points.push(next.clone());

@@ -370,7 +370,9 @@ fn newton_extended<M: FamilyMap>(
             .solve(&r)
             .ok_or_else(|| format!("singular extended system at p = {p}"))?;
         z += &dz;
-        if (dz[n] * sigma).abs() < options.param_tolerance && residual < 10.0 * options.tolerance {
+        if (dz[n] * sigma).abs() < options.param_tolerance * p.abs().max(1.0)
+            && residual < 10.0 * options.tolerance
+        {
             let (x, p) = split(&z, sigma);
             let ev = map.eval(&x, p).map_err(|e| e.message)?;
             return Ok((z, ev, iteration));
@@ -646,6 +648,8 @@ fn bisect_piece<M: FamilyMap>(
         }
     }
     let located = note.is_none() && steps < MAX_BISECTIONS;
+    // No fixed point at a midpoint: the family does not pass this border continuously.
+    let ends_family = note.is_some();
     let side = |p: &FamilyPoint<M::Info>| Side {
         param: p.param,
         piece: map.piece(&p.info),
@@ -671,7 +675,7 @@ fn bisect_piece<M: FamilyMap>(
         info: Some(lo.info.clone()),
         note,
         direction: (hi.z(sigma) - lo.z(sigma)).normalize(),
-        ends_family: false,
+        ends_family,
         jump: f64::NAN,
     }
 }

@@ -83,12 +83,18 @@ impl ModelArgs {
 }
 
 /// The flag of each job setting that the library names by its field (the Python keyword).
-const FLAGS: [(&str, &str); 5] = [
+const FLAGS: [(&str, &str); 11] = [
     ("transient_steps", "--transient"),
     ("tolerance", "--tolerance"),
     ("steps", "--steps"),
     ("sample_dt", "--sample-dt"),
     ("speed", "--speed"),
+    ("max_points", "--max-points"),
+    ("max_step", "--max-step"),
+    ("start", "--start"),
+    ("plot", "--plot"),
+    ("period", "--period"),
+    ("from", "--from/--to"),
 ];
 
 /// A job's error with its settings named by their flags: the rule is the library's, the name the command

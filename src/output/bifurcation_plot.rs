@@ -194,6 +194,8 @@ impl Figure for BifurcationFigure {
                 font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Bottom)),
             ))?;
         }
+        // The rectangles of the words written at the families' ends.
+        let mut words: Vec<(i32, i32, i32, i32)> = Vec::new();
         for (k, family) in self.families.iter().enumerate() {
             for (param, value, why) in &family.ends {
                 if !(param.is_finite() && value.is_finite() && self.x.contains(param)) {
@@ -210,14 +212,27 @@ impl Figure for BifurcationFigure {
                     vec![(at.0 - r, at.1 + r), (at.0 + r, at.1 - r)],
                     style,
                 ))?;
-                // Right of the cross, or left of it where the word would leave the plot.
+                // The word right of the cross, or left of it where it would leave the plot; none at a border
+                // (its BC label says it) or where it would overlap a word already written.
+                if why == "border" {
+                    continue;
+                }
                 let style = font(LEGEND_FONT * 0.8);
-                let (tw, _) = panel.estimate_text_size(why, &style)?;
-                let (x, h_pos) = if at.0 + r + 4 + tw as i32 > px.end - base.0 {
-                    (at.0 - r - 4, HPos::Right)
+                let (tw, th) = panel.estimate_text_size(why, &style)?;
+                let (tw, th) = (tw as i32, th as i32);
+                let (x, h_pos, left) = if at.0 + r + 4 + tw > px.end - base.0 {
+                    (at.0 - r - 4, HPos::Right, at.0 - r - 4 - tw)
                 } else {
-                    (at.0 + r + 4, HPos::Left)
+                    (at.0 + r + 4, HPos::Left, at.0 + r + 4)
                 };
+                let rect = (left, at.1 + r + 4, left + tw, at.1 + r + 4 + th);
+                let overlaps = |o: &(i32, i32, i32, i32)| {
+                    rect.0 < o.2 && o.0 < rect.2 && rect.1 < o.3 && o.1 < rect.3
+                };
+                if words.iter().any(overlaps) {
+                    continue;
+                }
+                words.push(rect);
                 panel.draw(&Text::new(
                     why.clone(),
                     (x, at.1 + r + 4),
