@@ -12,6 +12,8 @@
 //!   reached after `SETTLE_STEPS` steps, to a residual below 1e-10, plus the Floquet multipliers
 //!   (`central`: one central-difference Jacobian, as in sweeps; `refined`: with the Richardson error estimate,
 //!   as `vrw gait` does).
+//! - `family/300_points`: one gait family of 300 points by pseudo-arclength continuation (`vrw continue`'s
+//!   core, without its end analysis and files).
 //! - `gait_job`: the whole `vrw gait` search on the defaults (`vrw::app::compute_gait`: transient, Newton,
 //!   refined multipliers), the function the Python binding's `vrw.find_gait(vrw.Params())` calls;
 //!   `python/bench/overhead.py` compares the two.
@@ -27,6 +29,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 use vrw::app::{compute_gait, GaitJob};
+use vrw::bifurcation::{continue_family, ContinuationOptions, GaitFamily};
 use vrw::contact::{constrained_dynamics, ActiveSet};
 use vrw::dynamics::{Coords, Model};
 use vrw::gait::{find_gait, GaitOptions, StepMap};
@@ -204,6 +207,41 @@ fn jacobian_routes(c: &mut Criterion) {
     group.finish();
 }
 
+/// `family/300_points`: pseudo-arclength continuation of the default family (`vrw::bifurcation`) from the gait
+/// at c = 50, 150 points each way with steps of at most 0.01 (c from about 3 to 98), special points
+/// detected: the "one family of 300 points".
+fn family(c: &mut Criterion) {
+    let config = Config::default();
+    let model = Model::new(&config.params).expect("the paper's parameters are valid");
+    let map = StepMap::new(&model, &config.solver);
+    let gait = find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None,
+    )
+    .expect("the gait");
+    let family_map = GaitFamily::new(&config, "viscosity", gait.section).expect("a numeric key");
+    let x0 = family_map.reduce(&gait.section);
+    let options = ContinuationOptions {
+        max_points: 150,
+        max_step: 0.01,
+        ..ContinuationOptions::for_range(1.0, 300.0)
+    };
+    let mut group = c.benchmark_group("family");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(8));
+    group.bench_function("300_points", |b| {
+        b.iter(|| {
+            let family = continue_family(&family_map, &x0, 50.0, black_box(&options))
+                .expect("the family starts");
+            assert_eq!(family.points.len(), 301);
+            black_box(family)
+        })
+    });
+    group.finish();
+}
+
 fn gait_job(c: &mut Criterion) {
     let job = GaitJob {
         config: Config::default(),
@@ -233,6 +271,7 @@ criterion_group!(
     twenty_steps,
     gait_after_transient,
     jacobian_routes,
+    family,
     gait_job
 );
 criterion_main!(benches);

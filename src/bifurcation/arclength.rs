@@ -27,8 +27,8 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use super::corrector::{
-    augmented, bordered, correct, corrector_failure, point_at, split, start_point,
-    ContinuationOptions, FamilyPoint,
+    augmented, bordered, correct, correct_to_point, corrector_failure, point_at, split,
+    start_point, ContinuationOptions, FamilyPoint,
 };
 use super::special::{border_at_end, detect_between, SpecialPoint};
 use super::{FamilyMap, MapFailure};
@@ -179,6 +179,15 @@ fn follow<M: FamilyMap>(
     let mut held = augmented(&start.jacobian, &start.dparam, sigma);
     let mut current = start;
     let mut h = options.initial_step;
+    // The tangent at the point before `current` and the arclength between them (for the predictor's
+    // curvature), and the corrector's last contraction rate (to evaluate with derivatives where it expects to
+    // converge).
+    let mut curvature: Option<(DVector<f64>, f64)> = None;
+    let mut rate_hint = f64::NAN;
+    // The last jump of the map a rejected step crossed (reported at the end if nothing else ends the family).
+    let mut pending_jump: Option<SpecialPoint<M::Info>> = None;
+    // The parameter of the last corrected point rejected for jumping or turning too far.
+    let mut rejected_at = f64::NAN;
     let mut last_failure: Option<MapFailure> = None;
     // The last failure of the map itself since the last accepted step, and the parameter it failed at.
     let mut map_failure: Option<(MapFailure, f64)> = None;
@@ -212,11 +221,19 @@ fn follow<M: FamilyMap>(
                             border_at_end(map, previous, &current, options)
                         })
                         .flatten();
-                    // Just past the border, where the walk looks for what takes over.
-                    let beyond = border.as_ref().map_or(f64::NAN, |b| {
-                        let step = options.param_tolerance.max(1e-7) * b.param.abs().max(1.0);
-                        b.param + step.copysign(b.param - current.param)
-                    });
+                    // Just past the border, where the walk looks for what takes over; past a jump of the map
+                    // found on the way, its far side.
+                    let beyond = match (&border, &pending_jump) {
+                        (Some(b), _) => {
+                            let step = options.param_tolerance.max(1e-7) * b.param.abs().max(1.0);
+                            b.param + step.copysign(b.param - current.param)
+                        }
+                        (None, Some(jump)) => jump.bracket[1],
+                        // Where the last step that jumped or turned too far landed: the walk from there says
+                        // what takes over.
+                        (None, None) => rejected_at,
+                    };
+                    let border = border.or(pending_jump);
                     // The border is the end's cause where one was found; else the corrector's last failure.
                     let failure = match &border {
                         Some(b) => MapFailure {
@@ -246,16 +263,24 @@ fn follow<M: FamilyMap>(
             };
         }
         let z = current.z(sigma);
-        let z_pred = &z + h * &current.tangent;
+        // The tangent predictor, with the curvature of the last step where there is one (the change of the
+        // tangent over it): quadratic extrapolation, which leaves the corrector a residual of order h^3.
+        let mut z_pred = &z + h * &current.tangent;
+        if let Some((t_before, s_before)) = &curvature {
+            z_pred += (0.5 * h * h / s_before) * (&current.tangent - t_before);
+        }
         if current.has_derivatives() {
             held = augmented(&current.jacobian, &current.dparam, sigma);
         }
         let m = bordered(&held, &current.tangent);
-        let next = correct(map, &z_pred, &current.tangent, &m, options).and_then(|(zc, it)| {
-            let mut next = point_at(map, &zc, &current.tangent, options)?;
-            next.iterations = it;
-            Ok(next)
-        });
+        let next = correct_to_point(
+            map,
+            &z_pred,
+            &current.tangent,
+            &m,
+            (&current.tangent, rate_hint),
+            options,
+        );
         let mut next = match next {
             Ok(next) => next,
             Err(failure) => {
@@ -280,6 +305,7 @@ fn follow<M: FamilyMap>(
                     current.param
                 ),
             });
+            rejected_at = next.param;
             h *= 0.5;
             continue;
         }
@@ -312,34 +338,35 @@ fn follow<M: FamilyMap>(
             // A border between the two points with no fixed point at its middle: the step reached another
             // family across a jump of the map. The family ends at the last point before the border.
             if let Some(jump) = found.iter().find(|s| s.ends_family) {
-                let message = format!(
-                    "the family ends at the border between {} and {}: {}",
-                    current.param,
-                    next.param,
-                    jump.note
-                        .as_deref()
-                        .unwrap_or("no fixed point at its middle")
-                );
-                special.extend(
-                    found
-                        .iter()
-                        .filter(|s| s.arclength <= jump.arclength)
-                        .cloned(),
-                );
-                return Followed {
-                    points,
-                    special,
-                    end: FamilyEnd::Ended {
-                        param: current.param,
-                        beyond: next.param,
-                        failure: "border".to_string(),
-                        message,
-                    },
-                };
+                // The step reached past a jump of the map (another family's fixed point): rejected, like a
+                // step that jumps, so that the steps shrink toward the family's own end; the jump is kept
+                // for the end.
+                last_failure = Some(MapFailure {
+                    kind: "border".to_string(),
+                    message: format!(
+                        "a jump of the step map between {} and {}: {}",
+                        current.param,
+                        next.param,
+                        jump.note
+                            .as_deref()
+                            .unwrap_or("no fixed point at its middle")
+                    ),
+                });
+                pending_jump = Some(jump.clone());
+                travelled -= step;
+                h *= 0.5;
+                continue;
             }
             special.extend(found);
         }
+        // A jump crossed before this accepted step is not where the family ends (steps toward an end fail
+        // in a row after the last accepted one).
+        pending_jump = None;
+        rejected_at = f64::NAN;
         let iterations = next.iterations;
+        rate_hint = next.corrector_rate;
+        curvature = (current.has_derivatives() && next.has_derivatives())
+            .then(|| (current.tangent.clone(), step));
         points.push(next.clone());
         current = next;
         // Back at the start after going round: a closed family.

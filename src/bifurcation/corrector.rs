@@ -124,6 +124,8 @@ pub struct FamilyPoint<I> {
     pub tangent: DVector<f64>,
     /// Corrector iterations it took (0 for the start).
     pub iterations: usize,
+    /// The residual's contraction per corrector iteration (`NaN` if fewer than two residuals).
+    pub corrector_rate: f64,
     /// What the map records of it.
     pub info: I,
 }
@@ -258,9 +260,19 @@ pub(crate) fn point_at<M: FamilyMap>(
     orient: &DVector<f64>,
     options: &ContinuationOptions,
 ) -> Result<FamilyPoint<M::Info>, MapFailure> {
-    let sigma = options.param_scale;
-    let (x, p) = split(z, sigma);
+    let (x, p) = split(z, options.param_scale);
     let ev = map.eval(&x, p)?;
+    point_from(ev, z, orient, options.param_scale)
+}
+
+/// The family point at `z` from the map's evaluation there, with its tangent oriented along `orient`.
+fn point_from<I>(
+    ev: super::Evaluation<I>,
+    z: &DVector<f64>,
+    orient: &DVector<f64>,
+    sigma: f64,
+) -> Result<FamilyPoint<I>, MapFailure> {
+    let (x, p) = split(z, sigma);
     let j = augmented(&ev.jacobian, &ev.dparam, sigma);
     // Without derivatives (the map is not differentiable there) the tangent is the previous one.
     let t = if j.iter().all(|v| v.is_finite()) {
@@ -282,8 +294,71 @@ pub(crate) fn point_at<M: FamilyMap>(
         exact: ev.exact,
         tangent: t,
         iterations: 0,
+        corrector_rate: f64::NAN,
         info: ev.info,
     })
+}
+
+/// [`correct`] and [`point_at`] in one: the iteration whose residual the contraction so far (or, before this
+/// corrector has two residuals, `rate_hint`, the last corrector's) predicts below the tolerance evaluates the map with its derivatives, which is the converged point's own evaluation (one
+/// evaluation of `P` fewer per point) or, if it is not yet converged, gives the remaining iterations a fresh
+/// matrix.
+pub(crate) fn correct_to_point<M: FamilyMap>(
+    map: &M,
+    z_pred: &DVector<f64>,
+    row: &DVector<f64>,
+    m: &DMatrix<f64>,
+    (orient, rate_hint): (&DVector<f64>, f64),
+    options: &ContinuationOptions,
+) -> Result<FamilyPoint<M::Info>, MapFailure> {
+    let sigma = options.param_scale;
+    let mut lu = m.clone().lu();
+    let mut z = z_pred.clone();
+    let mut previous = f64::INFINITY;
+    // The residual's contraction per iteration: the last corrector's until this one has its own.
+    let mut rate = rate_hint;
+    for iteration in 0..=options.max_corrector_iterations {
+        let (x, p) = split(&z, sigma);
+        let expect_converged = previous * rate < options.tolerance;
+        let (h, ev) = if expect_converged {
+            let ev = map.eval(&x, p)?;
+            (&ev.value - &x, Some(ev))
+        } else {
+            (map.value(&x, p)? - &x, None)
+        };
+        let residual = h.amax();
+        if residual < options.tolerance {
+            let ev = match ev {
+                Some(ev) => ev,
+                None => map.eval(&x, p)?,
+            };
+            let mut point = point_from(ev, &z, orient, sigma)?;
+            point.iterations = iteration;
+            point.corrector_rate = rate;
+            return Ok(point);
+        }
+        if residual.is_nan()
+            || residual >= 0.5 * previous
+            || iteration == options.max_corrector_iterations
+        {
+            return Err(corrector_failure(iteration, residual));
+        }
+        if previous.is_finite() {
+            rate = residual / previous;
+        }
+        previous = residual;
+        if let Some(ev) = ev.filter(|ev| ev.jacobian.iter().all(|v| v.is_finite())) {
+            lu = bordered(&augmented(&ev.jacobian, &ev.dparam, sigma), row).lu();
+        }
+        let n = h.len();
+        let mut r = h.insert_row(n, row.dot(&(&z - z_pred)));
+        r.neg_mut();
+        let dz = lu
+            .solve(&r)
+            .ok_or_else(|| corrector_failure(iteration, residual))?;
+        z += dz;
+    }
+    unreachable!("the loop returns at its last iteration")
 }
 
 /// The fixed point near `x0` at `p0`, with its tangent pointing to increasing `p` (or, at a fold, along the

@@ -24,7 +24,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::corrector::{
-    augmented, bordered, correct, multipliers, point_at, split, ContinuationOptions, FamilyPoint,
+    augmented, bordered, correct, multipliers, point_at, solve_on_hyperplane, split,
+    ContinuationOptions, FamilyPoint,
 };
 use super::{Evaluation, FamilyMap};
 
@@ -600,7 +601,8 @@ const MAX_APPROACH_ITERATIONS: usize = 60;
 const MAX_APPROACH_HALVINGS: usize = 40;
 
 /// The change of piece between `a` and `b` bracketed by bisection along the family: each midpoint of the
-/// bracket corrected onto the family on the hyperplane through it normal to the bracket, until the bracket's
+/// bracket corrected onto the family on the hyperplane through it normal to the bracket (the chord method with
+/// the matrix of the bracket's end on the old piece, else Newton's method with `DP` at every iterate), until the bracket's
 /// parameter width is below the parameter tolerance and its state width below `1e-9`.
 fn bisect_piece<M: FamilyMap>(
     map: &M,
@@ -626,13 +628,9 @@ fn bisect_piece<M: FamilyMap>(
         // With the matrix of the bracket's end on the old piece, or (where `DP` jumps across the border and
         // that fails) with the midpoint's own.
         let point = correct(map, &mid, &d, &m, options)
-            .or_else(|_| {
-                let (x, p) = split(&mid, sigma);
-                let ev = map.eval(&x, p)?;
-                let fresh = bordered(&augmented(&ev.jacobian, &ev.dparam, sigma), &d);
-                correct(map, &mid, &d, &fresh, options)
-            })
-            .and_then(|(z, _)| point_at(map, &z, &lo.tangent, options));
+            .map(|(z, _)| z)
+            .or_else(|_| solve_on_hyperplane(map, &mid, &d, options))
+            .and_then(|z| point_at(map, &z, &lo.tangent, options));
         match point {
             Ok(point) if map.piece(&point.info) == piece_a => lo = point,
             Ok(point) => hi = point,
