@@ -18,8 +18,8 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
 use vrw::app::{
-    compute_basin, compute_gait, compute_simulation, compute_sweep, AppError, BasinJob, GaitJob,
-    SimulateJob,
+    compute_basin, compute_continuation, compute_gait, compute_simulation, compute_sweep,
+    family_rows, AppError, BasinJob, ContinueJob, GaitJob, SimulateJob,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -27,8 +27,8 @@ use vrw::gait::basin::Coordinate;
 use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::output::{
-    basin_header, basin_row, step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER,
-    TRAJECTORY_HEADER,
+    basin_header, basin_row, family_header, family_row, step_row, sweep_header, sweep_row,
+    trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -525,6 +525,58 @@ fn basin<'py>(
     Ok(result)
 }
 
+/// Follow the gait family through the gait at `start` in `param` by pseudo-arclength continuation (`vrw
+/// continue`, without the figure).
+///
+/// Returns the fields of `special_points.json` (`families` with how each ends and why, `special_points`,
+/// `warnings`, ...) and `branch`, the columns of `branch.csv` as numpy arrays. Keyword arguments as the command
+/// line's options: `start` (default the parameter's value in `params`), `range` (`(from, to)`, `None`: the
+/// command line's `(1, 300)`), `initial`, `period`, `max_points`, `max_step`, `switch` (follow the families born at period
+/// doublings, border collisions and ends; the command line's `--no-switch` is `switch=False`).
+#[pyfunction]
+#[pyo3(signature = (params, param = "viscosity", *, start = None, range = None, initial = None, period = None, max_points = 300, max_step = 0.1, switch = true))]
+#[allow(clippy::too_many_arguments)]
+fn continue_family<'py>(
+    py: Python<'py>,
+    params: &Params,
+    param: &str,
+    start: Option<f64>,
+    range: Option<(f64, f64)>,
+    initial: Option<[f64; 3]>,
+    period: Option<usize>,
+    #[pyo3(from_py_with = max_points_arg)] max_points: usize,
+    max_step: f64,
+    switch: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let range = range.unwrap_or((1.0, 300.0));
+    let job = ContinueJob {
+        config: params.config.clone(),
+        param: param.to_string(),
+        start,
+        from: range.0,
+        to: range.1,
+        initial: section(initial),
+        period,
+        max_points,
+        max_step,
+        switch,
+        plot: "thetadot".to_string(),
+        out_dir: PathBuf::new(),
+        interrupt: Some(Arc::clone(&flag)),
+    };
+    let result = interruptible(py, &flag, || compute_continuation(&job))?.map_err(app_error)?;
+    let out = pythonize(py, &result.summary)?.downcast_into::<PyDict>()?;
+    let rows: Vec<Vec<Cell>> = family_rows(&result).iter().map(family_row).collect();
+    out.set_item("branch", table(py, &family_header(param), &rows)?)?;
+    Ok(out)
+}
+
+/// `continue_family`'s `max_points`, named in its errors.
+fn max_points_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("max_points", value)
+}
+
 /// `basin`'s `nx`, named in its errors.
 fn nx_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("nx", value)
@@ -625,6 +677,7 @@ fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(find_gait, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(basin, m)?)?;
+    m.add_function(wrap_pyfunction!(continue_family, m)?)?;
     m.add_function(wrap_pyfunction!(linspace, m)?)?;
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("WalkError", py.get_type::<WalkError>())?;

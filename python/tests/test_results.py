@@ -82,3 +82,25 @@ def test_basin_equals_basin_csv_and_converts_to_a_grid(cli, tmp_path):
     assert repr(result).startswith("BasinResult(20 starts")
     with pytest.raises(vrw.ConfigError, match="`x`"):
         vrw.basin(vrw.Params(), x="theta", nx=3, ny=3)
+
+
+def test_continue_family_equals_branch_csv(cli, tmp_path):
+    args = ["--param", "slope", "--from", "0.3", "--to", "0.34", "--start", "0.32", "--no-switch"]
+    cli("continue", *args, "--out", tmp_path)
+    result = vrw.continue_family(vrw.Params(), "slope", start=0.32, range=(0.3, 0.34), switch=False)
+    csv = pd.read_csv(tmp_path / "branch.csv")
+    frame = result.to_pandas()
+    assert list(frame.columns) == list(csv.columns) and frame.shape == csv.shape
+    assert list(frame["signature"]) == list(csv["signature"])
+    assert list(frame["stability"]) == list(csv["stability"])
+    for column in ["slope", "thetadot", "mu1_re", "arclength"]:
+        assert np.array_equal(frame[column].to_numpy(), csv[column].to_numpy()), column
+    expected = __import__("json").loads((tmp_path / "special_points.json").read_text())
+    assert [p["kind"] for p in result.special_points] == ["LP"]
+    assert result.special_points[0]["param"] == expected["special_points"][0]["param"]
+    assert list(result.families[0]["ends"]) == expected["families"][0]["ends"]
+    assert repr(result).startswith("FamilyResult(slope: 1 families,")
+    with pytest.raises(ValueError, match="outside the range"):
+        vrw.continue_family(vrw.Params(), "slope", start=0.5, range=(0.3, 0.34))
+    with pytest.raises(vrw.ConfigError, match="max_points"):
+        vrw.continue_family(vrw.Params(), max_points=-1)

@@ -1,7 +1,7 @@
 """vrw: passive dynamic walking of a viscoelastic-legged rimless wheel, from Python.
 
 A front to the vrw Rust library: the same parameters (``Params``, every key of a vrw TOML file), the same
-jobs as the command line (``simulate``, ``find_gait``, ``sweep``) and the same names for their results (the
+jobs as the command line (``simulate``, ``find_gait``, ``sweep``, ``basin``, ``continue_family``) and the same names for their results (the
 columns of ``steps.csv``, ``trajectory.csv`` and ``sweep.csv``, the fields of ``summary.json``,
 ``gait.json`` and ``thresholds.json``). Computation runs in Rust with the GIL released; ``Params`` and every
 result pickle, so they travel to worker processes (see ``vrw.grid`` for grids of gaits on a Dask cluster).
@@ -25,7 +25,17 @@ from ._vrw import (
     __version__,
     linspace,
 )
-from .results import BasinResult, GaitResult, Grid, Result, Run, SweepResult, Table, wrap_tables
+from .results import (
+    BasinResult,
+    FamilyResult,
+    GaitResult,
+    Grid,
+    Result,
+    Run,
+    SweepResult,
+    Table,
+    wrap_tables,
+)
 
 
 def simulate(
@@ -72,8 +82,18 @@ def basin(params: Params, **options: Any) -> BasinResult:
     return result
 
 
+def continue_family(params: Params, param: str = "viscosity", **options: Any) -> FamilyResult:
+    """Follow the gait family through the gait at ``start`` in ``param`` by pseudo-arclength continuation
+    (``vrw continue``): a ``FamilyResult``, the fields of ``special_points.json`` with ``branch`` (the columns of
+    ``branch.csv``) as a ``Table``. See ``vrw._vrw.continue_family`` for the options."""
+    result = FamilyResult(_vrw.continue_family(params, param, **options))
+    wrap_tables(result, ["branch"])
+    return result
+
+
 __all__ = [
     "BasinResult",
+    "FamilyResult",
     "ConfigError",
     "GaitResult",
     "Grid",
@@ -85,6 +105,7 @@ __all__ = [
     "WalkError",
     "__version__",
     "basin",
+    "continue_family",
     "find_gait",
     "linspace",
     "simulate",

@@ -14,6 +14,7 @@ __all__ = [
     "WalkError",
     "__version__",
     "basin",
+    "continue_family",
     "find_gait",
     "linspace",
     "simulate",
@@ -117,6 +118,22 @@ def sweep(
 def linspace(start: float, stop: float, points: int) -> List[float]:
     """The values ``vrw sweep --from START --to STOP --points POINTS`` visits (bit for bit); 2 to 100000
     points, else ``ConfigError``."""
+
+def continue_family(
+    params: Params,
+    param: str = "viscosity",
+    *,
+    start: Optional[float] = None,
+    range: Optional[Tuple[float, float]] = None,
+    initial: Optional[Section] = None,
+    period: Optional[int] = None,
+    max_points: int = 300,
+    max_step: float = 0.1,
+    switch: bool = True,
+) -> Dict[str, Any]:
+    """Follow the gait family through the gait at ``start`` by pseudo-arclength continuation (``vrw continue``,
+    without the figure): the fields of ``special_points.json`` and ``branch``, the columns of ``branch.csv``.
+    ``range`` is ``(from, to)``, default ``(1, 300)``."""
 
 def basin(
     params: Params,

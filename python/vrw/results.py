@@ -166,6 +166,20 @@ class BasinResult(_WithTable):
         return f"BasinResult({self['points'].rows} starts: {dict(self['outcomes'])})"
 
 
+class FamilyResult(_WithTable):
+    """``vrw.continue_family``: the fields of ``special_points.json`` (``families``, ``special_points``, ...),
+    with ``branch`` (the columns of ``branch.csv``: one row per point of every family) a ``Table``."""
+
+    _table = "branch"
+
+    def __repr__(self) -> str:
+        kinds = [p["kind"] for p in self.get("special_points", [])]
+        return (
+            f"FamilyResult({self.get('param')}: {len(self.get('families', []))} families, "
+            f"{self['branch'].rows} points, special points {kinds})"
+        )
+
+
 def wrap_tables(result: Dict[str, Any], names: List[str]) -> None:
     """Make the named entries of ``result`` that are dicts of columns into ``Table``s (in place)."""
     for name in names:

@@ -22,6 +22,30 @@ pub fn run_continuation(job: &ContinueJob) -> Result<ContinueResult, AppError> {
     })
 }
 
+/// The rows of `branch.csv` of a computed continuation (also the Python binding's `branch` table).
+pub fn family_rows(result: &ContinueResult) -> Vec<FamilyRow<'_>> {
+    result
+        .families
+        .iter()
+        .zip(&result.stability)
+        .enumerate()
+        .flat_map(|(k, (family, verdicts))| {
+            family
+                .points
+                .iter()
+                .zip(verdicts)
+                .enumerate()
+                .map(move |(index, (point, &stability))| FamilyRow {
+                    family: k + 1,
+                    period_k: family.period,
+                    index,
+                    point,
+                    stability,
+                })
+        })
+        .collect()
+}
+
 /// Write the files of a computed continuation into `run`.
 fn write_continuation(
     job: &ContinueJob,
@@ -29,23 +53,7 @@ fn write_continuation(
     run: &mut RunDir,
 ) -> Result<(), AppError> {
     let param = &job.param;
-    let rows: Vec<FamilyRow> = result
-        .families
-        .iter()
-        .zip(&result.stability)
-        .enumerate()
-        .flat_map(|(k, (family, verdicts))| {
-            family.points.iter().zip(verdicts).enumerate().map(
-                move |(index, (point, &stability))| FamilyRow {
-                    family: k + 1,
-                    period_k: family.period,
-                    index,
-                    point,
-                    stability,
-                },
-            )
-        })
-        .collect();
+    let rows = family_rows(result);
     write_family_csv(&run.path("branch.csv"), param, &rows)?;
     run.add("branch.csv");
     let mut files = vec!["branch.csv".to_string()];
