@@ -30,18 +30,15 @@ pub fn family_rows(result: &ContinueResult) -> Vec<FamilyRow<'_>> {
         .zip(&result.stability)
         .enumerate()
         .flat_map(|(k, (family, verdicts))| {
-            family
-                .points
-                .iter()
-                .zip(verdicts)
-                .enumerate()
-                .map(move |(index, (point, &stability))| FamilyRow {
+            family.points.iter().zip(verdicts).enumerate().map(
+                move |(index, (point, &stability))| FamilyRow {
                     family: k + 1,
                     period_k: family.period,
                     index,
                     point,
                     stability,
-                })
+                },
+            )
         })
         .collect()
 }
