@@ -21,6 +21,7 @@
 //! | exact derivatives of the step map: variational equations, saltation matrices | [`variational`] |
 //! | reference problems with known answers, the default start | [`reference`](mod@reference) |
 //! | step map, gait, Floquet multipliers, sweeps, maps, orbits, basins, thresholds | [`gait`] |
+//! | gait families by pseudo-arclength continuation, special points, branch switching | [`bifurcation`] |
 //! | tables and figures | [`output`] |
 //! | the command-line jobs | [`app`] |
 //!
@@ -50,6 +51,11 @@
 //!   thresholds [`gait::find_thresholds`]; two-parameter maps [`gait::map_gaits`] and [`gait::map_curves`];
 //!   orbit diagrams [`gait::orbit::orbit_diagram`]; basins of attraction [`gait::basin::basin`]; families of
 //!   gaits [`gait::continuation`].
+//! - **Bifurcation analysis**: [`bifurcation::continue_family`] over any [`bifurcation::FamilyMap`] (the VRW's
+//!   is [`bifurcation::GaitFamily`]) with [`bifurcation::ContinuationOptions`], giving a
+//!   [`bifurcation::Family`] of [`bifurcation::FamilyPoint`]s with its [`bifurcation::SpecialPoint`]s and
+//!   [`bifurcation::FamilyEnd`]s; branch switching [`bifurcation::switch_at_period_doubling`] and
+//!   [`bifurcation::switch_at_border`].
 //! - **Output**: the tables [`output::write_steps_csv`], [`output::write_trajectory_csv`] (and the streaming
 //!   [`output::StepsCsv`], [`output::TrajectoryCsv`]), [`output::write_sweep_csv`], their headers and rows;
 //!   reading a run directory back with [`output::read::read_run`]; the figures
@@ -57,10 +63,10 @@
 //!   [`output::animate::write_animation`].
 //! - **Jobs** (what each `vrw` command runs, writing its files into a directory): [`app::run_simulate`],
 //!   [`app::run_gait`], [`app::run_sweep`], [`app::run_map`], [`app::run_orbit`], [`app::run_basin`],
-//!   [`app::run_plot`], [`app::run_animate`], [`app::run_still`], with their job structs
-//!   ([`app::SimulateJob`], ...) and [`app::AppError`]; and the jobs that return their results instead
-//!   ([`app::compute_simulation`], [`app::compute_gait`], [`app::compute_sweep`]), which the Python binding
-//!   uses.
+//!   [`app::run_plot`], [`app::run_animate`], [`app::run_still`], [`app::run_continuation`], with their job
+//!   structs ([`app::SimulateJob`], ...) and [`app::AppError`]; and the jobs that return their results
+//!   instead ([`app::compute_simulation`], [`app::compute_gait`], [`app::compute_sweep`],
+//!   [`app::compute_continuation`]), which the Python binding uses.
 //!
 //! Everything else is internal to the crate (`pub(crate)`): the integrator driver and DOP853, the event
 //! functions and audits of a step, the grid runner behind sweeps and maps, continuation's tolerances, the
