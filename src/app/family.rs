@@ -61,7 +61,8 @@ pub struct ContinueJob {
     /// Where the search for the first gait starts (`None`: the default start); with `period` it is taken as a
     /// point of the gait itself.
     pub initial: Option<SectionState>,
-    /// Steps per period of the family (`None`: the period the gait search finds).
+    /// The largest period of the first gait (`None`: any up to 8, period 1 first); the family is that of the
+    /// least period the search finds.
     pub period: Option<usize>,
     /// Most points of a family in each direction.
     pub max_points: usize,

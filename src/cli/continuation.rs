@@ -30,7 +30,8 @@ pub(super) struct ContinueArgs {
     /// Where the search for the first gait starts, `L2,thetadot,L2dot`; default as for simulate.
     #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
     initial: Option<SectionState>,
-    /// Follow the family of period-k gaits (fixed points of P^k); default: the period the gait search finds.
+    /// Start from a gait of period at most K (the least period the walk settles on, as `vrw gait` finds it;
+    /// fixed points of P^k); default: any period up to 8, period 1 first.
     #[arg(long)]
     period: Option<usize>,
     /// Most points of a family in each direction from its start.
@@ -39,7 +40,8 @@ pub(super) struct ContinueArgs {
     /// Largest continuation step, in the scaled unknowns (section state, parameter / (range / 10)).
     #[arg(long, default_value_t = 0.1)]
     max_step: f64,
-    /// Do not follow the period-2 family born at each period doubling.
+    /// Follow the start's family only: not the period-2 family of each period doubling, the other piece's family
+    /// at a border where a family ends, nor the family of the gait a walk past an end settles on.
     #[arg(long)]
     no_switch: bool,
     /// The quantity the diagram draws against the parameter.

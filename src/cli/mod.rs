@@ -48,8 +48,8 @@ enum Command {
     /// Basin of the gait on a slice of the Poincare section: what the walk from every grid point does.
     Basin(basin::BasinArgs),
     /// Follow the gait family through folds by pseudo-arclength continuation in one parameter: its special
-    /// points (fold, period doubling, Neimark-Sacker, border collision) located by solving for them, the
-    /// period-2 family of every period doubling, branch.csv, special_points.json and a bifurcation diagram.
+    /// points (fold, period doubling, Neimark-Sacker, border collision) located by solving for them, why each
+    /// family ends, the families born there, branch.csv, special_points.json and a bifurcation diagram.
     Continue(continuation::ContinueArgs),
     /// Map the gait over two parameters: map.csv, the threshold curves (curves.json) and heat maps (map.png).
     Map(map::MapArgs),
