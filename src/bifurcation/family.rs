@@ -105,6 +105,26 @@ impl<'a> GaitFamily<'a> {
         self.param
     }
 
+    /// `P(x; p, q)` with `DP` and `dP/dp`: this family in the configuration with the key `second` at `q` (a
+    /// two-parameter curve's map, [`super::curve`]).
+    pub fn eval_with(
+        &self,
+        second: &str,
+        x: &DVector<f64>,
+        p: f64,
+        q: f64,
+    ) -> Result<Evaluation<GaitInfo>, MapFailure> {
+        let config = self.config.with(second, q).map_err(|e| MapFailure {
+            kind: "invalid_parameter".to_string(),
+            message: e.to_string(),
+        })?;
+        GaitFamily {
+            config: &config,
+            ..*self
+        }
+        .eval(x, p)
+    }
+
     /// The configuration with the parameter at `p`, and its model.
     fn configured(&self, p: f64) -> Result<(Config, Model), MapFailure> {
         let invalid = |message: String| MapFailure {

@@ -13,6 +13,7 @@
 
 pub mod arclength;
 pub mod corrector;
+pub mod curve;
 pub mod family;
 pub mod special;
 pub mod switch;
@@ -23,6 +24,9 @@ use nalgebra::{DMatrix, DVector};
 
 pub use arclength::{continue_family, ContinuationError, Family, FamilyEnd};
 pub use corrector::{ContinuationOptions, FamilyPoint};
+pub use curve::{
+    continue_curve, curve_at_p2, Curve, CurveEnd, CurveOptions, CurvePoint, CurveProblem,
+};
 pub use family::{GaitFamily, GaitInfo};
 pub use special::{SpecialKind, SpecialPoint};
 pub use switch::{switch_at_border, switch_at_period_doubling};

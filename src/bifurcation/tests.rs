@@ -374,3 +374,58 @@ fn dls_family_ends_at_a_border_collision() {
     let sides = bc.sides.as_ref().unwrap();
     assert!(sides[0].piece.starts_with("TD DLS") && sides[1].piece.starts_with("TD BOUNCE"));
 }
+
+/// The border collision lambda_2+ = 0 followed as a curve in (stiffness, viscosity) from c = 20 crosses c = 4
+/// where natural continuation along the stiffness at c = 4 ends (k = 564.367191, the README's sweep), to 1e-6.
+#[test]
+fn border_curve_agrees_with_the_one_parameter_end() {
+    let (config, section) = vrw_gait(&[("viscosity", 20.0), ("stiffness", 590.0)]);
+    let family_map = GaitFamily::new(&config, "stiffness", section).unwrap();
+    let options = ContinuationOptions::for_range(585.0, 600.0);
+    let family =
+        continue_family(&family_map, &family_map.reduce(&section), 590.0, &options).unwrap();
+    let bc = of_kind(&family, SpecialKind::BorderCollision)[0].clone();
+    let eval = |x: &DVector<f64>, k: f64, c: f64| family_map.eval_with("viscosity", x, k, c);
+    let test = |ev: &Evaluation<GaitInfo>| {
+        family_map
+            .borders(&ev.info)
+            .into_iter()
+            .find(|(name, _)| *name == "lambda_2_plus")
+            .map_or(f64::NAN, |(_, g)| g)
+    };
+    let problem = CurveProblem {
+        eval: &eval,
+        test: &test,
+        offset: crate::bifurcation::curve::BORDER_OFFSET,
+    };
+    let curve_options = CurveOptions {
+        steps: (0.05, 1e-6, 0.5),
+        ..CurveOptions::for_ranges((500.0, 700.0), (3.0, 21.0))
+    };
+    let curve = continue_curve(&problem, &bc.x, (bc.param, 20.0), &curve_options).unwrap();
+    assert!(curve
+        .points
+        .iter()
+        .all(|p| p.test_value.abs() < 1e-6 && p.residual < 1e-9));
+    assert_eq!(curve.ends, [CurveEnd::LeftRange, CurveEnd::LeftRange]);
+    let at4 = curve_at_p2(&problem, &curve, 4.0, &curve_options).expect("the curve crosses c = 4");
+    // Natural continuation along the stiffness at c = 4, as a sweep does.
+    let (config4, section4) = vrw_gait(&[("viscosity", 4.0), ("stiffness", 560.0)]);
+    let natural = Continuation::new(&config4, "stiffness", &GaitOptions::default()).follow(
+        GaitPoint {
+            value: 560.0,
+            section: section4,
+        },
+        570.0,
+        None,
+    );
+    let Followed::Ended { last, beyond } = natural else {
+        panic!("{natural:?}");
+    };
+    assert!(
+        at4.p1 >= last.value - 1e-6 && at4.p1 <= beyond + 1e-6,
+        "curve {} sweep [{}, {beyond}]",
+        at4.p1,
+        last.value
+    );
+}
