@@ -214,16 +214,53 @@ pub(crate) fn correct<M: FamilyMap>(
     m: &DMatrix<f64>,
     options: &ContinuationOptions,
 ) -> Result<(DVector<f64>, usize), MapFailure> {
+    chord(map, (z_pred, row), m, None, options).map(|c| (c.z, c.iterations))
+}
+
+/// Where the chord method converged.
+struct Converged<I> {
+    /// The converged unknowns.
+    z: DVector<f64>,
+    /// Iterations.
+    iterations: usize,
+    /// The residual's contraction per iteration (`NaN` if unknown).
+    rate: f64,
+    /// The evaluation at `z` with derivatives, if the last iteration made one.
+    ev: Option<super::Evaluation<I>>,
+}
+
+/// The chord method of [`correct`]. With `rate_hint` (the last corrector's contraction rate, until this one
+/// has its own), the iteration whose residual the contraction predicts below the tolerance evaluates the map
+/// with its derivatives (see [`correct_to_point`]); without, only `P` is evaluated.
+fn chord<M: FamilyMap>(
+    map: &M,
+    (z_pred, row): (&DVector<f64>, &DVector<f64>),
+    m: &DMatrix<f64>,
+    rate_hint: Option<f64>,
+    options: &ContinuationOptions,
+) -> Result<Converged<M::Info>, MapFailure> {
     let sigma = options.param_scale;
-    let lu = m.clone().lu();
+    let mut lu = m.clone().lu();
     let mut z = z_pred.clone();
     let mut previous = f64::INFINITY;
+    let mut rate = rate_hint.unwrap_or(f64::NAN);
     for iteration in 0..=options.max_corrector_iterations {
         let (x, p) = split(&z, sigma);
-        let h = map.value(&x, p)? - &x;
+        let expect_converged = rate_hint.is_some() && previous * rate < options.tolerance;
+        let (h, ev) = if expect_converged {
+            let ev = map.eval(&x, p)?;
+            (&ev.value - &x, Some(ev))
+        } else {
+            (map.value(&x, p)? - &x, None)
+        };
         let residual = h.amax();
         if residual < options.tolerance {
-            return Ok((z, iteration));
+            return Ok(Converged {
+                z,
+                iterations: iteration,
+                rate,
+                ev,
+            });
         }
         if residual.is_nan()
             || residual >= 0.5 * previous
@@ -231,7 +268,13 @@ pub(crate) fn correct<M: FamilyMap>(
         {
             return Err(corrector_failure(iteration, residual));
         }
+        if previous.is_finite() {
+            rate = residual / previous;
+        }
         previous = residual;
+        if let Some(ev) = ev.filter(|ev| ev.jacobian.iter().all(|v| v.is_finite())) {
+            lu = bordered(&augmented(&ev.jacobian, &ev.dparam, sigma), row).lu();
+        }
         let n = h.len();
         let mut r = h.insert_row(n, row.dot(&(&z - z_pred)));
         r.neg_mut();
@@ -300,9 +343,9 @@ fn point_from<I>(
 }
 
 /// [`correct`] and [`point_at`] in one: the iteration whose residual the contraction so far (or, before this
-/// corrector has two residuals, `rate_hint`, the last corrector's) predicts below the tolerance evaluates the map with its derivatives, which is the converged point's own evaluation (one
-/// evaluation of `P` fewer per point) or, if it is not yet converged, gives the remaining iterations a fresh
-/// matrix.
+/// corrector has two residuals, `rate_hint`, the last corrector's) predicts below the tolerance evaluates
+/// the map with its derivatives, which is the converged point's own evaluation (one evaluation of `P` fewer
+/// per point) or, if it is not yet converged, gives the remaining iterations a fresh matrix.
 pub(crate) fn correct_to_point<M: FamilyMap>(
     map: &M,
     z_pred: &DVector<f64>,
@@ -311,54 +354,18 @@ pub(crate) fn correct_to_point<M: FamilyMap>(
     (orient, rate_hint): (&DVector<f64>, f64),
     options: &ContinuationOptions,
 ) -> Result<FamilyPoint<M::Info>, MapFailure> {
-    let sigma = options.param_scale;
-    let mut lu = m.clone().lu();
-    let mut z = z_pred.clone();
-    let mut previous = f64::INFINITY;
-    // The residual's contraction per iteration: the last corrector's until this one has its own.
-    let mut rate = rate_hint;
-    for iteration in 0..=options.max_corrector_iterations {
-        let (x, p) = split(&z, sigma);
-        let expect_converged = previous * rate < options.tolerance;
-        let (h, ev) = if expect_converged {
-            let ev = map.eval(&x, p)?;
-            (&ev.value - &x, Some(ev))
-        } else {
-            (map.value(&x, p)? - &x, None)
-        };
-        let residual = h.amax();
-        if residual < options.tolerance {
-            let ev = match ev {
-                Some(ev) => ev,
-                None => map.eval(&x, p)?,
-            };
-            let mut point = point_from(ev, &z, orient, sigma)?;
-            point.iterations = iteration;
-            point.corrector_rate = rate;
-            return Ok(point);
+    let c = chord(map, (z_pred, row), m, Some(rate_hint), options)?;
+    let ev = match c.ev {
+        Some(ev) => ev,
+        None => {
+            let (x, p) = split(&c.z, options.param_scale);
+            map.eval(&x, p)?
         }
-        if residual.is_nan()
-            || residual >= 0.5 * previous
-            || iteration == options.max_corrector_iterations
-        {
-            return Err(corrector_failure(iteration, residual));
-        }
-        if previous.is_finite() {
-            rate = residual / previous;
-        }
-        previous = residual;
-        if let Some(ev) = ev.filter(|ev| ev.jacobian.iter().all(|v| v.is_finite())) {
-            lu = bordered(&augmented(&ev.jacobian, &ev.dparam, sigma), row).lu();
-        }
-        let n = h.len();
-        let mut r = h.insert_row(n, row.dot(&(&z - z_pred)));
-        r.neg_mut();
-        let dz = lu
-            .solve(&r)
-            .ok_or_else(|| corrector_failure(iteration, residual))?;
-        z += dz;
-    }
-    unreachable!("the loop returns at its last iteration")
+    };
+    let mut point = point_from(ev, &c.z, orient, options.param_scale)?;
+    point.iterations = c.iterations;
+    point.corrector_rate = c.rate;
+    Ok(point)
 }
 
 /// The fixed point near `x0` at `p0`, with its tangent pointing to increasing `p` (or, at a fold, along the

@@ -87,6 +87,14 @@ pub trait FamilyMap: Sync {
         Vec::new()
     }
 
+    /// The border function `name` of [`FamilyMap::borders`] at the point (`NaN` if it has none of that name).
+    fn border(&self, info: &Self::Info, name: &str) -> f64 {
+        self.borders(info)
+            .into_iter()
+            .find(|(other, _)| *other == name)
+            .map_or(f64::NAN, |(_, g)| g)
+    }
+
     /// The smooth piece of the map the point lies on (the VRW: the event sequence of its step); a change along
     /// a family is a border collision.
     fn piece(&self, _info: &Self::Info) -> String {

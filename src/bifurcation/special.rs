@@ -219,12 +219,7 @@ pub(crate) fn detect_between<M: FamilyMap>(
         }
         border_crossed = true;
         let name = *name;
-        let test = |ev: &Evaluation<M::Info>| {
-            map.borders(&ev.info)
-                .into_iter()
-                .find(|(other, _)| *other == name)
-                .map_or(f64::NAN, |(_, g)| g)
-        };
+        let test = |ev: &Evaluation<M::Info>| map.border(&ev.info, name);
         let mut sp = locate(map, a, b, (*ga, *gb), &test, options);
         sp.kind = SpecialKind::BorderCollision;
         // DP does not exist on the border: the one-sided multipliers are in `sides`.
@@ -455,40 +450,25 @@ pub(crate) fn border_at_end<M: FamilyMap>(
         if distance > END_BORDER_REACH || best.as_ref().is_some_and(|(d, _)| *d <= distance) {
             continue;
         }
-        let test = |info: &M::Info| {
-            map.borders(info)
-                .into_iter()
-                .find(|(other, _)| *other == name)
-                .map_or(f64::NAN, |(_, g)| g)
-        };
-        let ev = Evaluation {
-            value: point.x.clone(),
-            jacobian: point.jacobian.clone(),
-            dparam: point.dparam.clone(),
-            exact: point.exact,
-            info: point.info.clone(),
-        };
-        let iterations_note = format!(
-            "secant along the family on {name} from its last point: {iterations} iterations"
-        );
-        let test_value = test(&ev.info);
-        let residual = point.residual;
         let (x, p) = split(&z, sigma);
         let mut sp = SpecialPoint {
             kind: SpecialKind::BorderCollision,
             param: p,
-            residual,
+            residual: point.residual,
             x,
             arclength: last.arclength + distance,
             bracket: [last.param, p],
             located: true,
-            method: iterations_note,
+            method: format!(
+                "secant along the family on {name} from its last point: {iterations} iterations"
+            ),
             iterations,
-            test_value,
-            multipliers: multipliers(&ev.jacobian),
+            test_value: map.border(&point.info, name),
+            // DP does not exist on the border: the one-sided multipliers are in `sides`.
+            multipliers: Vec::new(),
             border: Some(name.to_string()),
             sides: None,
-            info: Some(ev.info),
+            info: Some(point.info),
             note: None,
             direction: last.tangent.normalize(),
             ends_family: true,
@@ -520,8 +500,6 @@ pub(crate) fn border_at_end<M: FamilyMap>(
                  fixed point continues the family on the other side"
             )
         });
-        // DP does not exist on the border: the one-sided multipliers are in `sides`.
-        sp.multipliers = Vec::new();
         best = Some((distance, sp));
     }
     best.map(|(_, sp)| sp)
@@ -543,12 +521,7 @@ fn approach_border<M: FamilyMap>(
     let sigma = options.param_scale;
     let z0 = last.z(sigma);
     let t = &last.tangent;
-    let g = |p: &FamilyPoint<M::Info>| {
-        map.borders(&p.info)
-            .into_iter()
-            .find(|(other, _)| *other == name)
-            .map_or(f64::NAN, |(_, g)| g)
-    };
+    let g = |p: &FamilyPoint<M::Info>| map.border(&p.info, name);
     let m = bordered(&augmented(&last.jacobian, &last.dparam, sigma), t);
     let at = |s: f64| -> Option<FamilyPoint<M::Info>> {
         let (z, _) = correct(map, &(&z0 + s * t), t, &m, options).ok()?;

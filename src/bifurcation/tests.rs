@@ -386,13 +386,7 @@ fn border_curve_agrees_with_the_one_parameter_end() {
         continue_family(&family_map, &family_map.reduce(&section), 590.0, &options).unwrap();
     let bc = of_kind(&family, SpecialKind::BorderCollision)[0].clone();
     let eval = |x: &DVector<f64>, k: f64, c: f64| family_map.eval_with("viscosity", x, k, c);
-    let test = |ev: &Evaluation<GaitInfo>| {
-        family_map
-            .borders(&ev.info)
-            .into_iter()
-            .find(|(name, _)| *name == "lambda_2_plus")
-            .map_or(f64::NAN, |(_, g)| g)
-    };
+    let test = |ev: &Evaluation<GaitInfo>| family_map.border(&ev.info, "lambda_2_plus");
     let problem = CurveProblem {
         eval: &eval,
         test: &test,
