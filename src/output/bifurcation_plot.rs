@@ -9,8 +9,8 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::chart::{
-    draw_axes_and_curves, draw_legend, draw_marker, finite_range, titled, Axes, Curve, DrawResult,
-    Figure, Marker, Stroke, LEGEND_FONT,
+    data_to_px, draw_axes_and_curves, draw_legend, draw_marker, finite_range, titled, Axes, Curve,
+    DrawResult, Figure, Marker, Stroke, LEGEND_FONT,
 };
 use super::style::{
     font, padded, COLOR_BLACK, COLOR_BLUE, COLOR_GREEN, COLOR_MARK, COLOR_ORANGE, COLOR_PURPLE,
@@ -167,14 +167,7 @@ impl Figure for BifurcationFigure {
             .collect();
         let (px, py) = draw_axes_and_curves(&panel, &axes, &curves, &[], &[])?;
         let base = panel.get_base_pixel();
-        let to_px = |(a, b): (f64, f64)| {
-            let fx = (a - self.x.start) / (self.x.end - self.x.start);
-            let fy = (b - y.start) / (y.end - y.start);
-            (
-                px.start + (fx * f64::from(px.end - px.start - 1)).round() as i32 - base.0,
-                py.end - 1 - (fy * f64::from(py.end - py.start - 1)).round() as i32 - base.1,
-            )
-        };
+        let to_px = data_to_px(self.x.clone(), y.clone(), (px.clone(), py.clone()), base);
         for sp in &self.special {
             if !(sp.param.is_finite() && sp.value.is_finite() && self.x.contains(&sp.param)) {
                 continue;

@@ -10,8 +10,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::chart::{
-    draw_axes_and_curves, draw_legend, finite_range, titled, write_png, Axes, Band, Clip, Curve,
-    DrawResult, Figure, Stroke, DASH_GAP,
+    data_to_px, draw_axes_and_curves, draw_legend, finite_range, titled, write_png, Axes, Band,
+    Clip, Curve, DrawResult, Figure, Stroke, DASH_GAP,
 };
 use super::style::{padded, PlotError, COLOR_BLACK, COLOR_BLUE, COLOR_MARK, COLOR_VERMILLION};
 
@@ -176,14 +176,7 @@ impl Figure for OrbitFigure {
                 .collect();
             let (px, py) = draw_axes_and_curves(&sub, &axes, &[], &bands, &[])?;
             let base = sub.get_base_pixel();
-            let to_px = |(a, b): (f64, f64)| {
-                let fx = (a - self.x.start) / (self.x.end - self.x.start);
-                let fy = (b - y.start) / (y.end - y.start);
-                (
-                    px.start + (fx * f64::from(px.end - px.start - 1)).round() as i32 - base.0,
-                    py.end - 1 - (fy * f64::from(py.end - py.start - 1)).round() as i32 - base.1,
-                )
-            };
+            let to_px = data_to_px(self.x.clone(), y.clone(), (px.clone(), py.clone()), base);
             let clip = Clip::new(
                 px.start - base.0..px.end - base.0,
                 py.start - base.1..py.end - base.1,

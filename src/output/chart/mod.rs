@@ -109,6 +109,25 @@ pub(crate) struct Stack<'a> {
 /// Pixel ranges (x, y) of a plotting area on the canvas.
 pub(crate) type PixelRect = (Range<i32>, Range<i32>);
 
+/// The pixel, relative to an area whose base pixel is `base`, of a data point on the axes `x`, `y` drawn in
+/// the plot rectangle `(px, py)` (what [`draw_axes_and_curves`] returns): the ranges' ends on its last
+/// pixels.
+pub(crate) fn data_to_px(
+    x: Range<f64>,
+    y: Range<f64>,
+    (px, py): PixelRect,
+    base: (i32, i32),
+) -> impl Fn((f64, f64)) -> (i32, i32) {
+    move |(a, b)| {
+        let fx = (a - x.start) / (x.end - x.start);
+        let fy = (b - y.start) / (y.end - y.start);
+        (
+            px.start + (fx * f64::from(px.end - px.start - 1)).round() as i32 - base.0,
+            py.end - 1 - (fy * f64::from(py.end - py.start - 1)).round() as i32 - base.1,
+        )
+    }
+}
+
 /// The result of a drawing call on backend `DB`.
 pub(crate) type DrawResult<DB> =
     Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
