@@ -966,3 +966,68 @@ fn continue_refuses_bad_options() {
         assert!(!run.out.join("branch.csv").exists());
     }
 }
+
+/// `vrw continue --two-param`: the curve of the border collision in a second parameter, its table and figure.
+#[test]
+fn continue_follows_a_border_curve_in_two_parameters() {
+    let args = [
+        "--param",
+        "stiffness",
+        "--set",
+        "viscosity=20",
+        "--from",
+        "585",
+        "--to",
+        "600",
+        "--start",
+        "590",
+        "--no-switch",
+        "--two-param",
+        "viscosity",
+        "--two-range",
+        "18,22",
+    ];
+    let run = command_in(temp_dir_with(&[]), "continue", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let table = run.read("curves.csv");
+    assert!(table.starts_with("curve,border,stiffness,viscosity,L2"));
+    assert!(data_rows(&table) > 5);
+    let summary: Value = serde_json::from_str(&run.read("special_points.json")).unwrap();
+    assert_eq!(summary["curves"][0]["border"], "lambda_2_plus");
+    assert_eq!(summary["curves"][0]["kind"], "BC");
+    // The curve ends on the range's bound c = 22, where a family followed in k alone at c = 22 meets the
+    // same border: the two agree to 1e-6.
+    let last = table.lines().last().unwrap().split(',').collect::<Vec<_>>();
+    assert_eq!(last[3].parse::<f64>().unwrap(), 22.0);
+    let line = command_in(
+        temp_dir_with(&[]),
+        "continue",
+        &[
+            "--param",
+            "stiffness",
+            "--set",
+            "viscosity=22",
+            "--from",
+            "585",
+            "--to",
+            "605",
+            "--start",
+            "590",
+            "--no-switch",
+        ],
+    );
+    assert_eq!(line.code(), Some(0), "{}", line.stderr());
+    let one: Value = serde_json::from_str(&line.read("special_points.json")).unwrap();
+    let threshold = one["special_points"][0]["param"].as_f64().unwrap();
+    let on_curve = last[2].parse::<f64>().unwrap();
+    assert!(
+        (on_curve - threshold).abs() < 1e-6,
+        "curve {on_curve} vs family {threshold}"
+    );
+    let run = command_in(
+        temp_dir_with(&[]),
+        "continue",
+        &["--two-param", "viscosity", "--two-range", "1,10"],
+    );
+    assert_error(&run, &["--two-param"]);
+}

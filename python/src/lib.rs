@@ -19,7 +19,7 @@ use pythonize::pythonize;
 
 use vrw::app::{
     compute_basin, compute_continuation, compute_gait, compute_simulation, compute_sweep,
-    family_rows, AppError, BasinJob, ContinueJob, GaitJob, SimulateJob,
+    curve_rows, family_rows, AppError, BasinJob, ContinueJob, GaitJob, SimulateJob,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -27,8 +27,8 @@ use vrw::gait::basin::Coordinate;
 use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, SweepSpec};
 use vrw::output::{
-    basin_header, basin_row, family_header, family_row, step_row, sweep_header, sweep_row,
-    trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
+    basin_header, basin_row, curve_header, curve_row, family_header, family_row, step_row,
+    sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -532,9 +532,11 @@ fn basin<'py>(
 /// `warnings`, ...) and `branch`, the columns of `branch.csv` as numpy arrays. Keyword arguments as the command
 /// line's options: `start` (default the parameter's value in `params`), `range` (`(from, to)`, `None`: the
 /// command line's `(1, 300)`), `initial`, `period`, `max_points`, `max_step`, `switch` (follow the families born at period
-/// doublings, border collisions and ends; the command line's `--no-switch` is `switch=False`).
+/// doublings, border collisions and ends; the command line's `--no-switch` is `switch=False`), `two_param`
+/// (`(name, from, to)`: the command line's `--two-param name --two-range from,to`; the curves' points are then
+/// `curve_points`, the columns of `curves.csv`).
 #[pyfunction]
-#[pyo3(signature = (params, param = "viscosity", *, start = None, range = None, initial = None, period = None, max_points = 300, max_step = 0.1, switch = true))]
+#[pyo3(signature = (params, param = "viscosity", *, start = None, range = None, initial = None, period = None, max_points = 300, max_step = 0.1, switch = true, two_param = None))]
 #[allow(clippy::too_many_arguments)]
 fn continue_family<'py>(
     py: Python<'py>,
@@ -547,6 +549,7 @@ fn continue_family<'py>(
     #[pyo3(from_py_with = max_points_arg)] max_points: usize,
     max_step: f64,
     switch: bool,
+    two_param: Option<(String, f64, f64)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let flag = Arc::new(AtomicBool::new(false));
     let range = range.unwrap_or((1.0, 300.0));
@@ -564,11 +567,17 @@ fn continue_family<'py>(
         plot: "thetadot".to_string(),
         out_dir: PathBuf::new(),
         interrupt: Some(Arc::clone(&flag)),
+        two_param,
     };
     let result = interruptible(py, &flag, || compute_continuation(&job))?.map_err(app_error)?;
     let out = pythonize(py, &result.summary)?.downcast_into::<PyDict>()?;
     let rows: Vec<Vec<Cell>> = family_rows(&result).iter().map(family_row).collect();
     out.set_item("branch", table(py, &family_header(param), &rows)?)?;
+    if let Some(first) = result.summary.curves.first() {
+        let rows: Vec<Vec<Cell>> = curve_rows(&result).iter().map(curve_row).collect();
+        let header = curve_header((param, &first.param2));
+        out.set_item("curve_points", table(py, &header, &rows)?)?;
+    }
     Ok(out)
 }
 

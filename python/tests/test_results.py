@@ -104,3 +104,25 @@ def test_continue_family_equals_branch_csv(cli, tmp_path):
         vrw.continue_family(vrw.Params(), "slope", start=0.5, range=(0.3, 0.34))
     with pytest.raises(vrw.ConfigError, match="max_points"):
         vrw.continue_family(vrw.Params(), max_points=-1)
+
+
+def test_continue_family_curves_equal_curves_csv(cli, tmp_path):
+    args = ["--param", "stiffness", "--set", "viscosity=20", "--from", "585", "--to", "600", "--start", "590"]
+    cli("continue", *args, "--no-switch", "--two-param", "viscosity", "--two-range", "18,22", "--out", tmp_path)
+    result = vrw.continue_family(
+        vrw.Params(viscosity=20),
+        "stiffness",
+        start=590,
+        range=(585, 600),
+        switch=False,
+        two_param=("viscosity", 18, 22),
+    )
+    csv = pd.read_csv(tmp_path / "curves.csv")
+    frame = result["curve_points"].to_pandas()
+    assert list(frame.columns) == list(csv.columns) and frame.shape == csv.shape
+    for column in ["stiffness", "viscosity", "thetadot", "test_value"]:
+        assert np.array_equal(frame[column].to_numpy(), csv[column].to_numpy()), column
+    expected = __import__("json").loads((tmp_path / "special_points.json").read_text())
+    assert [dict(c, ends=list(c["ends"])) for c in result["curves"]] == expected["curves"]
+    with pytest.raises(ValueError, match="two_param"):
+        vrw.continue_family(vrw.Params(), two_param=("viscosity", 1, 10))

@@ -130,10 +130,13 @@ def continue_family(
     max_points: int = 300,
     max_step: float = 0.1,
     switch: bool = True,
+    two_param: Optional[Tuple[str, float, float]] = None,
 ) -> Dict[str, Any]:
     """Follow the gait family through the gait at ``start`` by pseudo-arclength continuation (``vrw continue``,
     without the figure): the fields of ``special_points.json`` and ``branch``, the columns of ``branch.csv``.
-    ``range`` is ``(from, to)``, default ``(1, 300)``."""
+    ``range`` is ``(from, to)``, default ``(1, 300)``; ``two_param`` ``(name, from, to)`` also follows every
+    border collision's curve in that second parameter (``curves`` in
+    ``special_points.json``'s form, and ``curve_points``, the columns of ``curves.csv``)."""
 
 def basin(
     params: Params,

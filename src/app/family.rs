@@ -11,7 +11,9 @@ use serde::Serialize;
 
 use super::family_records::{special_record, EndRecord, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
+use crate::bifurcation::curve::{border_curve_seed, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR};
 use crate::bifurcation::special::JUMP_TOL;
+use crate::bifurcation::{continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem};
 use crate::bifurcation::{
     continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
     ContinuationOptions, Family, FamilyEnd, FamilyMap, GaitFamily, GaitInfo, SpecialKind,
@@ -76,6 +78,9 @@ pub struct ContinueJob {
     pub out_dir: PathBuf,
     /// Stops the walks when set.
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// Follow the curve of every located border collision in a second parameter over its range (`name`,
+    /// from, to): `curves.csv`, `curves.png`.
+    pub two_param: Option<(String, f64, f64)>,
 }
 
 /// `special_points.json`: what was followed, the families and their special points.
@@ -97,6 +102,8 @@ pub struct ContinueSummary {
     pub families: Vec<FamilyRecord>,
     /// Their special points, by family and arclength.
     pub special_points: Vec<SpecialRecord>,
+    /// The two-parameter curves followed (`two_param`), in `curves.csv`'s order.
+    pub curves: Vec<CurveRecord>,
     /// Audit warnings of the families' gaits, and families that could not be followed.
     pub warnings: Vec<String>,
     /// The files written.
@@ -114,6 +121,31 @@ pub struct ContinueResult {
     pub families: Vec<Family<GaitInfo>>,
     /// Each family's points' stability verdicts.
     pub stability: Vec<Vec<Stability>>,
+    /// The two-parameter curves, as the summary's `curves`.
+    pub curves: Vec<Curve<GaitInfo>>,
+}
+
+/// One two-parameter curve in `special_points.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct CurveRecord {
+    /// Its number (`curve` in `curves.csv`), from 1.
+    pub curve: usize,
+    /// The family and the index of the special point (in `special_points`) it starts from.
+    pub family: usize,
+    /// Index into `special_points`.
+    pub special_point: usize,
+    /// The special point's kind (`BC`).
+    pub kind: SpecialKind,
+    /// The border function followed.
+    pub border: String,
+    /// The second parameter.
+    pub param2: String,
+    /// Points in `curves.csv`.
+    pub points: usize,
+    /// How it ends at its first point and at its last.
+    pub ends: [CurveEnd; 2],
+    /// How it was computed.
+    pub method: String,
 }
 
 impl ContinueJob {
@@ -301,7 +333,12 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
             );
         }
     }
+    let (curve_records, curves) = match &job.two_param {
+        Some(second) => two_param_curves(job, &config, second, &families, &mut warnings)?,
+        None => (Vec::new(), Vec::new()),
+    };
     let summary = ContinueSummary {
+        curves: curve_records,
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: config.clone(),
         param: job.param.clone(),
@@ -318,7 +355,105 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         summary,
         families: families.into_iter().map(|f| f.family).collect(),
         stability,
+        curves,
     })
+}
+
+/// The curves of every located border collision of `families` in the second parameter (`name`, from, to),
+/// each followed on its family's side of the border (docs/model.md section 11, "Two-parameter curves").
+fn two_param_curves(
+    job: &ContinueJob,
+    config: &Config,
+    (name, from, to): &(String, f64, f64),
+    families: &[Followed],
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<CurveRecord>, Vec<Curve<GaitInfo>>), AppError> {
+    let invalid = |reason: String| AppError::InvalidOption {
+        option: "two_param",
+        reason,
+    };
+    if !Config::numeric_keys().contains(&name.as_str()) || *name == job.param {
+        return Err(invalid(format!(
+            "{name:?} must be a real-valued key other than the followed parameter {:?}",
+            job.param
+        )));
+    }
+    let q0 = config.get_numeric(name)?;
+    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
+        return Err(invalid(format!(
+            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
+        )));
+    }
+    let options = CurveOptions::for_ranges((job.from, job.to), (*from, *to));
+    let mut records = Vec::new();
+    let mut curves = Vec::new();
+    let mut index = 0;
+    for (k, f) in families.iter().enumerate() {
+        for sp in &f.family.special {
+            let this = index;
+            index += 1;
+            let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
+                continue;
+            };
+            if sp.kind != SpecialKind::BorderCollision || !sp.located {
+                continue;
+            }
+            let Some((before, side)) = border_curve_seed(&f.map, &f.family, sp.arclength, &border)
+            else {
+                warnings.push(format!(
+                    "family {} BC {border} at {} = {}: no point of the family lies clearly on one side of \
+                     the border; no curve followed",
+                    k + 1,
+                    job.param,
+                    sp.param
+                ));
+                continue;
+            };
+            let map = f.map;
+            let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.eval_with(name, x, p, q);
+            let test =
+                |ev: &crate::bifurcation::Evaluation<GaitInfo>| f.map.border(&ev.info, &border);
+            let observe =
+                |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
+            let problem = CurveProblem {
+                eval: &eval,
+                observe: Some(&observe),
+                test: &test,
+                offset: BORDER_OFFSET.copysign(side),
+            };
+            // From the family's last point before the border (the located point itself lies on the border,
+            // perhaps a rounding error past it).
+            match continue_curve(&problem, &before.x, (before.param, q0), &options) {
+                Ok(curve) => {
+                    records.push(CurveRecord {
+                        curve: records.len() + 1,
+                        family: k + 1,
+                        special_point: this,
+                        kind: sp.kind,
+                        border: border.clone(),
+                        param2: name.clone(),
+                        points: curve.points.len(),
+                        ends: curve.ends.clone(),
+                        method: format!(
+                            "pseudo-arclength on P(x) = x, {border} = {:e} (the family's side), steps at \
+                             {:e}, polished",
+                            problem.offset,
+                            problem.offset * FOLLOW_OFFSET_FACTOR
+                        ),
+                    });
+                    curves.push(curve);
+                }
+                Err(e) => warnings.push(format!(
+                    "family {} BC {border} at {} = {}: no curve in {name}: {}",
+                    k + 1,
+                    job.param,
+                    sp.param,
+                    e.message
+                )),
+            }
+        }
+    }
+    Ok((records, curves))
 }
 
 /// A family being followed: where it came from, its map and its ends with their causes.

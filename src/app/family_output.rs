@@ -10,7 +10,7 @@ use crate::output::bifurcation_plot::{
 };
 use crate::output::chart::write_svg_png;
 use crate::output::manifest::RunDir;
-use crate::output::{write_family_csv, write_json, FamilyRow};
+use crate::output::{write_curves_csv, write_family_csv, write_json, CurveRow, FamilyRow};
 
 /// Run `vrw continue`: [`compute_continuation`], then write `branch.csv`, `special_points.json` and the
 /// diagram.
@@ -43,6 +43,22 @@ pub fn family_rows(result: &ContinueResult) -> Vec<FamilyRow<'_>> {
         .collect()
 }
 
+/// The rows of `curves.csv` of a computed continuation: every point of every two-parameter curve.
+pub fn curve_rows(result: &ContinueResult) -> Vec<CurveRow<'_>> {
+    result
+        .curves
+        .iter()
+        .zip(&result.summary.curves)
+        .flat_map(|(curve, record)| {
+            curve.points.iter().map(move |point| CurveRow {
+                curve: record.curve,
+                border: &record.border,
+                point,
+            })
+        })
+        .collect()
+}
+
 /// Write the files of a computed continuation into `run`.
 fn write_continuation(
     job: &ContinueJob,
@@ -65,11 +81,71 @@ fn write_continuation(
         run.add(name);
         files.push(name.to_string());
     }
+    if !result.curves.is_empty() {
+        let param2 = result.summary.curves[0].param2.clone();
+        write_curves_csv(
+            &run.path("curves.csv"),
+            (param, &param2),
+            &curve_rows(result),
+        )?;
+        let figure = curves_figure(job, result, &param2);
+        write_svg_png(
+            &figure,
+            &run.path("curves.svg"),
+            &run.path("curves.png"),
+            BIFURCATION_SIZE,
+        )?;
+        for name in ["curves.csv", "curves.svg", "curves.png"] {
+            run.add(name);
+            files.push(name.to_string());
+        }
+    }
     files.insert(1, "special_points.json".to_string());
     result.summary.files = files;
     write_json(&run.path("special_points.json"), &result.summary)?;
     run.add("special_points.json");
     Ok(())
+}
+
+/// The two-parameter curves in the plane of the two parameters.
+fn curves_figure(job: &ContinueJob, result: &ContinueResult, param2: &str) -> BifurcationFigure {
+    BifurcationFigure {
+        title: format!("Curves of border collisions in ({}, {param2})", job.param),
+        param_label: axis_label(&job.param),
+        y_label: axis_label(param2),
+        x: job.from..job.to,
+        families: result
+            .curves
+            .iter()
+            .zip(&result.summary.curves)
+            .map(|(curve, record)| DiagramFamily {
+                label: format!("curve {}: {} = 0", record.curve, record.border),
+                phases: vec![curve
+                    .points
+                    .iter()
+                    .map(|p| (p.p1, p.p2, Some(true)))
+                    .collect()],
+                ends: Vec::new(),
+            })
+            .collect(),
+        // Each curve's start: the border collision of the family it was continued from.
+        special: result
+            .summary
+            .curves
+            .iter()
+            .enumerate()
+            .filter_map(|(k, record)| {
+                let sp = result.summary.special_points.get(record.special_point)?;
+                Some(DiagramSpecial {
+                    family: k,
+                    param: sp.param,
+                    value: result.summary.config.get_numeric(param2).ok()?,
+                    label: "BC".to_string(),
+                })
+            })
+            .collect(),
+        styles_in_legend: false,
+    }
 }
 
 /// The bifurcation diagram of a computed continuation.
@@ -161,6 +237,7 @@ fn diagram(job: &ContinueJob, result: &ContinueResult) -> BifurcationFigure {
         x: job.from..job.to,
         families,
         special,
+        styles_in_legend: true,
     }
 }
 

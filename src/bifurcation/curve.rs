@@ -17,7 +17,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::corrector::tangent;
-use super::{Evaluation, MapFailure};
+use super::{Evaluation, Family, FamilyMap, FamilyPoint, MapFailure};
 
 /// Relative step of the central differences of the curve's Jacobian.
 pub const CURVE_FD_STEP: f64 = 1e-6;
@@ -121,6 +121,10 @@ pub type TwoParamEval<'f, I> =
 pub struct CurveProblem<'f, I> {
     /// `P(x; p1, p2)` with its derivatives in `x` and `p1`.
     pub eval: &'f TwoParamEval<'f, I>,
+    /// `P(x; p1, p2)` and what the map records, without derivatives (the evaluation's `jacobian` and `dparam`
+    /// may be empty): the corrector's iterations and the differences use it, and `eval` is called once per
+    /// point. `None` where `test` needs the derivatives (a fold's, period doubling's or Neimark-Sacker's `g`).
+    pub observe: Option<&'f TwoParamEval<'f, I>>,
     /// `g` of an evaluation.
     pub test: &'f (dyn Fn(&Evaluation<I>) -> f64 + Sync),
     /// The value of `g` followed (0 for a fold, period doubling or Neimark-Sacker curve; the side's small value
@@ -153,18 +157,23 @@ impl<I: Clone + Send> CurveProblem<'_, I> {
         u: &DVector<f64>,
         o: &CurveOptions,
     ) -> Result<(DVector<f64>, Evaluation<I>), MapFailure> {
-        self.residual_at(u, o, self.offset)
+        self.residual_at(u, o, self.offset, true)
     }
 
-    /// The residual with `g` followed at `offset`.
+    /// The residual with `g` followed at `offset`; the evaluation with derivatives if `derivatives` (else
+    /// perhaps without, see [`CurveProblem::observe`]).
     fn residual_at(
         &self,
         u: &DVector<f64>,
         o: &CurveOptions,
         offset: f64,
+        derivatives: bool,
     ) -> Result<(DVector<f64>, Evaluation<I>), MapFailure> {
         let (x, p1, p2) = self.split(u, o);
-        let ev = (self.eval)(&x, p1, p2)?;
+        let ev = match self.observe {
+            Some(observe) if !derivatives => observe(&x, p1, p2)?,
+            _ => (self.eval)(&x, p1, p2)?,
+        };
         let g = (self.test)(&ev) - offset;
         let n = x.len();
         let mut r = DVector::zeros(n + 1);
@@ -189,7 +198,7 @@ impl<I: Clone + Send> CurveProblem<'_, I> {
                 let at = |sign: f64| {
                     let mut v = u.clone();
                     v[i] += sign * step;
-                    self.residual(&v, o).map(|(r, _)| r)
+                    self.residual_at(&v, o, self.offset, false).map(|(r, _)| r)
                 };
                 // A difference whose walk fails, or that lands on the other side of a border (g + offset of
                 // the opposite sign to offset), is replaced by the one-sided difference on the other side.
@@ -198,7 +207,7 @@ impl<I: Clone + Send> CurveProblem<'_, I> {
                     Err(_) => false,
                 };
                 let (plus, minus) = (at(1.0), at(-1.0));
-                let here = || self.residual(u, o).map(|(r, _)| r);
+                let here = || self.residual_at(u, o, self.offset, false).map(|(r, _)| r);
                 let d = match (usable(&plus), usable(&minus), plus, minus) {
                     (true, true, Ok(p), Ok(m)) => (p - m) / (2.0 * step),
                     (false, true, _, Ok(m)) => (here()? - m) / step,
@@ -251,9 +260,15 @@ impl<I: Clone + Send> CurveProblem<'_, I> {
         let mut u = u_pred.clone();
         let mut last_step = f64::INFINITY;
         for iteration in 0..MAX_CURVE_ITERATIONS {
-            let (r, ev) = self.residual_at(&u, o, offset)?;
+            let (r, ev) = self.residual_at(&u, o, offset, false)?;
             let residual = r.rows(0, n).amax();
             if residual < o.tolerance && last_step < CURVE_STEP_TOL {
+                // The point's derivatives for the next matrix (the same walk, its value agreeing to the
+                // integrator's tolerance; the point's residual is recomputed from this evaluation).
+                let ev = match self.observe {
+                    Some(_) => self.residual_at(&u, o, offset, true)?.1,
+                    None => ev,
+                };
                 return Ok((u, ev, iteration));
             }
             let mut rhs = r.insert_row(n + 1, row.dot(&(&u - u_pred)));
@@ -283,6 +298,39 @@ const MAX_CURVE_ITERATIONS: usize = 10;
 /// The corrector's last step must be below this in every scaled unknown.
 const CURVE_STEP_TOL: f64 = 1e-9;
 
+/// Where a border collision's curve starts from: the family's point nearest the border (in arclength from
+/// `arclength`, the collision's) whose border function `border` is clearly off it (ten times the offset the
+/// curve's steps aim at), and the function's sign there (the family's side). The located collision, and the
+/// family's last point before a border that ends it, lie on the border itself, perhaps a rounding error past
+/// it: a side taken there could be the other piece's.
+pub fn border_curve_seed<'p, M: FamilyMap>(
+    map: &M,
+    family: &'p Family<M::Info>,
+    arclength: f64,
+    border: &str,
+) -> Option<(&'p FamilyPoint<M::Info>, f64)> {
+    let clear = 10.0 * BORDER_OFFSET * FOLLOW_OFFSET_FACTOR;
+    family
+        .points
+        .iter()
+        .map(|p| (p, map.border(&p.info, border)))
+        .filter(|(_, g)| g.abs() >= clear)
+        .min_by(|a, b| {
+            let d = |p: &FamilyPoint<M::Info>| (p.arclength - arclength).abs();
+            d(a.0).total_cmp(&d(b.0))
+        })
+        .map(|(p, g)| (p, g.signum()))
+}
+
+/// The scale of parameter `k` (0 or 1).
+fn o_sigma(o: &CurveOptions, k: usize) -> f64 {
+    if k == 0 {
+        o.sigma.0
+    } else {
+        o.sigma.1
+    }
+}
+
 /// A corrector failure.
 fn failure(message: &str) -> MapFailure {
     MapFailure {
@@ -303,11 +351,16 @@ pub fn continue_curve<I: Clone + Send>(
     u0.rows_mut(0, n).copy_from(x0);
     u0[n] = p1 / options.sigma.0;
     u0[n + 1] = p2 / options.sigma.1;
-    // The start corrected at its own p2.
-    let (_, ev0) = problem.residual(&u0, options)?;
+    // The start corrected at its own p2, as the steps are: to the safe offset (from a special point located
+    // on the border itself, which may lie a rounding error on its other side), then polished.
+    let (_, ev0) =
+        problem.residual_at(&u0, options, problem.offset * FOLLOW_OFFSET_FACTOR, true)?;
     let j0 = problem.jacobian(&u0, &ev0, options)?;
     let mut e2 = DVector::zeros(n + 2);
     e2[n + 1] = 1.0;
+    let follow_offset = problem.offset * FOLLOW_OFFSET_FACTOR;
+    let (u0, ev0, _) = problem.correct_at(&u0, &e2, &j0, options, follow_offset)?;
+    let j0 = problem.jacobian(&u0, &ev0, options)?;
     let (u0, ev0, _) = problem.correct(&u0, &e2, &j0, options)?;
     let j0 = problem.jacobian(&u0, &ev0, options)?;
     let t0 =
@@ -400,11 +453,31 @@ fn follow<I: Clone + Send>(
             Ok((un, ev, jn, tn, it)) if (&un - &u_pred).norm() <= 0.5 * h && tn.dot(&t) >= 0.9 => {
                 s += (&un - &u).norm();
                 let p = point(problem, &un, &ev, o, s);
-                let outside = !inside(p.p1, p.p2);
-                points.push(p);
-                if outside {
+                if !inside(p.p1, p.p2) {
+                    // The last point lies on the bound the step crossed first, where one can be solved for.
+                    let n = un.len() - 2;
+                    let crossed = |k: usize, v: f64, (lo, hi): (f64, f64)| {
+                        let bound = if v > hi { hi } else { lo };
+                        let fraction = (bound / o_sigma(o, k) - u[n + k]) / (un[n + k] - u[n + k]);
+                        (v < lo || v > hi).then_some((fraction, n + k, bound / o_sigma(o, k)))
+                    };
+                    let first = [crossed(0, p.p1, o.range1), crossed(1, p.p2, o.range2)]
+                        .into_iter()
+                        .flatten()
+                        .min_by(|a, b| a.0.total_cmp(&b.0));
+                    let on_bound = first.and_then(|(_, index, value)| {
+                        on_hyperplane(problem, (&u, &j, &t), index, value, o)
+                    });
+                    points.push(match on_bound {
+                        Some((ub, evb)) => {
+                            let sb = s - (&un - &u).norm() + (&ub - &u).norm();
+                            point(problem, &ub, &evb, o, sb)
+                        }
+                        None => p,
+                    });
                     return (points, CurveEnd::LeftRange);
                 }
+                points.push(p);
                 (u, j, t) = (un, jn, tn);
                 if it <= EASY_CURVE_CORRECTOR {
                     h = (1.5 * h).min(o.steps.2);
@@ -448,16 +521,39 @@ pub fn curve_at_p2<I: Clone + Send>(
     let (_, ev0) = problem.residual(&u0, options).ok()?;
     let j0 = problem.jacobian(&u0, &ev0, options).ok()?;
     let t0 = tangent(&j0, &(&u1 - &u0))?;
-    let s = (p2 / options.sigma.1 - u0[n + 1]) / t0[n + 1];
-    let mut u_pred = &u0 + s * &t0;
-    u_pred[n + 1] = p2 / options.sigma.1;
-    let mut e2 = DVector::zeros(n + 2);
-    e2[n + 1] = 1.0;
+    let (u, ev) = on_hyperplane(
+        problem,
+        (&u0, &j0, &t0),
+        n + 1,
+        p2 / options.sigma.1,
+        options,
+    )?;
+    Some(point(problem, &u, &ev, options, f64::NAN))
+}
+
+/// The curve's point where the scaled unknown `index` equals `value`: a step from `u0` along its tangent `t0`
+/// to the hyperplane, corrected on it as the curve's own steps are (to the safe offset with `u0`'s matrix
+/// `j0`, then polished with the new point's).
+fn on_hyperplane<I: Clone + Send>(
+    problem: &CurveProblem<'_, I>,
+    (u0, j0, t0): (&DVector<f64>, &DMatrix<f64>, &DVector<f64>),
+    index: usize,
+    value: f64,
+    options: &CurveOptions,
+) -> Option<(DVector<f64>, Evaluation<I>)> {
+    let s = (value - u0[index]) / t0[index];
+    if !s.is_finite() {
+        return None;
+    }
+    let mut u_pred = u0 + s * t0;
+    u_pred[index] = value;
+    let mut e = DVector::zeros(u0.len());
+    e[index] = 1.0;
     let follow_offset = problem.offset * FOLLOW_OFFSET_FACTOR;
     let (u, ev, _) = problem
-        .correct_at(&u_pred, &e2, &j0, options, follow_offset)
+        .correct_at(&u_pred, &e, j0, options, follow_offset)
         .ok()?;
     let j = problem.jacobian(&u, &ev, options).ok()?;
-    let (u, ev, _) = problem.correct(&u, &e2, &j, options).ok()?;
-    Some(point(problem, &u, &ev, options, f64::NAN))
+    let (u, ev, _) = problem.correct(&u, &e, &j, options).ok()?;
+    (u[index] == value).then_some((u, ev))
 }

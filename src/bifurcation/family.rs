@@ -125,6 +125,41 @@ impl<'a> GaitFamily<'a> {
         .eval(x, p)
     }
 
+    /// `P(x; p, q)` and what the map records, without derivatives (`jacobian` and `dparam` empty, `exact`
+    /// false): a two-parameter curve's [`super::CurveProblem::observe`].
+    pub fn observe_with(
+        &self,
+        second: &str,
+        x: &DVector<f64>,
+        p: f64,
+        q: f64,
+    ) -> Result<Evaluation<GaitInfo>, MapFailure> {
+        let config = self.config.with(second, q).map_err(|e| MapFailure {
+            kind: "invalid_parameter".to_string(),
+            message: e.to_string(),
+        })?;
+        let family = GaitFamily {
+            config: &config,
+            ..*self
+        };
+        let (c, model) = family.configured(p)?;
+        let signed = family
+            .step_map(&model, &c)
+            .eval_signature(&family.expand(x))
+            .map_err(walk_failure)?;
+        Ok(Evaluation {
+            value: family.reduce(&signed.outcome.next),
+            jacobian: DMatrix::zeros(0, 0),
+            dparam: DVector::zeros(0),
+            exact: false,
+            info: GaitInfo {
+                report: signed.outcome.report,
+                cycle: signed.cycle,
+                signature: signed.signature,
+            },
+        })
+    }
+
     /// The configuration with the parameter at `p`, and its model.
     fn configured(&self, p: f64) -> Result<(Config, Model), MapFailure> {
         let invalid = |message: String| MapFailure {

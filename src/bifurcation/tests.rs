@@ -3,6 +3,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::curve::border_curve_seed;
 use super::*;
 use crate::reference::{DelayedLogisticFamily, QuadraticFamily};
 
@@ -387,16 +388,21 @@ fn border_curve_agrees_with_the_one_parameter_end() {
     let bc = of_kind(&family, SpecialKind::BorderCollision)[0].clone();
     let eval = |x: &DVector<f64>, k: f64, c: f64| family_map.eval_with("viscosity", x, k, c);
     let test = |ev: &Evaluation<GaitInfo>| family_map.border(&ev.info, "lambda_2_plus");
+    let observe = |x: &DVector<f64>, p: f64, q: f64| family_map.observe_with("viscosity", x, p, q);
     let problem = CurveProblem {
         eval: &eval,
+        observe: Some(&observe),
         test: &test,
         offset: crate::bifurcation::curve::BORDER_OFFSET,
     };
+    let (seed, side) =
+        border_curve_seed(&family_map, &family, bc.arclength, "lambda_2_plus").unwrap();
+    assert_eq!(side, 1.0, "lambda_2+ > 0 on the DLS side");
     let curve_options = CurveOptions {
         steps: (0.05, 1e-6, 0.5),
         ..CurveOptions::for_ranges((500.0, 700.0), (3.0, 21.0))
     };
-    let curve = continue_curve(&problem, &bc.x, (bc.param, 20.0), &curve_options).unwrap();
+    let curve = continue_curve(&problem, &seed.x, (seed.param, 20.0), &curve_options).unwrap();
     assert!(curve
         .points
         .iter()

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use vrw::app::{run_continuation, ContinueJob, DIAGRAM_QUANTITIES};
-use vrw::bifurcation::FamilyEnd;
+use vrw::bifurcation::{CurveEnd, CurvePoint, FamilyEnd, GaitInfo};
 use vrw::walk::SectionState;
 
 use super::{flagged, interrupt_flag, print_warnings, ModelArgs};
@@ -47,6 +47,13 @@ pub(super) struct ContinueArgs {
     /// The quantity the diagram draws against the parameter.
     #[arg(long, default_value = "thetadot", help = plot_help())]
     plot: String,
+    /// Follow the curve of every located border collision (a DLS indicator crossing zero) in this second
+    /// parameter too: curves.csv and curves.png (needs --two-range).
+    #[arg(long, value_name = "NAME", requires = "two_range")]
+    two_param: Option<String>,
+    /// The second parameter's range, `A,B`.
+    #[arg(long, value_name = "A,B", value_parser = super::parse_range, allow_hyphen_values = true)]
+    two_range: Option<(f64, f64)>,
     /// Output directory for branch.csv, special_points.json and bifurcation.{svg,png}.
     #[arg(long, default_value = "out/continue")]
     out: PathBuf,
@@ -101,6 +108,11 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
         plot: args.plot.clone(),
         out_dir: args.out.clone(),
         interrupt: Some(flag),
+        two_param: args
+            .two_param
+            .clone()
+            .zip(args.two_range)
+            .map(|(name, (a, b))| (name, a, b)),
     };
     let result = run_continuation(&job)
         .map_err(flagged)
@@ -153,6 +165,30 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
             sp.family,
             s.param,
             sp.param,
+        );
+    }
+    for (c, curve) in s.curves.iter().zip(&result.curves) {
+        let at = |p: Option<&CurvePoint<GaitInfo>>| {
+            p.map(|p| format!("({:.9}, {:.9})", p.p1, p.p2))
+                .unwrap_or_default()
+        };
+        let end = |e: &CurveEnd| match e {
+            CurveEnd::LeftRange => "the range's bound".to_string(),
+            CurveEnd::MaxPoints => "the most points".to_string(),
+            CurveEnd::Ended { message } => format!("its end ({message})"),
+        };
+        println!(
+            "  curve {} ({} = 0 of family {}) in ({}, {}): {} points from {} at {} to {} at {}",
+            c.curve,
+            c.border,
+            c.family,
+            s.param,
+            c.param2,
+            c.points,
+            at(curve.points.first()),
+            end(&c.ends[0]),
+            at(curve.points.last()),
+            end(&c.ends[1]),
         );
     }
     print_warnings(&s.warnings, "special_points.json");

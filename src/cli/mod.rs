@@ -83,7 +83,7 @@ impl ModelArgs {
 }
 
 /// The flag of each job setting that the library names by its field (the Python keyword).
-const FLAGS: [(&str, &str); 11] = [
+const FLAGS: [(&str, &str); 12] = [
     ("transient_steps", "--transient"),
     ("tolerance", "--tolerance"),
     ("steps", "--steps"),
@@ -95,6 +95,7 @@ const FLAGS: [(&str, &str); 11] = [
     ("plot", "--plot"),
     ("period", "--period"),
     ("from", "--from/--to"),
+    ("two_param", "--two-param"),
 ];
 
 /// A job's error with its settings named by their flags: the rule is the library's, the name the command

@@ -81,6 +81,9 @@ pub(crate) struct BifurcationFigure {
     pub families: Vec<DiagramFamily>,
     /// The special points.
     pub special: Vec<DiagramSpecial>,
+    /// The legend explains the line styles and special points (a diagram of families; not the plane of
+    /// two-parameter curves).
+    pub styles_in_legend: bool,
 }
 
 /// The colour of family `k`.
@@ -244,6 +247,8 @@ impl Figure for BifurcationFigure {
                 points: Vec::new(),
             })
             .collect();
+        // The line styles' and special points' rows only where they are drawn.
+        let styles = if self.styles_in_legend { 4 } else { 0 };
         legend.push(Curve {
             label: "stable".to_string(),
             color: COLOR_BLACK,
@@ -267,6 +272,7 @@ impl Figure for BifurcationFigure {
                 points: Vec::new(),
             });
         }
+        legend.truncate(self.families.len() + styles);
         let area_base = area.get_base_pixel();
         draw_legend(
             &area,

@@ -1,10 +1,10 @@
-//! The table of `vrw continue`: `branch.csv`, one row per point of every family followed (docs/model.md
-//! section 11), and its writer.
+//! The tables of `vrw continue`: `branch.csv`, one row per point of every family followed, and `curves.csv`,
+//! one row per point of every two-parameter curve (docs/model.md section 11), and their writers.
 
 use std::path::Path;
 
 use super::{header, row, Cell, Column};
-use crate::bifurcation::{FamilyPoint, GaitInfo};
+use crate::bifurcation::{CurvePoint, FamilyPoint, GaitInfo};
 use crate::gait::Stability;
 use crate::output::{write_table, OutputError};
 
@@ -174,4 +174,81 @@ pub(crate) fn write_family_csv(
     rows: &[FamilyRow],
 ) -> Result<(), OutputError> {
     write_table(path, &family_header(param), rows.iter().map(family_row))
+}
+
+/// One row of `curves.csv`: a point of a two-parameter curve.
+pub struct CurveRow<'a> {
+    /// The curve's number (from 1).
+    pub curve: usize,
+    /// The border function followed.
+    pub border: &'a str,
+    /// The point.
+    pub point: &'a CurvePoint<GaitInfo>,
+}
+
+/// The columns of `curves.csv`: the curve, both parameters (named after their keys) and the gait there.
+pub(crate) fn curve_columns<'a>() -> [Column<CurveRow<'a>>; 10] {
+    [
+        Column::new(
+            "curve",
+            "Number of the curve (from 1; special_points.json's curves).",
+            |r| Count(r.curve),
+        ),
+        Column::new(
+            "border",
+            "The border function that is zero along the curve.",
+            |r| Text(r.border.to_string()),
+        ),
+        Column::param(0, "The followed parameter (its config key's unit).", |r| {
+            Real(r.point.p1)
+        }),
+        Column::param(1, "The second parameter (its config key's unit).", |r| {
+            Real(r.point.p2)
+        }),
+        Column::new("L2", "Length of Leg 2 at the fixed point [m].", |r| {
+            Real(r.point.info.report.section.l2)
+        }),
+        Column::new(
+            "thetadot",
+            "Angular velocity at the fixed point [rad/s].",
+            |r| Real(r.point.info.report.section.theta_dot),
+        ),
+        Column::new(
+            "L2dot",
+            "Rate of change of Leg 2's length at the fixed point [m/s].",
+            |r| Real(r.point.info.report.section.l2_dot),
+        ),
+        Column::new(
+            "test_value",
+            "The border function minus its offset (zero to the corrector's accuracy).",
+            |r| Real(r.point.test_value),
+        ),
+        Column::new("residual", "max |P(s) - s| (section coordinates).", |r| {
+            Real(r.point.residual)
+        }),
+        Column::new(
+            "arclength",
+            "Arclength from the curve's first point (scaled unknowns).",
+            |r| Real(r.point.arclength),
+        ),
+    ]
+}
+
+/// Write `curves.csv` for curves in `(param, param2)`.
+pub(crate) fn write_curves_csv(
+    path: &Path,
+    params: (&str, &str),
+    rows: &[CurveRow],
+) -> Result<(), OutputError> {
+    write_table(path, &curve_header(params), rows.iter().map(curve_row))
+}
+
+/// The header of `curves.csv` for curves in `(param, param2)`.
+pub fn curve_header<'a>((param, param2): (&'a str, &'a str)) -> Vec<&'a str> {
+    header(&curve_columns(), &[param, param2])
+}
+
+/// One row of `curves.csv`.
+pub fn curve_row(r: &CurveRow) -> Vec<Cell> {
+    row(&curve_columns(), r)
 }
