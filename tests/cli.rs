@@ -833,6 +833,72 @@ fn map_writes_table_curves_and_figure() {
     assert!(run.read("map.svg").contains("<svg"));
 }
 
+/// `vrw map` follows the `lambda_2+ = 0` curve by continuation across a small grid near `c = 4`: the curve runs
+/// through the whole map, lies on the refined crossings of the lines it crosses (the column at `c = 4` among
+/// them, at the README's `k = 564.367191`) to `LINE_CHECK_TOL`, and says how it was computed; with
+/// `--curve-method crossings` the same curve is joined from the crossings instead.
+#[test]
+fn map_continues_the_indicator_curves() {
+    let args = [
+        "--x-from", "1", "--x-to", "7", "--nx", "3", "--y-from", "540", "--y-to", "600", "--ny",
+        "4",
+    ];
+    let run = command_in(temp_dir_with(&[]), "map", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let curves: Value = serde_json::from_str(&run.read("curves.json")).unwrap();
+    let list = curves["curves"].as_array().unwrap();
+    let continued = list
+        .iter()
+        .find(|c| c["name"] == "lambda_2_plus = 0" && c["method"]["kind"] == "continuation")
+        .expect("a continued lambda_2+ curve");
+    let method = &continued["method"];
+    assert_eq!(method["border"], "lambda_2_plus");
+    assert_eq!(
+        method["ends"],
+        serde_json::json!(["left_range", "left_range"])
+    );
+    assert!(method["lines_checked"].as_u64().unwrap() >= 3, "{method}");
+    assert!(
+        method["max_line_difference"].as_f64().unwrap() <= 2e-6,
+        "{method}"
+    );
+    assert!(method["max_residual"].as_f64().unwrap() < 1e-9, "{method}");
+    let points = continued["points"].as_array().unwrap();
+    let (first, last) = (&points[0], &points[points.len() - 1]);
+    assert_eq!(
+        (first[0].as_f64(), last[0].as_f64()),
+        (Some(1.0), Some(7.0))
+    );
+    // The column at c = 4 crosses the curve where the README's sweep along k at c = 4 loses the DLS gait.
+    let column = curves["thresholds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| {
+            t["along"] == "y" && t["line"] == 1 && t["threshold"]["name"] == "lambda_2_plus = 0"
+        })
+        .expect("the column at c = 4 crosses lambda_2+ = 0");
+    let k = column["threshold"]["value"].as_f64().unwrap();
+    assert!((k - 564.367191).abs() < 1e-6, "{k}");
+    assert!(
+        run.stdout().contains("1 continued, on the crossings of"),
+        "{}",
+        run.stdout()
+    );
+    let run = command_in(
+        temp_dir_with(&[]),
+        "map",
+        &[&args[..], &["--curve-method", "crossings"]].concat(),
+    );
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let curves: Value = serde_json::from_str(&run.read("curves.json")).unwrap();
+    assert!(curves["curves"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|c| c["method"]["kind"] == "crossings"));
+}
+
 /// `vrw map --second-route` on the same small grid: every row's and column's end of existence is found again
 /// by the other integrator and confirmed, in curves.json and on the terminal.
 #[test]
@@ -990,10 +1056,10 @@ fn continue_follows_a_border_curve_in_two_parameters() {
     let run = command_in(temp_dir_with(&[]), "continue", &args);
     assert_eq!(run.code(), Some(0), "{}", run.stderr());
     let table = run.read("curves.csv");
-    assert!(table.starts_with("curve,border,stiffness,viscosity,L2"));
+    assert!(table.starts_with("curve,condition,stiffness,viscosity,L2"));
     assert!(data_rows(&table) > 5);
     let summary: Value = serde_json::from_str(&run.read("special_points.json")).unwrap();
-    assert_eq!(summary["curves"][0]["border"], "lambda_2_plus");
+    assert_eq!(summary["curves"][0]["condition"], "lambda_2_plus");
     assert_eq!(summary["curves"][0]["kind"], "BC");
     // The curve ends on the range's bound c = 22, where a family followed in k alone at c = 22 meets the
     // same border: the two agree to 1e-6.

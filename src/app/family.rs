@@ -12,7 +12,7 @@ use serde::Serialize;
 use super::family_records::{special_record, EndRecord, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
 use crate::bifurcation::curve::{border_curve_seed, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR};
-use crate::bifurcation::special::JUMP_TOL;
+use crate::bifurcation::special::{test_function, test_name, JUMP_TOL};
 use crate::bifurcation::{continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem};
 use crate::bifurcation::{
     continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
@@ -78,8 +78,9 @@ pub struct ContinueJob {
     pub out_dir: PathBuf,
     /// Stops the walks when set.
     pub interrupt: Option<Arc<AtomicBool>>,
-    /// Follow the curve of every located border collision in a second parameter over its range (`name`,
-    /// from, to): `curves.csv`, `curves.png`.
+    /// Follow the curve of every located special point (indicator border collisions, folds, period doublings,
+    /// Neimark-Sacker points) in a second parameter over its range (`name`, from, to): `curves.csv`,
+    /// `curves.png`.
     pub two_param: Option<(String, f64, f64)>,
 }
 
@@ -134,10 +135,11 @@ pub struct CurveRecord {
     pub family: usize,
     /// Index into `special_points`.
     pub special_point: usize,
-    /// The special point's kind (`BC`).
+    /// The special point's kind.
     pub kind: SpecialKind,
-    /// The border function followed.
-    pub border: String,
+    /// The function that is zero along the curve: a DLS indicator for a `BC`, a test function of `DP` for the
+    /// others (`det(DP - I)`, `det(DP + I)`, `bialternate product`).
+    pub condition: String,
     /// The second parameter.
     pub param2: String,
     /// Points in `curves.csv`.
@@ -392,68 +394,101 @@ fn two_param_curves(
         for sp in &f.family.special {
             let this = index;
             index += 1;
-            let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
-                continue;
-            };
-            if sp.kind != SpecialKind::BorderCollision || !sp.located {
+            if !sp.located {
                 continue;
             }
-            let Some((before, side)) = border_curve_seed(&f.map, &f.family, sp.arclength, &border)
-            else {
-                warnings.push(format!(
-                    "family {} BC {border} at {} = {}: no point of the family lies clearly on one side of \
-                     the border; no curve followed",
-                    k + 1,
-                    job.param,
-                    sp.param
-                ));
-                continue;
-            };
             let map = f.map;
+            let at = format!(
+                "family {} {} at {} = {}",
+                k + 1,
+                sp.kind,
+                job.param,
+                sp.param
+            );
+            // What is followed, from where: an indicator border on the family's side of it, from the family's
+            // point nearest the collision clearly on that side; a fold, period doubling or Neimark-Sacker point
+            // by its test function of `DP`, from the located point.
+            let (test_of, offset, start, border): (TestOf, f64, _, String) = match sp.kind {
+                SpecialKind::BorderCollision => {
+                    let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
+                        continue;
+                    };
+                    let Some((before, side)) =
+                        border_curve_seed(&f.map, &f.family, sp.arclength, &border)
+                    else {
+                        warnings.push(format!(
+                            "{at} ({border}): no point of the family lies clearly on one side of the \
+                             border; no curve followed"
+                        ));
+                        continue;
+                    };
+                    (
+                        TestOf::Border(border.clone()),
+                        BORDER_OFFSET.copysign(side),
+                        (before.x.clone(), before.param),
+                        border,
+                    )
+                }
+                kind => {
+                    let Some(test) = test_function(kind) else {
+                        continue;
+                    };
+                    (
+                        TestOf::Jacobian(test),
+                        0.0,
+                        (sp.x.clone(), sp.param),
+                        test_name(kind).to_string(),
+                    )
+                }
+            };
             let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.eval_with(name, x, p, q);
-            let test =
-                |ev: &crate::bifurcation::Evaluation<GaitInfo>| f.map.border(&ev.info, &border);
             let observe =
                 |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
+            let test = |ev: &crate::bifurcation::Evaluation<GaitInfo>| match &test_of {
+                TestOf::Border(b) => f.map.border(&ev.info, b),
+                TestOf::Jacobian(t) => t(&ev.jacobian),
+            };
             let problem = CurveProblem {
                 eval: &eval,
-                observe: Some(&observe),
+                // A test function of DP needs every evaluation's derivatives.
+                observe: matches!(test_of, TestOf::Border(_)).then_some(&observe),
                 test: &test,
-                offset: BORDER_OFFSET.copysign(side),
+                offset,
             };
-            // From the family's last point before the border (the located point itself lies on the border,
-            // perhaps a rounding error past it).
-            match continue_curve(&problem, &before.x, (before.param, q0), &options) {
+            match continue_curve(&problem, &start.0, (start.1, q0), &options) {
                 Ok(curve) => {
+                    let aim = if offset == 0.0 {
+                        String::new()
+                    } else {
+                        format!(
+                            " (the family's side), steps at {:e}, polished",
+                            offset * FOLLOW_OFFSET_FACTOR
+                        )
+                    };
                     records.push(CurveRecord {
                         curve: records.len() + 1,
                         family: k + 1,
                         special_point: this,
                         kind: sp.kind,
-                        border: border.clone(),
+                        condition: border.clone(),
                         param2: name.clone(),
                         points: curve.points.len(),
                         ends: curve.ends.clone(),
-                        method: format!(
-                            "pseudo-arclength on P(x) = x, {border} = {:e} (the family's side), steps at \
-                             {:e}, polished",
-                            problem.offset,
-                            problem.offset * FOLLOW_OFFSET_FACTOR
-                        ),
+                        method: format!("pseudo-arclength on P(x) = x, {border} = {offset:e}{aim}"),
                     });
                     curves.push(curve);
                 }
-                Err(e) => warnings.push(format!(
-                    "family {} BC {border} at {} = {}: no curve in {name}: {}",
-                    k + 1,
-                    job.param,
-                    sp.param,
-                    e.message
-                )),
+                Err(e) => warnings.push(format!("{at}: no curve in {name}: {}", e.message)),
             }
         }
     }
     Ok((records, curves))
+}
+
+/// The defining condition of a two-parameter curve: a border function by name, or a test function of `DP`.
+enum TestOf {
+    Border(String),
+    Jacobian(fn(&nalgebra::DMatrix<f64>) -> f64),
 }
 
 /// A family being followed: where it came from, its map and its ends with their causes.

@@ -52,7 +52,7 @@ pub fn curve_rows(result: &ContinueResult) -> Vec<CurveRow<'_>> {
         .flat_map(|(curve, record)| {
             curve.points.iter().map(move |point| CurveRow {
                 curve: record.curve,
-                border: &record.border,
+                condition: &record.condition,
                 point,
             })
         })
@@ -110,16 +110,32 @@ fn write_continuation(
 /// The two-parameter curves in the plane of the two parameters.
 fn curves_figure(job: &ContinueJob, result: &ContinueResult, param2: &str) -> BifurcationFigure {
     BifurcationFigure {
-        title: format!("Curves of border collisions in ({}, {param2})", job.param),
+        title: format!("Curves of special points in ({}, {param2})", job.param),
         param_label: axis_label(&job.param),
         y_label: axis_label(param2),
-        x: job.from..job.to,
+        // The curves' extent in the followed parameter, with a margin (a fold's curve may span a sliver of
+        // the family's range).
+        x: {
+            let p1 = result
+                .curves
+                .iter()
+                .flat_map(|c| c.points.iter().map(|p| p.p1));
+            let (lo, hi) = p1.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+            let margin = 0.05 * (hi - lo).max(1e-9 * hi.abs().max(1.0));
+            if lo <= hi {
+                (lo - margin).max(job.from)..(hi + margin).min(job.to)
+            } else {
+                job.from..job.to
+            }
+        },
         families: result
             .curves
             .iter()
             .zip(&result.summary.curves)
             .map(|(curve, record)| DiagramFamily {
-                label: format!("curve {}: {} = 0", record.curve, record.border),
+                label: format!("curve {}: {} = 0", record.curve, record.condition),
                 phases: vec![curve
                     .points
                     .iter()
@@ -128,7 +144,7 @@ fn curves_figure(job: &ContinueJob, result: &ContinueResult, param2: &str) -> Bi
                 ends: Vec::new(),
             })
             .collect(),
-        // Each curve's start: the border collision of the family it was continued from.
+        // Each curve's start: the special point of the family it was continued from.
         special: result
             .summary
             .curves
@@ -140,7 +156,7 @@ fn curves_figure(job: &ContinueJob, result: &ContinueResult, param2: &str) -> Bi
                     family: k,
                     param: sp.param,
                     value: result.summary.config.get_numeric(param2).ok()?,
-                    label: "BC".to_string(),
+                    label: record.kind.to_string(),
                 })
             })
             .collect(),

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
+use crate::bifurcation::map_curves::continue_map_curves;
 use crate::dynamics::Model;
 use crate::fmt::short;
 use crate::gait::map::{LineThreshold, ThresholdCurve};
@@ -33,6 +34,9 @@ pub struct MapJob {
     pub curves: bool,
     /// The most columns the curves are refined on ([`crate::gait::map::curve_columns`]; every row is).
     pub curve_columns: usize,
+    /// Follow the indicator curves by continuation from the rows' crossings
+    /// ([`crate::bifurcation::map_curves`]); false: every curve through the refined crossings.
+    pub continue_curves: bool,
     /// Search every threshold again by a second route (the whole map with the other integrator) and record in
     /// each whether it is confirmed ([`SecondRoute`]); only with `curves`.
     pub second_route: bool,
@@ -63,6 +67,9 @@ pub struct MapSummary {
     /// reproducible).
     #[serde(skip)]
     pub seconds: [f64; 2],
+    /// Of the curves' seconds, those spent on the continued curves and their checks (printed, not written).
+    #[serde(skip)]
+    pub continuation_seconds: f64,
     /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
     #[serde(skip)]
     pub second_route_seconds: f64,
@@ -109,8 +116,15 @@ fn map_into(
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;
     let clock = std::time::Instant::now();
+    let mut curve_warnings = Vec::new();
+    let mut continuation_seconds = 0.0;
     let (curves, thresholds) = if job.curves {
-        let c = map_curves(&job.config, &map, &job.options, job.curve_columns);
+        let mut c = map_curves(&job.config, &map, &job.options, job.curve_columns);
+        if job.continue_curves {
+            let clock = std::time::Instant::now();
+            curve_warnings = continue_map_curves(&job.config, &map, &mut c);
+            continuation_seconds = clock.elapsed().as_secs_f64();
+        }
         (c.curves, c.thresholds)
     } else {
         (Vec::new(), Vec::new())
@@ -130,6 +144,7 @@ fn map_into(
         curves,
         thresholds,
         seconds: [gait_seconds, curve_seconds],
+        continuation_seconds,
         second_route_seconds: 0.0,
         warnings: super::gait_warnings(map.ys.iter().zip(&map.rows).flat_map(|(y, row)| {
             row.iter().map(move |p| {
@@ -144,6 +159,7 @@ fn map_into(
             })
         })),
     };
+    summary.warnings.extend(curve_warnings);
     let curves_json = run.path("curves.json");
     output::write_json(&curves_json, &summary)?;
     run.add("curves.json");

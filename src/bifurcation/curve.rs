@@ -505,10 +505,41 @@ pub fn curve_at_p2<I: Clone + Send>(
     p2: f64,
     options: &CurveOptions,
 ) -> Option<CurvePoint<I>> {
-    let w = curve
-        .points
-        .windows(2)
-        .find(|w| (w[0].p2 - p2) * (w[1].p2 - p2) <= 0.0 && w[0].p2 != w[1].p2)?;
+    curve_at(problem, curve, (1, p2), f64::NAN, options)
+}
+
+/// The point of `curve` where parameter `which` (0: `p1`, 1: `p2`) equals `value`, as [`curve_at_p2`]; where the
+/// curve crosses that line more than once, the crossing whose other parameter is nearest `near` (the first if
+/// `near` is `NaN`).
+pub fn curve_at<I: Clone + Send>(
+    problem: &CurveProblem<'_, I>,
+    curve: &Curve<I>,
+    (which, value): (usize, f64),
+    near: f64,
+    options: &CurveOptions,
+) -> Option<CurvePoint<I>> {
+    let split = |p: &CurvePoint<I>| {
+        if which == 0 {
+            (p.p1, p.p2)
+        } else {
+            (p.p2, p.p1)
+        }
+    };
+    let crossing = |w: &[CurvePoint<I>]| {
+        let ((a, a_other), (b, b_other)) = (split(&w[0]), split(&w[1]));
+        ((a - value) * (b - value) <= 0.0 && a != b)
+            .then(|| a_other + (value - a) / (b - a) * (b_other - a_other))
+    };
+    let distance = |w: &[CurvePoint<I>]| crossing(w).map_or(f64::INFINITY, |o| (o - near).abs());
+    let w = if near.is_nan() {
+        curve.points.windows(2).find(|w| crossing(w).is_some())?
+    } else {
+        curve
+            .points
+            .windows(2)
+            .filter(|w| crossing(w).is_some())
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))?
+    };
     let n = w[0].x.len();
     let scaled = |p: &CurvePoint<I>| {
         let mut u = DVector::zeros(n + 2);
@@ -521,13 +552,8 @@ pub fn curve_at_p2<I: Clone + Send>(
     let (_, ev0) = problem.residual(&u0, options).ok()?;
     let j0 = problem.jacobian(&u0, &ev0, options).ok()?;
     let t0 = tangent(&j0, &(&u1 - &u0))?;
-    let (u, ev) = on_hyperplane(
-        problem,
-        (&u0, &j0, &t0),
-        n + 1,
-        p2 / options.sigma.1,
-        options,
-    )?;
+    let scaled_value = value / o_sigma(options, which);
+    let (u, ev) = on_hyperplane(problem, (&u0, &j0, &t0), n + which, scaled_value, options)?;
     Some(point(problem, &u, &ev, options, f64::NAN))
 }
 

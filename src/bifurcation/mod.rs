@@ -15,6 +15,7 @@ pub mod arclength;
 pub mod corrector;
 pub mod curve;
 pub mod family;
+pub mod map_curves;
 pub mod special;
 pub mod switch;
 #[cfg(test)]
@@ -25,7 +26,7 @@ use nalgebra::{DMatrix, DVector};
 pub use arclength::{continue_family, ContinuationError, Family, FamilyEnd};
 pub use corrector::{ContinuationOptions, FamilyPoint};
 pub use curve::{
-    continue_curve, curve_at_p2, Curve, CurveEnd, CurveOptions, CurvePoint, CurveProblem,
+    continue_curve, curve_at, curve_at_p2, Curve, CurveEnd, CurveOptions, CurvePoint, CurveProblem,
 };
 pub use family::{GaitFamily, GaitInfo};
 pub use special::{SpecialKind, SpecialPoint};

@@ -123,6 +123,37 @@ pub struct SpecialPoint<I> {
     pub jump: f64,
 }
 
+impl std::fmt::Display for SpecialKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SpecialKind::Fold => "LP",
+            SpecialKind::PeriodDoubling => "PD",
+            SpecialKind::NeimarkSacker => "NS",
+            SpecialKind::BorderCollision => "BC",
+        })
+    }
+}
+
+/// The test function of `DP` whose zero is a special point of `kind` (`None` for a border collision).
+pub fn test_function(kind: SpecialKind) -> Option<fn(&DMatrix<f64>) -> f64> {
+    match kind {
+        SpecialKind::Fold => Some(fold_test),
+        SpecialKind::PeriodDoubling => Some(flip_test),
+        SpecialKind::NeimarkSacker => Some(neimark_sacker_test),
+        SpecialKind::BorderCollision => None,
+    }
+}
+
+/// The name of [`test_function`]'s function, as `curves.csv`'s `border` column gives it.
+pub fn test_name(kind: SpecialKind) -> &'static str {
+    match kind {
+        SpecialKind::Fold => "det(DP - I)",
+        SpecialKind::PeriodDoubling => "det(DP + I)",
+        SpecialKind::NeimarkSacker => "bialternate product",
+        SpecialKind::BorderCollision => "border",
+    }
+}
+
 /// `det(DP - I)`.
 fn fold_test(dp: &DMatrix<f64>) -> f64 {
     (dp - DMatrix::identity(dp.nrows(), dp.ncols())).determinant()

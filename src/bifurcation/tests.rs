@@ -429,3 +429,47 @@ fn border_curve_agrees_with_the_one_parameter_end() {
         last.value
     );
 }
+
+/// The slope fold followed as a curve in (slope, viscosity) from c = 50 (`det(DP - I) = 0`, every evaluation
+/// with its derivatives): at c = 60 it lies where the family followed in the slope alone at c = 60 folds, to
+/// 1e-7 (the fold is located to 1e-8; the curve solves the same condition).
+#[test]
+fn fold_curve_agrees_with_the_fold_of_another_line() {
+    let fold_at = |c: f64| {
+        let (config, section) = vrw_gait(&[("slope", 0.3), ("viscosity", c)]);
+        let family_map = GaitFamily::new(&config, "slope", section).unwrap();
+        let options = ContinuationOptions::for_range(0.29, 0.34);
+        let family =
+            continue_family(&family_map, &family_map.reduce(&section), 0.3, &options).unwrap();
+        let fold = of_kind(&family, SpecialKind::Fold)[0].clone();
+        (config, fold)
+    };
+    let (config, fold) = fold_at(50.0);
+    let (_, fold60) = fold_at(60.0);
+    let family_map =
+        GaitFamily::new(&config, "slope", crate::reference::default_initial(&config)).unwrap();
+    let eval = |x: &DVector<f64>, p: f64, c: f64| family_map.eval_with("viscosity", x, p, c);
+    let test = |ev: &Evaluation<GaitInfo>| {
+        special::test_function(SpecialKind::Fold).unwrap()(&ev.jacobian)
+    };
+    let problem = CurveProblem {
+        eval: &eval,
+        observe: None,
+        test: &test,
+        offset: 0.0,
+    };
+    let curve_options = CurveOptions::for_ranges((0.29, 0.34), (45.0, 65.0));
+    let curve = continue_curve(&problem, &fold.x, (fold.param, 50.0), &curve_options).unwrap();
+    assert!(curve
+        .points
+        .iter()
+        .all(|p| p.test_value.abs() < 1e-8 && p.residual < 1e-9));
+    let at60 =
+        curve_at_p2(&problem, &curve, 60.0, &curve_options).expect("the curve crosses c = 60");
+    assert!(
+        (at60.p1 - fold60.param).abs() < 1e-7,
+        "curve {} family {}",
+        at60.p1,
+        fold60.param
+    );
+}

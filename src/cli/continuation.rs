@@ -47,8 +47,9 @@ pub(super) struct ContinueArgs {
     /// The quantity the diagram draws against the parameter.
     #[arg(long, default_value = "thetadot", help = plot_help())]
     plot: String,
-    /// Follow the curve of every located border collision (a DLS indicator crossing zero) in this second
-    /// parameter too: curves.csv and curves.png (needs --two-range).
+    /// Follow the curve of every located special point (a DLS indicator crossing zero, a fold, a period
+    /// doubling, a Neimark-Sacker point) in this second parameter too: curves.csv and curves.png (needs
+    /// --two-range).
     #[arg(long, value_name = "NAME", requires = "two_range")]
     two_param: Option<String>,
     /// The second parameter's range, `A,B`.
@@ -180,7 +181,7 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
         println!(
             "  curve {} ({} = 0 of family {}) in ({}, {}): {} points from {} at {} to {} at {}",
             c.curve,
-            c.border,
+            c.condition,
             c.family,
             s.param,
             c.param2,

@@ -6,7 +6,7 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use vrw::app::{run_map, MapJob};
-use vrw::gait::{GaitOptions, MapSpec, SecondRoute, SweepSpec};
+use vrw::gait::{CurveMethod, GaitOptions, MapSpec, SecondRoute, SweepSpec};
 use vrw::output::map_plot::MapMark;
 use vrw::walk::SectionState;
 
@@ -56,6 +56,11 @@ pub(super) struct MapArgs {
     #[arg(long, default_value_t = vrw::gait::map::DEFAULT_CURVE_COLUMNS as u64,
           value_parser = clap::value_parser!(u64).range(2..))]
     curve_columns: u64,
+    /// How the indicator curves (lambda = 0) are traced: `continuation` (followed in both parameters from a
+    /// crossing a row found, checked against every row it crosses) or `crossings` (the refined crossings of
+    /// rows and columns joined cell by cell, as every other curve is).
+    #[arg(long, default_value = "continuation", value_parser = ["continuation", "crossings"])]
+    curve_method: String,
     /// Search every threshold again by a second route, the whole map with the other integrator (dopri5 for
     /// the default dop853), and say of each whether it is confirmed (in curves.json: `second_route`).
     #[arg(long, conflicts_with = "no_curves")]
@@ -116,6 +121,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         options: GaitOptions::default(),
         curves: !args.no_curves,
         curve_columns: usize::try_from(args.curve_columns).unwrap_or(usize::MAX),
+        continue_curves: args.curve_method == "continuation",
         second_route: args.second_route,
         marks: args.mark.into_iter().map(|m| m.0).collect(),
         out_dir: args.out.clone(),
@@ -133,7 +139,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     bar.finish_and_clear();
     println!(
         "vrw map: {} from {} to {} ({}) x {} from {} to {} ({}): gait found at {} of {} points; {:.2} s \
-         (gaits {:.2} s, curves {:.2} s)",
+         (gaits {:.2} s, curves {:.2} s, of which continued {:.2} s)",
         args.x,
         args.x_from,
         args.x_to,
@@ -146,7 +152,8 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         summary.points,
         started.elapsed().as_secs_f64(),
         summary.seconds[0],
-        summary.seconds[1]
+        summary.seconds[1],
+        summary.continuation_seconds
     );
     let unrefined = summary
         .thresholds
@@ -154,11 +161,32 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         .filter(|t| !t.threshold.value.is_finite())
         .count();
     let mut names: Vec<&str> = summary.curves.iter().map(|c| c.name.as_str()).collect();
+    names.sort_unstable();
     names.dedup();
     for name in names {
         let own: Vec<_> = summary.curves.iter().filter(|c| c.name == name).collect();
+        let continued: Vec<_> = own
+            .iter()
+            .filter_map(|c| match &c.method {
+                CurveMethod::Continuation(m) => Some(m),
+                CurveMethod::Crossings => None,
+            })
+            .collect();
+        let how = if continued.is_empty() {
+            "refined points".to_string()
+        } else {
+            format!(
+                "points; {} continued, on the crossings of {} rows and columns to {:.1e}",
+                continued.len(),
+                continued.iter().map(|m| m.lines_checked).sum::<usize>(),
+                continued
+                    .iter()
+                    .map(|m| m.max_line_difference)
+                    .fold(0.0, f64::max)
+            )
+        };
         println!(
-            "  {:<18} {} polyline(s), {} refined points",
+            "  {:<18} {} polyline(s), {} {how}",
             name,
             own.len(),
             own.iter().map(|c| c.points.len()).sum::<usize>()

@@ -196,7 +196,70 @@ pub struct ThresholdCurve {
     pub refined_on: Vec<RefinedOn>,
     /// The curve is closed (its last point joins its first).
     pub closed: bool,
+    /// How the curve was computed.
+    pub method: CurveMethod,
 }
+
+/// How a threshold curve of a map was computed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum CurveMethod {
+    /// The refined crossings of the rows and refined columns, joined cell by cell (see the module
+    /// documentation); `refined_on` says where each point comes from.
+    Crossings,
+    /// Followed by pseudo-arclength continuation of the fixed point together with `border = offset` in both
+    /// parameters (docs/model.md section 11), from the crossing `seed` of a row (`refined_on` is empty: the
+    /// points are the curve's own).
+    Continuation(ContinuedCurve),
+}
+
+/// A threshold curve followed by continuation: where from, how it ends, and its check against the rows.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContinuedCurve {
+    /// The row crossing it was started from.
+    pub seed: RefinedOn,
+    /// The border function followed (`lambda_2_plus`, ...).
+    pub border: String,
+    /// The value of the border function followed: a small number on the side of the gaits it was started from.
+    pub offset: f64,
+    /// How it ends at its first point and at its last (`left_range`, `max_points`, or the failure).
+    pub ends: [String; 2],
+    /// The largest `|P(x) - x|` of its points.
+    pub max_residual: f64,
+    /// The largest `|border - offset|` of its points.
+    pub max_test_value: f64,
+    /// The rows and refined columns whose crossing of the same threshold lies on it: the curve solved for at
+    /// the line's `y` (a row) or `x` (a column) is within [`LINE_CHECK_TOL`] of the line's refined threshold
+    /// (the lines are the curve's second route; their crossings on it are drawn by it).
+    pub lines_checked: usize,
+    /// The largest of those differences (`NaN` if no line was checked).
+    pub max_line_difference: f64,
+    /// Crossings of the same threshold within one grid cell of the curve but not on it (farther than
+    /// [`LINE_CHECK_TOL`], or the curve could not be solved for on their line): another border nearby, such
+    /// as a period-2 family's where the curve is a period-1 family's; they keep their curves through the
+    /// crossings.
+    pub near_misses: Vec<NearMiss>,
+    /// How it was computed, in words.
+    pub description: String,
+}
+
+/// A crossing near a continued curve but not on it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NearMiss {
+    /// The line's direction.
+    pub along: Along,
+    /// The line.
+    pub line: usize,
+    /// The line's refined threshold.
+    pub value: f64,
+    /// Its distance from the curve on that line (`NaN`: the curve could not be solved for there).
+    pub difference: f64,
+}
+
+/// A continued curve agrees with the lines' refined thresholds when none differs by more than this: a line's
+/// threshold is the middle of a bracket at most `PARAM_TOL` wide, and the curve lies `offset / |grad border|`
+/// (about `1e-7`) from the border.
+pub const LINE_CHECK_TOL: f64 = 2.0 * super::continuation::PARAM_TOL;
 
 /// A 1-D threshold of a row or a column.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -406,6 +469,7 @@ fn connect(
                     })
                     .collect(),
                 closed,
+                method: CurveMethod::Crossings,
             });
         }
     }

@@ -19,7 +19,10 @@ pub(crate) mod thresholds;
 pub use derivative::{check_jacobian, JacobianCheck, ParamDerivative, DERIVATIVE_CHECK_TIGHTENING};
 pub use grid::{clear_interrupt, interrupt_flag, interrupted};
 pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions, Stability};
-pub use map::{map_curves, map_gaits, GaitMap, MapCurves, MapSpec, ThresholdCurve};
+pub use map::{
+    map_curves, map_gaits, ContinuedCurve, CurveMethod, GaitMap, MapCurves, MapSpec,
+    ThresholdCurve, LINE_CHECK_TOL,
+};
 pub use options::{FD_STEP_RANGE, MAX_NEWTON_ITERATIONS, MAX_TRANSIENT_STEPS, TOLERANCE_RANGE};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};
 pub use step_map::{DerivativeError, SignedOutcome, StepDerivatives, StepMap, StepOutcome};

@@ -180,8 +180,8 @@ pub(crate) fn write_family_csv(
 pub struct CurveRow<'a> {
     /// The curve's number (from 1).
     pub curve: usize,
-    /// The border function followed.
-    pub border: &'a str,
+    /// The condition followed: a border function (`lambda_2_plus`) or a test function of `DP` (`det(DP - I)`).
+    pub condition: &'a str,
     /// The point.
     pub point: &'a CurvePoint<GaitInfo>,
 }
@@ -195,9 +195,11 @@ pub(crate) fn curve_columns<'a>() -> [Column<CurveRow<'a>>; 10] {
             |r| Count(r.curve),
         ),
         Column::new(
-            "border",
-            "The border function that is zero along the curve.",
-            |r| Text(r.border.to_string()),
+            "condition",
+            "The function that is zero along the curve: a DLS indicator (a border collision's curve) or a test \
+             function of DP (det(DP - I) for a fold, det(DP + I) for a period doubling, the bialternate product \
+             for a Neimark-Sacker point).",
+            |r| Text(r.condition.to_string()),
         ),
         Column::param(0, "The followed parameter (its config key's unit).", |r| {
             Real(r.point.p1)
@@ -220,7 +222,7 @@ pub(crate) fn curve_columns<'a>() -> [Column<CurveRow<'a>>; 10] {
         ),
         Column::new(
             "test_value",
-            "The border function minus its offset (zero to the corrector's accuracy).",
+            "The condition's function minus its offset (zero to the corrector's accuracy).",
             |r| Real(r.point.test_value),
         ),
         Column::new("residual", "max |P(s) - s| (section coordinates).", |r| {

@@ -1,0 +1,362 @@
+//! The indicator curves of a map followed by continuation (docs/model.md section 11, "Two-parameter curves";
+//! `vrw map`): each curve `lambda = 0` is traced across the map from a crossing that a row found, as the
+//! solutions of `P(x; x_param, y_param) = x` and `lambda = offset` ([`super::curve`]), instead of joining the
+//! crossings of neighbouring grid lines. Every other crossing of the same indicator that the curve passes
+//! through (within one grid cell) is taken as covered by it, and the curve is solved for at that row's `y`
+//! and compared with the row's refined threshold: the rows are the curve's second route. Crossings that no
+//! continued curve covers (a period-k gait, a continuation that failed) keep their curves through the
+//! crossings ([`crate::gait::CurveMethod::Crossings`]).
+
+use rayon::prelude::*;
+
+use super::curve::{
+    border_curve_seed, continue_curve, curve_at, Curve, CurveEnd, CurveOptions, CurveProblem,
+    BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
+};
+use super::{
+    continue_family, ContinuationOptions, Evaluation, FamilyMap, GaitFamily, GaitInfo, MapFailure,
+    SpecialKind,
+};
+use crate::gait::map::NearMiss;
+use crate::gait::map::{Along, LineThreshold, RefinedOn};
+use crate::gait::{
+    ContinuedCurve, CurveMethod, GaitMap, MapCurves, ThresholdCurve, LINE_CHECK_TOL,
+};
+use crate::params::Config;
+
+/// The map's curves that are followed by continuation: the threshold's name and its border function.
+pub const CONTINUED_CURVES: [(&str, &str); 3] = [
+    ("lambda_4_plus = 0", "lambda_4_plus"),
+    ("lambda_2_plus = 0", "lambda_2_plus"),
+    ("lambda_I4 = 0", "lambda_I4"),
+];
+
+/// Crossings of one curve from which continuation failed before its remaining crossings are left to the
+/// curves through the crossings (each failure costs a continuation's start).
+const MAX_FAILED_SEEDS: usize = 4;
+
+/// Replace the curves of `curves` whose indicator can be followed ([`CONTINUED_CURVES`]) by curves continued
+/// from the rows' crossings (see the module documentation). Returns the warnings: a continuation that failed
+/// from a crossing inside a family.
+pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurves) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for (name, border) in CONTINUED_CURVES {
+        // A crossing where the row's family ends (the indicator vanishes with the family, at the same value as
+        // the end's threshold): the curve may run along the end of existence, where a curve of
+        // `lambda = offset` can often be followed but not always; where it cannot, the crossing silently stays
+        // with the curves through the crossings.
+        let at_family_end = |t: &LineThreshold| {
+            curves.thresholds.iter().any(|o| {
+                o.along == t.along
+                    && o.line == t.line
+                    && o.threshold.value == t.threshold.value
+                    && !CONTINUED_CURVES.iter().any(|(n, _)| *n == o.threshold.name)
+            })
+        };
+        // The crossings of rows and columns; the curves start from rows'.
+        let seeds: Vec<&LineThreshold> = curves
+            .thresholds
+            .iter()
+            .filter(|t| t.threshold.name == name && t.threshold.value.is_finite())
+            .collect();
+        let mut covered = vec![false; seeds.len()];
+        // Crossings within a grid cell of a continued curve but not on it: a different border nearby (e.g. a
+        // period-2 family's where the curve is a period-1 family's). Continuing from one would most likely
+        // follow the same curve again.
+        let mut near = vec![false; seeds.len()];
+        // Failures at family ends and elsewhere.
+        let mut failures = [0, 0];
+        let mut continued = Vec::new();
+        for k in 0..seeds.len() {
+            let end = usize::from(!at_family_end(seeds[k]));
+            if covered[k]
+                || near[k]
+                || seeds[k].along != Along::X
+                || failures[end] >= MAX_FAILED_SEEDS
+            {
+                continue;
+            }
+            match follow_from_crossing(config, map, &seeds, k, border) {
+                Ok((curve, hits, misses)) => {
+                    for h in hits {
+                        covered[h] = true;
+                    }
+                    for m in misses {
+                        near[m] = true;
+                    }
+                    continued.push(curve);
+                }
+                Err(_) if end == 0 => failures[0] += 1,
+                Err(message) => {
+                    failures[1] += 1;
+                    warnings.push(format!(
+                        "{name}: no curve continued from the crossing of row {} at {} = {}: {message}; \
+                         its curve is drawn through the crossings",
+                        seeds[k].line, map.spec.x.param, seeds[k].threshold.value
+                    ));
+                }
+            }
+        }
+        // The crossings a continued curve covers leave the curves through the crossings, which split into the
+        // runs of the crossings left.
+        let covered_points: Vec<[f64; 2]> = seeds
+            .iter()
+            .zip(&covered)
+            .filter(|(_, &c)| c)
+            .map(|(t, _)| crossing_point(map, t))
+            .collect();
+        let (own, others): (Vec<ThresholdCurve>, Vec<ThresholdCurve>) =
+            std::mem::take(&mut curves.curves)
+                .into_iter()
+                .partition(|c| c.name == name);
+        curves.curves = others;
+        for c in own {
+            curves.curves.extend(uncovered_runs(c, &covered_points));
+        }
+        curves.curves.extend(continued);
+    }
+    warnings
+}
+
+/// The curve through the crossing `seeds[k]` (a row's), the indices of the crossings in `seeds` it covers, and
+/// those of the crossings within a grid cell of it that it does not cover.
+fn follow_from_crossing(
+    config: &Config,
+    map: &GaitMap,
+    seeds: &[&LineThreshold],
+    k: usize,
+    border: &str,
+) -> Result<(ThresholdCurve, Vec<usize>, Vec<usize>), String> {
+    let seed = seeds[k];
+    let spec = &map.spec;
+    let (j, t) = (seed.line, &seed.threshold);
+    let y = map.ys[j];
+    // The grid point of the crossing's bracket nearest it that has a period-1 gait: its fixed point starts
+    // the curve, on its side of the border.
+    let lo = t.grid_bracket[0].min(t.grid_bracket[1]);
+    let i = map
+        .xs
+        .iter()
+        .position(|&x| x == lo)
+        .ok_or("the crossing's bracket is not a grid cell")?;
+    let (gait, x0) = [i, i + 1]
+        .into_iter()
+        .filter_map(|i| {
+            let p = map.rows[j].get(i)?;
+            let g = p.gait.as_ref().filter(|g| g.period_k == 1)?;
+            Some((g, p.value))
+        })
+        .min_by(|a, b| (a.1 - t.value).abs().total_cmp(&(b.1 - t.value).abs()))
+        .ok_or("no period-1 gait next to the crossing")?;
+    let mut row_config = config.clone();
+    row_config
+        .set_numeric(&spec.y.param, y)
+        .map_err(|e| e.to_string())?;
+    let family =
+        GaitFamily::new(&row_config, &spec.x.param, gait.section).map_err(|e| e.message)?;
+    let y_param = spec.y.param.as_str();
+    // The row's family followed across the crossing's cell and one more on either side (pseudo-arclength, the
+    // border collision located on it), and the curve started from its point nearest the collision that lies
+    // clearly on one side: near the end of a family's domain (lambda_2+ often reaches zero just before the
+    // wheel rolls back) a Newton step from the grid gait straight to the border could leave the domain.
+    let cell = (spec.x.to - spec.x.from).abs() / (map.xs.len().max(2) - 1) as f64;
+    let (x_min, x_max) = (spec.x.from.min(spec.x.to), spec.x.from.max(spec.x.to));
+    let hi = t.grid_bracket[0].max(t.grid_bracket[1]);
+    let row_options =
+        ContinuationOptions::for_range((lo - cell).max(x_min), (hi + cell).min(x_max));
+    let row_family = continue_family(&family, &family.reduce(&gait.section), x0, &row_options)
+        .map_err(|e| format!("the row's family: {e}"))?;
+    let collision = row_family
+        .special
+        .iter()
+        .filter(|s| {
+            s.kind == SpecialKind::BorderCollision
+                && s.located
+                && s.border.as_deref() == Some(border)
+        })
+        .min_by(|a, b| {
+            (a.param - t.value)
+                .abs()
+                .total_cmp(&(b.param - t.value).abs())
+        })
+        .map(|s| s.arclength)
+        // Where the family ends with the indicator (no sign change on it), its point nearest the crossing.
+        .or_else(|| {
+            row_family
+                .points
+                .iter()
+                .min_by(|a, b| {
+                    (a.param - t.value)
+                        .abs()
+                        .total_cmp(&(b.param - t.value).abs())
+                })
+                .map(|p| p.arclength)
+        })
+        .ok_or("the row's family has no points")?;
+    let (seed_point, side) = border_curve_seed(&family, &row_family, collision, border)
+        .ok_or("no point of the row's family lies clearly on one side of the border")?;
+    let (start, x_start) = (seed_point.x.clone(), seed_point.param);
+    let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.eval_with(y_param, x, p, q);
+    let observe =
+        |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.observe_with(y_param, x, p, q);
+    let test = |ev: &Evaluation<GaitInfo>| family.border(&ev.info, border);
+    let problem = CurveProblem {
+        eval: &eval,
+        observe: Some(&observe),
+        test: &test,
+        offset: BORDER_OFFSET.copysign(side),
+    };
+    let options = CurveOptions::for_ranges((spec.x.from, spec.x.to), (spec.y.from, spec.y.to));
+    let curve = continue_curve(&problem, &start, (x_start, y), &options)
+        .map_err(|e: MapFailure| e.message)?;
+    // The crossings it may pass through: every one within one grid cell of the curve's polyline on its line.
+    let y_cell = (spec.y.to - spec.y.from).abs() / (map.ys.len().max(2) - 1) as f64;
+    let candidates: Vec<usize> = (0..seeds.len())
+        .filter(|&m| {
+            let s = seeds[m];
+            match s.along {
+                Along::X => crossings_at(&curve, 1, map.ys[s.line])
+                    .any(|x| (x - s.threshold.value).abs() <= cell),
+                Along::Y => crossings_at(&curve, 0, map.xs[s.line])
+                    .any(|y| (y - s.threshold.value).abs() <= y_cell),
+            }
+        })
+        .collect();
+    // Each solved for on the curve and compared with its line's threshold: those within LINE_CHECK_TOL are the
+    // curve's, the others a different border nearby.
+    let differences: Vec<f64> = candidates
+        .par_iter()
+        .map(|&m| {
+            let s = seeds[m];
+            let v = s.threshold.value;
+            let on_curve = match s.along {
+                Along::X => {
+                    curve_at(&problem, &curve, (1, map.ys[s.line]), v, &options).map(|p| p.p1)
+                }
+                Along::Y => {
+                    curve_at(&problem, &curve, (0, map.xs[s.line]), v, &options).map(|p| p.p2)
+                }
+            };
+            on_curve.map_or(f64::NAN, |v| (v - s.threshold.value).abs())
+        })
+        .collect();
+    type Checked = Vec<(usize, f64)>;
+    let (hits, misses): (Checked, Checked) = candidates
+        .into_iter()
+        .zip(differences)
+        .partition(|(_, d)| *d <= LINE_CHECK_TOL);
+    let checked: Vec<f64> = hits.iter().map(|h| h.1).collect();
+    let end_words = |e: &CurveEnd| match e {
+        CurveEnd::LeftRange => "left_range".to_string(),
+        CurveEnd::MaxPoints => "max_points".to_string(),
+        CurveEnd::Ended { message } => format!("ended: {message}"),
+    };
+    let method = ContinuedCurve {
+        seed: RefinedOn {
+            along: Along::X,
+            line: j,
+            threshold: t.name.clone(),
+        },
+        border: border.to_string(),
+        offset: problem.offset,
+        ends: [end_words(&curve.ends[0]), end_words(&curve.ends[1])],
+        max_residual: curve.points.iter().map(|p| p.residual).fold(0.0, f64::max),
+        max_test_value: curve
+            .points
+            .iter()
+            .map(|p| p.test_value.abs())
+            .fold(0.0, f64::max),
+        lines_checked: checked.len(),
+        near_misses: misses
+            .iter()
+            .map(|&(m, difference)| NearMiss {
+                along: seeds[m].along,
+                line: seeds[m].line,
+                value: seeds[m].threshold.value,
+                difference,
+            })
+            .collect(),
+        max_line_difference: checked.iter().copied().reduce(f64::max).unwrap_or(f64::NAN),
+        description: format!(
+            "pseudo-arclength continuation of P(x) = x and {border} = {:e} in ({}, {}), from the gait of row \
+             {j}'s family at {} = {}; steps aimed at {border} = {:e}, each point polished",
+            problem.offset,
+            spec.x.param,
+            spec.y.param,
+            spec.x.param,
+            x_start,
+            problem.offset * FOLLOW_OFFSET_FACTOR
+        ),
+    };
+    let curve_out = ThresholdCurve {
+        name: t.name.clone(),
+        points: curve.points.iter().map(|p| [p.p1, p.p2]).collect(),
+        refined_on: Vec::new(),
+        closed: false,
+        method: CurveMethod::Continuation(method),
+    };
+    Ok((
+        curve_out,
+        hits.into_iter().map(|h| h.0).collect(),
+        misses.into_iter().map(|m| m.0).collect(),
+    ))
+}
+
+/// Where the curve's polyline crosses the line where parameter `which` (0: `x`, 1: `y`) equals `value`: the
+/// other parameter there (each segment that does).
+fn crossings_at(
+    curve: &Curve<GaitInfo>,
+    which: usize,
+    value: f64,
+) -> impl Iterator<Item = f64> + '_ {
+    let split = move |p: &super::CurvePoint<GaitInfo>| {
+        if which == 0 {
+            (p.p1, p.p2)
+        } else {
+            (p.p2, p.p1)
+        }
+    };
+    curve.points.windows(2).filter_map(move |w| {
+        let ((a, a_other), (b, b_other)) = (split(&w[0]), split(&w[1]));
+        ((a - value) * (b - value) <= 0.0 && a != b)
+            .then(|| a_other + (value - a) / (b - a) * (b_other - a_other))
+    })
+}
+
+/// The runs of a curve through crossings between its covered points (the whole curve if none is covered).
+fn uncovered_runs(curve: ThresholdCurve, covered: &[[f64; 2]]) -> Vec<ThresholdCurve> {
+    if !curve.points.iter().any(|p| covered.contains(p)) {
+        return vec![curve];
+    }
+    let mut runs = Vec::new();
+    let mut run = ThresholdCurve {
+        points: Vec::new(),
+        refined_on: Vec::new(),
+        closed: false,
+        ..curve.clone()
+    };
+    for (p, on) in curve.points.iter().zip(&curve.refined_on) {
+        if covered.contains(p) {
+            if !run.points.is_empty() {
+                runs.push(run.clone());
+                run.points.clear();
+                run.refined_on.clear();
+            }
+        } else {
+            run.points.push(*p);
+            run.refined_on.push(on.clone());
+        }
+    }
+    if !run.points.is_empty() {
+        runs.push(run);
+    }
+    runs
+}
+
+/// The point `[x, y]` of a line's crossing (as the curves through the crossings have it).
+fn crossing_point(map: &GaitMap, t: &LineThreshold) -> [f64; 2] {
+    match t.along {
+        Along::X => [t.threshold.value, map.ys[t.line]],
+        Along::Y => [map.xs[t.line], t.threshold.value],
+    }
+}
