@@ -14,6 +14,8 @@
 //!   as `vrw gait` does).
 //! - `family/300_points`: one gait family of 300 points by pseudo-arclength continuation (`vrw continue`'s
 //!   core, without its end analysis and files).
+//! - `map_curves/continued_21x21`: the indicator curves of the default map by continuation, given its gaits
+//!   and crossings (the 100 x 100 map's take 0.94 s, printed by `vrw map --nx 100 --ny 100` as "continued").
 //! - `gait_job`: the whole `vrw gait` search on the defaults (`vrw::app::compute_gait`: transient, Newton,
 //!   refined multipliers), the function the Python binding's `vrw.find_gait(vrw.Params())` calls;
 //!   `python/bench/overhead.py` compares the two.
@@ -29,10 +31,15 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 use vrw::app::{compute_gait, GaitJob};
+use vrw::bifurcation::map_curves::continue_map_curves;
 use vrw::bifurcation::{continue_family, ContinuationOptions, GaitFamily};
 use vrw::contact::{constrained_dynamics, ActiveSet};
 use vrw::dynamics::{Coords, Model};
-use vrw::gait::{find_gait, GaitOptions, StepMap};
+use vrw::gait::map::DEFAULT_CURVE_COLUMNS;
+use vrw::gait::{
+    find_gait, map_curves as map_curves_of, map_gaits, CurveMethod, GaitOptions, MapSpec, StepMap,
+    SweepSpec,
+};
 use vrw::params::Config;
 use vrw::reference::default_initial;
 use vrw::walk::{simulate, Walker};
@@ -242,6 +249,49 @@ fn family(c: &mut Criterion) {
     group.finish();
 }
 
+/// `map_curves/continued_21x21`: the indicator curves of the default 21 x 21 map followed by continuation
+/// (`vrw::bifurcation::map_curves`: the seeds' row families, the curves across the map, each row's and column's
+/// crossing solved for on the curve), given the map's gaits and crossings (computed once, outside the timing).
+fn map_curves(c: &mut Criterion) {
+    let config = Config::default();
+    let spec = MapSpec {
+        x: SweepSpec {
+            param: "viscosity".to_string(),
+            from: 1.0,
+            to: 300.0,
+            points: 21,
+        },
+        y: SweepSpec {
+            param: "stiffness".to_string(),
+            from: 300.0,
+            to: 1500.0,
+            points: 21,
+        },
+    };
+    let options = GaitOptions::default();
+    let map = map_gaits(&config, &spec, &default_initial(&config), &options, &|_| {})
+        .expect("the default map");
+    let crossings = map_curves_of(&config, &map, &options, DEFAULT_CURVE_COLUMNS);
+    let mut group = c.benchmark_group("map_curves");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(15));
+    group.bench_function("continued_21x21", |b| {
+        b.iter_batched(
+            || crossings.clone(),
+            |mut curves| {
+                let warnings = continue_map_curves(&config, &map, &mut curves);
+                assert!(curves
+                    .curves
+                    .iter()
+                    .any(|c| matches!(c.method, CurveMethod::Continuation(_))));
+                black_box((curves, warnings))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+}
+
 fn gait_job(c: &mut Criterion) {
     let job = GaitJob {
         config: Config::default(),
@@ -272,6 +322,7 @@ criterion_group!(
     gait_after_transient,
     jacobian_routes,
     family,
+    map_curves,
     gait_job
 );
 criterion_main!(benches);
