@@ -9,11 +9,12 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
+use super::family_curves::{self, two_param_curves, CurveRecord};
 use super::family_records::{special_record, EndRecord, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
-use crate::bifurcation::curve::{border_curve_seed, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR};
-use crate::bifurcation::special::{test_function, test_name, JUMP_TOL};
-use crate::bifurcation::{continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem};
+use crate::bifurcation::corrector::solve_on_hyperplane;
+use crate::bifurcation::special::JUMP_TOL;
+use crate::bifurcation::Curve;
 use crate::bifurcation::{
     continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
     ContinuationOptions, Family, FamilyEnd, FamilyMap, GaitFamily, GaitInfo, SpecialKind,
@@ -126,30 +127,6 @@ pub struct ContinueResult {
     pub curves: Vec<Curve<GaitInfo>>,
 }
 
-/// One two-parameter curve in `special_points.json`.
-#[derive(Debug, Clone, Serialize)]
-pub struct CurveRecord {
-    /// Its number (`curve` in `curves.csv`), from 1.
-    pub curve: usize,
-    /// The family and the index of the special point (in `special_points`) it starts from.
-    pub family: usize,
-    /// Index into `special_points`.
-    pub special_point: usize,
-    /// The special point's kind.
-    pub kind: SpecialKind,
-    /// The function that is zero along the curve: a DLS indicator for a `BC`, a test function of `DP` for the
-    /// others (`det(DP - I)`, `det(DP + I)`, `bialternate product`).
-    pub condition: String,
-    /// The second parameter.
-    pub param2: String,
-    /// Points in `curves.csv`.
-    pub points: usize,
-    /// How it ends at its first point and at its last.
-    pub ends: [CurveEnd; 2],
-    /// How it was computed.
-    pub method: String,
-}
-
 impl ContinueJob {
     /// Checks the settings that are not model parameters.
     fn validate(&self) -> Result<f64, AppError> {
@@ -250,13 +227,14 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         option: "start",
         reason: format!("no gait at {} = {start} to start from: {e}", job.param),
     })?;
-    let family_map = GaitFamily::new(&config, &job.param, gait.section)
+    // The step map P itself (every family's map is an iterate of it), and the first family's P^k.
+    let base_map = GaitFamily::new(&config, &job.param, gait.section)
         .map_err(|e| AppError::InvalidOption {
             option: "param",
             reason: e.message,
         })?
-        .with_interrupt(flag)
-        .iterated(gait.period_k);
+        .with_interrupt(flag);
+    let family_map = base_map.iterated(gait.period_k);
     let options = job.options();
     let first = continue_family(
         &family_map,
@@ -265,7 +243,6 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         &options,
     )
     .map_err(|e| continuation_error(e, &job.param))?;
-    let base_map = family_map.iterated(1);
     let mut families = vec![Followed {
         family: first,
         origin: "start".to_string(),
@@ -336,7 +313,15 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         }
     }
     let (curve_records, curves) = match &job.two_param {
-        Some(second) => two_param_curves(job, &config, second, &families, &mut warnings)?,
+        Some(second) => {
+            let followed = family_curves::FollowedParam {
+                param: &job.param,
+                from: job.from,
+                to: job.to,
+            };
+            let maps: Vec<_> = families.iter().map(|f| (&f.family, f.map)).collect();
+            two_param_curves(&followed, &config, second, &maps, &mut warnings)?
+        }
         None => (Vec::new(), Vec::new()),
     };
     let summary = ContinueSummary {
@@ -359,136 +344,6 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         stability,
         curves,
     })
-}
-
-/// The curves of every located border collision of `families` in the second parameter (`name`, from, to),
-/// each followed on its family's side of the border (docs/model.md section 11, "Two-parameter curves").
-fn two_param_curves(
-    job: &ContinueJob,
-    config: &Config,
-    (name, from, to): &(String, f64, f64),
-    families: &[Followed],
-    warnings: &mut Vec<String>,
-) -> Result<(Vec<CurveRecord>, Vec<Curve<GaitInfo>>), AppError> {
-    let invalid = |reason: String| AppError::InvalidOption {
-        option: "two_param",
-        reason,
-    };
-    if !Config::numeric_keys().contains(&name.as_str()) || *name == job.param {
-        return Err(invalid(format!(
-            "{name:?} must be a real-valued key other than the followed parameter {:?}",
-            job.param
-        )));
-    }
-    let q0 = config.get_numeric(name)?;
-    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
-        return Err(invalid(format!(
-            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
-        )));
-    }
-    let options = CurveOptions::for_ranges((job.from, job.to), (*from, *to));
-    let mut records = Vec::new();
-    let mut curves = Vec::new();
-    let mut index = 0;
-    for (k, f) in families.iter().enumerate() {
-        for sp in &f.family.special {
-            let this = index;
-            index += 1;
-            if !sp.located {
-                continue;
-            }
-            let map = f.map;
-            let at = format!(
-                "family {} {} at {} = {}",
-                k + 1,
-                sp.kind,
-                job.param,
-                sp.param
-            );
-            // What is followed, from where: an indicator border on the family's side of it, from the family's
-            // point nearest the collision clearly on that side; a fold, period doubling or Neimark-Sacker point
-            // by its test function of `DP`, from the located point.
-            let (test_of, offset, start, border): (TestOf, f64, _, String) = match sp.kind {
-                SpecialKind::BorderCollision => {
-                    let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
-                        continue;
-                    };
-                    let Some((before, side)) =
-                        border_curve_seed(&f.map, &f.family, sp.arclength, &border)
-                    else {
-                        warnings.push(format!(
-                            "{at} ({border}): no point of the family lies clearly on one side of the \
-                             border; no curve followed"
-                        ));
-                        continue;
-                    };
-                    (
-                        TestOf::Border(border.clone()),
-                        BORDER_OFFSET.copysign(side),
-                        (before.x.clone(), before.param),
-                        border,
-                    )
-                }
-                kind => {
-                    let Some(test) = test_function(kind) else {
-                        continue;
-                    };
-                    (
-                        TestOf::Jacobian(test),
-                        0.0,
-                        (sp.x.clone(), sp.param),
-                        test_name(kind).to_string(),
-                    )
-                }
-            };
-            let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.eval_with(name, x, p, q);
-            let observe =
-                |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
-            let test = |ev: &crate::bifurcation::Evaluation<GaitInfo>| match &test_of {
-                TestOf::Border(b) => f.map.border(&ev.info, b),
-                TestOf::Jacobian(t) => t(&ev.jacobian),
-            };
-            let problem = CurveProblem {
-                eval: &eval,
-                // A test function of DP needs every evaluation's derivatives.
-                observe: matches!(test_of, TestOf::Border(_)).then_some(&observe),
-                test: &test,
-                offset,
-            };
-            match continue_curve(&problem, &start.0, (start.1, q0), &options) {
-                Ok(curve) => {
-                    let aim = if offset == 0.0 {
-                        String::new()
-                    } else {
-                        format!(
-                            " (the family's side), steps at {:e}, polished",
-                            offset * FOLLOW_OFFSET_FACTOR
-                        )
-                    };
-                    records.push(CurveRecord {
-                        curve: records.len() + 1,
-                        family: k + 1,
-                        special_point: this,
-                        kind: sp.kind,
-                        condition: border.clone(),
-                        param2: name.clone(),
-                        points: curve.points.len(),
-                        ends: curve.ends.clone(),
-                        method: format!("pseudo-arclength on P(x) = x, {border} = {offset:e}{aim}"),
-                    });
-                    curves.push(curve);
-                }
-                Err(e) => warnings.push(format!("{at}: no curve in {name}: {}", e.message)),
-            }
-        }
-    }
-    Ok((records, curves))
-}
-
-/// The defining condition of a two-parameter curve: a border function by name, or a test function of `DP`.
-enum TestOf {
-    Border(String),
-    Jacobian(fn(&nalgebra::DMatrix<f64>) -> f64),
 }
 
 /// A family being followed: where it came from, its map and its ends with their causes.
@@ -576,8 +431,16 @@ fn switched_families<'a>(
         else {
             continue;
         };
+        // The walk's period may be a multiple of the gait's least period (its detection compares states
+        // within the walk's tolerance): the family is followed as P^j for the least period j of its fixed
+        // point at the walk's parameter.
+        let walked = base_map.iterated(*period_k);
+        let x = walked.reduce(section);
+        let least = solve_on_parameter(&walked, &x, *beyond, options)
+            .and_then(|fixed| walked.value_with_info(&fixed, *beyond).ok())
+            .map_or(*period_k, |info| info.least_period());
+        let period_k = &least;
         let map = base_map.iterated(*period_k);
-        let x = map.reduce(section);
         if known_gait(families, base_map, *period_k, &x, *beyond) {
             continue;
         }
@@ -608,6 +471,22 @@ fn switched_families<'a>(
         );
     }
     born
+}
+
+/// The fixed point of `map` at `p` by Newton's method from `x` (`None` if it does not converge).
+fn solve_on_parameter(
+    map: &GaitFamily,
+    x: &nalgebra::DVector<f64>,
+    p: f64,
+    options: &ContinuationOptions,
+) -> Option<nalgebra::DVector<f64>> {
+    let sigma = options.param_scale;
+    let n = x.len();
+    let mut z = x.clone().insert_row(n, p / sigma);
+    let mut row = nalgebra::DVector::zeros(n + 1);
+    row[n] = 1.0;
+    z = solve_on_hyperplane(map, &z, &row, options).ok()?;
+    Some(z.rows(0, n).into_owned())
 }
 
 /// Does a family already followed pass through the period-`k` gait `x` at `p` (any of its `k` phases)? Each

@@ -9,6 +9,7 @@
 
 mod basin;
 mod family;
+mod family_curves;
 mod family_output;
 mod family_records;
 mod figures;
@@ -20,9 +21,10 @@ mod sweep;
 
 pub use basin::{compute_basin, default_basin_range, run_basin, BasinJob, BasinSummary};
 pub use family::{
-    compute_continuation, ContinueJob, ContinueResult, ContinueSummary, CurveRecord,
-    DIAGRAM_QUANTITIES, MAX_FAMILIES, MAX_FAMILY_POINTS, STABILITY_BAND,
+    compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
+    MAX_FAMILIES, MAX_FAMILY_POINTS, STABILITY_BAND,
 };
+pub use family_curves::CurveRecord;
 pub use family_output::{curve_rows, family_rows, run_continuation};
 pub use family_records::{EndRecord, FamilyRecord, SectionRecord, SideRecord, SpecialRecord};
 pub use figures::{

@@ -229,9 +229,19 @@ fn follow<M: FamilyMap>(
                             b.param + step.copysign(b.param - current.param)
                         }
                         (None, Some(jump)) => jump.bracket[1],
-                        // Where the last step that jumped or turned too far landed: the walk from there says
-                        // what takes over.
-                        (None, None) => rejected_at,
+                        // Just past the last point in the direction of travel (the steps that jumped or turned
+                        // too far may have landed back inside the family): the walk from there says what
+                        // takes over. Without a direction, where the last rejected step landed.
+                        (None, None) => {
+                            let direction = current.tangent[current.tangent.len() - 1];
+                            let step =
+                                options.param_tolerance.max(1e-7) * current.param.abs().max(1.0);
+                            if direction != 0.0 {
+                                current.param + step.copysign(direction)
+                            } else {
+                                rejected_at
+                            }
+                        }
                     };
                     let border = border.or(pending_jump);
                     // The border is the end's cause where one was found; else the corrector's last failure.

@@ -125,6 +125,20 @@ impl<'a> GaitFamily<'a> {
         .eval(x, p)
     }
 
+    /// `P(x; p)`'s record of its walk (without derivatives): the steps' reports and event sequence.
+    pub fn value_with_info(&self, x: &DVector<f64>, p: f64) -> Result<GaitInfo, MapFailure> {
+        let (c, model) = self.configured(p)?;
+        let signed = self
+            .step_map(&model, &c)
+            .eval_signature(&self.expand(x))
+            .map_err(walk_failure)?;
+        Ok(GaitInfo {
+            report: signed.outcome.report,
+            cycle: signed.cycle,
+            signature: signed.signature,
+        })
+    }
+
     /// `P(x; p, q)` and what the map records, without derivatives (`jacobian` and `dparam` empty, `exact`
     /// false): a two-parameter curve's [`super::CurveProblem::observe`].
     pub fn observe_with(

@@ -1,0 +1,175 @@
+//! `vrw continue --two-param`: the curves of the families' special points in a second parameter
+//! (docs/model.md section 11, "Two-parameter curves"), and their records in `special_points.json`.
+
+use serde::Serialize;
+
+use super::AppError;
+use crate::bifurcation::curve::{border_curve_seed, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR};
+use crate::bifurcation::special::{test_function, test_name};
+use crate::bifurcation::{
+    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, FamilyMap, GaitFamily,
+    GaitInfo, SpecialKind,
+};
+use crate::params::Config;
+
+/// One two-parameter curve in `special_points.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct CurveRecord {
+    /// Its number (`curve` in `curves.csv`), from 1.
+    pub curve: usize,
+    /// The family and the index of the special point (in `special_points`) it starts from.
+    pub family: usize,
+    /// Index into `special_points`.
+    pub special_point: usize,
+    /// The special point's kind.
+    pub kind: SpecialKind,
+    /// The function that is zero along the curve: a DLS indicator for a `BC`, a test function of `DP` for the
+    /// others (`det(DP - I)`, `det(DP + I)`, `bialternate product`).
+    pub condition: String,
+    /// The second parameter.
+    pub param2: String,
+    /// Points in `curves.csv`.
+    pub points: usize,
+    /// How it ends at its first point and at its last.
+    pub ends: [CurveEnd; 2],
+    /// How it was computed.
+    pub method: String,
+}
+
+/// The followed parameter and its range: `vrw continue`'s `--param`, `--from`, `--to`.
+pub(super) struct FollowedParam<'s> {
+    pub param: &'s str,
+    pub from: f64,
+    pub to: f64,
+}
+
+/// The curves of every located special point of `families` (each with its map) in the second parameter
+/// (`name`, from, to), a border collision's followed on its family's side of the border (docs/model.md
+/// section 11, "Two-parameter curves").
+pub(super) fn two_param_curves(
+    job: &FollowedParam,
+    config: &Config,
+    (name, from, to): &(String, f64, f64),
+    families: &[(&Family<GaitInfo>, GaitFamily)],
+    warnings: &mut Vec<String>,
+) -> Result<(Vec<CurveRecord>, Vec<Curve<GaitInfo>>), AppError> {
+    let invalid = |reason: String| AppError::InvalidOption {
+        option: "two_param",
+        reason,
+    };
+    if !Config::numeric_keys().contains(&name.as_str()) || *name == job.param {
+        return Err(invalid(format!(
+            "{name:?} must be a real-valued key other than the followed parameter {:?}",
+            job.param
+        )));
+    }
+    let q0 = config.get_numeric(name)?;
+    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
+        return Err(invalid(format!(
+            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
+        )));
+    }
+    let options = CurveOptions::for_ranges((job.from, job.to), (*from, *to));
+    let mut records = Vec::new();
+    let mut curves = Vec::new();
+    let mut index = 0;
+    for (k, (family, family_map)) in families.iter().enumerate() {
+        for sp in &family.special {
+            let this = index;
+            index += 1;
+            if !sp.located {
+                continue;
+            }
+            let map = *family_map;
+            let at = format!(
+                "family {} {} at {} = {}",
+                k + 1,
+                sp.kind,
+                job.param,
+                sp.param
+            );
+            // What is followed, from where: an indicator border on the family's side of it, from the family's
+            // point nearest the collision clearly on that side; a fold, period doubling or Neimark-Sacker point
+            // by its test function of `DP`, from the located point.
+            let (test_of, offset, start, border): (TestOf, f64, _, String) = match sp.kind {
+                SpecialKind::BorderCollision => {
+                    let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
+                        continue;
+                    };
+                    let Some((before, side)) =
+                        border_curve_seed(family_map, family, sp.arclength, &border)
+                    else {
+                        warnings.push(format!(
+                            "{at} ({border}): no point of the family lies clearly on one side of the \
+                             border; no curve followed"
+                        ));
+                        continue;
+                    };
+                    (
+                        TestOf::Border(border.clone()),
+                        BORDER_OFFSET.copysign(side),
+                        (before.x.clone(), before.param),
+                        border,
+                    )
+                }
+                kind => {
+                    let Some(test) = test_function(kind) else {
+                        continue;
+                    };
+                    (
+                        TestOf::Jacobian(test),
+                        0.0,
+                        (sp.x.clone(), sp.param),
+                        test_name(kind).to_string(),
+                    )
+                }
+            };
+            let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.eval_with(name, x, p, q);
+            let observe =
+                |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
+            let test = |ev: &crate::bifurcation::Evaluation<GaitInfo>| match &test_of {
+                TestOf::Border(b) => family_map.border(&ev.info, b),
+                TestOf::Jacobian(t) => t(&ev.jacobian),
+            };
+            let problem = CurveProblem {
+                eval: &eval,
+                // A test function of DP needs every evaluation's derivatives.
+                observe: matches!(test_of, TestOf::Border(_)).then_some(&observe),
+                test: &test,
+                offset,
+            };
+            match continue_curve(&problem, &start.0, (start.1, q0), &options) {
+                Ok(curve) => {
+                    let aim = if offset == 0.0 {
+                        String::new()
+                    } else {
+                        format!(
+                            " (the family's side), steps at {:e}, polished",
+                            offset * FOLLOW_OFFSET_FACTOR
+                        )
+                    };
+                    records.push(CurveRecord {
+                        curve: records.len() + 1,
+                        family: k + 1,
+                        special_point: this,
+                        kind: sp.kind,
+                        condition: border.clone(),
+                        param2: name.clone(),
+                        points: curve.points.len(),
+                        ends: curve.ends.clone(),
+                        method: format!("pseudo-arclength on P(x) = x, {border} = {offset:e}{aim}"),
+                    });
+                    curves.push(curve);
+                }
+                Err(e) => warnings.push(format!("{at}: no curve in {name}: {}", e.message)),
+            }
+        }
+    }
+    Ok((records, curves))
+}
+
+/// The defining condition of a two-parameter curve: a border function by name, or a test function of `DP`.
+enum TestOf {
+    Border(String),
+    Jacobian(fn(&nalgebra::DMatrix<f64>) -> f64),
+}
