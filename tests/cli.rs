@@ -852,7 +852,7 @@ fn map_continues_the_indicator_curves() {
         .find(|c| c["name"] == "lambda_2_plus = 0" && c["method"]["kind"] == "continuation")
         .expect("a continued lambda_2+ curve");
     let method = &continued["method"];
-    assert_eq!(method["border"], "lambda_2_plus");
+    assert_eq!(method["condition"], "lambda_2_plus");
     assert_eq!(
         method["ends"],
         serde_json::json!(["left_range", "left_range"])

@@ -34,7 +34,7 @@ pub struct MapJob {
     pub curves: bool,
     /// The most columns the curves are refined on ([`crate::gait::map::curve_columns`]; every row is).
     pub curve_columns: usize,
-    /// Follow the indicator curves by continuation from the rows' crossings
+    /// Follow the indicator, fold and stability curves by continuation from the lines' crossings
     /// ([`crate::bifurcation::map_curves`]); false: every curve through the refined crossings.
     pub continue_curves: bool,
     /// Search every threshold again by a second route (the whole map with the other integrator) and record in

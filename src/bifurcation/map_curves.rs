@@ -1,11 +1,11 @@
-//! The indicator curves of a map followed by continuation (docs/model.md section 11, "Two-parameter curves";
-//! `vrw map`): each curve `lambda = 0` is traced across the map from a crossing that a row found, as the
-//! solutions of `P(x; x_param, y_param) = x` and `lambda = offset` ([`super::curve`]), instead of joining the
-//! crossings of neighbouring grid lines. Every other crossing of the same indicator that the curve passes
-//! through (within one grid cell) is taken as covered by it, and the curve is solved for at that row's `y`
-//! and compared with the row's refined threshold: the rows are the curve's second route. Crossings that no
-//! continued curve covers (a period-k gait, a continuation that failed) keep their curves through the
-//! crossings ([`crate::gait::CurveMethod::Crossings`]).
+//! The curves of a map followed by continuation (docs/model.md section 11, "Curves of a map"; `vrw map`): each
+//! indicator curve `lambda = 0`, fold and loss of stability is traced across the map from a crossing that a row
+//! (or column) found, as the solutions of `P(x; x_param, y_param) = x` together with its condition
+//! ([`super::curve`]), instead of joining the crossings of neighbouring grid lines. Every other crossing of the
+//! same threshold within one grid cell of the curve is solved for on the curve at its line and compared with
+//! the line's refined threshold: the lines are the curve's second route, and the crossings on it are covered
+//! by it. Crossings that no continued curve covers (a period-k gait, a continuation that failed, another
+//! border nearby) keep their curves through the crossings ([`crate::gait::CurveMethod::Crossings`]).
 
 use rayon::prelude::*;
 
@@ -13,6 +13,7 @@ use super::curve::{
     border_curve_seed, continue_curve, curve_at, Curve, CurveEnd, CurveOptions, CurveProblem,
     BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
+use super::special::{test_function, test_name};
 use super::{
     continue_family, ContinuationOptions, Evaluation, FamilyMap, GaitFamily, GaitInfo, MapFailure,
     SpecialKind,
@@ -20,27 +21,56 @@ use super::{
 use crate::gait::map::NearMiss;
 use crate::gait::map::{Along, LineThreshold, RefinedOn};
 use crate::gait::{
-    ContinuedCurve, CurveMethod, GaitMap, MapCurves, ThresholdCurve, LINE_CHECK_TOL,
+    ContinuedCurve, CurveMethod, GaitMap, MapCurves, SweepSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
 use crate::params::Config;
 
-/// The map's curves that are followed by continuation: the threshold's name and its border function.
-pub const CONTINUED_CURVES: [(&str, &str); 3] = [
-    ("lambda_4_plus = 0", "lambda_4_plus"),
-    ("lambda_2_plus = 0", "lambda_2_plus"),
-    ("lambda_I4 = 0", "lambda_I4"),
+/// What a continued curve of a map solves for with the fixed point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Condition {
+    /// A border function (a DLS indicator) at a small offset on the gaits' side.
+    Border(&'static str),
+    /// The test function of the special point of these kinds located nearest the crossing on the row's family
+    /// (`det(DP - I)` for a fold, `det(DP + I)` for a period doubling, the bialternate product for a
+    /// Neimark-Sacker point).
+    Special(&'static [SpecialKind]),
+}
+
+/// The map's curves that are followed by continuation: the threshold's name and what is solved for.
+pub const CONTINUED_CURVES: [(&str, Condition); 5] = [
+    ("lambda_4_plus = 0", Condition::Border("lambda_4_plus")),
+    ("lambda_2_plus = 0", Condition::Border("lambda_2_plus")),
+    ("lambda_I4 = 0", Condition::Border("lambda_I4")),
+    ("fold", Condition::Special(&[SpecialKind::Fold])),
+    (
+        "stability_lost",
+        Condition::Special(&[
+            SpecialKind::PeriodDoubling,
+            SpecialKind::NeimarkSacker,
+            SpecialKind::Fold,
+        ]),
+    ),
+];
+
+/// The thresholds that are ends of a row's family (a crossing at the same value is at the family's end).
+const FAMILY_END_NAMES: [&str; 5] = [
+    "gait_lost",
+    "gait_found",
+    "branch_switch",
+    "fold",
+    "unconfirmed",
 ];
 
 /// Crossings of one curve from which continuation failed before its remaining crossings are left to the
 /// curves through the crossings (each failure costs a continuation's start).
 const MAX_FAILED_SEEDS: usize = 4;
 
-/// Replace the curves of `curves` whose indicator can be followed ([`CONTINUED_CURVES`]) by curves continued
-/// from the rows' crossings (see the module documentation). Returns the warnings: a continuation that failed
+/// Replace the curves of `curves` that can be followed ([`CONTINUED_CURVES`]) by curves continued from the
+/// lines' crossings (see the module documentation). Returns the warnings: a continuation that failed
 /// from a crossing inside a family.
 pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurves) -> Vec<String> {
     let mut warnings = Vec::new();
-    for (name, border) in CONTINUED_CURVES {
+    for (name, condition) in CONTINUED_CURVES {
         // A crossing where the row's family ends (the indicator vanishes with the family, at the same value as
         // the end's threshold): the curve may run along the end of existence, where a curve of
         // `lambda = offset` can often be followed but not always; where it cannot, the crossing silently stays
@@ -50,10 +80,10 @@ pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurve
                 o.along == t.along
                     && o.line == t.line
                     && o.threshold.value == t.threshold.value
-                    && !CONTINUED_CURVES.iter().any(|(n, _)| *n == o.threshold.name)
+                    && FAMILY_END_NAMES.contains(&o.threshold.name.as_str())
             })
         };
-        // The crossings of rows and columns; the curves start from rows'.
+        // The crossings of rows and columns (rows' first: the curves start from them where they can).
         let seeds: Vec<&LineThreshold> = curves
             .thresholds
             .iter()
@@ -69,14 +99,10 @@ pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurve
         let mut continued = Vec::new();
         for k in 0..seeds.len() {
             let end = usize::from(!at_family_end(seeds[k]));
-            if covered[k]
-                || near[k]
-                || seeds[k].along != Along::X
-                || failures[end] >= MAX_FAILED_SEEDS
-            {
+            if covered[k] || near[k] || failures[end] >= MAX_FAILED_SEEDS {
                 continue;
             }
-            match follow_from_crossing(config, map, &seeds, k, border) {
+            match follow_from_crossing(config, map, &seeds, k, condition) {
                 Ok((curve, hits, misses)) => {
                     for h in hits {
                         covered[h] = true;
@@ -89,10 +115,14 @@ pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurve
                 Err(_) if end == 0 => failures[0] += 1,
                 Err(message) => {
                     failures[1] += 1;
+                    let (line, param) = match seeds[k].along {
+                        Along::X => ("row", &map.spec.x.param),
+                        Along::Y => ("column", &map.spec.y.param),
+                    };
                     warnings.push(format!(
-                        "{name}: no curve continued from the crossing of row {} at {} = {}: {message}; \
-                         its curve is drawn through the crossings",
-                        seeds[k].line, map.spec.x.param, seeds[k].threshold.value
+                        "{name}: no curve continued from the crossing of {line} {} at {param} = {}: \
+                         {message}; its curve is drawn through the crossings",
+                        seeds[k].line, seeds[k].threshold.value
                     ));
                 }
             }
@@ -118,105 +148,156 @@ pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurve
     warnings
 }
 
-/// The curve through the crossing `seeds[k]` (a row's), the indices of the crossings in `seeds` it covers, and
+/// The curve through the crossing `seeds[k]` (a row's or a column's), the indices of the crossings in `seeds` it covers, and
 /// those of the crossings within a grid cell of it that it does not cover.
 fn follow_from_crossing(
     config: &Config,
     map: &GaitMap,
     seeds: &[&LineThreshold],
     k: usize,
-    border: &str,
+    condition: Condition,
 ) -> Result<(ThresholdCurve, Vec<usize>, Vec<usize>), String> {
     let seed = seeds[k];
     let spec = &map.spec;
     let (j, t) = (seed.line, &seed.threshold);
-    let y = map.ys[j];
+    // The line's parameter (x on a row, y on a column), the other one and its value on the line.
+    let (line_spec, other_spec, values, fixed) = match seed.along {
+        Along::X => (&spec.x, &spec.y, &map.xs, map.ys[j]),
+        Along::Y => (&spec.y, &spec.x, &map.ys, map.xs[j]),
+    };
     // The grid point of the crossing's bracket nearest it that has a period-1 gait: its fixed point starts
-    // the curve, on its side of the border.
+    // the line's family.
     let lo = t.grid_bracket[0].min(t.grid_bracket[1]);
-    let i = map
-        .xs
+    let i = values
         .iter()
-        .position(|&x| x == lo)
+        .position(|&v| v == lo)
         .ok_or("the crossing's bracket is not a grid cell")?;
-    let (gait, x0) = [i, i + 1]
+    let (gait, v0) = [i, i + 1]
         .into_iter()
         .filter_map(|i| {
-            let p = map.rows[j].get(i)?;
+            let p = match seed.along {
+                Along::X => map.rows[j].get(i)?,
+                Along::Y => map.rows.get(i)?.get(j)?,
+            };
             let g = p.gait.as_ref().filter(|g| g.period_k == 1)?;
-            Some((g, p.value))
+            Some((g, values[i]))
         })
         .min_by(|a, b| (a.1 - t.value).abs().total_cmp(&(b.1 - t.value).abs()))
         .ok_or("no period-1 gait next to the crossing")?;
-    let mut row_config = config.clone();
-    row_config
-        .set_numeric(&spec.y.param, y)
+    let mut line_config = config.clone();
+    line_config
+        .set_numeric(&other_spec.param, fixed)
         .map_err(|e| e.to_string())?;
-    let family =
-        GaitFamily::new(&row_config, &spec.x.param, gait.section).map_err(|e| e.message)?;
-    let y_param = spec.y.param.as_str();
-    // The row's family followed across the crossing's cell and one more on either side (pseudo-arclength, the
-    // border collision located on it), and the curve started from its point nearest the collision that lies
-    // clearly on one side: near the end of a family's domain (lambda_2+ often reaches zero just before the
-    // wheel rolls back) a Newton step from the grid gait straight to the border could leave the domain.
-    let cell = (spec.x.to - spec.x.from).abs() / (map.xs.len().max(2) - 1) as f64;
-    let (x_min, x_max) = (spec.x.from.min(spec.x.to), spec.x.from.max(spec.x.to));
+    let line_family =
+        GaitFamily::new(&line_config, &line_spec.param, gait.section).map_err(|e| e.message)?;
+    // The line's family followed across the crossing's cell and one more on either side (pseudo-arclength,
+    // its special points located), and the curve started from it: for a border, from its point nearest the
+    // collision that lies clearly on one side (near the end of a family's domain, lambda_2+ often reaches zero
+    // just before the wheel rolls back, a Newton step from the grid gait straight to the border could leave
+    // the domain); for a fold, period doubling or Neimark-Sacker point, from the located point.
+    let cell = |s: &SweepSpec, n: usize| (s.to - s.from).abs() / (n.max(2) - 1) as f64;
+    let x_cell = cell(&spec.x, map.xs.len());
+    let y_cell = cell(&spec.y, map.ys.len());
+    let line_cell = cell(line_spec, values.len());
+    let (v_min, v_max) = (
+        line_spec.from.min(line_spec.to),
+        line_spec.from.max(line_spec.to),
+    );
     let hi = t.grid_bracket[0].max(t.grid_bracket[1]);
     let row_options =
-        ContinuationOptions::for_range((lo - cell).max(x_min), (hi + cell).min(x_max));
-    let row_family = continue_family(&family, &family.reduce(&gait.section), x0, &row_options)
-        .map_err(|e| format!("the row's family: {e}"))?;
-    let collision = row_family
-        .special
-        .iter()
-        .filter(|s| {
-            s.kind == SpecialKind::BorderCollision
-                && s.located
-                && s.border.as_deref() == Some(border)
-        })
-        .min_by(|a, b| {
-            (a.param - t.value)
-                .abs()
-                .total_cmp(&(b.param - t.value).abs())
-        })
-        .map(|s| s.arclength)
-        // Where the family ends with the indicator (no sign change on it), its point nearest the crossing.
-        .or_else(|| {
-            row_family
-                .points
-                .iter()
-                .min_by(|a, b| {
-                    (a.param - t.value)
-                        .abs()
-                        .total_cmp(&(b.param - t.value).abs())
-                })
-                .map(|p| p.arclength)
-        })
-        .ok_or("the row's family has no points")?;
-    let (seed_point, side) = border_curve_seed(&family, &row_family, collision, border)
-        .ok_or("no point of the row's family lies clearly on one side of the border")?;
-    let (start, x_start) = (seed_point.x.clone(), seed_point.param);
+        ContinuationOptions::for_range((lo - line_cell).max(v_min), (hi + line_cell).min(v_max));
+    let row_family = continue_family(
+        &line_family,
+        &line_family.reduce(&gait.section),
+        v0,
+        &row_options,
+    )
+    .map_err(|e| format!("the line's family: {e}"))?;
+    // The curve's map: the family in x, whose evaluations set y.
+    let family =
+        GaitFamily::new(&line_config, &spec.x.param, gait.section).map_err(|e| e.message)?;
+    let y_param = spec.y.param.as_str();
     let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.eval_with(y_param, x, p, q);
     let observe =
         |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.observe_with(y_param, x, p, q);
-    let test = |ev: &Evaluation<GaitInfo>| family.border(&ev.info, border);
+    let nearest = |a: f64, b: f64| (a - t.value).abs().total_cmp(&(b - t.value).abs());
+    let (start, v_start, offset, test, name): (_, _, _, TestOf, String) = match condition {
+        Condition::Border(border) => {
+            let collision = row_family
+                .special
+                .iter()
+                .filter(|s| {
+                    s.kind == SpecialKind::BorderCollision
+                        && s.located
+                        && s.border.as_deref() == Some(border)
+                })
+                .min_by(|a, b| nearest(a.param, b.param))
+                .map(|s| s.arclength)
+                // Where the family ends with the indicator (no sign change on it), its point nearest the
+                // crossing.
+                .or_else(|| {
+                    row_family
+                        .points
+                        .iter()
+                        .min_by(|a, b| nearest(a.param, b.param))
+                        .map(|p| p.arclength)
+                })
+                .ok_or("the row's family has no points")?;
+            let (seed_point, side) =
+                border_curve_seed(&line_family, &row_family, collision, border)
+                    .ok_or("no point of the row's family lies clearly on one side of the border")?;
+            (
+                seed_point.x.clone(),
+                seed_point.param,
+                BORDER_OFFSET.copysign(side),
+                TestOf::Border(border),
+                border.to_string(),
+            )
+        }
+        Condition::Special(kinds) => {
+            let sp = row_family
+                .special
+                .iter()
+                .filter(|s| kinds.contains(&s.kind) && s.located)
+                .min_by(|a, b| nearest(a.param, b.param))
+                .ok_or_else(|| {
+                    format!("the row's family has no located {kinds:?} point near the crossing")
+                })?;
+            let test = test_function(sp.kind).ok_or("not a special point with a test function")?;
+            (
+                sp.x.clone(),
+                sp.param,
+                0.0,
+                TestOf::Jacobian(test),
+                test_name(sp.kind).to_string(),
+            )
+        }
+    };
+    let test = |ev: &Evaluation<GaitInfo>| match test {
+        TestOf::Border(b) => family.border(&ev.info, b),
+        TestOf::Jacobian(f) => f(&ev.jacobian),
+    };
     let problem = CurveProblem {
         eval: &eval,
-        observe: Some(&observe),
+        // A test function of DP needs every evaluation's derivatives.
+        observe: (offset != 0.0).then_some(&observe),
         test: &test,
-        offset: BORDER_OFFSET.copysign(side),
+        offset,
     };
     let options = CurveOptions::for_ranges((spec.x.from, spec.x.to), (spec.y.from, spec.y.to));
-    let curve = continue_curve(&problem, &start, (x_start, y), &options)
-        .map_err(|e: MapFailure| e.message)?;
+    let at = match seed.along {
+        Along::X => (v_start, fixed),
+        Along::Y => (fixed, v_start),
+    };
+    let curve =
+        continue_curve(&problem, &start, at, &options).map_err(|e: MapFailure| e.message)?;
     // The crossings it may pass through: every one within one grid cell of the curve's polyline on its line.
-    let y_cell = (spec.y.to - spec.y.from).abs() / (map.ys.len().max(2) - 1) as f64;
     let candidates: Vec<usize> = (0..seeds.len())
         .filter(|&m| {
             let s = seeds[m];
             match s.along {
                 Along::X => crossings_at(&curve, 1, map.ys[s.line])
-                    .any(|x| (x - s.threshold.value).abs() <= cell),
+                    .any(|x| (x - s.threshold.value).abs() <= x_cell),
                 Along::Y => crossings_at(&curve, 0, map.xs[s.line])
                     .any(|y| (y - s.threshold.value).abs() <= y_cell),
             }
@@ -253,11 +334,11 @@ fn follow_from_crossing(
     };
     let method = ContinuedCurve {
         seed: RefinedOn {
-            along: Along::X,
+            along: seed.along,
             line: j,
             threshold: t.name.clone(),
         },
-        border: border.to_string(),
+        condition: name.clone(),
         offset: problem.offset,
         ends: [end_words(&curve.ends[0]), end_words(&curve.ends[1])],
         max_residual: curve.points.iter().map(|p| p.residual).fold(0.0, f64::max),
@@ -278,14 +359,22 @@ fn follow_from_crossing(
             .collect(),
         max_line_difference: checked.iter().copied().reduce(f64::max).unwrap_or(f64::NAN),
         description: format!(
-            "pseudo-arclength continuation of P(x) = x and {border} = {:e} in ({}, {}), from the gait of row \
-             {j}'s family at {} = {}; steps aimed at {border} = {:e}, each point polished",
+            "pseudo-arclength continuation of P(x) = x and {name} = {:e} in ({}, {}), from the gait of {} \
+             {j}'s family at {} = {}{}",
             problem.offset,
             spec.x.param,
             spec.y.param,
-            spec.x.param,
-            x_start,
-            problem.offset * FOLLOW_OFFSET_FACTOR
+            if seed.along == Along::X { "row" } else { "column" },
+            line_spec.param,
+            v_start,
+            if problem.offset == 0.0 {
+                String::new()
+            } else {
+                format!(
+                    "; steps aimed at {name} = {:e}, each point polished",
+                    problem.offset * FOLLOW_OFFSET_FACTOR
+                )
+            }
         ),
     };
     let curve_out = ThresholdCurve {
@@ -300,6 +389,13 @@ fn follow_from_crossing(
         hits.into_iter().map(|h| h.0).collect(),
         misses.into_iter().map(|m| m.0).collect(),
     ))
+}
+
+/// A continued curve's condition as evaluated: a border function by name, or a test function of `DP`.
+#[derive(Clone, Copy)]
+enum TestOf {
+    Border(&'static str),
+    Jacobian(fn(&nalgebra::DMatrix<f64>) -> f64),
 }
 
 /// Where the curve's polyline crosses the line where parameter `which` (0: `x`, 1: `y`) equals `value`: the

@@ -56,9 +56,10 @@ pub(super) struct MapArgs {
     #[arg(long, default_value_t = vrw::gait::map::DEFAULT_CURVE_COLUMNS as u64,
           value_parser = clap::value_parser!(u64).range(2..))]
     curve_columns: u64,
-    /// How the indicator curves (lambda = 0) are traced: `continuation` (followed in both parameters from a
-    /// crossing a row found, checked against every row it crosses) or `crossings` (the refined crossings of
-    /// rows and columns joined cell by cell, as every other curve is).
+    /// How the indicator curves (lambda = 0), folds and losses of stability are traced: `continuation`
+    /// (followed in both parameters from a crossing a row or column found, checked against every line it
+    /// crosses) or `crossings` (the refined crossings of rows and columns joined cell by cell, as the ends of
+    /// existence always are).
     #[arg(long, default_value = "continuation", value_parser = ["continuation", "crossings"])]
     curve_method: String,
     /// Search every threshold again by a second route, the whole map with the other integrator (dopri5 for

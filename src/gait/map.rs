@@ -218,9 +218,11 @@ pub enum CurveMethod {
 pub struct ContinuedCurve {
     /// The row crossing it was started from.
     pub seed: RefinedOn,
-    /// The border function followed (`lambda_2_plus`, ...).
-    pub border: String,
-    /// The value of the border function followed: a small number on the side of the gaits it was started from.
+    /// The function that is zero along the curve: a DLS indicator (`lambda_2_plus`, ...) or a test function
+    /// of `DP` (`det(DP - I)` for a fold, `det(DP + I)` for a period doubling, `bialternate product`).
+    pub condition: String,
+    /// The value of that function followed: for an indicator, a small number on the side of the gaits it was
+    /// started from; 0 for a test function.
     pub offset: f64,
     /// How it ends at its first point and at its last (`left_range`, `max_points`, or the failure).
     pub ends: [String; 2],
