@@ -307,13 +307,23 @@ fn follow<M: FamilyMap>(
         // A turn over a step this short is a corner of the family (it crosses a border where DP jumps), not
         // a jump to another family.
         let turned = next.tangent.dot(&current.tangent) < MAX_TURN && h > CORNER_STEP;
-        if (jumped || turned) && h > options.min_step {
+        // A step to a point that cannot be this family's (the VRW: another least period).
+        let other = !map.same_family(&current.info, &next.info);
+        if (jumped || turned || other) && h > options.min_step {
             last_failure = Some(MapFailure {
                 kind: "step".to_string(),
-                message: format!(
-                    "steps near p = {} turn or jump too far (the family turns sharply, or another is near)",
-                    current.param
-                ),
+                message: if other {
+                    format!(
+                        "steps near p = {} reach another family (its least period differs)",
+                        current.param
+                    )
+                } else {
+                    format!(
+                        "steps near p = {} turn or jump too far (the family turns sharply, or another is \
+                         near)",
+                        current.param
+                    )
+                },
             });
             rejected_at = next.param;
             h *= 0.5;

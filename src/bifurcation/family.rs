@@ -366,4 +366,24 @@ impl<'a> FamilyMap for GaitFamily<'a> {
     fn piece(&self, info: &GaitInfo) -> String {
         info.signature.clone()
     }
+
+    /// The same least period, or a change where the longer orbit's phases lie within [`PHASE_MERGE_TOL`] of
+    /// each other (near the branch point of a period doubling, where they merge).
+    fn same_family(&self, a: &GaitInfo, b: &GaitInfo) -> bool {
+        let (pa, pb) = (a.least_period(), b.least_period());
+        if pa == pb {
+            return true;
+        }
+        let (longer, shorter) = if pa > pb { (a, pb) } else { (b, pa) };
+        longer
+            .cycle
+            .get(shorter)
+            .zip(longer.cycle.first())
+            .is_some_and(|(x, y)| x.section.distance(&y.section) < PHASE_MERGE_TOL)
+    }
 }
+
+/// Near a period doubling the two phases of the period-2 orbit are close (their distance grows like the square
+/// root of the distance to the branch point); a change of least period between two points of a family whose
+/// longer orbit has its phases farther apart than this is a jump to another family.
+pub const PHASE_MERGE_TOL: f64 = 0.05;

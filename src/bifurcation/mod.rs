@@ -101,4 +101,11 @@ pub trait FamilyMap: Sync {
     fn piece(&self, _info: &Self::Info) -> String {
         String::new()
     }
+
+    /// Can two successive points of a family be one family's? A step whose two ends cannot is a jump to
+    /// another family (the VRW: the least period changes where the longer orbit's phases are far apart, which
+    /// no branch point of one family does), and is rejected like a step that jumps.
+    fn same_family(&self, _a: &Self::Info, _b: &Self::Info) -> bool {
+        true
+    }
 }
