@@ -18,17 +18,19 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
 use vrw::app::{
-    compute_basin, compute_continuation, compute_gait, compute_simulation, compute_sweep,
-    curve_rows, family_rows, AppError, BasinJob, ContinueJob, GaitJob, SimulateJob,
+    compute_basin, compute_continuation, compute_gait, compute_map, compute_simulation,
+    compute_sweep, curve_rows, family_rows, AppError, BasinJob, ContinueJob, GaitJob, MapJob,
+    SimulateJob,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
 use vrw::gait::basin::Coordinate;
 use vrw::gait::MAX_SWEEP_POINTS;
-use vrw::gait::{GaitOptions, SweepSpec};
+use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
 use vrw::output::{
-    basin_header, basin_row, curve_header, curve_row, family_header, family_row, step_row,
-    sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
+    basin_header, basin_row, curve_header, curve_row, family_header, family_row, map_header,
+    map_rows, step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER,
+    TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -210,8 +212,9 @@ impl Params {
 }
 
 /// A table (CSV header and typed rows) as a dict of numpy arrays keyed by the header: real columns as
-/// float64 (`NaN` for empty cells), counts as int64 (0 for empty cells), flags as bool (False for empty
-/// cells), words as numpy string arrays.
+/// float64 (`NaN` for empty cells), counts as int64 (as float64 with `NaN` where a cell is empty, as pandas
+/// reads the CSV: a count of 0 would be a value), flags as bool (False for empty cells), words as numpy
+/// string arrays.
 fn table<'py, H: AsRef<str>>(
     py: Python<'py>,
     header: &[H],
@@ -226,6 +229,14 @@ fn table<'py, H: AsRef<str>>(
             None | Some(Cell::Real(_)) | Some(Cell::Empty) => column
                 .map(|c| match c {
                     Cell::Real(v) => *v,
+                    _ => f64::NAN,
+                })
+                .collect::<Vec<f64>>()
+                .into_pyarray(py)
+                .into_any(),
+            Some(Cell::Count(_)) if column.clone().any(|c| matches!(c, Cell::Empty)) => column
+                .map(|c| match c {
+                    Cell::Count(n) => *n as f64,
                     _ => f64::NAN,
                 })
                 .collect::<Vec<f64>>()
@@ -525,6 +536,91 @@ fn basin<'py>(
     Ok(result)
 }
 
+/// The gait over a grid of two parameters and the threshold curves across it (`vrw map`, without the
+/// figure).
+///
+/// Returns the fields of `curves.json` (`spec`, `gaits_found`, `curves` with each one's `method`, `thresholds`,
+/// `warnings`, ...) and `map`, the columns of `map.csv` as numpy arrays (row by row in `y`, each row along
+/// `x`). Keyword arguments as the command line's options: `x`, `y` (parameter names), `x_range`, `y_range`
+/// (`(from, to)`, default the command line's `(1, 300)` and `(300, 1500)`), `nx`, `ny`, `curves` (`False`: the
+/// command line's `--no-curves`), `curve_columns`, `curve_method` (`"continuation"` or `"crossings"`),
+/// `second_route`, `initial` (where every row's first search starts).
+#[pyfunction]
+#[pyo3(name = "map", signature = (params, *, x = "viscosity", y = "stiffness", x_range = None, y_range = None, nx = 21, ny = 21, curves = true, curve_columns = 25, curve_method = "continuation", second_route = false, initial = None))]
+#[allow(clippy::too_many_arguments)]
+fn gait_map<'py>(
+    py: Python<'py>,
+    params: &Params,
+    x: &str,
+    y: &str,
+    x_range: Option<(f64, f64)>,
+    y_range: Option<(f64, f64)>,
+    #[pyo3(from_py_with = nx_arg)] nx: usize,
+    #[pyo3(from_py_with = ny_arg)] ny: usize,
+    curves: bool,
+    #[pyo3(from_py_with = curve_columns_arg)] curve_columns: usize,
+    curve_method: &str,
+    second_route: bool,
+    initial: Option<[f64; 3]>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let continue_curves = match curve_method {
+        "continuation" => true,
+        "crossings" => false,
+        other => {
+            return Err(ConfigError::new_err(format!(
+                "invalid value {other:?} for `curve_method`: expected \"continuation\" or \"crossings\""
+            )))
+        }
+    };
+    if curve_columns < 2 {
+        return Err(ConfigError::new_err(format!(
+            "invalid value {curve_columns} for `curve_columns`: at least 2 (both ends of the map)"
+        )));
+    }
+    if second_route && !curves {
+        return Err(ConfigError::new_err(
+            "`second_route` searches the curves' thresholds again: it needs `curves=True`",
+        ));
+    }
+    let (x_range, y_range) = (
+        x_range.unwrap_or((1.0, 300.0)),
+        y_range.unwrap_or((300.0, 1500.0)),
+    );
+    let axis = |param: &str, (from, to): (f64, f64), points: usize| SweepSpec {
+        param: param.to_string(),
+        from,
+        to,
+        points,
+    };
+    let job = MapJob {
+        config: params.config.clone(),
+        spec: MapSpec {
+            x: axis(x, x_range, nx),
+            y: axis(y, y_range, ny),
+        },
+        initial: section(initial),
+        options: GaitOptions::default(),
+        curves,
+        curve_columns,
+        continue_curves,
+        second_route,
+        marks: Vec::new(),
+        out_dir: PathBuf::new(),
+    };
+    let (summary, map) = interruptible(py, vrw::gait::interrupt_flag(), || {
+        compute_map(&job, &|_| {})
+    })?
+    .map_err(app_error)?;
+    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
+    result.set_item("map", table(py, &map_header(x, y), &map_rows(&map))?)?;
+    Ok(result)
+}
+
+/// `map`'s `curve_columns`, named in its errors.
+fn curve_columns_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("curve_columns", value)
+}
+
 /// Follow the gait family through the gait at `start` in `param` by pseudo-arclength continuation (`vrw
 /// continue`, without the figure).
 ///
@@ -687,6 +783,7 @@ fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(basin, m)?)?;
     m.add_function(wrap_pyfunction!(continue_family, m)?)?;
+    m.add_function(wrap_pyfunction!(gait_map, m)?)?;
     m.add_function(wrap_pyfunction!(linspace, m)?)?;
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("WalkError", py.get_type::<WalkError>())?;

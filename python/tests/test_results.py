@@ -126,3 +126,32 @@ def test_continue_family_curves_equal_curves_csv(cli, tmp_path):
     assert [dict(c, ends=list(c["ends"])) for c in result["curves"]] == expected["curves"]
     with pytest.raises(ValueError, match="two_param"):
         vrw.continue_family(vrw.Params(), two_param=("viscosity", 1, 10))
+
+
+def test_map_equals_map_csv_and_curves_json(cli, tmp_path):
+    args = ["--x-from", "30", "--x-to", "70", "--nx", "3", "--y-from", "440", "--y-to", "560", "--ny", "3"]
+    cli("map", *args, "--out", tmp_path)
+    result = vrw.map(vrw.Params(), x_range=(30, 70), nx=3, y_range=(440, 560), ny=3)
+    csv = pd.read_csv(tmp_path / "map.csv")
+    frame = result.to_pandas()
+    assert list(frame.columns) == list(csv.columns) and frame.shape == csv.shape
+    for column in csv.columns:
+        if csv[column].dtype.kind == "f":
+            assert np.array_equal(frame[column], csv[column], equal_nan=True), column
+    assert list(frame["status"]) == list(csv["status"])
+    expected = __import__("json").loads((tmp_path / "curves.json").read_text())
+    assert result.points == expected["points"] == 9 and result.gaits_found == expected["gaits_found"]
+    assert [c["name"] for c in result.curves] == [c["name"] for c in expected["curves"]]
+    assert [[list(p) for p in c["points"]] for c in result.curves] == [c["points"] for c in expected["curves"]]
+    assert [t["threshold"]["value"] for t in result.thresholds] == [
+        t["threshold"]["value"] for t in expected["thresholds"]
+    ]
+    ds = result.to_xarray()
+    assert dict(ds.sizes) == {"stiffness": 3, "viscosity": 3}
+    assert list(ds["viscosity"].values) == [30.0, 50.0, 70.0]
+    assert ds["status"].dims == ("stiffness", "viscosity")
+    assert repr(result).startswith("MapResult(viscosity x stiffness: gait at")
+    with pytest.raises(vrw.ConfigError, match="curve_method"):
+        vrw.map(vrw.Params(), nx=3, ny=3, curve_method="squares")
+    with pytest.raises(vrw.ConfigError, match="second_route"):
+        vrw.map(vrw.Params(), nx=3, ny=3, curves=False, second_route=True)

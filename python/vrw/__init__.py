@@ -29,6 +29,7 @@ from .results import (
     BasinResult,
     FamilyResult,
     GaitResult,
+    MapResult,
     Grid,
     Result,
     Run,
@@ -92,11 +93,21 @@ def continue_family(params: Params, param: str = "viscosity", **options: Any) ->
     return result
 
 
+def map(params: Params, **options: Any) -> MapResult:
+    """The gait over a grid of two parameters and the threshold curves across it (``vrw map``, without the
+    figure): a ``MapResult``, the fields of ``curves.json`` with ``map`` (the columns of ``map.csv``) as a
+    ``Table``; ``to_xarray()`` gives the grid over both parameters. See ``vrw._vrw.map`` for the options."""
+    result = MapResult(_vrw.map(params, **options))
+    wrap_tables(result, ["map"])
+    return result
+
+
 __all__ = [
     "BasinResult",
     "FamilyResult",
     "ConfigError",
     "GaitResult",
+    "MapResult",
     "Grid",
     "Params",
     "Result",
@@ -109,6 +120,7 @@ __all__ = [
     "continue_family",
     "find_gait",
     "linspace",
+    "map",
     "simulate",
     "sweep",
 ]

@@ -16,6 +16,7 @@ __all__ = [
     "basin",
     "continue_family",
     "find_gait",
+    "map",
     "linspace",
     "simulate",
     "sweep",
@@ -137,6 +138,26 @@ def continue_family(
     ``range`` is ``(from, to)``, default ``(1, 300)``; ``two_param`` ``(name, from, to)`` also follows every
     border collision's curve in that second parameter (``curves`` in
     ``special_points.json``'s form, and ``curve_points``, the columns of ``curves.csv``)."""
+
+def map(
+    params: Params,
+    *,
+    x: str = "viscosity",
+    y: str = "stiffness",
+    x_range: Optional[Tuple[float, float]] = None,
+    y_range: Optional[Tuple[float, float]] = None,
+    nx: int = 21,
+    ny: int = 21,
+    curves: bool = True,
+    curve_columns: int = 25,
+    curve_method: str = "continuation",
+    second_route: bool = False,
+    initial: Optional[Section] = None,
+) -> Dict[str, Any]:
+    """The gait over a grid of two parameters and the threshold curves (``vrw map``, without the figure): the
+    fields of ``curves.json`` and ``map``, the columns of ``map.csv``. ``x_range`` and ``y_range`` default to
+    the command line's ``(1, 300)`` and ``(300, 1500)``; ``curve_method`` is ``"continuation"`` or
+    ``"crossings"``."""
 
 def basin(
     params: Params,

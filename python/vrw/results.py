@@ -166,6 +166,38 @@ class BasinResult(_WithTable):
         return f"BasinResult({self['points'].rows} starts: {dict(self['outcomes'])})"
 
 
+class MapResult(_WithTable):
+    """``vrw.map``: the fields of ``curves.json`` (``spec``, ``points``, ``gaits_found``, ``curves``,
+    ``thresholds``, ``warnings``, ...), with ``map`` (the columns of ``map.csv``: one row per grid point, row by
+    row in ``y``) a ``Table``."""
+
+    _table = "map"
+
+    def to_xarray(self) -> Any:
+        """The grid as an ``xarray.Dataset`` over the two parameters (``y`` by ``x``, named by their keys):
+        every other column of ``map.csv`` as a variable."""
+        xr = _optional("xarray")
+        spec, points = self["spec"], self["map"]
+        x, y = spec["x"]["param"], spec["y"]["param"]
+        nx, ny = spec["x"]["points"], spec["y"]["points"]
+        xs = np.asarray(points[x])[:nx]
+        ys = np.asarray(points[y])[::nx]
+        data = {
+            name: ((y, x), np.asarray(column).reshape(ny, nx))
+            for name, column in points.items()
+            if name not in (x, y)
+        }
+        return xr.Dataset(data, coords={x: xs, y: ys})
+
+    def __repr__(self) -> str:
+        spec = self.get("spec", {})
+        names = sorted({c["name"] for c in self.get("curves", [])})
+        return (
+            f"MapResult({spec.get('x', {}).get('param')} x {spec.get('y', {}).get('param')}: gait at "
+            f"{self.get('gaits_found')} of {self.get('points')} points, curves {names})"
+        )
+
+
 class FamilyResult(_WithTable):
     """``vrw.continue_family``: the fields of ``special_points.json`` (``families``, ``special_points``, ...),
     with ``branch`` (the columns of ``branch.csv``: one row per point of every family) a ``Table``."""

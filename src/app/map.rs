@@ -83,6 +83,30 @@ pub fn run_map(
     job: &MapJob,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<MapSummary, AppError> {
+    let initial = checked_initial(job)?;
+    in_run(&job.out_dir, "map", |run| {
+        map_into(job, &initial, run, progress).map(|s| (s, None))
+    })
+}
+
+/// The work of [`run_map`] without writing anything: the summary (`curves.json`'s fields) and the map's
+/// gaits (`map.csv`'s rows). The Python front's `vrw.map`.
+pub fn compute_map(
+    job: &MapJob,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<(MapSummary, GaitMap), AppError> {
+    let initial = checked_initial(job)?;
+    let clock = std::time::Instant::now();
+    let map = map_gaits(&job.config, &job.spec, &initial, &job.options, progress)?;
+    let points = map.xs.len() * map.ys.len();
+    check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
+    let mut summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
+    second_route(job, &initial, progress, &mut summary)?;
+    Ok((summary, map))
+}
+
+/// The job checked before anything is computed, and the state every row's first search starts from.
+fn checked_initial(job: &MapJob) -> Result<SectionState, AppError> {
     job.config.validate()?;
     job.spec.validate(&job.config)?;
     let model = Model::new(&job.config.params)?;
@@ -96,9 +120,7 @@ pub fn run_map(
             });
         }
     }
-    in_run(&job.out_dir, "map", |run| {
-        map_into(job, &initial, run, progress).map(|s| (s, None))
-    })
+    Ok(initial)
 }
 
 /// The work of [`run_map`] in its run directory.
@@ -115,14 +137,31 @@ fn map_into(
     run.add("map.csv");
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;
+    let mut summary = map_summary(job, &map, gait_seconds);
+    let curves_json = run.path("curves.json");
+    output::write_json(&curves_json, &summary)?;
+    run.add("curves.json");
+    write_figure(job, &map, &summary.curves)?;
+    run.add("map.svg");
+    run.add("map.png");
+    if job.second_route && job.curves {
+        // Everything of the first route is written: nothing is lost if this fails.
+        second_route(job, initial, progress, &mut summary)?;
+        output::write_json(&curves_json, &summary)?;
+    }
+    Ok(summary)
+}
+
+/// The curves of `map` (with `job.curves`) and the summary of the map and its curves.
+fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> MapSummary {
     let clock = std::time::Instant::now();
     let mut curve_warnings = Vec::new();
     let mut continuation_seconds = 0.0;
     let (curves, thresholds) = if job.curves {
-        let mut c = map_curves(&job.config, &map, &job.options, job.curve_columns);
+        let mut c = map_curves(&job.config, map, &job.options, job.curve_columns);
         if job.continue_curves {
             let clock = std::time::Instant::now();
-            curve_warnings = continue_map_curves(&job.config, &map, &mut c);
+            curve_warnings = continue_map_curves(&job.config, map, &mut c);
             continuation_seconds = clock.elapsed().as_secs_f64();
         }
         (c.curves, c.thresholds)
@@ -140,7 +179,7 @@ fn map_into(
             .flatten()
             .filter(|p| p.gait.is_some())
             .count(),
-        points,
+        points: map.xs.len() * map.ys.len(),
         curves,
         thresholds,
         seconds: [gait_seconds, curve_seconds],
@@ -160,35 +199,39 @@ fn map_into(
         })),
     };
     summary.warnings.extend(curve_warnings);
-    let curves_json = run.path("curves.json");
-    output::write_json(&curves_json, &summary)?;
-    run.add("curves.json");
-    write_figure(job, &map, &summary.curves)?;
-    run.add("map.svg");
-    run.add("map.png");
-    if job.second_route && job.curves {
-        // Everything of the first route is written: nothing is lost if this fails.
-        let clock = std::time::Instant::now();
-        let (second_config, route) = second_route_config(&job.config);
-        let second_map = map_gaits(&second_config, &job.spec, initial, &job.options, progress)?;
-        check_interrupted(
-            second_map.rows.iter().map(Vec::len).sum(),
-            points,
-            "map.csv (first route; the second route is dropped)",
-        )?;
-        let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
-        for t in &mut summary.thresholds {
-            let same_line = second
-                .thresholds
-                .iter()
-                .filter(|o| o.along == t.along && o.line == t.line)
-                .map(|o| &o.threshold);
-            t.threshold.second_route = Some(SecondRoute::check(&t.threshold, same_line, &route));
-        }
-        summary.second_route_seconds = clock.elapsed().as_secs_f64();
-        output::write_json(&curves_json, &summary)?;
+    summary
+}
+
+/// With `job.second_route` (and curves): the whole map again with the other integrator, each threshold of
+/// `summary` checked against the second route's on the same line.
+fn second_route(
+    job: &MapJob,
+    initial: &SectionState,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+    summary: &mut MapSummary,
+) -> Result<(), AppError> {
+    if !(job.second_route && job.curves) {
+        return Ok(());
     }
-    Ok(summary)
+    let clock = std::time::Instant::now();
+    let (second_config, route) = second_route_config(&job.config);
+    let second_map = map_gaits(&second_config, &job.spec, initial, &job.options, progress)?;
+    check_interrupted(
+        second_map.rows.iter().map(Vec::len).sum(),
+        summary.points,
+        "map.csv (first route; the second route is dropped)",
+    )?;
+    let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
+    for t in &mut summary.thresholds {
+        let same_line = second
+            .thresholds
+            .iter()
+            .filter(|o| o.along == t.along && o.line == t.line)
+            .map(|o| &o.threshold);
+        t.threshold.second_route = Some(SecondRoute::check(&t.threshold, same_line, &route));
+    }
+    summary.second_route_seconds = clock.elapsed().as_secs_f64();
+    Ok(())
 }
 
 fn write_figure(job: &MapJob, map: &GaitMap, curves: &[ThresholdCurve]) -> Result<(), AppError> {

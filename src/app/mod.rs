@@ -34,7 +34,7 @@ pub use figures::{
 pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
 };
-pub use map::{run_map, MapJob, MapSummary};
+pub use map::{compute_map, run_map, MapJob, MapSummary};
 pub use orbit::{run_orbit, OrbitJob, OrbitSummary};
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,

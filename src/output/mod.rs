@@ -30,6 +30,7 @@ pub(crate) use tables::attractors::{write_basin_csv, write_branch_csv, write_orb
 pub use tables::family::{curve_header, curve_row, family_header, family_row, CurveRow, FamilyRow};
 pub(crate) use tables::family::{write_curves_csv, write_family_csv};
 pub(crate) use tables::map::write_map_csv;
+pub use tables::map::{map_header, map_rows};
 pub use tables::steps::{step_row, write_steps_csv, StepsCsv, STEPS_HEADER};
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
 pub use tables::trajectory::{

@@ -87,16 +87,25 @@ pub(crate) fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
 /// row), `period_k`, the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
 /// verdict; empty gait fields where no gait was found.
 pub(crate) fn write_map_csv(path: &Path, map: &GaitMap) -> Result<(), OutputError> {
-    let columns = map_columns();
-    let params = [map.spec.x.param.as_str(), map.spec.y.param.as_str()];
-    let points = map
-        .rows
-        .iter()
-        .zip(&map.ys)
-        .flat_map(|(points, &y)| points.iter().map(move |point| MapPoint { y, point }));
     write_table(
         path,
-        &header(&columns, &params),
-        points.map(|m| row(&columns, &m)),
+        &map_header(&map.spec.x.param, &map.spec.y.param),
+        map_rows(map),
     )
+}
+
+/// The header of `map.csv` for a map over `x` and `y`.
+pub fn map_header<'a>(x: &'a str, y: &'a str) -> Vec<&'a str> {
+    header(&map_columns(), &[x, y])
+}
+
+/// The rows of `map.csv`: every point of the map, row by row (`y`), each row along `x`.
+pub fn map_rows(map: &GaitMap) -> Vec<Vec<Cell>> {
+    let columns = map_columns();
+    map.rows
+        .iter()
+        .zip(&map.ys)
+        .flat_map(|(points, &y)| points.iter().map(move |point| MapPoint { y, point }))
+        .map(|m| row(&columns, &m))
+        .collect()
 }
