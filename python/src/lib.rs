@@ -18,19 +18,20 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
 use vrw::app::{
-    compute_basin, compute_continuation, compute_gait, compute_map, compute_simulation,
-    compute_sweep, curve_rows, family_rows, AppError, BasinJob, ContinueJob, GaitJob, MapJob,
-    SimulateJob,
+    compute_basin, compute_continuation, compute_gait, compute_map, compute_orbit,
+    compute_simulation, compute_sweep, curve_rows, family_rows, AppError, BasinJob, ContinueJob,
+    GaitJob, MapJob, OrbitJob, SimulateJob,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
 use vrw::gait::basin::Coordinate;
+use vrw::gait::orbit::OrbitSpec;
 use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
 use vrw::output::{
-    basin_header, basin_row, curve_header, curve_row, family_header, family_row, map_header,
-    map_rows, step_row, sweep_header, sweep_row, trajectory_row, Cell, STEPS_HEADER,
-    TRAJECTORY_HEADER,
+    basin_header, basin_row, branch_header, branch_rows, curve_header, curve_row, family_header,
+    family_row, map_header, map_rows, orbit_header, orbit_rows, step_row, sweep_header, sweep_row,
+    trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -358,7 +359,7 @@ fn real(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
     })
 }
 
-/// `simulate`'s `steps`, named in its errors.
+/// `simulate`'s and `orbit`'s `steps`, named in their errors.
 fn steps_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("steps", value)
 }
@@ -616,6 +617,72 @@ fn gait_map<'py>(
     Ok(result)
 }
 
+/// The orbit diagram along one parameter: the states the walk visits after a transient at each value, and the
+/// period-1 branch beside it (`vrw orbit`, without the figure).
+///
+/// Returns the fields of `orbit.json` (`spec`, `outcomes`, `branch_gaits`, ...), `orbit`, the columns of
+/// `orbit.csv` (one row per recorded step of every value), and with `branch` (default) `branch`, the columns of
+/// `branch.csv`. Keyword arguments as the command line's options: `range` (`(from, to)`, default the command
+/// line's `(1, 150)`), `points` (300), `transient` (32), `steps` (64), `initial`, `branch`.
+#[pyfunction]
+#[pyo3(signature = (params, param = "viscosity", *, range = None, points = 300, transient = 32, steps = 64, initial = None, branch = true))]
+#[allow(clippy::too_many_arguments)]
+fn orbit<'py>(
+    py: Python<'py>,
+    params: &Params,
+    param: &str,
+    range: Option<(f64, f64)>,
+    #[pyo3(from_py_with = points_arg)] points: usize,
+    #[pyo3(from_py_with = transient_arg)] transient: usize,
+    #[pyo3(from_py_with = steps_arg)] steps: usize,
+    initial: Option<[f64; 3]>,
+    branch: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (from, to) = range.unwrap_or((1.0, 150.0));
+    let job = OrbitJob {
+        config: params.config.clone(),
+        spec: OrbitSpec {
+            range: SweepSpec {
+                param: param.to_string(),
+                from,
+                to,
+                points,
+            },
+            transient,
+            steps,
+        },
+        initial: section(initial),
+        branch,
+        out_dir: PathBuf::new(),
+    };
+    let (summary, columns, gaits) = interruptible(py, vrw::gait::interrupt_flag(), || {
+        compute_orbit(&job, &|_| {})
+    })?
+    .map_err(app_error)?;
+    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
+    result.set_item(
+        "orbit",
+        table(py, &orbit_header(param), &orbit_rows(&columns))?,
+    )?;
+    if branch {
+        result.set_item(
+            "branch",
+            table(py, &branch_header(param), &branch_rows(&gaits))?,
+        )?;
+    }
+    Ok(result)
+}
+
+/// `orbit`'s `points`, named in its errors.
+fn points_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("points", value)
+}
+
+/// `orbit`'s `transient`, named in its errors.
+fn transient_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    count("transient", value)
+}
+
 /// `map`'s `curve_columns`, named in its errors.
 fn curve_columns_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
     count("curve_columns", value)
@@ -784,6 +851,7 @@ fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(basin, m)?)?;
     m.add_function(wrap_pyfunction!(continue_family, m)?)?;
     m.add_function(wrap_pyfunction!(gait_map, m)?)?;
+    m.add_function(wrap_pyfunction!(orbit, m)?)?;
     m.add_function(wrap_pyfunction!(linspace, m)?)?;
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("WalkError", py.get_type::<WalkError>())?;

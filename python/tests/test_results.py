@@ -155,3 +155,23 @@ def test_map_equals_map_csv_and_curves_json(cli, tmp_path):
         vrw.map(vrw.Params(), nx=3, ny=3, curve_method="squares")
     with pytest.raises(vrw.ConfigError, match="second_route"):
         vrw.map(vrw.Params(), nx=3, ny=3, curves=False, second_route=True)
+
+
+def test_orbit_equals_orbit_csv_and_branch_csv(cli, tmp_path):
+    args = ["--from", "40", "--to", "60", "--points", "5", "--transient", "4", "--steps", "8"]
+    cli("orbit", *args, "--out", tmp_path)
+    result = vrw.orbit(vrw.Params(), range=(40, 60), points=5, transient=4, steps=8)
+    for name in ["orbit", "branch"]:
+        csv = pd.read_csv(tmp_path / f"{name}.csv")
+        frame = result[name].to_pandas()
+        assert list(frame.columns) == list(csv.columns) and frame.shape == csv.shape, name
+        for column in csv.columns:
+            if csv[column].dtype.kind == "f":
+                assert np.array_equal(frame[column], csv[column], equal_nan=True), (name, column)
+    expected = __import__("json").loads((tmp_path / "orbit.json").read_text())
+    assert dict(result.outcomes) == expected["outcomes"]
+    assert list(result.branch_gaits) == expected["branch_gaits"]
+    assert repr(result).startswith("OrbitResult(viscosity: 5 values, outcomes")
+    assert "branch" not in vrw.orbit(vrw.Params(), range=(40, 60), points=2, steps=2, branch=False)
+    with pytest.raises(vrw.ConfigError, match="steps"):
+        vrw.orbit(vrw.Params(), steps=-1)

@@ -30,6 +30,7 @@ from .results import (
     FamilyResult,
     GaitResult,
     MapResult,
+    OrbitResult,
     Grid,
     Result,
     Run,
@@ -102,12 +103,22 @@ def map(params: Params, **options: Any) -> MapResult:
     return result
 
 
+def orbit(params: Params, param: str = "viscosity", **options: Any) -> OrbitResult:
+    """The orbit diagram along ``param`` and the period-1 branch beside it (``vrw orbit``, without the figure):
+    an ``OrbitResult``, the fields of ``orbit.json`` with ``orbit`` and ``branch`` (the columns of ``orbit.csv``
+    and ``branch.csv``) as ``Table``s. See ``vrw._vrw.orbit`` for the options."""
+    result = OrbitResult(_vrw.orbit(params, param, **options))
+    wrap_tables(result, ["orbit", "branch"])
+    return result
+
+
 __all__ = [
     "BasinResult",
     "FamilyResult",
     "ConfigError",
     "GaitResult",
     "MapResult",
+    "OrbitResult",
     "Grid",
     "Params",
     "Result",
@@ -121,6 +132,7 @@ __all__ = [
     "find_gait",
     "linspace",
     "map",
+    "orbit",
     "simulate",
     "sweep",
 ]

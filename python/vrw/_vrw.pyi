@@ -17,6 +17,7 @@ __all__ = [
     "continue_family",
     "find_gait",
     "map",
+    "orbit",
     "linspace",
     "simulate",
     "sweep",
@@ -158,6 +159,21 @@ def map(
     fields of ``curves.json`` and ``map``, the columns of ``map.csv``. ``x_range`` and ``y_range`` default to
     the command line's ``(1, 300)`` and ``(300, 1500)``; ``curve_method`` is ``"continuation"`` or
     ``"crossings"``."""
+
+def orbit(
+    params: Params,
+    param: str = "viscosity",
+    *,
+    range: Optional[Tuple[float, float]] = None,
+    points: int = 300,
+    transient: int = 32,
+    steps: int = 64,
+    initial: Optional[Section] = None,
+    branch: bool = True,
+) -> Dict[str, Any]:
+    """The orbit diagram along ``param`` (``vrw orbit``, without the figure): the fields of ``orbit.json``,
+    ``orbit`` (the columns of ``orbit.csv``) and, with ``branch``, ``branch`` (the columns of ``branch.csv``).
+    ``range`` defaults to the command line's ``(1, 150)``."""
 
 def basin(
     params: Params,

@@ -198,6 +198,21 @@ class MapResult(_WithTable):
         )
 
 
+class OrbitResult(_WithTable):
+    """``vrw.orbit``: the fields of ``orbit.json`` (``spec``, ``outcomes``, ``branch_gaits``, ...), with ``orbit``
+    (the columns of ``orbit.csv``: one row per recorded step of every value) and ``branch`` (the columns of
+    ``branch.csv``) as ``Table``s."""
+
+    _table = "orbit"
+
+    def __repr__(self) -> str:
+        spec = self.get("spec", {}).get("range", {})
+        return (
+            f"OrbitResult({spec.get('param')}: {spec.get('points')} values, outcomes "
+            f"{dict(self.get('outcomes', {}))})"
+        )
+
+
 class FamilyResult(_WithTable):
     """``vrw.continue_family``: the fields of ``special_points.json`` (``families``, ``special_points``, ...),
     with ``branch`` (the columns of ``branch.csv``: one row per point of every family) a ``Table``."""

@@ -35,7 +35,7 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
 };
 pub use map::{compute_map, run_map, MapJob, MapSummary};
-pub use orbit::{run_orbit, OrbitJob, OrbitSummary};
+pub use orbit::{compute_orbit, run_orbit, OrbitJob, OrbitSummary};
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,

@@ -66,6 +66,83 @@ pub fn run_orbit(
     })
 }
 
+/// The period-1 branch beside the diagram: each value and its period-1 gait, if there is one.
+pub type Branch = Vec<(f64, Option<Gait>)>;
+
+/// The work of [`run_orbit`] without writing anything: the summary (`orbit.json`'s fields, no files), the
+/// diagram's columns (`orbit.csv`'s rows) and the period-1 branch (`branch.csv`'s; empty without
+/// `job.branch`). The Python front's `vrw.orbit`.
+pub fn compute_orbit(
+    job: &OrbitJob,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<(OrbitSummary, Vec<OrbitColumn>, Branch), AppError> {
+    let (_, initial) = prepared(&job.config, job.initial)?;
+    job.spec.validate(&job.config)?;
+    let clock = std::time::Instant::now();
+    let columns = orbit_diagram(&job.config, &job.spec, &initial, progress)?;
+    let orbit_seconds = clock.elapsed().as_secs_f64();
+    let total = job.spec.range.points;
+    check_interrupted(columns.len(), total, "the orbit diagram")?;
+    let clock = std::time::Instant::now();
+    let branch = period_one_branch(job, &initial)?;
+    if job.branch {
+        check_interrupted(branch.len(), total, "the branch")?;
+    }
+    let seconds = [orbit_seconds, clock.elapsed().as_secs_f64()];
+    let summary = orbit_summary(job, &columns, &branch, Vec::new(), seconds);
+    Ok((summary, columns, branch))
+}
+
+/// The period-1 branch over the diagram's values (a sweep with continuation), with `job.branch`; else empty.
+fn period_one_branch(job: &OrbitJob, initial: &SectionState) -> Result<Branch, AppError> {
+    if !job.branch {
+        return Ok(Vec::new());
+    }
+    Ok(sweep(
+        &job.config,
+        &job.spec.range,
+        initial,
+        &GaitOptions::default(),
+        &|_| {},
+    )?
+    .into_iter()
+    .map(|p| (p.value, p.gait.filter(|g| g.period_k == 1)))
+    .collect())
+}
+
+/// `orbit.json`'s fields: how each value's walk ended, and the branch's gaits.
+fn orbit_summary(
+    job: &OrbitJob,
+    columns: &[OrbitColumn],
+    branch: &[(f64, Option<Gait>)],
+    files: Vec<String>,
+    seconds: [f64; 2],
+) -> OrbitSummary {
+    let mut outcomes = BTreeMap::new();
+    for c in columns {
+        let key = match (c.status.as_str(), c.period_k) {
+            ("walking", Some(k)) => format!("period_{k}"),
+            ("walking", None) => "not_settled".to_string(),
+            (kind, _) => kind.to_string(),
+        };
+        *outcomes.entry(key).or_insert(0) += 1;
+    }
+    let gaits = branch.iter().filter_map(|(_, g)| g.as_ref());
+    let branch_gaits = [
+        gaits.clone().count(),
+        gaits.filter(|g| g.stability == Stability::Stable).count(),
+    ];
+    OrbitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: job.config.clone(),
+        spec: job.spec.clone(),
+        outcomes,
+        branch_gaits,
+        files,
+        seconds,
+    }
+}
+
 /// The work of [`run_orbit`] in its run directory.
 fn orbit_into(
     job: &OrbitJob,
@@ -83,20 +160,7 @@ fn orbit_into(
     let total = job.spec.range.points;
     check_interrupted(columns.len(), total, "orbit.csv")?;
     let clock = std::time::Instant::now();
-    let branch: Vec<(f64, Option<Gait>)> = if job.branch {
-        sweep(
-            &job.config,
-            &job.spec.range,
-            initial,
-            &GaitOptions::default(),
-            &|_| {},
-        )?
-        .into_iter()
-        .map(|p| (p.value, p.gait.filter(|g| g.period_k == 1)))
-        .collect()
-    } else {
-        Vec::new()
-    };
+    let branch = period_one_branch(job, initial)?;
     let branch_seconds = clock.elapsed().as_secs_f64();
     if job.branch {
         write_branch_csv(&run.path("branch.csv"), param, &branch)?;
@@ -104,20 +168,6 @@ fn orbit_into(
         run.add("branch.csv");
         check_interrupted(branch.len(), total, "branch.csv (and orbit.csv, complete)")?;
     }
-    let mut outcomes = BTreeMap::new();
-    for c in &columns {
-        let key = match (c.status.as_str(), c.period_k) {
-            ("walking", Some(k)) => format!("period_{k}"),
-            ("walking", None) => "not_settled".to_string(),
-            (kind, _) => kind.to_string(),
-        };
-        *outcomes.entry(key).or_insert(0) += 1;
-    }
-    let gaits = branch.iter().filter_map(|(_, g)| g.as_ref());
-    let branch_gaits = [
-        gaits.clone().count(),
-        gaits.filter(|g| g.stability == Stability::Stable).count(),
-    ];
     let figure = orbit_figure(job, &columns, &branch);
     match write_orbit_figure(&figure, &run.path("orbit.png")) {
         Ok(()) => {
@@ -128,15 +178,13 @@ fn orbit_into(
         Err(e) => return Err(e.into()),
     }
     files.push("orbit.json".to_string());
-    let summary = OrbitSummary {
-        vrw_version: env!("CARGO_PKG_VERSION"),
-        config: job.config.clone(),
-        spec: job.spec.clone(),
-        outcomes,
-        branch_gaits,
+    let summary = orbit_summary(
+        job,
+        &columns,
+        &branch,
         files,
-        seconds: [orbit_seconds, branch_seconds],
-    };
+        [orbit_seconds, branch_seconds],
+    );
     output::write_json(&run.path("orbit.json"), &summary)?;
     run.add("orbit.json");
     Ok(summary)

@@ -25,7 +25,9 @@ pub mod steps_plot;
 pub mod style;
 pub(crate) mod tables;
 
-pub use tables::attractors::{basin_header, basin_row};
+pub use tables::attractors::{
+    basin_header, basin_row, branch_header, branch_rows, orbit_header, orbit_rows,
+};
 pub(crate) use tables::attractors::{write_basin_csv, write_branch_csv, write_orbit_csv};
 pub use tables::family::{curve_header, curve_row, family_header, family_row, CurveRow, FamilyRow};
 pub(crate) use tables::family::{write_curves_csv, write_family_csv};

@@ -91,18 +91,27 @@ pub(crate) fn write_orbit_csv(
     param: &str,
     columns: &[OrbitColumn],
 ) -> Result<(), OutputError> {
+    write_table(path, &orbit_header(param), orbit_rows(columns))
+}
+
+/// The header of `orbit.csv` along `param`.
+pub fn orbit_header(param: &str) -> Vec<&str> {
+    header(&orbit_columns(), &[param])
+}
+
+/// The rows of `orbit.csv`: every recorded step of every value (one empty row for a value with none).
+pub fn orbit_rows(columns: &[OrbitColumn]) -> Vec<Vec<Cell>> {
     let table = orbit_columns();
-    let rows = columns.iter().flat_map(|column| {
-        let steps = column.returns.iter().enumerate();
-        let steps: Vec<_> = steps.map(|(n, s)| Some((n + 1, s))).collect();
-        let steps = if steps.is_empty() { vec![None] } else { steps };
-        steps.into_iter().map(move |step| OrbitRow { column, step })
-    });
-    write_table(
-        path,
-        &header(&table, &[param]),
-        rows.map(|r| row(&table, &r)),
-    )
+    columns
+        .iter()
+        .flat_map(|column| {
+            let steps = column.returns.iter().enumerate();
+            let steps: Vec<_> = steps.map(|(n, s)| Some((n + 1, s))).collect();
+            let steps = if steps.is_empty() { vec![None] } else { steps };
+            steps.into_iter().map(move |step| OrbitRow { column, step })
+        })
+        .map(|r| row(&table, &r))
+        .collect()
 }
 
 /// A cell of the branch's gait, [`Cell::Empty`] where there is none.
@@ -158,11 +167,17 @@ pub(crate) fn write_branch_csv(
     param: &str,
     branch: &[(f64, Option<Gait>)],
 ) -> Result<(), OutputError> {
-    write_table(
-        path,
-        &header(&BRANCH, &[param]),
-        branch.iter().map(|b| row(&BRANCH, b)),
-    )
+    write_table(path, &branch_header(param), branch_rows(branch))
+}
+
+/// The header of the orbit diagram's `branch.csv` along `param`.
+pub fn branch_header(param: &str) -> Vec<&str> {
+    header(&BRANCH, &[param])
+}
+
+/// The rows of the orbit diagram's `branch.csv`.
+pub fn branch_rows(branch: &[(f64, Option<Gait>)]) -> Vec<Vec<Cell>> {
+    branch.iter().map(|b| row(&BRANCH, b)).collect()
 }
 
 /// A coordinate of the section state where the walk ended, [`Cell::Empty`] if none was reached.
