@@ -4,11 +4,13 @@
 use serde::Serialize;
 
 use super::AppError;
-use crate::bifurcation::curve::{border_curve_seed, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR};
+use crate::bifurcation::curve::{
+    border_curve_seed, CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
+};
 use crate::bifurcation::special::{test_function, test_name};
 use crate::bifurcation::{
-    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, FamilyMap, GaitFamily,
-    GaitInfo, SpecialKind,
+    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, GaitFamily, GaitInfo,
+    SpecialKind,
 };
 use crate::params::Config;
 
@@ -91,7 +93,7 @@ pub(super) fn two_param_curves(
             // What is followed, from where: an indicator border on the family's side of it, from the family's
             // point nearest the collision clearly on that side; a fold, period doubling or Neimark-Sacker point
             // by its test function of `DP`, from the located point.
-            let (test_of, offset, start, border): (TestOf, f64, _, String) = match sp.kind {
+            let (jacobian_test, offset, start, border) = match sp.kind {
                 SpecialKind::BorderCollision => {
                     let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
                         continue;
@@ -106,7 +108,7 @@ pub(super) fn two_param_curves(
                         continue;
                     };
                     (
-                        TestOf::Border(border.clone()),
+                        None,
                         BORDER_OFFSET.copysign(side),
                         (before.x.clone(), before.param),
                         border,
@@ -117,7 +119,7 @@ pub(super) fn two_param_curves(
                         continue;
                     };
                     (
-                        TestOf::Jacobian(test),
+                        Some(test),
                         0.0,
                         (sp.x.clone(), sp.param),
                         test_name(kind).to_string(),
@@ -127,14 +129,11 @@ pub(super) fn two_param_curves(
             let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.eval_with(name, x, p, q);
             let observe =
                 |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
-            let test = |ev: &crate::bifurcation::Evaluation<GaitInfo>| match &test_of {
-                TestOf::Border(b) => family_map.border(&ev.info, b),
-                TestOf::Jacobian(t) => t(&ev.jacobian),
-            };
+            let condition = jacobian_test.map_or(CurveTest::Border(&border), CurveTest::Jacobian);
+            let test = |ev: &crate::bifurcation::Evaluation<GaitInfo>| condition.of(family_map, ev);
             let problem = CurveProblem {
                 eval: &eval,
-                // A test function of DP needs every evaluation's derivatives.
-                observe: matches!(test_of, TestOf::Border(_)).then_some(&observe),
+                observe: (!condition.needs_derivatives()).then_some(&observe),
                 test: &test,
                 offset,
             };
@@ -166,10 +165,4 @@ pub(super) fn two_param_curves(
         }
     }
     Ok((records, curves))
-}
-
-/// The defining condition of a two-parameter curve: a border function by name, or a test function of `DP`.
-enum TestOf {
-    Border(String),
-    Jacobian(fn(&nalgebra::DMatrix<f64>) -> f64),
 }

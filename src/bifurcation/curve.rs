@@ -132,6 +132,32 @@ pub struct CurveProblem<'f, I> {
     pub offset: f64,
 }
 
+/// What a curve of special points solves for together with the fixed point: a border function by name
+/// (followed at a small offset on one side, [`BORDER_OFFSET`]) or a test function of `DP` (a fold's, period
+/// doubling's or Neimark-Sacker point's, followed at zero).
+#[derive(Debug, Clone, Copy)]
+pub enum CurveTest<'a> {
+    /// A border function of [`FamilyMap::borders`].
+    Border(&'a str),
+    /// A test function of `DP` ([`super::special::test_function`]).
+    Jacobian(fn(&DMatrix<f64>) -> f64),
+}
+
+impl CurveTest<'_> {
+    /// Its value at an evaluation of `map`.
+    pub fn of<M: FamilyMap>(&self, map: &M, ev: &Evaluation<M::Info>) -> f64 {
+        match self {
+            CurveTest::Border(name) => map.border(&ev.info, name),
+            CurveTest::Jacobian(test) => test(&ev.jacobian),
+        }
+    }
+
+    /// A test function of `DP` needs every evaluation's derivatives (no [`CurveProblem::observe`]).
+    pub fn needs_derivatives(&self) -> bool {
+        matches!(self, CurveTest::Jacobian(_))
+    }
+}
+
 /// The offset of a border curve from its border, on the side of `g`'s sign (see [`CurveProblem`]).
 pub const BORDER_OFFSET: f64 = 1e-8;
 

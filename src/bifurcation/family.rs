@@ -9,7 +9,9 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Evaluation, FamilyMap, MapFailure};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
-use crate::gait::{DerivativeError, StepMap, DERIVATIVE_CHECK_TIGHTENING, MAX_PERIOD};
+use crate::gait::{
+    DerivativeError, SignedOutcome, StepMap, DERIVATIVE_CHECK_TIGHTENING, MAX_PERIOD,
+};
 use crate::params::{Config, ImpactModel};
 use crate::walk::{Branch, SectionState, StepReport};
 
@@ -37,6 +39,15 @@ pub struct GaitInfo {
 }
 
 impl GaitInfo {
+    /// The record of a walk of the step map.
+    fn of(signed: SignedOutcome) -> GaitInfo {
+        GaitInfo {
+            report: signed.outcome.report,
+            cycle: signed.cycle,
+            signature: signed.signature,
+        }
+    }
+
     /// The least period of the gait: the least `j` dividing the family's period `k` with the section state
     /// before the `j+1`-th touchdown within [`LEAST_PERIOD_TOL`] of the first (a family of `P^k` passes
     /// through gaits of any period dividing `k`).
@@ -114,29 +125,12 @@ impl<'a> GaitFamily<'a> {
         p: f64,
         q: f64,
     ) -> Result<Evaluation<GaitInfo>, MapFailure> {
-        let config = self.config.with(second, q).map_err(|e| MapFailure {
-            kind: "invalid_parameter".to_string(),
-            message: e.to_string(),
-        })?;
-        GaitFamily {
-            config: &config,
-            ..*self
-        }
-        .eval(x, p)
+        self.with_second(second, q, |family| family.eval(x, p))
     }
 
     /// `P(x; p)`'s record of its walk (without derivatives): the steps' reports and event sequence.
     pub fn value_with_info(&self, x: &DVector<f64>, p: f64) -> Result<GaitInfo, MapFailure> {
-        let (c, model) = self.configured(p)?;
-        let signed = self
-            .step_map(&model, &c)
-            .eval_signature(&self.expand(x))
-            .map_err(walk_failure)?;
-        Ok(GaitInfo {
-            report: signed.outcome.report,
-            cycle: signed.cycle,
-            signature: signed.signature,
-        })
+        self.walked(x, p).map(|(_, info)| info)
     }
 
     /// `P(x; p, q)` and what the map records, without derivatives (`jacobian` and `dparam` empty, `exact`
@@ -148,30 +142,41 @@ impl<'a> GaitFamily<'a> {
         p: f64,
         q: f64,
     ) -> Result<Evaluation<GaitInfo>, MapFailure> {
+        let (value, info) = self.with_second(second, q, |family| family.walked(x, p))?;
+        Ok(Evaluation {
+            value,
+            jacobian: DMatrix::zeros(0, 0),
+            dparam: DVector::zeros(0),
+            exact: false,
+            info,
+        })
+    }
+
+    /// `f` of this family in the configuration with the key `second` at `q`.
+    fn with_second<R>(
+        &self,
+        second: &str,
+        q: f64,
+        f: impl FnOnce(&GaitFamily) -> Result<R, MapFailure>,
+    ) -> Result<R, MapFailure> {
         let config = self.config.with(second, q).map_err(|e| MapFailure {
             kind: "invalid_parameter".to_string(),
             message: e.to_string(),
         })?;
-        let family = GaitFamily {
+        f(&GaitFamily {
             config: &config,
             ..*self
-        };
-        let (c, model) = family.configured(p)?;
-        let signed = family
-            .step_map(&model, &c)
-            .eval_signature(&family.expand(x))
-            .map_err(walk_failure)?;
-        Ok(Evaluation {
-            value: family.reduce(&signed.outcome.next),
-            jacobian: DMatrix::zeros(0, 0),
-            dparam: DVector::zeros(0),
-            exact: false,
-            info: GaitInfo {
-                report: signed.outcome.report,
-                cycle: signed.cycle,
-                signature: signed.signature,
-            },
         })
+    }
+
+    /// `P(x; p)` and its walk's record, without derivatives.
+    fn walked(&self, x: &DVector<f64>, p: f64) -> Result<(DVector<f64>, GaitInfo), MapFailure> {
+        let (c, model) = self.configured(p)?;
+        let signed = self
+            .step_map(&model, &c)
+            .eval_signature(&self.expand(x))
+            .map_err(walk_failure)?;
+        Ok((self.reduce(&signed.outcome.next), GaitInfo::of(signed)))
     }
 
     /// The configuration with the parameter at `p`, and its model.
@@ -313,11 +318,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
                     jacobian,
                     dparam,
                     exact: false,
-                    info: GaitInfo {
-                        report: signed.outcome.report,
-                        cycle: signed.cycle,
-                        signature: signed.signature,
-                    },
+                    info: GaitInfo::of(signed),
                 })
             }
         }

@@ -11,12 +11,11 @@ use rayon::prelude::*;
 
 use super::curve::{
     border_curve_seed, continue_curve, curve_at, Curve, CurveEnd, CurveOptions, CurveProblem,
-    BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
+    CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
 use super::special::{test_function, test_name};
 use super::{
-    continue_family, ContinuationOptions, Evaluation, FamilyMap, GaitFamily, GaitInfo, MapFailure,
-    SpecialKind,
+    continue_family, ContinuationOptions, Evaluation, GaitFamily, GaitInfo, MapFailure, SpecialKind,
 };
 use crate::gait::map::NearMiss;
 use crate::gait::map::{Along, LineThreshold, RefinedOn};
@@ -221,7 +220,7 @@ fn follow_from_crossing(
     let observe =
         |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.observe_with(y_param, x, p, q);
     let nearest = |a: f64, b: f64| (a - t.value).abs().total_cmp(&(b - t.value).abs());
-    let (start, v_start, offset, test, name): (_, _, _, TestOf, String) = match condition {
+    let (start, v_start, offset, condition, name): (_, _, _, CurveTest, String) = match condition {
         Condition::Border(border) => {
             let collision = row_family
                 .special
@@ -250,7 +249,7 @@ fn follow_from_crossing(
                 seed_point.x.clone(),
                 seed_point.param,
                 BORDER_OFFSET.copysign(side),
-                TestOf::Border(border),
+                CurveTest::Border(border),
                 border.to_string(),
             )
         }
@@ -268,19 +267,15 @@ fn follow_from_crossing(
                 sp.x.clone(),
                 sp.param,
                 0.0,
-                TestOf::Jacobian(test),
+                CurveTest::Jacobian(test),
                 test_name(sp.kind).to_string(),
             )
         }
     };
-    let test = |ev: &Evaluation<GaitInfo>| match test {
-        TestOf::Border(b) => family.border(&ev.info, b),
-        TestOf::Jacobian(f) => f(&ev.jacobian),
-    };
+    let test = |ev: &Evaluation<GaitInfo>| condition.of(&family, ev);
     let problem = CurveProblem {
         eval: &eval,
-        // A test function of DP needs every evaluation's derivatives.
-        observe: (offset != 0.0).then_some(&observe),
+        observe: (!condition.needs_derivatives()).then_some(&observe),
         test: &test,
         offset,
     };
@@ -389,13 +384,6 @@ fn follow_from_crossing(
         hits.into_iter().map(|h| h.0).collect(),
         misses.into_iter().map(|m| m.0).collect(),
     ))
-}
-
-/// A continued curve's condition as evaluated: a border function by name, or a test function of `DP`.
-#[derive(Clone, Copy)]
-enum TestOf {
-    Border(&'static str),
-    Jacobian(fn(&nalgebra::DMatrix<f64>) -> f64),
 }
 
 /// Where the curve's polyline crosses the line where parameter `which` (0: `x`, 1: `y`) equals `value`: the
