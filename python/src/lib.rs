@@ -7,7 +7,7 @@
 //! impls, through `pythonize`). Each library error becomes one Python exception with the same message.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use numpy::{Complex64, IntoPyArray, PyArray2};
@@ -17,10 +17,15 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
 use pythonize::pythonize;
 
+mod animate;
+mod parts;
+mod progress;
+
+use progress::{interruptible_with, Progress};
 use vrw::app::{
-    compute_basin, compute_continuation, compute_gait, compute_map, compute_orbit,
-    compute_simulation, compute_sweep, curve_rows, family_rows, AppError, BasinJob, ContinueJob,
-    GaitJob, MapJob, OrbitJob, SimulateJob,
+    compute_basin_part, compute_continuation, compute_gait, compute_map, compute_map_part,
+    compute_orbit, compute_orbit_part, compute_simulation, compute_sweep, curve_rows, family_rows,
+    AppError, BasinJob, ContinueJob, GaitJob, MapJob, OrbitJob, OrbitJobPart, SimulateJob,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -65,7 +70,7 @@ fn app_error(e: AppError) -> PyErr {
         AppError::Config(e) => config_error(e),
         AppError::Walk(e) => walk_error(e),
         AppError::Output(e) => PyOSError::new_err(e.to_string()),
-        e @ AppError::InvalidOption { .. } => PyValueError::new_err(e.to_string()),
+        e @ AppError::InvalidOption { .. } => ConfigError::new_err(e.to_string()),
         // Reading run directories and drawing figures are command-line jobs, not reached from Python.
         e @ (AppError::Read(_)
         | AppError::Animate(_)
@@ -451,28 +456,31 @@ fn find_gait<'py>(
 /// figure).
 ///
 /// Returns `param`, `sweep` (the columns of `sweep.csv` as numpy arrays), `thresholds` (the entries of
-/// `thresholds.json`), `gaits_found` and `seconds`. Keyword options as for `find_gait`, defaulting to the
+/// `thresholds.json`), `gaits_found` and `seconds`. `progress`: a callable `progress(done, total)`, called on
+/// this thread as points finish. Keyword options as for `find_gait`, defaulting to the
 /// command line's sweep settings. `vrw.linspace` gives the command line's values.
 #[pyfunction]
-#[pyo3(signature = (params, param, values, *, initial = None, **options))]
+#[pyo3(signature = (params, param, values, *, initial = None, progress = None, **options))]
 fn sweep<'py>(
     py: Python<'py>,
     params: &Params,
     param: &str,
     values: Vec<f64>,
     initial: Option<[f64; 3]>,
+    progress: Option<Py<PyAny>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = gait_options(GaitOptions::for_sweeps(), options)?;
     let config = &params.config;
-    let result = interruptible(py, vrw::gait::interrupt_flag(), || {
+    let progress = Progress::new(progress, values.len());
+    let result = interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
         compute_sweep(
             config,
             param,
             &values,
             section(initial),
             &options,
-            &|_| {},
+            &|_| progress.tick(),
             &mut |_| Ok(()),
         )
     })?
@@ -495,9 +503,12 @@ fn sweep<'py>(
 /// Returns the fields of `basin.json` (`spec`, `gait`, `outcomes`, ...) and `points`, the columns of
 /// `basin.csv` as numpy arrays (one row per grid point, row by row). Keyword arguments as the command line's
 /// options: `x`, `y` (`"L2"`, `"thetadot"`, `"L2dot"`), `x_range`, `y_range` (`(from, to)`, default the command
-/// line's), `nx`, `ny`, `max_steps`, `tolerance`, `initial` (where the gait search starts).
+/// line's), `nx`, `ny`, `max_steps`, `tolerance`, `initial` (where the gait search starts); and `rows`
+/// (`(start, end)`: only the grid rows `start..end`, each point as the whole basin has it, `outcomes` counting
+/// them: a part of a study spread over processes, see `vrw.grid`) and `progress` (a callable
+/// `progress(done, total)`, called on this thread as grid points finish).
 #[pyfunction]
-#[pyo3(signature = (params, *, x = "L2", y = "thetadot", x_range = None, y_range = None, nx = 61, ny = 61, max_steps = 100, tolerance = 1e-3, initial = None))]
+#[pyo3(signature = (params, *, x = "L2", y = "thetadot", x_range = None, y_range = None, nx = 61, ny = 61, max_steps = 100, tolerance = 1e-3, initial = None, rows = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn basin<'py>(
     py: Python<'py>,
@@ -511,6 +522,8 @@ fn basin<'py>(
     #[pyo3(from_py_with = max_steps_arg)] max_steps: usize,
     #[pyo3(from_py_with = tolerance_arg)] tolerance: f64,
     initial: Option<[f64; 3]>,
+    rows: Option<(usize, usize)>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let coordinate = |name: &str, value: &str| {
         value
@@ -527,10 +540,13 @@ fn basin<'py>(
         tolerance,
         out_dir: PathBuf::new(),
     };
-    let (summary, grid) = interruptible(py, vrw::gait::interrupt_flag(), || {
-        compute_basin(&job, &|_| {})
-    })?
-    .map_err(app_error)?;
+    let part = rows.map(|(start, end)| start..end);
+    let progress = Progress::new(progress, nx * part.as_ref().map_or(ny, |p| p.len()));
+    let (summary, grid) =
+        interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
+            compute_basin_part(&job, part, &|_| progress.tick())
+        })?
+        .map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
     let rows: Vec<Vec<Cell>> = grid.iter().flatten().map(basin_row).collect();
     result.set_item("points", table(py, &basin_header(), &rows)?)?;
@@ -545,9 +561,12 @@ fn basin<'py>(
 /// `x`). Keyword arguments as the command line's options: `x`, `y` (parameter names), `x_range`, `y_range`
 /// (`(from, to)`, default the command line's `(1, 300)` and `(300, 1500)`), `nx`, `ny`, `curves` (`False`: the
 /// command line's `--no-curves`), `curve_columns`, `curve_method` (`"continuation"` or `"crossings"`),
-/// `second_route`, `initial` (where every row's first search starts).
+/// `second_route`, `initial` (where every row's first search starts); and `rows` (`(start, end)`: only the
+/// gaits of the rows `start..end` of `y`, each point as the whole map has it, with `curves=False`: a part of a
+/// study spread over processes, see `vrw.grid`) and `progress` (a callable `progress(done, total)`, called on
+/// this thread as grid points finish; the curves, after the gaits, are not counted).
 #[pyfunction]
-#[pyo3(name = "map", signature = (params, *, x = "viscosity", y = "stiffness", x_range = None, y_range = None, nx = 21, ny = 21, curves = true, curve_columns = 25, curve_method = "continuation", second_route = false, initial = None))]
+#[pyo3(name = "map", signature = (params, *, x = "viscosity", y = "stiffness", x_range = None, y_range = None, nx = 21, ny = 21, curves = true, curve_columns = 25, curve_method = "continuation", second_route = false, initial = None, rows = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn gait_map<'py>(
     py: Python<'py>,
@@ -563,6 +582,8 @@ fn gait_map<'py>(
     curve_method: &str,
     second_route: bool,
     initial: Option<[f64; 3]>,
+    rows: Option<(usize, usize)>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let continue_curves = match curve_method {
         "continuation" => true,
@@ -608,10 +629,18 @@ fn gait_map<'py>(
         marks: Vec::new(),
         out_dir: PathBuf::new(),
     };
-    let (summary, map) = interruptible(py, vrw::gait::interrupt_flag(), || {
-        compute_map(&job, &|_| {})
-    })?
-    .map_err(app_error)?;
+    let part = rows.map(|(start, end)| start..end);
+    let points = nx * part.as_ref().map_or(ny, |p| p.len());
+    let progress = Progress::new(progress, points * if second_route { 2 } else { 1 });
+    let (summary, map) =
+        interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
+            let tick = |_: &_| progress.tick();
+            match part {
+                Some(part) => compute_map_part(&job, part, &tick),
+                None => compute_map(&job, &tick),
+            }
+        })?
+        .map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
     result.set_item("map", table(py, &map_header(x, y), &map_rows(&map))?)?;
     Ok(result)
@@ -623,9 +652,12 @@ fn gait_map<'py>(
 /// Returns the fields of `orbit.json` (`spec`, `outcomes`, `branch_gaits`, ...), `orbit`, the columns of
 /// `orbit.csv` (one row per recorded step of every value), and with `branch` (default) `branch`, the columns of
 /// `branch.csv`. Keyword arguments as the command line's options: `range` (`(from, to)`, default the command
-/// line's `(1, 150)`), `points` (300), `transient` (32), `steps` (64), `initial`, `branch`.
+/// line's `(1, 150)`), `points` (300), `transient` (32), `steps` (64), `initial`, `branch`; and `progress` (a
+/// callable `progress(done, total)`, called on this thread as the values' walks finish). `part` computes one
+/// part of the job apart (a study spread over processes, see `vrw.grid.orbit_grid`): `"coarse"`, `("fill",
+/// k, left)` or `"branch"`; the result then also has `ends` and `column_rows` (see `parts`).
 #[pyfunction]
-#[pyo3(signature = (params, param = "viscosity", *, range = None, points = 300, transient = 32, steps = 64, initial = None, branch = true))]
+#[pyo3(signature = (params, param = "viscosity", *, range = None, points = 300, transient = 32, steps = 64, initial = None, branch = true, progress = None, part = None))]
 #[allow(clippy::too_many_arguments)]
 fn orbit<'py>(
     py: Python<'py>,
@@ -637,6 +669,8 @@ fn orbit<'py>(
     #[pyo3(from_py_with = steps_arg)] steps: usize,
     initial: Option<[f64; 3]>,
     branch: bool,
+    progress: Option<Py<PyAny>>,
+    #[pyo3(from_py_with = parts::orbit_part_arg)] part: Option<OrbitJobPart>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (from, to) = range.unwrap_or((1.0, 150.0));
     let job = OrbitJob {
@@ -655,11 +689,20 @@ fn orbit<'py>(
         branch,
         out_dir: PathBuf::new(),
     };
-    let (summary, columns, gaits) = interruptible(py, vrw::gait::interrupt_flag(), || {
-        compute_orbit(&job, &|_| {})
-    })?
-    .map_err(app_error)?;
+    let progress = Progress::new(progress, points);
+    let (summary, columns, ends, gaits) =
+        interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
+            let tick = |_: &_| progress.tick();
+            match part {
+                Some(part) => compute_orbit_part(&job, part, &tick),
+                None => compute_orbit(&job, &tick).map(|(s, c, g)| (s, c, Vec::new(), g)),
+            }
+        })?
+        .map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
+    if part.is_some() {
+        parts::orbit_part_extras(&result, &columns, &ends)?;
+    }
     result.set_item(
         "orbit",
         table(py, &orbit_header(param), &orbit_rows(&columns))?,
@@ -769,44 +812,15 @@ fn tolerance_arg(value: &Bound<'_, PyAny>) -> PyResult<f64> {
     real("tolerance", value)
 }
 
-/// Run `work` with the GIL released on a thread of its own while this (the calling, main) thread checks
-/// Python's signals every [`SIGNAL_POLL`]: on Ctrl-C (`KeyboardInterrupt`, or any exception a signal handler
-/// raises) it sets `flag`, the interrupt flag `work` reads (the library's own for grids, where the grid runner
-/// stops between points; a job's for a walk or a gait search, whose walker stops inside a step), waits for
-/// `work` to return, discards its partial result and raises the signal's exception.
+/// Run `work` with the GIL released, Ctrl-C stopping it ([`progress::interruptible_with`] without a progress
+/// report).
 fn interruptible<T: Send>(
     py: Python<'_>,
     flag: &AtomicBool,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
-    flag.store(false, Ordering::SeqCst);
-    py.allow_threads(|| {
-        std::thread::scope(|scope| {
-            let handle = scope.spawn(work);
-            let mut raised = None;
-            while !handle.is_finished() {
-                std::thread::sleep(SIGNAL_POLL);
-                if raised.is_none() {
-                    if let Err(e) = Python::with_gil(|py| py.check_signals()) {
-                        flag.store(true, Ordering::SeqCst);
-                        raised = Some(e);
-                    }
-                }
-            }
-            let value = handle
-                .join()
-                .map_err(|_| PyRuntimeError::new_err("the computation panicked"));
-            flag.store(false, Ordering::SeqCst);
-            match raised {
-                Some(e) => Err(e),
-                None => value,
-            }
-        })
-    })
+    interruptible_with(py, flag, None, work)
 }
-
-/// How often a long computation checks Python's signals.
-const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
 /// The values `vrw sweep --from START --to STOP --points POINTS` visits (evenly spaced, ends included), checked
 /// as the command line checks them (2 to `MAX_SWEEP_POINTS` points) before any is made.
@@ -853,6 +867,7 @@ fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gait_map, m)?)?;
     m.add_function(wrap_pyfunction!(orbit, m)?)?;
     m.add_function(wrap_pyfunction!(linspace, m)?)?;
+    m.add_function(wrap_pyfunction!(animate::animate, m)?)?;
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("WalkError", py.get_type::<WalkError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -44,3 +44,46 @@ def test_ctrl_c_during_a_long_walk_or_gait_search_raises_within_a_second(job):
     assert time.monotonic() - start < delay + 1.0
     # The next call runs normally.
     assert vrw.find_gait(vrw.Params())["status"] == "found"
+
+
+@pytest.mark.parametrize(
+    "job, total",
+    [
+        (lambda progress: vrw.sweep(vrw.Params(), "viscosity", vrw.linspace(20, 80, 40), progress=progress), 40),
+        (lambda progress: vrw.map(vrw.Params(), nx=4, ny=3, curves=False, progress=progress), 12),
+        (lambda progress: vrw.orbit(vrw.Params(), range=(20, 60), points=6, transient=4, steps=4,
+                                    branch=False, progress=progress), 6),
+        (lambda progress: vrw.basin(vrw.Params(), nx=4, ny=5, max_steps=10, progress=progress), 20),
+    ],
+    ids=["sweep", "map", "orbit", "basin"],
+)
+def test_progress_is_reported_on_the_calling_thread_up_to_the_total(job, total):
+    calls = []
+    job(lambda done, of: calls.append((done, of, threading.get_ident())))
+    assert calls, "never reported"
+    assert all(of == total for _, of, _ in calls)
+    done = [d for d, _, _ in calls]
+    assert done == sorted(set(done)) and done[-1] == total
+    assert {t for _, _, t in calls} == {threading.get_ident()}
+
+
+def test_an_exception_in_the_progress_callback_stops_the_job():
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        raise Stop(f"{done} of {total}")
+
+    start = time.monotonic()
+    with pytest.raises(Stop):
+        vrw.sweep(vrw.Params(), "viscosity", vrw.linspace(20, 140, 4000), progress=stop)
+    assert time.monotonic() - start < 1.5
+    with pytest.raises(TypeError, match="progress must be"):
+        vrw.sweep(vrw.Params(), "viscosity", [40.0, 50.0], progress="yes")
+
+
+def test_progress_true_draws_a_tqdm_bar(capsys):
+    pytest.importorskip("tqdm")
+    result = vrw.sweep(vrw.Params(), "viscosity", vrw.linspace(40, 60, 5), progress=True)
+    assert result["gaits_found"] == 5
+    assert "5/5" in capsys.readouterr().err

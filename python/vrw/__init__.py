@@ -1,10 +1,19 @@
 """vrw: passive dynamic walking of a viscoelastic-legged rimless wheel, from Python.
 
 A front to the vrw Rust library: the same parameters (``Params``, every key of a vrw TOML file), the same
-jobs as the command line (``simulate``, ``find_gait``, ``sweep``, ``basin``, ``continue_family``) and the same names for their results (the
-columns of ``steps.csv``, ``trajectory.csv`` and ``sweep.csv``, the fields of ``summary.json``,
-``gait.json`` and ``thresholds.json``). Computation runs in Rust with the GIL released; ``Params`` and every
-result pickle, so they travel to worker processes (see ``vrw.grid`` for grids of gaits on a Dask cluster).
+jobs as the command line (``simulate``, ``find_gait``, ``sweep``, ``map``, ``orbit``, ``basin``,
+``continue_family``, ``animate``), with its defaults, checks and numbers, and the same names for their results
+(the columns of its CSV files as ``Table``s, ``.to_pandas()``; the fields of its JSON files; grids
+``.to_xarray()``). ``vrw.plot`` draws the command line's figures on matplotlib axes; ``vrw.grid`` spreads maps,
+orbit diagrams, basins and grids of sweeps over a Dask cluster. Computation runs in Rust with the GIL released;
+``Params`` and every result pickle, so they travel to worker processes.
+
+**Long jobs.** ``sweep``, ``map``, ``orbit`` and ``basin`` take ``progress``: a callable ``progress(done,
+total)`` called on the calling thread as points finish, or ``True`` for a tqdm bar (``pip install tqdm``).
+Ctrl-C (``KeyboardInterrupt``) stops any job within about a second: the job stops starting points, the
+points under way finish, and what was computed is discarded (a result is whole or not returned at all); the
+next call runs normally. An exception raised by the ``progress`` callable stops the job the same way. To keep
+what a long study has computed, split it into several calls (e.g. a map in parts of rows, ``rows=``).
 
 >>> import vrw
 >>> p = vrw.Params(viscosity=37)
@@ -17,7 +26,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
-from . import _vrw
+from . import _progress, _vrw
 from ._vrw import (
     ConfigError,
     Params,
@@ -25,6 +34,8 @@ from ._vrw import (
     __version__,
     linspace,
 )
+from . import plot
+from ._animate import animate, record_walk
 from .results import (
     BasinResult,
     FamilyResult,
@@ -48,9 +59,11 @@ def simulate(
     sample_dt: float = 0.005,
 ) -> Run:
     """Walk ``steps`` steps from ``initial`` (``vrw simulate``): a ``Run``, the fields of ``summary.json`` with
-    ``steps`` and ``trajectory`` as ``Table``s (``.to_pandas()``). See ``vrw._vrw.simulate``."""
+    ``steps`` and ``trajectory`` as ``Table``s (``.to_pandas()``). See ``vrw._vrw.simulate``. The ``Run``
+    keeps the arguments it was walked with (not as a field), so that ``vrw.animate`` draws this very walk."""
     run = Run(_vrw.simulate(params, steps, initial, trajectory, sample_dt))
     wrap_tables(run, ["steps", "trajectory"])
+    record_walk(run, params, steps, initial, sample_dt)
     return run
 
 
@@ -70,6 +83,7 @@ def sweep(
 ) -> SweepResult:
     """Sweep ``param`` over ``values`` (``vrw sweep``): a ``SweepResult`` whose ``sweep`` is a ``Table``
     (``.to_pandas()``). See ``vrw._vrw.sweep``."""
+    options = _progress.resolve(options, f"sweep {param}")
     result = SweepResult(_vrw.sweep(params, param, values, initial=initial, **options))
     wrap_tables(result, ["sweep"])
     return result
@@ -79,7 +93,7 @@ def basin(params: Params, **options: Any) -> BasinResult:
     """The basin of the gait on a slice of the section (``vrw basin``): a ``BasinResult``, the fields of
     ``basin.json`` with ``points`` (the columns of ``basin.csv``) as a ``Table``; ``.to_xarray()`` gives the
     grid over the slice's two coordinates. See ``vrw._vrw.basin`` for the options."""
-    result = BasinResult(_vrw.basin(params, **options))
+    result = BasinResult(_vrw.basin(params, **_progress.resolve(options, "basin")))
     wrap_tables(result, ["points"])
     return result
 
@@ -98,7 +112,7 @@ def map(params: Params, **options: Any) -> MapResult:
     """The gait over a grid of two parameters and the threshold curves across it (``vrw map``, without the
     figure): a ``MapResult``, the fields of ``curves.json`` with ``map`` (the columns of ``map.csv``) as a
     ``Table``; ``to_xarray()`` gives the grid over both parameters. See ``vrw._vrw.map`` for the options."""
-    result = MapResult(_vrw.map(params, **options))
+    result = MapResult(_vrw.map(params, **_progress.resolve(options, "map")))
     wrap_tables(result, ["map"])
     return result
 
@@ -107,7 +121,7 @@ def orbit(params: Params, param: str = "viscosity", **options: Any) -> OrbitResu
     """The orbit diagram along ``param`` and the period-1 branch beside it (``vrw orbit``, without the figure):
     an ``OrbitResult``, the fields of ``orbit.json`` with ``orbit`` and ``branch`` (the columns of ``orbit.csv``
     and ``branch.csv``) as ``Table``s. See ``vrw._vrw.orbit`` for the options."""
-    result = OrbitResult(_vrw.orbit(params, param, **options))
+    result = OrbitResult(_vrw.orbit(params, param, **_progress.resolve(options, f"orbit {param}")))
     wrap_tables(result, ["orbit", "branch"])
     return result
 
@@ -127,12 +141,14 @@ __all__ = [
     "Table",
     "WalkError",
     "__version__",
+    "animate",
     "basin",
     "continue_family",
     "find_gait",
     "linspace",
     "map",
     "orbit",
+    "plot",
     "simulate",
     "sweep",
 ]

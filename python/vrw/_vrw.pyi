@@ -1,7 +1,7 @@
 """Type stubs of the compiled extension ``vrw._vrw`` (re-exported by ``vrw``)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -13,6 +13,7 @@ __all__ = [
     "Params",
     "WalkError",
     "__version__",
+    "animate",
     "basin",
     "continue_family",
     "find_gait",
@@ -25,6 +26,8 @@ __all__ = [
 
 Value = Union[float, int, bool, str]
 Section = Union[Tuple[float, float, float], Sequence[float]]
+# A job's progress report: called as ``progress(done, total)`` on the calling thread as points finish.
+Progress = Callable[[int, int], object]
 
 class GaitOptions(TypedDict, total=False):
     """Search settings (the library's ``GaitOptions``; ``gait.json``'s ``options``), as keyword arguments."""
@@ -106,13 +109,15 @@ def sweep(
     values: Union[Sequence[float], npt.NDArray[np.float64]],
     *,
     initial: Optional[Section] = None,
+    progress: Optional[Progress] = None,
     **options: Unpack[GaitOptions],
 ) -> Dict[str, Any]:
     """Sweep ``param`` over ``values`` with continuation and locate the thresholds (``vrw sweep``).
 
     Returns ``{"param", "sweep", "thresholds", "gaits_found", "seconds"}``: ``sweep`` holds the columns
-    of ``sweep.csv`` as numpy arrays (reals as float64 with NaN, flags as bool with False, counts as int64
-    with 0 and words as strings where no gait was found), ``thresholds`` the entries of
+    of ``sweep.csv`` as numpy arrays, of the dtypes ``pandas.read_csv`` gives the file (reals as float64 with
+    NaN, flags as bool with False and words as strings with '' where no gait was found; counts as int64, or
+    float64 with NaN if a cell is empty; a column with no value at all as float64 NaN), ``thresholds`` the entries of
     ``thresholds.json`` as dicts. Options default to the command line's sweep settings (one central
     difference for the final Jacobian). ``vrw.linspace`` gives the command line's evenly spaced values.
     """
@@ -154,11 +159,14 @@ def map(
     curve_method: str = "continuation",
     second_route: bool = False,
     initial: Optional[Section] = None,
+    rows: Optional[Tuple[int, int]] = None,
+    progress: Optional[Progress] = None,
 ) -> Dict[str, Any]:
     """The gait over a grid of two parameters and the threshold curves (``vrw map``, without the figure): the
     fields of ``curves.json`` and ``map``, the columns of ``map.csv``. ``x_range`` and ``y_range`` default to
     the command line's ``(1, 300)`` and ``(300, 1500)``; ``curve_method`` is ``"continuation"`` or
-    ``"crossings"``."""
+    ``"crossings"``. ``rows=(start, end)`` computes only those rows' gaits (with ``curves=False``), each point
+    as the whole map has it; ``progress(done, total)`` is called on this thread as points finish."""
 
 def orbit(
     params: Params,
@@ -170,10 +178,14 @@ def orbit(
     steps: int = 64,
     initial: Optional[Section] = None,
     branch: bool = True,
+    progress: Optional[Progress] = None,
+    part: Optional[Union[str, Tuple[str, int, Optional[Section]]]] = None,
 ) -> Dict[str, Any]:
     """The orbit diagram along ``param`` (``vrw orbit``, without the figure): the fields of ``orbit.json``,
     ``orbit`` (the columns of ``orbit.csv``) and, with ``branch``, ``branch`` (the columns of ``branch.csv``).
-    ``range`` defaults to the command line's ``(1, 150)``."""
+    ``range`` defaults to the command line's ``(1, 150)``. ``progress(done, total)`` is called on this thread as
+    values finish; ``part`` (``"coarse"``, ``("fill", k, left)`` or ``"branch"``) computes one part of the job,
+    for ``vrw.grid.orbit_grid``, and adds ``ends`` and ``column_rows``."""
 
 def basin(
     params: Params,
@@ -187,12 +199,36 @@ def basin(
     max_steps: int = 100,
     tolerance: float = 1e-3,
     initial: Optional[Section] = None,
+    rows: Optional[Tuple[int, int]] = None,
+    progress: Optional[Progress] = None,
 ) -> Dict[str, Any]:
     """The basin of the gait on a slice of the section (``vrw basin``, without the figure).
 
     Returns the fields of ``basin.json`` (``spec``, ``gait``, ``outcomes``, ...) and ``points``: the columns
     of ``basin.csv`` as numpy arrays, one row per grid point, row by row. The options are the command line's
     (``x``, ``y``: ``"L2"``, ``"thetadot"``, ``"L2dot"``; ``x_range``, ``y_range``: ``(from, to)``, default
-    the command line's), validated as it validates them. Ctrl-C raises ``KeyboardInterrupt`` within about a
-    second.
+    the command line's), validated as it validates them. ``rows=(start, end)`` computes only those grid
+    rows, each point as the whole basin has it; ``progress(done, total)`` is called on this thread as points
+    finish. Ctrl-C raises ``KeyboardInterrupt`` within about a second.
     """
+
+def animate(
+    params: Params,
+    steps: int = 20,
+    initial: Optional[Section] = None,
+    sample_dt: float = 0.005,
+    *,
+    fps: int = 25,
+    speed: float = 1.0,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    width: int = 640,
+    height: int = 360,
+    horizontal: bool = False,
+    still: Optional[float] = None,
+) -> bytes:
+    """Walk ``steps`` steps from ``initial`` as ``simulate`` does and draw the walk as ``vrw animate`` does:
+    the bytes of the GIF ``walk.gif`` it writes for the directory of ``vrw simulate``, or with ``still`` (a
+    time [s]) those of the PNG of that frame (``vrw animate --still``). The options are the command line's
+    (``from_`` is ``--from``), with its defaults and ranges; a bad one, more than 90000 frames or a window
+    outside the walk raises ``ConfigError`` with the command line's message. See ``vrw.animate``."""

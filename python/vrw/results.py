@@ -19,7 +19,18 @@ from typing import Any, Dict, List
 
 import numpy as np
 
-__all__ = ["Result", "Table", "Run", "GaitResult", "SweepResult", "Grid", "BasinResult"]
+__all__ = [
+    "Result",
+    "Table",
+    "Run",
+    "GaitResult",
+    "SweepResult",
+    "Grid",
+    "BasinResult",
+    "MapResult",
+    "OrbitResult",
+    "FamilyResult",
+]
 
 
 def _optional(module: str) -> Any:

@@ -2,13 +2,14 @@
 //! grid point does), `basin.csv`, `basin.json` and `basin.png`.
 
 use std::collections::BTreeMap;
+use std::ops::Range;
 use std::path::PathBuf;
 
 use serde::Serialize;
 
 use crate::fmt::short;
-use crate::gait::basin::{basin, Axis, BasinPoint, BasinSpec, Coordinate};
-use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use crate::gait::basin::{basin, basin_part, Axis, BasinPoint, BasinSpec, Coordinate};
+use crate::gait::{check_part, find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
 use crate::output;
 use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::params::Config;
@@ -146,13 +147,33 @@ pub fn compute_basin(
     job: &BasinJob,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<(BasinSummary, Vec<Vec<BasinPoint>>), AppError> {
+    compute_basin_part(job, None, progress)
+}
+
+/// [`compute_basin`] of the rows `part` of the grid only (`None`: all of them; a basin computed in parts, a
+/// study spread over processes): each point exactly as the whole basin has it, `outcomes` counting this
+/// part's points.
+pub fn compute_basin_part(
+    job: &BasinJob,
+    part: Option<Range<usize>>,
+    progress: &(dyn Fn(&BasinPoint) + Sync),
+) -> Result<(BasinSummary, Vec<Vec<BasinPoint>>), AppError> {
     let (model, gait, spec) = prepare_basin(job)?;
+    let part = part.unwrap_or(0..spec.y.points);
+    check_part(&part, spec.y.points)?;
     let clock = std::time::Instant::now();
-    let grid = basin(&model, &job.config.solver, &gait, &spec, progress);
+    let grid = basin_part(
+        &model,
+        &job.config.solver,
+        &gait,
+        &spec,
+        part.clone(),
+        progress,
+    );
     let seconds = clock.elapsed().as_secs_f64();
     check_interrupted(
         grid.iter().map(Vec::len).sum(),
-        spec.x.points * spec.y.points,
+        spec.x.points * part.len(),
         "no file",
     )?;
     let summary = BasinSummary {

@@ -9,13 +9,15 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::fmt::short;
 use crate::output::animate::{write_animation, write_still, AnimateOptions, AnimationReport};
 use crate::output::manifest::{Manifest, RunDir, RunStatus};
 use crate::output::read::{read_run, RunData};
 use crate::output::{run_plot, steps_plot, write_atomic};
 
 use super::AppError;
+
+/// The most frames `vrw animate` draws (see [`write_animation`]).
+pub use crate::output::animate::MAX_ANIMATION_FRAMES;
 
 /// What `vrw animate` runs.
 #[derive(Debug, Clone)]
@@ -97,37 +99,10 @@ pub struct AnimateOutcome {
     pub warnings: Vec<String>,
 }
 
-/// The most frames `vrw animate` draws: an hour of playback at 25 frames per second. The regular frames
-/// number `(to - from) fps / speed + 1` over the window `[from, to]` of simulated time.
-pub const MAX_ANIMATION_FRAMES: usize = 90_000;
-
-/// Refuses an animation of more than [`MAX_ANIMATION_FRAMES`] frames, counted before any is planned.
-fn check_frame_count(run: &RunData, options: &AnimateOptions) -> Result<(), AppError> {
-    let (start, end) = run.time_span();
-    let from = options.from.unwrap_or(start).max(start);
-    let to = options.to.unwrap_or(end).min(end);
-    let frames = ((to - from).max(0.0) * f64::from(options.fps) / options.speed).floor() + 1.0;
-    if frames > MAX_ANIMATION_FRAMES as f64 {
-        return Err(AppError::InvalidOption {
-            option: "speed",
-            reason: format!(
-                "{} s of simulated time at speed {} and {} frames per second is {} frames, more than \
-                 {MAX_ANIMATION_FRAMES}: raise --speed, lower --fps or narrow the window with --from/--to",
-                short(to - from),
-                short(options.speed),
-                options.fps,
-                short(frames)
-            ),
-        });
-    }
-    Ok(())
-}
-
 /// Run `vrw animate`: read the run and write `DIR/walk.gif`.
 pub fn run_animate(job: &AnimateJob) -> Result<AnimateOutcome, AppError> {
     job.options.validate()?;
     let (run, mut dir) = checked_run(&job.dir, job.partial)?;
-    check_frame_count(&run, &job.options)?;
     let path = job.dir.join("walk.gif");
     let mut report = write_atomic(&path, |temp| -> Result<_, AppError> {
         Ok(write_animation(&run, &job.options, temp)?)

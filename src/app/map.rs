@@ -1,6 +1,7 @@
 //! The job of `vrw map`: the gait over a grid of two parameters, the threshold curves across it, `map.csv`,
 //! `curves.json` and the heat maps.
 
+use std::ops::Range;
 use std::path::PathBuf;
 
 use serde::Serialize;
@@ -9,7 +10,9 @@ use crate::bifurcation::map_curves::continue_map_curves;
 use crate::dynamics::Model;
 use crate::fmt::short;
 use crate::gait::map::{LineThreshold, ThresholdCurve};
-use crate::gait::{map_curves, map_gaits, GaitMap, GaitOptions, MapSpec, SecondRoute, SweepPoint};
+use crate::gait::{
+    map_curves, map_gaits, map_gaits_part, GaitMap, GaitOptions, MapSpec, SecondRoute, SweepPoint,
+};
 use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
 use crate::output::{self, write_map_csv};
 use crate::params::Config;
@@ -102,6 +105,39 @@ pub fn compute_map(
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
     let mut summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
     second_route(job, &initial, progress, &mut summary)?;
+    Ok((summary, map))
+}
+
+/// The rows `part` (indices of `y` values) of [`compute_map`]'s gaits, each exactly as the whole map has them,
+/// with the summary of those rows (a map computed in parts, a study spread over processes). A part has no
+/// curves (they need every row): `job.curves` is refused.
+pub fn compute_map_part(
+    job: &MapJob,
+    part: Range<usize>,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<(MapSummary, GaitMap), AppError> {
+    if job.curves {
+        return Err(AppError::InvalidOption {
+            option: "rows",
+            reason:
+                "a part of the map's rows has no curves (they need every row): compute the part \
+                     without curves"
+                    .to_string(),
+        });
+    }
+    let initial = checked_initial(job)?;
+    let clock = std::time::Instant::now();
+    let map = map_gaits_part(
+        &job.config,
+        &job.spec,
+        part,
+        &initial,
+        &job.options,
+        progress,
+    )?;
+    let points = map.xs.len() * map.ys.len();
+    check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
+    let summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
     Ok((summary, map))
 }
 

@@ -19,7 +19,9 @@ mod orbit;
 mod simulate;
 mod sweep;
 
-pub use basin::{compute_basin, default_basin_range, run_basin, BasinJob, BasinSummary};
+pub use basin::{
+    compute_basin, compute_basin_part, default_basin_range, run_basin, BasinJob, BasinSummary,
+};
 pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
     MAX_FAMILIES, MAX_FAMILY_POINTS, STABILITY_BAND,
@@ -34,8 +36,11 @@ pub use figures::{
 pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
 };
-pub use map::{compute_map, run_map, MapJob, MapSummary};
-pub use orbit::{compute_orbit, run_orbit, OrbitJob, OrbitSummary};
+pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
+pub use orbit::{
+    compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
+    OrbitSummary,
+};
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,

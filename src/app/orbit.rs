@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::fmt::short;
-use crate::gait::orbit::{orbit_diagram, OrbitColumn, OrbitSpec};
+use crate::gait::orbit::{orbit_diagram, orbit_part, OrbitColumn, OrbitPart, OrbitSpec};
 use crate::gait::{sweep, Gait, GaitOptions, Stability};
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
@@ -91,6 +91,52 @@ pub fn compute_orbit(
     let seconds = [orbit_seconds, clock.elapsed().as_secs_f64()];
     let summary = orbit_summary(job, &columns, &branch, Vec::new(), seconds);
     Ok((summary, columns, branch))
+}
+
+/// A part of `vrw orbit` computed apart (a study spread over processes: `vrw.grid.orbit_grid`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OrbitJobPart {
+    /// A part of the diagram ([`OrbitPart`]).
+    Diagram(OrbitPart),
+    /// The period-1 branch beside it (empty without `job.branch`).
+    Branch,
+}
+
+/// A part's summary, its columns, the states their walks ended in, and the branch (see
+/// [`compute_orbit_part`]).
+pub type OrbitPartResult = (
+    OrbitSummary,
+    Vec<OrbitColumn>,
+    Vec<Option<SectionState>>,
+    Branch,
+);
+
+/// The columns of one part of [`compute_orbit`]'s diagram and the states their walks ended in (`None` where a
+/// walk failed), or its branch: each exactly as the whole job computes it, with the summary of that part
+/// (`outcomes` counting its columns, `branch_gaits` its branch).
+pub fn compute_orbit_part(
+    job: &OrbitJob,
+    part: OrbitJobPart,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<OrbitPartResult, AppError> {
+    let (_, initial) = prepared(&job.config, job.initial)?;
+    job.spec.validate(&job.config)?;
+    let total = job.spec.range.points;
+    let (columns, ends, branch) = match part {
+        OrbitJobPart::Diagram(p) => {
+            let walked = orbit_part(&job.config, &job.spec, &initial, p, progress)?;
+            check_interrupted(walked.len(), total, "the orbit diagram")?;
+            let (columns, ends) = walked.into_iter().unzip();
+            (columns, ends, Vec::new())
+        }
+        OrbitJobPart::Branch => {
+            let branch = period_one_branch(job, &initial)?;
+            check_interrupted(branch.len(), total, "the branch")?;
+            (Vec::new(), Vec::new(), branch)
+        }
+    };
+    let summary = orbit_summary(job, &columns, &branch, Vec::new(), [0.0; 2]);
+    Ok((summary, columns, ends, branch))
 }
 
 /// The period-1 branch over the diagram's values (a sweep with continuation), with `job.branch`; else empty.

@@ -14,9 +14,11 @@
 //! The grid runs on the `grid` runner, one row per value of the second coordinate (every start is
 //! independent, so nothing is handed along a row).
 
+use std::ops::Range;
+
 use serde::Serialize;
 
-use super::grid::{run_rows, Evaluated};
+use super::grid::{run_rows_part, Evaluated};
 use super::limit_cycle::Gait;
 use super::periodicity::{least_period, MAX_PERIOD};
 use crate::dynamics::Model;
@@ -213,7 +215,21 @@ pub fn basin(
     spec: &BasinSpec,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Vec<Vec<BasinPoint>> {
-    run_rows(
+    basin_part(model, opts, gait, spec, 0..spec.y.points, progress)
+}
+
+/// The rows `part` (indices of `y` values, within `0..spec.y.points`) of [`basin`], each point exactly as the
+/// whole basin has it (a basin computed in parts, a study spread over processes, is the basin).
+pub fn basin_part(
+    model: &Model,
+    opts: &SolverOptions,
+    gait: &Gait,
+    spec: &BasinSpec,
+    part: Range<usize>,
+    progress: &(dyn Fn(&BasinPoint) + Sync),
+) -> Vec<Vec<BasinPoint>> {
+    run_rows_part(
+        part,
         spec.y.points,
         spec.x.points,
         |cell, _: Option<(usize, &())>| {

@@ -31,6 +31,7 @@
 //! The example of a running sum along each row is the test `running_sum_along_rows` below (the runner is
 //! internal to the crate, so it is not a doc test).
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
@@ -95,11 +96,41 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
+    run_part_until(0..rows, rows, cols, stop, eval)
+}
+
+/// The rows `part` of a grid of `rows` rows (a chunk of a study spread over processes, see
+/// [`crate::gait::map::map_gaits_part`]): every point of these rows exactly as [`run_rows`] computes it for the
+/// whole grid (the schedule is the whole grid's: a grid of one row is split, the rows of a larger one run in
+/// order), returned in the order of `part`. `part` must lie within `0..rows`.
+pub fn run_rows_part<P, C, F>(part: Range<usize>, rows: usize, cols: usize, eval: F) -> Vec<Vec<P>>
+where
+    P: Send,
+    C: Send + Sync,
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
+{
+    run_part_until(part, rows, cols, &INTERRUPT, eval)
+}
+
+fn run_part_until<P, C, F>(
+    part: Range<usize>,
+    rows: usize,
+    cols: usize,
+    stop: &AtomicBool,
+    eval: F,
+) -> Vec<Vec<P>>
+where
+    P: Send,
+    C: Send + Sync,
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
+{
+    debug_assert!(part.end <= rows, "rows {part:?} of a grid of {rows}");
     if rows == 1 {
-        return vec![run_split_row(0, cols, stop, &eval)];
+        return part
+            .map(|row| run_split_row(row, cols, stop, &eval))
+            .collect();
     }
-    (0..rows)
-        .into_par_iter()
+    part.into_par_iter()
         .map(|row| run_row_in_order(row, cols, stop, &eval))
         .collect()
 }
@@ -133,7 +164,53 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    let mut coarse_points: Vec<P> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
+    let (coarse_points, carries) = coarse_pass_until(row, cols, stop, eval);
+    let fills: Vec<Vec<P>> = carries
+        .par_iter()
+        .enumerate()
+        .map(|(k, left)| fill_until(row, cols, k, left.as_ref(), stop, eval))
+        .collect();
+    // The complete prefix: stop after the first interval whose fill was cut short (or before a coarse point
+    // that was never evaluated).
+    let mut points = Vec::with_capacity(cols);
+    for (k, (left, fill)) in coarse_points.into_iter().zip(fills).enumerate() {
+        let cut = fill.len() < fill_len(cols, k);
+        points.push(left);
+        points.extend(fill);
+        if cut {
+            break;
+        }
+    }
+    points
+}
+
+/// The number of points between coarse point `k` and the next (or the row's end).
+pub(crate) fn fill_len(cols: usize, k: usize) -> usize {
+    let first = k * COARSE_STRIDE;
+    (first + COARSE_STRIDE).min(cols).saturating_sub(first + 1)
+}
+
+/// The coarse pass of a split row (see the module documentation): every [`COARSE_STRIDE`]-th point in order,
+/// each continuing the previous coarse point; their points and what each hands on, in order. Stops starting
+/// points once the library's [`interrupt_flag`] is set. With [`fill`], the parts of a split row computed
+/// apart (a study spread over processes): the row is the coarse points with the fills between them.
+pub(crate) fn coarse_pass<P, C, F>(row: usize, cols: usize, eval: &F) -> (Vec<P>, Vec<Option<C>>)
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    coarse_pass_until(row, cols, &INTERRUPT, eval)
+}
+
+fn coarse_pass_until<P, C, F>(
+    row: usize,
+    cols: usize,
+    stop: &AtomicBool,
+    eval: &F,
+) -> (Vec<P>, Vec<Option<C>>)
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    let mut points: Vec<P> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
     let mut carries: Vec<Option<C>> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
     for col in (0..cols).step_by(COARSE_STRIDE) {
         if stopped(stop) {
@@ -143,44 +220,46 @@ where
             .last()
             .and_then(|c| c.as_ref().map(|c| (col - COARSE_STRIDE, c)));
         let e = eval(Cell { row, col }, from);
-        coarse_points.push(e.point);
+        points.push(e.point);
         carries.push(e.carry);
     }
-    let fills: Vec<Vec<P>> = carries
-        .par_iter()
-        .enumerate()
-        .map(|(k, left)| {
-            let first = k * COARSE_STRIDE;
-            let end = (first + COARSE_STRIDE).min(cols);
-            let mut last: Option<(usize, Option<C>)> = None;
-            let mut points = Vec::with_capacity(end - first - 1);
-            for col in first + 1..end {
-                if stopped(stop) {
-                    break;
-                }
-                let from = match &last {
-                    None => left.as_ref().map(|c| (first, c)),
-                    Some((j, c)) => c.as_ref().map(|c| (*j, c)),
-                };
-                let e = eval(Cell { row, col }, from);
-                points.push(e.point);
-                last = Some((col, e.carry));
-            }
-            points
-        })
-        .collect();
-    // The complete prefix: stop after the first interval whose fill was cut short (or before a coarse point
-    // that was never evaluated).
-    let mut points = Vec::with_capacity(cols);
-    for (k, (left, fill)) in coarse_points.into_iter().zip(fills).enumerate() {
-        let first = k * COARSE_STRIDE;
-        let full = (first + COARSE_STRIDE).min(cols) - first - 1;
-        let cut = fill.len() < full;
-        points.push(left);
-        points.extend(fill);
-        if cut {
+    (points, carries)
+}
+
+/// The points between coarse point `k` (which handed on `left`) and the next, in order, each continuing the
+/// one before (see [`coarse_pass`]). Stops starting points once the library's [`interrupt_flag`] is set.
+pub(crate) fn fill<P, C, F>(row: usize, cols: usize, k: usize, left: Option<&C>, eval: &F) -> Vec<P>
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    fill_until(row, cols, k, left, &INTERRUPT, eval)
+}
+
+fn fill_until<P, C, F>(
+    row: usize,
+    cols: usize,
+    k: usize,
+    left: Option<&C>,
+    stop: &AtomicBool,
+    eval: &F,
+) -> Vec<P>
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    let first = k * COARSE_STRIDE;
+    let mut last: Option<(usize, Option<C>)> = None;
+    let mut points = Vec::with_capacity(fill_len(cols, k));
+    for col in first + 1..first + 1 + fill_len(cols, k) {
+        if stopped(stop) {
             break;
         }
+        let from = match &last {
+            None => left.map(|c| (first, c)),
+            Some((j, c)) => c.as_ref().map(|c| (*j, c)),
+        };
+        let e = eval(Cell { row, col }, from);
+        points.push(e.point);
+        last = Some((col, e.carry));
     }
     points
 }
@@ -266,6 +345,44 @@ mod tests {
         );
         assert!(run_rows(0, 5, eval).is_empty());
         assert_eq!(run_rows(1, 0, eval), vec![Vec::<Cell>::new()]);
+    }
+
+    /// A part of a grid is those rows of the whole grid, point for point, for one row (split) and several.
+    #[test]
+    fn a_part_is_the_whole_grids_rows() {
+        let eval = |cell: Cell, from: Option<(usize, &usize)>| Evaluated {
+            point: (cell, from.map(|(j, c)| (j, *c))),
+            carry: Some(cell.col * 7 + cell.row),
+        };
+        let cols = 2 * COARSE_STRIDE + 3;
+        for rows in [1, 4] {
+            let whole = run_rows(rows, cols, eval);
+            for part in [0..rows, rows - 1..rows, 0..0] {
+                assert_eq!(
+                    run_rows_part(part.clone(), rows, cols, eval),
+                    whole[part].to_vec()
+                );
+            }
+        }
+    }
+
+    /// A split row computed as its coarse pass and its fills apart is the row.
+    #[test]
+    fn coarse_pass_and_fills_make_the_split_row() {
+        let eval = |cell: Cell, from: Option<(usize, &usize)>| Evaluated {
+            point: (cell, from.map(|(j, c)| (j, *c))),
+            carry: (cell.col != 13).then_some(cell.col * 3),
+        };
+        for cols in [1, COARSE_STRIDE, 2 * COARSE_STRIDE + 3] {
+            let whole = run_rows(1, cols, eval).remove(0);
+            let (coarse, carries) = coarse_pass(0, cols, &eval);
+            let mut parts = Vec::new();
+            for (k, (point, left)) in coarse.into_iter().zip(&carries).enumerate() {
+                parts.push(point);
+                parts.extend(fill(0, cols, k, left.as_ref(), &eval));
+            }
+            assert_eq!(parts, whole, "{cols} points");
+        }
     }
 
     #[test]

@@ -21,11 +21,13 @@
 //! The curve of the end of existence joins `gait_lost` and `gait_found` crossings (which of the two a crossing
 //! is depends only on the direction of the line it was refined on).
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::limit_cycle::GaitOptions;
-use super::sweep::{gait_rows, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec};
+use super::sweep::{gait_rows_part, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec};
 use super::thresholds::{find_thresholds, Threshold};
 use crate::fmt::short;
 use crate::params::{Config, ConfigError};
@@ -142,8 +144,23 @@ pub fn map_gaits(
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<GaitMap, ConfigError> {
+    map_gaits_part(config, spec, 0..spec.y.points, initial, options, progress)
+}
+
+/// The rows `part` (indices of `y` values, within `0..spec.y.points`) of [`map_gaits`]: each row's points
+/// exactly as the whole map has them, so a map computed in parts (a study spread over processes) is the map.
+/// The returned map has those rows and their `ys` only.
+pub fn map_gaits_part(
+    config: &Config,
+    spec: &MapSpec,
+    part: Range<usize>,
+    initial: &SectionState,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<GaitMap, ConfigError> {
     spec.validate(config)?;
     options.validate()?;
+    check_part(&part, spec.y.points)?;
     let xs = spec.x.values();
     let ys = spec.y.values();
     let rows: Vec<GaitRow> = ys
@@ -154,12 +171,24 @@ pub fn map_gaits(
             values: xs.clone(),
         })
         .collect();
-    let rows = gait_rows(&rows, initial, options, progress);
+    let rows = gait_rows_part(&rows, part.clone(), initial, options, progress);
     Ok(GaitMap {
         spec: spec.clone(),
         xs,
-        ys,
+        ys: ys[part].to_vec(),
         rows,
+    })
+}
+
+/// A part of a grid's rows must be a non-empty range of its `rows` rows.
+pub fn check_part(part: &Range<usize>, rows: usize) -> Result<(), ConfigError> {
+    if part.start < part.end && part.end <= rows {
+        return Ok(());
+    }
+    Err(ConfigError::InvalidValue {
+        key: "rows".to_string(),
+        value: format!("{}..{}", part.start, part.end),
+        reason: format!("a part of the grid's rows is a non-empty range within 0..{rows}"),
     })
 }
 

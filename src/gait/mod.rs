@@ -20,8 +20,8 @@ pub use derivative::{check_jacobian, JacobianCheck, ParamDerivative, DERIVATIVE_
 pub use grid::{clear_interrupt, interrupt_flag, interrupted};
 pub use limit_cycle::{find_gait, Gait, GaitError, GaitOptions, Stability};
 pub use map::{
-    map_curves, map_gaits, ContinuedCurve, CurveMethod, GaitMap, MapCurves, MapSpec,
-    ThresholdCurve, LINE_CHECK_TOL,
+    check_part, map_curves, map_gaits, map_gaits_part, ContinuedCurve, CurveMethod, GaitMap,
+    MapCurves, MapSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
 pub use options::{FD_STEP_RANGE, MAX_NEWTON_ITERATIONS, MAX_TRANSIENT_STEPS, TOLERANCE_RANGE};
 pub use period_k::{find_gait_any_period, find_periodic_gait, MAX_PERIOD};

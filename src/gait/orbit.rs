@@ -13,7 +13,7 @@
 
 use serde::Serialize;
 
-use super::grid::{run_rows, Evaluated};
+use super::grid::{coarse_pass, fill, run_rows, Cell, Evaluated, COARSE_STRIDE};
 use super::periodicity::{least_period, MAX_PERIOD};
 use super::sweep::{RangeNames, SweepSpec};
 use crate::dynamics::Model;
@@ -189,31 +189,97 @@ pub fn orbit_diagram(
 ) -> Result<Vec<OrbitColumn>, ConfigError> {
     spec.validate(config)?;
     let values = spec.range.values();
-    let fresh = spec.transient.saturating_mul(FRESH_TRANSIENT_FACTOR);
-    let mut rows = run_rows(
-        1,
-        values.len(),
-        |cell, from: Option<(usize, &SectionState)>| {
-            let value = values[cell.col];
-            let (start, transient, continued_from) = match from {
-                Some((j, s)) => (*s, spec.transient, Some(values[j])),
-                None => (*initial, fresh, None),
-            };
-            let (mut column, end) = walk_column(
-                config,
-                &spec.range.param,
-                value,
-                &start,
-                transient,
-                spec.steps,
-            );
-            column.continued_from = continued_from;
-            progress(&column);
-            Evaluated {
-                point: column,
-                carry: end,
-            }
-        },
-    );
+    let eval = column_eval(config, spec, initial, &values, progress);
+    let mut rows = run_rows(1, values.len(), eval);
     Ok(rows.pop().unwrap_or_default())
+}
+
+/// A part of an orbit diagram computed apart (a study spread over processes): the diagram's coarse pass, or
+/// the values between two of its points (the grid runner's schedule, see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OrbitPart {
+    /// Every `COARSE_STRIDE`-th value in order, each continuing the one before.
+    Coarse,
+    /// The values after the `k`-th coarse value up to the next, continuing from `left`, where the walk at
+    /// the `k`-th coarse value ended (`None` if it failed).
+    Fill {
+        /// Which interval.
+        k: usize,
+        /// The end state of the coarse value's walk.
+        left: Option<SectionState>,
+    },
+}
+
+/// The columns of `part` of [`orbit_diagram`], each exactly as the whole diagram has it, with the state each
+/// walk ended in (`None` if it failed: what the coarse pass hands to the fills). The diagram is the coarse
+/// columns with every interval's fill after its coarse column.
+pub fn orbit_part(
+    config: &Config,
+    spec: &OrbitSpec,
+    initial: &SectionState,
+    part: OrbitPart,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<Vec<(OrbitColumn, Option<SectionState>)>, ConfigError> {
+    spec.validate(config)?;
+    let values = spec.range.values();
+    let eval = column_eval(config, spec, initial, &values, progress);
+    // The end state as the column's point too, so that a fill hands it back.
+    let with_end = |cell, from: Option<(usize, &SectionState)>| {
+        let e = eval(cell, from);
+        Evaluated {
+            point: (e.point, e.carry),
+            carry: e.carry,
+        }
+    };
+    match part {
+        OrbitPart::Coarse => Ok(coarse_pass(0, values.len(), &with_end).0),
+        OrbitPart::Fill { k, left } => {
+            let intervals = values.len().div_ceil(COARSE_STRIDE);
+            if k >= intervals {
+                return Err(ConfigError::InvalidValue {
+                    key: "orbit part".to_string(),
+                    value: k.to_string(),
+                    reason: format!(
+                        "the diagram's {} values have {intervals} intervals",
+                        values.len()
+                    ),
+                });
+            }
+            Ok(fill(0, values.len(), k, left.as_ref(), &with_end))
+        }
+    }
+}
+
+/// The walk at one value of the diagram, from where the value it continues ended (else from `initial` with the
+/// longer transient): the grid runner's evaluation.
+fn column_eval<'a>(
+    config: &'a Config,
+    spec: &'a OrbitSpec,
+    initial: &'a SectionState,
+    values: &'a [f64],
+    progress: &'a (dyn Fn(&OrbitColumn) + Sync),
+) -> impl Fn(Cell, Option<(usize, &SectionState)>) -> Evaluated<OrbitColumn, SectionState> + Sync + 'a
+{
+    let fresh = spec.transient.saturating_mul(FRESH_TRANSIENT_FACTOR);
+    move |cell, from| {
+        let value = values[cell.col];
+        let (start, transient, continued_from) = match from {
+            Some((j, s)) => (*s, spec.transient, Some(values[j])),
+            None => (*initial, fresh, None),
+        };
+        let (mut column, end) = walk_column(
+            config,
+            &spec.range.param,
+            value,
+            &start,
+            transient,
+            spec.steps,
+        );
+        column.continued_from = continued_from;
+        progress(&column);
+        Evaluated {
+            point: column,
+            carry: end,
+        }
+    }
 }

@@ -13,11 +13,13 @@
 //! parallel; a map is many rows, run in parallel. Inside each point the exact Jacobian and the second one of
 //! its error estimate run in parallel as well.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::continuation::{Continuation, FamilyPoint, Followed};
-use super::grid::{run_rows, Evaluated};
+use super::grid::{run_rows_part, Evaluated};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::period_k::{find_gait_any_period, periodic_gait_at};
 use super::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
@@ -411,25 +413,42 @@ pub fn gait_rows(
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Vec<Vec<SweepPoint>> {
+    gait_rows_part(rows, 0..rows.len(), initial, options, progress)
+}
+
+/// The rows `part` of [`gait_rows`] of `rows` (within `0..rows.len()`), each exactly as the whole grid has it.
+pub(crate) fn gait_rows_part(
+    rows: &[GaitRow],
+    part: Range<usize>,
+    initial: &SectionState,
+    options: &GaitOptions,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Vec<Vec<SweepPoint>> {
     let cols = rows.iter().map(|r| r.values.len()).max().unwrap_or(0);
-    let mut points = run_rows(rows.len(), cols, |cell, from: Option<(usize, &Gait)>| {
-        let row = &rows[cell.row];
-        let Some(&value) = row.values.get(cell.col) else {
-            // A shorter row: nothing here (dropped below).
-            return Evaluated {
-                point: None,
-                carry: None,
+    let mut points = run_rows_part(
+        part.clone(),
+        rows.len(),
+        cols,
+        |cell, from: Option<(usize, &Gait)>| {
+            let row = &rows[cell.row];
+            let Some(&value) = row.values.get(cell.col) else {
+                // A shorter row: nothing here (dropped below).
+                return Evaluated {
+                    point: None,
+                    carry: None,
+                };
             };
-        };
-        let previous = from.map(|(j, g)| (j, row.values[j], g));
-        let point = gait_at_value(&row.config, &row.param, value, initial, previous, options);
-        progress(&point);
-        Evaluated {
-            carry: continuable(&point).cloned(),
-            point: Some(point),
-        }
-    });
-    rows.par_iter()
+            let previous = from.map(|(j, g)| (j, row.values[j], g));
+            let point = gait_at_value(&row.config, &row.param, value, initial, previous, options);
+            progress(&point);
+            Evaluated {
+                carry: continuable(&point).cloned(),
+                point: Some(point),
+            }
+        },
+    );
+    rows[part]
+        .par_iter()
         .zip(points.par_iter_mut())
         .map(|(row, points)| {
             let mut points: Vec<SweepPoint> = points.drain(..).flatten().collect();

@@ -15,6 +15,10 @@ use std::path::{Path, PathBuf};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize};
 
+use super::{step_row, trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER};
+use crate::params::Config;
+use crate::walk::{Sample, StepReport};
+
 /// A run directory could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
@@ -345,14 +349,23 @@ pub fn read_complete_rows<T: DeserializeOwned>(
     path: &Path,
     allow_empty: bool,
 ) -> Result<(Vec<T>, Option<String>), ReadError> {
+    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_rows(path, bytes, allow_empty)
+}
+
+/// [`read_complete_rows`] of the text `bytes` of the file `path`.
+fn parse_rows<T: DeserializeOwned>(
+    path: &Path,
+    mut bytes: Vec<u8>,
+    allow_empty: bool,
+) -> Result<(Vec<T>, Option<String>), ReadError> {
     let csv_err = |source| ReadError::Csv {
         path: path.to_path_buf(),
         source,
     };
-    let mut bytes = std::fs::read(path).map_err(|source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
     let mut warning = None;
     if bytes.last().is_some_and(|&b| b != b'\n') {
         let end = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1);
@@ -402,11 +415,15 @@ fn read_summary(path: &Path) -> Result<(Geometry, String), ReadError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let json: serde_json::Value =
-        serde_json::from_str(&text).map_err(|source| ReadError::Json {
-            path: path.to_path_buf(),
-            source,
-        })?;
+    summary_fields(path, &text)
+}
+
+/// The geometry and the status of the text `text` of `summary.json` (the file `path`).
+fn summary_fields(path: &Path, text: &str) -> Result<(Geometry, String), ReadError> {
+    let json: serde_json::Value = serde_json::from_str(text).map_err(|source| ReadError::Json {
+        path: path.to_path_buf(),
+        source,
+    })?;
     let config = json.get("config").unwrap_or(&serde_json::Value::Null);
     let number = |key| {
         parameter(config, path, key, "finite number", |v| {
@@ -458,26 +475,13 @@ pub fn read_run(dir: &Path) -> Result<RunData, ReadError> {
     let steps_path = file("steps.csv")?;
     let summary_path = file("summary.json")?;
     let (geometry, status) = read_summary(&summary_path)?;
-    let (samples, warning): (Vec<TrajectoryRow>, _) = read_complete_rows(&trajectory_path, false)?;
+    let (samples, warning) = read_complete_rows(&trajectory_path, false)?;
     let mut warnings: Vec<String> = warning.into_iter().collect();
-    let mut last = f64::NEG_INFINITY;
-    for (k, s) in samples.iter().enumerate() {
-        if !(s.time.is_finite() && s.time >= last) {
-            return Err(ReadError::Unordered {
-                path: trajectory_path,
-                row: k + 1,
-                time: s.time,
-            });
-        }
-        last = s.time;
-        check_sample(&trajectory_path, k + 1, s, &geometry)?;
-    }
+    check_samples(&trajectory_path, &samples, &geometry)?;
     // A walk that stopped during its first step has no step rows, but its trajectory can still be shown.
     let (steps, warning): (Vec<StepRow>, _) = read_complete_rows(&steps_path, true)?;
     warnings.extend(warning);
-    for (k, s) in steps.iter().enumerate() {
-        check_step(&steps_path, k + 1, s)?;
-    }
+    check_steps(&steps_path, &steps)?;
     Ok(RunData {
         dir: dir.to_path_buf(),
         geometry,
@@ -486,6 +490,109 @@ pub fn read_run(dir: &Path) -> Result<RunData, ReadError> {
         steps,
         warnings,
     })
+}
+
+/// A walk held in memory as the [`RunData`] that [`read_run`] reads from the files `vrw simulate` writes for
+/// it, without files (for a front that draws a walk it has just computed, such as the Python binding): the
+/// parameters go through the JSON text of `summary.json` and the tables through the CSV text of
+/// `steps.csv` and `trajectory.csv`, written as their writers write them and read back as [`read_run`] reads
+/// them, so a figure drawn from it is the one drawn from the directory, bit for bit (its numbers are those
+/// the files give back, not the walk's own: a cell is the shortest text that reads back to the same number
+/// but writes `-0` as `0`, and serde_json may read a JSON number one unit in the last place off). `status`
+/// is `summary.json`'s; the paths named in errors are the bare file names.
+///
+/// # Errors
+/// [`ReadError`] as [`read_run`]'s checks raise it (a walk computed by vrw passes them).
+pub fn run_from_walk(
+    config: &Config,
+    status: &str,
+    steps: &[StepReport],
+    samples: &[Sample],
+) -> Result<RunData, ReadError> {
+    #[derive(Serialize)]
+    struct Summary<'a> {
+        config: &'a Config,
+        status: &'a str,
+    }
+    let summary_path = Path::new("summary.json");
+    let text =
+        serde_json::to_string(&Summary { config, status }).map_err(|source| ReadError::Json {
+            path: summary_path.to_path_buf(),
+            source,
+        })?;
+    let (geometry, status) = summary_fields(summary_path, &text)?;
+    let trajectory_path = Path::new("trajectory.csv");
+    let text = csv_text(
+        trajectory_path,
+        &TRAJECTORY_HEADER,
+        samples.iter().map(trajectory_row),
+    )?;
+    let (samples, _) = parse_rows(trajectory_path, text, false)?;
+    check_samples(trajectory_path, &samples, &geometry)?;
+    let steps_path = Path::new("steps.csv");
+    let text = csv_text(steps_path, &STEPS_HEADER, steps.iter().map(step_row))?;
+    let (steps, _) = parse_rows(steps_path, text, true)?;
+    check_steps(steps_path, &steps)?;
+    Ok(RunData {
+        dir: PathBuf::new(),
+        geometry,
+        status,
+        samples,
+        steps,
+        warnings: Vec::new(),
+    })
+}
+
+/// The CSV text of a table with `header` and `rows`, as the streaming writers write the file `path`.
+fn csv_text(
+    path: &Path,
+    header: &[&str],
+    rows: impl Iterator<Item = Vec<Cell>>,
+) -> Result<Vec<u8>, ReadError> {
+    let csv_err = |source| ReadError::Csv {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header).map_err(csv_err)?;
+    for row in rows {
+        w.write_record(row.iter().map(Cell::to_csv))
+            .map_err(csv_err)?;
+    }
+    w.into_inner().map_err(|e| ReadError::Io {
+        path: path.to_path_buf(),
+        source: e.into_error(),
+    })
+}
+
+/// Check the samples of `trajectory.csv` (the file `path`): in time order, each a state of the wheel
+/// `geometry` ([`check_sample`]).
+fn check_samples(
+    path: &Path,
+    samples: &[TrajectoryRow],
+    geometry: &Geometry,
+) -> Result<(), ReadError> {
+    let mut last = f64::NEG_INFINITY;
+    for (k, s) in samples.iter().enumerate() {
+        if !(s.time.is_finite() && s.time >= last) {
+            return Err(ReadError::Unordered {
+                path: path.to_path_buf(),
+                row: k + 1,
+                time: s.time,
+            });
+        }
+        last = s.time;
+        check_sample(path, k + 1, s, geometry)?;
+    }
+    Ok(())
+}
+
+/// Check the rows of `steps.csv` (the file `path`) with [`check_step`].
+fn check_steps(path: &Path, steps: &[StepRow]) -> Result<(), ReadError> {
+    for (k, s) in steps.iter().enumerate() {
+        check_step(path, k + 1, s)?;
+    }
+    Ok(())
 }
 
 /// The error for `value` in `column` of data row `row` of `path`.
@@ -595,4 +702,36 @@ fn check_step(path: &Path, row: usize, s: &StepRow) -> Result<(), ReadError> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::{compute_simulation, run_simulate, SimulateJob};
+
+    /// A walk held in memory reads as its run directory reads: the same samples, steps and parameters.
+    #[test]
+    fn walk_in_memory_reads_as_its_directory() {
+        let dir = tempfile::tempdir().unwrap();
+        let job = SimulateJob {
+            config: Config::default(),
+            initial: None,
+            steps: 2,
+            sample_dt: 0.01,
+            trajectory: true,
+            out_dir: dir.path().to_path_buf(),
+            interrupt: None,
+        };
+        run_simulate(&job, &mut |_| {}).unwrap();
+        let files = read_run(dir.path()).unwrap();
+        let (summary, trajectory) = compute_simulation(&job, true).unwrap();
+        let samples = trajectory.unwrap().samples;
+        let memory = run_from_walk(&job.config, &summary.status, &summary.steps, &samples).unwrap();
+        assert_eq!(memory.geometry, files.geometry);
+        assert_eq!(memory.status, files.status);
+        assert_eq!(memory.samples, files.samples);
+        // Debug text, where NaN (an undefined indicator) equals NaN.
+        assert_eq!(format!("{:?}", memory.steps), format!("{:?}", files.steps));
+        assert!(memory.warnings.is_empty());
+    }
 }

@@ -332,16 +332,24 @@ pub fn png_size(bytes: &[u8]) -> Option<(u32, u32)> {
 /// failed write (a full disk) is an error that says what happened (`No space left on device`), where plotters
 /// prints debug text, and it is never lost in a buffered writer's drop.
 pub(crate) fn save_png(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<(), PlotError> {
-    use image::ImageEncoder;
-    let fail = |message: String| PlotError::Draw {
+    let bytes = png_bytes(path, rgb, size)?;
+    std::fs::write(path, bytes).map_err(|e| PlotError::Draw {
         path: path.display().to_string(),
-        message,
-    };
+        message: e.to_string(),
+    })
+}
+
+/// The bytes [`save_png`] writes (errors name `path`, the file being made).
+pub(crate) fn png_bytes(path: &Path, rgb: &[u8], size: (u32, u32)) -> Result<Vec<u8>, PlotError> {
+    use image::ImageEncoder;
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(rgb, size.0, size.1, image::ColorType::Rgb8)
-        .map_err(|e| fail(e.to_string()))?;
-    std::fs::write(path, bytes).map_err(|e| fail(e.to_string()))
+        .map_err(|e| PlotError::Draw {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+    Ok(bytes)
 }
 
 impl PlotError {

@@ -1,8 +1,7 @@
 //! GIF encoding: frames mapped to a fixed palette through a 15-bit lookup table, each stored as the
 //! rectangle that changed since the previous frame (the "Encoding" paragraph of the module doc).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 use plotters::coord::Shift;
@@ -68,12 +67,31 @@ pub(super) fn centis(k: usize, fps: u32) -> u64 {
     (k as f64 * 100.0 / f64::from(fps)).round() as u64
 }
 
-/// Draws `frames` with `draw` and writes them to `path` as a looping GIF of `width` x `height` pixels played
-/// at `fps` frames per second; returns the size of the file \[bytes\].
+/// A writer that counts the bytes it passes on.
+struct Counted<W> {
+    inner: W,
+    bytes: u64,
+}
+
+impl<W: Write> Write for Counted<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.bytes += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// Draws `frames` with `draw` and writes them to `out` (errors name `path`, the file being made) as a looping
+/// GIF of `width` x `height` pixels played at `fps` frames per second; returns the size of the GIF \[bytes\].
 ///
 /// Frames are drawn, mapped to the palette and LZW-compressed in parallel, a chunk at a time, and written in
 /// order.
 pub(super) fn write_gif(
+    out: impl Write,
     path: &Path,
     (width, height): (u32, u32),
     fps: u32,
@@ -90,9 +108,12 @@ pub(super) fn write_gif(
     let mut flat: Vec<u8> = palette.iter().flatten().copied().collect();
     flat.extend([255, 0, 255]);
     let (w, h) = (width as usize, height as usize);
-    let file = File::create(path).map_err(|e| write_err(e.to_string()))?;
-    let mut encoder = gif::Encoder::new(BufWriter::new(file), w as u16, h as u16, &flat)
-        .map_err(|e| write_err(e.to_string()))?;
+    let out = Counted {
+        inner: out,
+        bytes: 0,
+    };
+    let mut encoder =
+        gif::Encoder::new(out, w as u16, h as u16, &flat).map_err(|e| write_err(e.to_string()))?;
     encoder
         .set_repeat(gif::Repeat::Infinite)
         .map_err(|e| write_err(e.to_string()))?;
@@ -144,9 +165,7 @@ pub(super) fn write_gif(
     }
     let mut out = encoder.into_inner().map_err(|e| write_err(e.to_string()))?;
     out.flush().map_err(|e| write_err(e.to_string()))?;
-    Ok(std::fs::metadata(path)
-        .map_err(|e| write_err(e.to_string()))?
-        .len())
+    Ok(out.bytes)
 }
 
 /// The GIF frame for `current`: the whole frame first, then only the rectangle that changed since `previous`,

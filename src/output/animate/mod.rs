@@ -34,14 +34,16 @@ mod encode;
 mod plan;
 mod pose;
 
+use std::fs::File;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
 use super::read::RunData;
-use super::style::{require_font, save_png, PlotError};
+use super::style::{png_bytes, require_font, save_png, PlotError};
 use draw::Renderer;
-pub use plan::{plan_frames, FrameTime, SlowMotion};
+pub use plan::{plan_frames, FrameTime, SlowMotion, MAX_ANIMATION_FRAMES};
 
 /// Largest frame rate: GIF delays are whole hundredths of a second and viewers slow down delays below
 /// 0.02 s, so faster frame rates would not play at their speed.
@@ -123,8 +125,8 @@ pub enum AnimateError {
 }
 
 impl AnimateOptions {
-    /// Check every option; the error names the option and the value.
-    pub(crate) fn validate(&self) -> Result<(), AnimateError> {
+    /// Check every option; the error names the option (by its flag) and the value.
+    pub fn validate(&self) -> Result<(), AnimateError> {
         let bad = |option, reason: String| Err(AnimateError::InvalidOption { option, reason });
         if !(1..=MAX_FPS).contains(&self.fps) {
             return bad(
@@ -190,24 +192,68 @@ pub struct AnimationReport {
 /// Writes the animation of `run` to `path` (see the module doc).
 ///
 /// # Errors
-/// [`AnimateError::InvalidOption`] for an option out of range, [`AnimateError::EmptyWindow`] when the time
-/// window misses the trajectory, [`AnimateError::Draw`] / [`AnimateError::Write`] when a frame cannot be drawn
-/// or the file written.
+/// [`AnimateError::InvalidOption`] for an option out of range or more than [`MAX_ANIMATION_FRAMES`] frames,
+/// [`AnimateError::EmptyWindow`] when the time window misses the trajectory, [`AnimateError::Draw`] /
+/// [`AnimateError::Write`] when a frame cannot be drawn or the file written.
 pub fn write_animation(
     run: &RunData,
     opts: &AnimateOptions,
     path: &Path,
 ) -> Result<AnimationReport, AnimateError> {
+    let (window, frames) = planned(run, opts, path)?;
+    let file = File::create(path).map_err(|e| AnimateError::Write {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    encoded(run, opts, (window, &frames), BufWriter::new(file), path)
+}
+
+/// Writes the animation of `run` to `out`: the bytes [`write_animation`] writes to a file (errors and the
+/// report name `name`), e.g. into a `Vec<u8>` for a front that shows the GIF without a file.
+///
+/// # Errors
+/// As [`write_animation`].
+pub fn write_animation_to(
+    run: &RunData,
+    opts: &AnimateOptions,
+    out: impl Write,
+    name: &Path,
+) -> Result<AnimationReport, AnimateError> {
+    let (window, frames) = planned(run, opts, name)?;
+    encoded(run, opts, (window, &frames), out, name)
+}
+
+/// The checked options' window and frames (errors name `path`, the file being made).
+fn planned(
+    run: &RunData,
+    opts: &AnimateOptions,
+    path: &Path,
+) -> Result<((f64, f64), Vec<FrameTime>), AnimateError> {
     opts.validate()?;
+    plan::check_frame_count(run, opts)?;
     let window = plan::window(run, opts)?;
     require_font(path)?;
-    let frames = plan_frames(&run.samples, window, opts.fps, opts.speed);
+    Ok((
+        window,
+        plan_frames(&run.samples, window, opts.fps, opts.speed),
+    ))
+}
+
+/// Draws and encodes the planned `frames` of `run` into `out`.
+fn encoded(
+    run: &RunData,
+    opts: &AnimateOptions,
+    (window, frames): ((f64, f64), &[FrameTime]),
+    out: impl Write,
+    path: &Path,
+) -> Result<AnimationReport, AnimateError> {
     let renderer = Renderer::new(run, opts);
     let bytes = encode::write_gif(
+        out,
         path,
         (opts.width, opts.height),
         opts.fps,
-        &frames,
+        frames,
         |root, frame| renderer.draw(root, frame, path),
     )?;
     Ok(AnimationReport {
@@ -231,6 +277,32 @@ pub(crate) fn write_still(
     time: f64,
     path: &Path,
 ) -> Result<(), AnimateError> {
+    let rgb = still_rgb(run, opts, time, path)?;
+    Ok(save_png(path, &rgb, (opts.width, opts.height))?)
+}
+
+/// One frame of the animation, at simulated time `time`, as the bytes of a PNG: the file `vrw animate --still`
+/// writes (errors name `name`).
+///
+/// # Errors
+/// As [`write_animation`]; a `time` outside the trajectory is an [`AnimateError::EmptyWindow`].
+pub fn still_png(
+    run: &RunData,
+    opts: &AnimateOptions,
+    time: f64,
+    name: &Path,
+) -> Result<Vec<u8>, AnimateError> {
+    let rgb = still_rgb(run, opts, time, name)?;
+    Ok(png_bytes(name, &rgb, (opts.width, opts.height))?)
+}
+
+/// The RGB bitmap of the frame at `time` (errors name `path`, the file being made).
+fn still_rgb(
+    run: &RunData,
+    opts: &AnimateOptions,
+    time: f64,
+    path: &Path,
+) -> Result<Vec<u8>, AnimateError> {
     opts.validate()?;
     let (start, end) = run.time_span();
     if !(start..=end).contains(&time) {
@@ -250,7 +322,7 @@ pub(crate) fn write_still(
         let frame = FrameTime { time, slow: None };
         Renderer::new(run, opts).draw(&root, &frame, path)?;
     }
-    Ok(save_png(path, &rgb, size)?)
+    Ok(rgb)
 }
 
 #[cfg(test)]
@@ -277,5 +349,42 @@ mod tests {
         );
         bad(AnimateOptions { height: 5, ..d() }, "--height");
         assert!(d().validate().is_ok());
+    }
+
+    /// The GIF written to a writer is the file's, and the report counts its bytes.
+    #[test]
+    fn gif_in_memory_is_the_file() {
+        let config = crate::params::Config::default();
+        let job = crate::app::SimulateJob {
+            config: config.clone(),
+            initial: None,
+            steps: 1,
+            sample_dt: 0.01,
+            trajectory: true,
+            out_dir: PathBuf::new(),
+            interrupt: None,
+        };
+        let (summary, trajectory) = crate::app::compute_simulation(&job, true).unwrap();
+        let samples = trajectory.unwrap().samples;
+        let run =
+            super::super::read::run_from_walk(&config, &summary.status, &summary.steps, &samples)
+                .unwrap();
+        let opts = AnimateOptions {
+            fps: 5,
+            width: 160,
+            height: 160,
+            ..AnimateOptions::default()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("walk.gif");
+        let file = write_animation(&run, &opts, &path).unwrap();
+        let mut bytes = Vec::new();
+        let memory = write_animation_to(&run, &opts, &mut bytes, &path).unwrap();
+        assert_eq!(bytes, std::fs::read(&path).unwrap());
+        assert_eq!(memory, file);
+        assert_eq!(memory.bytes, bytes.len() as u64);
+        let png = still_png(&run, &opts, 0.5, &path).unwrap();
+        write_still(&run, &opts, 0.5, &path).unwrap();
+        assert_eq!(png, std::fs::read(&path).unwrap());
     }
 }

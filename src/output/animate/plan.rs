@@ -3,6 +3,8 @@
 
 use super::super::read::{RunData, TrajectoryRow};
 use super::{AnimateError, AnimateOptions};
+use crate::fmt::short;
+
 /// Extra frames given to a phase that no regular frame falls into.
 pub(crate) const SLOW_FRAMES: usize = 3;
 
@@ -24,6 +26,32 @@ pub struct FrameTime {
     pub time: f64,
     /// Set on frames added to show a short phase.
     pub slow: Option<SlowMotion>,
+}
+
+/// The most frames an animation has: an hour of playback at 25 frames per second. The regular frames number
+/// `(to - from) fps / speed + 1` over the window `[from, to]` of simulated time.
+pub const MAX_ANIMATION_FRAMES: usize = 90_000;
+
+/// Refuses an animation of more than [`MAX_ANIMATION_FRAMES`] frames, counted before any is planned.
+pub(super) fn check_frame_count(run: &RunData, opts: &AnimateOptions) -> Result<(), AnimateError> {
+    let (start, end) = run.time_span();
+    let from = opts.from.unwrap_or(start).max(start);
+    let to = opts.to.unwrap_or(end).min(end);
+    let frames = ((to - from).max(0.0) * f64::from(opts.fps) / opts.speed).floor() + 1.0;
+    if frames > MAX_ANIMATION_FRAMES as f64 {
+        return Err(AnimateError::InvalidOption {
+            option: "--speed",
+            reason: format!(
+                "{} s of simulated time at speed {} and {} frames per second is {} frames, more than \
+                 {MAX_ANIMATION_FRAMES}: raise --speed, lower --fps or narrow the window with --from/--to",
+                short(to - from),
+                short(opts.speed),
+                opts.fps,
+                short(frames)
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The simulated window `[from, to]` of the animation, clipped to the samples.
