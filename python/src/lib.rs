@@ -35,8 +35,8 @@ use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
 use vrw::output::{
     basin_header, basin_row, branch_header, branch_rows, curve_header, curve_row, family_header,
-    family_row, map_header, map_rows, orbit_header, orbit_rows, step_row, sweep_header, sweep_row,
-    trajectory_row, Cell, STEPS_HEADER, TRAJECTORY_HEADER,
+    family_row, map_header, map_rows, orbit_header, orbit_rows, steps_header, steps_row,
+    sweep_header, sweep_row, trajectory_row, Cell, TRAJECTORY_HEADER,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -403,8 +403,13 @@ fn simulate<'py>(
     let (summary, samples) =
         interruptible(py, &flag, || compute_simulation(&job, trajectory))?.map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
-    let rows: Vec<Vec<Cell>> = summary.steps.iter().map(step_row).collect();
-    result.set_item("steps", table(py, &STEPS_HEADER, &rows)?)?;
+    let rear_exit = params.config.params.rear_exit;
+    let rows: Vec<Vec<Cell>> = summary
+        .steps
+        .iter()
+        .map(|s| steps_row(s, rear_exit))
+        .collect();
+    result.set_item("steps", table(py, &steps_header(rear_exit), &rows)?)?;
     match samples {
         Some(t) => {
             let rows: Vec<Vec<Cell>> = t.samples.iter().map(trajectory_row).collect();

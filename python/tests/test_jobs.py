@@ -31,6 +31,18 @@ def test_simulate_equals_the_command_lines_files(cli, tmp_path):
     assert vrw.simulate(vrw.Params(viscosity=37), steps=4, trajectory=False)["trajectory"] is None
 
 
+def test_a_reset_walk_has_the_reset_energy_column_of_the_command_line(cli, tmp_path):
+    # Stiff legs whose old rear leg is still free at a touchdown: `rear_exit = "reset"` walks on.
+    keys = {"viscosity": 28.181818181818183, "stiffness": 1945.4545454545455, "rear_exit": "reset"}
+    sets = [a for k, v in keys.items() for a in ("--set", f"{k}={v}")]
+    cli("simulate", "--steps", 20, *sets, "--out", tmp_path)
+    run = vrw.simulate(vrw.Params(**keys), steps=20, trajectory=False)
+    assert list(run["steps"])[-1] == "reset_energy"
+    assert_table_equals_csv(run["steps"], tmp_path / "steps.csv")
+    assert run["status"] == "completed"
+    assert "reset_energy" not in vrw.simulate(vrw.Params(**dict(keys, rear_exit="relock")), steps=2)["steps"]
+
+
 def test_a_walk_that_stops_is_a_status(cli, tmp_path):
     # Uphill the wheel cannot walk: it rolls back (whatever the other parameters).
     cli("simulate", "--steps", 3, "--set", "slope=-0.1", "--out", tmp_path, check=False)

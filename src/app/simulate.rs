@@ -229,7 +229,8 @@ pub(super) fn simulate_into(
     output::write_json(&run.path("summary.json"), &running)?;
     let names: Vec<&str> = files.iter().map(String::as_str).collect();
     run.add_streaming(&names)?;
-    let mut steps_csv = output::StepsCsv::create(&run.path("steps.csv"))?;
+    let mut steps_csv =
+        output::StepsCsv::create(&run.path("steps.csv"), job.config.params.rear_exit)?;
     let trajectory_path = run.path("trajectory.csv");
     let mut trajectory = if job.trajectory {
         let sink = output::TrajectoryCsv::create(&trajectory_path)?;

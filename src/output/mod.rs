@@ -33,7 +33,9 @@ pub use tables::family::{curve_header, curve_row, family_header, family_row, Cur
 pub(crate) use tables::family::{write_curves_csv, write_family_csv};
 pub(crate) use tables::map::write_map_csv;
 pub use tables::map::{map_header, map_rows};
-pub use tables::steps::{step_row, write_steps_csv, StepsCsv, STEPS_HEADER};
+pub use tables::steps::{
+    step_row, steps_header, steps_row, write_steps_csv, StepsCsv, STEPS_HEADER,
+};
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
 pub use tables::trajectory::{
     trajectory_row, write_trajectory_csv, TrajectoryCsv, TRAJECTORY_HEADER,

@@ -36,7 +36,7 @@ pub(crate) mod solver;
 pub use model::{
     LegTimeScale, Params, MASS_RATIO_LIMIT, MAX_LEGS, MIN_LEG_TIME_SCALE, SLOW_LEG_TIME_SCALE,
 };
-pub use solver::{ContactInconsistency, ImpactModel, SolverOptions};
+pub use solver::{ContactInconsistency, ImpactModel, RearExit, SolverOptions};
 pub use solver::{
     ATOL_RANGE, EVENT_TIME_TOL_RANGE, GAP_RANGE, MAX_EVENTS_PER_STEP_LIMIT, MAX_STEP_RANGE,
     MAX_STEP_TIME_RANGE, RTOL_RANGE,

@@ -3,7 +3,7 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::solver::{ContactInconsistency, ImpactModel};
+use super::solver::{ContactInconsistency, ImpactModel, RearExit};
 use super::{finite, invalid, non_negative, ordered, positive, ConfigError, Order::*, Rules};
 use crate::fmt::short;
 
@@ -58,6 +58,10 @@ pub struct Params {
     /// What happens when no no-slip contact state is consistent (a lift-off with a non-zero tangential
     /// contact force). Default [`ContactInconsistency::Slide`]. `docs/model.md` sections 3-4.
     pub inconsistent_contact: ContactInconsistency,
+    /// What becomes of the old rear leg when it leaves the coordinates at a touchdown. Default
+    /// [`RearExit::Relock`] (it must be locked on its stopper by then). `docs/model.md` section 5.
+    #[serde(skip_serializing_if = "RearExit::is_relock")]
+    pub rear_exit: RearExit,
 }
 
 impl Default for Params {
@@ -79,6 +83,7 @@ impl Default for Params {
             impact: ImpactModel::Dlsi,
             rigid_legs: false,
             inconsistent_contact: ContactInconsistency::Slide,
+            rear_exit: RearExit::Relock,
         }
     }
 }

@@ -1,7 +1,8 @@
 //! The numerical side of a configuration: [`SolverOptions`] (integrator, tolerances, and every guard against
 //! grazing and chatter, `docs/model.md` section 4) with their accepted ranges, and the named choices a
 //! configuration makes between models and methods: the impact law ([`ImpactModel`]), the treatment of an
-//! inconsistent contact ([`ContactInconsistency`]) and the integrator ([`Method`]).
+//! inconsistent contact ([`ContactInconsistency`]), the old rear leg at re-indexing ([`RearExit`]) and the
+//! integrator ([`Method`]).
 //!
 //! In a file and on the command line a choice is written as its lowercase name (`impact = "traditional"`);
 //! serde's `rename_all = "lowercase"` is the only place these names are declared for reading, and
@@ -72,6 +73,47 @@ impl ContactInconsistency {
 }
 
 impl fmt::Display for ContactInconsistency {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What becomes of the old rear leg (Leg 2) when it leaves the coordinates at a touchdown (`docs/model.md`
+/// section 5, "Re-indexing"): the model keeps only Legs 1 and 2 free, so the leg that leaves must become a
+/// rigid spoke at `L0`.
+///
+/// In TOML and on the command line the values are the strings `"relock"` (default) and `"reset"`;
+/// [`Display`](fmt::Display) gives the same strings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RearExit {
+    /// The leg must already be locked on its stopper (and in the air) at the touchdown; if it is not, the walk
+    /// stops with `rear_leg_not_locked`. Nothing is discarded, so energy is conserved through re-indexing.
+    #[default]
+    Relock,
+    /// The leg's length and rate are discarded at the touchdown and it becomes a spoke at `L0` (as a
+    /// third-party MATLAB VRW code does). Not physical: the energy this adds or removes is reported per step
+    /// (`reset_energy`). The leg must still be in the air.
+    Reset,
+}
+
+impl RearExit {
+    /// The name of this choice, as in TOML and on the command line (serde's name of the variant).
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            RearExit::Relock => "relock",
+            RearExit::Reset => "reset",
+        }
+    }
+
+    /// The default, [`RearExit::Relock`] (left out of written configurations, so that they stay as they were
+    /// before the key existed).
+    pub(crate) fn is_relock(&self) -> bool {
+        *self == RearExit::Relock
+    }
+}
+
+impl fmt::Display for RearExit {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }

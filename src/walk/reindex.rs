@@ -1,15 +1,18 @@
 //! Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg becomes Leg 1, the legs
-//! behind it shift, and the legs that leave `q` must be locked and in the air.
+//! behind it shift, and the legs that leave `q` must be in the air, and locked or reset.
 
 use crate::contact::{ActiveSet, Leg};
 use crate::dynamics::{Coords, Model, L1, THETA};
+use crate::params::RearExit;
 
 use super::error::WalkError;
 
 /// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
 /// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
-/// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be locked at `L0` and in the air.
-/// The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact)`.
+/// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be in the air, and locked at
+/// `L0` ([`RearExit::Relock`]) or reset to it ([`RearExit::Reset`]: their length and rate are discarded). The
+/// origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact, energy removed by
+/// the reset)`: `T + V` before minus after the reset \[J\], 0 when no leg was reset.
 pub(super) fn reindex(
     model: &Model,
     time: f64,
@@ -17,15 +20,24 @@ pub(super) fn reindex(
     qd: &Coords,
     active: ActiveSet,
     touching: usize,
-) -> Result<(Coords, Coords, ActiveSet), WalkError> {
+) -> Result<(Coords, Coords, ActiveSet, f64), WalkError> {
     // The touching leg is `shift` legs ahead of Leg 1; with `shift > 1` the new Leg 2 is a locked leg.
     let shift = model.legs() - touching;
     let leaving: &[Leg] = if shift == 1 { &[Leg::Two] } else { &Leg::BOTH };
+    let reset = model.params().rear_exit == RearExit::Reset;
+    let (mut q_reset, mut qd_reset) = (*q, *qd);
     for &leg in leaving {
         if active.contact(leg) {
             return Err(WalkError::RearLegInContact { time });
         }
-        if !active.lock(leg) {
+        if active.lock(leg) {
+            // Locked: at `L0` and at rest (to the stopper's tolerance, which both choices leave out).
+            continue;
+        }
+        if reset {
+            q_reset[leg.length_coordinate()] = model.params().stopper_length;
+            qd_reset[leg.length_coordinate()] = 0.0;
+        } else {
             let i = leg.length_coordinate();
             return Err(WalkError::RearLegNotLocked {
                 time,
@@ -58,5 +70,11 @@ pub(super) fn reindex(
         lock2: shift > 1 || active.lock1,
         ..Default::default()
     };
-    Ok((q_new, qd_new, before))
+    // Only a free leg is reset: with none, the reset removes nothing, exactly.
+    let reset_energy = if (q_reset, qd_reset) == (*q, *qd) {
+        0.0
+    } else {
+        model.energy(q, qd) - model.energy(&q_reset, &qd_reset)
+    };
+    Ok((q_new, qd_new, before, reset_energy))
 }

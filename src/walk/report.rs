@@ -29,6 +29,15 @@ pub struct EnergyAudit {
     pub stopper: f64,
     /// `loss - (damper + impact + stopper)` \[J\]: zero up to the integration error.
     pub residual: f64,
+    /// Energy removed (negative: added) after the step, at the touchdown that ends it, by discarding the old
+    /// rear leg's length and rate (`rear_exit = "reset"`, docs/model.md section 5) \[J\]: `end` minus `T + V`
+    /// of the reset state. 0 with `rear_exit = "relock"` (written only when not 0).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub reset: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// A step whose energy audit leaves more than this unexplained \[J\] is a warning: the integration or an event

@@ -279,6 +279,7 @@ impl<'m> Walker<'m> {
         let step_length = front.position.x - start.q[X];
         let period = t - start.time;
         self.steps_done += 1;
+        let reindexed = reindex(model, t, &q, &qd, active, touching);
         let report = StepReport {
             step: self.steps_done,
             time: start.time,
@@ -302,11 +303,12 @@ impl<'m> Walker<'m> {
                 impact: tally.impact_loss,
                 stopper: tally.stopper_loss,
                 residual: loss - (damper + tally.impact_loss + tally.stopper_loss),
+                reset: reindexed.as_ref().map_or(0.0, |r| r.3),
             },
             contact: tally.audit,
         };
-        match reindex(model, t, &q, &qd, active, touching) {
-            Ok((q_new, qd_new, before)) => {
+        match reindexed {
+            Ok((q_new, qd_new, before, _)) => {
                 self.state = WalkState {
                     time: t,
                     q: q_new,

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use super::{fixed_names, row, Cell, Column};
 use crate::output::{CsvStream, OutputError};
+use crate::params::RearExit;
 use crate::walk::StepReport;
 
 use Cell::{Count, Flag, Real, Text};
@@ -156,29 +157,62 @@ pub const STEPS: [Column<StepReport>; 30] = [
 /// Header of `steps.csv` (the names of `STEPS`).
 pub const STEPS_HEADER: [&str; 30] = fixed_names(&STEPS, 0);
 
+/// The last column of `steps.csv` of a walk with `rear_exit = "reset"` (only there, so that every other walk's
+/// file is as it was before the option existed).
+pub(crate) const RESET_COLUMN: Column<StepReport> = Column::new(
+    "reset_energy",
+    "Energy removed (negative: added) at the touchdown that ends the step by discarding the old rear leg's \
+     length and rate, rear_exit = \"reset\": not part of energy_loss [J].",
+    |s| Real(s.energy.reset),
+);
+
 /// One row of `steps.csv`, in the order of [`STEPS_HEADER`].
 pub fn step_row(s: &StepReport) -> Vec<Cell> {
     row(&STEPS, s)
 }
 
+/// The header of `steps.csv` of a walk whose old rear legs leave as `rear_exit` says: [`STEPS_HEADER`], and
+/// [`RESET_COLUMN`] last under [`RearExit::Reset`].
+pub fn steps_header(rear_exit: RearExit) -> Vec<&'static str> {
+    let mut header = STEPS_HEADER.to_vec();
+    if rear_exit == RearExit::Reset {
+        header.push(RESET_COLUMN.header_name(&[]));
+    }
+    header
+}
+
+/// One row of `steps.csv` under `rear_exit`, in the order of [`steps_header`].
+pub fn steps_row(s: &StepReport, rear_exit: RearExit) -> Vec<Cell> {
+    let mut cells = step_row(s);
+    if rear_exit == RearExit::Reset {
+        cells.push((RESET_COLUMN.get)(s));
+    }
+    cells
+}
+
 /// `steps.csv` written step by step (`CsvStream`).
-pub struct StepsCsv(CsvStream);
+pub struct StepsCsv(CsvStream, RearExit);
 
 impl StepsCsv {
-    /// Create `path` with the header [`STEPS_HEADER`].
-    pub(crate) fn create(path: &Path) -> Result<StepsCsv, OutputError> {
-        CsvStream::create(path, STEPS_HEADER).map(StepsCsv)
+    /// Create `path` with the header [`steps_header`] of `rear_exit`.
+    pub(crate) fn create(path: &Path, rear_exit: RearExit) -> Result<StepsCsv, OutputError> {
+        CsvStream::create(path, steps_header(rear_exit)).map(|w| StepsCsv(w, rear_exit))
     }
 
     /// Write the row of one step and flush it.
     pub(crate) fn write(&mut self, step: &StepReport) -> Result<(), OutputError> {
-        self.0.write(step_row(step).iter().map(Cell::to_csv))
+        self.0
+            .write(steps_row(step, self.1).iter().map(Cell::to_csv))
     }
 }
 
-/// Write the per-step table `steps.csv`: one row per touchdown (section state before it, DLS indicators,
-/// branch, step measures, flags, the energy audit, and the contact audit).
-pub fn write_steps_csv(path: &Path, steps: &[StepReport]) -> Result<(), OutputError> {
-    let mut w = StepsCsv::create(path)?;
+/// Write the per-step table `steps.csv` of a walk under `rear_exit`: one row per touchdown (section state
+/// before it, DLS indicators, branch, step measures, flags, the energy audit, and the contact audit).
+pub fn write_steps_csv(
+    path: &Path,
+    steps: &[StepReport],
+    rear_exit: RearExit,
+) -> Result<(), OutputError> {
+    let mut w = StepsCsv::create(path, rear_exit)?;
     steps.iter().try_for_each(|s| w.write(s))
 }

@@ -25,7 +25,7 @@ use crate::output::{
     write_map_csv, write_orbit_csv, write_steps_csv, write_sweep_csv, write_trajectory_csv,
     STEPS_HEADER, SWEEP_COLUMNS, TRAJECTORY_HEADER,
 };
-use crate::params::Config;
+use crate::params::{Config, RearExit};
 use crate::reference::default_initial;
 use crate::walk::{simulate, Sample, SectionState, StepReport, Trajectory};
 
@@ -159,7 +159,7 @@ fn every_table_reads_back_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name);
 
-    write_steps_csv(&path("steps.csv"), &f.steps).unwrap();
+    write_steps_csv(&path("steps.csv"), &f.steps, RearExit::Relock).unwrap();
     check_by_name(&path("steps.csv"), &STEPS, &[], &f.steps);
     write_trajectory_csv(&path("trajectory.csv"), &f.samples).unwrap();
     check_by_name(&path("trajectory.csv"), &TRAJECTORY, &[], &f.samples);
@@ -301,7 +301,7 @@ fn readers_follow_the_declarations() {
     let f = fixture();
     let dir = tempfile::tempdir().unwrap();
     let steps_path = dir.path().join("steps.csv");
-    write_steps_csv(&steps_path, &f.steps).unwrap();
+    write_steps_csv(&steps_path, &f.steps, RearExit::Relock).unwrap();
     let steps: Vec<StepRow> = read_csv(&steps_path, false).unwrap();
     check("steps.csv", &STEPS, &f.steps, &steps);
     let trajectory_path = dir.path().join("trajectory.csv");
@@ -339,7 +339,7 @@ fn readers_hold_the_named_quantities() {
         assert_eq!((r.time, r.leg1), (s.time, s.leg1));
     }
     let path = dir.path().join("steps.csv");
-    write_steps_csv(&path, &f.steps).unwrap();
+    write_steps_csv(&path, &f.steps, RearExit::Relock).unwrap();
     let rows: Vec<StepRow> = read_csv(&path, false).unwrap();
     for (s, r) in f.steps.iter().zip(&rows) {
         let i = &s.indicators;
