@@ -2,10 +2,10 @@
 //! expressible. Here `rear_exit`: what becomes of the old rear leg when it leaves the coordinates at a
 //! touchdown (docs/model.md section 5).
 
-use vrw::dynamics::Model;
+use vrw::dynamics::{Model, L1, L2};
 use vrw::params::{Config, RearExit};
 use vrw::reference::default_initial;
-use vrw::walk::{simulate, WalkError, WalkRun};
+use vrw::walk::{simulate, Trajectory, WalkError, WalkRun};
 
 /// Stiff legs where the old rear leg bounces on its stopper and is still free (within a micrometre of `L0`)
 /// at a touchdown of the transient: `rear_exit = "relock"` stops there.
@@ -119,4 +119,87 @@ fn rear_exit_reads_and_writes_its_names() {
     assert!(serde_json::to_string(&config)
         .unwrap()
         .contains("\"rear_exit\":\"reset\""));
+}
+
+/// The third-party code's reading: Leg 2 without its stopper (`rear_stopper = false`), its state discarded
+/// at the next touchdown (`rear_exit = "reset"`).
+fn third_party() -> Config {
+    let mut c = Config::default();
+    c.params.rear_stopper = false;
+    c.params.rear_exit = RearExit::Reset;
+    c
+}
+
+#[test]
+fn without_a_rear_stopper_leg_2_extends_past_l0_and_the_audits_stay_clean() {
+    let config = third_party();
+    let model = Model::new(&config.params).unwrap();
+    let mut trajectory = Trajectory::new(0.002);
+    let run = simulate(
+        &model,
+        &config.solver,
+        &default_initial(&config),
+        12,
+        Some(&mut trajectory),
+    )
+    .unwrap();
+    assert!(run.failure.is_none(), "{:?}", run.failure);
+    let l0 = config.params.stopper_length;
+    let longest_rear = trajectory
+        .samples
+        .iter()
+        .map(|s| s.q[L2])
+        .fold(0.0, f64::max);
+    let longest_fore = trajectory
+        .samples
+        .iter()
+        .map(|s| s.q[L1])
+        .fold(0.0, f64::max);
+    assert!(
+        longest_rear > l0 + 1e-3,
+        "Leg 2 reached only {longest_rear}"
+    );
+    assert!(
+        longest_fore <= l0 + 1e-8,
+        "Leg 1 went past its stopper: {longest_fore}"
+    );
+    for s in &run.steps {
+        assert!(
+            s.energy.residual.abs() < 1e-8,
+            "step {}: {:?}",
+            s.step,
+            s.energy
+        );
+        assert!(s.contact.pull_force <= 1e-6 && s.contact.pull_impulse <= 1e-9);
+        assert!(s.contact.penetration <= 1e-9 && s.contact.stopper_overrun <= 1e-8);
+        // The extended rear leg is reset to `L0` at every touchdown, which adds the spring energy back.
+        assert!(s.energy.reset < 0.0, "step {}: {:?}", s.step, s.energy);
+    }
+    assert_energy_carries_over(&run, &config, 1e-9);
+}
+
+#[test]
+fn a_rear_leg_without_a_stopper_needs_reset_and_soft_legs() {
+    let mut config = third_party();
+    config.params.rear_exit = RearExit::Relock;
+    let error = config.validate().unwrap_err().to_string();
+    assert!(
+        error.contains("rear_stopper") && error.contains("reset"),
+        "{error}"
+    );
+    let mut config = third_party();
+    config.params.rigid_legs = true;
+    let error = config.validate().unwrap_err().to_string();
+    assert!(
+        error.contains("rear_stopper") && error.contains("rigid"),
+        "{error}"
+    );
+    assert!(third_party().validate().is_ok());
+    // Left out of written configurations at its default, written when false.
+    assert!(!serde_json::to_string(&Config::default())
+        .unwrap()
+        .contains("rear_stopper"));
+    assert!(serde_json::to_string(&third_party())
+        .unwrap()
+        .contains("\"rear_stopper\":false"));
 }

@@ -291,6 +291,8 @@ pub struct Geometry {
     pub slope: f64,
     /// Leg viscosity `c` \[N s/m\].
     pub viscosity: f64,
+    /// Whether Leg 2 has its stopper (`rear_stopper`, true when the key is absent, as it is at its default).
+    pub rear_stopper: bool,
 }
 
 impl Geometry {
@@ -440,6 +442,12 @@ fn summary_fields(path: &Path, text: &str) -> Result<(Geometry, String), ReadErr
         leg_mass_offset: number("leg_mass_offset")?,
         slope: number("slope")?,
         viscosity: number("viscosity")?,
+        rear_stopper: match config.get("rear_stopper") {
+            None => true,
+            Some(_) => parameter(config, path, "rear_stopper", "true or false", |v| {
+                v.as_bool()
+            })?,
+        },
     };
     let status = json
         .get("status")
@@ -652,15 +660,22 @@ fn check_sample(
     for (column, v) in numbers {
         check_number(path, row, column, v)?;
     }
-    let longest = geometry.stopper_length + LENGTH_SLACK;
-    for (column, l) in [("L1", s.l1), ("L2", s.l2)] {
+    let stopped = geometry.stopper_length + LENGTH_SLACK;
+    // Without its stopper Leg 2 extends past `L0`, though not (with a sound spring) to twice its natural length.
+    let free = 2.0 * geometry.spring_natural_length.max(geometry.stopper_length);
+    for (column, l, stopper) in [("L1", s.l1, true), ("L2", s.l2, geometry.rear_stopper)] {
+        let (longest, which) = if stopper {
+            (stopped, format!("L0 + {LENGTH_SLACK:e}"))
+        } else {
+            (free, "2 max(L0, Lstar), no rear stopper".to_string())
+        };
         if !(l > 0.0 && l <= longest) {
             return Err(implausible(
                 path,
                 row,
                 column,
                 l.to_string(),
-                format!("is not a leg length in (0, L0 + {LENGTH_SLACK:e}] = (0, {longest}] m"),
+                format!("is not a leg length in (0, {which}] = (0, {longest}] m"),
             ));
         }
     }

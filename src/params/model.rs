@@ -62,6 +62,16 @@ pub struct Params {
     /// [`RearExit::Relock`] (it must be locked on its stopper by then). `docs/model.md` section 5.
     #[serde(skip_serializing_if = "RearExit::is_relock")]
     pub rear_exit: RearExit,
+    /// Whether Leg 2 (the rear leg) has its extension stopper. Default `true`. `false`: it has no extension
+    /// limit, as in a third-party MATLAB VRW code (Leg 1, the fore leg, keeps its stopper, and a leg loses it
+    /// when it becomes Leg 2 at a touchdown). Needs `rear_exit = "reset"` (the rear leg is then never relocked)
+    /// and `rigid_legs = false`. `docs/model.md` section 5.
+    #[serde(skip_serializing_if = "is_true")]
+    pub rear_stopper: bool,
+}
+
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 impl Default for Params {
@@ -84,6 +94,7 @@ impl Default for Params {
             rigid_legs: false,
             inconsistent_contact: ContactInconsistency::Slide,
             rear_exit: RearExit::Relock,
+            rear_stopper: true,
         }
     }
 }
@@ -183,6 +194,31 @@ impl Params {
                 given,
             )
         });
+        if !self.rear_stopper {
+            rules.between(["rear_stopper", "rear_exit"], |_| {
+                if self.rear_exit != RearExit::Reset {
+                    return Err(invalid(
+                        "rear_stopper",
+                        self.rear_stopper,
+                        format!(
+                            "a rear leg without a stopper is never relocked: it needs rear_exit = \"reset\", not \"{}\"",
+                            self.rear_exit
+                        ),
+                    ));
+                }
+                Ok(())
+            });
+            rules.between(["rear_stopper", "rigid_legs"], |_| {
+                if self.rigid_legs {
+                    return Err(invalid(
+                        "rear_stopper",
+                        self.rear_stopper,
+                        "rigid legs are held by their stoppers both ways: they need rear_stopper = true",
+                    ));
+                }
+                Ok(())
+            });
+        }
         // The time scale needs sound masses: not when the mass ratio is already refused.
         let ratio = self.leg_mass / self.hub_mass;
         if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)

@@ -21,12 +21,17 @@ impl ContactAudit {
     }
 
     /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`),
-    /// and the farthest Leg 1 or 2 is past its stopper.
+    /// and the farthest Leg 1 or 2 is past its stopper (Leg 1 alone when Leg 2 has none, `rear_stopper`).
     pub(crate) fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
         let l0 = model.params().stopper_length;
-        self.stopper_overrun = self.stopper_overrun.max(q[L1].max(q[L2]) - l0);
+        let longest = if model.params().rear_stopper {
+            q[L1].max(q[L2])
+        } else {
+            q[L1]
+        };
+        self.stopper_overrun = self.stopper_overrun.max(longest - l0);
     }
 
     /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).

@@ -6,7 +6,7 @@ use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ConstrainedD
 use crate::dynamics::{Coords, Model, THETA};
 use crate::params::SolverOptions;
 
-use super::impact::{touchdown_leg, COMPLEMENTARITY_TOL};
+use super::impact::{has_stopper, touchdown_leg, COMPLEMENTARITY_TOL};
 use super::phase::{unpack, WalkVector};
 
 /// A lift-off or stopper-unlock event fires when the force falls this far below zero \[N\] (or below its
@@ -74,7 +74,7 @@ impl<'a> EventSet<'a> {
             } else {
                 EventKind::Landing(leg)
             });
-            if !model.params().rigid_legs {
+            if !model.params().rigid_legs && has_stopper(model, leg) {
                 kinds.push(if active.lock(leg) {
                     EventKind::Unlock(leg)
                 } else {

@@ -521,6 +521,11 @@ pub(crate) fn touchdown_impact(
 
 /// The stoppers that act both ways and are always active: both with `rigid_legs` (docs/model.md section 7), none
 /// otherwise. Every active-set resolution starts from this set.
+/// Does `leg` have its extension stopper? Leg 1 always; Leg 2 unless `rear_stopper = false`.
+pub(crate) fn has_stopper(model: &Model, leg: Leg) -> bool {
+    leg == Leg::One || model.params().rear_stopper
+}
+
 pub(crate) fn bilateral_stoppers(model: &Model) -> ActiveSet {
     let rigid = model.params().rigid_legs;
     ActiveSet {

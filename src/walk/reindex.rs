@@ -67,7 +67,8 @@ pub(super) fn reindex(
         contact1: false,
         contact2: shift == 1 && active.contact1,
         lock1: true,
-        lock2: shift > 1 || active.lock1,
+        // A leg that becomes Leg 2 keeps its lock only if Leg 2 has a stopper (`rear_stopper`).
+        lock2: (shift > 1 || active.lock1) && model.params().rear_stopper,
         ..Default::default()
     };
     // Only a free leg is reset: with none, the reset removes nothing, exactly.

@@ -32,8 +32,8 @@ use crate::params::ContactInconsistency;
 use super::error::WalkError;
 
 use super::impact::{
-    bilateral_stoppers, consistent_active_set, plastic_impact, post_impact_candidates, Candidate,
-    Mode, Unit, COMPLEMENTARITY_TOL,
+    bilateral_stoppers, consistent_active_set, has_stopper, plastic_impact, post_impact_candidates,
+    Candidate, Mode, Unit, COMPLEMENTARITY_TOL,
 };
 
 /// A Zeno lock whose stopper impulse exceeds this \[N s\] is reported as a warning by `vrw simulate`: the rule
@@ -89,7 +89,8 @@ fn zeno_units(
     };
     for leg in Leg::BOTH {
         let i = leg.length_coordinate();
-        let stopper_free = !(active.lock(leg) || bilateral.lock(leg) || exclude.lock(leg));
+        let stopper_free = has_stopper(model, leg)
+            && !(active.lock(leg) || bilateral.lock(leg) || exclude.lock(leg));
         let v = qd[i];
         if stopper_free && l0 - q[i] <= stopper_gap && v < -COMPLEMENTARITY_TOL {
             let a_out = free_dynamics()?.qdd[i];

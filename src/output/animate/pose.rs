@@ -142,6 +142,7 @@ mod tests {
             leg_mass_offset: 0.3,
             slope: 0.1,
             viscosity: 50.0,
+            rear_stopper: true,
         };
         let alpha = geometry.alpha();
         let before = TrajectoryRow {
