@@ -3,6 +3,7 @@
 //! touchdown (docs/model.md section 5).
 
 use vrw::dynamics::{Model, L1, L2};
+use vrw::gait::{sweep_values, GaitOptions};
 use vrw::params::{Config, RearExit};
 use vrw::reference::default_initial;
 use vrw::walk::{simulate, Trajectory, WalkError, WalkRun};
@@ -202,4 +203,56 @@ fn a_rear_leg_without_a_stopper_needs_reset_and_soft_legs() {
     assert!(serde_json::to_string(&third_party())
         .unwrap()
         .contains("\"rear_stopper\":false"));
+}
+
+/// Every reading in `readings/` loads, and on a sweep of `c` over 1..300 every gait it has passes the audits:
+/// the energy balance closes, the ground never pulls, no tip goes below it, no leg past its stopper.
+#[test]
+fn every_reading_walks_with_clean_audits_where_it_has_a_gait() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("readings");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 5, "{files:?}");
+    let values: Vec<f64> = (0..12).map(|i| 1.0 + 299.0 * i as f64 / 11.0).collect();
+    for file in files {
+        let config = Config::from_file(&file).unwrap();
+        let points = sweep_values(
+            &config,
+            "viscosity",
+            &values,
+            &default_initial(&config),
+            &GaitOptions::for_sweeps(),
+            &|_| {},
+        )
+        .unwrap();
+        let gaits: Vec<_> = points
+            .iter()
+            .filter_map(|p| p.gait.as_ref().map(|g| (p.value, g)))
+            .collect();
+        assert!(!gaits.is_empty(), "{}: no gait", file.display());
+        for (c, g) in gaits {
+            let at = format!("{} at c = {c}", file.display());
+            assert!(
+                g.energy_residual.abs() < 1e-8,
+                "{at}: {}",
+                g.energy_residual
+            );
+            for s in &g.cycle {
+                assert!(s.energy.residual.abs() < 1e-8, "{at}: {:?}", s.energy);
+                let c = &s.contact;
+                assert!(
+                    c.pull_force <= 1e-6 && c.pull_impulse <= 1e-9,
+                    "{at}: {c:?}"
+                );
+                assert!(
+                    c.penetration <= 1e-9 && c.stopper_overrun <= 1e-8,
+                    "{at}: {c:?}"
+                );
+            }
+        }
+    }
 }
