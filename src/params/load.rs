@@ -808,7 +808,10 @@ mod tests {
             assert_eq!(key_of(&error), Some("stopper_length"), "{error}");
             assert_eq!(
                 error.to_string(),
-                "invalid value 2 for `stopper_length`: must be <= spring_natural_length (1.02)"
+                concat!(
+                "invalid value 2 for `stopper_length`: must be <= spring_natural_length (1.02)",
+                " (a shorter spring pulls a free leg off its stopper, so the rear leg is never relocked: it needs rear_exit = \"reset\")"
+            )
             );
         }
         // Given both, or only the other key, the rule names the key it always named.
@@ -816,7 +819,10 @@ mod tests {
             Config::load(None, &["stopper_length=2", "spring_natural_length=1.5"]).unwrap_err();
         assert_eq!(
             error.to_string(),
-            "invalid value 1.5 for `spring_natural_length`: must be >= stopper_length (2)"
+            concat!(
+                "invalid value 1.5 for `spring_natural_length`: must be >= stopper_length (2)",
+                " (a shorter spring pulls a free leg off its stopper, so the rear leg is never relocked: it needs rear_exit = \"reset\")"
+            )
         );
         // Every rule it breaks is listed, each naming the key given.
         let error = Config::load(None, &["stopper_length=0.2"]).unwrap_err();

@@ -36,7 +36,7 @@ pub struct Params {
     pub stopper_length: f64,
     /// Natural length `Lstar` of the leg spring \[m\]. Default 1.02 (Table 1). At least `stopper_length`:
     /// the spring is preloaded by `k (Lstar - L0)` (10 N by default) so that an unloaded leg rests on its
-    /// stopper. `docs/model.md` section 2.
+    /// stopper; shorter (the tension reading) only with `rear_exit = "reset"`. `docs/model.md` sections 2 and 5.
     pub spring_natural_length: f64,
     /// Spring stiffness `k` of Legs 1 and 2 \[N/m\]. Default 500 (Table 1). Positive. `docs/model.md` section 2.
     pub stiffness: f64,
@@ -110,7 +110,8 @@ impl Params {
     ///
     /// Rules: `3 <= legs <=` [`MAX_LEGS`]; every real value finite; `hub_mass`, `leg_mass`, `gravity`, `stopper_length`,
     /// `stiffness > 0`; `hub_inertia`, `viscosity >= 0`; `|slope| < pi/2`;
-    /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length`;
+    /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length` (unless
+    /// `rear_exit = "reset"`); `rear_stopper = false` only with `rear_exit = "reset"` and soft legs;
     /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1; legs not too stiff to integrate (the time scale
     /// of [`Params::leg_time_scale`] at least [`MIN_LEG_TIME_SCALE`]).
     pub fn validate(&self) -> Result<(), ConfigError> {
@@ -186,14 +187,29 @@ impl Params {
                 given,
             )
         });
-        rules.between(["spring_natural_length", "stopper_length"], |given| {
-            ordered(
-                ("spring_natural_length", self.spring_natural_length),
-                AtLeast,
-                stopper,
-                given,
-            )
-        });
+        // A spring shorter than the stopper (the tension reading) pulls a free leg off its stopper, so a rear leg
+        // is never relocked: allowed only where its state is discarded at the next touchdown.
+        if self.rear_exit != RearExit::Reset {
+            rules.between(["spring_natural_length", "stopper_length"], |given| {
+                ordered(
+                    ("spring_natural_length", self.spring_natural_length),
+                    AtLeast,
+                    stopper,
+                    given,
+                )
+                .map_err(|e| match e {
+                    ConfigError::InvalidValue { key, value, reason } => ConfigError::InvalidValue {
+                        key,
+                        value,
+                        reason: format!(
+                            "{reason} (a shorter spring pulls a free leg off its stopper, so the rear leg is \
+                             never relocked: it needs rear_exit = \"reset\")"
+                        ),
+                    },
+                    other => other,
+                })
+            });
+        }
         if !self.rear_stopper {
             rules.between(["rear_stopper", "rear_exit"], |_| {
                 if self.rear_exit != RearExit::Reset {
