@@ -172,7 +172,7 @@ pub fn step_row(s: &StepReport) -> Vec<Cell> {
 }
 
 /// The header of `steps.csv` of a walk whose old rear legs leave as `rear_exit` says: [`STEPS_HEADER`], and
-/// [`RESET_COLUMN`] last under [`RearExit::Reset`].
+/// the column `reset_energy` last under [`RearExit::Reset`].
 pub fn steps_header(rear_exit: RearExit) -> Vec<&'static str> {
     let mut header = STEPS_HEADER.to_vec();
     if rear_exit == RearExit::Reset {
