@@ -165,9 +165,10 @@ impl Params {
         })
     }
 
-    /// Every key and its value, as a TOML file (or `summary.json`'s `config`) holds them.
+    /// Every key and its value, as a TOML file (or `summary.json`'s `config`) holds them (with the keys files
+    /// leave out at their defaults, `rear_exit` and `rear_stopper`, too).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        Ok(pythonize(py, &self.config)?)
+        every_key(py, &self.config)
     }
 
     /// A copy with the given keys changed (validated as in the constructor).
@@ -206,7 +207,7 @@ impl Params {
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         let all = self.to_dict(py)?;
-        let defaults = pythonize(py, &Config::default())?;
+        let defaults = every_key(py, &Config::default())?;
         let mut changed = Vec::new();
         for (key, value) in all.downcast::<PyDict>()?.iter() {
             if !value.eq(defaults.get_item(&key)?)? {
@@ -215,6 +216,20 @@ impl Params {
         }
         Ok(format!("Params({})", changed.join(", ")))
     }
+}
+
+/// Every key of `config` and its value: its serialization, which leaves out `rear_exit` and `rear_stopper` at
+/// their defaults (so that written files stay as they were before those keys existed), with those two added.
+fn every_key<'py>(py: Python<'py>, config: &Config) -> PyResult<Bound<'py, PyAny>> {
+    let dict = pythonize(py, config)?.downcast_into::<PyDict>()?;
+    let p = &config.params;
+    if !dict.contains("rear_exit")? {
+        dict.set_item("rear_exit", p.rear_exit.to_string())?;
+    }
+    if !dict.contains("rear_stopper")? {
+        dict.set_item("rear_stopper", p.rear_stopper)?;
+    }
+    Ok(dict.into_any())
 }
 
 /// A table (CSV header and typed rows) as a dict of numpy arrays keyed by the header: real columns as

@@ -5,7 +5,7 @@ import pickle
 import pytest
 
 import vrw
-from conftest import cli_error
+from conftest import ROOT, cli_error
 
 
 def test_defaults_and_keywords_match_the_toml_keys():
@@ -18,6 +18,17 @@ def test_defaults_and_keywords_match_the_toml_keys():
     assert {k for k in d if d[k] != defaults[k]} == {"viscosity", "legs", "impact"}
     assert p["viscosity"] == 37.0
     assert set(vrw.Params.numeric_keys()) <= set(defaults)
+
+
+def test_the_keys_files_leave_out_at_their_defaults_are_keys_too(tmp_path):
+    # rear_exit and rear_stopper are not written at their defaults (files stay as before them), but they are keys.
+    defaults = vrw.Params()
+    assert defaults["rear_exit"] == "relock" and defaults["rear_stopper"] is True
+    third_party = vrw.Params.from_toml(ROOT / "readings" / "third-party-reset.toml")
+    assert third_party == vrw.Params(rear_exit="reset", rear_stopper=False)
+    assert repr(third_party) == "Params(rear_exit='reset', rear_stopper=False)"
+    assert pickle.loads(pickle.dumps(third_party)) == third_party
+    assert vrw.Params(**third_party.to_dict()) == third_party
 
 
 def test_from_toml_equals_keywords(tmp_path):
@@ -46,6 +57,9 @@ def test_replace_and_round_trips():
         ({"impact": "elastic"}, "impact=elastic"),
         ({"inconsistent_contact": "bounce"}, "inconsistent_contact=bounce"),
         ({"integrator": "rk4"}, "integrator=rk4"),
+        ({"rear_exit": "continue"}, "rear_exit=continue"),
+        ({"rear_stopper": False}, "rear_stopper=false"),
+        ({"spring_natural_length": 0.99}, "spring_natural_length=0.99"),
     ],
 )
 def test_bad_keys_raise_the_command_lines_message(cli, tmp_path, keys, override):
