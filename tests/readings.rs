@@ -6,7 +6,7 @@ use vrw::dynamics::{Model, L1, L2};
 use vrw::gait::{sweep_values, GaitOptions};
 use vrw::params::{Config, RearExit};
 use vrw::reference::default_initial;
-use vrw::walk::{simulate, Trajectory, WalkError, WalkRun};
+use vrw::walk::{simulate, StepReport, Trajectory, WalkError, WalkRun};
 
 /// Stiff legs where the old rear leg bounces on its stopper and is still free (within a micrometre of `L0`)
 /// at a touchdown of the transient: `rear_exit = "relock"` stops there.
@@ -16,6 +16,21 @@ fn stiff(rear_exit: RearExit) -> Config {
     c.params.stiffness = 1945.4545454545455;
     c.params.rear_exit = rear_exit;
     c
+}
+
+/// The step's audits hold: the energy balance closes to 1e-8 J, no pulling force (1e-6 N) or impulse
+/// (1e-9 N s), no tip deeper than 1e-9 m, no leg past its stopper by more than 1e-8 m.
+fn assert_audits_clean(s: &StepReport, at: &str) {
+    assert!(s.energy.residual.abs() < 1e-8, "{at}: {:?}", s.energy);
+    let c = &s.contact;
+    assert!(
+        c.pull_force <= 1e-6 && c.pull_impulse <= 1e-9,
+        "{at}: {c:?}"
+    );
+    assert!(
+        c.penetration <= 1e-9 && c.stopper_overrun <= 1e-8,
+        "{at}: {c:?}"
+    );
 }
 
 fn walk(config: &Config, steps: usize) -> WalkRun {
@@ -67,30 +82,7 @@ fn reset_walks_on_with_clean_audits_and_reports_the_energy_it_changes() {
     assert!(run.failure.is_none(), "{:?}", run.failure);
     assert_eq!(run.steps.len(), 60);
     for s in &run.steps {
-        assert!(
-            s.energy.residual.abs() < 1e-8,
-            "step {}: {:?}",
-            s.step,
-            s.energy
-        );
-        assert!(
-            s.contact.pull_force <= 1e-6,
-            "step {}: {:?}",
-            s.step,
-            s.contact
-        );
-        assert!(
-            s.contact.pull_impulse <= 1e-9,
-            "step {}: {:?}",
-            s.step,
-            s.contact
-        );
-        assert!(
-            s.contact.penetration <= 1e-9,
-            "step {}: {:?}",
-            s.step,
-            s.contact
-        );
+        assert_audits_clean(s, &format!("step {}", s.step));
     }
     // Some touchdowns did discard a free rear leg's state (a tiny energy here: it was within the stopper gap).
     assert!(run.steps.iter().any(|s| s.energy.reset != 0.0));
@@ -165,14 +157,7 @@ fn without_a_rear_stopper_leg_2_extends_past_l0_and_the_audits_stay_clean() {
         "Leg 1 went past its stopper: {longest_fore}"
     );
     for s in &run.steps {
-        assert!(
-            s.energy.residual.abs() < 1e-8,
-            "step {}: {:?}",
-            s.step,
-            s.energy
-        );
-        assert!(s.contact.pull_force <= 1e-6 && s.contact.pull_impulse <= 1e-9);
-        assert!(s.contact.penetration <= 1e-9 && s.contact.stopper_overrun <= 1e-8);
+        assert_audits_clean(s, &format!("step {}", s.step));
         // The extended rear leg is reset to `L0` at every touchdown, which adds the spring energy back.
         assert!(s.energy.reset < 0.0, "step {}: {:?}", s.step, s.energy);
     }
@@ -248,16 +233,7 @@ fn every_reading_walks_with_clean_audits_where_it_has_a_gait() {
                 g.energy_residual
             );
             for s in &g.cycle {
-                assert!(s.energy.residual.abs() < 1e-8, "{at}: {:?}", s.energy);
-                let c = &s.contact;
-                assert!(
-                    c.pull_force <= 1e-6 && c.pull_impulse <= 1e-9,
-                    "{at}: {c:?}"
-                );
-                assert!(
-                    c.penetration <= 1e-9 && c.stopper_overrun <= 1e-8,
-                    "{at}: {c:?}"
-                );
+                assert_audits_clean(s, &at);
             }
         }
     }
@@ -292,18 +268,7 @@ fn a_spring_shorter_than_its_stopper_needs_reset_and_walks_with_clean_audits() {
         "{:?}",
         run.failure
     );
-    let s = &run.steps[0];
-    assert!(s.energy.residual.abs() < 1e-8, "{:?}", s.energy);
-    assert!(
-        s.contact.pull_force <= 1e-6 && s.contact.pull_impulse <= 1e-9,
-        "{:?}",
-        s.contact
-    );
-    assert!(
-        s.contact.penetration <= 1e-9 && s.contact.stopper_overrun <= 1e-8,
-        "{:?}",
-        s.contact
-    );
+    assert_audits_clean(&run.steps[0], "the walked step");
     // In tension from the touchdown on: Leg 1 is off its stopper at once, and shortens.
     let after = &trajectory.samples[1];
     assert!(!after.active.lock1 && after.q[L1] < config.params.stopper_length);

@@ -166,7 +166,7 @@ impl Params {
     }
 
     /// Every key and its value, as a TOML file (or `summary.json`'s `config`) holds them (with the keys files
-    /// leave out at their defaults, `rear_exit` and `rear_stopper`, too).
+    /// leave out at their defaults too).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         every_key(py, &self.config)
     }
@@ -218,16 +218,14 @@ impl Params {
     }
 }
 
-/// Every key of `config` and its value: its serialization, which leaves out `rear_exit` and `rear_stopper` at
-/// their defaults (so that written files stay as they were before those keys existed), with those two added.
+/// Every key of `config` and its value: its serialization, with the keys it leaves out at their defaults
+/// ([`vrw::params::Params::keys_left_out_at_defaults`]) added.
 fn every_key<'py>(py: Python<'py>, config: &Config) -> PyResult<Bound<'py, PyAny>> {
     let dict = pythonize(py, config)?.downcast_into::<PyDict>()?;
-    let p = &config.params;
-    if !dict.contains("rear_exit")? {
-        dict.set_item("rear_exit", p.rear_exit.to_string())?;
-    }
-    if !dict.contains("rear_stopper")? {
-        dict.set_item("rear_stopper", p.rear_stopper)?;
+    for (key, value) in config.params.keys_left_out_at_defaults() {
+        if !dict.contains(key)? {
+            dict.set_item(key, pythonize(py, &value)?)?;
+        }
     }
     Ok(dict.into_any())
 }

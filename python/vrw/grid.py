@@ -129,14 +129,27 @@ def _rows(options: Dict[str, Any], default: int) -> int:
         return 1
 
 
-def _run_parts(client: Optional[Any], job: Any, params: Params, parts: List[Tuple[int, int]],
-               options: Dict[str, Any]) -> List[Dict[str, Any]]:
-    """``job(params, rows=part, **options)`` for every part: here in order (``client=None``) or as one task
-    each on ``client``'s workers; the results in the parts' order."""
+def _run_rows(client: Optional[Any], job: Any, params: Params, rows: int, rows_per_task: int,
+              options: Dict[str, Any]) -> List[Dict[str, Any]]:
+    """``job(params, rows=part, **options)`` for every part of ``rows_per_task`` of the job's rows (``ny``,
+    ``rows`` by default), in the parts' order. The first part runs here, so that the options' errors are raised
+    before anything is submitted; the others here too (``client=None``) or as one task each on ``client``'s
+    workers."""
+    parts = _parts(_rows(options, rows), rows_per_task)
+    first = job(params, rows=parts[0], **options)
     if client is None:
-        return [job(params, rows=part, **options) for part in parts]
-    futures = client.map(lambda part: job(params, rows=part, **options), parts, pure=False)
-    return list(client.gather(futures))
+        return [first] + [job(params, rows=part, **options) for part in parts[1:]]
+    futures = client.map(lambda part: job(params, rows=part, **options), parts[1:], pure=False)
+    return [first] + list(client.gather(futures))
+
+
+def _outcomes(results: List[Dict[str, Any]]) -> Dict[str, int]:
+    """The parts' ``outcomes`` counts added up, by name in order (as the library's map of them)."""
+    outcomes: Dict[str, int] = {}
+    for r in results:
+        for kind, n in r["outcomes"].items():
+            outcomes[kind] = outcomes.get(kind, 0) + n
+    return dict(sorted(outcomes.items()))
 
 
 def _concatenate(tables: List[Dict[str, Any]]) -> Table:
@@ -176,12 +189,8 @@ def map_grid(client: Optional[Any], params: Params, *, rows_per_task: int = 1, *
         )
     from . import _vrw
 
-    options = dict(options, curves=False)
-    parts = _parts(_rows(options, 21), rows_per_task)
-    # The first part here: the options' errors are raised before anything is submitted.
-    first = _vrw.map(params, rows=parts[0], **options)
-    results = [first] + _run_parts(client, _vrw.map, params, parts[1:], options)
-    merged = dict(first)
+    results = _run_rows(client, _vrw.map, params, 21, rows_per_task, dict(options, curves=False))
+    merged = dict(results[0])
     merged["gaits_found"] = sum(r["gaits_found"] for r in results)
     merged["points"] = sum(r["points"] for r in results)
     merged["warnings"] = [w for r in results for w in r["warnings"]]
@@ -196,15 +205,9 @@ def basin_grid(client: Optional[Any], params: Params, *, rows_per_task: int = 4,
     The options are ``vrw.basin``'s, checked by the first part before the others start."""
     from . import _vrw
 
-    parts = _parts(_rows(options, 61), rows_per_task)
-    first = _vrw.basin(params, rows=parts[0], **options)
-    results = [first] + _run_parts(client, _vrw.basin, params, parts[1:], options)
-    merged = dict(first)
-    outcomes: Dict[str, int] = {}
-    for r in results:
-        for kind, n in r["outcomes"].items():
-            outcomes[kind] = outcomes.get(kind, 0) + n
-    merged["outcomes"] = dict(sorted(outcomes.items()))
+    results = _run_rows(client, _vrw.basin, params, 61, rows_per_task, options)
+    merged = dict(results[0])
+    merged["outcomes"] = _outcomes(results)
     merged["points"] = _concatenate([r["points"] for r in results])
     return BasinResult(merged)
 
@@ -235,11 +238,7 @@ def orbit_grid(client: Optional[Any], params: Params, param: str = "viscosity", 
         tables.append(Table({name: column[starts[k] : starts[k + 1]] for name, column in coarse["orbit"].items()}))
         tables.append(fill["orbit"])
     merged = {key: value for key, value in coarse.items() if key not in ("ends", "column_rows")}
-    outcomes: Dict[str, int] = {}
-    for r in [coarse] + fills:
-        for kind, n in r["outcomes"].items():
-            outcomes[kind] = outcomes.get(kind, 0) + n
-    merged["outcomes"] = dict(sorted(outcomes.items()))
+    merged["outcomes"] = _outcomes([coarse] + fills)
     merged["branch_gaits"] = branch["branch_gaits"]
     merged["orbit"] = _concatenate(tables)
     if "branch" in branch:

@@ -99,11 +99,7 @@ pub fn compute_map(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<(MapSummary, GaitMap), AppError> {
     let initial = checked_initial(job)?;
-    let clock = std::time::Instant::now();
-    let map = map_gaits(&job.config, &job.spec, &initial, &job.options, progress)?;
-    let points = map.xs.len() * map.ys.len();
-    check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
-    let mut summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
+    let (mut summary, map) = summarized_rows(job, &initial, 0..job.spec.y.points, progress)?;
     second_route(job, &initial, progress, &mut summary)?;
     Ok((summary, map))
 }
@@ -126,12 +122,23 @@ pub fn compute_map_part(
         });
     }
     let initial = checked_initial(job)?;
+    summarized_rows(job, &initial, part, progress)
+}
+
+/// The gaits of the rows `part` from `initial` (an error if interrupted) and their summary, with the curves
+/// when `job.curves`.
+fn summarized_rows(
+    job: &MapJob,
+    initial: &SectionState,
+    part: Range<usize>,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<(MapSummary, GaitMap), AppError> {
     let clock = std::time::Instant::now();
     let map = map_gaits_part(
         &job.config,
         &job.spec,
         part,
-        &initial,
+        initial,
         &job.options,
         progress,
     )?;

@@ -671,12 +671,20 @@ mod tests {
         let table = toml::Table::try_from(&defaults).unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
         // `rear_exit` and `rear_stopper` are left out at their defaults, so that written configurations stay as
-        // they were before them.
+        // they were before them; `keys_left_out_at_defaults` names them (and reads back as the defaults).
+        let left_out = defaults.params.keys_left_out_at_defaults();
+        let left_out: Vec<&str> = left_out.iter().map(|(key, _)| *key).collect();
+        assert_eq!(left_out, ["rear_exit", "rear_stopper"]);
         let mut read: Vec<&str> = all_keys()
             .iter()
             .copied()
-            .filter(|k| !["rear_exit", "rear_stopper"].contains(k))
+            .filter(|k| !left_out.contains(k))
             .collect();
+        for (key, value) in defaults.params.keys_left_out_at_defaults() {
+            let mut config = Config::default();
+            config.set_value(key, &value).unwrap();
+            assert_eq!(config, defaults, "{key} = {value}");
+        }
         written.sort_unstable();
         read.sort_unstable();
         assert_eq!(written, read);

@@ -100,6 +100,18 @@ impl Default for Params {
 }
 
 impl Params {
+    /// The keys that written configurations leave out at their defaults (so that files stay as they were before
+    /// these keys existed), with their values here: what a front listing every key adds to the serialization.
+    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 2] {
+        [
+            (
+                "rear_exit",
+                toml::Value::String(self.rear_exit.name().to_string()),
+            ),
+            ("rear_stopper", toml::Value::Boolean(self.rear_stopper)),
+        ]
+    }
+
     /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`docs/model.md` section 1); `pi/4` by default.
     pub fn alpha(&self) -> f64 {
         2.0 * PI / self.legs as f64

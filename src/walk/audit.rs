@@ -2,10 +2,12 @@
 //! the ground on the dense output ([`PENETRATION_SAMPLES`] points per integrator step), and legs past their
 //! stoppers.
 
-use crate::dynamics::{Model, L1, L2};
+use crate::contact::Leg;
+use crate::dynamics::Model;
 use crate::integrate::DenseStep;
 
 use super::events::EVENT_SAMPLES;
+use super::impact::has_stopper;
 use super::phase::{unpack, WalkVector, NY};
 use super::report::ContactAudit;
 
@@ -26,12 +28,9 @@ impl ContactAudit {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
         let l0 = model.params().stopper_length;
-        let longest = if model.params().rear_stopper {
-            q[L1].max(q[L2])
-        } else {
-            q[L1]
-        };
-        self.stopper_overrun = self.stopper_overrun.max(longest - l0);
+        for leg in Leg::BOTH.into_iter().filter(|&leg| has_stopper(model, leg)) {
+            self.stopper_overrun = self.stopper_overrun.max(q[leg.length_coordinate()] - l0);
+        }
     }
 
     /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).

@@ -6,6 +6,7 @@ use crate::dynamics::{Coords, Model, L1, THETA};
 use crate::params::RearExit;
 
 use super::error::WalkError;
+use super::impact::has_stopper;
 
 /// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
 /// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
@@ -68,7 +69,7 @@ pub(super) fn reindex(
         contact2: shift == 1 && active.contact1,
         lock1: true,
         // A leg that becomes Leg 2 keeps its lock only if Leg 2 has a stopper (`rear_stopper`).
-        lock2: (shift > 1 || active.lock1) && model.params().rear_stopper,
+        lock2: (shift > 1 || active.lock1) && has_stopper(model, Leg::Two),
         ..Default::default()
     };
     // Only a free leg is reset: with none, the reset removes nothing, exactly.
