@@ -63,9 +63,35 @@ impl Leg {
         2 * self.index() + 1
     }
 
-    /// Row of this leg's stopper in the multiplier vector.
+    /// Row of this leg's stopper (or compression stop: a leg is held at one of them at a time) in the
+    /// multiplier vector.
     pub(crate) fn stopper_row(self) -> usize {
         4 + self.index()
+    }
+}
+
+/// One of a leg's two stroke limits: the extension stopper (`L <= L0`) or the compression stop
+/// (`L >= min_length`). A leg held at either has the same constraint row `dL/dt = 0`; they differ in the
+/// direction the reaction may push and in the direction that moves the leg into the limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// The stopper at `L0`: its reaction pushes the leg inward.
+    Extension,
+    /// The compression stop at `min_length`: its reaction pushes the leg outward.
+    Compression,
+}
+
+impl Stop {
+    /// Both limits, the stopper first.
+    pub const BOTH: [Stop; 2] = [Stop::Extension, Stop::Compression];
+
+    /// `+1` for the stopper, `-1` for the compression stop: `sign * dL/dt > 0` moves the leg into the limit,
+    /// and `-sign * mu` (`mu` the multiplier of the row) is the reaction in its admissible direction.
+    pub(crate) fn sign(self) -> f64 {
+        match self {
+            Stop::Extension => 1.0,
+            Stop::Compression => -1.0,
+        }
     }
 }
 
@@ -84,6 +110,16 @@ pub struct ActiveSet {
     pub slide1: bool,
     /// The contact of Leg 2 slides: only its normal row is active (`lambda_3 = 0`).
     pub slide2: bool,
+    /// Leg 1 is held at `min_length` by its compression stop.
+    #[serde(skip_serializing_if = "is_false")]
+    pub compression1: bool,
+    /// Leg 2 is held at `min_length` by its compression stop.
+    #[serde(skip_serializing_if = "is_false")]
+    pub compression2: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 impl ActiveSet {
@@ -101,6 +137,20 @@ impl ActiveSet {
             Leg::One => self.lock1,
             Leg::Two => self.lock2,
         }
+    }
+
+    /// Is `leg` held at its `stop`?
+    pub fn held(&self, leg: Leg, stop: Stop) -> bool {
+        match (stop, leg) {
+            (Stop::Extension, _) => self.lock(leg),
+            (Stop::Compression, Leg::One) => self.compression1,
+            (Stop::Compression, Leg::Two) => self.compression2,
+        }
+    }
+
+    /// Is `leg` held at either of its stops (its length constraint row active)?
+    pub(crate) fn length_held(&self, leg: Leg) -> bool {
+        self.held(leg, Stop::Extension) || self.held(leg, Stop::Compression)
     }
 
     /// Does the contact of `leg` slide (normal constraint only)?
@@ -135,6 +185,15 @@ impl ActiveSet {
         }
     }
 
+    /// Hold `leg` at its `stop` (`on`) or free it from that stop.
+    pub(crate) fn set_held(&mut self, leg: Leg, stop: Stop, on: bool) {
+        match (stop, leg) {
+            (Stop::Extension, _) => self.set_lock(leg, on),
+            (Stop::Compression, Leg::One) => self.compression1 = on,
+            (Stop::Compression, Leg::Two) => self.compression2 = on,
+        }
+    }
+
     /// Which rows of the fixed stacking are active.
     pub(crate) fn row_mask(&self) -> [bool; NROWS] {
         [
@@ -142,8 +201,8 @@ impl ActiveSet {
             self.contact1,
             self.contact2 && !self.slide2,
             self.contact2,
-            self.lock1,
-            self.lock2,
+            self.length_held(Leg::One),
+            self.length_held(Leg::Two),
         ]
     }
 
@@ -178,6 +237,9 @@ impl ActiveSet {
                 lock2: on(3),
                 slide1: on(4),
                 slide2: on(5),
+                // The compression stops have the stoppers' rows: the sets above cover their solves.
+                compression1: false,
+                compression2: false,
             }
         })
     }
@@ -222,9 +284,9 @@ pub enum ContactError {
 impl std::fmt::Display for ActiveSet {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let mut units = Vec::new();
-        for (contact, slide, lock, leg) in [
-            (self.contact1, self.slide1, self.lock1, 1),
-            (self.contact2, self.slide2, self.lock2, 2),
+        for (contact, slide, lock, compression, leg) in [
+            (self.contact1, self.slide1, self.lock1, self.compression1, 1),
+            (self.contact2, self.slide2, self.lock2, self.compression2, 2),
         ] {
             match (contact, slide) {
                 (true, false) => units.push(format!("Leg {leg} tip fixed")),
@@ -233,6 +295,9 @@ impl std::fmt::Display for ActiveSet {
             }
             if lock {
                 units.push(format!("Leg {leg} stopper locked"));
+            }
+            if compression {
+                units.push(format!("Leg {leg} compression stop locked"));
             }
         }
         if units.is_empty() {
@@ -260,15 +325,17 @@ impl ConstrainedDynamics {
         self.multipliers[leg.normal_row()]
     }
 
-    /// Stopper reaction on `leg` \[N\], positive when it pushes the leg inward (its only admissible direction).
-    pub(crate) fn stopper_reaction(&self, leg: Leg) -> f64 {
-        -self.multipliers[leg.stopper_row()]
+    /// Reaction of `leg`'s `stop` \[N\], positive when it pushes the leg the way that stop may (inward for the
+    /// stopper, outward for the compression stop).
+    pub(crate) fn stop_reaction(&self, leg: Leg, stop: Stop) -> f64 {
+        -stop.sign() * self.multipliers[leg.stopper_row()]
     }
 }
 
 /// The largest pull among the unilateral units of `active` for multipliers (forces or impulses) in the fixed
-/// stacking: a negative normal multiplier (the ground pulling a tip down) or a positive stopper multiplier (a
-/// stopper pulling its leg outward), 0 if nothing pulls. Stoppers are skipped when `bilateral_stoppers` (rigid
+/// stacking: a negative normal multiplier (the ground pulling a tip down), a positive stopper multiplier (a
+/// stopper pulling its leg outward) or a negative one of a compression stop (pulling its leg inward), 0 if
+/// nothing pulls. Stoppers are skipped when `bilateral_stoppers` (rigid
 /// legs, where they act both ways). This is the contact audit of every step (docs/model.md section 4).
 pub(crate) fn largest_pull(
     multipliers: &Multipliers,
@@ -282,6 +349,9 @@ pub(crate) fn largest_pull(
         }
         if active.lock(leg) && !bilateral_stoppers {
             pull = pull.max(multipliers[leg.stopper_row()]);
+        }
+        if active.held(leg, Stop::Compression) {
+            pull = pull.max(-multipliers[leg.stopper_row()]);
         }
     }
     pull
@@ -302,9 +372,9 @@ impl ImpulseSolution {
         self.impulses[leg.normal_row()]
     }
 
-    /// Stopper impulse on `leg` \[N s\], positive when inward.
-    pub(crate) fn stopper_impulse(&self, leg: Leg) -> f64 {
-        -self.impulses[leg.stopper_row()]
+    /// Impulse of `leg`'s `stop` \[N s\], positive in the direction that stop may push.
+    pub(crate) fn stop_impulse(&self, leg: Leg, stop: Stop) -> f64 {
+        -stop.sign() * self.impulses[leg.stopper_row()]
     }
 }
 
@@ -329,7 +399,7 @@ fn constraint_rows(
                 jdq[r] = 0.0;
             }
         }
-        if active.lock(leg) {
+        if active.length_held(leg) {
             rows[(leg.stopper_row(), leg.length_coordinate())] = 1.0;
         }
     }

@@ -159,12 +159,13 @@ pub(crate) const VALID_START_MARGIN: f64 = 1.01;
 
 /// The default starting point on the Poincare section (docs/model.md section 6), derived from the parameters:
 ///
-/// - `L2 = min(L0, max(0.72 L0, 1.01 L0 cos(alpha), Lstar - M g cos(phi) / k))`, with `M = mH + N m` the
+/// - `L2 = min(L0, max(0.72 L0, 1.01 L0 cos(alpha), min_length, Lstar - M g cos(phi) / k))`, with `M = mH + N m` the
 ///   wheel's mass: Leg 2 at the length at which its spring alone carries the wheel's weight normal to the slope
 ///   (its static compression), but no shorter than `DEFAULT_START_LENGTH_FRACTION` of `L0` (the start tuned
 ///   for the paper's `k = 500 N/m`, where the static length is 0.669 m, so Table 1 starts at `(0.72, 1.0, 0.0)`
 ///   as before), no shorter than `VALID_START_MARGIN` times `L0 cos(alpha)` (with many legs a shorter Leg 2
-///   would put the next leg's tip in the ground), and no longer than the stopper. A stiff leg (`k = 3000 N/m`,
+///   would put the next leg's tip in the ground), no shorter than the compression stop, and no longer than the
+///   stopper. A stiff leg (`k = 3000 N/m`,
 ///   `Lstar = L0`: 0.941 m) thus starts near its stopper, where its gait is, instead of far inside the spring's
 ///   range;
 /// - `dtheta/dt = sqrt(L2 / (0.72 L0))` rad/s: 1.0 rad/s where `L2` is at its floor (Table 1), faster for a
@@ -196,7 +197,11 @@ pub fn default_initial(config: &Config) -> SectionState {
         let tuned = DEFAULT_START_LENGTH_FRACTION * p.stopper_length;
         // Below L0 cos(alpha) the leg behind Leg 2 would start below the ground.
         let floor = tuned.max(VALID_START_MARGIN * p.stopper_length * p.alpha().cos());
-        let l2 = static_length.max(floor).min(p.stopper_length);
+        // A compression stop (`min_length`) holds a loaded leg at it.
+        let l2 = static_length
+            .max(floor)
+            .max(p.min_length)
+            .min(p.stopper_length);
         SectionState {
             l2,
             theta_dot: (l2 / tuned).sqrt(),

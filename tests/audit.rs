@@ -2,7 +2,7 @@
 //! never push a leg outward, no impulse pulls, and no tip goes below the ground, on every step of every walk.
 //! Also the regression test of the bilateral stopper-lock impact.
 
-use vrw::contact::{impulse, ActiveSet, Leg};
+use vrw::contact::{impulse, ActiveSet, Leg, Stop};
 use vrw::dynamics::{Coords, Model, L1, L2, THETA};
 use vrw::params::Config;
 use vrw::reference::default_initial;
@@ -191,9 +191,15 @@ fn stopper_locking_while_the_rear_tip_slides_lifts_the_tip_and_never_pulls() {
     );
 
     // The impulse-level complementarity problem lets the tip go.
-    let closed = close_unit(&model, &q, &qd, sliding, Unit::Stopper(Leg::Two))
-        .unwrap()
-        .expect("a consistent active set after the lock");
+    let closed = close_unit(
+        &model,
+        &q,
+        &qd,
+        sliding,
+        Unit::Stop(Leg::Two, Stop::Extension),
+    )
+    .unwrap()
+    .expect("a consistent active set after the lock");
     assert!(
         closed.pull_impulse <= PULL_IMPULSE_TOL,
         "impulse pulled: {closed:?}"

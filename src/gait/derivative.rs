@@ -51,6 +51,7 @@ pub(crate) fn gait_jacobian(
     param: Option<&'static str>,
     estimate_error: bool,
 ) -> Result<GaitJacobian, DerivativeError> {
+    let map = &map.on_section_of(s);
     let factor = if map.options().rtol / DERIVATIVE_CHECK_TIGHTENING >= TIGHTEST_RTOL {
         1.0 / DERIVATIVE_CHECK_TIGHTENING
     } else {
@@ -93,6 +94,7 @@ pub(crate) fn newton_jacobian(
     s: &SectionState,
     fd_step: f64,
 ) -> Result<DMatrix<f64>, crate::walk::WalkError> {
+    let map = &map.on_section_of(s);
     match map.eval_with_derivatives(s, None) {
         Ok(d) => Ok(d.jacobian),
         Err(DerivativeError::Walk(e)) => Err(e),
@@ -143,6 +145,7 @@ pub fn check_jacobian(
     s: &SectionState,
     fd_step: f64,
 ) -> Result<JacobianCheck, DerivativeError> {
+    let map = &map.on_section_of(s);
     let exact = gait_jacobian(map, s, None, true)?;
     let (fd, fd_error) = map.jacobian(s, fd_step)?;
     let difference = (&exact.jacobian - &fd).amax();

@@ -290,7 +290,7 @@ pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitO
             gait
         }
         Err(e) => {
-            let n = map.free_coordinates().len();
+            let n = map.on_section_of(&fp.section).free_coordinates().len();
             let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
             gait.jacobian_failure = Some(e.to_string());
             gait
@@ -321,7 +321,20 @@ pub(crate) fn solve_fixed_point(
             .section()
             .map_err(transient(options.transient_steps))?;
     }
+    // A walk whose stance leg is held at its compression stop at touchdown starts every step with Leg 2 held
+    // there (`L2 = min_length`, `dL2/dt = 0`): one more step takes a start that is not onto that set, and the
+    // map then acts on `dtheta/dt` alone (`StepMap::on_section_of`).
+    if map.model().params().min_length > 0.0 && !s.rear_held(map.model()) {
+        if let Ok(first) = map.eval(&s) {
+            if first.next.rear_held(map.model()) {
+                s = first.next;
+            }
+        }
+    }
+    let map = &map.on_section_of(&s);
     let n = map.free_coordinates().len();
+    // A guess for the other coordinates (a neighbour held where this one is not) is no guess.
+    let jacobian_guess = jacobian_guess.filter(|j| j.nrows() == n);
     let eval =
         |s: &SectionState, iteration: usize| -> Result<(StepOutcome, DVector<f64>), GaitError> {
             let out = map

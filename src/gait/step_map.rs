@@ -98,6 +98,8 @@ pub struct StepMap<'m> {
     work: Arc<Mutex<WorkCounts>>,
     /// Stops its walks inside a step when set ([`StepMap::with_interrupt`]).
     interrupt: Option<&'m AtomicBool>,
+    /// The map acts on states whose Leg 2 is held at its compression stop ([`StepMap::on_section_of`]).
+    rear_held: bool,
 }
 
 impl<'m> StepMap<'m> {
@@ -109,7 +111,31 @@ impl<'m> StepMap<'m> {
             iterate: 1,
             work: Arc::default(),
             interrupt: None,
+            rear_held: false,
         }
+    }
+
+    /// The map whose coordinates fit the section state `s`: where Leg 2 is held at its compression stop there
+    /// ([`SectionState::rear_held`]: `L2 = min_length`, `dL2/dt = 0`, as at every touchdown of a walk whose
+    /// stance leg is held then), the map acts on `dtheta/dt` alone, as with rigid legs, and an evaluation whose
+    /// next touchdown has Leg 2 free fails ([`WalkError::HoldChanged`]); otherwise on all three coordinates.
+    pub fn on_section_of(&self, s: &SectionState) -> StepMap<'m> {
+        StepMap {
+            rear_held: s.rear_held(self.model),
+            ..self.clone()
+        }
+    }
+
+    /// `next`, or [`WalkError::HoldChanged`] where this map holds Leg 2 at its compression stop and `next`
+    /// does not.
+    fn check_hold(&self, next: SectionState) -> Result<SectionState, WalkError> {
+        if self.rear_held && !next.rear_held(self.model) {
+            return Err(WalkError::HoldChanged {
+                length: next.l2,
+                rate: next.l2_dot,
+            });
+        }
+        Ok(next)
     }
 
     /// The same map, whose walks stop with [`WalkError::Interrupted`] when `flag` is set (read every
@@ -128,6 +154,11 @@ impl<'m> StepMap<'m> {
             iterate: k.max(1),
             ..self.clone()
         }
+    }
+
+    /// The model the map walks.
+    pub(crate) fn model(&self) -> &'m Model {
+        self.model
     }
 
     /// The solver options the map integrates with.
@@ -178,7 +209,7 @@ impl<'m> StepMap<'m> {
         for _ in 1..self.iterate {
             walker.step(None)?;
         }
-        let next = walker.section()?;
+        let next = self.check_hold(walker.section()?)?;
         Ok(StepOutcome { next, report })
     }
 
@@ -206,6 +237,7 @@ impl<'m> StepMap<'m> {
             e[i] = 1.0;
             crate::variational::dual_of(value, e)
         };
+        let s = s.pinned(model);
         let (q, qd) = section_coords::<Dual4>(
             model,
             &mech,
@@ -231,7 +263,7 @@ impl<'m> StepMap<'m> {
             )?
             .sensitivity;
         }
-        let next = walker.section()?;
+        let next = self.check_hold(walker.section()?)?;
         let report = cycle[0];
         // Rows of the next section state (L2, dtheta/dt, dL2/dt) in (q, q').
         let rows = [L2, NQ + THETA, NQ + L2];
@@ -263,7 +295,7 @@ impl<'m> StepMap<'m> {
             words.push(tape.signature(step.branch));
             cycle.push(step);
         }
-        let next = walker.section()?;
+        let next = self.check_hold(walker.section()?)?;
         Ok(SignedOutcome {
             outcome: StepOutcome {
                 next,
@@ -276,7 +308,7 @@ impl<'m> StepMap<'m> {
 
     /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.
     pub(crate) fn free_coordinates(&self) -> &'static [usize] {
-        if self.model.params().rigid_legs {
+        if self.model.params().rigid_legs || self.rear_held {
             &[1]
         } else {
             &[0, 1, 2]

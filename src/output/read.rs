@@ -126,6 +126,19 @@ fn flag<'de, D: Deserializer<'de>>(d: D) -> Result<bool, D::Error> {
     }
 }
 
+/// A `lock1` / `lock2` column: 0 free, 1 held on the stopper, 2 held on the compression stop.
+fn stop_flag<'de, D: Deserializer<'de>>(d: D) -> Result<u8, D::Error> {
+    let s = String::deserialize(d)?;
+    match s.trim() {
+        "0" => Ok(0),
+        "1" => Ok(1),
+        "2" => Ok(2),
+        other => Err(serde::de::Error::custom(format!(
+            "expected 0, 1 (stopper) or 2 (compression stop), found {other:?}"
+        ))),
+    }
+}
+
 /// One row of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub struct TrajectoryRow {
@@ -164,12 +177,12 @@ pub struct TrajectoryRow {
     /// Leg 2's contact slides.
     #[serde(deserialize_with = "flag")]
     pub slide2: bool,
-    /// Leg 1 is held on its stopper.
-    #[serde(deserialize_with = "flag")]
-    pub lock1: bool,
-    /// Leg 2 is held on its stopper.
-    #[serde(deserialize_with = "flag")]
-    pub lock2: bool,
+    /// Which stop holds Leg 1: 0 none, 1 its stopper, 2 its compression stop.
+    #[serde(deserialize_with = "stop_flag")]
+    pub lock1: u8,
+    /// Which stop holds Leg 2: 0 none, 1 its stopper, 2 its compression stop.
+    #[serde(deserialize_with = "stop_flag")]
+    pub lock2: u8,
     /// Tangential force on Leg 1's tip \[N\].
     pub lambda_1: f64,
     /// Normal force on Leg 1's tip \[N\].
@@ -231,7 +244,7 @@ impl TrajectoryRow {
     }
 
     /// The discrete state (contacts, slides, stoppers, re-indexing) that changes only at events.
-    pub fn mode(&self) -> (bool, bool, bool, bool, bool, bool, usize) {
+    pub fn mode(&self) -> (bool, bool, bool, bool, u8, u8, usize) {
         (
             self.contact1,
             self.contact2,

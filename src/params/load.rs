@@ -40,7 +40,12 @@ fn keys() -> &'static Keys {
             .chain(solver)
             .copied()
             .collect();
-        let defaults = Config::default().stored().unwrap_or_default();
+        let config = Config::default();
+        let mut defaults = config.stored().unwrap_or_default();
+        // Keys files leave out at their defaults (`min_length = 0`) are still keys of their type.
+        for (key, value) in config.params.keys_left_out_at_defaults() {
+            defaults.insert(key.to_string(), Raw::Stored(value));
+        }
         let numeric = all
             .iter()
             .copied()
@@ -403,11 +408,11 @@ mod tests {
         // The file is flat and holds exactly the documented keys.
         let table: toml::Table = text.parse().unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
-        // `rear_stopper` stays at its default here (rigid legs need it), and is left out.
+        // `rear_stopper` and `min_length` stay at their defaults here (rigid legs need them), and are left out.
         let mut expected: Vec<&str> = all_keys()
             .iter()
             .copied()
-            .filter(|k| *k != "rear_stopper")
+            .filter(|k| !["rear_stopper", "min_length"].contains(k))
             .collect();
         written.sort_unstable();
         expected.sort_unstable();
@@ -626,7 +631,7 @@ mod tests {
     #[test]
     fn numeric_keys_get_set_round_trip() {
         let keys = Config::numeric_keys();
-        assert_eq!(keys.len(), 18);
+        assert_eq!(keys.len(), 19);
         assert!(keys.iter().all(|key| all_keys().contains(key)));
         for key in [
             "legs",
@@ -670,11 +675,12 @@ mod tests {
         let defaults = Config::default();
         let table = toml::Table::try_from(&defaults).unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
-        // `rear_exit` and `rear_stopper` are left out at their defaults, so that written configurations stay as
-        // they were before them; `keys_left_out_at_defaults` names them (and reads back as the defaults).
+        // `rear_exit`, `rear_stopper` and `min_length` are left out at their defaults, so that written
+        // configurations stay as they were before them; `keys_left_out_at_defaults` names them (and reads back as
+        // the defaults).
         let left_out = defaults.params.keys_left_out_at_defaults();
         let left_out: Vec<&str> = left_out.iter().map(|(key, _)| *key).collect();
-        assert_eq!(left_out, ["rear_exit", "rear_stopper"]);
+        assert_eq!(left_out, ["rear_exit", "rear_stopper", "min_length"]);
         let mut read: Vec<&str> = all_keys()
             .iter()
             .copied()

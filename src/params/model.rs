@@ -68,10 +68,21 @@ pub struct Params {
     /// and `rigid_legs = false`. `docs/model.md` section 5.
     #[serde(skip_serializing_if = "is_true")]
     pub rear_stopper: bool,
+    /// Length of the compression stop \[m\]: a rigid limit `L >= min_length` on Legs 1 and 2 (the stroke-limited
+    /// leg of the paper's readings), treated like the stopper in every force- and impulse-level
+    /// complementarity problem, with its own lock and unlock events; its reaction may only push the leg
+    /// outward. Default 0: no compression stop. Otherwise in `(0, stopper_length)`, with soft legs.
+    /// `docs/model.md` sections 2 and 4.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub min_length: f64,
 }
 
 fn is_true(b: &bool) -> bool {
     *b
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl Default for Params {
@@ -95,6 +106,7 @@ impl Default for Params {
             inconsistent_contact: ContactInconsistency::Slide,
             rear_exit: RearExit::Relock,
             rear_stopper: true,
+            min_length: 0.0,
         }
     }
 }
@@ -102,13 +114,14 @@ impl Default for Params {
 impl Params {
     /// The keys that written configurations leave out at their defaults (so that files stay as they were before
     /// these keys existed), with their values here: what a front listing every key adds to the serialization.
-    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 2] {
+    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 3] {
         [
             (
                 "rear_exit",
                 toml::Value::String(self.rear_exit.name().to_string()),
             ),
             ("rear_stopper", toml::Value::Boolean(self.rear_stopper)),
+            ("min_length", toml::Value::Float(self.min_length)),
         ]
     }
 
@@ -124,6 +137,7 @@ impl Params {
     /// `stiffness > 0`; `hub_inertia`, `viscosity >= 0`; `|slope| < pi/2`;
     /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length` (unless
     /// `rear_exit = "reset"`); `rear_stopper = false` only with `rear_exit = "reset"` and soft legs;
+    /// `min_length` 0 or in `(0, stopper_length)` with soft legs;
     /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1; legs not too stiff to integrate (the time scale
     /// of [`Params::leg_time_scale`] at least [`MIN_LEG_TIME_SCALE`]).
     pub fn validate(&self) -> Result<(), ConfigError> {
@@ -242,6 +256,23 @@ impl Params {
                         "rear_stopper",
                         self.rear_stopper,
                         "rigid legs are held by their stoppers both ways: they need rear_stopper = true",
+                    ));
+                }
+                Ok(())
+            });
+        }
+        rules.single(non_negative("min_length", self.min_length));
+        if self.min_length > 0.0 {
+            rules.between(["min_length", "stopper_length"], |given| {
+                ordered(("min_length", self.min_length), Below, stopper, given)
+            });
+            rules.between(["min_length", "rigid_legs"], |_| {
+                if self.rigid_legs {
+                    return Err(invalid(
+                        "min_length",
+                        short(self.min_length),
+                        "rigid legs never shorten: a compression stop needs rigid_legs = false (or min_length = 0, \
+                         none)",
                     ));
                 }
                 Ok(())

@@ -14,10 +14,11 @@
 //! the time of the event by `dt = -(g_y S + g_p) / (g_y f-)`; the sensitivity after it is
 //! `S+ = R_y (S- + f- dt) + R_p - f+ dt`, which for `p = 0` is the saltation matrix
 //! `S+ = [R_y + (f+ - R_y f-) g_y^T / (g_y f-)] S-`. `g_y S` and `g_y f-` come from one evaluation of `g` on
-//! duals carrying `S` and `f-` (`Dual<NDIR + 1>`): so the force guards (a normal force or a stopper
-//! reaction reaching zero, from the KKT solution) are differentiated through the KKT solve like the rest. `R` is
-//! the identity for a change of active set (lift-off, unlock, slide) and the collision equation (5) with the
-//! recorded units for an impact (touchdown, landing, stopper hit, Zeno locks), differentiated in duals.
+//! duals carrying `S` and `f-` (`Dual<NDIR + 1>`): so the force guards (a normal force, a stopper reaction
+//! or a compression stop's reaching zero, from the KKT solution) are differentiated through the KKT solve
+//! like the rest. `R` is the identity for a change of active set (lift-off, unlock, slide) and the collision
+//! equation (5) with the recorded units for an impact (touchdown, landing, stopper or compression-stop hit,
+//! Zeno locks), differentiated in duals.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -288,7 +289,7 @@ fn cross_guard(
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
     let singular = NotDifferentiable::Singular { time: end.time };
     let guard = match end.kind {
-        EventKind::LiftOff(_) | EventKind::Unlock(_) => {
+        EventKind::LiftOff(_) | EventKind::Unlock(_) | EventKind::CompressionUnlock(_) => {
             // A force guard: the multiplier's derivative through the KKT solve.
             let d = dynamics.ok_or(singular.clone())?;
             let (_, dlam) = dynamics_derivative(
@@ -298,10 +299,14 @@ fn cross_guard(
                 (&d.qdd, &d.multipliers),
             )
             .ok_or(singular.clone())?;
-            let (row, sign) = match end.kind {
-                EventKind::LiftOff(leg) => (leg.normal_row(), 1.0),
-                EventKind::Unlock(leg) => (leg.stopper_row(), -1.0),
-                _ => unreachable!("a force guard"),
+            // The guard is the unit's reaction in its admissible direction: `lambda` for a contact, `-mu` for a
+            // stopper, `mu` for a compression stop.
+            let (row, sign) = match end.kind.stop_unlock() {
+                Some((leg, stop)) => (leg.stopper_row(), -stop.sign()),
+                None => match end.kind {
+                    EventKind::LiftOff(leg) => (leg.normal_row(), 1.0),
+                    _ => unreachable!("a force guard"),
+                },
             };
             dual(sign * d.multipliers[row], dlam.row(row).transpose() * sign)
         }
@@ -333,9 +338,15 @@ fn guard<T: Real>(
         EventKind::Touchdown => Some(model.tip_height_with(mech, q, touching)),
         EventKind::Landing(leg) => Some(model.tip_height_with(mech, q, leg.index())),
         EventKind::StopperHit(leg) => Some(mech.stopper_length - q[leg.length_coordinate()]),
-        EventKind::LiftOff(_) | EventKind::Unlock(_) | EventKind::Fall | EventKind::RollBack => {
-            None
+        // `min_length` is not a differentiable key: a constant here.
+        EventKind::CompressionHit(leg) => {
+            Some(q[leg.length_coordinate()] - T::lit(model.params().min_length))
         }
+        EventKind::LiftOff(_)
+        | EventKind::Unlock(_)
+        | EventKind::CompressionUnlock(_)
+        | EventKind::Fall
+        | EventKind::RollBack => None,
     }
 }
 

@@ -43,8 +43,31 @@ fn cases() -> Vec<(Vec<&'static str>, SectionState)> {
         (vec!["viscosity=80", "stiffness=1450"], s(0.93, 1.2, 0.0)),
         // A start far from the gait: the rear tip lands again.
         (vec!["stiffness=300"], s(0.9, 1.3, 0.3)),
+        // The stroke-limited leg (readings/stroke-limited.toml): Leg 2 held at its compression stop at the
+        // section (the map on dtheta/dt alone), and free within its stroke.
+        (STROKE_LIMITED.to_vec(), s(1.0, 2.0, 0.0)),
+        (STROKE_LIMITED.to_vec(), s(1.01, 2.0, -0.05)),
+        // Stiff legs with a compression stop inside the spring's range: the stance leg bottoms out and is
+        // released again in single support as its load falls (a compression unlock).
+        (
+            vec![
+                "stiffness=3000",
+                "spring_natural_length=1.0",
+                "min_length=0.95",
+            ],
+            s(0.99, 1.2, 0.0),
+        ),
     ]
 }
+
+/// The stroke-limited reading: a compression stop at 1.0 m, stopper and natural length 1.02 m.
+const STROKE_LIMITED: [&str; 5] = [
+    "rear_exit=reset",
+    "rear_stopper=false",
+    "min_length=1.0",
+    "stopper_length=1.02",
+    "spring_natural_length=1.02",
+];
 
 fn config_of(overrides: &[&str]) -> Config {
     let mut config = Config::default();
@@ -73,6 +96,8 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
                 EventKind::Landing(Leg::One) => "landing of Leg 1",
                 EventKind::Landing(Leg::Two) => "rear re-contact",
                 EventKind::StopperHit(_) => "stopper lock",
+                EventKind::CompressionHit(_) => "compression lock",
+                EventKind::CompressionUnlock(_) => "compression unlock",
                 EventKind::Touchdown => "touchdown",
                 EventKind::Fall | EventKind::RollBack => "failure",
             };
@@ -114,14 +139,16 @@ fn saltation_based_jacobian_matches_finite_differences_at_every_event_kind() {
     for (overrides, s) in cases() {
         let config = config_of(&overrides);
         let model = Model::new(&config.params).unwrap();
-        let map = StepMap::new(&model, &config.solver);
+        let map = StepMap::new(&model, &config.solver).on_section_of(&s);
         let mut tape = StepTape::default();
         Walker::new(&model, &config.solver, &s)
             .unwrap()
             .step_taped(&mut tape)
             .unwrap();
         let seen = kinds(&tape);
-        let exact = map.eval_with_derivatives(&s, None).unwrap();
+        let exact = map
+            .eval_with_derivatives(&s, None)
+            .unwrap_or_else(|e| panic!("{overrides:?} from {s:?} ({seen:?}): {e}"));
         assert_columns_agree(
             &exact.jacobian,
             &central(&map, &s),
@@ -138,6 +165,8 @@ fn saltation_based_jacobian_matches_finite_differences_at_every_event_kind() {
         "landing of Leg 1",
         "rear re-contact",
         "zeno lock",
+        "compression lock",
+        "compression unlock",
     ] {
         assert!(
             covered.contains(kind),

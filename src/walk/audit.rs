@@ -1,13 +1,13 @@
 //! The contact audit's per-step checks (docs/model.md section 7): the largest pulling force seen, tips below
 //! the ground on the dense output ([`PENETRATION_SAMPLES`] points per integrator step), and legs past their
-//! stoppers.
+//! stoppers or compression stops.
 
-use crate::contact::Leg;
+use crate::contact::{Leg, Stop};
 use crate::dynamics::Model;
 use crate::integrate::DenseStep;
 
 use super::events::EVENT_SAMPLES;
-use super::impact::has_stopper;
+use super::impact::{has_stop, has_stopper, stop_length};
 use super::phase::{unpack, WalkVector, NY};
 use super::report::ContactAudit;
 
@@ -23,13 +23,21 @@ impl ContactAudit {
     }
 
     /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`),
-    /// and the farthest Leg 1 or 2 is past its stopper (Leg 1 alone when Leg 2 has none, `rear_stopper`).
+    /// and the farthest Leg 1 or 2 is past its stopper (Leg 1 alone when Leg 2 has none, `rear_stopper`) or
+    /// below its compression stop (`min_length > 0`).
     pub(crate) fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
-        let l0 = model.params().stopper_length;
-        for leg in Leg::BOTH.into_iter().filter(|&leg| has_stopper(model, leg)) {
-            self.stopper_overrun = self.stopper_overrun.max(q[leg.length_coordinate()] - l0);
+        for leg in Leg::BOTH {
+            // Rigid legs' bilateral stoppers are audited too (a rigid leg has no compression stop).
+            let audited = |stop| match stop {
+                Stop::Extension => has_stopper(model, leg),
+                Stop::Compression => has_stop(model, leg, stop),
+            };
+            for stop in Stop::BOTH.into_iter().filter(|&s| audited(s)) {
+                let past = stop.sign() * (q[leg.length_coordinate()] - stop_length(model, stop));
+                self.stopper_overrun = self.stopper_overrun.max(past);
+            }
         }
     }
 

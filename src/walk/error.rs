@@ -86,6 +86,19 @@ pub enum WalkError {
         /// Speed of the tip \[m/s\].
         speed: f64,
     },
+    /// A step map that acts on `dtheta/dt` alone because Leg 2 is held at its compression stop at the section
+    /// (`L2 = min_length`, `dL2/dt = 0`) reached a touchdown where it is free: the walk itself can go on, but the
+    /// map's coordinates do not describe it (a gait on the border between the two, docs/model.md section 6).
+    #[error(
+        "Leg 2 is held at its compression stop at the section the step map starts from, but free at the next \
+         touchdown (L2 = {length:.9} m, L2dot = {rate:.3e} m/s): the map on dtheta/dt alone cannot follow"
+    )]
+    HoldChanged {
+        /// `L2` at the touchdown \[m\].
+        length: f64,
+        /// `dL2/dt` there \[m/s\].
+        rate: f64,
+    },
     /// No set of active contacts and stoppers satisfies the unilateral conditions.
     #[error("no consistent contact state at t = {time:.6} s in {phase}")]
     InconsistentContacts {
@@ -151,7 +164,7 @@ impl WalkError {
                 IntegrationError::StepSizeTooSmall { time, .. }
                 | IntegrationError::NonFinite { time } => *time,
             }),
-            WalkError::InvalidSection { .. } => None,
+            WalkError::InvalidSection { .. } | WalkError::HoldChanged { .. } => None,
         }
     }
 
@@ -166,6 +179,7 @@ impl WalkError {
             WalkError::RearLegNotLocked { .. } => "rear_leg_not_locked",
             WalkError::RearLegInContact { .. } => "rear_leg_in_contact",
             WalkError::OffSection { .. } => "off_section",
+            WalkError::HoldChanged { .. } => "hold_changed",
             WalkError::InconsistentContacts { .. } => "inconsistent_contacts",
             WalkError::Contact { .. } => "constraint_failure",
             WalkError::Integration { .. } => "solver_failure",

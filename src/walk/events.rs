@@ -2,11 +2,13 @@
 //! arm them, and the constants of the event search ([`EVENT_SAMPLES`], [`FORCE_EVENT_MARGIN`],
 //! [`APPROACH_GAP`]). The table of event functions is in the [module documentation](super).
 
-use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg};
+use crate::contact::{
+    constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Stop,
+};
 use crate::dynamics::{Coords, Model, THETA};
 use crate::params::SolverOptions;
 
-use super::impact::{has_stopper, touchdown_leg, COMPLEMENTARITY_TOL};
+use super::impact::{has_stop, stop_length, touchdown_leg, COMPLEMENTARITY_TOL};
 use super::phase::{unpack, WalkVector};
 
 /// A lift-off or stopper-unlock event fires when the force falls this far below zero \[N\] (or below its
@@ -39,6 +41,46 @@ pub(crate) enum EventKind {
     Unlock(Leg),
     Landing(Leg),
     StopperHit(Leg),
+    /// A free leg reaches its compression stop (`L = min_length`).
+    CompressionHit(Leg),
+    /// The compression stop's reaction on a held leg falls to zero.
+    CompressionUnlock(Leg),
+}
+
+impl EventKind {
+    /// The event at which a free leg reaches `stop`.
+    pub(crate) fn hit(leg: Leg, stop: Stop) -> EventKind {
+        match stop {
+            Stop::Extension => EventKind::StopperHit(leg),
+            Stop::Compression => EventKind::CompressionHit(leg),
+        }
+    }
+
+    /// The event at which `stop`'s reaction on a held leg falls to zero.
+    pub(crate) fn unlock(leg: Leg, stop: Stop) -> EventKind {
+        match stop {
+            Stop::Extension => EventKind::Unlock(leg),
+            Stop::Compression => EventKind::CompressionUnlock(leg),
+        }
+    }
+
+    /// The leg and stop of a stop hit, if this is one.
+    pub(crate) fn stop_hit(self) -> Option<(Leg, Stop)> {
+        match self {
+            EventKind::StopperHit(leg) => Some((leg, Stop::Extension)),
+            EventKind::CompressionHit(leg) => Some((leg, Stop::Compression)),
+            _ => None,
+        }
+    }
+
+    /// The leg and stop of an unlock, if this is one.
+    pub(crate) fn stop_unlock(self) -> Option<(Leg, Stop)> {
+        match self {
+            EventKind::Unlock(leg) => Some((leg, Stop::Extension)),
+            EventKind::CompressionUnlock(leg) => Some((leg, Stop::Compression)),
+            _ => None,
+        }
+    }
 }
 
 /// One event of a phase: its kind and the level at which its function fires.
@@ -74,11 +116,11 @@ impl<'a> EventSet<'a> {
             } else {
                 EventKind::Landing(leg)
             });
-            if !model.params().rigid_legs && has_stopper(model, leg) {
-                kinds.push(if active.lock(leg) {
-                    EventKind::Unlock(leg)
+            for stop in Stop::BOTH.into_iter().filter(|&s| has_stop(model, leg, s)) {
+                kinds.push(if active.held(leg, stop) {
+                    EventKind::unlock(leg, stop)
                 } else {
-                    EventKind::StopperHit(leg)
+                    EventKind::hit(leg, stop)
                 });
             }
         }
@@ -124,7 +166,7 @@ impl<'a> EventSet<'a> {
     fn guard(opts: &SolverOptions, kind: EventKind) -> Option<f64> {
         match kind {
             EventKind::Landing(_) => Some(opts.recontact_gap),
-            EventKind::StopperHit(_) => Some(opts.stopper_gap),
+            EventKind::StopperHit(_) | EventKind::CompressionHit(_) => Some(opts.stopper_gap),
             _ => None,
         }
     }
@@ -135,17 +177,18 @@ impl<'a> EventSet<'a> {
             EventKind::Landing(leg) => {
                 self.model.tip(q, qd, leg.index()).velocity(qd).y < -COMPLEMENTARITY_TOL
             }
-            EventKind::StopperHit(leg) => qd[leg.length_coordinate()] > COMPLEMENTARITY_TOL,
-            _ => false,
+            _ => kind.stop_hit().is_some_and(|(leg, stop)| {
+                stop.sign() * qd[leg.length_coordinate()] > COMPLEMENTARITY_TOL
+            }),
         }
     }
 
-    /// Does a free leg leave its stopper (move inward) faster than [`COMPLEMENTARITY_TOL`] at `q'`?
+    /// Does a free leg leave its stop (move inward from the stopper, outward from the compression stop) faster
+    /// than [`COMPLEMENTARITY_TOL`] at `q'`?
     fn separating(&self, kind: EventKind, qd: &Coords) -> bool {
-        match kind {
-            EventKind::StopperHit(leg) => qd[leg.length_coordinate()] < -COMPLEMENTARITY_TOL,
-            _ => false,
-        }
+        kind.stop_hit().is_some_and(|(leg, stop)| {
+            stop.sign() * qd[leg.length_coordinate()] < -COMPLEMENTARITY_TOL
+        })
     }
 
     /// The unshifted function of an event.
@@ -162,10 +205,14 @@ impl<'a> EventSet<'a> {
             EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
             EventKind::RollBack => qd[THETA],
             EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)),
-            EventKind::Unlock(leg) => force(&|d| d.stopper_reaction(leg)),
+            EventKind::Unlock(leg) | EventKind::CompressionUnlock(leg) => {
+                let stop = kind.stop_unlock().map_or(Stop::Extension, |(_, stop)| stop);
+                force(&|d| d.stop_reaction(leg, stop))
+            }
             EventKind::Landing(leg) => self.model.tip_height(q, leg.index()),
-            EventKind::StopperHit(leg) => {
-                self.model.params().stopper_length - q[leg.length_coordinate()]
+            EventKind::StopperHit(leg) | EventKind::CompressionHit(leg) => {
+                let stop = kind.stop_hit().map_or(Stop::Extension, |(_, stop)| stop);
+                stop.sign() * (stop_length(self.model, stop) - q[leg.length_coordinate()])
             }
         }
     }
@@ -182,7 +229,10 @@ impl<'a> EventSet<'a> {
     }
 
     fn needs_forces(kind: EventKind) -> bool {
-        matches!(kind, EventKind::LiftOff(_) | EventKind::Unlock(_))
+        matches!(
+            kind,
+            EventKind::LiftOff(_) | EventKind::Unlock(_) | EventKind::CompressionUnlock(_)
+        )
     }
 
     fn dynamics_if(&self, needed: bool, q: &Coords, qd: &Coords) -> Option<ConstrainedDynamics> {

@@ -1,8 +1,9 @@
 //! Touchdown: re-indexing and the DLS-indicator impact procedure (docs/model.md section 5, paper Sec. 2.2,
 //! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event.
 //!
-//! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward) are resolved by
-//! enumerating the few possible active sets (at most four optional units, so at most 16 sets) and keeping a
+//! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward, compression stops
+//! that may only push it outward) are resolved by enumerating the few possible active sets (at most four
+//! optional units, a leg being at one of its stops at a time, so at most 16 sets) and keeping a
 //! set that satisfies complementarity: included units push the right way, excluded units do not penetrate.
 //! Where several sets qualify, the one that best matches the stated preference (keep what was active, add no
 //! stopper that is not needed, follow the paper's branch) wins, so in the regular case the result is exactly
@@ -12,10 +13,12 @@ use serde::Serialize;
 
 use crate::contact::{
     constrained_dynamics, impulse, largest_pull, ActiveSet, ConstrainedDynamics, ContactError,
-    ImpulseSolution, Leg, Multipliers,
+    ImpulseSolution, Leg, Multipliers, Stop,
 };
 use crate::dynamics::{Coords, LegIndex, Model, THETA};
 use crate::params::{ContactInconsistency, ImpactModel};
+
+use super::error::WalkError;
 
 /// Tolerance of the complementarity checks (forces \[N\], impulses \[N s\], velocities \[m/s\], accelerations
 /// \[m/s^2\]): a value within this of zero counts as zero, so that an event located at a force or velocity
@@ -83,8 +86,8 @@ impl std::fmt::Display for Branch {
 pub enum Unit {
     /// Ground contact of a leg tip.
     Contact(Leg),
-    /// Stopper of a leg.
-    Stopper(Leg),
+    /// One of a leg's stroke limits: its stopper or its compression stop.
+    Stop(Leg, Stop),
 }
 
 /// State of a unit in an active set.
@@ -100,12 +103,21 @@ pub(crate) enum Mode {
 }
 
 impl Unit {
+    /// The units of `leg`: its ground contact, its stopper and its compression stop.
+    pub(crate) fn of(leg: Leg) -> [Unit; 3] {
+        [
+            Unit::Contact(leg),
+            Unit::Stop(leg, Stop::Extension),
+            Unit::Stop(leg, Stop::Compression),
+        ]
+    }
+
     /// Put the unit in `mode` in `active`.
     pub(crate) fn apply(self, active: &mut ActiveSet, mode: Mode) {
         match (self, mode) {
             (Unit::Contact(leg), Mode::Slide) => active.set_sliding(leg),
             (Unit::Contact(leg), m) => active.set_contact(leg, m == Mode::On),
-            (Unit::Stopper(leg), m) => active.set_lock(leg, m != Mode::Off),
+            (Unit::Stop(leg, stop), m) => active.set_held(leg, stop, m != Mode::Off),
         }
     }
 
@@ -114,7 +126,7 @@ impl Unit {
         match self {
             Unit::Contact(leg) if active.slide(leg) => Mode::Slide,
             Unit::Contact(leg) if active.contact(leg) => Mode::On,
-            Unit::Stopper(leg) if active.lock(leg) => Mode::On,
+            Unit::Stop(leg, stop) if active.held(leg, stop) => Mode::On,
             _ => Mode::Off,
         }
     }
@@ -293,10 +305,10 @@ pub(crate) fn plastic_impact(
                 model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
             }
             (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
-            (Unit::Stopper(leg), Mode::Off) => {
-                sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+            (Unit::Stop(leg, stop), Mode::Off) => {
+                stop.sign() * sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
             }
-            (Unit::Stopper(leg), _) => sol.stopper_impulse(leg) >= -COMPLEMENTARITY_TOL,
+            (Unit::Stop(leg, stop), _) => sol.stop_impulse(leg, stop) >= -COMPLEMENTARITY_TOL,
         })
     })?;
     match found {
@@ -336,10 +348,10 @@ pub(crate) fn consistent_active_set(
                     && model.tip(q, qd, leg.index()).velocity(qd).x.abs() <= STICK_SPEED_TOL
             }
             (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
-            (Unit::Stopper(leg), Mode::Off) => {
-                dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+            (Unit::Stop(leg, stop), Mode::Off) => {
+                stop.sign() * dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
             }
-            (Unit::Stopper(leg), _) => dynamics.stopper_reaction(leg) >= -COMPLEMENTARITY_TOL,
+            (Unit::Stop(leg, stop), _) => dynamics.stop_reaction(leg, stop) >= -COMPLEMENTARITY_TOL,
         })
     })?;
     if found.is_some() || allow_slide {
@@ -401,18 +413,19 @@ pub(crate) fn touchdown_leg(model: &Model, q: &Coords) -> LegIndex {
 }
 
 /// The candidates of a touchdown impulse: the new Leg 1's contact, closing (no-slip if its normal impulse
-/// pushes, else frictionless under [`ContactInconsistency::Slide`]), and the stoppers that may take an impulse:
-/// Leg 1's (at `L0`, locked before touchdown) and Leg 2's if locked, unless they act both ways (`rigid_legs`,
-/// then they are forced).
+/// pushes, else frictionless under [`ContactInconsistency::Slide`]), and the stops that may take an impulse:
+/// Leg 1's stopper (at `L0`, locked before touchdown) and Leg 2's stopper or compression stop if it holds the
+/// leg, unless they act both ways (`rigid_legs`, then they are forced).
 fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
     let bilateral = bilateral_stoppers(model);
     let mut candidates = vec![Candidate::closing(Unit::Contact(Leg::One), model)];
-    candidates.extend(
-        Leg::BOTH
-            .into_iter()
-            .filter(|leg| before.lock(*leg) && !bilateral.lock(*leg))
-            .map(|leg| Candidate::new(Unit::Stopper(leg), Mode::Off)),
-    );
+    for leg in Leg::BOTH {
+        for stop in Stop::BOTH {
+            if before.held(leg, stop) && !bilateral.held(leg, stop) {
+                candidates.push(Candidate::new(Unit::Stop(leg, stop), Mode::Off));
+            }
+        }
+    }
     candidates
 }
 
@@ -519,13 +532,33 @@ pub(crate) fn touchdown_impact(
     Ok(finish(dls_set, dls_sol, indicators, branch, preferred))
 }
 
-/// The stoppers that act both ways and are always active: both with `rigid_legs` (docs/model.md section 7), none
-/// otherwise. Every active-set resolution starts from this set.
 /// Does `leg` have its extension stopper? Leg 1 always; Leg 2 unless `rear_stopper = false`.
 pub(crate) fn has_stopper(model: &Model, leg: Leg) -> bool {
     leg == Leg::One || model.params().rear_stopper
 }
 
+/// Does `leg` have `stop` as a unilateral limit with its own events? The stopper as [`has_stopper`] says, the
+/// compression stop where `min_length > 0`; neither with `rigid_legs` (the stoppers are then bilateral and
+/// always active, and the legs never shorten).
+pub(crate) fn has_stop(model: &Model, leg: Leg, stop: Stop) -> bool {
+    let params = model.params();
+    !params.rigid_legs
+        && match stop {
+            Stop::Extension => has_stopper(model, leg),
+            Stop::Compression => params.min_length > 0.0,
+        }
+}
+
+/// The stop `stop`'s limit on a leg's length \[m\]: `L0` or `min_length`.
+pub(crate) fn stop_length(model: &Model, stop: Stop) -> f64 {
+    match stop {
+        Stop::Extension => model.params().stopper_length,
+        Stop::Compression => model.params().min_length,
+    }
+}
+
+/// The stoppers that act both ways and are always active: both with `rigid_legs` (docs/model.md section 7), none
+/// otherwise. Every active-set resolution starts from this set.
 pub(crate) fn bilateral_stoppers(model: &Model) -> ActiveSet {
     let rigid = model.params().rigid_legs;
     ActiveSet {
@@ -561,15 +594,18 @@ pub(crate) fn post_impact_candidates(
         {
             candidates.push(Candidate::new(contact, Mode::Off));
         }
-        if forced.lock(leg) {
-            continue;
-        }
-        let stopper = Unit::Stopper(leg);
-        if impulse_set.lock(leg) {
-            candidates.push(Candidate::new(stopper, Mode::On));
-        } else if present.lock(leg) && qd_plus[leg.length_coordinate()].abs() <= COMPLEMENTARITY_TOL
-        {
-            candidates.push(Candidate::new(stopper, Mode::Off));
+        for stop in Stop::BOTH {
+            if forced.held(leg, stop) {
+                continue;
+            }
+            let unit = Unit::Stop(leg, stop);
+            if impulse_set.held(leg, stop) {
+                candidates.push(Candidate::new(unit, Mode::On));
+            } else if present.held(leg, stop)
+                && qd_plus[leg.length_coordinate()].abs() <= COMPLEMENTARITY_TOL
+            {
+                candidates.push(Candidate::new(unit, Mode::Off));
+            }
         }
     }
     (forced, candidates)
@@ -613,7 +649,7 @@ pub fn close_unit(
     let forced = bilateral_stoppers(model);
     let mut candidates = vec![Candidate::closing(unit, model)];
     for leg in Leg::BOTH {
-        for other in [Unit::Contact(leg), Unit::Stopper(leg)] {
+        for other in Unit::of(leg) {
             if other != unit && other.mode(&active) != Mode::Off && other.mode(&forced) == Mode::Off
             {
                 candidates.push(Candidate::keep(other, &active));
@@ -637,6 +673,40 @@ pub fn close_unit(
         loss: kinetic_loss(model, q, qd, &sol),
         pull_impulse: pull_of(model, &impulse_set, &sol),
     }))
+}
+
+/// A contact's normal force reached zero: the active set of the motion that follows, preferring the tip to
+/// leave the ground (it slides instead if leaving would drive it into the ground, see
+/// [`crate::params::ContactInconsistency`]).
+pub(crate) fn release_contact(
+    model: &Model,
+    time: f64,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+    leaving: Leg,
+) -> Result<ActiveSet, WalkError> {
+    let phase = active.phase();
+    let forced = bilateral_stoppers(model);
+    let mut candidates = Vec::new();
+    for leg in Leg::BOTH {
+        if active.contact(leg) {
+            candidates.push(if leg == leaving {
+                Candidate::releasing(leg)
+            } else {
+                Candidate::keep(Unit::Contact(leg), &active)
+            });
+        }
+        for stop in Stop::BOTH {
+            if active.held(leg, stop) && !forced.held(leg, stop) {
+                candidates.push(Candidate::keep(Unit::Stop(leg, stop), &active));
+            }
+        }
+    }
+    let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
+        .map_err(WalkError::contact_at(time, phase))?
+        .ok_or(WalkError::InconsistentContacts { time, phase })?;
+    Ok(new_active)
 }
 
 /// Kinetic energy an impact from `q'` to `sol.qd_plus` takes away \[J\].

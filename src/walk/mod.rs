@@ -12,6 +12,8 @@
 //! | landing / rear re-contact of an airborne tip | its height (armed once above `recontact_gap`, see below) |
 //! | stopper unlock | the stopper's inward reaction (to `FORCE_EVENT_MARGIN` below 0) |
 //! | stopper hit of a free leg | `L0 - L` (armed once below `L0 - stopper_gap`) |
+//! | compression-stop unlock (with `min_length > 0`) | the compression stop's outward reaction (to `FORCE_EVENT_MARGIN` below 0) |
+//! | compression-stop hit of a free leg (with `min_length > 0`) | `L - min_length` (armed once above `min_length + stopper_gap`) |
 //! | fall | hub height minus `fall_hub_height` |
 //! | rolling back | `dtheta/dt` |
 //!
@@ -20,7 +22,7 @@
 //! `height - (min(h0, 0) - recontact_gap)` with `h0` the height at the start of the phase, which fires only if
 //! the tip sinks `recontact_gap` below where it started (or below the ground) without having risen; once the
 //! height exceeds `recontact_gap` at an accepted step the event is armed and its function is the height itself.
-//! Stoppers use `stopper_gap` the same way. Both are options of [`SolverOptions`](crate::params::SolverOptions). (Measuring from `h0` matters
+//! Stoppers and compression stops use `stopper_gap` the same way. Both are options of [`SolverOptions`](crate::params::SolverOptions). (Measuring from `h0` matters
 //! after a re-contact located at `-recontact_gap`: a guard measured from the ground would start at zero and
 //! never fire, letting the tip sink.)
 //!

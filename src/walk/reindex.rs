@@ -32,7 +32,8 @@ pub(super) fn reindex(
             return Err(WalkError::RearLegInContact { time });
         }
         if active.lock(leg) {
-            // Locked: at `L0` and at rest (to the stopper's tolerance, which both choices leave out).
+            // Locked: at `L0` and at rest (to the stopper's tolerance, which both choices leave out). A leg held
+            // at its compression stop is not: it is reset, or not relocked.
             continue;
         }
         if reset {
@@ -70,6 +71,8 @@ pub(super) fn reindex(
         lock1: true,
         // A leg that becomes Leg 2 keeps its lock only if Leg 2 has a stopper (`rear_stopper`).
         lock2: (shift > 1 || active.lock1) && has_stopper(model, Leg::Two),
+        // A leg held at its compression stop stays held as Leg 2.
+        compression2: shift == 1 && active.compression1,
         ..Default::default()
     };
     // Only a free leg is reset: with none, the reset removes nothing, exactly.

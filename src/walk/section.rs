@@ -18,6 +18,10 @@ pub(crate) const RIGID_SECTION_TOL: f64 = 1e-9;
 /// penetration the contact audit tolerates): a section state deeper than that is not a state of the wheel.
 pub(crate) const SECTION_GROUND_TOL: f64 = 1e-9;
 
+/// How far above `min_length` `L2` may be, and `dL2/dt` from 0, at a section state whose Leg 2 is held at its
+/// compression stop \[m, m/s\] ([`SectionState::rear_held`]): a held leg drifts by rounding only.
+pub(crate) const HELD_SECTION_TOL: f64 = 1e-9;
+
 /// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SectionState {
@@ -78,6 +82,13 @@ impl SectionState {
         if !(self.l2 > 0.0 && self.l2 <= l0) {
             return bad("L2", self.l2, "must lie in (0, stopper_length]");
         }
+        if self.l2 < model.params().min_length - HELD_SECTION_TOL {
+            return bad(
+                "L2",
+                self.l2,
+                "must be at least min_length (the compression stop)",
+            );
+        }
         if self.theta_dot <= 0.0 {
             return bad(
                 "thetadot",
@@ -106,14 +117,38 @@ impl SectionState {
         Ok(())
     }
 
+    /// Is Leg 2 held at its compression stop in this state (`min_length > 0`, `L2 = min_length` and
+    /// `dL2/dt = 0` within [`HELD_SECTION_TOL`])? A walk that reaches a touchdown with its stance leg held there
+    /// starts the next step so; a walker started from such a state does the same, and the step map then acts on
+    /// `dtheta/dt` alone (docs/model.md section 6).
+    pub fn rear_held(&self, model: &Model) -> bool {
+        let min = model.params().min_length;
+        min > 0.0
+            && !model.params().rigid_legs
+            && self.l2 - min <= HELD_SECTION_TOL
+            && self.l2_dot.abs() <= HELD_SECTION_TOL
+    }
+
+    /// This state with `L2 = min_length` and `dL2/dt = 0` exactly where Leg 2 is held at its compression stop
+    /// ([`SectionState::rear_held`]), else unchanged.
+    pub fn pinned(&self, model: &Model) -> SectionState {
+        if self.rear_held(model) {
+            SectionState {
+                l2: model.params().min_length,
+                l2_dot: 0.0,
+                ..*self
+            }
+        } else {
+            *self
+        }
+    }
+
     /// Generalized coordinates and velocities `(q_dagger, q'_dagger)` of this section state (with
-    /// `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly).
+    /// `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly; with Leg 2 held at its compression stop,
+    /// `L2 = min_length` and `dL2/dt = 0` exactly).
     pub fn to_coords(&self, model: &Model) -> (Coords, Coords) {
-        section_coords(
-            model,
-            model.mechanics(),
-            (self.l2, self.theta_dot, self.l2_dot),
-        )
+        let s = self.pinned(model);
+        section_coords(model, model.mechanics(), (s.l2, s.theta_dot, s.l2_dot))
     }
 
     /// The section state of generalized coordinates at the section.

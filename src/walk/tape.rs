@@ -3,7 +3,7 @@
 //! each phase. With it, `crate::variational` integrates the variational equations over the very steps the walk
 //! took and composes the saltation matrix of every event, without deciding anything again.
 
-use crate::contact::{ActiveSet, Leg};
+use crate::contact::{ActiveSet, Leg, Stop};
 
 use super::events::EventKind;
 use super::phase::WalkVector;
@@ -96,7 +96,8 @@ impl StepTape {
     /// The step's event sequence in words (`branch.csv`'s `signature`, docs/model.md section 11): the touchdown
     /// and its branch (`TD DLS`), then one word per change of a unit between successive phases, in the order
     /// the phases follow and, within one change, Leg 1 before Leg 2: `LIFT`/`LAND` (ground contact off/on),
-    /// `SLIDE`/`STICK` (a contact starts/stops sliding), `UNLOCK`/`LOCK` (stopper), each with the leg's number,
+    /// `SLIDE`/`STICK` (a contact starts/stops sliding), `UNLOCK`/`LOCK` (stopper), `UNLOCKMIN`/`LOCKMIN`
+    /// (compression stop, `min_length`), each with the leg's number,
     /// as `TD DLS UNLOCK1 LIFT2 LOCK2`. Two steps with the same signature took the same smooth piece of the
     /// step map; a family whose signature changes crossed a border between pieces.
     pub(crate) fn signature(&self, branch: impl std::fmt::Display) -> String {
@@ -121,6 +122,12 @@ impl StepTape {
                         "STICK",
                     ),
                     (a.lock(leg), b.lock(leg), "LOCK", "UNLOCK"),
+                    (
+                        a.held(leg, Stop::Compression),
+                        b.held(leg, Stop::Compression),
+                        "LOCKMIN",
+                        "UNLOCKMIN",
+                    ),
                 ];
                 for (before, after, on, off) in changes {
                     if before != after {

@@ -6,16 +6,16 @@
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::contact::{ActiveSet, Leg, Phase};
-use crate::dynamics::{Coords, Model, NQ, THETA, X};
+use crate::contact::{ActiveSet, Leg, Phase, Stop};
+use crate::dynamics::{Model, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
 
 use super::error::WalkError;
 use super::events::{EventKind, EventSet, EVENT_SAMPLES};
 use super::impact::{
-    bilateral_stoppers, close_unit, consistent_active_set, post_impact_candidates,
-    touchdown_impact, touchdown_leg, Branch, Candidate, TouchdownImpact, Unit,
+    close_unit, consistent_active_set, post_impact_candidates, release_contact, touchdown_impact,
+    touchdown_leg, Branch, TouchdownImpact, Unit,
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::reindex::reindex;
@@ -84,6 +84,7 @@ impl<'m> Walker<'m> {
                 contact2: true,
                 lock1: true,
                 lock2: model.params().rigid_legs,
+                compression2: section.rear_held(model),
                 ..Default::default()
             },
             x_origin: 0.0,
@@ -608,11 +609,17 @@ impl<'a> Phases<'a> {
                 self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
                 self.tally.scuffing |= self.active.slide2;
             }
-            EventKind::Unlock(leg) => self.active.set_lock(leg, false),
-            EventKind::Landing(leg) | EventKind::StopperHit(leg) => {
-                let unit = match kind {
-                    EventKind::Landing(_) => Unit::Contact(leg),
-                    _ => Unit::Stopper(leg),
+            EventKind::Unlock(leg) | EventKind::CompressionUnlock(leg) => {
+                for stop in Stop::BOTH {
+                    self.active.set_held(leg, stop, false);
+                }
+            }
+            EventKind::Landing(leg)
+            | EventKind::StopperHit(leg)
+            | EventKind::CompressionHit(leg) => {
+                let unit = match kind.stop_hit() {
+                    Some((_, stop)) => Unit::Stop(leg, stop),
+                    None => Unit::Contact(leg),
                 };
                 let closed = close_unit(model, &q, &qd, self.active, unit)
                     .map_err(WalkError::contact_at(t, phase))?
@@ -625,7 +632,7 @@ impl<'a> Phases<'a> {
                 tally.audit.pull_impulse = tally.audit.pull_impulse.max(closed.pull_impulse);
                 match unit {
                     Unit::Contact(_) => tally.impact_loss += closed.loss,
-                    Unit::Stopper(_) => tally.stopper_loss += closed.loss,
+                    Unit::Stop(..) => tally.stopper_loss += closed.loss,
                 }
                 tally.scuffing |=
                     (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
@@ -674,36 +681,4 @@ impl<'a> Phases<'a> {
             tape.begin(active, self.t, self.y);
         }
     }
-}
-
-/// A contact's normal force reached zero: the active set of the motion that follows, preferring the tip to
-/// leave the ground (it slides instead if leaving would drive it into the ground, see
-/// [`crate::params::ContactInconsistency`]).
-fn release_contact(
-    model: &Model,
-    time: f64,
-    q: &Coords,
-    qd: &Coords,
-    active: ActiveSet,
-    leaving: Leg,
-) -> Result<ActiveSet, WalkError> {
-    let phase = active.phase();
-    let forced = bilateral_stoppers(model);
-    let mut candidates = Vec::new();
-    for leg in Leg::BOTH {
-        if active.contact(leg) {
-            candidates.push(if leg == leaving {
-                Candidate::releasing(leg)
-            } else {
-                Candidate::keep(Unit::Contact(leg), &active)
-            });
-        }
-        if active.lock(leg) && !forced.lock(leg) {
-            candidates.push(Candidate::keep(Unit::Stopper(leg), &active));
-        }
-    }
-    let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
-        .map_err(WalkError::contact_at(time, phase))?
-        .ok_or(WalkError::InconsistentContacts { time, phase })?;
-    Ok(new_active)
 }

@@ -30,6 +30,16 @@ pub struct EventCounts {
     pub fall: usize,
     /// Roll-backs (the step fails).
     pub roll_back: usize,
+    /// Compression-stop hits of a free leg (`min_length > 0`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub compression_hit: usize,
+    /// Compression-stop unlocks (`min_length > 0`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub compression_unlock: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 impl EventCounts {
@@ -42,6 +52,8 @@ impl EventCounts {
         stopper_hit: 0,
         fall: 0,
         roll_back: 0,
+        compression_hit: 0,
+        compression_unlock: 0,
     };
 
     /// Count one event of `kind`.
@@ -54,6 +66,8 @@ impl EventCounts {
             EventKind::StopperHit(_) => &mut self.stopper_hit,
             EventKind::Fall => &mut self.fall,
             EventKind::RollBack => &mut self.roll_back,
+            EventKind::CompressionHit(_) => &mut self.compression_hit,
+            EventKind::CompressionUnlock(_) => &mut self.compression_unlock,
         };
         *n += 1;
     }
@@ -68,6 +82,8 @@ impl AddAssign for EventCounts {
         self.stopper_hit += o.stopper_hit;
         self.fall += o.fall;
         self.roll_back += o.roll_back;
+        self.compression_hit += o.compression_hit;
+        self.compression_unlock += o.compression_unlock;
     }
 }
 
@@ -90,7 +106,7 @@ pub struct WorkCounts {
     pub root_evals: usize,
     /// Events handled, by kind.
     pub events: EventCounts,
-    /// Impacts solved: touchdowns, rear re-contacts and landings, stopper hits.
+    /// Impacts solved: touchdowns, rear re-contacts and landings, stopper and compression-stop hits.
     pub impacts: usize,
 }
 
@@ -125,6 +141,8 @@ impl WorkCounts {
                 stopper_hit: self.events.stopper_hit - e.stopper_hit,
                 fall: self.events.fall - e.fall,
                 roll_back: self.events.roll_back - e.roll_back,
+                compression_hit: self.events.compression_hit - e.compression_hit,
+                compression_unlock: self.events.compression_unlock - e.compression_unlock,
             },
             impacts: self.impacts - earlier.impacts,
         }

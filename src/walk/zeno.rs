@@ -25,15 +25,15 @@
 //! [`ZENO_IMPULSE_WARNING`] (a tip sliding fast along the ground), then frictionless; the motion goes on with
 //! both tips on the ground.
 
-use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ContactError, Leg};
+use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ContactError, Leg, Stop};
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
 
 use super::error::WalkError;
 
 use super::impact::{
-    bilateral_stoppers, consistent_active_set, has_stopper, plastic_impact, post_impact_candidates,
-    Candidate, Mode, Unit, COMPLEMENTARITY_TOL,
+    bilateral_stoppers, consistent_active_set, has_stop, plastic_impact, post_impact_candidates,
+    stop_length, Candidate, Mode, Unit, COMPLEMENTARITY_TOL,
 };
 
 /// A Zeno lock whose stopper impulse exceeds this \[N s\] is reported as a warning by `vrw simulate`: the rule
@@ -77,7 +77,6 @@ fn zeno_units(
     (stopper_gap, recontact_gap): (f64, f64),
     exclude: &ActiveSet,
 ) -> Result<ActiveSet, ContactError> {
-    let l0 = model.params().stopper_length;
     let bilateral = bilateral_stoppers(model);
     let mut units = ActiveSet::default();
     let mut dynamics = None;
@@ -89,13 +88,23 @@ fn zeno_units(
     };
     for leg in Leg::BOTH {
         let i = leg.length_coordinate();
-        let stopper_free = has_stopper(model, leg)
-            && !(active.lock(leg) || bilateral.lock(leg) || exclude.lock(leg));
-        let v = qd[i];
-        if stopper_free && l0 - q[i] <= stopper_gap && v < -COMPLEMENTARITY_TOL {
-            let a_out = free_dynamics()?.qdd[i];
-            if a_out > 0.0 && v * v < 2.0 * a_out * stopper_gap {
-                units.set_lock(leg, true);
+        // A compression stop the same way, mirrored: a free leg within `stopper_gap` above `min_length`,
+        // moving outward slower than its inward acceleration can turn round within the gap.
+        for stop in Stop::BOTH {
+            let s = stop.sign();
+            let free = has_stop(model, leg, stop)
+                && !(active.held(leg, stop)
+                    || bilateral.held(leg, stop)
+                    || exclude.held(leg, stop));
+            let v = s * qd[i];
+            if free
+                && s * (stop_length(model, stop) - q[i]) <= stopper_gap
+                && v < -COMPLEMENTARITY_TOL
+            {
+                let a_back = s * free_dynamics()?.qdd[i];
+                if a_back > 0.0 && v * v < 2.0 * a_back * stopper_gap {
+                    units.set_held(leg, stop, true);
+                }
             }
         }
         let tip_free = !(active.contact(leg) || exclude.contact(leg));
@@ -122,6 +131,8 @@ fn union(a: &ActiveSet, b: &ActiveSet) -> ActiveSet {
         lock2: a.lock2 || b.lock2,
         slide1: a.slide1 || b.slide1,
         slide2: a.slide2 || b.slide2,
+        compression1: a.compression1 || b.compression1,
+        compression2: a.compression2 || b.compression2,
     }
 }
 
@@ -135,13 +146,15 @@ fn zeno_impact_units(
     let mut forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
     for leg in Leg::BOTH {
-        if closing.lock(leg) {
-            forced.set_lock(leg, true);
+        for stop in Stop::BOTH {
+            if closing.held(leg, stop) {
+                forced.set_held(leg, stop, true);
+            }
         }
         if closing.contact(leg) {
             Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(closing));
         }
-        for unit in [Unit::Contact(leg), Unit::Stopper(leg)] {
+        for unit in Unit::of(leg) {
             if unit.mode(active) != Mode::Off && unit.mode(&forced) == Mode::Off {
                 candidates.push(Candidate::keep(unit, active));
             }
@@ -208,8 +221,10 @@ pub fn lock_zeno_stoppers(
             legs = union(&legs, &kicked);
         };
         for leg in Leg::BOTH {
-            if legs.lock(leg) {
-                locked.set_lock(leg, true);
+            for stop in Stop::BOTH {
+                if legs.held(leg, stop) {
+                    locked.set_held(leg, stop, true);
+                }
             }
             if legs.contact(leg) {
                 Unit::Contact(leg).apply(&mut locked, Unit::Contact(leg).mode(&legs));
@@ -219,10 +234,12 @@ pub fn lock_zeno_stoppers(
         let mut others = impulse_set;
         let mut present = active_now;
         for leg in Leg::BOTH {
-            if legs.lock(leg) {
-                others.set_lock(leg, false);
-                present.set_lock(leg, true);
-                zeno_impulse = zeno_impulse.max(-sol.stopper_impulse(leg));
+            for stop in Stop::BOTH {
+                if legs.held(leg, stop) {
+                    others.set_held(leg, stop, false);
+                    present.set_held(leg, stop, true);
+                    zeno_impulse = zeno_impulse.max(-sol.stop_impulse(leg, stop));
+                }
             }
             if legs.contact(leg) {
                 others.set_contact(leg, false);

@@ -116,9 +116,9 @@ pub(super) fn leg_states(
         .map(|(p, &length)| LegState {
             length,
             compliant: if p == sample.leg1 % n {
-                Some((COLOR_BLUE, tip1, sample.lock1))
+                Some((COLOR_BLUE, tip1, sample.lock1 != 0))
             } else if p == (sample.leg1 + 1) % n {
-                Some((COLOR_VERMILLION, tip2, sample.lock2))
+                Some((COLOR_VERMILLION, tip2, sample.lock2 != 0))
             } else {
                 None
             },

@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use super::{fixed_names, row, Cell, Column};
+use crate::contact::{ActiveSet, Leg, Stop};
 use crate::output::{CsvStream, OutputError};
 use crate::walk::{Sample, SampleSink};
 
@@ -12,6 +13,15 @@ use Cell::{Count, Real};
 /// `0`/`1` for a flag of `trajectory.csv`.
 fn bit(b: bool) -> Cell {
     Count(usize::from(b))
+}
+
+/// Which stop holds `leg`: 1 the stopper, 2 the compression stop, 0 none.
+fn stop_state(active: &ActiveSet, leg: Leg) -> Cell {
+    Count(if active.held(leg, Stop::Compression) {
+        2
+    } else {
+        usize::from(active.lock(leg))
+    })
 }
 
 /// The columns of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
@@ -49,12 +59,16 @@ pub(crate) const TRAJECTORY: [Column<Sample>; 24] = [
     Column::new("slide2", "1 if Leg 2's contact slides.", |s| {
         bit(s.active.slide2)
     }),
-    Column::new("lock1", "1 if Leg 1 is held on its stopper.", |s| {
-        bit(s.active.lock1)
-    }),
-    Column::new("lock2", "1 if Leg 2 is held on its stopper.", |s| {
-        bit(s.active.lock2)
-    }),
+    Column::new(
+        "lock1",
+        "1 if Leg 1 is held on its stopper, 2 if on its compression stop (min_length), else 0.",
+        |s| stop_state(&s.active, Leg::One),
+    ),
+    Column::new(
+        "lock2",
+        "1 if Leg 2 is held on its stopper, 2 if on its compression stop (min_length), else 0.",
+        |s| stop_state(&s.active, Leg::Two),
+    ),
     Column::new("lambda_1", "Tangential force on Leg 1's tip [N].", |s| {
         Real(s.multipliers[0])
     }),
