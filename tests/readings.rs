@@ -273,3 +273,99 @@ fn a_spring_shorter_than_its_stopper_needs_reset_and_walks_with_clean_audits() {
     let after = &trajectory.samples[1];
     assert!(!after.active.lock1 && after.q[L1] < config.params.stopper_length);
 }
+
+/// The stroke-limited reading (`readings/stroke-limited.toml`): a rigid compression stop at 1.0 m, stopper and
+/// natural length 1.02 m, the rear leg reset and without its stopper.
+fn stroke_limited() -> Config {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("readings/stroke-limited.toml");
+    Config::from_file(&path).unwrap()
+}
+
+/// Issue 21's "done means" for the stroke-limited leg: a gait at every `c` from 5 to 300 at `k = 500`, with
+/// `lambda_I4 > 0`, `lambda_4+` falling through zero between 51 and 52.3 (the README's refined threshold
+/// 51.627) and the (B3) branch past it, the stance leg held at its compression stop at every touchdown (the
+/// step map on `dtheta/dt` alone, one multiplier), and clean audits on every step, the legs never below the
+/// stop (the stopper audit).
+#[test]
+fn the_stroke_limited_leg_has_the_papers_shape_with_its_threshold_near_52() {
+    let config = stroke_limited();
+    let model = Model::new(&config.params).unwrap();
+    let mut values: Vec<f64> = (0..12).map(|i| 5.0 + 295.0 * i as f64 / 11.0).collect();
+    values.extend([51.0, 52.3]);
+    values.sort_by(f64::total_cmp);
+    let points = sweep_values(
+        &config,
+        "viscosity",
+        &values,
+        &default_initial(&config),
+        &GaitOptions::for_sweeps(),
+        &|_| {},
+    )
+    .unwrap();
+    let mut last_lambda_4 = f64::INFINITY;
+    for p in &points {
+        let at = format!("stroke-limited at c = {}", p.value);
+        let g = p
+            .gait
+            .as_ref()
+            .unwrap_or_else(|| panic!("{at}: {:?}", p.message));
+        assert!(g.section.rear_held(&model), "{at}: {:?}", g.section);
+        assert_eq!(g.floquet_multipliers.len(), 1, "{at}");
+        assert!(g.lambda_i4 > 0.0, "{at}: {}", g.lambda_i4);
+        assert!(g.lambda_4_plus < last_lambda_4, "{at}: lambda_4+ rises");
+        last_lambda_4 = g.lambda_4_plus;
+        let b3 = g.branch.to_string() == "SLS_B3";
+        assert_eq!(
+            g.lambda_4_plus < 0.0,
+            b3,
+            "{at}: {} {}",
+            g.branch,
+            g.lambda_4_plus
+        );
+        assert_eq!(
+            g.lambda_4_plus > 0.0,
+            p.value <= 51.0,
+            "{at}: {}",
+            g.lambda_4_plus
+        );
+        assert!(g.lambda_2_plus > 0.0, "{at}: {}", g.lambda_2_plus);
+        for s in &g.cycle {
+            assert_audits_clean(s, &at);
+        }
+    }
+}
+
+/// `min_length` is refused where it is not a compression stop: negative, at or above the stopper, with rigid
+/// legs; and a section state with Leg 2 below it is not a state of the wheel.
+#[test]
+fn a_compression_stop_is_validated_where_it_enters() {
+    for (set, needle) in [
+        ("min_length=-0.1", "must be non-negative"),
+        ("min_length=1.0", "must be < stopper_length (1)"),
+        ("min_length=1.5", "must be < stopper_length (1)"),
+        ("min_length=nan", "min_length"),
+    ] {
+        let error = Config::load(None, &[set]).unwrap_err().to_string();
+        assert!(error.contains(needle), "{set}: {error}");
+    }
+    let error = Config::load(None, &["min_length=0.9", "rigid_legs=true"])
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("rigid legs never shorten"), "{error}");
+    let config = stroke_limited();
+    let model = Model::new(&config.params).unwrap();
+    let below = vrw::walk::SectionState {
+        l2: 0.99,
+        theta_dot: 2.0,
+        l2_dot: 0.0,
+    };
+    let error = below.validate(&model).unwrap_err().to_string();
+    assert!(error.contains("min_length"), "{error}");
+    // Written configurations leave the key out at its default (0, none), and keep it otherwise.
+    let text = toml::to_string(&Config::default()).unwrap();
+    assert!(!text.contains("min_length"), "{text}");
+    assert!(toml::to_string(&config)
+        .unwrap()
+        .contains("min_length = 1.0"));
+}

@@ -69,8 +69,12 @@ pub struct GaitFamily<'a> {
     config: &'a Config,
     param: &'static str,
     period: usize,
-    /// The section state whose coordinates that are not free (with rigid legs) every point keeps.
+    /// The section state whose coordinates that are not free (with rigid legs, or Leg 2 held at its
+    /// compression stop) every point keeps.
     base: SectionState,
+    /// Leg 2 is held at its compression stop at `base`: the map acts on `dtheta/dt` alone
+    /// ([`StepMap::on_section_of`]).
+    rear_held: bool,
     /// Relative step of the central differences where the map is not differentiable.
     fd_step: f64,
     interrupt: Option<&'a AtomicBool>,
@@ -93,11 +97,21 @@ impl<'a> GaitFamily<'a> {
                 ),
             });
         };
+        let rear_held = base.rear_held_under(&config.params);
         Ok(GaitFamily {
             config,
             param,
             period: 1,
-            base,
+            base: if rear_held {
+                SectionState {
+                    l2: config.params.min_length,
+                    l2_dot: 0.0,
+                    ..base
+                }
+            } else {
+                base
+            },
+            rear_held,
             fd_step: 1e-6,
             interrupt: None,
         })
@@ -193,9 +207,14 @@ impl<'a> GaitFamily<'a> {
         Ok((c, model))
     }
 
+    /// Does the map act on `dtheta/dt` alone (rigid legs, or Leg 2 held at its compression stop)?
+    fn theta_dot_only(&self) -> bool {
+        self.config.params.rigid_legs || self.rear_held
+    }
+
     /// The free coordinates of a section state.
     pub fn reduce(&self, s: &SectionState) -> DVector<f64> {
-        if self.config.params.rigid_legs {
+        if self.theta_dot_only() {
             DVector::from_element(1, s.theta_dot)
         } else {
             DVector::from_column_slice(&s.to_array())
@@ -204,7 +223,7 @@ impl<'a> GaitFamily<'a> {
 
     /// The section state of the free coordinates `x`.
     pub fn expand(&self, x: &DVector<f64>) -> SectionState {
-        if self.config.params.rigid_legs {
+        if self.theta_dot_only() {
             SectionState {
                 theta_dot: x[0],
                 ..self.base
@@ -228,6 +247,7 @@ impl<'a> GaitFamily<'a> {
         'a: 'm,
     {
         StepMap::new(model, &c.solver)
+            .on_section_of(&self.base)
             .iterated(self.period)
             .with_interrupt(self.interrupt)
     }
@@ -267,7 +287,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
     type Info = GaitInfo;
 
     fn dim(&self) -> usize {
-        if self.config.params.rigid_legs {
+        if self.theta_dot_only() {
             1
         } else {
             3

@@ -94,7 +94,6 @@ pub(crate) fn newton_jacobian(
     s: &SectionState,
     fd_step: f64,
 ) -> Result<DMatrix<f64>, crate::walk::WalkError> {
-    let map = &map.on_section_of(s);
     match map.eval_with_derivatives(s, None) {
         Ok(d) => Ok(d.jacobian),
         Err(DerivativeError::Walk(e)) => Err(e),

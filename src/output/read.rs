@@ -306,6 +306,8 @@ pub struct Geometry {
     pub viscosity: f64,
     /// Whether Leg 2 has its stopper (`rear_stopper`, true when the key is absent, as it is at its default).
     pub rear_stopper: bool,
+    /// Length of the compression stop \[m\] (`min_length`; 0, none, when the key is absent, as at its default).
+    pub min_length: f64,
 }
 
 impl Geometry {
@@ -459,6 +461,12 @@ fn summary_fields(path: &Path, text: &str) -> Result<(Geometry, String), ReadErr
             None => true,
             Some(_) => parameter(config, path, "rear_stopper", "true or false", |v| {
                 v.as_bool()
+            })?,
+        },
+        min_length: match config.get("min_length") {
+            None => 0.0,
+            Some(_) => parameter(config, path, "min_length", "non-negative number", |v| {
+                v.as_f64().filter(|x| x.is_finite() && *x >= 0.0)
             })?,
         },
     };
@@ -689,6 +697,18 @@ fn check_sample(
                 column,
                 l.to_string(),
                 format!("is not a leg length in (0, {which}] = (0, {longest}] m"),
+            ));
+        }
+        if geometry.min_length > 0.0 && l < geometry.min_length - LENGTH_SLACK {
+            return Err(implausible(
+                path,
+                row,
+                column,
+                l.to_string(),
+                format!(
+                    "is below the compression stop: a leg length is at least min_length - {LENGTH_SLACK:e} = {} m",
+                    geometry.min_length - LENGTH_SLACK
+                ),
             ));
         }
     }

@@ -122,9 +122,14 @@ impl SectionState {
     /// starts the next step so; a walker started from such a state does the same, and the step map then acts on
     /// `dtheta/dt` alone (docs/model.md section 6).
     pub fn rear_held(&self, model: &Model) -> bool {
-        let min = model.params().min_length;
+        self.rear_held_under(model.params())
+    }
+
+    /// [`SectionState::rear_held`] under the parameters `params`.
+    pub fn rear_held_under(&self, params: &crate::params::Params) -> bool {
+        let min = params.min_length;
         min > 0.0
-            && !model.params().rigid_legs
+            && !params.rigid_legs
             && self.l2 - min <= HELD_SECTION_TOL
             && self.l2_dot.abs() <= HELD_SECTION_TOL
     }

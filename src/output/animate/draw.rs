@@ -195,7 +195,7 @@ fn draw_leg<DB: DrawingBackend>(
         vec![p(mid, off), p(rod_top, off), p(rod_top, 0.0)],
         thin,
     ))?;
-    // Stopper, drawn while it holds the leg at L0.
+    // Stopper, drawn while it holds the leg at L0 (or the compression stop at min_length).
     if locked {
         root.draw(&PathElement::new(
             vec![p(rod_top, -0.05), p(rod_top, 0.05)],
@@ -265,8 +265,13 @@ fn draw_ground<DB: DrawingBackend>(
     ))
 }
 
-/// The legend in the top right corner.
-fn draw_legend<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, w: i32) -> DrawResult<DB> {
+/// The legend in the top right corner (`compression`: the legs have a compression stop, whose lock is drawn
+/// as the stopper's).
+fn draw_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    w: i32,
+    compression: bool,
+) -> DrawResult<DB> {
     let size = 14.0;
     let x = w - 190;
     let mut y = 8;
@@ -279,7 +284,14 @@ fn draw_legend<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, w: i32) -> Dra
         ("tip on ground, no slip", Key::Tip(TipState::Stuck)),
         ("tip sliding", Key::Tip(TipState::Sliding)),
         ("tip in the air", Key::Tip(TipState::Air)),
-        ("stopper locked", Key::Bar(STOPPER, 4)),
+        (
+            if compression {
+                "stop locked (L0 or min)"
+            } else {
+                "stopper locked"
+            },
+            Key::Bar(STOPPER, 4),
+        ),
         ("Leg 1", Key::Bar(COLOR_BLUE, 5)),
         ("Leg 2", Key::Bar(COLOR_VERMILLION, 5)),
     ];
@@ -371,7 +383,7 @@ fn draw_frame<DB: DrawingBackend>(
         (12, 10 + (size * 2.4) as i32),
         font(size * 0.7),
     ))?;
-    draw_legend(root, w)
+    draw_legend(root, w, geometry.min_length > 0.0)
 }
 
 /// Draws frames of one run.

@@ -143,6 +143,7 @@ mod tests {
             slope: 0.1,
             viscosity: 50.0,
             rear_stopper: true,
+            min_length: 0.0,
         };
         let alpha = geometry.alpha();
         let before = TrajectoryRow {

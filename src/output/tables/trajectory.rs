@@ -83,12 +83,12 @@ pub(crate) const TRAJECTORY: [Column<Sample>; 24] = [
     }),
     Column::new(
         "stopper_1",
-        "Stopper reaction on Leg 1, positive inward (-mu_1) [N].",
+        "Stopper reaction on Leg 1, positive inward (-mu_1; a compression stop's, negative, pushes outward) [N].",
         |s| Real(-s.multipliers[4]),
     ),
     Column::new(
         "stopper_2",
-        "Stopper reaction on Leg 2, positive inward (-mu_2) [N].",
+        "Stopper reaction on Leg 2, positive inward (-mu_2; a compression stop's, negative, pushes outward) [N].",
         |s| Real(-s.multipliers[5]),
     ),
     Column::new("leg1", "Which physical leg (0 to N-1) is Leg 1.", |s| {
