@@ -187,7 +187,10 @@ fn print_check(check: &JacobianCheck) -> Result<()> {
     };
     show("exact DP", &check.exact);
     show(
-        "finite-difference DP (Richardson)",
+        &format!(
+            "finite-difference DP (Richardson, rtol {:e})",
+            check.finite_difference_rtol
+        ),
         &check.finite_difference,
     );
     println!(

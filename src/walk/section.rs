@@ -118,7 +118,7 @@ impl SectionState {
     }
 
     /// Is Leg 2 held at its compression stop in this state (`min_length > 0`, `L2 = min_length` and
-    /// `dL2/dt = 0` within [`HELD_SECTION_TOL`])? A walk that reaches a touchdown with its stance leg held there
+    /// `dL2/dt = 0` within 1e-9, `HELD_SECTION_TOL`)? A walk that reaches a touchdown with its stance leg held there
     /// starts the next step so; a walker started from such a state does the same, and the step map then acts on
     /// `dtheta/dt` alone (docs/model.md section 6).
     pub fn rear_held(&self, model: &Model) -> bool {
