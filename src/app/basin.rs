@@ -19,12 +19,13 @@ use super::{check_interrupted, in_run, prepared, AppError};
 use crate::output::manifest::RunDir;
 use crate::output::write_basin_csv;
 
-/// Default range of a coordinate on the basin slice around the gait's value `at`: `L2` from `L0 / 2` to `L0`,
-/// `dtheta/dt` from a twentieth of the gait's to three times it, `dL2/dt` the gait's plus and minus 1.5 m/s.
+/// Default range of a coordinate on the basin slice around the gait's value `at`: `L2` from `L0 / 2` (or the
+/// compression stop `min_length`, if higher) to `L0`, `dtheta/dt` from a twentieth of the gait's to three
+/// times it, `dL2/dt` the gait's plus and minus 1.5 m/s.
 pub fn default_basin_range(config: &Config, coordinate: Coordinate, at: f64) -> (f64, f64) {
     let l0 = config.params.stopper_length;
     match coordinate {
-        Coordinate::L2 => (0.5 * l0, l0),
+        Coordinate::L2 => ((0.5 * l0).max(config.params.min_length), l0),
         Coordinate::ThetaDot => (0.05 * at, 3.0 * at),
         Coordinate::L2Dot => (at - 1.5, at + 1.5),
     }

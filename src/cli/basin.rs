@@ -24,8 +24,8 @@ pub(super) struct BasinArgs {
     /// Vertical coordinate of the slice (the third is held at the gait's value).
     #[arg(long, default_value = "thetadot")]
     y: Coordinate,
-    /// Range of x, `A,B` (default: L2 from L0/2 to L0, thetadot from 0.05 to 3 times the gait's, L2dot the
-    /// gait's +- 1.5 m/s).
+    /// Range of x, `A,B` (default: L2 from max(L0/2, min_length) to L0, thetadot from 0.05 to 3 times the
+    /// gait's, L2dot the gait's +- 1.5 m/s).
     #[arg(long, value_name = "A,B", value_parser = parse_range, allow_hyphen_values = true)]
     x_range: Option<(f64, f64)>,
     /// Range of y, `A,B` (defaults as for --x-range).
