@@ -8,6 +8,7 @@ import pytest
 
 import vrw
 from vrw.grid import gait_grid
+from conftest import ROOT
 
 pd = pytest.importorskip("pandas")
 xr = pytest.importorskip("xarray")
@@ -32,6 +33,21 @@ def test_run_tables_convert_to_dataframes_like_the_csv_files(cli, tmp_path):
         for column in frame.columns:
             if frame[column].dtype.kind not in "fib":
                 assert frame[column].dtype == csv[column].dtype, column
+
+
+def test_the_stroke_limited_run_says_which_stop_holds_a_leg(cli, tmp_path):
+    # lock1 / lock2: 1 on the stopper, 2 on the compression stop (min_length), as trajectory.csv has them.
+    params = vrw.Params.from_toml(ROOT / "readings" / "stroke-limited.toml")
+    cli("simulate", "--steps", 2, "--config", ROOT / "readings" / "stroke-limited.toml", "--out", tmp_path)
+    run = vrw.simulate(params, steps=2)
+    frame = run.trajectory.to_pandas()
+    csv = pd.read_csv(tmp_path / "trajectory.csv")
+    for column in ["lock1", "lock2", "L1", "L2"]:
+        assert np.array_equal(frame[column], csv[column]), column
+    assert 2 in set(frame["lock1"]) <= {0, 1, 2} and frame["lock1"].dtype.kind == "i"
+    held = frame[frame["lock1"] == 2]
+    assert np.allclose(held["L1"], 1.0, atol=1e-9, rtol=0)
+    assert frame["L1"].min() > 1.0 - 1e-9 and frame["L2"].min() > 1.0 - 1e-9
 
 
 def test_gait_and_sweep_results_read_as_attributes():
