@@ -310,7 +310,11 @@ fn the_stroke_limited_leg_has_the_papers_shape_with_its_threshold_near_52() {
             .gait
             .as_ref()
             .unwrap_or_else(|| panic!("{at}: {:?}", p.message));
-        assert!(g.section.rear_held(&model), "{at}: {:?}", g.section);
+        assert!(
+            g.section.rear_held(&model) && g.rear_held,
+            "{at}: {:?}",
+            g.section
+        );
         assert_eq!(g.floquet_multipliers.len(), 1, "{at}");
         assert!(g.lambda_i4 > 0.0, "{at}: {}", g.lambda_i4);
         assert!(g.lambda_4_plus < last_lambda_4, "{at}: lambda_4+ rises");

@@ -153,6 +153,12 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         g.jacobian_error,
         g.stability
     );
+    if g.rear_held {
+        println!(
+            "(Leg 2 is held at its compression stop at the section: the map acts on dtheta/dt alone; the other \
+             two multipliers are 0)"
+        );
+    }
     if let Some(failure) = &g.jacobian_failure {
         println!("no Jacobian: {failure}");
     }

@@ -201,6 +201,10 @@ pub struct Gait {
     /// `stability == Stability::Stable`: all multipliers inside the unit circle by more than the error
     /// estimate.
     pub stable: bool,
+    /// Leg 2 is held at its compression stop at the section (`min_length`, docs/model.md section 6): the map,
+    /// its Jacobian and the multipliers are over `dtheta/dt` alone (the other two coordinates are fixed after
+    /// one step: their multipliers are 0).
+    pub rear_held: bool,
 }
 
 /// The stability verdict of a gait, honest about the Jacobian's error estimate `e`: `Stable` only when the
@@ -262,6 +266,8 @@ pub(crate) struct FixedPoint {
     pub residual: f64,
     /// Newton iterations used.
     pub iterations: usize,
+    /// Leg 2 is held at its compression stop at `s*`: the map acted on `dtheta/dt` alone.
+    pub rear_held: bool,
 }
 
 /// Find the gait from `initial`: `transient_steps` steps of the map, then Newton's method on `P(s) - s`,
@@ -435,10 +441,12 @@ pub(crate) fn solve_fixed_point(
         r = r_trial;
     }
     Ok(FixedPoint {
-        section: s,
+        // Held: `L2 = min_length`, `dL2/dt = 0` exactly (the walk's rounding left out, as the map does).
+        section: s.pinned(map.model()),
         outcome,
         residual: norm(&r),
         iterations,
+        rear_held: map.rear_held(),
     })
 }
 
@@ -484,6 +492,7 @@ pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) ->
         stability: Stability::judge(max_floquet, jacobian_error),
         jacobian_failure: None,
         stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
+        rear_held: fp.rear_held,
     }
 }
 
@@ -528,6 +537,10 @@ struct GaitRecord {
     #[serde(skip_serializing_if = "Option::is_none")]
     jacobian_failure: Option<String>,
     stable: bool,
+    /// Written only when true (a compression stop holds Leg 2 at the section), so other gaits' files are as
+    /// before.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    rear_held: bool,
 }
 
 impl From<Gait> for GaitRecord {
@@ -562,6 +575,7 @@ impl From<Gait> for GaitRecord {
             stability: g.stability,
             jacobian_failure: g.jacobian_failure,
             stable: g.stable,
+            rear_held: g.rear_held,
         }
     }
 }

@@ -126,6 +126,11 @@ impl<'m> StepMap<'m> {
         }
     }
 
+    /// Does the map act on states whose Leg 2 is held at its compression stop ([`StepMap::on_section_of`])?
+    pub(crate) fn rear_held(&self) -> bool {
+        self.rear_held
+    }
+
     /// `next`, or [`WalkError::HoldChanged`] where this map holds Leg 2 at its compression stop and `next`
     /// does not.
     fn check_hold(&self, next: SectionState) -> Result<SectionState, WalkError> {
