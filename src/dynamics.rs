@@ -145,6 +145,9 @@ pub(crate) struct Mechanics<T: Real = f64> {
     pub leg_mass_offset: T,
     /// `L0` \[m\].
     pub stopper_length: T,
+    /// The length of the legs other than Legs 1 and 2, at which a leg touches down
+    /// ([`Params::spoke_length`]: `touchdown_length`, or `L0`) \[m\].
+    pub spoke_length: T,
     /// `Lstar` \[m\].
     pub spring_natural_length: T,
     /// `k` \[N/m\].
@@ -183,6 +186,12 @@ impl<T: Real> Mechanics<T> {
             leg_mass: value("leg_mass", params.leg_mass),
             leg_mass_offset: value("leg_mass_offset", params.leg_mass_offset),
             stopper_length: value("stopper_length", params.stopper_length),
+            // At its default the touchdown length is the stopper length, and its derivative is that key's.
+            spoke_length: if params.touchdown_length == 0.0 {
+                value("stopper_length", params.stopper_length)
+            } else {
+                value("touchdown_length", params.touchdown_length)
+            },
             spring_natural_length: value("spring_natural_length", params.spring_natural_length),
             stiffness: value("stiffness", params.stiffness),
             viscosity: value("viscosity", params.viscosity),
@@ -300,7 +309,8 @@ impl Model {
         self.params.hub_mass + self.legs() as f64 * self.params.leg_mass
     }
 
-    /// Length of leg `j`: `L1`, `L2` from `q`, the stopper length `L0` for the locked legs (docs/model.md section 2).
+    /// Length of leg `j`: `L1`, `L2` from `q`, the spoke length (`touchdown_length`, by default the stopper
+    /// length `L0`) for the locked legs (docs/model.md section 2).
     fn leg_length<T: Real>(
         mech: &Mechanics<T>,
         q: &CoordsOf<T>,
@@ -309,7 +319,7 @@ impl Model {
         match j {
             0 => (q[L1], Some(L1)),
             1 => (q[L2], Some(L2)),
-            _ => (mech.stopper_length, None),
+            _ => (mech.spoke_length, None),
         }
     }
 
@@ -498,9 +508,9 @@ impl Model {
             let (b, vp, _) = point(p.leg_mass_offset);
             sums.add(p.leg_mass, &b, vp + p.up);
         }
-        // The locked legs j = 2..N, all of length L0 (see above).
+        // The locked legs j = 2..N, all of the spoke length (see above).
         let n = lit::<T>((self.legs() - 2) as f64);
-        let d = p.stopper_length - p.leg_mass_offset;
+        let d = p.spoke_length - p.leg_mass_offset;
         let (ss, sc) = self.locked_offsets;
         let (ss, sc) = (lit::<T>(ss), lit::<T>(sc));
         let (sum_sin, sum_cos) = (st * sc + ct * ss, ct * sc - st * ss);

@@ -196,7 +196,7 @@ pub fn default_initial(config: &Config) -> SectionState {
             p.spring_natural_length - mass * p.gravity * p.slope.cos() / p.stiffness;
         let tuned = DEFAULT_START_LENGTH_FRACTION * p.stopper_length;
         // Below L0 cos(alpha) the leg behind Leg 2 would start below the ground.
-        let floor = tuned.max(VALID_START_MARGIN * p.stopper_length * p.alpha().cos());
+        let floor = tuned.max(VALID_START_MARGIN * p.spoke_length() * p.alpha().cos());
         // A compression stop (`min_length`) holds a loaded leg at it.
         let l2 = static_length
             .max(floor)

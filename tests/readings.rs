@@ -373,3 +373,54 @@ fn a_compression_stop_is_validated_where_it_enters() {
         .unwrap()
         .contains("min_length = 1.0"));
 }
+
+/// A touchdown length inside the stroke (`touchdown_length`, between `min_length` and the stopper) lands every
+/// leg free at that length (the spokes have it too), with clean audits and the energy carried over through the
+/// resets; outside the stroke, or shorter than the stopper without `rear_exit = "reset"`, it is refused.
+#[test]
+fn a_touchdown_length_inside_the_stroke_lands_the_leg_free_there() {
+    for (sets, needle) in [
+        (
+            &["touchdown_length=1.2"][..],
+            "must be <= stopper_length (1)",
+        ),
+        (&["touchdown_length=0.9"][..], "needs rear_exit = \"reset\""),
+        (
+            &["rear_exit=reset", "touchdown_length=0.2"][..],
+            "must be > leg_mass_offset (0.3)",
+        ),
+        (
+            &["rear_exit=reset", "min_length=0.95", "touchdown_length=0.9"][..],
+            "must be >= min_length (0.95)",
+        ),
+    ] {
+        let error = Config::load(None, sets).unwrap_err().to_string();
+        assert!(error.contains(needle), "{sets:?}: {error}");
+    }
+    let mut config = stroke_limited();
+    config.params.touchdown_length = 1.01;
+    config.params.viscosity = 30.0;
+    config.validate().unwrap();
+    let model = Model::new(&config.params).unwrap();
+    let mut trajectory = Trajectory::new(0.01);
+    let run = simulate(
+        &model,
+        &config.solver,
+        &default_initial(&config),
+        6,
+        Some(&mut trajectory),
+    )
+    .unwrap();
+    assert!(run.failure.is_none(), "{:?}", run.failure);
+    for s in &run.steps {
+        assert_audits_clean(s, &format!("step {}", s.step));
+        let landed = trajectory
+            .samples
+            .iter()
+            .find(|x| x.time >= s.time)
+            .unwrap();
+        assert_eq!(landed.q[L1], 1.01, "step {}", s.step);
+        assert!(!landed.active.lock1, "step {}", s.step);
+    }
+    assert_energy_carries_over(&run, &config, 1e-9);
+}

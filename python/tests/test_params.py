@@ -31,6 +31,7 @@ def test_the_keys_files_leave_out_at_their_defaults_are_keys_too(tmp_path):
     assert vrw.Params(**third_party.to_dict()) == third_party
     # min_length (the compression stop; 0, none, by default) is such a key, and a numeric one.
     assert defaults["min_length"] == 0.0 and "min_length" in vrw.Params.numeric_keys()
+    assert defaults["touchdown_length"] == 0.0 and "touchdown_length" in vrw.Params.numeric_keys()
     stroke = vrw.Params.from_toml(ROOT / "readings" / "stroke-limited.toml")
     assert stroke["min_length"] == 1.0 and stroke == vrw.Params(**stroke.to_dict())
     assert pickle.loads(pickle.dumps(stroke)) == stroke
@@ -67,6 +68,7 @@ def test_replace_and_round_trips():
         ({"spring_natural_length": 0.99}, "spring_natural_length=0.99"),
         ({"min_length": 1.0}, "min_length=1"),
         ({"min_length": -0.5}, "min_length=-0.5"),
+        ({"touchdown_length": 0.9}, "touchdown_length=0.9"),
     ],
 )
 def test_bad_keys_raise_the_command_lines_message(cli, tmp_path, keys, override):

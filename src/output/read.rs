@@ -308,6 +308,9 @@ pub struct Geometry {
     pub rear_stopper: bool,
     /// Length of the compression stop \[m\] (`min_length`; 0, none, when the key is absent, as at its default).
     pub min_length: f64,
+    /// Length of the legs other than Legs 1 and 2 \[m\]: `touchdown_length`, or `L0` when the key is absent (as
+    /// at its default, 0).
+    pub spoke_length: f64,
 }
 
 impl Geometry {
@@ -450,9 +453,17 @@ fn summary_fields(path: &Path, text: &str) -> Result<(Geometry, String), ReadErr
     let legs = parameter(config, path, "legs", "whole number of at least 3", |v| {
         v.as_u64().filter(|&n| n >= 3).map(|n| n as usize)
     })?;
+    // A key files leave out at its default, 0.
+    let optional_length = |key| match config.get(key) {
+        None => Ok(0.0),
+        Some(_) => parameter(config, path, key, "non-negative number", |v| {
+            v.as_f64().filter(|x| x.is_finite() && *x >= 0.0)
+        }),
+    };
+    let stopper_length = number("stopper_length")?;
     let geometry = Geometry {
         legs,
-        stopper_length: number("stopper_length")?,
+        stopper_length,
         spring_natural_length: number("spring_natural_length")?,
         leg_mass_offset: number("leg_mass_offset")?,
         slope: number("slope")?,
@@ -463,11 +474,10 @@ fn summary_fields(path: &Path, text: &str) -> Result<(Geometry, String), ReadErr
                 v.as_bool()
             })?,
         },
-        min_length: match config.get("min_length") {
-            None => 0.0,
-            Some(_) => parameter(config, path, "min_length", "non-negative number", |v| {
-                v.as_f64().filter(|x| x.is_finite() && *x >= 0.0)
-            })?,
+        min_length: optional_length("min_length")?,
+        spoke_length: match optional_length("touchdown_length")? {
+            0.0 => stopper_length,
+            length => length,
         },
     };
     let status = json

@@ -408,11 +408,12 @@ mod tests {
         // The file is flat and holds exactly the documented keys.
         let table: toml::Table = text.parse().unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
-        // `rear_stopper` and `min_length` stay at their defaults here (rigid legs need them), and are left out.
+        // `rear_stopper`, `min_length` and `touchdown_length` stay at their defaults here (rigid legs need them),
+        // and are left out.
         let mut expected: Vec<&str> = all_keys()
             .iter()
             .copied()
-            .filter(|k| !["rear_stopper", "min_length"].contains(k))
+            .filter(|k| !["rear_stopper", "min_length", "touchdown_length"].contains(k))
             .collect();
         written.sort_unstable();
         expected.sort_unstable();
@@ -631,7 +632,7 @@ mod tests {
     #[test]
     fn numeric_keys_get_set_round_trip() {
         let keys = Config::numeric_keys();
-        assert_eq!(keys.len(), 19);
+        assert_eq!(keys.len(), 20);
         assert!(keys.iter().all(|key| all_keys().contains(key)));
         for key in [
             "legs",
@@ -675,12 +676,20 @@ mod tests {
         let defaults = Config::default();
         let table = toml::Table::try_from(&defaults).unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
-        // `rear_exit`, `rear_stopper` and `min_length` are left out at their defaults, so that written
+        // `rear_exit`, `rear_stopper`, `min_length` and `touchdown_length` are left out at their defaults, so that written
         // configurations stay as they were before them; `keys_left_out_at_defaults` names them (and reads back as
         // the defaults).
         let left_out = defaults.params.keys_left_out_at_defaults();
         let left_out: Vec<&str> = left_out.iter().map(|(key, _)| *key).collect();
-        assert_eq!(left_out, ["rear_exit", "rear_stopper", "min_length"]);
+        assert_eq!(
+            left_out,
+            [
+                "rear_exit",
+                "rear_stopper",
+                "min_length",
+                "touchdown_length"
+            ]
+        );
         let mut read: Vec<&str> = all_keys()
             .iter()
             .copied()

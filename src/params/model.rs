@@ -75,6 +75,12 @@ pub struct Params {
     /// `docs/model.md` sections 2 and 4.
     #[serde(skip_serializing_if = "is_zero")]
     pub min_length: f64,
+    /// Length at which a leg touches down, and of every leg other than Legs 1 and 2 (rigid spokes) \[m\].
+    /// Default 0: the stopper length. Otherwise within the stroke, `[min_length, stopper_length]`; shorter than
+    /// the stopper only with `rear_exit = "reset"` (a leg that leaves the coordinates is set to it) and soft
+    /// legs. A leg that lands shorter than its stopper is free at once. `docs/model.md` sections 2 and 5.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub touchdown_length: f64,
 }
 
 fn is_true(b: &bool) -> bool {
@@ -107,6 +113,7 @@ impl Default for Params {
             rear_exit: RearExit::Relock,
             rear_stopper: true,
             min_length: 0.0,
+            touchdown_length: 0.0,
         }
     }
 }
@@ -114,7 +121,7 @@ impl Default for Params {
 impl Params {
     /// The keys that written configurations leave out at their defaults (so that files stay as they were before
     /// these keys existed), with their values here: what a front listing every key adds to the serialization.
-    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 3] {
+    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 4] {
         [
             (
                 "rear_exit",
@@ -122,7 +129,21 @@ impl Params {
             ),
             ("rear_stopper", toml::Value::Boolean(self.rear_stopper)),
             ("min_length", toml::Value::Float(self.min_length)),
+            (
+                "touchdown_length",
+                toml::Value::Float(self.touchdown_length),
+            ),
         ]
+    }
+
+    /// The length at which a leg touches down, and of every leg other than Legs 1 and 2: `touchdown_length`,
+    /// or `stopper_length` where that is 0 (its default).
+    pub fn spoke_length(&self) -> f64 {
+        if self.touchdown_length == 0.0 {
+            self.stopper_length
+        } else {
+            self.touchdown_length
+        }
     }
 
     /// Inter-leg angle `alpha = 2 pi / legs` \[rad\] (`docs/model.md` section 1); `pi/4` by default.
@@ -278,6 +299,10 @@ impl Params {
                 Ok(())
             });
         }
+        rules.single(non_negative("touchdown_length", self.touchdown_length));
+        if self.touchdown_length > 0.0 {
+            self.touchdown_length_rules(rules);
+        }
         // The time scale needs sound masses: not when the mass ratio is already refused.
         let ratio = self.leg_mass / self.hub_mass;
         if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)
@@ -287,6 +312,37 @@ impl Params {
         {
             let result = self.stiff_legs_rule(&|key| rules.given(key));
             rules.between(["viscosity", "stiffness"], |_| result);
+        }
+    }
+
+    /// The rules of a touchdown length that is set: within the stroke (`[min_length, stopper_length]`, above
+    /// `leg_mass_offset`), and shorter than the stopper only where a leaving leg is reset to it.
+    fn touchdown_length_rules(&self, rules: &mut Rules<'_>) {
+        let td = ("touchdown_length", self.touchdown_length);
+        rules.between(["touchdown_length", "stopper_length"], |given| {
+            ordered(("stopper_length", self.stopper_length), AtLeast, td, given)
+        });
+        rules.between(["touchdown_length", "leg_mass_offset"], |given| {
+            ordered(("leg_mass_offset", self.leg_mass_offset), Below, td, given)
+        });
+        if self.min_length > 0.0 {
+            rules.between(["touchdown_length", "min_length"], |given| {
+                ordered(td, AtLeast, ("min_length", self.min_length), given)
+            });
+        }
+        if self.touchdown_length < self.stopper_length {
+            rules.between(["touchdown_length", "rear_exit"], |_| {
+                if self.rear_exit != RearExit::Reset || self.rigid_legs {
+                    return Err(invalid(
+                        "touchdown_length",
+                        short(self.touchdown_length),
+                        "a touchdown length shorter than the stopper makes the legs in the air spokes of that \
+                         length, which a leg relocked at stopper_length is not: it needs rear_exit = \"reset\" \
+                         (and soft legs)",
+                    ));
+                }
+                Ok(())
+            });
         }
     }
 

@@ -350,8 +350,9 @@ fn guard<T: Real>(
     }
 }
 
-/// Re-indexing at touchdown in duals (as `crate::walk`'s `reindex`): the touching leg becomes Leg 1, the old Leg
-/// 1 Leg 2 (or, after a long flight, a locked leg at `L0`), the origin moves to the new tip.
+/// Re-indexing at touchdown in duals (as `crate::walk`'s `reindex`): the touching leg becomes Leg 1 (at the
+/// touchdown length), the old Leg 1 Leg 2 (or, after a long flight, a spoke at the touchdown length), the
+/// origin moves to the new tip.
 fn reindex_duals(
     model: &Model,
     mech: &Mechanics<Dual4>,
@@ -363,7 +364,7 @@ fn reindex_duals(
     let shift = model.legs() - touching;
     let front = model.tip_with(mech, q, qd, touching);
     let v = front.velocity(qd);
-    let l0 = mech.stopper_length;
+    let l0 = mech.spoke_length;
     let zero = Dual4::lit(0.0);
     let (l2, l2_dot) = if shift == 1 {
         (q[L1], qd[L1])

@@ -47,6 +47,15 @@ fn cases() -> Vec<(Vec<&'static str>, SectionState)> {
         // section (the map on dtheta/dt alone), and free within its stroke.
         (STROKE_LIMITED.to_vec(), s(1.0, 2.0, 0.0)),
         (STROKE_LIMITED.to_vec(), s(1.01, 2.0, -0.05)),
+        // ... landing free, inside its stroke (the section's and the re-indexing's touchdown length).
+        (
+            [
+                &STROKE_LIMITED[..],
+                &["touchdown_length=1.01", "viscosity=30"],
+            ]
+            .concat(),
+            s(1.005, 2.0, 0.0),
+        ),
         // Stiff legs with a compression stop inside the spring's range: the stance leg bottoms out and is
         // released again in single support as its load falls (a compression unlock).
         (

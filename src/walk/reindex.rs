@@ -11,7 +11,8 @@ use super::impact::has_stopper;
 /// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
 /// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
 /// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be in the air, and locked at
-/// `L0` ([`RearExit::Relock`]) or reset to it ([`RearExit::Reset`]: their length and rate are discarded). The
+/// `L0` ([`RearExit::Relock`]) or reset to the spokes' length, `touchdown_length` or `L0`
+/// ([`RearExit::Reset`]: their length and rate are discarded). The new Leg 1 has the touchdown length. The
 /// origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact, energy removed by
 /// the reset)`: `T + V` before minus after the reset \[J\], 0 when no leg was reset.
 pub(super) fn reindex(
@@ -37,7 +38,7 @@ pub(super) fn reindex(
             continue;
         }
         if reset {
-            q_reset[leg.length_coordinate()] = model.params().stopper_length;
+            q_reset[leg.length_coordinate()] = model.params().spoke_length();
             qd_reset[leg.length_coordinate()] = 0.0;
         } else {
             let i = leg.length_coordinate();
@@ -50,11 +51,13 @@ pub(super) fn reindex(
     }
     let front = model.tip(q, qd, touching);
     let v = front.velocity(qd);
-    let l0 = model.params().stopper_length;
+    // The new Leg 1 lands at the touchdown length, and a spoke that becomes Leg 2 has it too.
+    let l_td = model.params().spoke_length();
+    let at_stopper = l_td == model.params().stopper_length;
     let (l2, l2_dot) = if shift == 1 {
         (q[L1], qd[L1])
     } else {
-        (l0, 0.0)
+        (l_td, 0.0)
     };
     let theta = if shift == 1 {
         q[THETA] - model.alpha()
@@ -63,14 +66,16 @@ pub(super) fn reindex(
         let psi = q[THETA] + touching as f64 * model.alpha();
         psi - std::f64::consts::TAU * (psi / std::f64::consts::TAU).round()
     };
-    let q_new = Coords::new(0.0, front.position.y, theta, l0, l2);
+    let q_new = Coords::new(0.0, front.position.y, theta, l_td, l2);
     let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot);
     let before = ActiveSet {
         contact1: false,
         contact2: shift == 1 && active.contact1,
-        lock1: true,
+        // It arrives locked on its stopper unless it lands shorter (`touchdown_length`).
+        lock1: at_stopper,
         // A leg that becomes Leg 2 keeps its lock only if Leg 2 has a stopper (`rear_stopper`).
-        lock2: (shift > 1 || active.lock1) && has_stopper(model, Leg::Two),
+        lock2: ((shift > 1 && at_stopper) || (shift == 1 && active.lock1))
+            && has_stopper(model, Leg::Two),
         // A leg held at its compression stop stays held as Leg 2.
         compression2: shift == 1 && active.compression1,
         ..Default::default()

@@ -1,6 +1,6 @@
 //! The Poincare section of docs/model.md section 6: just before touchdown, after re-indexing.
 //!
-//! There `x = z = 0` (the new Leg 1's tip is the origin), `L1 = L0`, `dL1/dt = 0`, and Leg 2's tip is on the
+//! There `x = z = 0` (the new Leg 1's tip is the origin), `L1 = L0` (the touchdown length), `dL1/dt = 0`, and Leg 2's tip is on the
 //! ground and at rest, so the state reduces to `s = (L2, dtheta/dt, dL2/dt)`: `theta` follows from Leg 2's tip
 //! touching the ground and `(dx, dz)` from Leg 2's tip being at rest.
 
@@ -167,7 +167,7 @@ impl SectionState {
 }
 
 /// The state `(q_dagger, q'_dagger)` at the section state `(L2, dtheta/dt, dL2/dt)` over any [`Real`] (the
-/// section's own constraint, docs/model.md section 6): `x = z = 0`, `L1 = L0`, `dL1/dt = 0`; `theta` puts Leg 2's
+/// section's own constraint, docs/model.md section 6): `x = z = 0`, `L1 = L0` (the touchdown length), `dL1/dt = 0`; `theta` puts Leg 2's
 /// tip on the ground, `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2
 /// sin(alpha))`; `(dx, dz)` hold Leg 2's tip at rest (`J_C2 q' = 0`, whose `x`, `z` columns are the identity).
 /// With `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly.
@@ -176,7 +176,8 @@ pub(crate) fn section_coords<T: Real>(
     mech: &Mechanics<T>,
     (l2, theta_dot, l2_dot): (T, T, T),
 ) -> (CoordsOf<T>, CoordsOf<T>) {
-    let l0 = mech.stopper_length;
+    // Leg 1 has just landed, at the touchdown length (`L0` by default, and always with rigid legs).
+    let l0 = mech.spoke_length;
     let (l2, l2_dot) = if model.params().rigid_legs {
         (l0, T::zero())
     } else {

@@ -82,7 +82,8 @@ impl<'m> Walker<'m> {
             active: ActiveSet {
                 contact1: false,
                 contact2: true,
-                lock1: true,
+                // Leg 1 arrives on its stopper unless it lands shorter (`touchdown_length`).
+                lock1: model.params().spoke_length() == model.params().stopper_length,
                 lock2: model.params().rigid_legs,
                 compression2: section.rear_held(model),
                 ..Default::default()

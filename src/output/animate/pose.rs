@@ -49,7 +49,7 @@ impl<'a> Track<'a> {
     fn pose_of(&self, k: usize) -> Pose {
         let s = &self.samples[k];
         let n = self.geometry.legs;
-        let mut lengths = vec![self.geometry.stopper_length; n];
+        let mut lengths = vec![self.geometry.spoke_length; n];
         lengths[s.leg1 % n] = s.l1;
         lengths[(s.leg1 + 1) % n] = s.l2;
         Pose {
@@ -144,6 +144,7 @@ mod tests {
             viscosity: 50.0,
             rear_stopper: true,
             min_length: 0.0,
+            spoke_length: 1.0,
         };
         let alpha = geometry.alpha();
         let before = TrajectoryRow {
