@@ -12,7 +12,9 @@
 //! on Zeno hybrid systems): right after an impact, a leg that is at its stopper (within `stopper_gap` of `L0`)
 //! and separates inward at a speed `v` with `v^2 < 2 a_out stopper_gap`, where `a_out > 0` is its outward
 //! acceleration as a free leg, is locked by a plastic stopper impact. The rule depends only on the state and on
-//! `stopper_gap`, not on the integrator's steps.
+//! `stopper_gap`, not on the integrator's steps. A compression stop (`min_length`) is treated the same way,
+//! mirrored: a leg within `stopper_gap` above it, moving outward slower than its inward acceleration turns it
+//! round within the gap, is locked there.
 //!
 //! **Landings.** The same happens with the two tips on the ground: when both tips touch a frictionless ground,
 //! the landing of one kicks the other up at about the speed it landed with (the impulse at one tip reaches the
