@@ -124,6 +124,14 @@ def test_run_draws_five_panels_against_time(walk):
     assert all(a is b for a, b in zip(vp.run(walk, ax=given), given))
 
 
+def test_run_draws_the_compression_stop_where_there_is_one():
+    stroke = vrw.Params(rear_exit="reset", rear_stopper=False, min_length=1.0, stopper_length=1.02,
+                        spring_natural_length=1.02)
+    axes = rendered(vp.run(vrw.simulate(stroke, steps=2)))
+    assert {"$L_0$ = 1.02 m", "min_length = 1 m"} <= set(legend_texts(axes[2]))
+    assert "min_length" not in " ".join(legend_texts(rendered(vp.run(vrw.simulate(vrw.Params(), steps=1)))[2]))
+
+
 def test_run_needs_the_trajectory():
     with pytest.raises(ValueError, match="trajectory"):
         vp.run(vrw.simulate(vrw.Params(), steps=1, trajectory=False))

@@ -280,6 +280,9 @@ def run(run: Mapping[str, Any], ax: AxesArg = None, **options: Any) -> np.ndarra
     _panels(axes, broken["time"], broken, _RUN, **options)
     l0 = run["config"]["stopper_length"]
     axes[2].axhline(l0, color=MARK, linestyle="--", label=f"$L_0$ = {l0:g} m")
+    min_length = run["config"].get("min_length", 0.0)  # the compression stop, where there is one
+    if min_length > 0:
+        axes[2].axhline(min_length, color=MARK, linestyle="--", label=f"min_length = {min_length:g} m")
     c1, c2, s1, s2 = (np.asarray(trajectory[c]) > 0 for c in ("contact1", "contact2", "slide1", "slide2"))
     phase = np.select([(c1 & s1) | (c2 & s2), c1 & c2, c1, c2], [1, 0, 2, 3], 4)[:-1]
     change = np.flatnonzero(np.diff(phase) != 0) + 1

@@ -161,6 +161,22 @@ impl RunFigure {
             )));
         }
         let l0 = run.geometry.stopper_length;
+        let level = |label: String, y: f64| Curve {
+            label,
+            color: COLOR_MARK,
+            stroke: Stroke::Dashed,
+            points: vec![(t0, y), (t1, y)],
+        };
+        let mut lengths = vec![
+            curve("L₁ (Leg 1)", COLOR_BLUE, series(s, |r| r.l1)),
+            curve("L₂ (Leg 2)", COLOR_VERMILLION, series(s, |r| r.l2)),
+            level(format!("L₀ = {l0} m"), l0),
+        ];
+        // The compression stop, where there is one.
+        let min = run.geometry.min_length;
+        if min > 0.0 {
+            lengths.push(level(format!("min_length = {min} m"), min));
+        }
         let panels = vec![
             Panel {
                 y_label: "θ of Leg 1 [rad]".into(),
@@ -172,16 +188,7 @@ impl RunFigure {
             },
             Panel {
                 y_label: "leg length [m]".into(),
-                curves: vec![
-                    curve("L₁ (Leg 1)", COLOR_BLUE, series(s, |r| r.l1)),
-                    curve("L₂ (Leg 2)", COLOR_VERMILLION, series(s, |r| r.l2)),
-                    Curve {
-                        label: format!("L₀ = {l0} m"),
-                        color: COLOR_MARK,
-                        stroke: Stroke::Dashed,
-                        points: vec![(t0, l0), (t1, l0)],
-                    },
-                ],
+                curves: lengths,
             },
             two_legs(s, "normal force [N]", ["λ₂", "λ₄"], |r| {
                 [r.lambda_2, r.lambda_4]
