@@ -424,3 +424,50 @@ fn a_touchdown_length_inside_the_stroke_lands_the_leg_free_there() {
     }
     assert_energy_carries_over(&run, &config, 1e-9);
 }
+
+/// A sweep in `min_length` itself carries the held leg with the stop (the gait at one value is the start at the
+/// next, held at the new stop): a gait at every value, each held at its own stop. Before, every step up the line
+/// started below the new stop and the sweep reported a false end of the gait.
+#[test]
+fn a_sweep_in_min_length_moves_the_held_leg_with_the_stop() {
+    let config = stroke_limited();
+    let model_at = |v: f64| {
+        let mut c = config.clone();
+        c.params.min_length = v;
+        Model::new(&c.params).unwrap()
+    };
+    let values = [0.99, 0.995, 1.0, 1.005, 1.01];
+    let points = sweep_values(
+        &config,
+        "min_length",
+        &values,
+        &default_initial(&config),
+        &GaitOptions::for_sweeps(),
+        &|_| {},
+    )
+    .unwrap();
+    for p in &points {
+        let g = p
+            .gait
+            .as_ref()
+            .unwrap_or_else(|| panic!("{}: {:?}", p.value, p.message));
+        assert!(
+            g.rear_held && g.section.rear_held(&model_at(p.value)),
+            "{}",
+            p.value
+        );
+        assert_eq!(g.section.l2, p.value);
+    }
+    // lambda_4+ changes sign between 1.0 and 1.005 (the sweep's refined threshold: 1.001078).
+    let sign = |v: f64| {
+        let g = points
+            .iter()
+            .find(|p| p.value == v)
+            .unwrap()
+            .gait
+            .as_ref()
+            .unwrap();
+        g.lambda_4_plus > 0.0
+    };
+    assert!(sign(1.0) && !sign(1.005));
+}

@@ -595,7 +595,7 @@ fn end_cause(
     Some(continuation.end_cause(
         &GaitPoint {
             value: last.param,
-            section: map.expand(&last.x),
+            section: map.section_at(&last.x, last.param),
         },
         *beyond,
     ))

@@ -188,7 +188,7 @@ impl<'a> GaitFamily<'a> {
         let (c, model) = self.configured(p)?;
         let signed = self
             .step_map(&model, &c)
-            .eval_signature(&self.expand(x))
+            .eval_signature(&self.section_at(x, p))
             .map_err(walk_failure)?;
         Ok((self.reduce(&signed.outcome.next), GaitInfo::of(signed)))
     }
@@ -233,11 +233,23 @@ impl<'a> GaitFamily<'a> {
         }
     }
 
+    /// The section state of the free coordinates `x` at the parameter `p`: [`GaitFamily::expand`], except that a
+    /// family held at its compression stop in `min_length` holds Leg 2 at the stop of `p` (`L2 = p`): the stop
+    /// moves with the parameter, and the held leg with it.
+    pub fn section_at(&self, x: &DVector<f64>, p: f64) -> SectionState {
+        let s = self.expand(x);
+        if self.rear_held && self.param == "min_length" {
+            SectionState { l2: p, ..s }
+        } else {
+            s
+        }
+    }
+
     /// `P(x; p)` at the parameter `p` (walk failures named by kind).
     fn outcome(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
         let (c, model) = self.configured(p)?;
         let map = self.step_map(&model, &c);
-        let out = map.eval(&self.expand(x)).map_err(walk_failure)?;
+        let out = map.eval(&self.section_at(x, p)).map_err(walk_failure)?;
         Ok(self.reduce(&out.next))
     }
 
@@ -247,7 +259,7 @@ impl<'a> GaitFamily<'a> {
         'a: 'm,
     {
         StepMap::new(model, &c.solver)
-            .on_section_of(&self.base)
+            .with_rear_held(self.rear_held)
             .iterated(self.period)
             .with_interrupt(self.interrupt)
     }
@@ -262,7 +274,7 @@ impl<'a> GaitFamily<'a> {
         let tighter = self
             .step_map(&model, &c)
             .with_tolerances_scaled(1.0 / DERIVATIVE_CHECK_TIGHTENING);
-        match tighter.eval_with_derivatives(&self.expand(x), None) {
+        match tighter.eval_with_derivatives(&self.section_at(x, p), None) {
             Ok(d) if d.jacobian.shape() == jacobian.shape() => (&d.jacobian - jacobian).amax(),
             _ => f64::NAN,
         }
@@ -297,7 +309,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<GaitInfo>, MapFailure> {
         let (c, model) = self.configured(p)?;
         let map = self.step_map(&model, &c);
-        let s = self.expand(x);
+        let s = self.section_at(x, p);
         let key = DIFFERENTIABLE_KEYS
             .contains(&self.param)
             .then_some(self.param);

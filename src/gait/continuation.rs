@@ -86,6 +86,28 @@ pub(crate) struct Continuation<'a> {
     period: usize,
 }
 
+/// The gait `from` of a family in `param` of `config` as a start at `value` (see `Continuation::start_from`):
+/// its section state, or, where `param` is `min_length` and Leg 2 is held at its compression stop there, the
+/// state held at the stop of `value`.
+pub(crate) fn carried_start(
+    config: &Config,
+    param: &str,
+    from: &FamilyPoint,
+    value: f64,
+) -> SectionState {
+    if param != "min_length" {
+        return from.section;
+    }
+    match config.with(param, from.value) {
+        Ok(c) if from.section.rear_held_under(&c.params) => SectionState {
+            l2: value,
+            l2_dot: 0.0,
+            ..from.section
+        },
+        _ => from.section,
+    }
+}
+
 /// A point of a family: the parameter value and the gait's section state there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FamilyPoint {
@@ -190,6 +212,14 @@ impl<'a> Continuation<'a> {
         Ok((c, model))
     }
 
+    /// The gait `from` of the family as a start at `value`: its section state, except that where the followed
+    /// parameter is `min_length` and Leg 2 is held at its compression stop there, it is held at the stop of
+    /// `value` (`L2 = value`, `dL2/dt = 0`): the stop moves with the parameter and the held leg with it (the
+    /// section state at the old stop would be below the new one, or off it).
+    fn start_from(&self, from: &FamilyPoint, value: f64) -> SectionState {
+        carried_start(self.config, self.param, from, value)
+    }
+
     /// The fixed point at `value` by Newton's method from `start` (no transient).
     pub(crate) fn solve(
         &self,
@@ -210,8 +240,16 @@ impl<'a> Continuation<'a> {
         value: f64,
         guess: Option<&DMatrix<f64>>,
     ) -> Option<FamilyPoint> {
-        let forward = self.solve(value, &from.section, guess).ok()?;
-        let back = self.solve(from.value, &forward.section, guess).ok()?;
+        let forward = self
+            .solve(value, &self.start_from(from, value), guess)
+            .ok()?;
+        let reached = FamilyPoint {
+            value,
+            section: forward.section,
+        };
+        let back = self
+            .solve(from.value, &self.start_from(&reached, from.value), guess)
+            .ok()?;
         (back.section.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
             value,
             section: forward.section,
@@ -222,8 +260,12 @@ impl<'a> Continuation<'a> {
     /// walked from the gait at `value` settles on a gait, and walked from that one at `from.value` comes back to
     /// `from` (a stable family followed the way an experiment would).
     pub(crate) fn walk_step(&self, from: &FamilyPoint, value: f64) -> Option<FamilyPoint> {
-        let forward = self.settle(value, &from.section)?;
-        let back = self.settle(from.value, &forward)?;
+        let forward = self.settle(value, &self.start_from(from, value))?;
+        let reached = FamilyPoint {
+            value,
+            section: forward,
+        };
+        let back = self.settle(from.value, &self.start_from(&reached, from.value))?;
         (back.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
             value,
             section: forward,
@@ -369,7 +411,7 @@ impl<'a> Continuation<'a> {
                 }
             }
         };
-        let mut walker = match Walker::new(&model, &c.solver, &last.section) {
+        let mut walker = match Walker::new(&model, &c.solver, &self.start_from(last, beyond)) {
             Ok(w) => w,
             Err(e) => {
                 return EndCause::WalkFails {

@@ -120,9 +120,15 @@ impl<'m> StepMap<'m> {
     /// stance leg is held then), the map acts on `dtheta/dt` alone, as with rigid legs, and an evaluation whose
     /// next touchdown has Leg 2 free fails ([`WalkError::HoldChanged`]); otherwise on all three coordinates.
     pub fn on_section_of(&self, s: &SectionState) -> StepMap<'m> {
+        self.clone().with_rear_held(s.rear_held(self.model))
+    }
+
+    /// The map on the states whose Leg 2 is held at its compression stop (`held`, see
+    /// [`StepMap::on_section_of`]) or on all three coordinates.
+    pub(crate) fn with_rear_held(self, held: bool) -> StepMap<'m> {
         StepMap {
-            rear_held: s.rear_held(self.model),
-            ..self.clone()
+            rear_held: held,
+            ..self
         }
     }
 

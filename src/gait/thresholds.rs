@@ -25,7 +25,7 @@ use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 
 pub(crate) use super::continuation::PARAM_TOL;
-use super::continuation::{Continuation, EndCause, FamilyPoint, Followed};
+use super::continuation::{carried_start, Continuation, EndCause, FamilyPoint, Followed};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::periodicity::SAME_GAIT_TOL;
 use super::step_map::StepMap;
@@ -463,11 +463,15 @@ fn refine_root(
             let model = Model::new(&c.params).map_err(|e| e.to_string())?;
             // A period-k family's gaits are fixed points of P^k; the indicators are those of its first step.
             let map = StepMap::new(&model, &c.solver).iterated(start.period_k);
+            let from = FamilyPoint {
+                value: a.value,
+                section: start.section,
+            };
+            let s = carried_start(config, &spec.param, &from, v);
             let y = if q == Quantity::Stability {
-                q.of(&find_gait(&map, &start.section, &continued, guess.as_ref())
-                    .map_err(|e| e.to_string())?)
+                q.of(&find_gait(&map, &s, &continued, guess.as_ref()).map_err(|e| e.to_string())?)
             } else {
-                let fp = solve_fixed_point(&map, &start.section, &continued, guess.as_ref())
+                let fp = solve_fixed_point(&map, &s, &continued, guess.as_ref())
                     .map_err(|e| e.to_string())?;
                 q.of_indicators(&fp.outcome.report.indicators)
             };
