@@ -34,13 +34,31 @@ fn assert_audits_clean(s: &StepReport, at: &str) {
 }
 
 fn walk(config: &Config, steps: usize) -> WalkRun {
+    walk_into(config, steps, None)
+}
+
+/// `steps` steps from the default start, sampled into `trajectory` if given.
+fn walk_into(config: &Config, steps: usize, trajectory: Option<&mut Trajectory>) -> WalkRun {
     let model = Model::new(&config.params).unwrap();
     simulate(
         &model,
         &config.solver,
         &default_initial(config),
         steps,
-        None,
+        trajectory,
+    )
+    .unwrap()
+}
+
+/// The gaits along `param` at `values`, as a sweep follows them from the default start.
+fn sweep(config: &Config, param: &str, values: &[f64]) -> Vec<vrw::gait::SweepPoint> {
+    sweep_values(
+        config,
+        param,
+        values,
+        &default_initial(config),
+        &GaitOptions::for_sweeps(),
+        &|_| {},
     )
     .unwrap()
 }
@@ -126,16 +144,8 @@ fn third_party() -> Config {
 #[test]
 fn without_a_rear_stopper_leg_2_extends_past_l0_and_the_audits_stay_clean() {
     let config = third_party();
-    let model = Model::new(&config.params).unwrap();
     let mut trajectory = Trajectory::new(0.002);
-    let run = simulate(
-        &model,
-        &config.solver,
-        &default_initial(&config),
-        12,
-        Some(&mut trajectory),
-    )
-    .unwrap();
+    let run = walk_into(&config, 12, Some(&mut trajectory));
     assert!(run.failure.is_none(), "{:?}", run.failure);
     let l0 = config.params.stopper_length;
     let longest_rear = trajectory
@@ -205,15 +215,7 @@ fn every_reading_walks_with_clean_audits_where_it_has_a_gait() {
     let values: Vec<f64> = (0..12).map(|i| 1.0 + 299.0 * i as f64 / 11.0).collect();
     for file in files {
         let config = Config::from_file(&file).unwrap();
-        let points = sweep_values(
-            &config,
-            "viscosity",
-            &values,
-            &default_initial(&config),
-            &GaitOptions::for_sweeps(),
-            &|_| {},
-        )
-        .unwrap();
+        let points = sweep(&config, "viscosity", &values);
         let gaits: Vec<_> = points
             .iter()
             .filter_map(|p| p.gait.as_ref().map(|g| (p.value, g)))
@@ -253,16 +255,8 @@ fn a_spring_shorter_than_its_stopper_needs_reset_and_walks_with_clean_audits() {
     );
     config.params.rear_exit = RearExit::Reset;
     config.validate().unwrap();
-    let model = Model::new(&config.params).unwrap();
     let mut trajectory = Trajectory::new(0.001);
-    let run = simulate(
-        &model,
-        &config.solver,
-        &default_initial(&config),
-        3,
-        Some(&mut trajectory),
-    )
-    .unwrap();
+    let run = walk_into(&config, 3, Some(&mut trajectory));
     assert!(
         matches!(run.failure, Some(WalkError::RolledBack { .. })),
         "{:?}",
@@ -294,15 +288,7 @@ fn the_stroke_limited_leg_has_the_papers_shape_with_its_threshold_near_52() {
     let mut values: Vec<f64> = (0..12).map(|i| 5.0 + 295.0 * i as f64 / 11.0).collect();
     values.extend([51.0, 52.3]);
     values.sort_by(f64::total_cmp);
-    let points = sweep_values(
-        &config,
-        "viscosity",
-        &values,
-        &default_initial(&config),
-        &GaitOptions::for_sweeps(),
-        &|_| {},
-    )
-    .unwrap();
+    let points = sweep(&config, "viscosity", &values);
     let mut last_lambda_4 = f64::INFINITY;
     for p in &points {
         let at = format!("stroke-limited at c = {}", p.value);
@@ -401,16 +387,8 @@ fn a_touchdown_length_inside_the_stroke_lands_the_leg_free_there() {
     config.params.touchdown_length = 1.01;
     config.params.viscosity = 30.0;
     config.validate().unwrap();
-    let model = Model::new(&config.params).unwrap();
     let mut trajectory = Trajectory::new(0.01);
-    let run = simulate(
-        &model,
-        &config.solver,
-        &default_initial(&config),
-        6,
-        Some(&mut trajectory),
-    )
-    .unwrap();
+    let run = walk_into(&config, 6, Some(&mut trajectory));
     assert!(run.failure.is_none(), "{:?}", run.failure);
     for s in &run.steps {
         assert_audits_clean(s, &format!("step {}", s.step));
@@ -437,15 +415,7 @@ fn a_sweep_in_min_length_moves_the_held_leg_with_the_stop() {
         Model::new(&c.params).unwrap()
     };
     let values = [0.99, 0.995, 1.0, 1.005, 1.01];
-    let points = sweep_values(
-        &config,
-        "min_length",
-        &values,
-        &default_initial(&config),
-        &GaitOptions::for_sweeps(),
-        &|_| {},
-    )
-    .unwrap();
+    let points = sweep(&config, "min_length", &values);
     for p in &points {
         let g = p
             .gait

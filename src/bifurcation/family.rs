@@ -102,15 +102,7 @@ impl<'a> GaitFamily<'a> {
             config,
             param,
             period: 1,
-            base: if rear_held {
-                SectionState {
-                    l2: config.params.min_length,
-                    l2_dot: 0.0,
-                    ..base
-                }
-            } else {
-                base
-            },
+            base: base.pinned_under(&config.params),
             rear_held,
             fd_step: 1e-6,
             interrupt: None,

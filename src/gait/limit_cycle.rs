@@ -330,10 +330,14 @@ pub(crate) fn solve_fixed_point(
     // A walk whose stance leg is held at its compression stop at touchdown starts every step with Leg 2 held
     // there (`L2 = min_length`, `dL2/dt = 0`): one more step takes a start that is not onto that set, and the
     // map then acts on `dtheta/dt` alone (`StepMap::on_section_of`).
+    // A step that stays off the held set is the first one Newton's method needs: kept, not walked again.
+    let mut first_step = None;
     if map.model().params().min_length > 0.0 && !s.rear_held(map.model()) {
         if let Ok(first) = map.eval(&s) {
             if first.next.rear_held(map.model()) {
                 s = first.next;
+            } else {
+                first_step = Some(first);
             }
         }
     }
@@ -351,7 +355,14 @@ pub(crate) fn solve_fixed_point(
         };
     let mut newton_matrix: Option<DMatrix<f64>> =
         jacobian_guess.map(|j| j - DMatrix::identity(n, n));
-    let (mut outcome, mut r) = eval(&s, 1)?;
+    let (mut outcome, mut r) = match first_step {
+        // The same map (`s` is not held) at the same point.
+        Some(out) => {
+            let r = map.reduce(&out.next) - map.reduce(&s);
+            (out, r)
+        }
+        None => eval(&s, 1)?,
+    };
     let mut iterations = 0;
     // Was the current Newton matrix computed at the current iterate (so recomputing it cannot help)?
     let mut fresh = false;

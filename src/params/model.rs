@@ -136,6 +136,11 @@ impl Params {
         ]
     }
 
+    /// Does a leg land on its stopper (locked), the touchdown length being the stopper length?
+    pub fn lands_on_stopper(&self) -> bool {
+        self.spoke_length() == self.stopper_length
+    }
+
     /// The length at which a leg touches down, and of every leg other than Legs 1 and 2: `touchdown_length`,
     /// or `stopper_length` where that is 0 (its default).
     pub fn spoke_length(&self) -> f64 {

@@ -301,12 +301,10 @@ fn cross_guard(
             .ok_or(singular.clone())?;
             // The guard is the unit's reaction in its admissible direction: `lambda` for a contact, `-mu` for a
             // stopper, `mu` for a compression stop.
-            let (row, sign) = match end.kind.stop_unlock() {
-                Some((leg, stop)) => (leg.stopper_row(), -stop.sign()),
-                None => match end.kind {
-                    EventKind::LiftOff(leg) => (leg.normal_row(), 1.0),
-                    _ => unreachable!("a force guard"),
-                },
+            let (row, sign) = match (end.kind, end.kind.stop_unlock()) {
+                (EventKind::LiftOff(leg), _) => (leg.normal_row(), 1.0),
+                (_, Some((leg, stop))) => (leg.stopper_row(), -stop.sign()),
+                _ => unreachable!("a force guard"),
             };
             dual(sign * d.multipliers[row], dlam.row(row).transpose() * sign)
         }

@@ -205,16 +205,19 @@ impl<'a> EventSet<'a> {
             EventKind::Fall => self.model.hub_height(q) - self.opts.fall_hub_height,
             EventKind::RollBack => qd[THETA],
             EventKind::LiftOff(leg) => force(&|d| d.normal_force(leg)),
-            EventKind::Unlock(leg) | EventKind::CompressionUnlock(leg) => {
-                let stop = kind.stop_unlock().map_or(Stop::Extension, |(_, stop)| stop);
-                force(&|d| d.stop_reaction(leg, stop))
+            EventKind::Unlock(leg) => force(&|d| d.stop_reaction(leg, Stop::Extension)),
+            EventKind::CompressionUnlock(leg) => {
+                force(&|d| d.stop_reaction(leg, Stop::Compression))
             }
             EventKind::Landing(leg) => self.model.tip_height(q, leg.index()),
-            EventKind::StopperHit(leg) | EventKind::CompressionHit(leg) => {
-                let stop = kind.stop_hit().map_or(Stop::Extension, |(_, stop)| stop);
-                stop.sign() * (stop_length(self.model, stop) - q[leg.length_coordinate()])
-            }
+            EventKind::StopperHit(leg) => self.room(leg, Stop::Extension, q),
+            EventKind::CompressionHit(leg) => self.room(leg, Stop::Compression, q),
         }
+    }
+
+    /// How far a free leg is from `stop` (positive on the allowed side): `L0 - L` or `L - min_length`.
+    fn room(&self, leg: Leg, stop: Stop, q: &Coords) -> f64 {
+        stop.sign() * (stop_length(self.model, stop) - q[leg.length_coordinate()])
     }
 
     /// The value of event `e` at `(q, q')`: its function measured from its floor.

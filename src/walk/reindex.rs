@@ -53,7 +53,7 @@ pub(super) fn reindex(
     let v = front.velocity(qd);
     // The new Leg 1 lands at the touchdown length, and a spoke that becomes Leg 2 has it too.
     let l_td = model.params().spoke_length();
-    let at_stopper = l_td == model.params().stopper_length;
+    let at_stopper = model.params().lands_on_stopper();
     let (l2, l2_dot) = if shift == 1 {
         (q[L1], qd[L1])
     } else {

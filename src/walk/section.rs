@@ -137,9 +137,14 @@ impl SectionState {
     /// This state with `L2 = min_length` and `dL2/dt = 0` exactly where Leg 2 is held at its compression stop
     /// ([`SectionState::rear_held`]), else unchanged.
     pub fn pinned(&self, model: &Model) -> SectionState {
-        if self.rear_held(model) {
+        self.pinned_under(model.params())
+    }
+
+    /// [`SectionState::pinned`] under the parameters `params`.
+    pub fn pinned_under(&self, params: &crate::params::Params) -> SectionState {
+        if self.rear_held_under(params) {
             SectionState {
-                l2: model.params().min_length,
+                l2: params.min_length,
                 l2_dot: 0.0,
                 ..*self
             }

@@ -83,7 +83,7 @@ impl<'m> Walker<'m> {
                 contact1: false,
                 contact2: true,
                 // Leg 1 arrives on its stopper unless it lands shorter (`touchdown_length`).
-                lock1: model.params().spoke_length() == model.params().stopper_length,
+                lock1: model.params().lands_on_stopper(),
                 lock2: model.params().rigid_legs,
                 compression2: section.rear_held(model),
                 ..Default::default()
@@ -610,10 +610,9 @@ impl<'a> Phases<'a> {
                 self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
                 self.tally.scuffing |= self.active.slide2;
             }
-            EventKind::Unlock(leg) | EventKind::CompressionUnlock(leg) => {
-                for stop in Stop::BOTH {
-                    self.active.set_held(leg, stop, false);
-                }
+            EventKind::Unlock(leg) => self.active.set_held(leg, Stop::Extension, false),
+            EventKind::CompressionUnlock(leg) => {
+                self.active.set_held(leg, Stop::Compression, false)
             }
             EventKind::Landing(leg)
             | EventKind::StopperHit(leg)
