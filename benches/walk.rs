@@ -78,8 +78,8 @@ fn rhs(c: &mut Criterion) {
     let config = Config::default();
     let model = Model::new(&config.params).expect("the paper's parameters are valid");
     // A stance state near double support: Leg 1 compressed, Leg 2 near its stopper.
-    let q = Coords::new(0.0, 0.0, -0.3, 0.97, 0.99);
-    let qd = Coords::new(0.0, 0.0, 1.0, -0.2, 0.1);
+    let q = Coords::new(0.0, 0.0, -0.3, 0.97, 0.99, 0.0);
+    let qd = Coords::new(0.0, 0.0, 1.0, -0.2, 0.1, 0.0);
     let sets = [
         (
             "sls",

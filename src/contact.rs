@@ -17,7 +17,7 @@
 use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
-use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, NQ, X, Z};
+use crate::dynamics::{swinging, Coords, EquationsOfMotion, Model, L1, L2, L3, NQ, X, Z};
 
 /// Number of constraint rows in the fixed stacking order.
 pub(crate) const NROWS: usize = 6;
@@ -414,15 +414,22 @@ fn solve_saddle(
     f: &Coords,
     b: &Multipliers,
 ) -> Result<(Coords, Multipliers), ContactError> {
+    solve_saddle_rows(m, rows, &active.row_mask(), active, f, b)
+}
+
+/// [`solve_saddle`] for `K` stacked rows of which `mask` says which are active.
+fn solve_saddle_rows<const K: usize>(
+    m: &SMatrix<f64, NQ, NQ>,
+    rows: &SMatrix<f64, K, NQ>,
+    mask: &[bool],
+    active: &ActiveSet,
+    f: &Coords,
+    b: &SVector<f64, K>,
+) -> Result<(Coords, SVector<f64, K>), ContactError> {
     let chol = m.cholesky().ok_or(ContactError::SingularMass)?;
     let x_free = chol.solve(f);
     let minv_jt = chol.solve(&rows.transpose());
-    let lam = solve_schur(
-        rows * minv_jt,
-        b - rows * x_free,
-        &active.row_mask(),
-        active,
-    )?;
+    let lam = solve_schur(rows * minv_jt, b - rows * x_free, mask, active)?;
     Ok((x_free + minv_jt * lam, lam))
 }
 
@@ -454,8 +461,8 @@ fn solve_schur<const K: usize>(
 /// Accelerations and multipliers of Eq. (1) with the constraints of `active` (docs/model.md section 3).
 ///
 /// Only the active rows enter the solve (see `solve_active_rows`); when Leg 1's tip is held (most of the walk)
-/// the system is first reduced to `(theta, L1, L2)` (`solve_with_fixed_leg_one`). Same result as
-/// `solve_saddle` on the full stacking (tested for every active set).
+/// the system is first reduced to `(theta, L1, L2)`, and `L3` while a leg swings (`solve_with_fixed_leg_one`).
+/// Same result as `solve_saddle` on the full stacking (tested for every active set).
 pub fn constrained_dynamics(
     model: &Model,
     q: &Coords,
@@ -466,7 +473,7 @@ pub fn constrained_dynamics(
     if active.contact1 && !active.slide1 {
         return solve_with_fixed_leg_one(&eom, active);
     }
-    // The general case (Leg 1 sliding or off the ground): all five coordinates.
+    // The general case (Leg 1 sliding or off the ground): all the coordinates.
     let mut rows = ActiveRows::<NQ, NROWS>::default();
     let mask = active.row_mask();
     let rear = &eom.rear_tip;
@@ -490,8 +497,10 @@ pub fn constrained_dynamics(
             rows.push(row, rhs, stacked);
         }
     }
-    let mut m = Ldl::<NQ>::zeros(NQ);
-    for i in 0..NQ {
+    // Without a swinging leg `L3` is left out (its row of M is the identity's, with no force).
+    let n = if swinging(q) { NQ } else { NQ - 1 };
+    let mut m = Ldl::<NQ>::zeros(n);
+    for i in 0..n {
         for j in 0..=i {
             m.l[i][j] = eom.mass[(i, j)];
         }
@@ -510,7 +519,7 @@ pub fn constrained_dynamics(
 
 /// The KKT system when Leg 1's tip is held (no-slip (C1), most of the walk): its rows are `e_x`, `e_z` with
 /// `dJ/dt q' = 0`, so `x'' = z'' = 0` and the system reduces exactly to the three coordinates
-/// `(theta, L1, L2)` with the remaining active rows ((C2), stoppers); `lambda_1`, `lambda_2` then follow from
+/// `(theta, L1, L2[, L3])` with the remaining active rows ((C2), stoppers); `lambda_1`, `lambda_2` then follow from
 /// the `x` and `z` equations. Same result as [`solve_saddle`] (tested), at a fraction of the cost.
 fn solve_with_fixed_leg_one(
     eom: &EquationsOfMotion,
@@ -518,8 +527,10 @@ fn solve_with_fixed_leg_one(
 ) -> Result<ConstrainedDynamics, ContactError> {
     const R: usize = NQ - 2;
     let (m, h) = (&eom.mass, &eom.bias);
-    let mut m_rr = Ldl::<R>::zeros(R);
-    for i in 0..R {
+    // `(theta, L1, L2)`, and `L3` while a leg swings.
+    let n = if eom.swing { R } else { R - 1 };
+    let mut m_rr = Ldl::<R>::zeros(n);
+    for i in 0..n {
         for j in 0..=i {
             m_rr.l[i][j] = m[(2 + i, 2 + j)];
         }
@@ -746,6 +757,38 @@ pub fn impulse(
     })
 }
 
+/// The stopper impact of the swinging leg (`L3`, `rear_exit = "continue"`): the collision equation (5) with the
+/// units of `active` and the row `dL3/dt = 0`, whose impulse (the last one returned) stops the leg on its
+/// stopper. Returns `q'+` and the impulses of the units of `active`, and of the stopper.
+pub(crate) fn swing_lock_impulse(
+    model: &Model,
+    q: &Coords,
+    qd_minus: &Coords,
+    active: &ActiveSet,
+) -> Result<(ImpulseSolution, f64), ContactError> {
+    const K: usize = NROWS + 1;
+    let m = model.mass_matrix(q);
+    let (rows, _) = constraint_rows(model, q, qd_minus, active);
+    let mut stacked = SMatrix::<f64, K, NQ>::zeros();
+    stacked.fixed_rows_mut::<NROWS>(0).copy_from(&rows);
+    stacked[(NROWS, L3)] = 1.0;
+    let mut mask = [true; K];
+    mask[..NROWS].copy_from_slice(&active.row_mask());
+    let (dqd, lam) = solve_saddle_rows(
+        &m,
+        &stacked,
+        &mask,
+        active,
+        &Coords::zeros(),
+        &(-(stacked * qd_minus)),
+    )?;
+    let solution = ImpulseSolution {
+        qd_plus: qd_minus + dqd,
+        impulses: lam.fixed_rows::<NROWS>(0).into_owned(),
+    };
+    Ok((solution, lam[NROWS]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -765,8 +808,8 @@ mod tests {
         let alpha = model.alpha();
         // solve z_tip2 = 0 for theta: l1 cos th = l2 cos(th + alpha)
         let theta = ((l2 * alpha.cos() - l1) / (l2 * alpha.sin())).atan();
-        let q = Coords::new(0.0, 0.0, theta, l1, l2);
-        (q, Coords::new(0.0, 0.0, 1.0, -0.2, 0.1))
+        let q = Coords::new(0.0, 0.0, theta, l1, l2, 0.0);
+        (q, Coords::new(0.0, 0.0, 1.0, -0.2, 0.1, 0.0))
     }
 
     #[test]
@@ -810,12 +853,13 @@ mod tests {
             let states = [
                 (q_dls, qd_dls),
                 (
-                    Coords::new(0.0, 0.0, -0.3, 0.97, 0.99),
-                    Coords::new(0.0, 0.0, 1.0, -0.2, 0.1),
+                    Coords::new(0.0, 0.0, -0.3, 0.97, 0.99, 0.0),
+                    Coords::new(0.0, 0.0, 1.0, -0.2, 0.1, 0.0),
                 ),
                 (
-                    Coords::new(0.2, 0.05, 0.4, 0.93, 1.0),
-                    Coords::new(0.7, -0.3, 1.4, 0.25, -0.6),
+                    // With a swinging leg.
+                    Coords::new(0.2, 0.05, 0.4, 0.93, 1.0, 0.96),
+                    Coords::new(0.7, -0.3, 1.4, 0.25, -0.6, 0.3),
                 ),
             ];
             let mut solved = 0;
@@ -898,7 +942,7 @@ mod tests {
         let model = model();
         // Both legs at L0 and both tips on the ground: theta = -alpha/2 makes the configuration symmetric.
         let l0 = model.params().stopper_length;
-        let q = Coords::new(0.0, 0.0, -model.alpha() / 2.0, l0, l0);
+        let q = Coords::new(0.0, 0.0, -model.alpha() / 2.0, l0, l0, 0.0);
         let all = ActiveSet {
             contact1: true,
             contact2: true,

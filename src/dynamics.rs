@@ -1,8 +1,9 @@
 //! Equations of motion of the viscoelastic-legged rimless wheel (docs/model.md sections 1-2, paper Eq. (1)).
 //!
-//! The wheel is described by `q = [x, z, theta, L1, L2]` in the slope frame (`x` down the slope, `z` normal to
-//! it). `(x, z)` is the tip of Leg 1, `theta` the angle of Leg 1 from the slope normal, `L1`, `L2` the lengths of
-//! Leg 1 and Leg 2. Every body is a point mass (the hub, and one sliding mass per leg at distance `a` from the
+//! The wheel is described by `q = [x, z, theta, L1, L2, L3]` in the slope frame (`x` down the slope, `z` normal
+//! to it). `(x, z)` is the tip of Leg 1, `theta` the angle of Leg 1 from the slope normal, `L1`, `L2` the lengths
+//! of Leg 1 and Leg 2, and `L3` the length of the swinging leg (the old Leg 2 after it left Legs 1 and 2 unlocked,
+//! under `rear_exit = "continue"`; 0 when no leg swings, see [`L3`]). Every body is a point mass (the hub, and one sliding mass per leg at distance `a` from the
 //! tip) plus the hub's rotational inertia, so the equations are assembled from point kinematics:
 //!
 //! ```text
@@ -77,13 +78,13 @@ pub(crate) fn lit<T: Real>(x: f64) -> T {
 }
 
 /// Number of generalized coordinates.
-pub(crate) const NQ: usize = 5;
-/// Generalized coordinates or velocities `[x, z, theta, L1, L2]`.
+pub(crate) const NQ: usize = 6;
+/// Generalized coordinates or velocities `[x, z, theta, L1, L2, L3]`.
 pub type Coords = SVector<f64, NQ>;
 /// Generalized coordinates or velocities over any [`Real`].
 pub(crate) type CoordsOf<T> = SVector<T, NQ>;
-/// A 5x5 matrix over the generalized coordinates.
-pub(crate) type Mat5 = SMatrix<f64, NQ, NQ>;
+/// A matrix over the generalized coordinates (`M`).
+pub(crate) type MatQ = SMatrix<f64, NQ, NQ>;
 /// Jacobian of a planar point with respect to `q`.
 pub(crate) type PointJacobian<T = f64> = SMatrix<T, 2, NQ>;
 
@@ -97,6 +98,17 @@ pub const THETA: usize = 2;
 pub const L1: usize = 3;
 /// Index of `L2` (length of Leg 2) in `q`.
 pub const L2: usize = 4;
+/// Index of `L3` in `q`: the length of the swinging leg, the old Leg 2 that left Legs 1 and 2 at the last
+/// touchdown before its stopper locked it (`rear_exit = "continue"`, docs/model.md section 5). It is leg `j = 2`
+/// until its stopper locks it, then a spoke again. `L3 = 0` (and `dL3/dt = 0`) when no leg swings: a leg's length
+/// is positive, so 0 cannot be one, and the coordinate is then left out of the dynamics (its row of `M` is the
+/// identity's, with no force) and of the integrator's error norm ([`PhaseSystem`](crate::walk::PhaseSystem)).
+pub const L3: usize = 5;
+
+/// Does `q` hold a swinging leg ([`L3`] nonzero)?
+pub fn swinging<T: Real>(q: &CoordsOf<T>) -> bool {
+    q[L3] != T::zero()
+}
 
 /// Position, Jacobian and velocity-product acceleration of one point of the wheel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,6 +141,8 @@ pub(crate) struct EquationsOfMotion<T: Real = f64> {
     pub bias: CoordsOf<T>,
     /// Kinematics of the tip of Leg 2 (the rows of (C2)), as [`Model::tip`] gives them.
     pub rear_tip: PointKinematics<T>,
+    /// Does a leg swing ([`L3`] a coordinate)? If not, `L3`'s row of `mass` is the identity's and of `bias` 0.
+    pub swing: bool,
 }
 
 /// The physical constants the equations of motion use, as [`Real`]s: the [`Params`] values (as `f64` for the
@@ -200,43 +214,50 @@ impl<T: Real> Mechanics<T> {
     }
 }
 
-/// Sums over point masses `m_i` with Jacobian columns `b_i = [b_theta, b_L1, b_L2]` (the `x`, `z` columns
-/// being the identity) and forces `f_i = m_i (dJ_i/dt q' + g_n)`, from which `M` and `h` are assembled.
+/// Number of length columns a point Jacobian can have besides `x`, `z`: `theta`, `L1`, `L2`, `L3`.
+const COLUMNS: usize = 4;
+
+/// Sums over point masses `m_i` with Jacobian columns `b_i = [b_theta, b_L1, b_L2, b_L3]` (the `x`, `z` columns
+/// being the identity) and forces `f_i = m_i (dJ_i/dt q' + g_n)`, from which `M` and `h` are assembled. Only the
+/// first `cols` columns are summed: 3 when no leg swings (`b_L3 = 0` for every point), 4 when one does.
 #[derive(Debug)]
 struct PointSums<T: Real> {
+    /// How many of the columns are summed.
+    cols: usize,
     /// `sum m_i`.
     mass: T,
     /// `sum m_i b_ik`.
-    b: [Vector2<T>; 3],
+    b: [Vector2<T>; COLUMNS],
     /// `sum m_i b_ik . b_il` for `k <= l`.
-    bb: [[T; 3]; 3],
+    bb: [[T; COLUMNS]; COLUMNS],
     /// `sum f_i`.
     f: Vector2<T>,
     /// `sum b_ik . f_i`.
-    bf: [T; 3],
+    bf: [T; COLUMNS],
 }
 
 impl<T: Real> PointSums<T> {
-    fn zero() -> Self {
+    fn zero(cols: usize) -> Self {
         let (z, v) = (T::zero(), Vector2::zeros());
         PointSums {
+            cols,
             mass: z,
-            b: [v; 3],
-            bb: [[z; 3]; 3],
+            b: [v; COLUMNS],
+            bb: [[z; COLUMNS]; COLUMNS],
             f: v,
-            bf: [z; 3],
+            bf: [z; COLUMNS],
         }
     }
 
     /// Add a point of mass `m`, Jacobian columns `b` and acceleration `a = dJ/dt q' + g_n`.
-    fn add(&mut self, m: T, b: &[Vector2<T>; 3], a: Vector2<T>) {
+    fn add(&mut self, m: T, b: &[Vector2<T>; COLUMNS], a: Vector2<T>) {
         let f = a * m;
         self.mass += m;
         self.f += f;
-        for k in 0..3 {
+        for k in 0..self.cols {
             self.b[k] += b[k] * m;
             self.bf[k] += b[k].dot(&f);
-            for l in k..3 {
+            for l in k..self.cols {
                 self.bb[k][l] += m * b[k].dot(&b[l]);
             }
         }
@@ -309,8 +330,8 @@ impl Model {
         self.params.hub_mass + self.legs() as f64 * self.params.leg_mass
     }
 
-    /// Length of leg `j`: `L1`, `L2` from `q`, the spoke length (`touchdown_length`, by default the stopper
-    /// length `L0`) for the locked legs (docs/model.md section 2).
+    /// Length of leg `j`: `L1`, `L2` (and `L3` for `j = 2` while a leg swings) from `q`, the spoke length
+    /// (`touchdown_length`, by default the stopper length `L0`) for the locked legs (docs/model.md section 2).
     fn leg_length<T: Real>(
         mech: &Mechanics<T>,
         q: &CoordsOf<T>,
@@ -319,6 +340,7 @@ impl Model {
         match j {
             0 => (q[L1], Some(L1)),
             1 => (q[L2], Some(L2)),
+            2 if swinging(q) => (q[L3], Some(L3)),
             _ => (mech.spoke_length, None),
         }
     }
@@ -441,7 +463,7 @@ impl Model {
     ///
     /// See [`Model::equations_of_motion`] for how they are assembled; [`Model::mass_and_bias_reference`] is the
     /// plain formula the tests compare against.
-    pub(crate) fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+    pub(crate) fn mass_and_bias(&self, q: &Coords, qd: &Coords) -> (MatQ, Coords) {
         let eom = self.equations_of_motion(q, qd);
         (eom.mass, eom.bias)
     }
@@ -476,6 +498,7 @@ impl Model {
             Vector2::new(l1 * ct, -l1 * st),
             Vector2::new(st, ct),
             Vector2::zeros(),
+            Vector2::zeros(),
         ];
         let hub_vp = Vector2::new(
             two * dl1 * ct * w - l1 * st * w * w,
@@ -502,16 +525,24 @@ impl Model {
             }
         };
         let (leg_one, leg_two) = (leg(0, l1, dl1, 1), leg(1, l2, dl2, 2));
-        let mut sums = PointSums::zero();
+        let swing = swinging(q);
+        let mut sums = PointSums::zero(if swing { COLUMNS } else { COLUMNS - 1 });
         sums.add(p.hub_mass, &hub_b, hub_vp + p.up);
         for point in [leg_one, leg_two] {
             let (b, vp, _) = point(p.leg_mass_offset);
             sums.add(p.leg_mass, &b, vp + p.up);
         }
-        // The locked legs j = 2..N, all of the spoke length (see above).
-        let n = lit::<T>((self.legs() - 2) as f64);
+        // The swinging leg j = 2, point by point, and the locked legs: j = 2..N, or j = 3..N while a leg swings,
+        // all of the spoke length (see above).
+        let (mut locked, (mut ss, mut sc)) = (self.legs() - 2, self.locked_offsets);
+        if swing {
+            let (b, vp, _) = leg(2, q[L3], qd[L3], 3)(p.leg_mass_offset);
+            sums.add(p.leg_mass, &b, vp + p.up);
+            locked -= 1;
+            (ss, sc) = (ss - self.offsets[2].0, sc - self.offsets[2].1);
+        }
+        let n = lit::<T>(locked as f64);
         let d = p.spoke_length - p.leg_mass_offset;
-        let (ss, sc) = self.locked_offsets;
         let (ss, sc) = (lit::<T>(ss), lit::<T>(sc));
         let (sum_sin, sum_cos) = (st * sc + ct * ss, ct * sc - st * ss);
         let sum_e = Vector2::new(-sum_sin, -sum_cos);
@@ -536,14 +567,14 @@ impl Model {
         mass[(Z, Z)] = sums.mass;
         bias[X] = sums.f.x;
         bias[Z] = sums.f.y;
-        for k in 0..3 {
+        for k in 0..sums.cols {
             let c = THETA + k;
             mass[(X, c)] = sums.b[k].x;
             mass[(c, X)] = sums.b[k].x;
             mass[(Z, c)] = sums.b[k].y;
             mass[(c, Z)] = sums.b[k].y;
             bias[c] = sums.bf[k];
-            for l in k..3 {
+            for l in k..sums.cols {
                 mass[(c, THETA + l)] = sums.bb[k][l];
                 mass[(THETA + l, c)] = sums.bb[k][l];
             }
@@ -551,6 +582,12 @@ impl Model {
         mass[(THETA, THETA)] += p.hub_inertia;
         bias[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
         bias[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
+        if swing {
+            bias[L3] += -p.stiffness * (p.spring_natural_length - q[L3]) + p.viscosity * qd[L3];
+        } else {
+            // No leg swings: `L3` is left out, with the identity's row so that M stays regular and `L3'' = 0`.
+            mass[(L3, L3)] = T::one();
+        }
 
         let (b, velocity_product, position) = leg_two(T::zero());
         let mut jacobian = PointJacobian::<T>::zeros();
@@ -567,13 +604,14 @@ impl Model {
                 jacobian,
                 velocity_product,
             },
+            swing,
         }
     }
 
     /// `M` and `h` by the plain point-mass formula `sum m_i J_i^T J_i`, `sum m_i J_i^T (dJ_i/dt q' + g_n)`:
     /// slower than [`Model::mass_and_bias`], kept as its reference.
     #[cfg(test)]
-    pub(crate) fn mass_and_bias_reference(&self, q: &Coords, qd: &Coords) -> (Mat5, Coords) {
+    pub(crate) fn mass_and_bias_reference(&self, q: &Coords, qd: &Coords) -> (MatQ, Coords) {
         let p = &self.params;
         let up = self.mech.up;
         let hub = self.hub(q, qd);
@@ -588,11 +626,16 @@ impl Model {
         }
         h[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
         h[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
+        if swinging(q) {
+            h[L3] += -p.stiffness * (p.spring_natural_length - q[L3]) + p.viscosity * qd[L3];
+        } else {
+            m[(L3, L3)] = 1.0;
+        }
         (m, h)
     }
 
     /// Mass matrix `M(q)` alone.
-    pub(crate) fn mass_matrix(&self, q: &Coords) -> Mat5 {
+    pub(crate) fn mass_matrix(&self, q: &Coords) -> MatQ {
         self.mass_and_bias(q, &Coords::zeros()).0
     }
 
@@ -602,7 +645,9 @@ impl Model {
     }
 
     /// Potential energy `V`: gravity of every body, `mass g (-p_x sin phi + p_z cos phi)`, plus the springs of
-    /// Legs 1 and 2, `1/2 k (Lstar - L)^2` \[J\] (docs/model.md section 2).
+    /// Legs 1 and 2, `1/2 k (Lstar - L)^2`, and that of a swinging leg less its value at the spoke length (so that
+    /// `V` is continuous where its stopper locks it and it becomes a spoke again, whose spring `V` leaves out)
+    /// \[J\] (docs/model.md section 2).
     pub(crate) fn potential_energy(&self, q: &Coords) -> f64 {
         let p = &self.params;
         let zero = Coords::zeros();
@@ -614,7 +659,12 @@ impl Model {
             v += p.leg_mass * leg.position.dot(&up);
         }
         let spring = |l: f64| 0.5 * p.stiffness * (p.spring_natural_length - l).powi(2);
-        v + spring(q[L1]) + spring(q[L2])
+        let v = v + spring(q[L1]) + spring(q[L2]);
+        if swinging(q) {
+            v + spring(q[L3]) - spring(p.spoke_length())
+        } else {
+            v
+        }
     }
 
     /// Total mechanical energy `T + V` \[J\].
@@ -642,9 +692,21 @@ mod tests {
 
     fn sample_state() -> (Coords, Coords) {
         (
-            Coords::new(0.1, 0.02, -0.2, 0.93, 0.81),
-            Coords::new(0.4, -0.3, 1.1, -0.25, 0.6),
+            Coords::new(0.1, 0.02, -0.2, 0.93, 0.81, 0.0),
+            Coords::new(0.4, -0.3, 1.1, -0.25, 0.6, 0.0),
         )
+    }
+
+    /// [`sample_state`] with a swinging leg ([`L3`]).
+    fn swinging_state() -> (Coords, Coords) {
+        let (mut q, mut qd) = sample_state();
+        (q[L3], qd[L3]) = (0.87, -0.45);
+        (q, qd)
+    }
+
+    /// Both sample states: without and with a swinging leg.
+    fn sample_states() -> [(Coords, Coords); 2] {
+        [sample_state(), swinging_state()]
     }
 
     fn unit(i: usize) -> Coords {
@@ -656,11 +718,12 @@ mod tests {
     #[test]
     fn structured_assembly_equals_the_point_mass_formula() {
         let model = model();
-        let (q, qd) = sample_state();
-        let (m, h) = model.mass_and_bias(&q, &qd);
-        let (m_ref, h_ref) = model.mass_and_bias_reference(&q, &qd);
-        assert_relative_eq!(m, m_ref, epsilon = 1e-12, max_relative = 1e-13);
-        assert_relative_eq!(h, h_ref, epsilon = 1e-11, max_relative = 1e-13);
+        for (q, qd) in sample_states() {
+            let (m, h) = model.mass_and_bias(&q, &qd);
+            let (m_ref, h_ref) = model.mass_and_bias_reference(&q, &qd);
+            assert_relative_eq!(m, m_ref, epsilon = 1e-12, max_relative = 1e-13);
+            assert_relative_eq!(h, h_ref, epsilon = 1e-11, max_relative = 1e-13);
+        }
     }
 
     /// A small deterministic generator of states (xorshift), uniform in `[-1, 1)` per component.
@@ -674,14 +737,20 @@ mod tests {
         };
         (0..count)
             .map(|_| {
+                // Every other state has a swinging leg.
+                let swing = uniform() > 0.0;
                 let q = Coords::new(
                     uniform(),
                     uniform(),
                     3.0 * uniform(),
                     0.9 + 0.1 * uniform(),
                     0.9 + 0.1 * uniform(),
+                    if swing { 0.9 + 0.1 * uniform() } else { 0.0 },
                 );
-                let qd = Coords::from_fn(|_, _| 2.0 * uniform());
+                let mut qd = Coords::from_fn(|_, _| 2.0 * uniform());
+                if !swing {
+                    qd[L3] = 0.0;
+                }
                 (q, qd)
             })
             .collect()
@@ -767,15 +836,17 @@ mod tests {
 
     #[test]
     fn mass_matrix_is_symmetric_positive_definite() {
-        let m = model().mass_matrix(&sample_state().0);
-        assert_relative_eq!(m, m.transpose(), epsilon = 1e-14);
-        assert!(m.cholesky().is_some());
+        for (q, _) in sample_states() {
+            let m = model().mass_matrix(&q);
+            assert_relative_eq!(m, m.transpose(), epsilon = 1e-14);
+            assert!(m.cholesky().is_some());
+        }
     }
 
     #[test]
     fn mass_matrix_is_the_hessian_of_kinetic_energy() {
         let model = model();
-        let (q, _) = sample_state();
+        let (q, _) = swinging_state();
         let m = model.mass_matrix(&q);
         for i in 0..NQ {
             for j in 0..NQ {
@@ -792,7 +863,7 @@ mod tests {
     fn bias_matches_lagrange_equations_from_energies() {
         let model = model();
         let p = model.params().clone();
-        let (q, qd) = sample_state();
+        let (q, qd) = swinging_state();
         let (_, h) = model.mass_and_bias(&q, &qd);
         // dM/dt q' = sum_k dM/dq_k qd_k q', by central differences along q'
         let m_at = |s: f64| model.mass_matrix(&(q + s * qd));
@@ -808,13 +879,14 @@ mod tests {
         }
         expected[L1] += p.viscosity * qd[L1];
         expected[L2] += p.viscosity * qd[L2];
+        expected[L3] += p.viscosity * qd[L3];
         assert_relative_eq!(h, expected, epsilon = 1e-6, max_relative = FD_TOL);
     }
 
     #[test]
     fn point_jacobians_and_velocity_products_match_finite_differences() {
         let model = model();
-        let (q, qd) = sample_state();
+        let (q, qd) = swinging_state();
         for j in 0..model.legs() {
             let tip = model.tip(&q, &qd, j);
             let pos = |q: &Coords| model.tip(q, &qd, j).position;

@@ -142,7 +142,7 @@ fn contact_audit_is_clean_for_every_impact_and_contact_option() {
 /// `L1 cos(theta) = L0 cos(theta + alpha)` (bisection; the rear tip's height is monotonic in `theta` there).
 fn both_tips_down(model: &Model, l1: f64) -> Coords {
     let l0 = model.params().stopper_length;
-    let mut q = Coords::new(0.0, 0.0, 0.0, l1, l0);
+    let mut q = Coords::new(0.0, 0.0, 0.0, l1, l0, 0.0);
     let (mut lo, mut hi) = (-model.alpha(), 0.0);
     for _ in 0..200 {
         q[THETA] = 0.5 * (lo + hi);
@@ -167,7 +167,7 @@ fn stopper_locking_while_the_rear_tip_slides_lifts_the_tip_and_never_pulls() {
     let q = both_tips_down(&model, 0.8);
     assert!(model.tip_height(&q, 1).abs() < 1e-12);
     // Rolling forward, Leg 2 extending at 0.4 m/s; L1' chosen so that Leg 2's tip has no normal velocity.
-    let mut qd = Coords::new(0.0, 0.0, 0.5, 0.0, 0.4);
+    let mut qd = Coords::new(0.0, 0.0, 0.5, 0.0, 0.4, 0.0);
     let tip = model.tip(&q, &qd, 1);
     qd[L1] = -(tip.jacobian.row(1) * qd)[0] / tip.jacobian[(1, L1)];
     assert!(model.tip(&q, &qd, 1).velocity(&qd).y.abs() < 1e-12);

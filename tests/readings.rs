@@ -118,6 +118,67 @@ fn reset_leaves_a_walk_whose_rear_leg_relocks_unchanged() {
     assert_energy_carries_over(&reset, &config, 1e-9);
 }
 
+/// `continue`: the old rear leg that is still free at the touchdown swings on as `L3` and locks on its stopper
+/// soon after (an impact counted with the stopper losses), so the walk that `relock` stops goes on, every step
+/// with clean audits and `T + V` carried through re-indexing, nothing discarded.
+#[test]
+fn continue_walks_on_where_relock_stops_with_clean_audits() {
+    let config = stiff(RearExit::Continue);
+    let run = walk(&config, 60);
+    assert!(run.failure.is_none(), "{:?}", run.failure);
+    assert_eq!(run.steps.len(), 60);
+    for s in &run.steps {
+        assert_audits_clean(s, &format!("step {}", s.step));
+        assert_eq!(s.energy.reset, 0.0);
+    }
+    assert!(run.work.events.swing_lock > 0, "{:?}", run.work.events);
+    assert_energy_carries_over(&run, &config, 1e-9);
+    // Up to the touchdown where relock stops, the two walks are the same (compared as text: airborne steps have
+    // NaN indicators).
+    let relock = walk(&stiff(RearExit::Relock), 60);
+    let n = relock.steps.len();
+    assert_eq!(
+        format!("{:?}", relock.steps),
+        format!("{:?}", &run.steps[..n])
+    );
+}
+
+/// Where the rear leg is always relocked in time (the default gait), `continue` has no leg to carry: the walk
+/// and the gait are the same, bit for bit.
+#[test]
+fn continue_leaves_the_default_gait_unchanged() {
+    let mut config = Config::default();
+    config.params.rear_exit = RearExit::Continue;
+    assert_eq!(walk(&Config::default(), 8).steps, walk(&config, 8).steps);
+    let gait = |c: &Config| {
+        let model = Model::new(&c.params).unwrap();
+        let map = vrw::gait::StepMap::new(&model, &c.solver);
+        vrw::gait::find_gait(&map, &default_initial(c), &GaitOptions::default(), None).unwrap()
+    };
+    let (relock, carried) = (gait(&Config::default()), gait(&config));
+    assert_eq!(relock.section, carried.section);
+    assert_eq!(relock.jacobian, carried.jacobian);
+    assert_eq!(relock.floquet_multipliers, carried.floquet_multipliers);
+}
+
+#[test]
+fn continue_needs_a_rear_stopper_and_no_compression_stop() {
+    let mut config = Config::default();
+    config.params.rear_exit = RearExit::Continue;
+    config.params.min_length = 0.9;
+    let error = config.params.validate().unwrap_err().to_string();
+    assert!(
+        error.contains("min_length") && error.contains("continue"),
+        "{error}"
+    );
+    let mut config = third_party();
+    config.params.rear_exit = RearExit::Continue;
+    let error = config.params.validate().unwrap_err().to_string();
+    assert!(error.contains("rear_stopper"), "{error}");
+    let config = Config::from_toml_str("rear_exit = \"continue\"").unwrap();
+    assert_eq!(config.params.rear_exit, RearExit::Continue);
+}
+
 #[test]
 fn rear_exit_reads_and_writes_its_names() {
     let config = Config::from_toml_str("rear_exit = \"reset\"").unwrap();

@@ -36,7 +36,7 @@ use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
 use vrw::output::{
     basin_header, basin_row, branch_header, branch_rows, curve_header, curve_row, family_header,
     family_row, map_header, map_rows, orbit_header, orbit_rows, steps_header, steps_row,
-    sweep_header, sweep_row, trajectory_row, Cell, TRAJECTORY_HEADER,
+    sweep_header, sweep_row, trajectory_header, trajectory_row_under, Cell,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -425,8 +425,13 @@ fn simulate<'py>(
     result.set_item("steps", table(py, &steps_header(rear_exit), &rows)?)?;
     match samples {
         Some(t) => {
-            let rows: Vec<Vec<Cell>> = t.samples.iter().map(trajectory_row).collect();
-            result.set_item("trajectory", table(py, &TRAJECTORY_HEADER, &rows)?)?
+            let rows: Vec<Vec<Cell>> = t
+                .samples
+                .iter()
+                .map(|s| trajectory_row_under(s, rear_exit))
+                .collect();
+            let header = trajectory_header(rear_exit);
+            result.set_item("trajectory", table(py, &header, &rows)?)?
         }
         None => result.set_item("trajectory", py.None())?,
     }

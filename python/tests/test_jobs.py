@@ -43,6 +43,20 @@ def test_a_reset_walk_has_the_reset_energy_column_of_the_command_line(cli, tmp_p
     assert "reset_energy" not in vrw.simulate(vrw.Params(**dict(keys, rear_exit="relock")), steps=2)["steps"]
 
 
+def test_a_continue_walk_has_the_swinging_leg_columns_of_the_command_line(cli, tmp_path):
+    # The same stiff legs under `rear_exit = "continue"`: the free old rear leg swings on as L3 until it locks.
+    keys = {"viscosity": 28.181818181818183, "stiffness": 1945.4545454545455, "rear_exit": "continue"}
+    sets = [a for k, v in keys.items() for a in ("--set", f"{k}={v}")]
+    cli("simulate", "--steps", 20, *sets, "--out", tmp_path)
+    run = vrw.simulate(vrw.Params(**keys), steps=20)
+    assert run["status"] == "completed"
+    assert list(run["trajectory"])[-2:] == ["L3", "L3dot"]
+    assert (run["trajectory"]["L3"] > 0).any()
+    assert_table_equals_csv(run["trajectory"], tmp_path / "trajectory.csv")
+    assert_table_equals_csv(run["steps"], tmp_path / "steps.csv")
+    assert "L3" not in vrw.simulate(vrw.Params(**dict(keys, rear_exit="relock")), steps=2)["trajectory"]
+
+
 def test_a_walk_that_stops_is_a_status(cli, tmp_path):
     # Uphill the wheel cannot walk: it rolls back (whatever the other parameters).
     cli("simulate", "--steps", 3, "--set", "slope=-0.1", "--out", tmp_path, check=False)

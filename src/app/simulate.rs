@@ -233,7 +233,7 @@ pub(super) fn simulate_into(
         output::StepsCsv::create(&run.path("steps.csv"), job.config.params.rear_exit)?;
     let trajectory_path = run.path("trajectory.csv");
     let mut trajectory = if job.trajectory {
-        let sink = output::TrajectoryCsv::create(&trajectory_path)?;
+        let sink = output::TrajectoryCsv::create(&trajectory_path, job.config.params.rear_exit)?;
         Some(Trajectory::streaming(job.sample_dt, Box::new(sink)))
     } else {
         None

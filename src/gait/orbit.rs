@@ -18,7 +18,6 @@ use super::periodicity::{least_period, MAX_PERIOD};
 use super::sweep::{RangeNames, SweepSpec};
 use crate::dynamics::Model;
 use crate::params::{Config, ConfigError};
-use crate::walk::WalkError;
 use crate::walk::{SectionState, StepReport, Walker};
 
 /// A value that does not continue another walks this many times the transient.
@@ -157,7 +156,7 @@ fn walk_column(
         // The next value continues from a touchdown on the section (one where the stance tip is at rest).
         for _ in 0..MAX_PERIOD {
             match walker.section() {
-                Err(WalkError::OffSection { .. }) => {
+                Err(e) if e.leaves_section() => {
                     walker.step(None)?;
                 }
                 other => return other,

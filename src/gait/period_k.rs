@@ -86,7 +86,7 @@ pub fn find_periodic_gait(
         returns.push(walker.touchdown_coordinates());
         match walker.section() {
             Ok(s) => last_on_section = Some(s),
-            Err(crate::walk::WalkError::OffSection { .. }) => {}
+            Err(e) if e.leaves_section() => {}
             Err(source) => return Err(transient(source)),
         }
     }
@@ -173,7 +173,7 @@ pub fn find_gait_any_period(
             if (!matches!(
                 e,
                 GaitError::Transient { .. } | GaitError::InvalidOptions { .. }
-            ) || e.kind() == "off_section")
+            ) || matches!(e.kind(), "off_section" | "leg_swings_at_section"))
                 && max_period > 1 =>
         {
             find_periodic_gait(map, initial, options, max_period)

@@ -165,8 +165,9 @@ fn initial_step<const N: usize>(
     f0: &SVector<f64, N>,
     order: i32,
 ) -> f64 {
-    let d0 = scaled_rms(tol, y0, y0, y0);
-    let d1 = scaled_rms(tol, f0, y0, y0);
+    let skip = sys.unmeasured();
+    let d0 = scaled_rms(tol, y0, (y0, y0), skip);
+    let d1 = scaled_rms(tol, f0, (y0, y0), skip);
     let h0 = if d0 < 1e-5 || d1 < 1e-5 {
         1e-6
     } else {
@@ -174,7 +175,7 @@ fn initial_step<const N: usize>(
     }
     .min(tol.h_max);
     let f1 = sys.rhs(t + h0, &(y0 + f0 * h0));
-    let d2 = scaled_rms(tol, &(f1 - f0), y0, y0) / h0;
+    let d2 = scaled_rms(tol, &(f1 - f0), (y0, y0), skip) / h0;
     let d12 = d1.max(d2);
     let h1 = if d12 <= 1e-15 {
         (h0 * 1e-3).max(1e-6)

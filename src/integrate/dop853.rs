@@ -22,7 +22,7 @@ use differential_equations::tableau::ButcherTableau;
 use nalgebra::SVector;
 
 use super::core::{all_finite, Core};
-use super::tolerances::scaled_rms;
+use super::tolerances::{measured, scaled_rms};
 use super::{DenseStep, FixedStep, IntegrationError, OdeSystem, Tolerances};
 
 /// Stages of one step.
@@ -150,9 +150,10 @@ impl<const N: usize> Dop853<N> {
             e3 = yseg - e3;
             let y1 = y0 + yseg * h;
             // HNW I, Eq. (10.17): err = |h| err5^2 / sqrt(n (err5^2 + 0.01 err3^2)), each a scaled sum of squares.
-            let n = N as f64;
-            let err5 = scaled_rms(&self.core.tol, &e5, &y0, &y1).powi(2) * n;
-            let err3 = scaled_rms(&self.core.tol, &e3, &y0, &y1).powi(2) * n;
+            let skip = sys.unmeasured();
+            let n = measured(N, skip);
+            let err5 = scaled_rms(&self.core.tol, &e5, (&y0, &y1), skip).powi(2) * n;
+            let err3 = scaled_rms(&self.core.tol, &e3, (&y0, &y1), skip).powi(2) * n;
             let mut deno = err5 + ERR3_WEIGHT * err3;
             if deno <= 0.0 {
                 deno = 1.0;

@@ -180,7 +180,7 @@ impl<const N: usize> Dopri5<N> {
             self.core.stats.rhs_evals += 6;
 
             let e = (k1 * E1 + k3 * E3 + k4 * E4 + k5 * E5 + k6 * E6 + k7 * E7) * h;
-            let err = scaled_rms(&self.core.tol, &e, &y0, &y1);
+            let err = scaled_rms(&self.core.tol, &e, (&y0, &y1), sys.unmeasured());
 
             if !(err.is_finite() && all_finite(&y1) && all_finite(&k7)) {
                 rejected_before = true;

@@ -66,6 +66,13 @@ pub use self::tolerances::Tolerances;
 pub trait OdeSystem<const N: usize> {
     /// The right-hand side f(t, y).
     fn rhs(&self, t: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
+
+    /// Components of `y` the error norm leaves out (none by default): components that are constant in this
+    /// system (a coordinate that is absent from it, as the walk's swinging-leg length when no leg swings), so
+    /// that the norm, and every step size, is that of the system without them, bit for bit.
+    fn unmeasured(&self) -> &[usize] {
+        &[]
+    }
 }
 
 /// A step of given size without error control (`Integrator::fixed_step`): its end, the vector field there, and

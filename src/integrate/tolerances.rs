@@ -34,20 +34,28 @@ impl Default for Tolerances {
     }
 }
 
-/// Weighted RMS norm of `v` with scale `atol + rtol * max(|a_i|, |b_i|)` (HNW I, Eq. II.4.11).
+/// Weighted RMS norm of `v` with scale `atol + rtol * max(|a_i|, |b_i|)` (HNW I, Eq. II.4.11), over the
+/// components not in `unmeasured` ([`OdeSystem::unmeasured`](super::OdeSystem::unmeasured)).
 pub(super) fn scaled_rms<const N: usize>(
     tol: &Tolerances,
     v: &SVector<f64, N>,
-    a: &SVector<f64, N>,
-    b: &SVector<f64, N>,
+    (a, b): (&SVector<f64, N>, &SVector<f64, N>),
+    unmeasured: &[usize],
 ) -> f64 {
     let sum: f64 = v
         .iter()
         .zip(a.iter().zip(b.iter()))
-        .map(|(vi, (ai, bi))| {
+        .enumerate()
+        .filter(|(i, _)| !unmeasured.contains(i))
+        .map(|(_, (vi, (ai, bi)))| {
             let r = vi / (tol.atol + tol.rtol * ai.abs().max(bi.abs()));
             r * r
         })
         .sum();
-    (sum / N as f64).sqrt()
+    (sum / measured(N, unmeasured)).sqrt()
+}
+
+/// How many of `N` components the norm measures.
+pub(super) fn measured(n: usize, unmeasured: &[usize]) -> f64 {
+    (n - unmeasured.len()) as f64
 }

@@ -38,7 +38,8 @@ pub use tables::steps::{
 };
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
 pub use tables::trajectory::{
-    trajectory_row, write_trajectory_csv, TrajectoryCsv, TRAJECTORY_HEADER,
+    trajectory_header, trajectory_row, trajectory_row_under, write_trajectory_csv, TrajectoryCsv,
+    TRAJECTORY_HEADER,
 };
 pub use tables::Cell;
 

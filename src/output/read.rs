@@ -193,6 +193,10 @@ pub struct TrajectoryRow {
     pub lambda_4: f64,
     /// Which physical leg (0 to N-1) is Leg 1.
     pub leg1: usize,
+    /// Length of the swinging leg (the old rear leg under `rear_exit = "continue"`, one leg behind Leg 2) while
+    /// it swings, 0 when none does or the file has no such column \[m\].
+    #[serde(rename = "L3", default)]
+    pub l3: f64,
 }
 
 /// The contact state of a leg's tip.
@@ -687,6 +691,7 @@ fn check_sample(
         ("lambda_2", s.lambda_2),
         ("lambda_3", s.lambda_3),
         ("lambda_4", s.lambda_4),
+        ("L3", s.l3),
     ];
     for (column, v) in numbers {
         check_number(path, row, column, v)?;
@@ -721,6 +726,18 @@ fn check_sample(
                 ),
             ));
         }
+    }
+    // The swinging leg (rear_exit = continue): 0 when none swings, else a length up to its stopper.
+    if !(s.l3 == 0.0 || (s.l3 > 0.0 && s.l3 <= stopped)) {
+        return Err(implausible(
+            path,
+            row,
+            "L3",
+            s.l3.to_string(),
+            format!(
+                "is neither 0 (no swinging leg) nor a leg length in (0, L0 + {LENGTH_SLACK:e}] m"
+            ),
+        ));
     }
     if s.leg1 >= geometry.legs {
         return Err(implausible(

@@ -58,8 +58,9 @@ pub struct Params {
     /// What happens when no no-slip contact state is consistent (a lift-off with a non-zero tangential
     /// contact force). Default [`ContactInconsistency::Slide`]. `docs/model.md` sections 3-4.
     pub inconsistent_contact: ContactInconsistency,
-    /// What becomes of the old rear leg when it leaves the coordinates at a touchdown. Default
-    /// [`RearExit::Relock`] (it must be locked on its stopper by then). `docs/model.md` section 5.
+    /// What becomes of the old rear leg when it leaves Legs 1 and 2 at a touchdown. Default
+    /// [`RearExit::Relock`] (it must be locked on its stopper by then); [`RearExit::Continue`] lets it swing on
+    /// as the coordinate `L3`; [`RearExit::Reset`] discards its state. `docs/model.md` section 5.
     #[serde(skip_serializing_if = "RearExit::is_relock")]
     pub rear_exit: RearExit,
     /// Whether Leg 2 (the rear leg) has its extension stopper. Default `true`. `false`: it has no extension
@@ -163,7 +164,7 @@ impl Params {
     /// `stiffness > 0`; `hub_inertia`, `viscosity >= 0`; `|slope| < pi/2`;
     /// `0 <= leg_mass_offset < stopper_length`; `spring_natural_length >= stopper_length` (unless
     /// `rear_exit = "reset"`); `rear_stopper = false` only with `rear_exit = "reset"` and soft legs;
-    /// `min_length` 0 or in `(0, stopper_length)` with soft legs;
+    /// `min_length` 0 or in `(0, stopper_length)` with soft legs, and not with `rear_exit = "continue"`;
     /// `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1; legs not too stiff to integrate (the time scale
     /// of [`Params::leg_time_scale`] at least [`MIN_LEG_TIME_SCALE`]).
     pub fn validate(&self) -> Result<(), ConfigError> {
@@ -299,6 +300,17 @@ impl Params {
                         short(self.min_length),
                         "rigid legs never shorten: a compression stop needs rigid_legs = false (or min_length = 0, \
                          none)",
+                    ));
+                }
+                Ok(())
+            });
+            rules.between(["min_length", "rear_exit"], |_| {
+                if self.rear_exit == RearExit::Continue {
+                    return Err(invalid(
+                        "min_length",
+                        short(self.min_length),
+                        "the swinging leg of rear_exit = \"continue\" has no compression stop yet: use \
+                         rear_exit = \"relock\" or \"reset\" with min_length (or min_length = 0, none)",
                     ));
                 }
                 Ok(())

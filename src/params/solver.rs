@@ -78,12 +78,12 @@ impl fmt::Display for ContactInconsistency {
     }
 }
 
-/// What becomes of the old rear leg (Leg 2) when it leaves the coordinates at a touchdown (`docs/model.md`
-/// section 5, "Re-indexing"): the model keeps only Legs 1 and 2 free, so the leg that leaves must become a
-/// rigid spoke at `L0`.
+/// What becomes of the old rear leg (Leg 2) when it leaves Legs 1 and 2 at a touchdown (`docs/model.md`
+/// section 5, "Re-indexing"): the legs other than Legs 1 and 2 are rigid spokes at `L0`, so the leg that leaves
+/// must be one by then, or become one later.
 ///
-/// In TOML and on the command line the values are the strings `"relock"` (default) and `"reset"`;
-/// [`Display`](fmt::Display) gives the same strings.
+/// In TOML and on the command line the values are the strings `"relock"` (default), `"continue"` and
+/// `"reset"`; [`Display`](fmt::Display) gives the same strings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RearExit {
@@ -91,6 +91,12 @@ pub enum RearExit {
     /// stops with `rear_leg_not_locked`. Nothing is discarded, so energy is conserved through re-indexing.
     #[default]
     Relock,
+    /// A leg that is not locked keeps its free dynamics (spring, damper, its sliding mass coupled with the
+    /// wheel) as the sixth coordinate `L3` until its stopper locks it, at an impact counted with the stopper
+    /// losses; it is then a spoke again. The walk stops with `swinging_leg_not_locked` if it still swings at the
+    /// next touchdown (when another leg would leave), and with `swinging_leg_landed` if its tip reaches the
+    /// ground. Nothing is discarded. Not with `min_length` (the swinging leg has no compression stop yet).
+    Continue,
     /// The leg's length and rate are discarded at the touchdown and it becomes a spoke at `L0` (as a
     /// third-party MATLAB VRW code does). Not physical: the energy this adds or removes is reported per step
     /// (`reset_energy`). The leg must still be in the air.
@@ -102,6 +108,7 @@ impl RearExit {
     pub(crate) fn name(self) -> &'static str {
         match self {
             RearExit::Relock => "relock",
+            RearExit::Continue => "continue",
             RearExit::Reset => "reset",
         }
     }

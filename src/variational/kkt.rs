@@ -106,7 +106,7 @@ impl<const N: usize> Saddle<N> {
 
 /// The KKT matrix `[M -J^T; J 0]` of the active rows of `active` at one configuration, factored in `f64`:
 /// solves for many right-hand sides. When Leg 1's tip is held (no-slip (C1), most of the walk) its rows `e_x`,
-/// `e_z` fix `x`, `z` and the system is reduced to `(theta, L1, L2)`, as the walk's own solve does.
+/// `e_z` fix `x`, `z` and the system is reduced to `(theta, L1, L2, L3)`, as the walk's own solve does.
 pub(crate) struct Kkt {
     /// `M`.
     mass: SMatrix<f64, NQ, NQ>,
@@ -114,7 +114,7 @@ pub(crate) struct Kkt {
     rows: SMatrix<f64, NROWS, NQ>,
     /// The stacked positions of the rows of the saddle system (those of (C1) excluded when held).
     stacked: [usize; NROWS],
-    /// The factored system: over all five coordinates, or over `(theta, L1, L2)` with (C1) held.
+    /// The factored system: over all six coordinates, or over `(theta, L1, L2, L3)` with (C1) held.
     saddle: Reduced,
 }
 
@@ -123,8 +123,9 @@ pub(crate) struct Kkt {
 enum Reduced {
     /// Over `(x, z, theta, L1, L2)`.
     General(Saddle<NQ>),
-    /// Over `(theta, L1, L2)`, with `x`, `z` fixed by (C1).
-    Held(Saddle<3>),
+    /// Over `(theta, L1, L2, L3)`, with `x`, `z` fixed by (C1) (`L3`'s row is the identity's when no leg
+    /// swings, as in `M`, and its solution 0).
+    Held(Saddle<{ NQ - 2 }>),
 }
 
 impl Kkt {
@@ -143,7 +144,7 @@ impl Kkt {
         }
         let m = &eom.mass;
         let saddle = if held {
-            let r: Vec<[f64; 3]> = stacked[..k]
+            let r: Vec<[f64; NQ - 2]> = stacked[..k]
                 .iter()
                 .map(|&i| std::array::from_fn(|l| rows[(i, 2 + l)]))
                 .collect();
@@ -191,7 +192,7 @@ impl Kkt {
                     }
                 }
                 Reduced::Held(saddle) => {
-                    // (C1): x'' = b_x, z'' = b_z; the rest on (theta, L1, L2).
+                    // (C1): x'' = b_x, z'' = b_z; the rest on (theta, L1, L2, L3).
                     let xz = [b[(0, c)], b[(1, c)]];
                     let f_r = std::array::from_fn(|l| {
                         f[(2 + l, c)]
@@ -209,7 +210,7 @@ impl Kkt {
                     let (x_r, l_c) = saddle.solve(f_r, &b_c);
                     x[(0, c)] = xz[0];
                     x[(1, c)] = xz[1];
-                    for l in 0..3 {
+                    for l in 0..NQ - 2 {
                         x[(2 + l, c)] = x_r[l];
                     }
                     for i in 0..saddle.k {
@@ -288,6 +289,7 @@ fn residual_parts<const D: usize>(
             jacobian: eom.rear_tip.jacobian.map(|x| re(&x)),
             velocity_product: eom.rear_tip.velocity_product.map(|x| re(&x)),
         },
+        swing: eom.swing,
     };
     ResidualParts { eom, r1, r2 }
 }
@@ -374,10 +376,10 @@ mod tests {
             ..Params::default()
         };
         let model = Model::new(&params).unwrap();
-        let q = Coords::new(0.01, -0.02, -0.3, 0.97, 0.93);
-        let qd = Coords::new(0.2, -0.1, 1.0, -0.2, 0.1);
-        let dir_q = Coords::new(0.3, -0.2, 0.5, 0.1, -0.4);
-        let dir_qd = Coords::new(-0.5, 0.2, 0.3, 0.6, 0.1);
+        let q = Coords::new(0.01, -0.02, -0.3, 0.97, 0.93, 0.95);
+        let qd = Coords::new(0.2, -0.1, 1.0, -0.2, 0.1, 0.3);
+        let dir_q = Coords::new(0.3, -0.2, 0.5, 0.1, -0.4, 0.2);
+        let dir_qd = Coords::new(-0.5, 0.2, 0.3, 0.6, 0.1, -0.1);
         let h = 1e-6;
         let mut compared = 0;
         for active in ActiveSet::all() {

@@ -74,6 +74,13 @@ pub enum NotDifferentiable {
     /// The recorded step is incomplete (it did not reach its touchdown).
     #[error("the step was not recorded to its touchdown")]
     Incomplete,
+    /// A leg swings in the step (`rear_exit = "continue"`): the step does not start on the Poincare section,
+    /// and the saltation of the swinging leg's lock is not built.
+    #[error("a leg swings in the step at t = {time} s: its exact derivative is not built")]
+    Swinging {
+        /// Time \[s\].
+        time: f64,
+    },
 }
 
 #[cfg(test)]

@@ -23,12 +23,14 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::contact::{impulse, ActiveSet};
-use crate::dynamics::{Coords, CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA};
+use crate::dynamics::{
+    swinging, Coords, CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA,
+};
 use crate::integrate::{Integrator, OdeSystem};
 use crate::params::SolverOptions;
 use crate::walk::impact::touchdown_leg;
 use crate::walk::tape::{Segment, StepTape};
-use crate::walk::{EventKind, PhaseSystem, WalkVector};
+use crate::walk::{unpack, EventKind, PhaseSystem, WalkVector};
 
 use super::dual::{dual, eps, seeded, Dual4, Dual5, NDIR};
 use super::kkt::{dynamics_derivative, impulse_derivative};
@@ -117,10 +119,7 @@ impl OdeSystem<NAUG> for Variational<'_> {
     fn rhs(&self, _t: f64, a: &Augmented) -> Augmented {
         let (y, s) = Self::split(a);
         // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
-        let phase = PhaseSystem {
-            model: self.model,
-            active: self.active,
-        };
+        let phase = PhaseSystem::at(self.model, self.active, &y);
         let (fy, dynamics) = phase.rhs_and_dynamics(&y);
         let (q, qd) = duals(&y, &s);
         let derivative = dynamics.and_then(|d| {
@@ -197,6 +196,9 @@ pub(crate) fn replay_step(
     let mut y0 = first.y0;
     let mut last_event: Option<f64> = None;
     for (k, segment) in tape.segments.iter().enumerate() {
+        if swinging(&unpack(&segment.y0).0) {
+            return Err(NotDifferentiable::Swinging { time: segment.t0 });
+        }
         let (y_minus, s_minus) = integrate_segment(model, opts, &mech, segment, &y0, &s)?;
         let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
         if last_event.is_some_and(|t| (end.time - t).abs() < COINCIDENT_EVENTS) {
@@ -217,11 +219,7 @@ pub(crate) fn replay_step(
             .ok_or(NotDifferentiable::Incomplete)?;
         // The reset: the recorded impacts, differentiated.
         let (_, s_reset) = apply_impacts(model, &mech, &y_minus, &s_event, &end.impacts, end.time)?;
-        let f_plus = PhaseSystem {
-            model,
-            active: next.active,
-        }
-        .rhs(end.time, &next.y0);
+        let f_plus = PhaseSystem::at(model, next.active, &next.y0).rhs(end.time, &next.y0);
         s = s_reset - rate_outer(&f_plus, &dt);
         y0 = next.y0;
     }
@@ -280,11 +278,7 @@ fn cross_guard(
     s: &Sensitivity,
 ) -> Result<(Sensitivity, SVector<f64, NDIR>), NotDifferentiable> {
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
-    let (f, dynamics) = PhaseSystem {
-        model,
-        active: segment.active,
-    }
-    .rhs_and_dynamics(y);
+    let (f, dynamics) = PhaseSystem::at(model, segment.active, y).rhs_and_dynamics(y);
     let (q, qd) = with_rate(y, s, &f);
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
     let singular = NotDifferentiable::Singular { time: end.time };
@@ -344,7 +338,10 @@ fn guard<T: Real>(
         | EventKind::Unlock(_)
         | EventKind::CompressionUnlock(_)
         | EventKind::Fall
-        | EventKind::RollBack => None,
+        | EventKind::RollBack
+        // Not in a step without a swinging leg (refused in `step_derivative`).
+        | EventKind::SwingLock
+        | EventKind::SwingLanding => None,
     }
 }
 
@@ -377,7 +374,7 @@ fn reindex_duals(
         let turns = (psi.re / std::f64::consts::TAU).round();
         psi - Dual4::lit(std::f64::consts::TAU * turns)
     };
-    let q_new = CoordsOf::<Dual4>::new(zero, front.position.y, theta, l0, l2);
-    let qd_new = CoordsOf::<Dual4>::new(v.x, v.y, qd[THETA], zero, l2_dot);
+    let q_new = CoordsOf::<Dual4>::new(zero, front.position.y, theta, l0, l2, zero);
+    let qd_new = CoordsOf::<Dual4>::new(v.x, v.y, qd[THETA], zero, l2_dot, zero);
     (q_new, qd_new)
 }

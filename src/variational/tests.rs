@@ -109,6 +109,7 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
                 EventKind::CompressionUnlock(_) => "compression unlock",
                 EventKind::Touchdown => "touchdown",
                 EventKind::Fall | EventKind::RollBack => "failure",
+                EventKind::SwingLock | EventKind::SwingLanding => "swinging leg",
             };
             kinds.insert(name.to_string());
             if end.impacts.len() > 1 {

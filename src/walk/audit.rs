@@ -3,7 +3,7 @@
 //! stoppers or compression stops.
 
 use crate::contact::{Leg, Stop};
-use crate::dynamics::Model;
+use crate::dynamics::{swinging, Model, L3};
 use crate::integrate::DenseStep;
 
 use super::events::EVENT_SAMPLES;
@@ -24,7 +24,7 @@ impl ContactAudit {
 
     /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`),
     /// and the farthest Leg 1 or 2 is past its stopper (Leg 1 alone when Leg 2 has none, `rear_stopper`) or
-    /// below its compression stop (`min_length > 0`).
+    /// below its compression stop (`min_length > 0`), or a swinging leg past its stopper.
     pub(crate) fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
@@ -38,6 +38,10 @@ impl ContactAudit {
                 let past = stop.sign() * (q[leg.length_coordinate()] - stop_length(model, stop));
                 self.stopper_overrun = self.stopper_overrun.max(past);
             }
+        }
+        if swinging(&q) {
+            let past = q[L3] - model.params().stopper_length;
+            self.stopper_overrun = self.stopper_overrun.max(past);
         }
     }
 

@@ -67,6 +67,45 @@ pub enum WalkError {
         /// Its rate of extension \[m/s\].
         rate: f64,
     },
+    /// Under `rear_exit = "continue"`, the swinging leg (`L3`, the old rear leg) still swung at the touchdown
+    /// after the one where it left Legs 1 and 2 (another leg would leave then, or it is the leg touching down).
+    #[error(
+        "the swinging leg (the old rear leg) was not locked by the next touchdown (t = {time:.6} s, length \
+         {length:.6} m, rate {rate:.4} m/s)"
+    )]
+    SwingingLegNotLocked {
+        /// Time \[s\].
+        time: f64,
+        /// Its length \[m\].
+        length: f64,
+        /// Its rate of extension \[m/s\].
+        rate: f64,
+    },
+    /// Under `rear_exit = "continue"`, the tip of the swinging leg reached the ground.
+    #[error("the swinging leg (the old rear leg) touched the ground at t = {time:.6} s in {phase} (length {length:.6} m)")]
+    SwingingLegLanded {
+        /// Time \[s\].
+        time: f64,
+        /// Phase.
+        phase: Phase,
+        /// Its length \[m\].
+        length: f64,
+    },
+    /// Under `rear_exit = "continue"`, the old rear leg still swings at this touchdown (it left Legs 1 and 2
+    /// unlocked): the walk goes on, but the Poincare section `(L2, thetadot, L2dot)` does not hold the swinging
+    /// leg's state, so no step map starts here (gaits whose rear leg is late are not analysed yet).
+    #[error(
+        "the old rear leg still swings at touchdown (t = {time:.6} s, L3 = {length:.6} m, L3dot = {rate:.4} \
+         m/s): the walk goes on, but the Poincare section (L2, thetadot, L2dot) does not hold it"
+    )]
+    SwingAtSection {
+        /// Time \[s\].
+        time: f64,
+        /// Its length \[m\].
+        length: f64,
+        /// Its rate of extension \[m/s\].
+        rate: f64,
+    },
     /// At touchdown the old Leg 2 was still on the ground: three legs would support the wheel.
     #[error("old rear leg still on the ground at touchdown (t = {time:.6} s)")]
     RearLegInContact {
@@ -138,6 +177,15 @@ pub enum WalkError {
 }
 
 impl WalkError {
+    /// Is this a touchdown that is not on the Poincare section although the walk goes on there
+    /// ([`WalkError::OffSection`], [`WalkError::SwingAtSection`])?
+    pub(crate) fn leaves_section(&self) -> bool {
+        matches!(
+            self,
+            WalkError::OffSection { .. } | WalkError::SwingAtSection { .. }
+        )
+    }
+
     /// Wraps a failed constraint solve at `time` in `phase` (for `map_err`).
     pub(crate) fn contact_at(time: f64, phase: Phase) -> impl Fn(ContactError) -> WalkError + Copy {
         move |source| WalkError::Contact {
@@ -157,6 +205,9 @@ impl WalkError {
             | WalkError::Chatter { time, .. }
             | WalkError::RearLegNotLocked { time, .. }
             | WalkError::RearLegInContact { time }
+            | WalkError::SwingingLegNotLocked { time, .. }
+            | WalkError::SwingingLegLanded { time, .. }
+            | WalkError::SwingAtSection { time, .. }
             | WalkError::OffSection { time, .. }
             | WalkError::InconsistentContacts { time, .. }
             | WalkError::Contact { time, .. } => Some(*time),
@@ -178,6 +229,9 @@ impl WalkError {
             WalkError::Chatter { .. } => "chatter",
             WalkError::RearLegNotLocked { .. } => "rear_leg_not_locked",
             WalkError::RearLegInContact { .. } => "rear_leg_in_contact",
+            WalkError::SwingingLegNotLocked { .. } => "swinging_leg_not_locked",
+            WalkError::SwingingLegLanded { .. } => "swinging_leg_landed",
+            WalkError::SwingAtSection { .. } => "leg_swings_at_section",
             WalkError::OffSection { .. } => "off_section",
             WalkError::HoldChanged { .. } => "hold_changed",
             WalkError::InconsistentContacts { .. } => "inconsistent_contacts",

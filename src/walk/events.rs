@@ -5,11 +5,12 @@
 use crate::contact::{
     constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Stop,
 };
-use crate::dynamics::{Coords, Model, THETA};
+use crate::dynamics::{swinging, Coords, Model, L3, THETA};
 use crate::params::SolverOptions;
 
 use super::impact::{has_stop, stop_length, touchdown_leg, COMPLEMENTARITY_TOL};
 use super::phase::{unpack, WalkVector};
+use super::reindex::SWING_LEG;
 
 /// A lift-off or stopper-unlock event fires when the force falls this far below zero \[N\] (or below its
 /// value at the start of the phase, if the force-level problem accepted a slightly negative one within
@@ -45,6 +46,11 @@ pub(crate) enum EventKind {
     CompressionHit(Leg),
     /// The compression stop's reaction on a held leg falls to zero.
     CompressionUnlock(Leg),
+    /// The swinging leg (`L3`, `rear_exit = "continue"`) reaches its stopper (`L3 = L0`).
+    SwingLock,
+    /// The tip of the swinging leg reaches the ground (the walk stops; with three legs it is the next leg to
+    /// touch down, and that is a touchdown).
+    SwingLanding,
 }
 
 impl EventKind {
@@ -124,6 +130,12 @@ impl<'a> EventSet<'a> {
                 });
             }
         }
+        if swinging(&q) {
+            kinds.push(EventKind::SwingLock);
+            if touchdown_leg(model, &q) != SWING_LEG {
+                kinds.push(EventKind::SwingLanding);
+            }
+        }
         let mut set = EventSet {
             model,
             opts,
@@ -166,7 +178,9 @@ impl<'a> EventSet<'a> {
     fn guard(opts: &SolverOptions, kind: EventKind) -> Option<f64> {
         match kind {
             EventKind::Landing(_) => Some(opts.recontact_gap),
-            EventKind::StopperHit(_) | EventKind::CompressionHit(_) => Some(opts.stopper_gap),
+            EventKind::StopperHit(_) | EventKind::CompressionHit(_) | EventKind::SwingLock => {
+                Some(opts.stopper_gap)
+            }
             _ => None,
         }
     }
@@ -174,6 +188,7 @@ impl<'a> EventSet<'a> {
     /// Is the unit of a guarded event moving into the ground (past its stopper) at `(q, q')`?
     fn approaching(&self, kind: EventKind, q: &Coords, qd: &Coords) -> bool {
         match kind {
+            EventKind::SwingLock => qd[L3] > COMPLEMENTARITY_TOL,
             EventKind::Landing(leg) => {
                 self.model.tip(q, qd, leg.index()).velocity(qd).y < -COMPLEMENTARITY_TOL
             }
@@ -186,6 +201,9 @@ impl<'a> EventSet<'a> {
     /// Does a free leg leave its stop (move inward from the stopper, outward from the compression stop) faster
     /// than [`COMPLEMENTARITY_TOL`] at `q'`?
     fn separating(&self, kind: EventKind, qd: &Coords) -> bool {
+        if kind == EventKind::SwingLock {
+            return qd[L3] < -COMPLEMENTARITY_TOL;
+        }
         kind.stop_hit().is_some_and(|(leg, stop)| {
             stop.sign() * qd[leg.length_coordinate()] < -COMPLEMENTARITY_TOL
         })
@@ -212,6 +230,8 @@ impl<'a> EventSet<'a> {
             EventKind::Landing(leg) => self.model.tip_height(q, leg.index()),
             EventKind::StopperHit(leg) => self.room(leg, Stop::Extension, q),
             EventKind::CompressionHit(leg) => self.room(leg, Stop::Compression, q),
+            EventKind::SwingLock => self.model.params().stopper_length - q[L3],
+            EventKind::SwingLanding => self.model.tip_height(q, SWING_LEG),
         }
     }
 

@@ -12,10 +12,10 @@
 use serde::Serialize;
 
 use crate::contact::{
-    constrained_dynamics, impulse, largest_pull, ActiveSet, ConstrainedDynamics, ContactError,
-    ImpulseSolution, Leg, Multipliers, Stop,
+    constrained_dynamics, impulse, largest_pull, swing_lock_impulse, ActiveSet,
+    ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, Stop,
 };
-use crate::dynamics::{Coords, LegIndex, Model, THETA};
+use crate::dynamics::{Coords, LegIndex, Model, L3, THETA};
 use crate::params::{ContactInconsistency, ImpactModel};
 
 use super::error::WalkError;
@@ -298,8 +298,21 @@ pub(crate) fn plastic_impact(
     forced: ActiveSet,
     candidates: &[Candidate],
 ) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
-    let solve = |set: &ActiveSet| impulse(model, q, qd, set);
-    let found = best_subset(forced, candidates, Level::Impulse, solve, |set, sol| {
+    plastic_impact_by(model, (q, qd), forced, candidates, |set| {
+        impulse(model, q, qd, set)
+    })
+}
+
+/// [`plastic_impact`] with the collision equation solved by `solve` for each combination of units (which may
+/// add a row of its own, as the swinging leg's stopper, [`lock_swinging_leg`]).
+fn plastic_impact_by(
+    model: &Model,
+    (q, qd): (&Coords, &Coords),
+    forced: ActiveSet,
+    candidates: &[Candidate],
+    solve: impl Fn(&ActiveSet) -> Result<ImpulseSolution, ContactError>,
+) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
+    let found = best_subset(forced, candidates, Level::Impulse, &solve, |set, sol| {
         candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
             (Unit::Contact(leg), Mode::Off) => {
                 model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
@@ -672,6 +685,67 @@ pub fn close_unit(
         impulses: sol.impulses,
         loss: kinetic_loss(model, q, qd, &sol),
         pull_impulse: pull_of(model, &impulse_set, &sol),
+    }))
+}
+
+/// The swinging leg's stopper lock (see [`lock_swinging_leg`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SwingLock {
+    /// `q` with the leg a spoke again (`L3 = 0`).
+    pub(crate) q: Coords,
+    /// `q'+` (`dL3/dt = 0`).
+    pub(crate) qd_plus: Coords,
+    /// The active set of the motion that follows.
+    pub(crate) active: ActiveSet,
+    /// Energy `T + V` lost \[J\]: the impact's, and the rounding of setting the leg to its stopper length.
+    pub(crate) loss: f64,
+    /// The largest pulling impulse of the units that took an impulse \[N s\] (contact audit).
+    pub(crate) pull_impulse: f64,
+}
+
+/// The swinging leg (`L3`, `rear_exit = "continue"`) reaches its stopper: a plastic impact (5) that stops it
+/// there, in which every other unit of `active` is a candidate of the impulse-level complementarity problem as
+/// in [`close_unit`] (it pushes, or takes no impulse and separates), after which the leg is a spoke of the
+/// wheel again (`L3` leaves `q`); then the active set of the motion that follows, `None` if none is
+/// consistent.
+pub(crate) fn lock_swinging_leg(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: ActiveSet,
+) -> Result<Option<SwingLock>, ContactError> {
+    let forced = bilateral_stoppers(model);
+    let candidates: Vec<Candidate> = Leg::BOTH
+        .into_iter()
+        .flat_map(Unit::of)
+        .filter(|u| u.mode(&active) != Mode::Off && u.mode(&forced) == Mode::Off)
+        .map(|u| Candidate::keep(u, &active))
+        .collect();
+    let (impulse_set, sol) = plastic_impact_by(model, (q, qd), forced, &candidates, |set| {
+        swing_lock_impulse(model, q, qd, set).map(|(sol, _)| sol)
+    })?;
+    let pull_impulse = pull_of(model, &impulse_set, &sol);
+    let mut q_spoke = *q;
+    let mut qd_plus = sol.qd_plus;
+    (q_spoke[L3], qd_plus[L3]) = (0.0, 0.0);
+    let (forced, candidates) = post_impact_candidates(
+        model,
+        &q_spoke,
+        &qd_plus,
+        &impulse_set,
+        &active,
+        &impulse_set,
+    );
+    let Some((next, _)) = consistent_active_set(model, &q_spoke, &qd_plus, forced, &candidates)?
+    else {
+        return Ok(None);
+    };
+    Ok(Some(SwingLock {
+        q: q_spoke,
+        qd_plus,
+        active: next,
+        loss: model.energy(q, qd) - model.energy(&q_spoke, &qd_plus),
+        pull_impulse,
     }))
 }
 

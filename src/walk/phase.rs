@@ -5,7 +5,7 @@
 use nalgebra::SVector;
 
 use crate::contact::{constrained_dynamics, ActiveSet, ConstrainedDynamics};
-use crate::dynamics::{Coords, Model, L1, L2, NQ};
+use crate::dynamics::{swinging, Coords, Model, L1, L2, L3, NQ};
 use crate::integrate::OdeSystem;
 
 /// Size of the integrated state `[q, q', E_damper]`.
@@ -29,16 +29,28 @@ pub(crate) fn unpack(y: &WalkVector) -> (Coords, Coords) {
 }
 
 /// The vector field of one phase: Eq. (1) with the constraints of `active`, plus the damper power
-/// `c (dL1^2 + dL2^2)` as a quadrature.
+/// `c (dL1^2 + dL2^2 + dL3^2)` as a quadrature (`dL3/dt = 0` when no leg swings).
 #[derive(Debug, Clone, Copy)]
 pub struct PhaseSystem<'a> {
     /// The model.
     pub model: &'a Model,
     /// Active contacts and stoppers.
     pub active: ActiveSet,
+    /// Does a leg swing ([`L3`](crate::dynamics::L3) a coordinate) in this phase? (It swings, or not, through
+    /// the whole phase: its stopper's lock is an event.)
+    pub swing: bool,
 }
 
-impl PhaseSystem<'_> {
+impl<'a> PhaseSystem<'a> {
+    /// The phase that starts at `y` with `active`.
+    pub fn at(model: &'a Model, active: ActiveSet, y: &WalkVector) -> PhaseSystem<'a> {
+        PhaseSystem {
+            model,
+            active,
+            swing: swinging(&unpack(y).0),
+        }
+    }
+
     /// The vector field at `y` and the constrained dynamics it came from (`None` where the KKT system is
     /// singular; the field is then `NaN`).
     pub(crate) fn rhs_and_dynamics(
@@ -49,7 +61,8 @@ impl PhaseSystem<'_> {
         match constrained_dynamics(self.model, &q, &qd, &self.active) {
             Ok(d) => {
                 let c = self.model.params().viscosity;
-                let f = pack(&qd, &d.qdd, c * (qd[L1] * qd[L1] + qd[L2] * qd[L2]));
+                let power = qd[L1] * qd[L1] + qd[L2] * qd[L2] + qd[L3] * qd[L3];
+                let f = pack(&qd, &d.qdd, c * power);
                 (f, Some(d))
             }
             // The integrator reports a non-finite derivative as an error with its time.
@@ -61,6 +74,15 @@ impl PhaseSystem<'_> {
 impl OdeSystem<NY> for PhaseSystem<'_> {
     fn rhs(&self, _t: f64, y: &WalkVector) -> WalkVector {
         self.rhs_and_dynamics(y).0
+    }
+
+    /// `L3` and `dL3/dt` when no leg swings (both stay 0).
+    fn unmeasured(&self) -> &[usize] {
+        if self.swing {
+            &[]
+        } else {
+            &[L3, NQ + L3]
+        }
     }
 }
 

@@ -2,17 +2,22 @@
 //! behind it shift, and the legs that leave `q` must be in the air, and locked or reset.
 
 use crate::contact::{ActiveSet, Leg};
-use crate::dynamics::{Coords, Model, L1, THETA};
+use crate::dynamics::{swinging, Coords, Model, L1, L3, THETA};
 use crate::params::RearExit;
 
 use super::error::WalkError;
+
+/// The index of the swinging leg (`L3`, [`RearExit::Continue`]): the old Leg 2, one leg behind the new Leg 2.
+pub(crate) const SWING_LEG: usize = 2;
 use super::impact::has_stopper;
 
 /// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
 /// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
 /// that leave `q` (the old Leg 2; after a long flight also the old Leg 1) must be in the air, and locked at
-/// `L0` ([`RearExit::Relock`]) or reset to the spokes' length, `touchdown_length` or `L0`
-/// ([`RearExit::Reset`]: their length and rate are discarded). The new Leg 1 has the touchdown length. The
+/// `L0` ([`RearExit::Relock`]), or swing on as `L3` ([`RearExit::Continue`], the old Leg 2 after a step, which
+/// must have been locked by now if it swung since the last touchdown), or reset to the spokes' length,
+/// `touchdown_length` or `L0` ([`RearExit::Reset`]: their length and rate are discarded). The new Leg 1 has the
+/// touchdown length. The
 /// origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact, energy removed by
 /// the reset)`: `T + V` before minus after the reset \[J\], 0 when no leg was reset.
 pub(super) fn reindex(
@@ -26,27 +31,43 @@ pub(super) fn reindex(
     // The touching leg is `shift` legs ahead of Leg 1; with `shift > 1` the new Leg 2 is a locked leg.
     let shift = model.legs() - touching;
     let leaving: &[Leg] = if shift == 1 { &[Leg::Two] } else { &Leg::BOTH };
-    let reset = model.params().rear_exit == RearExit::Reset;
+    let exit = model.params().rear_exit;
+    if swinging(q) {
+        // The leg that left at the last touchdown still swings: it would leave again, or it is touching down.
+        return Err(WalkError::SwingingLegNotLocked {
+            time,
+            length: q[L3],
+            rate: qd[L3],
+        });
+    }
     let (mut q_reset, mut qd_reset) = (*q, *qd);
+    // The old Leg 2 swinging on as `L3` (`RearExit::Continue`).
+    let mut swing = (0.0, 0.0);
     for &leg in leaving {
         if active.contact(leg) {
             return Err(WalkError::RearLegInContact { time });
         }
         if active.lock(leg) {
-            // Locked: at `L0` and at rest (to the stopper's tolerance, which both choices leave out). A leg held
+            // Locked: at `L0` and at rest (to the stopper's tolerance, which every choice leaves out). A leg held
             // at its compression stop is not: it is reset, or not relocked.
             continue;
         }
-        if reset {
-            q_reset[leg.length_coordinate()] = model.params().spoke_length();
-            qd_reset[leg.length_coordinate()] = 0.0;
-        } else {
-            let i = leg.length_coordinate();
-            return Err(WalkError::RearLegNotLocked {
-                time,
-                length: q[i],
-                rate: qd[i],
-            });
+        let i = leg.length_coordinate();
+        match exit {
+            RearExit::Reset => {
+                q_reset[i] = model.params().spoke_length();
+                qd_reset[i] = 0.0;
+            }
+            // One leg at a time: the old Leg 2 after a step (after a flight that moves Leg 1 out too, both would
+            // leave).
+            RearExit::Continue if shift == 1 => swing = (q[i], qd[i]),
+            _ => {
+                return Err(WalkError::RearLegNotLocked {
+                    time,
+                    length: q[i],
+                    rate: qd[i],
+                })
+            }
         }
     }
     let front = model.tip(q, qd, touching);
@@ -66,8 +87,8 @@ pub(super) fn reindex(
         let psi = q[THETA] + touching as f64 * model.alpha();
         psi - std::f64::consts::TAU * (psi / std::f64::consts::TAU).round()
     };
-    let q_new = Coords::new(0.0, front.position.y, theta, l_td, l2);
-    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot);
+    let q_new = Coords::new(0.0, front.position.y, theta, l_td, l2, swing.0);
+    let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot, swing.1);
     let before = ActiveSet {
         contact1: false,
         contact2: shift == 1 && active.contact1,

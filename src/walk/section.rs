@@ -192,8 +192,8 @@ pub(crate) fn section_coords<T: Real>(
     let (cos_alpha, sin_alpha) = (lit::<T>(alpha.cos()), lit::<T>(alpha.sin()));
     let theta = ((l2 * cos_alpha - l0) / (l2 * sin_alpha)).atan();
     let zero = T::zero();
-    let q = CoordsOf::<T>::new(zero, zero, theta, l0, l2);
-    let mut qd = CoordsOf::<T>::new(zero, zero, theta_dot, zero, l2_dot);
+    let q = CoordsOf::<T>::new(zero, zero, theta, l0, l2, zero);
+    let mut qd = CoordsOf::<T>::new(zero, zero, theta_dot, zero, l2_dot, zero);
     let v = model
         .tip_with(mech, &q, &qd, Leg::Two.index())
         .velocity(&qd);

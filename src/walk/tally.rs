@@ -1,6 +1,9 @@
 //! The bookkeeping of a step in progress ([`StepTally`]): durations, the contact audit, flags and the energy
 //! lost in impacts, which the step's report is made of.
 
+use crate::contact::ActiveSet;
+
+use super::impact::SwingLock;
 use super::report::ContactAudit;
 use super::zeno::ZenoLock;
 
@@ -32,6 +35,15 @@ impl StepTally {
         self.stopper_loss += lock.loss;
         self.audit.zeno_impulse = self.audit.zeno_impulse.max(lock.impulse);
         self.audit.pull_impulse = self.audit.pull_impulse.max(lock.pull_impulse);
+        self.scuffing |= lock.active.slide2;
+    }
+
+    /// Account for the swinging leg's stopper lock from `before` (rear_exit = continue): a stopper loss, its
+    /// pulls to the contact audit, and Leg 1 leaving or Leg 2 sliding through it.
+    pub(super) fn see_swing_lock(&mut self, lock: &SwingLock, before: &ActiveSet) {
+        self.stopper_loss += lock.loss;
+        self.audit.pull_impulse = self.audit.pull_impulse.max(lock.pull_impulse);
+        self.bounce |= before.contact1 && !lock.active.contact1;
         self.scuffing |= lock.active.slide2;
     }
 }

@@ -7,15 +7,15 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::contact::{ActiveSet, Leg, Phase, Stop};
-use crate::dynamics::{Model, NQ, THETA, X};
+use crate::dynamics::{swinging, Model, L3, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
 
 use super::error::WalkError;
 use super::events::{EventKind, EventSet, EVENT_SAMPLES};
 use super::impact::{
-    close_unit, consistent_active_set, post_impact_candidates, release_contact, touchdown_impact,
-    touchdown_leg, Branch, TouchdownImpact, Unit,
+    close_unit, consistent_active_set, lock_swinging_leg, post_impact_candidates, release_contact,
+    touchdown_impact, touchdown_leg, Branch, TouchdownImpact, Unit,
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::reindex::reindex;
@@ -115,12 +115,20 @@ impl<'m> Walker<'m> {
     }
 
     /// The current Poincare-section state, or why the walk cannot continue, or why the wheel is not on the
-    /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest, slides).
+    /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest, slides;
+    /// [`WalkError::SwingAtSection`]: the old rear leg still swings).
     pub fn section(&self) -> Result<SectionState, WalkError> {
         if let Some(e) = &self.blocked {
             return Err(e.clone());
         }
         let (q, qd) = (&self.state.q, &self.state.qd);
+        if swinging(q) {
+            return Err(WalkError::SwingAtSection {
+                time: self.state.time,
+                length: q[L3],
+                rate: qd[L3],
+            });
+        }
         let speed = self.model.tip(q, qd, Leg::Two.index()).velocity(qd).norm();
         if speed > SECTION_TIP_SPEED_TOL {
             return Err(WalkError::OffSection {
@@ -398,7 +406,7 @@ impl<'a> Phases<'a> {
         let t_limit = start.time + opts.max_step_time;
         let solver = Integrator::new(
             opts.integrator,
-            &PhaseSystem { model, active },
+            &PhaseSystem::at(model, active, &y),
             t,
             y,
             walker.tolerances(),
@@ -476,7 +484,7 @@ impl<'a> Phases<'a> {
                 phase,
             });
         }
-        let sys = PhaseSystem { model, active };
+        let sys = PhaseSystem::at(model, active, &self.y);
         let step = self
             .solver
             .step(&sys, self.t_limit)
@@ -605,6 +613,22 @@ impl<'a> Phases<'a> {
                 })
             }
             EventKind::RollBack => return Err(WalkError::RolledBack { time: t, phase }),
+            EventKind::SwingLanding => {
+                return Err(WalkError::SwingingLegLanded {
+                    time: t,
+                    phase,
+                    length: q[L3],
+                })
+            }
+            EventKind::SwingLock => {
+                let lock = lock_swinging_leg(model, &q, &qd, self.active)
+                    .map_err(WalkError::contact_at(t, phase))?
+                    .ok_or(WalkError::InconsistentContacts { time: t, phase })?;
+                self.work.impacts += 1;
+                self.tally.see_swing_lock(&lock, &self.active);
+                self.active = lock.active;
+                self.y = pack(&lock.q, &lock.qd_plus, self.y[2 * NQ]);
+            }
             EventKind::LiftOff(leg) => {
                 self.active = release_contact(model, t, &q, &qd, self.active, leg)?;
                 self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
@@ -668,7 +692,7 @@ impl<'a> Phases<'a> {
     /// new active set, and the trajectory takes a sample there.
     fn restart_phase(&mut self) {
         let (model, active) = (self.model, self.active);
-        let sys = PhaseSystem { model, active };
+        let sys = PhaseSystem::at(model, active, &self.y);
         self.solver.restart(&sys, self.t, self.y);
         self.events = EventSet::new(model, self.opts, active, &self.y);
         let pull;

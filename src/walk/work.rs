@@ -36,6 +36,12 @@ pub struct EventCounts {
     /// Compression-stop unlocks (`min_length > 0`).
     #[serde(skip_serializing_if = "is_zero")]
     pub compression_unlock: usize,
+    /// Stopper locks of the swinging leg (`rear_exit = "continue"`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub swing_lock: usize,
+    /// Landings of the swinging leg (the step fails).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub swing_landing: usize,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -54,6 +60,8 @@ impl EventCounts {
         roll_back: 0,
         compression_hit: 0,
         compression_unlock: 0,
+        swing_lock: 0,
+        swing_landing: 0,
     };
 
     /// Count one event of `kind`.
@@ -68,6 +76,8 @@ impl EventCounts {
             EventKind::RollBack => &mut self.roll_back,
             EventKind::CompressionHit(_) => &mut self.compression_hit,
             EventKind::CompressionUnlock(_) => &mut self.compression_unlock,
+            EventKind::SwingLock => &mut self.swing_lock,
+            EventKind::SwingLanding => &mut self.swing_landing,
         };
         *n += 1;
     }
@@ -84,6 +94,8 @@ impl AddAssign for EventCounts {
         self.roll_back += o.roll_back;
         self.compression_hit += o.compression_hit;
         self.compression_unlock += o.compression_unlock;
+        self.swing_lock += o.swing_lock;
+        self.swing_landing += o.swing_landing;
     }
 }
 
@@ -143,6 +155,8 @@ impl WorkCounts {
                 roll_back: self.events.roll_back - e.roll_back,
                 compression_hit: self.events.compression_hit - e.compression_hit,
                 compression_unlock: self.events.compression_unlock - e.compression_unlock,
+                swing_lock: self.events.swing_lock - e.swing_lock,
+                swing_landing: self.events.swing_landing - e.swing_landing,
             },
             impacts: self.impacts - earlier.impacts,
         }

@@ -281,8 +281,8 @@ mod tests {
     /// A wheel in flight with Leg 1 locked and Leg 2 just kicked off its stopper.
     fn flight(model: &Model, v2: f64) -> (Coords, Coords, ActiveSet) {
         let l0 = model.params().stopper_length;
-        let q = Coords::new(0.0, 0.1, -0.2, l0, l0);
-        let qd = Coords::new(1.0, 0.5, 1.5, 0.0, v2);
+        let q = Coords::new(0.0, 0.1, -0.2, l0, l0, 0.0);
+        let qd = Coords::new(1.0, 0.5, 1.5, 0.0, v2, 0.0);
         let active = ActiveSet {
             lock1: true,
             ..ActiveSet::default()
@@ -360,14 +360,14 @@ mod tests {
         let (l1, l2) = (0.95, 0.9);
         let alpha = model.alpha();
         let theta = ((l2 * alpha.cos() - l1) / (l2 * alpha.sin())).atan();
-        let q = Coords::new(0.0, 0.0, theta, l1, l2);
+        let q = Coords::new(0.0, 0.0, theta, l1, l2, 0.0);
         let active = ActiveSet {
             contact1: true,
             ..ActiveSet::default()
         };
         // Leg 2's tip velocity is J_2 q'; with Leg 1 held (x' = z' = 0), move L2 to lift it.
         let with_tip_speed = |v: f64| {
-            let mut qd = Coords::new(0.0, 0.0, 0.8, -0.1, 0.0);
+            let mut qd = Coords::new(0.0, 0.0, 0.8, -0.1, 0.0, 0.0);
             let tip = model.tip(&q, &qd, 1);
             let (vx, vz) = (tip.velocity(&qd).x, tip.velocity(&qd).y);
             // Solve for the theta' and L2' that give the tip velocity (0, v) with L1' fixed.

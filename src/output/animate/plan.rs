@@ -147,6 +147,7 @@ pub(super) mod tests {
             lambda_3: 0.0,
             lambda_4: 1.0,
             leg1: 0,
+            l3: 0.0,
         }
     }
 

@@ -52,6 +52,10 @@ impl<'a> Track<'a> {
         let mut lengths = vec![self.geometry.spoke_length; n];
         lengths[s.leg1 % n] = s.l1;
         lengths[(s.leg1 + 1) % n] = s.l2;
+        // The swinging leg (rear_exit = continue), one behind Leg 2, while it swings.
+        if s.l3 > 0.0 {
+            lengths[(s.leg1 + 2) % n] = s.l3;
+        }
         Pose {
             hub: (s.x + s.l1 * s.theta.sin(), s.z + s.l1 * s.theta.cos()),
             psi0: self.psi0[k],

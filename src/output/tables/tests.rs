@@ -10,7 +10,7 @@ use super::attractors::{orbit_columns, OrbitRow, BASIN, BRANCH};
 use super::map::{map_columns, MapPoint};
 use super::steps::STEPS;
 use super::sweep::SWEEP;
-use super::trajectory::TRAJECTORY;
+use super::trajectory::{SWING_COLUMNS, TRAJECTORY};
 use super::*;
 use crate::dynamics::Model;
 use crate::gait::basin::{BasinPoint, Outcome};
@@ -161,7 +161,7 @@ fn every_table_reads_back_by_name() {
 
     write_steps_csv(&path("steps.csv"), &f.steps, RearExit::Relock).unwrap();
     check_by_name(&path("steps.csv"), &STEPS, &[], &f.steps);
-    write_trajectory_csv(&path("trajectory.csv"), &f.samples).unwrap();
+    write_trajectory_csv(&path("trajectory.csv"), &f.samples, RearExit::Relock).unwrap();
     check_by_name(&path("trajectory.csv"), &TRAJECTORY, &[], &f.samples);
 
     let points = sweep_points(&f.gait);
@@ -280,12 +280,13 @@ fn reads_as(value: &serde_json::Value, cell: &Cell) -> bool {
 /// field holds the quantity its name says).
 #[test]
 fn readers_follow_the_declarations() {
-    fn check<T, R: serde::Serialize>(file: &str, columns: &[Column<T>], items: &[T], read: &[R]) {
+    fn check<T, R: serde::Serialize>(file: &str, tables: &[&[Column<T>]], items: &[T], read: &[R]) {
         assert_eq!(items.len(), read.len(), "{file}");
         for (item, row) in items.iter().zip(read) {
             for (name, value) in fields_by_name(row) {
-                let column = columns
+                let column = tables
                     .iter()
+                    .flat_map(|columns| columns.iter())
                     .find(|c| matches!(c.name, Name::Fixed(n) if n == name))
                     .unwrap_or_else(|| {
                         panic!("{file}: the reader's {name} is not a declared column")
@@ -303,11 +304,17 @@ fn readers_follow_the_declarations() {
     let steps_path = dir.path().join("steps.csv");
     write_steps_csv(&steps_path, &f.steps, RearExit::Relock).unwrap();
     let steps: Vec<StepRow> = read_csv(&steps_path, false).unwrap();
-    check("steps.csv", &STEPS, &f.steps, &steps);
+    check("steps.csv", &[&STEPS], &f.steps, &steps);
     let trajectory_path = dir.path().join("trajectory.csv");
-    write_trajectory_csv(&trajectory_path, &f.samples).unwrap();
+    // With the swinging leg's columns (rear_exit = continue), which the reader reads too.
+    write_trajectory_csv(&trajectory_path, &f.samples, RearExit::Continue).unwrap();
     let samples: Vec<TrajectoryRow> = read_csv(&trajectory_path, false).unwrap();
-    check("trajectory.csv", &TRAJECTORY, &f.samples, &samples);
+    check(
+        "trajectory.csv",
+        &[&TRAJECTORY, &SWING_COLUMNS],
+        &f.samples,
+        &samples,
+    );
 }
 
 /// The readers' fields hold the quantities their names say, checked against the walk's own fields (so two
@@ -317,7 +324,7 @@ fn readers_hold_the_named_quantities() {
     let f = fixture();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("trajectory.csv");
-    write_trajectory_csv(&path, &f.samples).unwrap();
+    write_trajectory_csv(&path, &f.samples, RearExit::Relock).unwrap();
     let rows: Vec<TrajectoryRow> = read_csv(&path, false).unwrap();
     for (s, r) in f.samples.iter().zip(&rows) {
         let q = [r.x, r.z, r.theta, r.l1, r.l2];

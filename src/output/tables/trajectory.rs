@@ -5,7 +5,9 @@ use std::path::Path;
 
 use super::{fixed_names, row, Cell, Column};
 use crate::contact::{ActiveSet, Leg, Stop};
+use crate::dynamics::L3;
 use crate::output::{CsvStream, OutputError};
+use crate::params::RearExit;
 use crate::walk::{Sample, SampleSink};
 
 use Cell::{Count, Real};
@@ -99,6 +101,39 @@ pub(crate) const TRAJECTORY: [Column<Sample>; 24] = [
 /// Header of `trajectory.csv` (the names of `TRAJECTORY`).
 pub const TRAJECTORY_HEADER: [&str; 24] = fixed_names(&TRAJECTORY, 0);
 
+/// The columns `trajectory.csv` adds last under `rear_exit = "continue"`: the swinging leg (docs/model.md
+/// section 5), 0 when no leg swings.
+pub(crate) const SWING_COLUMNS: [Column<Sample>; 2] = [
+    Column::new(
+        "L3",
+        "Length of the swinging leg (the old rear leg until its stopper locks it; rear_exit = continue), 0 when \
+         none swings [m].",
+        |s| Real(s.q[L3]),
+    ),
+    Column::new("L3dot", "dL3/dt [m/s] (0 when no leg swings).", |s| {
+        Real(s.qd[L3])
+    }),
+];
+
+/// The header of `trajectory.csv` of a walk under `rear_exit`: [`TRAJECTORY_HEADER`], and `L3`, `L3dot` last
+/// under [`RearExit::Continue`].
+pub fn trajectory_header(rear_exit: RearExit) -> Vec<&'static str> {
+    let mut header = TRAJECTORY_HEADER.to_vec();
+    if rear_exit == RearExit::Continue {
+        header.extend(SWING_COLUMNS.iter().map(|c| c.header_name(&[])));
+    }
+    header
+}
+
+/// One row of `trajectory.csv` under `rear_exit`, in the order of [`trajectory_header`].
+pub fn trajectory_row_under(s: &Sample, rear_exit: RearExit) -> Vec<Cell> {
+    let mut cells = trajectory_row(s);
+    if rear_exit == RearExit::Continue {
+        cells.extend(SWING_COLUMNS.iter().map(|c| (c.get)(s)));
+    }
+    cells
+}
+
 /// One row of `trajectory.csv`, in the order of [`TRAJECTORY_HEADER`]: time, the ten states (`x` from the
 /// start of the walk), the active contacts and stoppers as `0`/`1`, the multipliers (stopper reactions
 /// positive inward) and which physical leg is Leg 1.
@@ -109,12 +144,12 @@ pub fn trajectory_row(s: &Sample) -> Vec<Cell> {
 /// `trajectory.csv` written sample by sample: the [`SampleSink`] of a streaming
 /// [`Trajectory`](crate::walk::Trajectory). Rows are buffered and flushed when the walk flushes the trajectory
 /// (after every step).
-pub struct TrajectoryCsv(CsvStream);
+pub struct TrajectoryCsv(CsvStream, RearExit);
 
 impl TrajectoryCsv {
-    /// Create `path` with the header [`TRAJECTORY_HEADER`].
-    pub(crate) fn create(path: &Path) -> Result<TrajectoryCsv, OutputError> {
-        CsvStream::create(path, TRAJECTORY_HEADER).map(TrajectoryCsv)
+    /// Create `path` with the header [`trajectory_header`] of `rear_exit`.
+    pub(crate) fn create(path: &Path, rear_exit: RearExit) -> Result<TrajectoryCsv, OutputError> {
+        CsvStream::create(path, trajectory_header(rear_exit)).map(|w| TrajectoryCsv(w, rear_exit))
     }
 
     /// The file written.
@@ -126,7 +161,11 @@ impl TrajectoryCsv {
 impl SampleSink for TrajectoryCsv {
     fn write(&mut self, sample: &Sample) -> std::io::Result<()> {
         self.0
-            .row(trajectory_row(sample).iter().map(Cell::to_csv))
+            .row(
+                trajectory_row_under(sample, self.1)
+                    .iter()
+                    .map(Cell::to_csv),
+            )
             .map_err(std::io::Error::from)
     }
 
@@ -135,11 +174,15 @@ impl SampleSink for TrajectoryCsv {
     }
 }
 
-/// Write the sampled trajectory `trajectory.csv`: time, the ten states (`x` from the start of the walk), the
+/// Write the sampled trajectory `trajectory.csv` of a walk under `rear_exit` ([`trajectory_header`]): time, the ten states (`x` from the start of the walk), the
 /// active contacts and stoppers, the multipliers (stopper reactions positive inward) and which physical leg is
 /// Leg 1.
-pub fn write_trajectory_csv(path: &Path, samples: &[Sample]) -> Result<(), OutputError> {
-    let mut w = TrajectoryCsv::create(path)?;
+pub fn write_trajectory_csv(
+    path: &Path,
+    samples: &[Sample],
+    rear_exit: RearExit,
+) -> Result<(), OutputError> {
+    let mut w = TrajectoryCsv::create(path, rear_exit)?;
     samples
         .iter()
         .try_for_each(|s| w.write(s))
