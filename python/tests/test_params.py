@@ -63,7 +63,7 @@ def test_replace_and_round_trips():
         ({"impact": "elastic"}, "impact=elastic"),
         ({"inconsistent_contact": "bounce"}, "inconsistent_contact=bounce"),
         ({"integrator": "rk4"}, "integrator=rk4"),
-        ({"rear_exit": "continue"}, "rear_exit=continue"),
+        ({"rear_exit": "drop"}, "rear_exit=drop"),
         ({"rear_stopper": False}, "rear_stopper=false"),
         ({"spring_natural_length": 0.99}, "spring_natural_length=0.99"),
         ({"min_length": 1.0}, "min_length=1"),
