@@ -471,7 +471,12 @@ pub fn constrained_dynamics(
 ) -> Result<ConstrainedDynamics, ContactError> {
     let eom = model.equations_of_motion(q, qd);
     if active.contact1 && !active.slide1 {
-        return solve_with_fixed_leg_one(&eom, active);
+        // `(theta, L1, L2)`, and `L3` while a leg swings: a constant size, so that the small loops unroll.
+        return if eom.swing {
+            solve_with_fixed_leg_one::<{ NQ - 2 }>(&eom, active)
+        } else {
+            solve_with_fixed_leg_one::<{ NQ - 3 }>(&eom, active)
+        };
     }
     // The general case (Leg 1 sliding or off the ground): all the coordinates.
     let mut rows = ActiveRows::<NQ, NROWS>::default();
@@ -521,16 +526,13 @@ pub fn constrained_dynamics(
 /// `dJ/dt q' = 0`, so `x'' = z'' = 0` and the system reduces exactly to the three coordinates
 /// `(theta, L1, L2[, L3])` with the remaining active rows ((C2), stoppers); `lambda_1`, `lambda_2` then follow from
 /// the `x` and `z` equations. Same result as [`solve_saddle`] (tested), at a fraction of the cost.
-fn solve_with_fixed_leg_one(
+fn solve_with_fixed_leg_one<const R: usize>(
     eom: &EquationsOfMotion,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
-    const R: usize = NQ - 2;
     let (m, h) = (&eom.mass, &eom.bias);
-    // `(theta, L1, L2)`, and `L3` while a leg swings.
-    let n = if eom.swing { R } else { R - 1 };
-    let mut m_rr = Ldl::<R>::zeros(n);
-    for i in 0..n {
+    let mut m_rr = Ldl::<R>::zeros(R);
+    for i in 0..R {
         for j in 0..=i {
             m_rr.l[i][j] = m[(2 + i, 2 + j)];
         }

@@ -214,50 +214,45 @@ impl<T: Real> Mechanics<T> {
     }
 }
 
-/// Number of length columns a point Jacobian can have besides `x`, `z`: `theta`, `L1`, `L2`, `L3`.
-const COLUMNS: usize = 4;
-
-/// Sums over point masses `m_i` with Jacobian columns `b_i = [b_theta, b_L1, b_L2, b_L3]` (the `x`, `z` columns
-/// being the identity) and forces `f_i = m_i (dJ_i/dt q' + g_n)`, from which `M` and `h` are assembled. Only the
-/// first `cols` columns are summed: 3 when no leg swings (`b_L3 = 0` for every point), 4 when one does.
+/// Sums over point masses `m_i` with Jacobian columns `b_i = [b_theta, b_L1, b_L2(, b_L3)]` (the `x`, `z`
+/// columns being the identity) and forces `f_i = m_i (dJ_i/dt q' + g_n)`, from which `M` and `h` are assembled:
+/// `C = 3` columns when no leg swings, `C = 4` (with `L3`) when one does. A constant, so that the loops over the
+/// columns unroll (the right-hand side spends much of its time here).
 #[derive(Debug)]
-struct PointSums<T: Real> {
-    /// How many of the columns are summed.
-    cols: usize,
+struct PointSums<T: Real, const C: usize> {
     /// `sum m_i`.
     mass: T,
     /// `sum m_i b_ik`.
-    b: [Vector2<T>; COLUMNS],
+    b: [Vector2<T>; C],
     /// `sum m_i b_ik . b_il` for `k <= l`.
-    bb: [[T; COLUMNS]; COLUMNS],
+    bb: [[T; C]; C],
     /// `sum f_i`.
     f: Vector2<T>,
     /// `sum b_ik . f_i`.
-    bf: [T; COLUMNS],
+    bf: [T; C],
 }
 
-impl<T: Real> PointSums<T> {
-    fn zero(cols: usize) -> Self {
+impl<T: Real, const C: usize> PointSums<T, C> {
+    fn zero() -> Self {
         let (z, v) = (T::zero(), Vector2::zeros());
         PointSums {
-            cols,
             mass: z,
-            b: [v; COLUMNS],
-            bb: [[z; COLUMNS]; COLUMNS],
+            b: [v; C],
+            bb: [[z; C]; C],
             f: v,
-            bf: [z; COLUMNS],
+            bf: [z; C],
         }
     }
 
     /// Add a point of mass `m`, Jacobian columns `b` and acceleration `a = dJ/dt q' + g_n`.
-    fn add(&mut self, m: T, b: &[Vector2<T>; COLUMNS], a: Vector2<T>) {
+    fn add(&mut self, m: T, b: &[Vector2<T>; C], a: Vector2<T>) {
         let f = a * m;
         self.mass += m;
         self.f += f;
-        for k in 0..self.cols {
+        for k in 0..C {
             self.b[k] += b[k] * m;
             self.bf[k] += b[k].dot(&f);
-            for l in k..self.cols {
+            for l in k..C {
                 self.bb[k][l] += m * b[k].dot(&b[l]);
             }
         }
@@ -489,17 +484,29 @@ impl Model {
         q: &CoordsOf<T>,
         qd: &CoordsOf<T>,
     ) -> EquationsOfMotion<T> {
+        if swinging(q) {
+            self.assemble::<T, 4>(mech, q, qd)
+        } else {
+            self.assemble::<T, 3>(mech, q, qd)
+        }
+    }
+
+    /// [`Model::equations_of_motion_with`] with `C` length columns: 3 without a swinging leg, 4 with one.
+    fn assemble<T: Real, const C: usize>(
+        &self,
+        mech: &Mechanics<T>,
+        q: &CoordsOf<T>,
+        qd: &CoordsOf<T>,
+    ) -> EquationsOfMotion<T> {
+        let swing = C == 4;
         let p = mech;
         let two = lit::<T>(2.0);
         let (st, ct) = q[THETA].sin_cos();
         let (l1, dl1, l2, dl2, w) = (q[L1], qd[L1], q[L2], qd[L2], qd[THETA]);
         // Hub: b_theta = (L1 c, -L1 s), b_L1 = (s, c), b_L2 = 0; dJ/dt q' as in `hub`.
-        let hub_b = [
-            Vector2::new(l1 * ct, -l1 * st),
-            Vector2::new(st, ct),
-            Vector2::zeros(),
-            Vector2::zeros(),
-        ];
+        let mut hub_b = [Vector2::zeros(); C];
+        hub_b[0] = Vector2::new(l1 * ct, -l1 * st);
+        hub_b[1] = Vector2::new(st, ct);
         let hub_vp = Vector2::new(
             two * dl1 * ct * w - l1 * st * w * w,
             -two * dl1 * st * w - l1 * ct * w * w,
@@ -525,8 +532,7 @@ impl Model {
             }
         };
         let (leg_one, leg_two) = (leg(0, l1, dl1, 1), leg(1, l2, dl2, 2));
-        let swing = swinging(q);
-        let mut sums = PointSums::zero(if swing { COLUMNS } else { COLUMNS - 1 });
+        let mut sums = PointSums::<T, C>::zero();
         sums.add(p.hub_mass, &hub_b, hub_vp + p.up);
         for point in [leg_one, leg_two] {
             let (b, vp, _) = point(p.leg_mass_offset);
@@ -567,14 +573,14 @@ impl Model {
         mass[(Z, Z)] = sums.mass;
         bias[X] = sums.f.x;
         bias[Z] = sums.f.y;
-        for k in 0..sums.cols {
+        for k in 0..C {
             let c = THETA + k;
             mass[(X, c)] = sums.b[k].x;
             mass[(c, X)] = sums.b[k].x;
             mass[(Z, c)] = sums.b[k].y;
             mass[(c, Z)] = sums.b[k].y;
             bias[c] = sums.bf[k];
-            for l in k..sums.cols {
+            for l in k..C {
                 mass[(c, THETA + l)] = sums.bb[k][l];
                 mass[(THETA + l, c)] = sums.bb[k][l];
             }

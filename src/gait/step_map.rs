@@ -22,11 +22,11 @@ use std::sync::{Arc, Mutex};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, NQ, THETA};
+use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, THETA};
 use crate::params::ImpactModel;
 use crate::params::SolverOptions;
 use crate::variational::{
-    replay_step, seeded, sensitivity, Dual4, NotDifferentiable, Sensitivity, BORDER_TOL, NDIR,
+    replay_step, seeded, sensitivity, Dual4, NotDifferentiable, Sensitivity, BORDER_TOL, NC, NDIR,
     PARAM,
 };
 use crate::walk::section::section_coords;
@@ -277,7 +277,8 @@ impl<'m> StepMap<'m> {
         let next = self.check_hold(walker.section()?)?;
         let report = cycle[0];
         // Rows of the next section state (L2, dtheta/dt, dL2/dt) in (q, q').
-        let rows = [L2, NQ + THETA, NQ + L2];
+        // The sensitivity's rows of L2, dtheta/dt and dL2/dt.
+        let rows = [L2, NC + THETA, NC + L2];
         let free = self.free_coordinates();
         let jacobian = DMatrix::from_fn(free.len(), free.len(), |i, j| {
             sens[(rows[free[i]], free[j])]

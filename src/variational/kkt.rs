@@ -123,9 +123,21 @@ pub(crate) struct Kkt {
 enum Reduced {
     /// Over `(x, z, theta, L1, L2)`.
     General(Saddle<NQ>),
-    /// Over `(theta, L1, L2, L3)`, with `x`, `z` fixed by (C1) (`L3`'s row is the identity's when no leg
-    /// swings, as in `M`, and its solution 0).
-    Held(Saddle<{ NQ - 2 }>),
+    /// Over `(theta, L1, L2)`, with `x`, `z` fixed by (C1).
+    Held(Saddle<{ NQ - 3 }>),
+    /// Over `(theta, L1, L2, L3)`, with `x`, `z` fixed by (C1), while a leg swings.
+    HeldSwinging(Saddle<{ NQ - 2 }>),
+}
+
+/// The rows `stacked[..k]` of `rows` restricted to the `R` coordinates from `theta` on.
+fn reduced_rows<const R: usize>(
+    rows: &SMatrix<f64, NROWS, NQ>,
+    stacked: &[usize],
+) -> Vec<[f64; R]> {
+    stacked
+        .iter()
+        .map(|&i| std::array::from_fn(|l| rows[(i, 2 + l)]))
+        .collect()
 }
 
 impl Kkt {
@@ -143,12 +155,11 @@ impl Kkt {
             }
         }
         let m = &eom.mass;
-        let saddle = if held {
-            let r: Vec<[f64; NQ - 2]> = stacked[..k]
-                .iter()
-                .map(|&i| std::array::from_fn(|l| rows[(i, 2 + l)]))
-                .collect();
-            Reduced::Held(Saddle::new(|i, j| m[(2 + i, 2 + j)], &r)?)
+        let reduced = |i: usize, j: usize| m[(2 + i, 2 + j)];
+        let saddle = if held && eom.swing {
+            Reduced::HeldSwinging(Saddle::new(reduced, &reduced_rows(&rows, &stacked[..k]))?)
+        } else if held {
+            Reduced::Held(Saddle::new(reduced, &reduced_rows(&rows, &stacked[..k]))?)
         } else {
             let r: Vec<[f64; NQ]> = stacked[..k]
                 .iter()
@@ -191,46 +202,56 @@ impl Kkt {
                         lam[(self.stacked[i], c)] = l_c[i];
                     }
                 }
-                Reduced::Held(saddle) => {
-                    // (C1): x'' = b_x, z'' = b_z; the rest on (theta, L1, L2, L3).
-                    let xz = [b[(0, c)], b[(1, c)]];
-                    let f_r = std::array::from_fn(|l| {
-                        f[(2 + l, c)]
-                            - self.mass[(2 + l, 0)] * xz[0]
-                            - self.mass[(2 + l, 1)] * xz[1]
-                    });
-                    let b_c = std::array::from_fn(|i| {
-                        if i < saddle.k {
-                            let row = self.stacked[i];
-                            b[(row, c)] - self.rows[(row, 0)] * xz[0] - self.rows[(row, 1)] * xz[1]
-                        } else {
-                            0.0
-                        }
-                    });
-                    let (x_r, l_c) = saddle.solve(f_r, &b_c);
-                    x[(0, c)] = xz[0];
-                    x[(1, c)] = xz[1];
-                    for l in 0..NQ - 2 {
-                        x[(2 + l, c)] = x_r[l];
-                    }
-                    for i in 0..saddle.k {
-                        lam[(self.stacked[i], c)] = l_c[i];
-                    }
-                    // lambda_1, lambda_2 from the x and z equations: (M x - f - J_o^T lam_o)_{x,z}.
-                    for axis in 0..2 {
-                        let mut v = -f[(axis, c)];
-                        for j in 0..NQ {
-                            v += self.mass[(axis, j)] * x[(j, c)];
-                        }
-                        for (&row, l_i) in self.stacked.iter().zip(&l_c).take(saddle.k) {
-                            v -= self.rows[(row, axis)] * l_i;
-                        }
-                        lam[(axis, c)] = v;
-                    }
+                Reduced::Held(saddle) => self.solve_held(saddle, (f, b), c, (&mut x, &mut lam)),
+                Reduced::HeldSwinging(saddle) => {
+                    self.solve_held(saddle, (f, b), c, (&mut x, &mut lam))
                 }
             }
         }
         (x, lam)
+    }
+
+    /// Column `c` of [`Kkt::solve`] with (C1) held: `x'' = b_x`, `z'' = b_z`, the rest on the `R` coordinates
+    /// from `theta` on.
+    fn solve_held<const R: usize, const D: usize>(
+        &self,
+        saddle: &Saddle<R>,
+        (f, b): (&SMatrix<f64, NQ, D>, &SMatrix<f64, NROWS, D>),
+        c: usize,
+        (x, lam): (&mut SMatrix<f64, NQ, D>, &mut SMatrix<f64, NROWS, D>),
+    ) {
+        let xz = [b[(0, c)], b[(1, c)]];
+        let f_r = std::array::from_fn(|l| {
+            f[(2 + l, c)] - self.mass[(2 + l, 0)] * xz[0] - self.mass[(2 + l, 1)] * xz[1]
+        });
+        let b_c = std::array::from_fn(|i| {
+            if i < saddle.k {
+                let row = self.stacked[i];
+                b[(row, c)] - self.rows[(row, 0)] * xz[0] - self.rows[(row, 1)] * xz[1]
+            } else {
+                0.0
+            }
+        });
+        let (x_r, l_c) = saddle.solve(f_r, &b_c);
+        x[(0, c)] = xz[0];
+        x[(1, c)] = xz[1];
+        for l in 0..R {
+            x[(2 + l, c)] = x_r[l];
+        }
+        for i in 0..saddle.k {
+            lam[(self.stacked[i], c)] = l_c[i];
+        }
+        // lambda_1, lambda_2 from the x and z equations: (M x - f - J_o^T lam_o)_{x,z}.
+        for axis in 0..2 {
+            let mut v = -f[(axis, c)];
+            for j in 0..NQ {
+                v += self.mass[(axis, j)] * x[(j, c)];
+            }
+            for (&row, l_i) in self.stacked.iter().zip(&l_c).take(saddle.k) {
+                v -= self.rows[(row, axis)] * l_i;
+            }
+            lam[(axis, c)] = v;
+        }
     }
 }
 

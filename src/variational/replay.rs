@@ -1,13 +1,13 @@
 //! The variational equations of each phase and the saltation matrix of each event, replayed over a walked step
 //! ([`StepTape`]): docs/model.md section 10.
 //!
-//! **Phases.** The sensitivity `S = d(q, q')/d(s, p)` (10 rows, [`NDIR`] columns) obeys `S' = F_y S + F_p`, with
-//! `F` the phase's vector field `(q', q'')`, `q''` from the KKT system with the active set fixed. Both products
-//! come from one evaluation of the KKT residual on dual numbers whose derivative parts are the rows of `S` (and
-//! the parameter's unit direction), forward-mode automatic differentiation, and one solve with the KKT matrix
-//! (`kkt.rs`). The augmented state
-//! `[y, S]` is integrated with the very steps the walk accepted (`Integrator::fixed_step`, the same stages and
-//! dense output): internal numerical differentiation (Bock), so the state part reproduces the walk bit for bit
+//! **Phases.** The sensitivity `S = d(q, q')/d(s, p)` (10 rows: `q`, `q'` without the swinging leg's `L3`,
+//! which no step of the map has; [`NDIR`] columns) obeys `S' = F_y S + F_p`, with `F` the phase's vector field
+//! `(q', q'')`, `q''` from the KKT system with the active set fixed. Both products come from one evaluation of
+//! the KKT residual on dual numbers whose derivative parts are the rows of `S` (and the parameter's unit
+//! direction), forward-mode automatic differentiation, and one solve with the KKT matrix (`kkt.rs`). The
+//! augmented state `[y, S]` is integrated with the very steps the walk accepted (`Integrator::fixed_step`, the
+//! same stages and dense output): internal numerical differentiation (Bock), so the state part reproduces the walk bit for bit
 //! and its error control is the walk's, untouched; `S` is the exact derivative of that discretization.
 //!
 //! **Events.** An event with guard `g(y, p) = 0`, reset `R` and vector fields `f-`, `f+` before and after moves
@@ -38,8 +38,11 @@ use super::NotDifferentiable;
 
 /// Column of the parameter in a sensitivity.
 pub(crate) const PARAM: usize = 3;
-/// Rows of a sensitivity: `q` and `q'`.
-pub(crate) const NS: usize = 2 * NQ;
+/// The coordinates a sensitivity covers: all but the swinging leg's `L3` (a step of the step map has no
+/// swinging leg: [`replay_step`] refuses one), so that the replay costs what it did before `L3` existed.
+pub(crate) const NC: usize = NQ - 1;
+/// Rows of a sensitivity: `q` and `q'` without `L3`, `dL3/dt` (the velocities from row [`NC`]).
+pub(crate) const NS: usize = 2 * NC;
 /// `d(q, q')/d(L2, dtheta/dt, dL2/dt, p)`.
 pub(crate) type Sensitivity = SMatrix<f64, NS, NDIR>;
 
@@ -58,12 +61,22 @@ pub const GRAZING_RATE: f64 = 1e-7;
 /// step map has a corner there and no derivative.
 pub const COINCIDENT_EVENTS: f64 = 1e-9;
 
+/// The index in the walk's state `y` of coordinate `i` of `q` (`velocity = false`) or `q'`, and its row in a
+/// sensitivity (`None` for `L3`, `dL3/dt`, whose derivatives are 0).
+fn rows_of(i: usize, velocity: bool) -> (usize, Option<usize>) {
+    let row = (i < NC).then_some(if velocity { NC + i } else { i });
+    (if velocity { NQ + i } else { i }, row)
+}
+
 /// `(q, q')` as duals: real parts from `y`, derivative parts from the rows of `s`.
 fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual4>, CoordsOf<Dual4>) {
-    let at = |i: usize| dual(y[i], s.row(i).transpose());
+    let at = |i: usize, velocity: bool| {
+        let (k, row) = rows_of(i, velocity);
+        dual(y[k], row.map_or(SVector::zeros(), |r| s.row(r).transpose()))
+    };
     (
-        CoordsOf::from_fn(|i, _| at(i)),
-        CoordsOf::from_fn(|i, _| at(NQ + i)),
+        CoordsOf::from_fn(|i, _| at(i, false)),
+        CoordsOf::from_fn(|i, _| at(i, true)),
     )
 }
 
@@ -73,22 +86,25 @@ fn with_rate(
     s: &Sensitivity,
     f: &WalkVector,
 ) -> (CoordsOf<Dual5>, CoordsOf<Dual5>) {
-    let at = |i: usize| {
+    let at = |i: usize, velocity: bool| {
+        let (k, row) = rows_of(i, velocity);
         let mut e = SVector::<f64, { NDIR + 1 }>::zeros();
-        e.fixed_rows_mut::<NDIR>(0).copy_from(&s.row(i).transpose());
-        e[NDIR] = f[i];
-        dual(y[i], e)
+        if let Some(r) = row {
+            e.fixed_rows_mut::<NDIR>(0).copy_from(&s.row(r).transpose());
+        }
+        e[NDIR] = f[k];
+        dual(y[k], e)
     };
     (
-        CoordsOf::from_fn(|i, _| at(i)),
-        CoordsOf::from_fn(|i, _| at(NQ + i)),
+        CoordsOf::from_fn(|i, _| at(i, false)),
+        CoordsOf::from_fn(|i, _| at(i, true)),
     )
 }
 
 /// The sensitivity carried by duals `(q, q')`.
 pub(crate) fn sensitivity(q: &CoordsOf<Dual4>, qd: &CoordsOf<Dual4>) -> Sensitivity {
     Sensitivity::from_fn(|i, c| {
-        let x = if i < NQ { &q[i] } else { &qd[i - NQ] };
+        let x = if i < NC { &q[i] } else { &qd[i - NC] };
         eps(x)[c]
     })
 }
@@ -130,9 +146,10 @@ impl OdeSystem<NAUG> for Variational<'_> {
             return Augmented::repeat(f64::NAN);
         };
         let mut ds = Sensitivity::zeros();
-        ds.fixed_rows_mut::<NQ>(0)
-            .copy_from(&s.fixed_rows::<NQ>(NQ));
-        ds.fixed_rows_mut::<NQ>(NQ).copy_from(&dqdd);
+        ds.fixed_rows_mut::<NC>(0)
+            .copy_from(&s.fixed_rows::<NC>(NC));
+        ds.fixed_rows_mut::<NC>(NC)
+            .copy_from(&dqdd.fixed_rows::<NC>(0));
         Self::join(&fy, &ds)
     }
 }
@@ -160,7 +177,8 @@ fn apply_impacts(
             (&(sol.qd_plus - qd), &sol.impulses),
         )
         .ok_or(singular)?;
-        s.fixed_rows_mut::<NQ>(NQ).copy_from(&dqd_plus);
+        s.fixed_rows_mut::<NC>(NC)
+            .copy_from(&dqd_plus.fixed_rows::<NC>(0));
         qd = sol.qd_plus;
     }
     Ok((qd, s))
@@ -228,7 +246,10 @@ pub(crate) fn replay_step(
 
 /// `f dt^T` over the rows `(q, q')` of the state's rate `f`.
 fn rate_outer(f: &WalkVector, dt: &SVector<f64, NDIR>) -> Sensitivity {
-    Sensitivity::from_fn(|i, c| f[i] * dt[c])
+    Sensitivity::from_fn(|i, c| {
+        let k = if i < NC { i } else { NQ + i - NC };
+        f[k] * dt[c]
+    })
 }
 
 /// Integrate the variational equations over the recorded steps of `segment` from `(y0, s0)`: the state and
