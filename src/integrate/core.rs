@@ -223,6 +223,49 @@ mod tests {
         }
     }
 
+    /// The harmonic oscillator with two constant components inserted (at 1 and 3) that the error norm leaves
+    /// out ([`OdeSystem::unmeasured`]): it must take the oscillator's steps, bit for bit.
+    struct Padded(HarmonicOscillator);
+    impl OdeSystem<4> for Padded {
+        fn rhs(&self, t: f64, y: &SVector<f64, 4>) -> SVector<f64, 4> {
+            let f = self.0.rhs(t, &SVector::<f64, 2>::new(y[0], y[2]));
+            SVector::<f64, 4>::new(f[0], 0.0, f[1], 0.0)
+        }
+        fn unmeasured(&self) -> &[usize] {
+            &[1, 3]
+        }
+    }
+
+    #[test]
+    fn unmeasured_components_leave_the_steps_unchanged() {
+        for method in METHODS {
+            let sys = HarmonicOscillator {
+                omega: 3.0,
+                amplitude: 0.7,
+                phase: 0.3,
+            };
+            let y0 = sys.exact(0.0);
+            let padded = Padded(sys);
+            let tol = tight();
+            let mut plain = Integrator::new(method, &sys, 0.0, y0, tol);
+            let start = SVector::<f64, 4>::new(y0[0], 5.0, y0[1], -2.0);
+            let mut with = Integrator::new(method, &padded, 0.0, start, tol);
+            for _ in 0..50 {
+                let (a, b) = (
+                    plain.step(&sys, 10.0).unwrap(),
+                    with.step(&padded, 10.0).unwrap(),
+                );
+                assert_eq!(a.t1().to_bits(), b.t1().to_bits());
+                let (ya, yb) = (plain.y(), with.y());
+                assert_eq!(
+                    (ya[0].to_bits(), ya[1].to_bits()),
+                    (yb[0].to_bits(), yb[2].to_bits())
+                );
+                assert_eq!((yb[1], yb[3]), (5.0, -2.0));
+            }
+        }
+    }
+
     /// y' = y², y(0) = 1: y = 1/(1 - t) blows up at t = 1.
     struct Riccati;
     impl OdeSystem<1> for Riccati {

@@ -139,7 +139,8 @@ fn stop_flag<'de, D: Deserializer<'de>>(d: D) -> Result<u8, D::Error> {
     }
 }
 
-/// One row of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
+/// One row of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame; and `L3`
+/// under `rear_exit = "continue"`).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub struct TrajectoryRow {
     /// Time \[s\].

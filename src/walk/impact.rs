@@ -699,7 +699,8 @@ pub(crate) struct SwingLock {
     pub(crate) active: ActiveSet,
     /// Energy `T + V` lost \[J\]: the impact's, and the rounding of setting the leg to its stopper length.
     pub(crate) loss: f64,
-    /// The largest pulling impulse of the units that took an impulse \[N s\] (contact audit).
+    /// The largest pulling impulse of the units that took an impulse, the swinging leg's stopper included \[N s\]
+    /// (contact audit).
     pub(crate) pull_impulse: f64,
 }
 
@@ -724,7 +725,9 @@ pub(crate) fn lock_swinging_leg(
     let (impulse_set, sol) = plastic_impact_by(model, (q, qd), forced, &candidates, |set| {
         swing_lock_impulse(model, q, qd, set).map(|(sol, _)| sol)
     })?;
-    let pull_impulse = pull_of(model, &impulse_set, &sol);
+    // The stopper's own impulse may only push the leg inward (`mu <= 0`): one that pulls goes to the audit.
+    let (_, mu) = swing_lock_impulse(model, q, qd, &impulse_set)?;
+    let pull_impulse = pull_of(model, &impulse_set, &sol).max(mu);
     let mut q_spoke = *q;
     let mut qd_plus = sol.qd_plus;
     (q_spoke[L3], qd_plus[L3]) = (0.0, 0.0);

@@ -6,10 +6,10 @@ use crate::dynamics::{swinging, Coords, Model, L1, L3, THETA};
 use crate::params::RearExit;
 
 use super::error::WalkError;
+use super::impact::has_stopper;
 
 /// The index of the swinging leg (`L3`, [`RearExit::Continue`]): the old Leg 2, one leg behind the new Leg 2.
 pub(crate) const SWING_LEG: usize = 2;
-use super::impact::has_stopper;
 
 /// Re-indexing at touchdown (paper Sec. 2.2, docs/model.md section 5): the touching leg `touching` (the front
 /// leg `j = -1` in a walk, see [`touchdown_leg`]) becomes Leg 1, the leg behind it becomes Leg 2, and the legs
@@ -17,8 +17,7 @@ use super::impact::has_stopper;
 /// `L0` ([`RearExit::Relock`]), or swing on as `L3` ([`RearExit::Continue`], the old Leg 2 after a step, which
 /// must have been locked by now if it swung since the last touchdown), or reset to the spokes' length,
 /// `touchdown_length` or `L0` ([`RearExit::Reset`]: their length and rate are discarded). The new Leg 1 has the
-/// touchdown length. The
-/// origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact, energy removed by
+/// touchdown length. The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact, energy removed by
 /// the reset)`: `T + V` before minus after the reset \[J\], 0 when no leg was reset.
 pub(super) fn reindex(
     model: &Model,

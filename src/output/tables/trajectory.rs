@@ -26,7 +26,8 @@ fn stop_state(active: &ActiveSet, leg: Leg) -> Cell {
     })
 }
 
-/// The columns of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame).
+/// The columns of `trajectory.csv` (docs/model.md section 1: `q = [x, z, theta, L1, L2]`, slope frame; the
+/// swinging leg's `L3` under `rear_exit = "continue"` is in `SWING_COLUMNS`).
 pub(crate) const TRAJECTORY: [Column<Sample>; 24] = [
     Column::new("time", "Time [s].", |s| Real(s.time)),
     Column::new(
