@@ -17,7 +17,7 @@
 use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
-use crate::dynamics::{swinging, Coords, EquationsOfMotion, Model, L1, L2, L3, NQ, X, Z};
+use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, L3, NQ, X, Z};
 
 /// Number of constraint rows in the fixed stacking order.
 pub(crate) const NROWS: usize = 6;
@@ -503,7 +503,7 @@ pub fn constrained_dynamics(
         }
     }
     // Without a swinging leg `L3` is left out (its row of M is the identity's, with no force).
-    let n = if swinging(q) { NQ } else { NQ - 1 };
+    let n = if eom.swing { NQ } else { NQ - 1 };
     let mut m = Ldl::<NQ>::zeros(n);
     for i in 0..n {
         for j in 0..=i {

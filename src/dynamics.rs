@@ -3,8 +3,9 @@
 //! The wheel is described by `q = [x, z, theta, L1, L2, L3]` in the slope frame (`x` down the slope, `z` normal
 //! to it). `(x, z)` is the tip of Leg 1, `theta` the angle of Leg 1 from the slope normal, `L1`, `L2` the lengths
 //! of Leg 1 and Leg 2, and `L3` the length of the swinging leg (the old Leg 2 after it left Legs 1 and 2 unlocked,
-//! under `rear_exit = "continue"`; 0 when no leg swings, see [`L3`]). Every body is a point mass (the hub, and one sliding mass per leg at distance `a` from the
-//! tip) plus the hub's rotational inertia, so the equations are assembled from point kinematics:
+//! under `rear_exit = "continue"`; 0 when no leg swings, see [`L3`]). Every body is a point mass (the hub, and
+//! one sliding mass per leg at distance `a` from the tip) plus the hub's rotational inertia, so the equations
+//! are assembled from point kinematics:
 //!
 //! ```text
 //! M(q)    = sum_i m_i J_i^T J_i + IH e_theta e_theta^T

@@ -131,6 +131,15 @@ impl GaitError {
             GaitError::InvalidOptions { .. } => "invalid_options",
         }
     }
+
+    /// Did the walk reach a touchdown that is not on the Poincare section ([`WalkError::leaves_section`])?
+    pub(crate) fn leaves_section(&self) -> bool {
+        matches!(
+            self,
+            GaitError::Transient { source, .. } | GaitError::Newton { source, .. }
+                if source.leaves_section()
+        )
+    }
 }
 
 /// A walking gait (limit cycle) and what it does. A period-k gait ([`super::period_k`]) is a fixed point of

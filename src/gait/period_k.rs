@@ -167,13 +167,13 @@ pub fn find_gait_any_period(
     max_period: usize,
 ) -> Result<Gait, GaitError> {
     match find_gait(map, initial, options, None) {
-        // A transient that ends off the section (the walk's cycle has touchdowns where the stance tip slides)
-        // is not a failure of the walk: look for a longer period.
+        // A transient that ends off the section (the walk's cycle has touchdowns where the stance tip slides, or
+        // where the old rear leg still swings) is not a failure of the walk: look for a longer period.
         Err(e)
             if (!matches!(
                 e,
                 GaitError::Transient { .. } | GaitError::InvalidOptions { .. }
-            ) || matches!(e.kind(), "off_section" | "leg_swings_at_section"))
+            ) || e.leaves_section())
                 && max_period > 1 =>
         {
             find_periodic_gait(map, initial, options, max_period)

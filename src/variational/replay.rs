@@ -7,8 +7,9 @@
 //! the KKT residual on dual numbers whose derivative parts are the rows of `S` (and the parameter's unit
 //! direction), forward-mode automatic differentiation, and one solve with the KKT matrix (`kkt.rs`). The
 //! augmented state `[y, S]` is integrated with the very steps the walk accepted (`Integrator::fixed_step`, the
-//! same stages and dense output): internal numerical differentiation (Bock), so the state part reproduces the walk bit for bit
-//! and its error control is the walk's, untouched; `S` is the exact derivative of that discretization.
+//! same stages and dense output): internal numerical differentiation (Bock), so the state part reproduces the
+//! walk bit for bit and its error control is the walk's, untouched; `S` is the exact derivative of that
+//! discretization.
 //!
 //! **Events.** An event with guard `g(y, p) = 0`, reset `R` and vector fields `f-`, `f+` before and after moves
 //! the time of the event by `dt = -(g_y S + g_p) / (g_y f-)`; the sensitivity after it is

@@ -17,8 +17,8 @@ pub(crate) const SWING_LEG: usize = 2;
 /// `L0` ([`RearExit::Relock`]), or swing on as `L3` ([`RearExit::Continue`], the old Leg 2 after a step, which
 /// must have been locked by now if it swung since the last touchdown), or reset to the spokes' length,
 /// `touchdown_length` or `L0` ([`RearExit::Reset`]: their length and rate are discarded). The new Leg 1 has the
-/// touchdown length. The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact, energy removed by
-/// the reset)`: `T + V` before minus after the reset \[J\], 0 when no leg was reset.
+/// touchdown length. The origin moves to the new tip. Returns `(q_dagger, q'_dagger, active set before impact,
+/// energy removed by the reset)`: `T + V` before minus after the reset \[J\], 0 when no leg was reset.
 pub(super) fn reindex(
     model: &Model,
     time: f64,

@@ -175,9 +175,9 @@ impl SampleSink for TrajectoryCsv {
     }
 }
 
-/// Write the sampled trajectory `trajectory.csv` of a walk under `rear_exit` ([`trajectory_header`]): time, the ten states (`x` from the start of the walk), the
-/// active contacts and stoppers, the multipliers (stopper reactions positive inward) and which physical leg is
-/// Leg 1.
+/// Write the sampled trajectory `trajectory.csv` of a walk under `rear_exit` ([`trajectory_header`]): time, the
+/// ten states (`x` from the start of the walk), the active contacts and stoppers, the multipliers (stopper
+/// reactions positive inward) and which physical leg is Leg 1.
 pub fn write_trajectory_csv(
     path: &Path,
     samples: &[Sample],
