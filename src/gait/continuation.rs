@@ -22,7 +22,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::derivative::newton_jacobian;
-use super::limit_cycle::{solve_fixed_point, FixedPoint, GaitOptions};
+use super::limit_cycle::{solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitOptions};
 pub(crate) use super::periodicity::SAME_GAIT_TOL;
 use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
 use super::step_map::StepMap;
@@ -139,6 +139,15 @@ pub enum Followed {
     },
 }
 
+/// Why a continuation step failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StepFailure {
+    /// The walk from the start fails at the new value: no Newton matrix would help.
+    Start,
+    /// Newton's method failed (there or back), or came back to another gait.
+    Newton,
+}
+
 /// What happens just past the end of a family.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -220,16 +229,17 @@ impl<'a> Continuation<'a> {
         carried_start(self.config, self.param, from, value)
     }
 
-    /// The fixed point at `value` by Newton's method from `start` (no transient).
+    /// The fixed point at `value` by Newton's method from `start` (no transient), the Newton matrix's guess
+    /// asked of `guess` once the map is evaluated at the start ([`solve_fixed_point_asking`]).
     pub(crate) fn solve(
         &self,
         value: f64,
         start: &SectionState,
-        guess: Option<&DMatrix<f64>>,
+        guess: &mut dyn FnMut() -> Option<DMatrix<f64>>,
     ) -> Result<FixedPoint, String> {
         let (c, model) = self.configured_at(value)?;
         let map = StepMap::new(&model, &c.solver).iterated(self.period);
-        solve_fixed_point(&map, start, &self.options, guess).map_err(|e| e.to_string())
+        solve_fixed_point_asking(&map, start, &self.options, guess).map_err(|e| e.to_string())
     }
 
     /// One verified continuation step from `from` to `value` by Newton's method, there and back (see the module
@@ -240,20 +250,46 @@ impl<'a> Continuation<'a> {
         value: f64,
         guess: Option<&DMatrix<f64>>,
     ) -> Option<FamilyPoint> {
-        let forward = self
-            .solve(value, &self.start_from(from, value), guess)
-            .ok()?;
+        self.step_asking(from, value, guess).ok()
+    }
+
+    /// [`Continuation::step`], failing with [`StepFailure::Start`] where the walk from `from`'s gait at `value`
+    /// fails (whatever the Newton matrix), else with [`StepFailure::Newton`].
+    fn step_asking(
+        &self,
+        from: &FamilyPoint,
+        value: f64,
+        guess: Option<&DMatrix<f64>>,
+    ) -> Result<FamilyPoint, StepFailure> {
+        // Newton's method asks for its matrix once the map is evaluated at the start.
+        let mut started = false;
+        let forward = self.solve(value, &self.start_from(from, value), &mut || {
+            started = true;
+            guess.cloned()
+        });
+        let forward = forward.map_err(|_| {
+            if started {
+                StepFailure::Newton
+            } else {
+                StepFailure::Start
+            }
+        })?;
         let reached = FamilyPoint {
             value,
             section: forward.section,
         };
         let back = self
-            .solve(from.value, &self.start_from(&reached, from.value), guess)
-            .ok()?;
-        (back.section.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
-            value,
-            section: forward.section,
-        })
+            .solve(
+                from.value,
+                &self.start_from(&reached, from.value),
+                &mut || guess.cloned(),
+            )
+            .map_err(|_| StepFailure::Newton)?;
+        if back.section.distance(&from.section) <= SAME_GAIT_TOL {
+            Ok(reached)
+        } else {
+            Err(StepFailure::Newton)
+        }
     }
 
     /// The same step by walking, where Newton's method fails (the step map is only piecewise smooth): the wheel
@@ -301,8 +337,9 @@ impl<'a> Continuation<'a> {
     }
 
     /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's
-    /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step that fails is retried once
-    /// with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere), then halved; a
+    /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step whose Newton's method fails
+    /// is retried once with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere;
+    /// not a step whose walk fails at its start, where no matrix helps), then halved; a
     /// step that works lets the next one double, or halve right after a failure (bisecting toward the end). At
     /// most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
     /// ([`Followed::GaveUp`]).
@@ -340,13 +377,23 @@ impl<'a> Continuation<'a> {
             } else {
                 current.value + h
             };
-            let mut next = self.step(&current, next_value, jac.as_ref().map(|(_, j)| j));
-            if next.is_none() && jac.as_ref().is_none_or(|(v, _)| *v != current.value) {
-                if let Some(j) = self.jacobian(&current) {
-                    jac = Some((current.value, j));
-                    next = self.step(&current, next_value, jac.as_ref().map(|(_, j)| j));
-                }
-            }
+            let mut next =
+                match self.step_asking(&current, next_value, jac.as_ref().map(|(_, j)| j)) {
+                    Ok(p) => Some(p),
+                    // A step that fails in Newton's method with a matrix computed elsewhere is retried with DP at
+                    // `current`; not one whose walk fails at the start, where no matrix would help (near an end
+                    // where the wheel rolls back, most steps of the bisection).
+                    Err(StepFailure::Newton)
+                        if jac.as_ref().is_none_or(|(v, _)| *v != current.value) =>
+                    {
+                        self.jacobian(&current).and_then(|j| {
+                            let next = self.step(&current, next_value, Some(&j));
+                            jac = Some((current.value, j));
+                            next
+                        })
+                    }
+                    Err(_) => None,
+                };
             let at_end = (next_value - current.value).abs() <= PARAM_TOL;
             // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and at
             // every WALK_AFTER_FAILURES-th one after that; once a walk works, through every halving of a walking

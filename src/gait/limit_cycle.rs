@@ -320,6 +320,18 @@ pub(crate) fn solve_fixed_point(
     options: &GaitOptions,
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<FixedPoint, GaitError> {
+    solve_fixed_point_asking(map, initial, options, &mut || jacobian_guess.cloned())
+}
+
+/// [`solve_fixed_point`] with the guess of `DP` asked of `jacobian_guess` once the map is evaluated at the
+/// start (not if that evaluation fails, where no matrix could help: a continuation step tells the two
+/// failures apart by it).
+pub(crate) fn solve_fixed_point_asking(
+    map: &StepMap,
+    initial: &SectionState,
+    options: &GaitOptions,
+    jacobian_guess: &mut dyn FnMut() -> Option<DMatrix<f64>>,
+) -> Result<FixedPoint, GaitError> {
     options.validate().map_err(|e| GaitError::InvalidOptions {
         message: e.to_string(),
     })?;
@@ -352,8 +364,6 @@ pub(crate) fn solve_fixed_point(
     }
     let map = &map.on_section_of(&s);
     let n = map.free_coordinates().len();
-    // A guess for the other coordinates (a neighbour held where this one is not) is no guess.
-    let jacobian_guess = jacobian_guess.filter(|j| j.nrows() == n);
     let eval =
         |s: &SectionState, iteration: usize| -> Result<(StepOutcome, DVector<f64>), GaitError> {
             let out = map
@@ -362,8 +372,6 @@ pub(crate) fn solve_fixed_point(
             let r = map.reduce(&out.next) - map.reduce(s);
             Ok((out, r))
         };
-    let mut newton_matrix: Option<DMatrix<f64>> =
-        jacobian_guess.map(|j| j - DMatrix::identity(n, n));
     let (mut outcome, mut r) = match first_step {
         // The same map (`s` is not held) at the same point.
         Some(out) => {
@@ -372,6 +380,10 @@ pub(crate) fn solve_fixed_point(
         }
         None => eval(&s, 1)?,
     };
+    // A guess for the other coordinates (a neighbour held where this one is not) is no guess.
+    let mut newton_matrix: Option<DMatrix<f64>> = jacobian_guess()
+        .filter(|j| j.nrows() == n)
+        .map(|j| j - DMatrix::identity(n, n));
     let mut iterations = 0;
     // Was the current Newton matrix computed at the current iterate (so recomputing it cannot help)?
     let mut fresh = false;
