@@ -122,7 +122,8 @@ pub struct FamilyPoint {
 pub enum Followed {
     /// The family reaches the target value.
     Reached(FamilyPoint),
-    /// The family ends between `last.value` and `beyond` (`|beyond - last.value| <= PARAM_TOL`).
+    /// The family ends between `last.value` and `beyond` (`|beyond - last.value| <= PARAM_TOL`, or the
+    /// tolerance given to [`Continuation::follow_to`]).
     Ended {
         /// The last point of the family.
         last: FamilyPoint,
@@ -349,6 +350,18 @@ impl<'a> Continuation<'a> {
         target: f64,
         guess: Option<&DMatrix<f64>>,
     ) -> Followed {
+        self.follow_to(from, target, guess, PARAM_TOL)
+    }
+
+    /// [`Continuation::follow`] with the family's end bracketed to `end_tol` instead of [`PARAM_TOL`] (the
+    /// coarse pass of a split row needs it only to a grid interval).
+    pub(crate) fn follow_to(
+        &self,
+        from: FamilyPoint,
+        target: f64,
+        guess: Option<&DMatrix<f64>>,
+        end_tol: f64,
+    ) -> Followed {
         let mut current = from;
         let mut steps = 0;
         // The Newton matrix and the parameter value where it was computed.
@@ -394,7 +407,7 @@ impl<'a> Continuation<'a> {
                     }
                     Err(_) => None,
                 };
-            let at_end = (next_value - current.value).abs() <= PARAM_TOL;
+            let at_end = (next_value - current.value).abs() <= end_tol;
             // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and at
             // every WALK_AFTER_FAILURES-th one after that; once a walk works, through every halving of a walking
             // step that fails, until Newton's method works again), a step is also tried by walking, before an

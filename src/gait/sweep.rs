@@ -18,7 +18,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::continuation::{Continuation, FamilyPoint, Followed};
+use super::continuation::{Continuation, FamilyPoint, Followed, PARAM_TOL};
 use super::grid::{run_rows_part, Evaluated};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::period_k::{find_gait_any_period, periodic_gait_at};
@@ -180,15 +180,28 @@ impl SweepPoint {
     }
 }
 
-/// The gait at `value`, followed from `previous` (a neighbouring gait at another value, with its index) in
-/// verified continuation steps if given; if the family does not reach `value`, searched from `initial` with the
-/// full transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
+/// The gait a point of a row continues from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Previous<'a> {
+    /// Its index in the row.
+    pub index: usize,
+    /// Its parameter value.
+    pub value: f64,
+    /// The gait.
+    pub gait: &'a Gait,
+    /// How closely a family end met on the way is bracketed ([`Continuation::follow_to`]).
+    pub end_tol: f64,
+}
+
+/// The gait at `value`, followed from `previous` (a neighbouring gait at another value) in verified
+/// continuation steps if given; if the family does not reach `value`, searched from `initial` with the full
+/// transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
 pub(crate) fn gait_at_value(
     config: &Config,
     param: &str,
     value: f64,
     initial: &SectionState,
-    previous: Option<(usize, f64, &Gait)>,
+    previous: Option<Previous>,
     options: &GaitOptions,
 ) -> SweepPoint {
     let configured = config
@@ -211,9 +224,9 @@ pub(crate) fn gait_at_value(
     let solver: &SolverOptions = &c.solver;
     let map = StepMap::new(&model, solver);
     let mut attempts = Vec::new();
-    let continued = previous.and_then(|(index, from, g)| {
-        match follow_gait(config, param, from, g, value, options) {
-            Ok(g) => Some((index, g)),
+    let continued = previous.and_then(|p| {
+        match follow_gait(config, param, p.value, p.gait, value, options, p.end_tol) {
+            Ok(g) => Some((p.index, g)),
             Err(attempt) => {
                 attempts.extend(attempt);
                 None
@@ -260,6 +273,7 @@ fn follow_gait(
     g: &Gait,
     value: f64,
     options: &GaitOptions,
+    end_tol: f64,
 ) -> Result<Gait, Option<FollowAttempt>> {
     let guess = g.jacobian_guess();
     let start = FamilyPoint {
@@ -267,7 +281,7 @@ fn follow_gait(
         section: g.section,
     };
     let cont = Continuation::new(config, param, options).with_period(g.period_k);
-    let p = match cont.follow(start, value, guess.as_ref()) {
+    let p = match cont.follow_to(start, value, guess.as_ref(), end_tol) {
         Followed::Reached(p) => p,
         followed => {
             return Err(Some(FollowAttempt {
@@ -315,7 +329,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
         if a.status == "invalid_parameter" {
             continue;
         }
-        match follow_gait(config, param, b.value, gb, a.value, options) {
+        match follow_gait(config, param, b.value, gb, a.value, options, PARAM_TOL) {
             Ok(g) => {
                 a.status = g.stability.to_string();
                 a.message = None;
@@ -438,7 +452,22 @@ pub(crate) fn gait_rows_part(
                     carry: None,
                 };
             };
-            let previous = from.map(|(j, g)| (j, row.values[j], g));
+            // A coarse point continues the previous coarse point over several grid intervals: where that
+            // family ends, its end is needed only to a grid interval (the fill between the two brackets it to
+            // `PARAM_TOL` from the neighbouring point, which is what thresholds use).
+            let previous = from.map(|(j, g)| {
+                let end_tol = if cell.col - j > 1 {
+                    (value - row.values[j]).abs() / (cell.col - j) as f64
+                } else {
+                    PARAM_TOL
+                };
+                Previous {
+                    index: j,
+                    value: row.values[j],
+                    gait: g,
+                    end_tol,
+                }
+            });
             let point = gait_at_value(&row.config, &row.param, value, initial, previous, options);
             progress(&point);
             Evaluated {
