@@ -187,8 +187,8 @@ fn gait_after_transient(c: &mut Criterion) {
 }
 
 /// One gait's `DP` by each route, in the units of the goal (step-map evaluations): `eval` is one step of
-/// the map, `exact` the step with its exact `DP` and `dP/dp`, `central` and `richardson` the finite differences
-/// (6 and 12 evaluations).
+/// the map, `exact_dp` the step with its exact `DP` (three directions, what Newton's method and the multipliers
+/// take), `exact` the step with `DP` and `dP/dp` (four), `central` the central differences (6 evaluations).
 fn jacobian_routes(c: &mut Criterion) {
     let config = Config::default();
     let model = Model::new(&config.params).expect("the paper's parameters are valid");
@@ -205,6 +205,9 @@ fn jacobian_routes(c: &mut Criterion) {
     group.sample_size(20);
     group.measurement_time(Duration::from_secs(4));
     group.bench_function("eval", |b| b.iter(|| black_box(map.eval(black_box(&s)))));
+    group.bench_function("exact_dp", |b| {
+        b.iter(|| black_box(map.eval_with_derivatives(black_box(&s), None)))
+    });
     group.bench_function("exact", |b| {
         b.iter(|| black_box(map.eval_with_derivatives(black_box(&s), Some("viscosity"))))
     });

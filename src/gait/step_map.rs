@@ -26,8 +26,8 @@ use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, THETA};
 use crate::params::ImpactModel;
 use crate::params::SolverOptions;
 use crate::variational::{
-    replay_step, seeded, sensitivity, Dual4, NotDifferentiable, Sensitivity, BORDER_TOL, NC, NDIR,
-    PARAM,
+    augmented, replay_step, seeded, sensitivity, Dual, NotDifferentiable, Sensitivity, BORDER_TOL,
+    NC, PARAM,
 };
 use crate::walk::section::section_coords;
 use crate::walk::tape::StepTape;
@@ -239,22 +239,36 @@ impl<'m> StepMap<'m> {
                 key: key.to_string(),
             });
         }
+        // Three directions (the section state's) without a parameter, four with one.
+        match param {
+            Some(_) => self.derivatives::<4, 5, { augmented(4) }>(s, param),
+            None => self.derivatives::<3, 4, { augmented(3) }>(s, None),
+        }
+    }
+
+    /// [`StepMap::eval_with_derivatives`] along `D` directions (`E = D + 1`, `A =` [`augmented`]`(D)`, see
+    /// [`replay_step`]).
+    fn derivatives<const D: usize, const E: usize, const A: usize>(
+        &self,
+        s: &SectionState,
+        param: Option<&str>,
+    ) -> Result<StepDerivatives, DerivativeError> {
         let model = self.model;
         let mut walker = self.walker(s)?;
         // The section's own constraint, differentiated: (q, q') as functions of (s, p).
-        let mech = seeded::<NDIR>(model, param, PARAM);
+        let mech = seeded::<D>(model, param, PARAM);
         let unit = |i: usize, value: f64| {
-            let mut e = nalgebra::SVector::<f64, NDIR>::zeros();
+            let mut e = nalgebra::SVector::<f64, D>::zeros();
             e[i] = 1.0;
             crate::variational::dual_of(value, e)
         };
         let s = s.pinned(model);
-        let (q, qd) = section_coords::<Dual4>(
+        let (q, qd) = section_coords::<Dual<D>>(
             model,
             &mech,
             (unit(0, s.l2), unit(1, s.theta_dot), unit(2, s.l2_dot)),
         );
-        let mut sens: Sensitivity = sensitivity(&q, &qd);
+        let mut sens: Sensitivity<D> = sensitivity(&q, &qd);
         let mut cycle = Vec::with_capacity(self.iterate);
         let mut words = Vec::with_capacity(self.iterate);
         for _ in 0..self.iterate {
@@ -264,7 +278,7 @@ impl<'m> StepMap<'m> {
             words.push(tape.signature(step.branch));
             on_border(model, &step)?;
             cycle.push(step);
-            sens = replay_step(
+            sens = replay_step::<D, E, A>(
                 model,
                 &self.opts,
                 param,
@@ -283,8 +297,9 @@ impl<'m> StepMap<'m> {
         let jacobian = DMatrix::from_fn(free.len(), free.len(), |i, j| {
             sens[(rows[free[i]], free[j])]
         });
-        let dparam =
-            param.map(|_| DVector::from_fn(free.len(), |i, _| sens[(rows[free[i]], PARAM)]));
+        let dparam = param
+            .filter(|_| D > PARAM)
+            .map(|_| DVector::from_fn(free.len(), |i, _| sens[(rows[free[i]], PARAM)]));
         Ok(StepDerivatives {
             outcome: StepOutcome { next, report },
             jacobian,

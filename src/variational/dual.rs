@@ -14,9 +14,6 @@ use num_traits::{One, Zero};
 
 use crate::dynamics::{Mechanics, Model, Real};
 
-/// Directions of the derivatives: the three section coordinates `(L2, dtheta/dt, dL2/dt)` and one parameter.
-pub(crate) const NDIR: usize = 4;
-
 /// `re + sum_i eps_i e_i` with `e_i e_j = 0`: a number and its derivatives along `N` directions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Dual<const N: usize> {
@@ -25,11 +22,6 @@ pub(crate) struct Dual<const N: usize> {
     /// Its derivatives.
     pub(crate) eps: [f64; N],
 }
-
-/// A number with its derivatives along the [`NDIR`] directions.
-pub(crate) type Dual4 = Dual<NDIR>;
-/// A number with its derivatives along the [`NDIR`] directions and along the flow (the event's rate).
-pub(crate) type Dual5 = Dual<{ NDIR + 1 }>;
 
 impl<const N: usize> Dual<N> {
     /// `re` with the derivatives `eps`.

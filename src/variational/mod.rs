@@ -19,8 +19,8 @@ mod dual;
 mod kkt;
 mod replay;
 
-pub(crate) use dual::{dual as dual_of, seeded, Dual4, NDIR};
-pub(crate) use replay::{replay_step, sensitivity, Sensitivity, NC, PARAM};
+pub(crate) use dual::{dual as dual_of, seeded, Dual};
+pub(crate) use replay::{augmented, replay_step, sensitivity, Sensitivity, NC, PARAM};
 pub use replay::{COINCIDENT_EVENTS, GRAZING_RATE};
 
 /// A DLS indicator closer to zero than this (\[N s\] for `lambda_I4`, \[N\] for `lambda_2+`, `lambda_4+`) puts

@@ -2,7 +2,8 @@
 //! ([`StepTape`]): docs/model.md section 10.
 //!
 //! **Phases.** The sensitivity `S = d(q, q')/d(s, p)` (10 rows: `q`, `q'` without the swinging leg's `L3`,
-//! which no step of the map has; [`NDIR`] columns) obeys `S' = F_y S + F_p`, with `F` the phase's vector field
+//! which no step of the map has; `D` columns: the three section coordinates, and the parameter's if one is
+//! asked for) obeys `S' = F_y S + F_p`, with `F` the phase's vector field
 //! `(q', q'')`, `q''` from the KKT system with the active set fixed. Both products come from one evaluation of
 //! the KKT residual on dual numbers whose derivative parts are the rows of `S` (and the parameter's unit
 //! direction), forward-mode automatic differentiation, and one solve with the KKT matrix (`kkt.rs`). The
@@ -15,7 +16,7 @@
 //! the time of the event by `dt = -(g_y S + g_p) / (g_y f-)`; the sensitivity after it is
 //! `S+ = R_y (S- + f- dt) + R_p - f+ dt`, which for `p = 0` is the saltation matrix
 //! `S+ = [R_y + (f+ - R_y f-) g_y^T / (g_y f-)] S-`. `g_y S` and `g_y f-` come from one evaluation of `g` on
-//! duals carrying `S` and `f-` (`Dual<NDIR + 1>`): so the force guards (a normal force, a stopper reaction
+//! duals carrying `S` and `f-` (`Dual<D + 1>`): so the force guards (a normal force, a stopper reaction
 //! or a compression stop's reaching zero, from the KKT solution) are differentiated through the KKT solve
 //! like the rest. `R` is the identity for a change of active set (lift-off, unlock, slide) and the collision
 //! equation (5) with the recorded units for an impact (touchdown, landing, stopper or compression-stop hit,
@@ -33,7 +34,7 @@ use crate::walk::impact::touchdown_leg;
 use crate::walk::tape::{Segment, StepTape};
 use crate::walk::{unpack, EventKind, PhaseSystem, WalkVector};
 
-use super::dual::{dual, eps, seeded, Dual4, Dual5, NDIR};
+use super::dual::{dual, eps, seeded, Dual};
 use super::kkt::{dynamics_derivative, impulse_derivative};
 use super::NotDifferentiable;
 
@@ -44,14 +45,20 @@ pub(crate) const PARAM: usize = 3;
 pub(crate) const NC: usize = NQ - 1;
 /// Rows of a sensitivity: `q` and `q'` without `L3`, `dL3/dt` (the velocities from row [`NC`]).
 pub(crate) const NS: usize = 2 * NC;
-/// `d(q, q')/d(L2, dtheta/dt, dL2/dt, p)`.
-pub(crate) type Sensitivity = SMatrix<f64, NS, NDIR>;
+/// `d(q, q')/d(L2, dtheta/dt, dL2/dt)` (`D = 3` directions) or `d(q, q')/d(L2, dtheta/dt, dL2/dt, p)`
+/// (`D = 4`, the parameter's column [`PARAM`]): without a parameter the replay carries three directions, a
+/// fifth less work per stage than four.
+pub(crate) type Sensitivity<const D: usize> = SMatrix<f64, NS, D>;
 
 /// Size of the walk's state `[q, q', E_damper]`.
 const NY: usize = 2 * NQ + 1;
-/// Size of the augmented state `[y, S]` (`S` column by column).
-const NAUG: usize = NY + NS * NDIR;
-type Augmented = SVector<f64, NAUG>;
+/// Size of the augmented state `[y, S]` (`S` column by column) with `D` directions: the third const
+/// parameter `A` of the replay's functions, which must equal it (checked at compile time, since a const
+/// generic cannot be computed from another on stable Rust).
+pub(crate) const fn augmented(d: usize) -> usize {
+    NY + NS * d
+}
+type Augmented<const A: usize> = SVector<f64, A>;
 
 /// A grazing event: the guard's rate along the flow `g_y f-` is at most this times its largest derivative
 /// `|g_y S + g_p|` (the event time would move by more than `1 / GRAZING_RATE` seconds per unit of the section
@@ -70,7 +77,10 @@ fn rows_of(i: usize, velocity: bool) -> (usize, Option<usize>) {
 }
 
 /// `(q, q')` as duals: real parts from `y`, derivative parts from the rows of `s`.
-fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual4>, CoordsOf<Dual4>) {
+fn duals<const D: usize>(
+    y: &WalkVector,
+    s: &Sensitivity<D>,
+) -> (CoordsOf<Dual<D>>, CoordsOf<Dual<D>>) {
     let at = |i: usize, velocity: bool| {
         let (k, row) = rows_of(i, velocity);
         dual(y[k], row.map_or(SVector::zeros(), |r| s.row(r).transpose()))
@@ -81,19 +91,21 @@ fn duals(y: &WalkVector, s: &Sensitivity) -> (CoordsOf<Dual4>, CoordsOf<Dual4>) 
     )
 }
 
-/// `(q, q')` as duals whose first [`NDIR`] directions are the rows of `s` and whose last one is the rate `f`.
-fn with_rate(
+/// `(q, q')` as duals whose first `D` directions are the rows of `s` and whose last one (`E = D + 1`) is the
+/// rate `f`.
+fn with_rate<const D: usize, const E: usize>(
     y: &WalkVector,
-    s: &Sensitivity,
+    s: &Sensitivity<D>,
     f: &WalkVector,
-) -> (CoordsOf<Dual5>, CoordsOf<Dual5>) {
+) -> (CoordsOf<Dual<E>>, CoordsOf<Dual<E>>) {
+    const { assert!(E == D + 1) };
     let at = |i: usize, velocity: bool| {
         let (k, row) = rows_of(i, velocity);
-        let mut e = SVector::<f64, { NDIR + 1 }>::zeros();
+        let mut e = SVector::<f64, E>::zeros();
         if let Some(r) = row {
-            e.fixed_rows_mut::<NDIR>(0).copy_from(&s.row(r).transpose());
+            e.fixed_rows_mut::<D>(0).copy_from(&s.row(r).transpose());
         }
-        e[NDIR] = f[k];
+        e[D] = f[k];
         dual(y[k], e)
     };
     (
@@ -103,7 +115,10 @@ fn with_rate(
 }
 
 /// The sensitivity carried by duals `(q, q')`.
-pub(crate) fn sensitivity(q: &CoordsOf<Dual4>, qd: &CoordsOf<Dual4>) -> Sensitivity {
+pub(crate) fn sensitivity<const D: usize>(
+    q: &CoordsOf<Dual<D>>,
+    qd: &CoordsOf<Dual<D>>,
+) -> Sensitivity<D> {
     Sensitivity::from_fn(|i, c| {
         let x = if i < NC { &q[i] } else { &qd[i - NC] };
         eps(x)[c]
@@ -111,29 +126,31 @@ pub(crate) fn sensitivity(q: &CoordsOf<Dual4>, qd: &CoordsOf<Dual4>) -> Sensitiv
 }
 
 /// The phase's vector field with its variational equation, on the augmented state `[y, S]`.
-struct Variational<'a> {
+struct Variational<'a, const D: usize, const A: usize> {
     model: &'a Model,
-    mech: &'a Mechanics<Dual4>,
+    mech: &'a Mechanics<Dual<D>>,
     active: ActiveSet,
 }
 
-impl Variational<'_> {
-    fn split(a: &Augmented) -> (WalkVector, Sensitivity) {
+impl<const D: usize, const A: usize> Variational<'_, D, A> {
+    fn split(a: &Augmented<A>) -> (WalkVector, Sensitivity<D>) {
+        const { assert!(A == augmented(D)) };
         let y = a.fixed_rows::<NY>(0).into_owned();
-        let s = Sensitivity::from_column_slice(&a.as_slice()[NY..]);
+        let s = Sensitivity::<D>::from_column_slice(&a.as_slice()[NY..]);
         (y, s)
     }
 
-    fn join(y: &WalkVector, s: &Sensitivity) -> Augmented {
-        let mut a = Augmented::zeros();
+    fn join(y: &WalkVector, s: &Sensitivity<D>) -> Augmented<A> {
+        const { assert!(A == augmented(D)) };
+        let mut a = Augmented::<A>::zeros();
         a.fixed_rows_mut::<NY>(0).copy_from(y);
         a.as_mut_slice()[NY..].copy_from_slice(s.as_slice());
         a
     }
 }
 
-impl OdeSystem<NAUG> for Variational<'_> {
-    fn rhs(&self, _t: f64, a: &Augmented) -> Augmented {
+impl<const D: usize, const A: usize> OdeSystem<A> for Variational<'_, D, A> {
+    fn rhs(&self, _t: f64, a: &Augmented<A>) -> Augmented<A> {
         let (y, s) = Self::split(a);
         // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
         let phase = PhaseSystem::at(self.model, self.active, &y);
@@ -144,9 +161,9 @@ impl OdeSystem<NAUG> for Variational<'_> {
             dynamics_derivative(self.model, &duals, &self.active, (&d.qdd, &d.multipliers))
         });
         let Some((dqdd, _)) = derivative else {
-            return Augmented::repeat(f64::NAN);
+            return Augmented::<A>::repeat(f64::NAN);
         };
-        let mut ds = Sensitivity::zeros();
+        let mut ds = Sensitivity::<D>::zeros();
         ds.fixed_rows_mut::<NC>(0)
             .copy_from(&s.fixed_rows::<NC>(NC));
         ds.fixed_rows_mut::<NC>(NC)
@@ -157,14 +174,14 @@ impl OdeSystem<NAUG> for Variational<'_> {
 
 /// The impacts `sets` applied in order at `q` to `q'` with sensitivity rows `s` (the collision equation (5)
 /// with the recorded units, differentiated): the velocity after them and the sensitivity.
-fn apply_impacts(
+fn apply_impacts<const D: usize>(
     model: &Model,
-    mech: &Mechanics<Dual4>,
+    mech: &Mechanics<Dual<D>>,
     y: &WalkVector,
-    s: &Sensitivity,
+    s: &Sensitivity<D>,
     sets: &[ActiveSet],
     time: f64,
-) -> Result<(Coords, Sensitivity), NotDifferentiable> {
+) -> Result<(Coords, Sensitivity<D>), NotDifferentiable> {
     let (q, mut qd) = crate::walk::unpack(y);
     let mut s = *s;
     for set in sets {
@@ -187,23 +204,26 @@ fn apply_impacts(
 
 /// The derivatives of one step: the sensitivity of the state after the re-indexing at the next touchdown (the
 /// next section).
-pub(crate) struct StepDerivative {
+pub(crate) struct StepDerivative<const D: usize> {
     /// `d(q, q')/d(s, p)` just after re-indexing.
-    pub(crate) sensitivity: Sensitivity,
+    pub(crate) sensitivity: Sensitivity<D>,
 }
 
 /// Replays `tape`, a step walked from the state `(q, q')` (at the section, before the touchdown impact) with
-/// sensitivity `s0`: the sensitivity after the re-indexing at the next touchdown. `opts` are the walk's.
-pub(crate) fn replay_step(
+/// sensitivity `s0`: the sensitivity after the re-indexing at the next touchdown. `opts` are the walk's. `D`
+/// directions (4 with a parameter `param`, its column [`PARAM`]; 3 without), `E = D + 1` (the guard's rate
+/// rides along) and `A =` [`augmented`]`(D)`.
+pub(crate) fn replay_step<const D: usize, const E: usize, const A: usize>(
     model: &Model,
     opts: &SolverOptions,
     param: Option<&str>,
     (q0, qd0): (&CoordsOf<f64>, &CoordsOf<f64>),
-    s0: &Sensitivity,
+    s0: &Sensitivity<D>,
     tape: &StepTape,
-) -> Result<StepDerivative, NotDifferentiable> {
-    let mech = seeded::<NDIR>(model, param, PARAM);
-    let mech5 = seeded::<{ NDIR + 1 }>(model, param, PARAM);
+) -> Result<StepDerivative<D>, NotDifferentiable> {
+    debug_assert!(param.is_none() || D > PARAM, "a parameter needs its column");
+    let mech = seeded::<D>(model, param, PARAM);
+    let mech5 = seeded::<E>(model, param, PARAM);
     // The touchdown impact at the section: the recorded collision, then any Zeno locks (no time shift: the
     // section is the touchdown instant).
     let (Some(first), Some(t0)) = (tape.segments.first(), tape.segments.first().map(|s| s.t0))
@@ -218,7 +238,7 @@ pub(crate) fn replay_step(
         if swinging(&unpack(&segment.y0).0) {
             return Err(NotDifferentiable::Swinging { time: segment.t0 });
         }
-        let (y_minus, s_minus) = integrate_segment(model, opts, &mech, segment, &y0, &s)?;
+        let (y_minus, s_minus) = integrate_segment::<D, A>(model, opts, &mech, segment, &y0, &s)?;
         let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
         if last_event.is_some_and(|t| (end.time - t).abs() < COINCIDENT_EVENTS) {
             return Err(NotDifferentiable::CoincidentEvents { time: end.time });
@@ -246,7 +266,7 @@ pub(crate) fn replay_step(
 }
 
 /// `f dt^T` over the rows `(q, q')` of the state's rate `f`.
-fn rate_outer(f: &WalkVector, dt: &SVector<f64, NDIR>) -> Sensitivity {
+fn rate_outer<const D: usize>(f: &WalkVector, dt: &SVector<f64, D>) -> Sensitivity<D> {
     Sensitivity::from_fn(|i, c| {
         let k = if i < NC { i } else { NQ + i - NC };
         f[k] * dt[c]
@@ -255,22 +275,22 @@ fn rate_outer(f: &WalkVector, dt: &SVector<f64, NDIR>) -> Sensitivity {
 
 /// Integrate the variational equations over the recorded steps of `segment` from `(y0, s0)`: the state and
 /// sensitivity at the event that ends it.
-fn integrate_segment(
+fn integrate_segment<const D: usize, const A: usize>(
     model: &Model,
     opts: &SolverOptions,
-    mech: &Mechanics<Dual4>,
+    mech: &Mechanics<Dual<D>>,
     segment: &Segment,
     y0: &WalkVector,
-    s0: &Sensitivity,
-) -> Result<(WalkVector, Sensitivity), NotDifferentiable> {
-    let sys = Variational {
+    s0: &Sensitivity<D>,
+) -> Result<(WalkVector, Sensitivity<D>), NotDifferentiable> {
+    let sys = Variational::<D, A> {
         model,
         mech,
         active: segment.active,
     };
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
     let mut t = segment.t0;
-    let mut a = Variational::join(y0, s0);
+    let mut a = Variational::<D, A>::join(y0, s0);
     let mut f = sys.rhs(t, &a);
     let mut at_event = None;
     for &(h, t1) in &segment.steps {
@@ -282,7 +302,7 @@ fn integrate_segment(
         }
         (a, f, t) = (step.y1, step.f1, t1);
     }
-    let (y, s) = Variational::split(&at_event.ok_or(NotDifferentiable::Incomplete)?);
+    let (y, s) = Variational::<D, A>::split(&at_event.ok_or(NotDifferentiable::Incomplete)?);
     // The replay takes the walk's steps with the walk's arithmetic: its state is the walk's, bit for bit.
     if y != end.y || !s.iter().all(|v| v.is_finite()) {
         return Err(NotDifferentiable::Diverged { time: end.time });
@@ -292,13 +312,13 @@ fn integrate_segment(
 
 /// The event that ends `segment`, crossed: its time's derivative `dt = -(g_y S + g_p) / (g_y f-)` and the
 /// sensitivity at the event `S- + f- dt` (before its reset).
-fn cross_guard(
+fn cross_guard<const D: usize, const E: usize>(
     model: &Model,
-    mech: &Mechanics<Dual5>,
+    mech: &Mechanics<Dual<E>>,
     segment: &Segment,
     y: &WalkVector,
-    s: &Sensitivity,
-) -> Result<(Sensitivity, SVector<f64, NDIR>), NotDifferentiable> {
+    s: &Sensitivity<D>,
+) -> Result<(Sensitivity<D>, SVector<f64, D>), NotDifferentiable> {
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
     let (f, dynamics) = PhaseSystem::at(model, segment.active, y).rhs_and_dynamics(y);
     let (q, qd) = with_rate(y, s, &f);
@@ -327,15 +347,15 @@ fn cross_guard(
         kind => guard(model, mech, (kind, touching), &q).ok_or(singular)?,
     };
     let d = eps(&guard);
-    let rate = d[NDIR];
-    let grazing = rate.abs() <= GRAZING_RATE * d.fixed_rows::<NDIR>(0).amax();
+    let rate = d[D];
+    let grazing = rate.abs() <= GRAZING_RATE * d.fixed_rows::<D>(0).amax();
     if grazing || !rate.is_finite() || rate == 0.0 {
         return Err(NotDifferentiable::Grazing {
             time: end.time,
             event: format!("{:?}", end.kind),
         });
     }
-    let dt: SVector<f64, NDIR> = -d.fixed_rows::<NDIR>(0) / rate;
+    let dt: SVector<f64, D> = -d.fixed_rows::<D>(0) / rate;
     Ok((s + rate_outer(&f, &dt), dt))
 }
 
@@ -370,19 +390,19 @@ fn guard<T: Real>(
 /// Re-indexing at touchdown in duals (as `crate::walk`'s `reindex`): the touching leg becomes Leg 1 (at the
 /// touchdown length), the old Leg 1 Leg 2 (or, after a long flight, a spoke at the touchdown length), the
 /// origin moves to the new tip.
-fn reindex_duals(
+fn reindex_duals<const D: usize>(
     model: &Model,
-    mech: &Mechanics<Dual4>,
-    q: &CoordsOf<Dual4>,
-    qd: &CoordsOf<Dual4>,
-) -> (CoordsOf<Dual4>, CoordsOf<Dual4>) {
+    mech: &Mechanics<Dual<D>>,
+    q: &CoordsOf<Dual<D>>,
+    qd: &CoordsOf<Dual<D>>,
+) -> (CoordsOf<Dual<D>>, CoordsOf<Dual<D>>) {
     let real_q = q.map(|x| x.re);
     let touching = touchdown_leg(model, &real_q);
     let shift = model.legs() - touching;
     let front = model.tip_with(mech, q, qd, touching);
     let v = front.velocity(qd);
     let l0 = mech.spoke_length;
-    let zero = Dual4::lit(0.0);
+    let zero = Dual::<D>::lit(0.0);
     let (l2, l2_dot) = if shift == 1 {
         (q[L1], qd[L1])
     } else {
@@ -390,13 +410,13 @@ fn reindex_duals(
     };
     let alpha = model.alpha();
     let theta = if shift == 1 {
-        q[THETA] - Dual4::lit(alpha)
+        q[THETA] - Dual::<D>::lit(alpha)
     } else {
-        let psi = q[THETA] + Dual4::lit(touching as f64 * alpha);
+        let psi = q[THETA] + Dual::<D>::lit(touching as f64 * alpha);
         let turns = (psi.re / std::f64::consts::TAU).round();
-        psi - Dual4::lit(std::f64::consts::TAU * turns)
+        psi - Dual::<D>::lit(std::f64::consts::TAU * turns)
     };
-    let q_new = CoordsOf::<Dual4>::new(zero, front.position.y, theta, l0, l2, zero);
-    let qd_new = CoordsOf::<Dual4>::new(v.x, v.y, qd[THETA], zero, l2_dot, zero);
+    let q_new = CoordsOf::<Dual<D>>::new(zero, front.position.y, theta, l0, l2, zero);
+    let qd_new = CoordsOf::<Dual<D>>::new(v.x, v.y, qd[THETA], zero, l2_dot, zero);
     (q_new, qd_new)
 }
