@@ -15,7 +15,9 @@
 //! point continuing its left neighbour. A grid of one row (a sweep, an orbit diagram) is split so that it too
 //! uses every core: first every [`COARSE_STRIDE`]-th point is evaluated in order, each continuing the previous
 //! coarse point (the coarse pass); then the points between two coarse points are evaluated in order, continuing
-//! from the left coarse point, all intervals in parallel. (A coarse pass costs extra work, continuation over ten
+//! from the left coarse point, all intervals in parallel, the one whose coarse step took longest first (the
+//! interval with a family's end in it brackets that end, and started last it made the run's tail; the order of
+//! the work is the only thing the clock decides). (A coarse pass costs extra work, continuation over ten
 //! grid intervals at a time: a fifth of a 30 x 30 map's gait search, so rows that can run in parallel anyway
 //! skip it.) The schedule is fixed by the grid, not by the threads, and a point's evaluation depends only on its
 //! cell and on what it continues, so as long as `eval` is a deterministic function of its arguments the results
@@ -33,6 +35,7 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
@@ -164,12 +167,19 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    let (coarse_points, carries) = coarse_pass_until(row, cols, stop, eval);
-    let fills: Vec<Vec<P>> = carries
-        .par_iter()
-        .enumerate()
-        .map(|(k, left)| fill_until(row, cols, k, left.as_ref(), stop, eval))
+    let (coarse_points, carries, took) = coarse_pass_timed(row, cols, stop, eval);
+    // The intervals are independent: they start longest first, each as long as the coarse step over it took
+    // (the one with a family's end in it takes the longest, and started last it was the wall time's tail).
+    // Only the order of the work depends on the clock, never a result.
+    let mut order: Vec<usize> = (0..carries.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(took.get(k + 1).copied().unwrap_or_default()));
+    let mut fills: Vec<(usize, Vec<P>)> = order
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|k| (k, fill_until(row, cols, k, carries[k].as_ref(), stop, eval)))
         .collect();
+    fills.sort_by_key(|(k, _)| *k);
+    let fills = fills.into_iter().map(|(_, fill)| fill);
     // The complete prefix: stop after the first interval whose fill was cut short (or before a coarse point
     // that was never evaluated).
     let mut points = Vec::with_capacity(cols);
@@ -210,8 +220,25 @@ fn coarse_pass_until<P, C, F>(
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
-    let mut points: Vec<P> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
-    let mut carries: Vec<Option<C>> = Vec::with_capacity(cols.div_ceil(COARSE_STRIDE));
+    let (points, carries, _) = coarse_pass_timed(row, cols, stop, eval);
+    (points, carries)
+}
+
+/// [`coarse_pass_until`] with the time each coarse point took.
+#[allow(clippy::type_complexity)]
+fn coarse_pass_timed<P, C, F>(
+    row: usize,
+    cols: usize,
+    stop: &AtomicBool,
+    eval: &F,
+) -> (Vec<P>, Vec<Option<C>>, Vec<Duration>)
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    let n = cols.div_ceil(COARSE_STRIDE);
+    let mut points: Vec<P> = Vec::with_capacity(n);
+    let mut carries: Vec<Option<C>> = Vec::with_capacity(n);
+    let mut took = Vec::with_capacity(n);
     for col in (0..cols).step_by(COARSE_STRIDE) {
         if stopped(stop) {
             break;
@@ -219,11 +246,13 @@ where
         let from = carries
             .last()
             .and_then(|c| c.as_ref().map(|c| (col - COARSE_STRIDE, c)));
+        let start = Instant::now();
         let e = eval(Cell { row, col }, from);
+        took.push(start.elapsed());
         points.push(e.point);
         carries.push(e.carry);
     }
-    (points, carries)
+    (points, carries, took)
 }
 
 /// The points between coarse point `k` (which handed on `left`) and the next, in order, each continuing the
