@@ -320,17 +320,25 @@ pub(crate) fn solve_fixed_point(
     options: &GaitOptions,
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<FixedPoint, GaitError> {
-    solve_fixed_point_asking(map, initial, options, &mut || jacobian_guess.cloned())
+    solve_fixed_point_asking(
+        map,
+        initial,
+        options,
+        &mut || jacobian_guess.cloned(),
+        false,
+    )
 }
 
 /// [`solve_fixed_point`] with the guess of `DP` asked of `jacobian_guess` once the map is evaluated at the
 /// start (not if that evaluation fails, where no matrix could help: a continuation step tells the two
-/// failures apart by it).
+/// failures apart by it). `undamped`: fail as soon as a Newton step must be damped (its full length does not
+/// reduce the residual), a quick test that Newton's method converges from `initial` as it is.
 pub(crate) fn solve_fixed_point_asking(
     map: &StepMap,
     initial: &SectionState,
     options: &GaitOptions,
     jacobian_guess: &mut dyn FnMut() -> Option<DMatrix<f64>>,
+    undamped: bool,
 ) -> Result<FixedPoint, GaitError> {
     options.validate().map_err(|e| GaitError::InvalidOptions {
         message: e.to_string(),
@@ -431,7 +439,7 @@ pub(crate) fn solve_fixed_point_asking(
             }
             lambda /= 2.0;
         }
-        let Some((trial, out, r_trial)) = accepted else {
+        let Some((trial, out, r_trial)) = accepted.filter(|_| !(undamped && lambda < 1.0)) else {
             if !fresh {
                 // A stale matrix (the guess, or DP from an earlier iterate): recompute DP here and retry.
                 newton_matrix = None;
