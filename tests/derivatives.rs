@@ -264,3 +264,30 @@ fn rigid_wheel_parameter_derivatives_match_the_closed_form() {
         );
     }
 }
+
+/// `DP` alone is carried along three directions, `DP` with `dP/dp` along four: the same `DP`, bit for bit
+/// (each direction's arithmetic is its own), on a period-1 and an iterated map.
+#[test]
+fn dp_without_a_parameter_is_the_same_dp() {
+    let config = Config::default();
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    let gait = find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None,
+    )
+    .unwrap();
+    for iterated in [map.clone(), map.iterated(2)] {
+        let alone = iterated.eval_with_derivatives(&gait.section, None).unwrap();
+        for key in ["viscosity", "slope"] {
+            let with = iterated
+                .eval_with_derivatives(&gait.section, Some(key))
+                .unwrap();
+            assert_eq!(alone.jacobian, with.jacobian, "{key}");
+            assert_eq!(alone.outcome.next, with.outcome.next);
+            assert!(alone.dparam.is_none() && with.dparam.is_some());
+        }
+    }
+}

@@ -565,3 +565,70 @@ fn on_orbit(map: &StepMap, orbit: &SectionState, k: usize, s: &SectionState) -> 
     }
     false
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gait::limit_cycle::find_gait;
+    use crate::reference::default_initial;
+
+    /// The default family in `viscosity` (it ends where the wheel rolls back, near `c = 135.489237`) and a
+    /// continuation of it.
+    fn family_at(config: &Config, c: f64) -> (FamilyPoint, Option<DMatrix<f64>>) {
+        let at = config.with("viscosity", c).unwrap();
+        let model = Model::new(&at.params).unwrap();
+        let map = StepMap::new(&model, &at.solver);
+        let g = find_gait(&map, &default_initial(&at), &GaitOptions::default(), None).unwrap();
+        let point = FamilyPoint {
+            value: c,
+            section: g.section,
+        };
+        (point, g.jacobian_guess())
+    }
+
+    /// A coarse step's end tolerance brackets the same end as `PARAM_TOL` does from a neighbouring point, only
+    /// more loosely: the sweep's coarse pass and its fill agree on where the family ends.
+    #[test]
+    fn a_coarse_end_tolerance_brackets_the_same_end() {
+        let config = Config::default();
+        let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
+        let (from, guess) = family_at(&config, 131.0);
+        let Followed::Ended { last, beyond } = cont.follow_to(from, 141.0, guess.as_ref(), 1.0)
+        else {
+            panic!("the family ends before 141");
+        };
+        assert!(
+            (beyond - last.value).abs() <= 1.0 && beyond > last.value,
+            "{last:?} {beyond}"
+        );
+        let (near, guess) = family_at(&config, 135.0);
+        let Followed::Ended {
+            last: fine,
+            beyond: fine_beyond,
+        } = cont.follow(near, 136.0, guess.as_ref())
+        else {
+            panic!("the family ends before 136");
+        };
+        assert!(fine_beyond - fine.value <= PARAM_TOL);
+        assert!(last.value <= fine.value && fine_beyond <= beyond);
+        assert!((fine.value - 135.489237).abs() < 1e-6, "{}", fine.value);
+    }
+
+    /// A step whose walk fails at its start says so (`Start`: `follow` then computes no `DP` to retry it). A
+    /// step Newton's method takes without damping succeeds undamped as damped, to the same gait.
+    #[test]
+    fn steps_tell_a_failing_start_from_a_failing_newton() {
+        let config = Config::default();
+        let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
+        let (from, guess) = family_at(&config, 135.0);
+        let beyond = cont.step_asking(&from, 137.0, guess.as_ref(), false);
+        assert_eq!(beyond, Err(StepFailure::Start));
+        let damped = cont
+            .step_asking(&from, 135.2, guess.as_ref(), false)
+            .unwrap();
+        let undamped = cont
+            .step_asking(&from, 135.2, guess.as_ref(), true)
+            .unwrap();
+        assert_eq!(damped, undamped);
+    }
+}
