@@ -123,7 +123,7 @@ pub enum Followed {
     /// The family reaches the target value.
     Reached(FamilyPoint),
     /// The family ends between `last.value` and `beyond` (`|beyond - last.value| <= PARAM_TOL`, or the
-    /// tolerance given to [`Continuation::follow_to`]).
+    /// tolerance the coarse pass of a sweep gives, one grid interval).
     Ended {
         /// The last point of the family.
         last: FamilyPoint,
