@@ -331,8 +331,9 @@ pub(crate) fn solve_fixed_point(
 
 /// [`solve_fixed_point`] with the guess of `DP` asked of `jacobian_guess` once the map is evaluated at the
 /// start (not if that evaluation fails, where no matrix could help: a continuation step tells the two
-/// failures apart by it). `undamped`: fail as soon as a Newton step must be damped (its full length does not
-/// reduce the residual), a quick test that Newton's method converges from `initial` as it is.
+/// failures apart by it). `undamped`: fail as soon as a Newton step taken with `DP` at its iterate must be
+/// damped (its full length does not reduce the residual; a matrix from elsewhere is first replaced by `DP`
+/// there, as always), a quick test that Newton's method converges from `initial` as it is.
 pub(crate) fn solve_fixed_point_asking(
     map: &StepMap,
     initial: &SectionState,
