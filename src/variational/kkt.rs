@@ -129,14 +129,16 @@ enum Reduced {
     HeldSwinging(Saddle<{ NQ - 2 }>),
 }
 
-/// The rows `stacked[..k]` of `rows` restricted to the `R` coordinates from `theta` on.
-fn reduced_rows<const R: usize>(
+/// The rows `stacked` of `rows` restricted to the `R` coordinates from column `first` on (`x` for the general
+/// solve, `theta` where (C1) holds `x`, `z`).
+fn rows_from<const R: usize>(
     rows: &SMatrix<f64, NROWS, NQ>,
     stacked: &[usize],
+    first: usize,
 ) -> Vec<[f64; R]> {
     stacked
         .iter()
-        .map(|&i| std::array::from_fn(|l| rows[(i, 2 + l)]))
+        .map(|&i| std::array::from_fn(|l| rows[(i, first + l)]))
         .collect()
 }
 
@@ -157,15 +159,14 @@ impl Kkt {
         let m = &eom.mass;
         let reduced = |i: usize, j: usize| m[(2 + i, 2 + j)];
         let saddle = if held && eom.swing {
-            Reduced::HeldSwinging(Saddle::new(reduced, &reduced_rows(&rows, &stacked[..k]))?)
+            Reduced::HeldSwinging(Saddle::new(reduced, &rows_from(&rows, &stacked[..k], 2))?)
         } else if held {
-            Reduced::Held(Saddle::new(reduced, &reduced_rows(&rows, &stacked[..k]))?)
+            Reduced::Held(Saddle::new(reduced, &rows_from(&rows, &stacked[..k], 2))?)
         } else {
-            let r: Vec<[f64; NQ]> = stacked[..k]
-                .iter()
-                .map(|&i| std::array::from_fn(|l| rows[(i, l)]))
-                .collect();
-            Reduced::General(Saddle::new(|i, j| m[(i, j)], &r)?)
+            Reduced::General(Saddle::new(
+                |i, j| m[(i, j)],
+                &rows_from(&rows, &stacked[..k], 0),
+            )?)
         };
         Some(Kkt {
             mass: eom.mass,
