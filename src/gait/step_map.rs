@@ -254,6 +254,12 @@ impl<'m> StepMap<'m> {
         param: Option<&str>,
     ) -> Result<StepDerivatives, DerivativeError> {
         let model = self.model;
+        if model.params().has_friction() {
+            return Err(NotDifferentiable::Friction {
+                friction: model.params().friction,
+            }
+            .into());
+        }
         let mut walker = self.walker(s)?;
         // The section's own constraint, differentiated: (q, q') as functions of (s, p).
         let mech = seeded::<D>(model, param, PARAM);

@@ -409,11 +409,13 @@ mod tests {
         let table: toml::Table = text.parse().unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
         // `rear_stopper`, `min_length` and `touchdown_length` stay at their defaults here (rigid legs need them),
-        // and are left out.
+        // and are left out, as `friction` at its default (infinity, no slip).
         let mut expected: Vec<&str> = all_keys()
             .iter()
             .copied()
-            .filter(|k| !["rear_stopper", "min_length", "touchdown_length"].contains(k))
+            .filter(|k| {
+                !["rear_stopper", "min_length", "touchdown_length", "friction"].contains(k)
+            })
             .collect();
         written.sort_unstable();
         expected.sort_unstable();
@@ -632,7 +634,7 @@ mod tests {
     #[test]
     fn numeric_keys_get_set_round_trip() {
         let keys = Config::numeric_keys();
-        assert_eq!(keys.len(), 20);
+        assert_eq!(keys.len(), 21);
         assert!(keys.iter().all(|key| all_keys().contains(key)));
         for key in [
             "legs",
@@ -676,7 +678,7 @@ mod tests {
         let defaults = Config::default();
         let table = toml::Table::try_from(&defaults).unwrap();
         let mut written: Vec<&str> = table.keys().map(String::as_str).collect();
-        // `rear_exit`, `rear_stopper`, `min_length` and `touchdown_length` are left out at their defaults, so that written
+        // `rear_exit`, `rear_stopper`, `min_length`, `touchdown_length` and `friction` are left out at their defaults, so that written
         // configurations stay as they were before them; `keys_left_out_at_defaults` names them (and reads back as
         // the defaults).
         let left_out = defaults.params.keys_left_out_at_defaults();
@@ -687,7 +689,8 @@ mod tests {
                 "rear_exit",
                 "rear_stopper",
                 "min_length",
-                "touchdown_length"
+                "touchdown_length",
+                "friction"
             ]
         );
         let mut read: Vec<&str> = all_keys()

@@ -452,6 +452,10 @@ mod tests {
     fn every_real_key_rejects_nan_and_infinity() {
         for &key in Config::numeric_keys() {
             for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                if key == "friction" && bad == f64::INFINITY {
+                    // No slip: the default.
+                    continue;
+                }
                 let mut config = Config::default();
                 config.set_numeric(key, bad).unwrap();
                 let error = config.validate().unwrap_err();
@@ -472,5 +476,27 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("stiffness"));
+    }
+
+    /// `friction` is a non-negative number or `inf` (no slip, the default); a finite one is refused with the
+    /// `rebound` treatment of an inconsistent no-slip contact, which it replaces.
+    #[test]
+    fn friction_is_non_negative_or_infinite() {
+        let config = Config::from_toml_str("friction = inf").unwrap();
+        assert_eq!(config.params.friction, f64::INFINITY);
+        let mut config = Config::default();
+        config.apply_override("friction=0.6").unwrap();
+        config.validate().unwrap();
+        assert!(config.params.has_friction());
+        config.apply_override("friction=0").unwrap();
+        config.validate().unwrap();
+        for bad in ["-0.1", "nan", "-inf"] {
+            let mut config = Config::default();
+            config.apply_override(&format!("friction={bad}")).unwrap();
+            let error = config.validate().unwrap_err();
+            assert_eq!(key_of(&error), Some("friction"), "{bad}: {error}");
+        }
+        let error = Config::from_toml_str("friction = 0.5\ninconsistent_contact = \"rebound\"").unwrap_err();
+        assert!(error.to_string().contains("rebound"), "{error}");
     }
 }

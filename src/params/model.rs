@@ -82,6 +82,17 @@ pub struct Params {
     /// legs. A leg that lands shorter than its stopper is free at once. `docs/model.md` sections 2 and 5.
     #[serde(skip_serializing_if = "is_zero")]
     pub touchdown_length: f64,
+    /// Coulomb friction coefficient `mu` of the ground at the leg tips \[-\]. Default infinity (`inf`): the paper's
+    /// no-slip contacts, with the frictionless slide of `inconsistent_contact` where no-slip is inconsistent.
+    /// Finite: a contact sticks while `|lambda_t| <= mu lambda_n`, slips with `lambda_t = -mu lambda_n
+    /// sign(slip velocity)` or is off, and impacts keep their impulses in the cone. Non-negative.
+    /// `docs/model.md` section 11.
+    #[serde(skip_serializing_if = "is_infinite")]
+    pub friction: f64,
+}
+
+fn is_infinite(x: &f64) -> bool {
+    *x == f64::INFINITY
 }
 
 fn is_true(b: &bool) -> bool {
@@ -115,6 +126,7 @@ impl Default for Params {
             rear_stopper: true,
             min_length: 0.0,
             touchdown_length: 0.0,
+            friction: f64::INFINITY,
         }
     }
 }
@@ -122,7 +134,7 @@ impl Default for Params {
 impl Params {
     /// The keys that written configurations leave out at their defaults (so that files stay as they were before
     /// these keys existed), with their values here: what a front listing every key adds to the serialization.
-    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 4] {
+    pub fn keys_left_out_at_defaults(&self) -> [(&'static str, toml::Value); 5] {
         [
             (
                 "rear_exit",
@@ -134,6 +146,7 @@ impl Params {
                 "touchdown_length",
                 toml::Value::Float(self.touchdown_length),
             ),
+            ("friction", toml::Value::Float(self.friction)),
         ]
     }
 
@@ -320,6 +333,7 @@ impl Params {
         if self.touchdown_length > 0.0 {
             self.touchdown_length_rules(rules);
         }
+        self.friction_rules(rules);
         // The time scale needs sound masses: not when the mass ratio is already refused.
         let ratio = self.leg_mass / self.hub_mass;
         if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)
@@ -330,6 +344,47 @@ impl Params {
             let result = self.stiff_legs_rule(&|key| rules.given(key));
             rules.between(["viscosity", "stiffness"], |_| result);
         }
+    }
+
+    /// The rules of the friction coefficient: non-negative, infinity allowed (no slip, the default); a finite
+    /// one replaces the treatment of an inconsistent no-slip contact, so not with `inconsistent_contact =
+    /// "rebound"`, and not with `rear_exit = "continue"`.
+    fn friction_rules(&self, rules: &mut Rules<'_>) {
+        if self.friction.is_nan() || self.friction < 0.0 {
+            rules.single(Err(invalid(
+                "friction",
+                short(self.friction),
+                "must be non-negative (or inf: no slip)",
+            )));
+        } else if self.has_friction() {
+            rules.between(["friction", "inconsistent_contact"], |_| {
+                if self.inconsistent_contact == ContactInconsistency::Rebound {
+                    return Err(invalid(
+                        "friction",
+                        short(self.friction),
+                        "a finite friction coefficient decides what a contact that cannot stick does (it slips): \
+                         inconsistent_contact = \"rebound\" is a resolution of friction = inf only",
+                    ));
+                }
+                Ok(())
+            });
+            rules.between(["friction", "rear_exit"], |_| {
+                if self.rear_exit == RearExit::Continue {
+                    return Err(invalid(
+                        "friction",
+                        short(self.friction),
+                        "the swinging leg's stopper impact of rear_exit = \"continue\" has no Coulomb impulse yet: \
+                         use rear_exit = \"relock\" or \"reset\" with a finite friction (or friction = inf)",
+                    ));
+                }
+                Ok(())
+            });
+        }
+    }
+
+    /// Is the friction coefficient finite (Coulomb friction at the tips rather than no slip)?
+    pub fn has_friction(&self) -> bool {
+        self.friction.is_finite()
     }
 
     /// The rules of a touchdown length that is set: within the stroke (`[min_length, stopper_length]`, above

@@ -59,6 +59,13 @@ pub enum NotDifferentiable {
         /// Its value.
         value: f64,
     },
+    /// The walk has Coulomb friction (a finite `friction`), whose slip phases and events the replay does not
+    /// differentiate yet: the finite-difference route gives `DP` there.
+    #[error("no exact derivatives with Coulomb friction (friction = {friction}) yet: finite differences instead")]
+    Friction {
+        /// The friction coefficient.
+        friction: f64,
+    },
     /// A KKT or collision solve in the replay was singular.
     #[error("singular constraint solve at t = {time} s in the derivative replay")]
     Singular {

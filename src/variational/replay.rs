@@ -383,7 +383,10 @@ fn guard<T: Real>(
         | EventKind::RollBack
         // Not in a step without a swinging leg (refused in `step_derivative`).
         | EventKind::SwingLock
-        | EventKind::SwingLanding => None,
+        | EventKind::SwingLanding
+        // Coulomb friction is refused before the replay (`NotDifferentiable::Friction`).
+        | EventKind::ConeLimit(_)
+        | EventKind::SlipStop(_) => None,
     }
 }
 

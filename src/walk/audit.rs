@@ -6,7 +6,7 @@ use crate::contact::{Leg, Stop};
 use crate::dynamics::{swinging, Model, L3};
 use crate::integrate::DenseStep;
 
-use super::events::EVENT_SAMPLES;
+use super::events::{Forces, EVENT_SAMPLES};
 use super::impact::{has_stop, has_stopper, stop_length};
 use super::phase::{unpack, WalkVector, NY};
 use super::report::ContactAudit;
@@ -17,9 +17,12 @@ use super::report::ContactAudit;
 pub(crate) const PENETRATION_SAMPLES: usize = EVENT_SAMPLES;
 
 impl ContactAudit {
-    /// A pulling force (or reaction) seen at some instant of the step.
-    pub(crate) fn see_force(&mut self, pull: f64) {
-        self.pull_force = self.pull_force.max(pull);
+    /// The pulling force (or reaction) and the friction cone's excess seen at some instant of the step.
+    pub(crate) fn see_force(&mut self, forces: Forces) {
+        self.pull_force = self.pull_force.max(forces.pull);
+        if let Some(friction) = &mut self.friction {
+            friction.cone_violation = friction.cone_violation.max(forces.cone);
+        }
     }
 
     /// Deepest tip below the ground at `y`, over every leg (Legs 1 and 2 at their lengths, the others at `L0`),

@@ -235,6 +235,10 @@ impl WalkError {
             WalkError::OffSection { .. } => "off_section",
             WalkError::HoldChanged { .. } => "hold_changed",
             WalkError::InconsistentContacts { .. } => "inconsistent_contacts",
+            WalkError::Contact {
+                source: ContactError::Painleve(_),
+                ..
+            } => "painleve",
             WalkError::Contact { .. } => "constraint_failure",
             WalkError::Integration { .. } => "solver_failure",
             WalkError::InvalidSection { .. } => "invalid_section",

@@ -3,7 +3,7 @@
 //! [`APPROACH_GAP`]). The table of event functions is in the [module documentation](super).
 
 use crate::contact::{
-    constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Stop,
+    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Stop,
 };
 use crate::dynamics::{swinging, Coords, Model, L3, THETA};
 use crate::params::SolverOptions;
@@ -32,6 +32,11 @@ pub(crate) const APPROACH_GAP: f64 = 1e-12;
 /// however long the steps of a high-order integrator are.
 pub(crate) const EVENT_SAMPLES: usize = 4;
 
+/// The grazing guard of a slip-stop event \[m/s\]: a tip that starts to slip from rest (its speed 0) is armed
+/// to stop once its slip speed exceeds this; one that stops again before, stops when it moves this fast the
+/// other way. The same size as the speed a no-slip contact may hold (`STICK_SPEED_TOL`).
+pub(crate) const SLIP_ARMING_SPEED: f64 = 1e-8;
+
 /// Kinds of events (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum EventKind {
@@ -51,6 +56,11 @@ pub(crate) enum EventKind {
     /// The tip of the swinging leg reaches the ground (the walk stops; with three legs it is the next leg to
     /// touch down, and that is a touchdown).
     SwingLanding,
+    /// With Coulomb friction, a sticking tip's tangential force reaches the edge of the cone:
+    /// `mu lambda_n - |lambda_t| = 0`.
+    ConeLimit(Leg),
+    /// With Coulomb friction, a slipping tip comes to rest: its slip velocity reaches 0.
+    SlipStop(Leg),
 }
 
 impl EventKind {
@@ -99,6 +109,22 @@ pub(crate) struct Event {
     pub(crate) floor: f64,
 }
 
+/// What the contact audit checks at an instant: the largest pulling force (see [`largest_pull`]) and the largest
+/// excess of a sticking contact's force over the friction cone (see [`cone_excess`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Forces {
+    pub(crate) pull: f64,
+    pub(crate) cone: f64,
+}
+
+impl Forces {
+    /// Nothing pulls, nothing leaves the cone.
+    pub(crate) const NONE: Forces = Forces {
+        pull: 0.0,
+        cone: 0.0,
+    };
+}
+
 /// Event functions of one phase.
 pub(crate) struct EventSet<'a> {
     model: &'a Model,
@@ -122,6 +148,13 @@ impl<'a> EventSet<'a> {
             } else {
                 EventKind::Landing(leg)
             });
+            if active.contact(leg) && model.params().has_friction() {
+                kinds.push(if active.slip(leg) != 0 {
+                    EventKind::SlipStop(leg)
+                } else {
+                    EventKind::ConeLimit(leg)
+                });
+            }
             for stop in Stop::BOTH.into_iter().filter(|&s| has_stop(model, leg, s)) {
                 kinds.push(if active.held(leg, stop) {
                     EventKind::unlock(leg, stop)
@@ -178,6 +211,7 @@ impl<'a> EventSet<'a> {
     fn guard(opts: &SolverOptions, kind: EventKind) -> Option<f64> {
         match kind {
             EventKind::Landing(_) => Some(opts.recontact_gap),
+            EventKind::SlipStop(_) => Some(SLIP_ARMING_SPEED),
             EventKind::StopperHit(_) | EventKind::CompressionHit(_) | EventKind::SwingLock => {
                 Some(opts.stopper_gap)
             }
@@ -232,6 +266,14 @@ impl<'a> EventSet<'a> {
             EventKind::CompressionHit(leg) => self.room(leg, Stop::Compression, q),
             EventKind::SwingLock => self.model.params().stopper_length - q[L3],
             EventKind::SwingLanding => self.model.tip_height(q, SWING_LEG),
+            EventKind::ConeLimit(leg) => force(&|d| {
+                self.model.params().friction * d.normal_force(leg)
+                    - d.multipliers[leg.tangential_row()].abs()
+            }),
+            EventKind::SlipStop(leg) => {
+                let v = self.model.tip(q, qd, leg.index()).velocity(qd).x;
+                f64::from(self.active.slip(leg)) * v
+            }
         }
     }
 
@@ -254,7 +296,10 @@ impl<'a> EventSet<'a> {
     fn needs_forces(kind: EventKind) -> bool {
         matches!(
             kind,
-            EventKind::LiftOff(_) | EventKind::Unlock(_) | EventKind::CompressionUnlock(_)
+            EventKind::LiftOff(_)
+                | EventKind::Unlock(_)
+                | EventKind::CompressionUnlock(_)
+                | EventKind::ConeLimit(_)
         )
     }
 
@@ -264,9 +309,9 @@ impl<'a> EventSet<'a> {
             .flatten()
     }
 
-    /// Values of all event functions at `y`, and the largest pulling force there (0 when no unilateral unit is
-    /// active, see [`largest_pull`]).
-    pub(crate) fn values(&self, y: &WalkVector) -> (Vec<f64>, f64) {
+    /// Values of all event functions at `y`, and the forces the contact audit checks there (0 when no unilateral
+    /// unit is active).
+    pub(crate) fn values(&self, y: &WalkVector) -> (Vec<f64>, Forces) {
         let (q, qd) = unpack(y);
         let needed = self.events.iter().any(|e| Self::needs_forces(e.kind));
         let dynamics = self.dynamics_if(needed, &q, &qd);
@@ -275,10 +320,12 @@ impl<'a> EventSet<'a> {
             .iter()
             .map(|e| self.shifted(e, &q, &qd, &dynamics))
             .collect();
-        let pull = dynamics.map_or(0.0, |d| {
-            largest_pull(&d.multipliers, &self.active, self.model.params().rigid_legs)
+        let params = self.model.params();
+        let forces = dynamics.map_or(Forces::NONE, |d| Forces {
+            pull: largest_pull(&d.multipliers, &self.active, params.rigid_legs),
+            cone: cone_excess(&d.multipliers, &self.active, params.friction),
         });
-        (values, pull)
+        (values, forces)
     }
 
     /// Value of event `k` at `y`.

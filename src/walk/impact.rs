@@ -1,34 +1,22 @@
 //! Touchdown: re-indexing and the DLS-indicator impact procedure (docs/model.md section 5, paper Sec. 2.2,
-//! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event.
-//!
-//! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward, compression stops
-//! that may only push it outward) are resolved by enumerating the few possible active sets (at most four
-//! optional units, a leg being at one of its stops at a time, so at most 16 sets) and keeping a
-//! set that satisfies complementarity: included units push the right way, excluded units do not penetrate.
-//! Where several sets qualify, the one that best matches the stated preference (keep what was active, add no
-//! stopper that is not needed, follow the paper's branch) wins, so in the regular case the result is exactly
-//! the paper's procedure.
+//! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event,
+//! each resolved by the complementarity problems of [`super::complementarity`].
 
 use serde::Serialize;
 
 use crate::contact::{
-    constrained_dynamics, impulse, largest_pull, swing_lock_impulse, ActiveSet,
-    ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, Stop,
+    cone_excess, constrained_dynamics, largest_pull, swing_lock_impulse, ActiveSet, ContactError,
+    ImpulseSolution, Leg, Multipliers, Stop,
 };
 use crate::dynamics::{Coords, LegIndex, Model, L3, THETA};
-use crate::params::{ContactInconsistency, ImpactModel};
+use crate::params::ImpactModel;
 
 use super::error::WalkError;
 
-/// Tolerance of the complementarity checks (forces \[N\], impulses \[N s\], velocities \[m/s\], accelerations
-/// \[m/s^2\]): a value within this of zero counts as zero, so that an event located at a force or velocity
-/// zero is not undone by rounding.
-pub(crate) const COMPLEMENTARITY_TOL: f64 = 1e-9;
-
-/// Largest tangential speed of a tip that a no-slip contact may hold at force level \[m/s\]: a tip at rest up to
-/// the integration error (~1e-12 m/s, as `SECTION_TIP_SPEED_TOL` of the walk); a tip that slides faster (after a
-/// frictionless impulse) is not stuck by the force-level problem, which has no impulse to stop it.
-pub(crate) const STICK_SPEED_TOL: f64 = 1e-8;
+pub use super::complementarity::Unit;
+pub(crate) use super::complementarity::{
+    consistent_active_set, plastic_impact, plastic_impact_by, Candidate, Mode, COMPLEMENTARITY_TOL,
+};
 
 /// The three DLS indicators of the paper (Sec. 2.2): `lambda_I4` from (A1), `lambda_2+`, `lambda_4+` from (B1).
 /// `NaN` where the procedure does not define them (`lambda_2+`, `lambda_4+` after (A3), all three when the
@@ -81,308 +69,6 @@ impl std::fmt::Display for Branch {
     }
 }
 
-/// A unilateral unit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Unit {
-    /// Ground contact of a leg tip.
-    Contact(Leg),
-    /// One of a leg's stroke limits: its stopper or its compression stop.
-    Stop(Leg, Stop),
-}
-
-/// State of a unit in an active set.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Mode {
-    /// Inactive: the tip is free / the leg is free of its stopper.
-    Off,
-    /// Active: a no-slip contact, or a locked stopper.
-    On,
-    /// A contact that slides without friction (normal row only); used only when neither `On` nor `Off` is
-    /// consistent and [`ContactInconsistency::Slide`] is selected.
-    Slide,
-}
-
-impl Unit {
-    /// The units of `leg`: its ground contact, its stopper and its compression stop.
-    pub(crate) fn of(leg: Leg) -> [Unit; 3] {
-        [
-            Unit::Contact(leg),
-            Unit::Stop(leg, Stop::Extension),
-            Unit::Stop(leg, Stop::Compression),
-        ]
-    }
-
-    /// Put the unit in `mode` in `active`.
-    pub(crate) fn apply(self, active: &mut ActiveSet, mode: Mode) {
-        match (self, mode) {
-            (Unit::Contact(leg), Mode::Slide) => active.set_sliding(leg),
-            (Unit::Contact(leg), m) => active.set_contact(leg, m == Mode::On),
-            (Unit::Stop(leg, stop), m) => active.set_held(leg, stop, m != Mode::Off),
-        }
-    }
-
-    /// The unit's mode in `active`.
-    pub(crate) fn mode(self, active: &ActiveSet) -> Mode {
-        match self {
-            Unit::Contact(leg) if active.slide(leg) => Mode::Slide,
-            Unit::Contact(leg) if active.contact(leg) => Mode::On,
-            Unit::Stop(leg, stop) if active.held(leg, stop) => Mode::On,
-            _ => Mode::Off,
-        }
-    }
-}
-
-/// What a candidate unit is doing at the moment its mode is resolved.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Role {
-    /// Present before (or touching after an impact): any mode its kind allows.
-    Keep,
-    /// Its normal force has just fallen through zero (a lift-off event): it may leave the ground or slide, but
-    /// not stay a no-slip contact.
-    Releasing,
-    /// The unit an impact closes (a landing tip, a leg hitting its stopper): it takes the impulse, no-slip if
-    /// that impulse pushes, else (under [`ContactInconsistency::Slide`]) as a frictionless sliding contact.
-    Closing {
-        /// Sliding is allowed (the model's `inconsistent_contact = slide`).
-        allow_slide: bool,
-    },
-}
-
-/// An optional unit and the mode the caller prefers for it when several are consistent.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Candidate {
-    /// The unit.
-    pub unit: Unit,
-    /// Preferred mode.
-    pub preferred: Mode,
-    /// What the unit is doing.
-    pub role: Role,
-}
-
-impl Candidate {
-    /// The candidate `unit` preferring the mode it has in `active`.
-    pub(crate) fn keep(unit: Unit, active: &ActiveSet) -> Candidate {
-        Candidate::new(unit, unit.mode(active))
-    }
-
-    /// The candidate `unit` preferring `preferred`.
-    pub(crate) fn new(unit: Unit, preferred: Mode) -> Candidate {
-        Candidate {
-            unit,
-            preferred,
-            role: Role::Keep,
-        }
-    }
-
-    /// A contact whose normal force has just reached zero: preferably it leaves; it may slide (under
-    /// [`ContactInconsistency::Slide`]), but it cannot stay a no-slip contact.
-    pub(crate) fn releasing(leg: Leg) -> Candidate {
-        Candidate {
-            unit: Unit::Contact(leg),
-            preferred: Mode::Off,
-            role: Role::Releasing,
-        }
-    }
-
-    /// The unit an impact closes, preferably no-slip (see [`Role::Closing`]).
-    pub(crate) fn closing(unit: Unit, model: &Model) -> Candidate {
-        Candidate {
-            unit,
-            preferred: Mode::On,
-            role: Role::Closing {
-                allow_slide: model.params().inconsistent_contact == ContactInconsistency::Slide,
-            },
-        }
-    }
-
-    /// The modes tried for this candidate. At impulse level a contact keeps its kind: a no-slip contact may
-    /// take a full (tangential and normal) impulse or none, a sliding one a frictionless normal impulse or none;
-    /// a closing unit always takes an impulse. At force level a contact may also start to slide when
-    /// `allow_slide`.
-    fn modes(&self, level: Level) -> &'static [Mode] {
-        let contact = matches!(self.unit, Unit::Contact(_));
-        match (self.role, level) {
-            (Role::Closing { allow_slide: true }, _) if contact => &[Mode::On, Mode::Slide],
-            (Role::Closing { .. }, _) => &[Mode::On],
-            (Role::Releasing, Level::Force { allow_slide: true }) => &[Mode::Off, Mode::Slide],
-            (Role::Releasing, _) => &[Mode::Off],
-            (Role::Keep, Level::Impulse) if contact && self.preferred == Mode::Slide => {
-                &[Mode::Off, Mode::Slide]
-            }
-            (Role::Keep, Level::Force { allow_slide: true }) if contact => {
-                &[Mode::Off, Mode::On, Mode::Slide]
-            }
-            _ => &[Mode::Off, Mode::On],
-        }
-    }
-
-    /// Preference score: the preferred mode 2, another regular mode 1, sliding (the last resort) 0.
-    fn score(&self, mode: Mode) -> usize {
-        if mode == self.preferred {
-            2
-        } else if mode == Mode::Slide {
-            0
-        } else {
-            1
-        }
-    }
-}
-
-/// Which complementarity problem an active set is resolved for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Level {
-    /// An impact (impulses and velocities just after it).
-    Impulse,
-    /// Continuous motion (forces and accelerations).
-    Force {
-        /// Contacts may slide without friction when neither sticking nor leaving is consistent.
-        allow_slide: bool,
-    },
-}
-
-/// Among `forced` plus every combination of modes of the `candidates`, the consistent set with the best
-/// preference score, or `None` if no combination is consistent.
-fn best_subset<T>(
-    forced: ActiveSet,
-    candidates: &[Candidate],
-    level: Level,
-    mut solve: impl FnMut(&ActiveSet) -> Result<T, ContactError>,
-    mut consistent: impl FnMut(&ActiveSet, &T) -> bool,
-) -> Result<Option<(ActiveSet, T)>, ContactError> {
-    let radix: Vec<usize> = candidates.iter().map(|c| c.modes(level).len()).collect();
-    let combinations: usize = radix.iter().product();
-    let mut best: Option<(usize, ActiveSet, T)> = None;
-    for mut code in 0..combinations {
-        let mut set = forced;
-        let mut score = 0;
-        for (c, r) in candidates.iter().zip(&radix) {
-            let mode = c.modes(level)[code % r];
-            code /= r;
-            c.unit.apply(&mut set, mode);
-            score += c.score(mode);
-        }
-        if best.as_ref().is_some_and(|(s, _, _)| *s >= score) {
-            continue;
-        }
-        match solve(&set) {
-            Ok(value) if consistent(&set, &value) => best = Some((score, set, value)),
-            Ok(_) => {}
-            // A redundant set is simply not a candidate; other failures are real.
-            Err(ContactError::RedundantConstraints(_)) => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(best.map(|(_, set, value)| (set, value)))
-}
-
-/// `forced` plus every candidate in its preferred mode.
-fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
-    let mut set = forced;
-    for c in candidates {
-        c.unit.apply(&mut set, c.preferred);
-    }
-    set
-}
-
-/// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
-/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (docs/model.md
-/// section 4). Every candidate either takes a non-negative impulse and ends at zero relative normal velocity,
-/// or takes none and separates (normal velocity after the impact `>= 0`, a free leg not moving past its
-/// stopper). A no-slip contact's impulse has a tangential part; a sliding contact's is normal only. If no
-/// combination is consistent the preferred one is used, and the step's contact audit
-/// ([`largest_pull`]) shows the pulling impulse.
-pub(crate) fn plastic_impact(
-    model: &Model,
-    q: &Coords,
-    qd: &Coords,
-    forced: ActiveSet,
-    candidates: &[Candidate],
-) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
-    plastic_impact_by(model, (q, qd), forced, candidates, |set| {
-        impulse(model, q, qd, set)
-    })
-}
-
-/// [`plastic_impact`] with the collision equation solved by `solve` for each combination of units (which may
-/// add a row of its own, as the swinging leg's stopper, [`lock_swinging_leg`]).
-fn plastic_impact_by(
-    model: &Model,
-    (q, qd): (&Coords, &Coords),
-    forced: ActiveSet,
-    candidates: &[Candidate],
-    solve: impl Fn(&ActiveSet) -> Result<ImpulseSolution, ContactError>,
-) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
-    let found = best_subset(forced, candidates, Level::Impulse, &solve, |set, sol| {
-        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
-            (Unit::Contact(leg), Mode::Off) => {
-                model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
-            }
-            (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
-            (Unit::Stop(leg, stop), Mode::Off) => {
-                stop.sign() * sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
-            }
-            (Unit::Stop(leg, stop), _) => sol.stop_impulse(leg, stop) >= -COMPLEMENTARITY_TOL,
-        })
-    })?;
-    match found {
-        Some(found) => Ok(found),
-        None => {
-            let set = preferred_set(forced, candidates);
-            Ok((set, solve(&set)?))
-        }
-    }
-}
-
-/// The active set for continuous motion (the force-level complementarity problem): `forced` units plus the
-/// `candidates` that must push (positive normal force, inward stopper reaction) so that no excluded unit
-/// penetrates (tip accelerating into the ground, leg accelerating past its stopper). Sliding contacts are
-/// tried only under [`ContactInconsistency::Slide`]; under [`ContactInconsistency::Rebound`], when no set is
-/// consistent, the paper's (B2)/(B3) rule decides: contacts with a pulling normal force are released.
-pub(crate) fn consistent_active_set(
-    model: &Model,
-    q: &Coords,
-    qd: &Coords,
-    forced: ActiveSet,
-    candidates: &[Candidate],
-) -> Result<Option<(ActiveSet, ConstrainedDynamics)>, ContactError> {
-    let allow_slide = model.params().inconsistent_contact == ContactInconsistency::Slide;
-    let solve = |set: &ActiveSet| constrained_dynamics(model, q, qd, set);
-    let level = Level::Force { allow_slide };
-    let found = best_subset(forced, candidates, level, solve, |set, dynamics| {
-        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
-            (Unit::Contact(leg), Mode::Off) => {
-                let tip = model.tip(q, qd, leg.index());
-                (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
-            }
-            // A no-slip contact needs its tip at rest: one that slides (after a frictionless impulse) stays
-            // sliding or leaves; holding it would make the tangential force do work.
-            (Unit::Contact(leg), Mode::On) => {
-                dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL
-                    && model.tip(q, qd, leg.index()).velocity(qd).x.abs() <= STICK_SPEED_TOL
-            }
-            (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
-            (Unit::Stop(leg, stop), Mode::Off) => {
-                stop.sign() * dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
-            }
-            (Unit::Stop(leg, stop), _) => dynamics.stop_reaction(leg, stop) >= -COMPLEMENTARITY_TOL,
-        })
-    })?;
-    if found.is_some() || allow_slide {
-        return Ok(found);
-    }
-    // ContactInconsistency::Rebound: the paper's rule (B2)/(B3) applied literally. Start from the preferred set
-    // and release every contact whose normal force pulls, even if the released tip then falls back at once.
-    let mut set = preferred_set(forced, candidates);
-    let dynamics = solve(&set)?;
-    for c in candidates {
-        if let Unit::Contact(leg) = c.unit {
-            if set.contact(leg) && dynamics.normal_force(leg) < 0.0 {
-                set.set_contact(leg, false);
-            }
-        }
-    }
-    Ok(Some((set, solve(&set)?)))
-}
 
 /// What the touchdown impact produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -401,6 +87,9 @@ pub(crate) struct TouchdownImpact {
     pub loss: f64,
     /// The largest pulling impulse of the applied collision \[N s\], 0 if none pulls (contact audit).
     pub pull_impulse: f64,
+    /// The largest excess of a sticking contact's impulse over the friction cone \[N s\], 0 if none (friction
+    /// audit).
+    pub cone_impulse: f64,
 }
 
 /// The leg whose touchdown ends the step: of the legs not in `q` (`j = 2..N`, all at `L0`), the one with the
@@ -456,6 +145,9 @@ fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
 /// contact is forced by the procedure (on in (A1), off in (A3)) and the new Leg 1 is the closing unit: it takes
 /// a no-slip impulse when that impulse pushes (the paper's `J_DLS`, `J_SLS`, and every regular touchdown), a
 /// frictionless one when a no-slip impulse would pull, as on a leg that lands behind the hub after a flight.
+/// With Coulomb friction (a finite `friction`) both tips of the (A1) collision take an impulse that sticks
+/// where the cone holds the no-slip impulse and slips with a Coulomb impulse where it does not
+/// (docs/model.md section 11); `lambda_I4` is then the normal impulse of that collision.
 ///
 /// With [`ImpactModel::Traditional`] the indicators are still computed and reported, but the collision is
 /// always the `J_SLS` one. With `rigid_legs` the stoppers act both ways and the exchange is the traditional
@@ -478,6 +170,7 @@ pub(crate) fn touchdown_impact(
         preferred,
         loss: kinetic_loss(model, q, qd, &sol),
         pull_impulse: pull_of(model, &impulse_set, &sol),
+        cone_impulse: cone_excess(&sol.impulses, &impulse_set, model.params().friction),
     };
     let sls = ActiveSet {
         contact1: true,
@@ -506,12 +199,19 @@ pub(crate) fn touchdown_impact(
         ));
     }
 
-    // (A1) the DLS collision.
+    // (A1) the DLS collision. With Coulomb friction Leg 2's tip takes its impulse sticking or slipping, as the
+    // cone decides: a closing unit of the impulse problem rather than a forced one.
     let dls = ActiveSet {
         contact2: true,
         ..sls
     };
-    let (dls_set, dls_sol) = plastic_impact(model, q, qd, rear_on, &candidates)?;
+    let (dls_set, dls_sol) = if model.params().has_friction() {
+        let mut with_rear = candidates.clone();
+        with_rear.push(Candidate::closing(Unit::Contact(Leg::Two), model));
+        plastic_impact(model, q, qd, rear_off, &with_rear)?
+    } else {
+        plastic_impact(model, q, qd, rear_on, &candidates)?
+    };
     let lambda_i4 = dls_sol.normal_impulse(Leg::Two);
     // (B1) forces just after the DLS collision, Eqs. (6)-(7).
     let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
@@ -639,6 +339,9 @@ pub struct UnitImpact {
     pub loss: f64,
     /// The largest pulling impulse \[N s\], 0 if none pulls (contact audit).
     pub pull_impulse: f64,
+    /// The largest excess of a sticking contact's impulse over the friction cone \[N s\], 0 if none (friction
+    /// audit).
+    pub cone_impulse: f64,
 }
 
 /// A plastic impact closing `unit` (a tip landing on the ground or a leg hitting its stopper) at `(q, q')` with
@@ -685,6 +388,7 @@ pub fn close_unit(
         impulses: sol.impulses,
         loss: kinetic_loss(model, q, qd, &sol),
         pull_impulse: pull_of(model, &impulse_set, &sol),
+        cone_impulse: cone_excess(&sol.impulses, &impulse_set, model.params().friction),
     }))
 }
 
@@ -752,24 +456,27 @@ pub(crate) fn lock_swinging_leg(
     }))
 }
 
-/// A contact's normal force reached zero: the active set of the motion that follows, preferring the tip to
-/// leave the ground (it slides instead if leaving would drive it into the ground, see
-/// [`crate::params::ContactInconsistency`]).
+/// A contact changes at a force-level event: the active set of the motion that follows, with `changing` the
+/// contact's candidate and every other active unit kept. At a lift-off ([`Candidate::releasing`]) the tip
+/// preferably leaves the ground (it slides instead if leaving would drive it into the ground, see
+/// [`crate::params::ContactInconsistency`], or slips with Coulomb friction); with Coulomb friction, at the edge
+/// of the cone ([`Candidate::cone_reached`]) it slips, and where a slip stops it sticks if the cone holds it.
+/// No consistent set is [`WalkError::InconsistentContacts`]; a Painleve case is a [`WalkError::Contact`] whose
+/// source is [`ContactError::Painleve`] (status `painleve`).
 pub(crate) fn release_contact(
     model: &Model,
     time: f64,
-    q: &Coords,
-    qd: &Coords,
+    (q, qd): (&Coords, &Coords),
     active: ActiveSet,
-    leaving: Leg,
+    changing: Candidate,
 ) -> Result<ActiveSet, WalkError> {
     let phase = active.phase();
     let forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
     for leg in Leg::BOTH {
         if active.contact(leg) {
-            candidates.push(if leg == leaving {
-                Candidate::releasing(leg)
+            candidates.push(if Unit::Contact(leg) == changing.unit {
+                changing
             } else {
                 Candidate::keep(Unit::Contact(leg), &active)
             });

@@ -46,6 +46,7 @@
 //! the sampled trajectory and `work.rs` the work counts ([`WorkCounts`]).
 
 mod audit;
+mod complementarity;
 mod error;
 mod events;
 pub mod impact;
@@ -67,8 +68,9 @@ pub use impact::{Branch, DlsIndicators};
 pub(crate) use phase::{pack, unpack};
 pub use phase::{PhaseSystem, WalkState, WalkVector};
 pub use report::{
-    ContactAudit, EnergyAudit, StepReport, ENERGY_RESIDUAL_WARNING, PENETRATION_WARNING,
-    PULL_FORCE_WARNING, PULL_IMPULSE_WARNING, STOPPER_OVERRUN_WARNING,
+    ContactAudit, EnergyAudit, FrictionAudit, StepReport, CONE_VIOLATION_WARNING,
+    ENERGY_RESIDUAL_WARNING, PENETRATION_WARNING, PULL_FORCE_WARNING, PULL_IMPULSE_WARNING,
+    SLIP_POWER_WARNING, STOPPER_OVERRUN_WARNING,
 };
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
 pub use section::{ParseSectionError, SectionState};

@@ -27,7 +27,11 @@ pub struct EnergyAudit {
     /// Kinetic energy lost when a sliding leg hits its stopper, and in Zeno locks (docs/model.md section 5)
     /// \[J\].
     pub stopper: f64,
-    /// `loss - (damper + impact + stopper)` \[J\]: zero up to the integration error.
+    /// Energy the Coulomb friction force dissipated while tips slipped between impacts, `-integral of lambda_t
+    /// v_t dt` \[J\] (a finite `friction` only; the friction inside an impact is part of `impact`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
+    /// `loss - (damper + impact + stopper + friction)` \[J\]: zero up to the integration error.
     pub residual: f64,
     /// Energy removed (negative: added) after the step, at the touchdown that ends it, by discarding the old
     /// rear leg's length and rate (`rear_exit = "reset"`, docs/model.md section 5) \[J\]: `end` minus `T + V`
@@ -84,8 +88,34 @@ pub struct ContactAudit {
     /// impacts \[N s\], 0 if none (docs/model.md section 5): the small velocity the lock removes, at most about
     /// `m sqrt(2 a_out stopper_gap)`; not a pull of the ground or a stopper, so it is not in `pull_impulse`.
     pub zeno_impulse: f64,
+    /// The Coulomb friction audit (a finite `friction` only).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionAudit>,
 }
 
+/// A sticking contact's force farther than this outside the friction cone \[N\] is a warning: the slip-start
+/// event fires [`FORCE_EVENT_MARGIN`](super::events) outside it, and its time is located to `event_time_tol`.
+pub const CONE_VIOLATION_WARNING: f64 = 1e-6;
+
+/// A positive friction power above this \[W\] is a warning: the friction force of a slipping tip opposes its
+/// slip velocity, so its power is `-mu lambda_n |v_t| <= 0`; a slip that reverses without its stop event, or a
+/// pulling normal force, would make it positive.
+pub const SLIP_POWER_WARNING: f64 = 1e-9;
+
+/// The Coulomb friction audit of one step (docs/model.md section 11): the force of a sticking contact stays in
+/// the cone `|lambda_t| <= mu lambda_n`, an impulse that sticks too, and the friction force of a slipping tip
+/// never does positive work. Each field is 0 when the law holds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct FrictionAudit {
+    /// The largest `|lambda_t| - mu lambda_n` of a sticking contact seen in the step \[N\] (where the pulling
+    /// force is checked), 0 if none is outside the cone.
+    pub cone_violation: f64,
+    /// The largest `|Lambda_t| - mu Lambda_n` of a contact that stuck through an impact \[N s\], 0 if none.
+    pub cone_violation_impulse: f64,
+    /// The largest power `lambda_t v_t` of the friction force on a slipping tip \[W\] (at the quadrature points
+    /// of the friction work), 0 if it never does positive work.
+    pub slip_power: f64,
+}
 /// One step of the walk: from a touchdown to the next.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct StepReport {
@@ -131,7 +161,7 @@ impl StepReport {
     /// tolerance. A NaN value is a warning too. Empty when every law holds.
     pub fn audit_warnings(&self) -> Vec<String> {
         let c = &self.contact;
-        let checks: [(&str, f64, f64, &str, &str); 6] = [
+        let mut checks: Vec<(&str, f64, f64, &str, &str)> = vec![
             (
                 "energy residual",
                 self.energy.residual.abs(),
@@ -175,6 +205,31 @@ impl StepReport {
                 "docs/model.md section 5: lower stopper_gap",
             ),
         ];
+        if let Some(f) = &c.friction {
+            checks.extend([
+                (
+                    "friction cone violation",
+                    f.cone_violation,
+                    CONE_VIOLATION_WARNING,
+                    "N",
+                    "a sticking tip's force left the friction cone",
+                ),
+                (
+                    "impulse cone violation",
+                    f.cone_violation_impulse,
+                    PULL_IMPULSE_WARNING,
+                    "N s",
+                    "a sticking impulse left the friction cone",
+                ),
+                (
+                    "friction power",
+                    f.slip_power,
+                    SLIP_POWER_WARNING,
+                    "W",
+                    "friction did positive work on a slipping tip",
+                ),
+            ]);
+        }
         checks
             .iter()
             .filter(|(_, value, limit, _, _)| value.is_nan() || value > limit)

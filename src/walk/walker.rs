@@ -6,20 +6,20 @@
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::contact::{ActiveSet, Leg, Phase, Stop};
+use crate::contact::{constrained_dynamics, ActiveSet, Leg, Phase, Stop};
 use crate::dynamics::{swinging, Model, L3, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
 
 use super::error::WalkError;
-use super::events::{EventKind, EventSet, EVENT_SAMPLES};
+use super::events::{EventKind, EventSet, Forces, EVENT_SAMPLES};
 use super::impact::{
     close_unit, consistent_active_set, lock_swinging_leg, post_impact_candidates, release_contact,
-    touchdown_impact, touchdown_leg, Branch, TouchdownImpact, Unit,
+    touchdown_impact, touchdown_leg, Branch, Candidate, Mode, TouchdownImpact, Unit,
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::reindex::reindex;
-use super::report::{EnergyAudit, StepReport};
+use super::report::{EnergyAudit, FrictionAudit, StepReport};
 use super::section::SectionState;
 use super::tally::StepTally;
 use super::tape::StepTape;
@@ -218,6 +218,12 @@ impl<'m> Walker<'m> {
             ..StepTally::default()
         };
         tally.audit.pull_impulse = td.pull_impulse;
+        if model.params().has_friction() {
+            tally.audit.friction = Some(FrictionAudit {
+                cone_violation_impulse: td.cone_impulse,
+                ..FrictionAudit::default()
+            });
+        }
         let mut present = start.active;
         present.set_contact(Leg::One, true);
         let (forced, candidates) = post_impact_candidates(
@@ -312,7 +318,9 @@ impl<'m> Walker<'m> {
                 damper,
                 impact: tally.impact_loss,
                 stopper: tally.stopper_loss,
-                residual: loss - (damper + tally.impact_loss + tally.stopper_loss),
+                friction: model.params().has_friction().then_some(tally.friction_loss),
+                residual: loss
+                    - (damper + tally.impact_loss + tally.stopper_loss + tally.friction_loss),
                 reset: reindexed.as_ref().map_or(0.0, |r| r.3),
             },
             contact: tally.audit,
@@ -380,7 +388,7 @@ struct StepSearch {
     /// Event values at the last sample point evaluated.
     g_next: Vec<f64>,
     /// The largest pulling force at that point.
-    pull_next: f64,
+    pull_next: Forces,
     /// The states at the sample points (all of them when no event cuts the step short).
     sampled: [WalkVector; EVENT_SAMPLES],
 }
@@ -505,6 +513,9 @@ impl<'a> Phases<'a> {
         if active.contact2 {
             self.tally.rear_contact_duration += t_end - step.t0();
         }
+        if active.any_slip() {
+            self.tally.see_slip(model, active, &step, t_end);
+        }
         match hit {
             // The same points see_dense would take (t0 + (t1 - t0) i / PENETRATION_SAMPLES), evaluated once.
             None => sampled
@@ -536,7 +547,7 @@ impl<'a> Phases<'a> {
     fn search_step(&mut self, step: &DenseStep<NY>) -> StepSearch {
         let opts = self.opts;
         let mut hit: Option<(f64, usize)> = None;
-        let (mut t_a, mut pull_next) = (step.t0(), 0.0);
+        let (mut t_a, mut pull_next) = (step.t0(), Forces::NONE);
         let mut g_next = Vec::new();
         // The states at the sample points, for the penetration audit when no event cuts the step short.
         let mut sampled = [WalkVector::zeros(); EVENT_SAMPLES];
@@ -630,9 +641,27 @@ impl<'a> Phases<'a> {
                 self.y = pack(&lock.q, &lock.qd_plus, self.y[2 * NQ]);
             }
             EventKind::LiftOff(leg) => {
-                self.active = release_contact(model, t, &q, &qd, self.active, leg)?;
+                let releasing = Candidate::releasing(leg);
+                self.active = release_contact(model, t, (&q, &qd), self.active, releasing)?;
                 self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
                 self.tally.scuffing |= self.active.slide2;
+            }
+            EventKind::ConeLimit(leg) => {
+                // The tip slips against the friction force that reached the edge of the cone.
+                let dynamics = constrained_dynamics(model, &q, &qd, &self.active)
+                    .map_err(WalkError::contact_at(t, phase))?;
+                let direction = if dynamics.multipliers[leg.tangential_row()] > 0.0 {
+                    -1
+                } else {
+                    1
+                };
+                let slipping = Candidate::cone_reached(leg, direction);
+                self.active = release_contact(model, t, (&q, &qd), self.active, slipping)?;
+                self.tally.scuffing |= self.active.slide2;
+            }
+            EventKind::SlipStop(leg) => {
+                let stick = Candidate::new(Unit::Contact(leg), Mode::On);
+                self.active = release_contact(model, t, (&q, &qd), self.active, stick)?;
             }
             EventKind::Unlock(leg) => self.active.set_held(leg, Stop::Extension, false),
             EventKind::CompressionUnlock(leg) => {
@@ -654,6 +683,7 @@ impl<'a> Phases<'a> {
                 }
                 let tally = &mut self.tally;
                 tally.audit.pull_impulse = tally.audit.pull_impulse.max(closed.pull_impulse);
+                tally.see_cone_impulse(closed.cone_impulse);
                 match unit {
                     Unit::Contact(_) => tally.impact_loss += closed.loss,
                     Unit::Stop(..) => tally.stopper_loss += closed.loss,

@@ -42,6 +42,12 @@ pub struct EventCounts {
     /// Landings of the swinging leg (the step fails).
     #[serde(skip_serializing_if = "is_zero")]
     pub swing_landing: usize,
+    /// Sticking tips starting to slip (Coulomb friction: the force reached the edge of the cone).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub slip_start: usize,
+    /// Slipping tips coming to rest (Coulomb friction: stick, or slip the other way).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub slip_stop: usize,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -62,6 +68,8 @@ impl EventCounts {
         compression_unlock: 0,
         swing_lock: 0,
         swing_landing: 0,
+        slip_start: 0,
+        slip_stop: 0,
     };
 
     /// Count one event of `kind`.
@@ -78,6 +86,8 @@ impl EventCounts {
             EventKind::CompressionUnlock(_) => &mut self.compression_unlock,
             EventKind::SwingLock => &mut self.swing_lock,
             EventKind::SwingLanding => &mut self.swing_landing,
+            EventKind::ConeLimit(_) => &mut self.slip_start,
+            EventKind::SlipStop(_) => &mut self.slip_stop,
         };
         *n += 1;
     }
@@ -96,6 +106,8 @@ impl AddAssign for EventCounts {
         self.compression_unlock += o.compression_unlock;
         self.swing_lock += o.swing_lock;
         self.swing_landing += o.swing_landing;
+        self.slip_start += o.slip_start;
+        self.slip_stop += o.slip_stop;
     }
 }
 
@@ -157,6 +169,8 @@ impl WorkCounts {
                 compression_unlock: self.events.compression_unlock - e.compression_unlock,
                 swing_lock: self.events.swing_lock - e.swing_lock,
                 swing_landing: self.events.swing_landing - e.swing_landing,
+                slip_start: self.events.slip_start - e.slip_start,
+                slip_stop: self.events.slip_stop - e.slip_stop,
             },
             impacts: self.impacts - earlier.impacts,
         }

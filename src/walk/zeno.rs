@@ -135,6 +135,8 @@ fn union(a: &ActiveSet, b: &ActiveSet) -> ActiveSet {
         slide2: a.slide2 || b.slide2,
         compression1: a.compression1 || b.compression1,
         compression2: a.compression2 || b.compression2,
+        slip1: if a.slip1 != 0 { a.slip1 } else { b.slip1 },
+        slip2: if a.slip2 != 0 { a.slip2 } else { b.slip2 },
     }
 }
 

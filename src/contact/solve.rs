@@ -1,385 +1,18 @@
-//! Contacts, stoppers and the constrained dynamics (docs/model.md section 3, paper Eqs. (1)-(2), (5)-(9)).
-//!
-//! A *constraint unit* is either the no-slip contact of a leg tip with the ground (two rows: tangential and
-//! normal) or the stopper of a leg holding it at `L0` (one row, `dL/dt = 0`). The rows are stacked in the
-//! fixed order `[C1 tangential, C1 normal, C2 tangential, C2 normal, stopper 1, stopper 2]`, so the multiplier
-//! vector is `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]` as in the paper's Eq. (2); inactive rows
-//! carry zero. Accelerations and multipliers come from the KKT system
-//!
-//! ```text
-//! [ M   -J^T ] [ q'' ]   [ -h          ]
-//! [ J    0   ] [ lam ] = [ -(dJ/dt) q' ]
-//! ```
-//!
-//! solved through the Schur complement `J M^-1 J^T` (both blocks are small and symmetric positive definite).
-//! The impulse problem of Eq. (5), `M (q'+ - q'-) = J^T lambda_I`, `J q'+ = 0`, has the same structure.
+//! The solves of the constrained dynamics (docs/model.md section 3): the KKT system of accelerations and
+//! multipliers, reduced when Leg 1's tip is held, and the impulse problem of Eq. (5).
 
 use nalgebra::{SMatrix, SVector};
-use serde::Serialize;
 
+use super::{
+    ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, NROWS,
+    REDUNDANCY_TOL,
+};
 use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, L3, NQ, X, Z};
 
-/// Number of constraint rows in the fixed stacking order.
-pub(crate) const NROWS: usize = 6;
-/// Multipliers `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]`.
-pub(crate) type Multipliers = SVector<f64, NROWS>;
-type Rows = SMatrix<f64, NROWS, NQ>;
-
-/// Relative size below which a pivot of the Schur complement `J M^-1 J^T` means the active constraints are
-/// redundant (linearly dependent rows).
-pub(crate) const REDUNDANCY_TOL: f64 = 1e-12;
-
-/// One of the two legs in `q`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Leg {
-    /// Leg 1, the fore stance leg (`j = 0`).
-    One,
-    /// Leg 2, the rear leg (`j = 1`).
-    Two,
-}
-
-impl Leg {
-    /// Both legs, Leg 1 first.
-    pub const BOTH: [Leg; 2] = [Leg::One, Leg::Two];
-
-    /// The leg index `j` of docs/model.md section 1.
-    pub fn index(self) -> usize {
-        match self {
-            Leg::One => 0,
-            Leg::Two => 1,
-        }
-    }
-
-    /// Index of this leg's length in `q`.
-    pub fn length_coordinate(self) -> usize {
-        match self {
-            Leg::One => L1,
-            Leg::Two => L2,
-        }
-    }
-
-    /// Row of this leg's normal contact force in the multiplier vector.
-    pub fn normal_row(self) -> usize {
-        2 * self.index() + 1
-    }
-
-    /// Row of this leg's stopper (or compression stop: a leg is held at one of them at a time) in the
-    /// multiplier vector.
-    pub(crate) fn stopper_row(self) -> usize {
-        4 + self.index()
-    }
-}
-
-/// One of a leg's two stroke limits: the extension stopper (`L <= L0`) or the compression stop
-/// (`L >= min_length`). A leg held at either has the same constraint row `dL/dt = 0`; they differ in the
-/// direction the reaction may push and in the direction that moves the leg into the limit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stop {
-    /// The stopper at `L0`: its reaction pushes the leg inward.
-    Extension,
-    /// The compression stop at `min_length`: its reaction pushes the leg outward.
-    Compression,
-}
-
-impl Stop {
-    /// Both limits, the stopper first.
-    pub const BOTH: [Stop; 2] = [Stop::Extension, Stop::Compression];
-
-    /// `+1` for the stopper, `-1` for the compression stop: `sign * dL/dt > 0` moves the leg into the limit,
-    /// and `-sign * mu` (`mu` the multiplier of the row) is the reaction in its admissible direction.
-    pub(crate) fn sign(self) -> f64 {
-        match self {
-            Stop::Extension => 1.0,
-            Stop::Compression => -1.0,
-        }
-    }
-}
-
-/// Which constraint units are active: the contacts (C1), (C2) and the stoppers of Legs 1 and 2.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-pub struct ActiveSet {
-    /// (C1): the tip of Leg 1 is fixed on the ground.
-    pub contact1: bool,
-    /// (C2): the tip of Leg 2 is fixed on the ground.
-    pub contact2: bool,
-    /// Leg 1 is held at `L0` by its stopper.
-    pub lock1: bool,
-    /// Leg 2 is held at `L0` by its stopper.
-    pub lock2: bool,
-    /// The contact of Leg 1 slides: only its normal row is active (`lambda_1 = 0`).
-    pub slide1: bool,
-    /// The contact of Leg 2 slides: only its normal row is active (`lambda_3 = 0`).
-    pub slide2: bool,
-    /// Leg 1 is held at `min_length` by its compression stop.
-    #[serde(skip_serializing_if = "is_false")]
-    pub compression1: bool,
-    /// Leg 2 is held at `min_length` by its compression stop.
-    #[serde(skip_serializing_if = "is_false")]
-    pub compression2: bool,
-}
-
-fn is_false(b: &bool) -> bool {
-    !*b
-}
-
-impl ActiveSet {
-    /// Is the ground contact of `leg` active?
-    pub fn contact(&self, leg: Leg) -> bool {
-        match leg {
-            Leg::One => self.contact1,
-            Leg::Two => self.contact2,
-        }
-    }
-
-    /// Is the stopper of `leg` active?
-    pub fn lock(&self, leg: Leg) -> bool {
-        match leg {
-            Leg::One => self.lock1,
-            Leg::Two => self.lock2,
-        }
-    }
-
-    /// Is `leg` held at its `stop`?
-    pub fn held(&self, leg: Leg, stop: Stop) -> bool {
-        match (stop, leg) {
-            (Stop::Extension, _) => self.lock(leg),
-            (Stop::Compression, Leg::One) => self.compression1,
-            (Stop::Compression, Leg::Two) => self.compression2,
-        }
-    }
-
-    /// Is `leg` held at either of its stops (its length constraint row active)?
-    pub(crate) fn length_held(&self, leg: Leg) -> bool {
-        self.held(leg, Stop::Extension) || self.held(leg, Stop::Compression)
-    }
-
-    /// Does the contact of `leg` slide (normal constraint only)?
-    pub(crate) fn slide(&self, leg: Leg) -> bool {
-        match leg {
-            Leg::One => self.slide1,
-            Leg::Two => self.slide2,
-        }
-    }
-
-    /// Set the ground contact of `leg` as a no-slip contact (`on`) or open it.
-    pub(crate) fn set_contact(&mut self, leg: Leg, on: bool) {
-        match leg {
-            Leg::One => (self.contact1, self.slide1) = (on, false),
-            Leg::Two => (self.contact2, self.slide2) = (on, false),
-        }
-    }
-
-    /// Make the contact of `leg` a sliding one (normal row only).
-    pub(crate) fn set_sliding(&mut self, leg: Leg) {
-        match leg {
-            Leg::One => (self.contact1, self.slide1) = (true, true),
-            Leg::Two => (self.contact2, self.slide2) = (true, true),
-        }
-    }
-
-    /// Set the stopper of `leg`.
-    pub(crate) fn set_lock(&mut self, leg: Leg, on: bool) {
-        match leg {
-            Leg::One => self.lock1 = on,
-            Leg::Two => self.lock2 = on,
-        }
-    }
-
-    /// Hold `leg` at its `stop` (`on`) or free it from that stop.
-    pub(crate) fn set_held(&mut self, leg: Leg, stop: Stop, on: bool) {
-        match (stop, leg) {
-            (Stop::Extension, _) => self.set_lock(leg, on),
-            (Stop::Compression, Leg::One) => self.compression1 = on,
-            (Stop::Compression, Leg::Two) => self.compression2 = on,
-        }
-    }
-
-    /// Which rows of the fixed stacking are active.
-    pub(crate) fn row_mask(&self) -> [bool; NROWS] {
-        [
-            self.contact1 && !self.slide1,
-            self.contact1,
-            self.contact2 && !self.slide2,
-            self.contact2,
-            self.length_held(Leg::One),
-            self.length_held(Leg::Two),
-        ]
-    }
-
-    /// Double-limb support in the paper's sense: (C1) and (C2) both hold, both tips on the ground without
-    /// slipping.
-    pub(crate) fn double_support(&self) -> bool {
-        self.contact1 && self.contact2 && !self.slide1 && !self.slide2
-    }
-
-    /// The support phase named by its contacts (docs/model.md section 4).
-    pub(crate) fn phase(&self) -> Phase {
-        match (self.contact1, self.contact2) {
-            (true, true) => Phase::DoubleSupport,
-            (true, false) => Phase::SingleSupport,
-            (false, true) => Phase::RearSupport,
-            (false, false) => Phase::Flight,
-        }
-    }
-}
-
-#[cfg(test)]
-impl ActiveSet {
-    /// Every active set: the six flags in all combinations (a sliding flag without its contact is the same as no
-    /// contact), for tests that check a solve on all of them.
-    pub(crate) fn all() -> impl Iterator<Item = ActiveSet> {
-        (0..1u32 << 6).map(|bits| {
-            let on = |b: u32| bits & (1 << b) != 0;
-            ActiveSet {
-                contact1: on(0),
-                contact2: on(1),
-                lock1: on(2),
-                lock2: on(3),
-                slide1: on(4),
-                slide2: on(5),
-                // The compression stops have the stoppers' rows: the sets above cover their solves.
-                compression1: false,
-                compression2: false,
-            }
-        })
-    }
-}
-
-/// Support phase, named by which tips are on the ground.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Phase {
-    /// Both Leg 1 and Leg 2 on the ground (DLS).
-    DoubleSupport,
-    /// Only Leg 1 on the ground (SLS).
-    SingleSupport,
-    /// Only Leg 2 on the ground (Leg 1 bounced).
-    RearSupport,
-    /// No leg on the ground.
-    Flight,
-}
-
-impl std::fmt::Display for Phase {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Phase::DoubleSupport => "DLS",
-            Phase::SingleSupport => "SLS",
-            Phase::RearSupport => "rear support",
-            Phase::Flight => "flight",
-        })
-    }
-}
-
-/// The constraint system could not be solved.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum ContactError {
-    /// `M(q)` lost positive definiteness (a degenerate configuration).
-    #[error("mass matrix is not positive definite")]
-    SingularMass,
-    /// The active constraints are redundant (e.g. both legs on the ground and both on their stoppers).
-    #[error("active constraints are redundant ({0})")]
-    RedundantConstraints(ActiveSet),
-}
-
-/// The active units in words, e.g. `Leg 1 tip fixed, Leg 2 tip sliding, Leg 2 stopper locked`.
-impl std::fmt::Display for ActiveSet {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mut units = Vec::new();
-        for (contact, slide, lock, compression, leg) in [
-            (self.contact1, self.slide1, self.lock1, self.compression1, 1),
-            (self.contact2, self.slide2, self.lock2, self.compression2, 2),
-        ] {
-            match (contact, slide) {
-                (true, false) => units.push(format!("Leg {leg} tip fixed")),
-                (true, true) => units.push(format!("Leg {leg} tip sliding")),
-                (false, _) => {}
-            }
-            if lock {
-                units.push(format!("Leg {leg} stopper locked"));
-            }
-            if compression {
-                units.push(format!("Leg {leg} compression stop locked"));
-            }
-        }
-        if units.is_empty() {
-            f.write_str("no contact, no stopper")
-        } else {
-            f.write_str(&units.join(", "))
-        }
-    }
-}
-
-/// Constrained accelerations and multipliers at one instant (the solution of the KKT system).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ConstrainedDynamics {
-    /// `q''`.
-    pub qdd: Coords,
-    /// `[lambda_1, lambda_2, lambda_3, lambda_4, mu_1, mu_2]`; zero for inactive rows. `lambda_2`, `lambda_4`
-    /// are the normal forces on Legs 1 and 2 (positive pushes the tip up); `mu_i` is the generalized force of
-    /// stopper `i` on `L_i` (negative pushes the leg inward, as a stopper must).
-    pub multipliers: Multipliers,
-}
-
-impl ConstrainedDynamics {
-    /// Normal ground force on `leg` \[N\] (positive pushes up).
-    pub(crate) fn normal_force(&self, leg: Leg) -> f64 {
-        self.multipliers[leg.normal_row()]
-    }
-
-    /// Reaction of `leg`'s `stop` \[N\], positive when it pushes the leg the way that stop may (inward for the
-    /// stopper, outward for the compression stop).
-    pub(crate) fn stop_reaction(&self, leg: Leg, stop: Stop) -> f64 {
-        -stop.sign() * self.multipliers[leg.stopper_row()]
-    }
-}
-
-/// The largest pull among the unilateral units of `active` for multipliers (forces or impulses) in the fixed
-/// stacking: a negative normal multiplier (the ground pulling a tip down), a positive stopper multiplier (a
-/// stopper pulling its leg outward) or a negative one of a compression stop (pulling its leg inward), 0 if
-/// nothing pulls. Stoppers are skipped when `bilateral_stoppers` (rigid
-/// legs, where they act both ways). This is the contact audit of every step (docs/model.md section 4).
-pub(crate) fn largest_pull(
-    multipliers: &Multipliers,
-    active: &ActiveSet,
-    bilateral_stoppers: bool,
-) -> f64 {
-    let mut pull: f64 = 0.0;
-    for leg in Leg::BOTH {
-        if active.contact(leg) {
-            pull = pull.max(-multipliers[leg.normal_row()]);
-        }
-        if active.lock(leg) && !bilateral_stoppers {
-            pull = pull.max(multipliers[leg.stopper_row()]);
-        }
-        if active.held(leg, Stop::Compression) {
-            pull = pull.max(-multipliers[leg.stopper_row()]);
-        }
-    }
-    pull
-}
-
-/// Result of an impulse problem (paper Eq. (5)).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ImpulseSolution {
-    /// Velocity just after the impact.
-    pub qd_plus: Coords,
-    /// Impulses in the fixed stacking; `lambda_I4 = impulses[3]` is DLS indicator 1.
-    pub impulses: Multipliers,
-}
-
-impl ImpulseSolution {
-    /// Normal impulse on `leg` \[N s\].
-    pub fn normal_impulse(&self, leg: Leg) -> f64 {
-        self.impulses[leg.normal_row()]
-    }
-
-    /// Impulse of `leg`'s `stop` \[N s\], positive in the direction that stop may push.
-    pub(crate) fn stop_impulse(&self, leg: Leg, stop: Stop) -> f64 {
-        -stop.sign() * self.impulses[leg.stopper_row()]
-    }
-}
+pub(super) type Rows = SMatrix<f64, NROWS, NQ>;
 
 /// Rows `J` of the active constraints and `dJ/dt q'`, zero where inactive.
-fn constraint_rows(
+pub(super) fn constraint_rows(
     model: &Model,
     q: &Coords,
     qd: &Coords,
@@ -463,7 +96,7 @@ fn solve_schur<const K: usize>(
 /// Only the active rows enter the solve (see `solve_active_rows`); when Leg 1's tip is held (most of the walk)
 /// the system is first reduced to `(theta, L1, L2)`, and `L3` while a leg swings (`solve_with_fixed_leg_one`).
 /// Same result as `solve_saddle` on the full stacking (tested for every active set).
-pub fn constrained_dynamics(
+pub(super) fn no_slip_dynamics(
     model: &Model,
     q: &Coords,
     qd: &Coords,
@@ -743,7 +376,7 @@ impl<const N: usize> Ldl<N> {
 }
 
 /// The collision equation (5): `M (q'+ - q'-) = J^T lambda_I`, `J q'+ = 0`, with the units of `active`.
-pub fn impulse(
+pub(super) fn no_slip_impulse(
     model: &Model,
     q: &Coords,
     qd_minus: &Coords,
@@ -794,6 +427,7 @@ pub(crate) fn swing_lock_impulse(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::{constrained_dynamics, impulse};
     use crate::dynamics::{THETA, X, Z};
     use crate::params::Params;
     use approx::assert_relative_eq;

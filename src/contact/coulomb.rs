@@ -1,0 +1,297 @@
+//! Coulomb slip in the constrained dynamics (docs/model.md section 11): the KKT system and the impulse problem
+//! when a ground contact slips with a finite friction coefficient `mu`.
+//!
+//! A slipping contact keeps its normal row `J_n q'' = -(dJ_n/dt) q'` (the tip stays on the ground) and its
+//! tangential force is not a free multiplier but `lambda_t = -s mu lambda_n` (`s = +-1` the direction of the
+//! slip), so the generalized force of the contact is `(J_n - s mu J_t)^T lambda_n`. The force columns `B` then
+//! differ from the constraint rows `A` in the slipping rows, and
+//!
+//! ```text
+//! [ M   -B^T ] [ q'' ]   [ -h          ]        (A M^-1 B^T) lambda = b - A M^-1 f,
+//! [ A    0   ] [ lam ] = [ -(dA/dt) q' ]   i.e. q'' = M^-1 (f + B^T lambda)
+//! ```
+//!
+//! with a Schur complement `A M^-1 B^T` that is no longer symmetric. It is solved by Gaussian elimination with
+//! the sticking rows (contacts, stoppers: a symmetric positive definite block) first and the slipping normal
+//! rows last, so that each slipping row's pivot is its effective normal inverse mass `w` given the other
+//! units. `w <= 0` is the Painleve case: with the slip held, a pushing normal force would accelerate the tip
+//! into the ground (or a pulling one away from it), so that the force-level problem has no solution or two
+//! ([`ContactError::Painleve`]). The impulse problem `M (q'+ - q'-) = B^T Lambda`, `A q'+ = 0` has the same
+//! structure (a Coulomb impulse `Lambda_t = -s mu Lambda_n`).
+//!
+//! Hand-written elimination (at most six rows) rather than nalgebra's LU: the order of the pivots is what
+//! tells the Painleve case from a redundant set, and a pivoting LU would reorder them.
+
+use nalgebra::SMatrix;
+
+use super::solve::{constraint_rows, Rows};
+use super::{
+    ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, NROWS,
+    REDUNDANCY_TOL,
+};
+use crate::dynamics::{Coords, Model, NQ};
+
+/// Accelerations and multipliers of Eq. (1) with the units of `active`, some of whose contacts slip with
+/// Coulomb friction (`active.slip1`, `active.slip2`); the tangential multiplier of a slipping contact is its
+/// friction force `-s mu lambda_n`.
+pub(crate) fn slipping_dynamics(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: &ActiveSet,
+) -> Result<ConstrainedDynamics, ContactError> {
+    let (m, h) = model.mass_and_bias(q, qd);
+    let (rows, jdq) = constraint_rows(model, q, qd, active);
+    let columns = force_columns(model, q, qd, active, &rows);
+    let (qdd, multipliers) = solve(&m, &rows, &columns, active, &(-h), &(-jdq))?;
+    Ok(ConstrainedDynamics {
+        qdd,
+        multipliers: with_friction(model, active, multipliers),
+    })
+}
+
+/// The collision equation (5) with the units of `active`, some of whose contacts slip through the impact with
+/// a Coulomb impulse `Lambda_t = -s mu Lambda_n` (reported in the tangential row).
+pub(crate) fn slipping_impulse(
+    model: &Model,
+    q: &Coords,
+    qd_minus: &Coords,
+    active: &ActiveSet,
+) -> Result<ImpulseSolution, ContactError> {
+    let m = model.mass_matrix(q);
+    let (rows, _) = constraint_rows(model, q, qd_minus, active);
+    let columns = force_columns(model, q, qd_minus, active, &rows);
+    let rhs = -(rows * qd_minus);
+    let (dqd, impulses) = solve(&m, &rows, &columns, active, &Coords::zeros(), &rhs)?;
+    Ok(ImpulseSolution {
+        qd_plus: qd_minus + dqd,
+        impulses: with_friction(model, active, impulses),
+    })
+}
+
+/// The force columns `B` (as rows): the constraint rows, except that a slipping contact's normal row carries
+/// its friction, `J_n - s mu J_t`.
+fn force_columns(model: &Model, q: &Coords, qd: &Coords, active: &ActiveSet, rows: &Rows) -> Rows {
+    let mu = model.params().friction;
+    let mut columns = *rows;
+    for leg in Leg::BOTH {
+        let s = active.slip(leg);
+        if s != 0 && active.contact(leg) {
+            let tip = model.tip(q, qd, leg.index());
+            let n = leg.normal_row();
+            for k in 0..NQ {
+                columns[(n, k)] -= f64::from(s) * mu * tip.jacobian[(0, k)];
+            }
+        }
+    }
+    columns
+}
+
+/// The friction force (impulse) `-s mu lambda_n` of each slipping contact in its tangential row.
+fn with_friction(model: &Model, active: &ActiveSet, mut lam: Multipliers) -> Multipliers {
+    let mu = model.params().friction;
+    for leg in Leg::BOTH {
+        let s = active.slip(leg);
+        if s != 0 && active.contact(leg) {
+            let n = leg.normal_row();
+            lam[n - 1] = -f64::from(s) * mu * lam[n];
+        }
+    }
+    lam
+}
+
+/// Solve `M x = f + B^T lam`, `A x = b` on the active rows of `active` (see the module documentation).
+fn solve(
+    m: &SMatrix<f64, NQ, NQ>,
+    rows: &Rows,
+    columns: &Rows,
+    active: &ActiveSet,
+    f: &Coords,
+    b: &Multipliers,
+) -> Result<(Coords, Multipliers), ContactError> {
+    let chol = m.cholesky().ok_or(ContactError::SingularMass)?;
+    let x_free = chol.solve(f);
+    let minv_bt = chol.solve(&columns.transpose());
+    let mut schur = rows * minv_bt;
+    let mut rhs = b - rows * x_free;
+    let mask = active.row_mask();
+    let slipping = |i: usize| {
+        Leg::BOTH
+            .into_iter()
+            .any(|leg| active.slip(leg) != 0 && active.contact(leg) && leg.normal_row() == i)
+    };
+    for (i, on) in mask.iter().enumerate() {
+        if !on {
+            schur.row_mut(i).fill(0.0);
+            schur.column_mut(i).fill(0.0);
+            schur[(i, i)] = 1.0;
+            rhs[i] = 0.0;
+        }
+    }
+    // Sticking rows first, the slipping normal rows last.
+    let mut order: Vec<usize> = (0..NROWS).filter(|&i| !slipping(i)).collect();
+    order.extend((0..NROWS).filter(|&i| slipping(i)));
+    let lam = eliminate(schur, rhs, &order, &slipping, active)?;
+    Ok((x_free + minv_bt * lam, lam))
+}
+
+/// Gaussian elimination of `S lam = rhs` with the pivots taken in `order`; a slipping row (`slipping`) whose
+/// pivot is not positive is the Painleve case, a tiny pivot a redundant set.
+fn eliminate(
+    mut s: SMatrix<f64, NROWS, NROWS>,
+    mut rhs: Multipliers,
+    order: &[usize],
+    slipping: &dyn Fn(usize) -> bool,
+    active: &ActiveSet,
+) -> Result<Multipliers, ContactError> {
+    let scale = s.diagonal().abs().max();
+    for (k, &p) in order.iter().enumerate() {
+        let pivot = s[(p, p)];
+        if slipping(p) && pivot <= 0.0 {
+            return Err(ContactError::Painleve(*active));
+        }
+        if pivot.abs() < REDUNDANCY_TOL * scale || pivot.is_nan() {
+            return Err(ContactError::RedundantConstraints(*active));
+        }
+        for &r in &order[k + 1..] {
+            let factor = s[(r, p)] / pivot;
+            if factor != 0.0 {
+                for &c in &order[k..] {
+                    s[(r, c)] -= factor * s[(p, c)];
+                }
+                rhs[r] -= factor * rhs[p];
+            }
+        }
+    }
+    let mut lam = Multipliers::zeros();
+    for (k, &p) in order.iter().enumerate().rev() {
+        let mut sum = rhs[p];
+        for &c in &order[k + 1..] {
+            sum -= s[(p, c)] * lam[c];
+        }
+        lam[p] = sum / s[(p, p)];
+    }
+    Ok(lam)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::{constrained_dynamics, impulse};
+    use crate::dynamics::{THETA, X, Z};
+    use crate::params::Params;
+    use approx::assert_relative_eq;
+
+    fn model(friction: f64) -> Model {
+        Model::new(&Params {
+            friction,
+            ..Params::default()
+        })
+        .unwrap()
+    }
+
+    /// A double-support state with Leg 2's tip moving along the ground.
+    fn state(model: &Model) -> (Coords, Coords) {
+        let (l1, l2) = (0.9, 0.85);
+        let alpha = model.alpha();
+        let theta = ((l2 * alpha.cos() - l1) / (l2 * alpha.sin())).atan();
+        let q = Coords::new(0.0, 0.0, theta, l1, l2, 0.0);
+        (q, Coords::new(0.0, 0.0, 1.0, -0.2, 0.1, 0.0))
+    }
+
+    /// With slip, the equations of motion hold with the friction force in the tangential row, the slipping tip
+    /// stays on the ground, and the friction force is `-s mu lambda_n`.
+    #[test]
+    fn slipping_dynamics_satisfy_the_equations_of_motion_with_coulomb_friction() {
+        let model = model(0.4);
+        let (q, qd) = state(&model);
+        for s in [1, -1] {
+            let mut active = ActiveSet {
+                contact1: true,
+                ..Default::default()
+            };
+            active.set_slipping(Leg::Two, s);
+            let d = constrained_dynamics(&model, &q, &qd, &active).unwrap();
+            let (m, h) = model.mass_and_bias(&q, &qd);
+            // The full rows, the tangential one of Leg 2 included, carry the friction force.
+            let stick = ActiveSet {
+                contact1: true,
+                contact2: true,
+                ..Default::default()
+            };
+            let (rows, jdq) = constraint_rows(&model, &q, &qd, &stick);
+            assert_relative_eq!(
+                m * d.qdd + h,
+                rows.transpose() * d.multipliers,
+                epsilon = 1e-9
+            );
+            assert_relative_eq!(
+                d.multipliers[2],
+                -f64::from(s) * 0.4 * d.multipliers[3],
+                epsilon = 1e-12
+            );
+            let normal = rows.row(3) * d.qdd;
+            assert_relative_eq!(normal[0], -jdq[3], epsilon = 1e-9);
+            assert_relative_eq!(d.qdd[X], 0.0, epsilon = 1e-12);
+            assert_relative_eq!(d.qdd[Z], 0.0, epsilon = 1e-12);
+            assert!(d.qdd[THETA].is_finite());
+        }
+    }
+
+    /// With `mu = 0` a slip is the frictionless slide, in either direction.
+    #[test]
+    fn frictionless_slip_is_the_slide() {
+        let model = model(0.0);
+        let (q, qd) = state(&model);
+        let mut slide = ActiveSet {
+            contact1: true,
+            ..Default::default()
+        };
+        slide.set_sliding(Leg::Two);
+        let expected = constrained_dynamics(&model, &q, &qd, &slide).unwrap();
+        let expected_impulse = impulse(&model, &q, &qd, &slide).unwrap();
+        for s in [1, -1] {
+            let mut active = slide;
+            active.set_slipping(Leg::Two, s);
+            let d = constrained_dynamics(&model, &q, &qd, &active).unwrap();
+            assert_relative_eq!(d.qdd, expected.qdd, epsilon = 1e-10);
+            assert_relative_eq!(d.multipliers, expected.multipliers, epsilon = 1e-9);
+            let i = impulse(&model, &q, &qd, &active).unwrap();
+            assert_relative_eq!(i.qd_plus, expected_impulse.qd_plus, epsilon = 1e-12);
+        }
+    }
+
+    /// A Coulomb impulse stops the normal velocity, leaves the tangential one in the slip direction's
+    /// half-line for a consistent choice, and never adds kinetic energy when it is consistent.
+    #[test]
+    fn coulomb_impulse_stops_the_normal_velocity_and_dissipates() {
+        let model = model(0.3);
+        let (q, _) = state(&model);
+        // Leg 2's tip comes down and moves up the slope.
+        let qd = Coords::new(0.0, 0.0, -1.2, 0.3, -0.2, 0.0);
+        let mut consistent = 0;
+        for s in [1, -1] {
+            let mut active = ActiveSet {
+                contact1: true,
+                ..Default::default()
+            };
+            active.set_slipping(Leg::Two, s);
+            let sol = impulse(&model, &q, &qd, &active).unwrap();
+            let tip = model.tip(&q, &qd, Leg::Two.index());
+            let v = tip.velocity(&sol.qd_plus);
+            assert_relative_eq!(v.y, 0.0, epsilon = 1e-12);
+            assert_relative_eq!(
+                sol.impulses[2],
+                -f64::from(s) * 0.3 * sol.impulses[3],
+                epsilon = 1e-12
+            );
+            if f64::from(s) * v.x >= 0.0 && sol.impulses[3] >= 0.0 {
+                consistent += 1;
+                let lost =
+                    model.kinetic_energy(&q, &qd) - model.kinetic_energy(&q, &sol.qd_plus);
+                assert!(lost >= -1e-12, "{lost}");
+            }
+        }
+        assert_eq!(consistent, 1);
+    }
+}

@@ -1,0 +1,419 @@
+//! The complementarity problems of contacts and stops (docs/model.md sections 4 and 11): the unilateral units,
+//! their modes (off, on, a frictionless slide, a Coulomb slip), and the enumeration of active sets at force and
+//! impulse level.
+//!
+//! Unilateral units (contacts that may only push, stoppers that may only pull a leg inward, compression stops
+//! that may only push it outward) are resolved by enumerating the few possible active sets and keeping a set
+//! that satisfies complementarity: included units push the right way, excluded units do not penetrate. Where
+//! several sets qualify, the one that best matches the stated preference (keep what was active, add no stopper
+//! that is not needed, follow the paper's branch) wins, so in the regular case the result is exactly the
+//! paper's procedure. With Coulomb friction a contact is off, sticking (its force inside the cone) or slipping
+//! one way or the other (the friction force on the cone's edge, against the slip).
+
+use crate::contact::{
+    constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution,
+    Leg, Stop,
+};
+use crate::dynamics::{Coords, Model};
+use crate::params::ContactInconsistency;
+
+/// Tolerance of the complementarity checks (forces \[N\], impulses \[N s\], velocities \[m/s\], accelerations
+/// \[m/s^2\]): a value within this of zero counts as zero, so that an event located at a force or velocity
+/// zero is not undone by rounding.
+pub(crate) const COMPLEMENTARITY_TOL: f64 = 1e-9;
+
+/// Largest tangential speed of a tip that a no-slip contact may hold at force level \[m/s\]: a tip at rest up to
+/// the integration error (~1e-12 m/s, as `SECTION_TIP_SPEED_TOL` of the walk); a tip that slides faster (after a
+/// frictionless impulse) is not stuck by the force-level problem, which has no impulse to stop it.
+pub(crate) const STICK_SPEED_TOL: f64 = 1e-8;
+
+/// A unilateral unit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// Ground contact of a leg tip.
+    Contact(Leg),
+    /// One of a leg's stroke limits: its stopper or its compression stop.
+    Stop(Leg, Stop),
+}
+
+/// State of a unit in an active set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mode {
+    /// Inactive: the tip is free / the leg is free of its stopper.
+    Off,
+    /// Active: a no-slip contact, or a locked stopper.
+    On,
+    /// A contact that slides without friction (normal row only); used only when neither `On` nor `Off` is
+    /// consistent and [`ContactInconsistency::Slide`] is selected.
+    Slide,
+    /// A contact that slips with Coulomb friction (a finite `friction`) in the direction `+1` (down the slope)
+    /// or `-1`: its normal row, and the friction force on the edge of the cone against the slip.
+    Slip(i8),
+}
+
+impl Unit {
+    /// The units of `leg`: its ground contact, its stopper and its compression stop.
+    pub(crate) fn of(leg: Leg) -> [Unit; 3] {
+        [
+            Unit::Contact(leg),
+            Unit::Stop(leg, Stop::Extension),
+            Unit::Stop(leg, Stop::Compression),
+        ]
+    }
+
+    /// Put the unit in `mode` in `active`.
+    pub(crate) fn apply(self, active: &mut ActiveSet, mode: Mode) {
+        match (self, mode) {
+            (Unit::Contact(leg), Mode::Slide) => active.set_sliding(leg),
+            (Unit::Contact(leg), Mode::Slip(s)) => active.set_slipping(leg, s),
+            (Unit::Contact(leg), m) => active.set_contact(leg, m == Mode::On),
+            (Unit::Stop(leg, stop), m) => active.set_held(leg, stop, m != Mode::Off),
+        }
+    }
+
+    /// The unit's mode in `active`.
+    pub(crate) fn mode(self, active: &ActiveSet) -> Mode {
+        match self {
+            Unit::Contact(leg) if active.slip(leg) != 0 => Mode::Slip(active.slip(leg)),
+            Unit::Contact(leg) if active.slide(leg) => Mode::Slide,
+            Unit::Contact(leg) if active.contact(leg) => Mode::On,
+            Unit::Stop(leg, stop) if active.held(leg, stop) => Mode::On,
+            _ => Mode::Off,
+        }
+    }
+}
+
+/// What a candidate unit is doing at the moment its mode is resolved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Role {
+    /// Present before (or touching after an impact): any mode its kind allows.
+    Keep,
+    /// Its normal force has just fallen through zero (a lift-off event), or, with Coulomb friction, its
+    /// tangential force has just reached the edge of the cone: it may leave the ground or slide (slip), but not
+    /// stay a no-slip contact.
+    Releasing,
+    /// The unit an impact closes (a landing tip, a leg hitting its stopper): it takes the impulse, no-slip if
+    /// that impulse pushes, else (under [`ContactInconsistency::Slide`]) as a frictionless sliding contact.
+    Closing {
+        /// Sliding is allowed (the model's `inconsistent_contact = slide`).
+        allow_slide: bool,
+    },
+}
+
+/// An optional unit and the mode the caller prefers for it when several are consistent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Candidate {
+    /// The unit.
+    pub unit: Unit,
+    /// Preferred mode.
+    pub preferred: Mode,
+    /// What the unit is doing.
+    pub role: Role,
+}
+
+impl Candidate {
+    /// The candidate `unit` preferring the mode it has in `active`.
+    pub(crate) fn keep(unit: Unit, active: &ActiveSet) -> Candidate {
+        Candidate::new(unit, unit.mode(active))
+    }
+
+    /// The candidate `unit` preferring `preferred`.
+    pub(crate) fn new(unit: Unit, preferred: Mode) -> Candidate {
+        Candidate {
+            unit,
+            preferred,
+            role: Role::Keep,
+        }
+    }
+
+    /// A contact whose normal force has just reached zero: preferably it leaves; it may slide (under
+    /// [`ContactInconsistency::Slide`], or slip with Coulomb friction), but it cannot stay a no-slip contact.
+    pub(crate) fn releasing(leg: Leg) -> Candidate {
+        Candidate::released(leg, Mode::Off)
+    }
+
+    /// A sticking contact whose tangential force has just reached the edge of the friction cone: preferably
+    /// it slips in `direction` (against the force that reached the edge); it may leave, but not stick.
+    pub(crate) fn cone_reached(leg: Leg, direction: i8) -> Candidate {
+        Candidate::released(leg, Mode::Slip(direction))
+    }
+
+    fn released(leg: Leg, preferred: Mode) -> Candidate {
+        Candidate {
+            unit: Unit::Contact(leg),
+            preferred,
+            role: Role::Releasing,
+        }
+    }
+
+    /// The unit an impact closes, preferably no-slip (see [`Role::Closing`]).
+    pub(crate) fn closing(unit: Unit, model: &Model) -> Candidate {
+        Candidate {
+            unit,
+            preferred: Mode::On,
+            role: Role::Closing {
+                allow_slide: model.params().inconsistent_contact == ContactInconsistency::Slide,
+            },
+        }
+    }
+
+    /// The modes tried for this candidate. At impulse level a contact keeps its kind: a no-slip contact may
+    /// take a full (tangential and normal) impulse or none, a sliding one a frictionless normal impulse or none;
+    /// a closing unit always takes an impulse. At force level a contact may also start to slide when
+    /// `allow_slide`.
+    ///
+    /// With Coulomb friction a contact's modes are: closing, stick or slip either way (it takes the impulse);
+    /// released, off or slip; otherwise off, stick or slip, at both levels (an impulse may stop a slipping tip,
+    /// or make a sticking one slip).
+    fn modes(&self, level: Level) -> &'static [Mode] {
+        let contact = matches!(self.unit, Unit::Contact(_));
+        if contact && level.friction() {
+            return match self.role {
+                Role::Closing { .. } => &[Mode::On, Mode::Slip(1), Mode::Slip(-1)],
+                Role::Releasing => &[Mode::Off, Mode::Slip(1), Mode::Slip(-1)],
+                Role::Keep => &[Mode::Off, Mode::On, Mode::Slip(1), Mode::Slip(-1)],
+            };
+        }
+        match (self.role, level) {
+            (Role::Closing { allow_slide: true }, _) if contact => &[Mode::On, Mode::Slide],
+            (Role::Closing { .. }, _) => &[Mode::On],
+            (Role::Releasing, Level::Force { allow_slide: true, .. }) => &[Mode::Off, Mode::Slide],
+            (Role::Releasing, _) => &[Mode::Off],
+            (Role::Keep, Level::Impulse { .. }) if contact && self.preferred == Mode::Slide => {
+                &[Mode::Off, Mode::Slide]
+            }
+            (Role::Keep, Level::Force { allow_slide: true, .. }) if contact => {
+                &[Mode::Off, Mode::On, Mode::Slide]
+            }
+            _ => &[Mode::Off, Mode::On],
+        }
+    }
+
+    /// Preference score: the preferred mode 2, another regular mode 1, sliding (the last resort) 0.
+    fn score(&self, mode: Mode) -> usize {
+        if mode == self.preferred {
+            2
+        } else if mode == Mode::Slide {
+            0
+        } else {
+            1
+        }
+    }
+}
+
+/// Which complementarity problem an active set is resolved for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Level {
+    /// An impact (impulses and velocities just after it).
+    Impulse {
+        /// Contacts have Coulomb friction (a finite `friction`).
+        friction: bool,
+    },
+    /// Continuous motion (forces and accelerations).
+    Force {
+        /// Contacts may slide without friction when neither sticking nor leaving is consistent.
+        allow_slide: bool,
+        /// Contacts have Coulomb friction (a finite `friction`).
+        friction: bool,
+    },
+}
+
+impl Level {
+    fn friction(self) -> bool {
+        match self {
+            Level::Impulse { friction } | Level::Force { friction, .. } => friction,
+        }
+    }
+}
+
+/// Among `forced` plus every combination of modes of the `candidates`, the consistent set with the best
+/// preference score, or `None` if no combination is consistent. When none is and some combination with a
+/// slipping contact was the Painleve case, that is the error ([`ContactError::Painleve`]): the problem has no
+/// solution because friction made a slip inconsistent, not because the units were chosen wrong.
+fn best_subset<T>(
+    forced: ActiveSet,
+    candidates: &[Candidate],
+    level: Level,
+    mut solve: impl FnMut(&ActiveSet) -> Result<T, ContactError>,
+    mut consistent: impl FnMut(&ActiveSet, &T) -> bool,
+) -> Result<Option<(ActiveSet, T)>, ContactError> {
+    let radix: Vec<usize> = candidates.iter().map(|c| c.modes(level).len()).collect();
+    let combinations: usize = radix.iter().product();
+    let mut best: Option<(usize, ActiveSet, T)> = None;
+    let mut painleve = None;
+    for mut code in 0..combinations {
+        let mut set = forced;
+        let mut score = 0;
+        for (c, r) in candidates.iter().zip(&radix) {
+            let mode = c.modes(level)[code % r];
+            code /= r;
+            c.unit.apply(&mut set, mode);
+            score += c.score(mode);
+        }
+        if best.as_ref().is_some_and(|(s, _, _)| *s >= score) {
+            continue;
+        }
+        match solve(&set) {
+            Ok(value) if consistent(&set, &value) => best = Some((score, set, value)),
+            Ok(_) => {}
+            // A redundant set is simply not a candidate; other failures are real.
+            Err(ContactError::RedundantConstraints(_)) => {}
+            Err(ContactError::Painleve(set)) => painleve = painleve.or(Some(set)),
+            Err(e) => return Err(e),
+        }
+    }
+    match (best, painleve) {
+        (Some((_, set, value)), _) => Ok(Some((set, value))),
+        (None, Some(set)) => Err(ContactError::Painleve(set)),
+        (None, None) => Ok(None),
+    }
+}
+
+/// `forced` plus every candidate in its preferred mode.
+fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
+    let mut set = forced;
+    for c in candidates {
+        c.unit.apply(&mut set, c.preferred);
+    }
+    set
+}
+
+/// Plastic impact with the units of `forced` closing and the `candidates` taking an impulse only where they
+/// must: paper Eq. (5) with the active set resolved as an impulse-level complementarity problem (docs/model.md
+/// section 4). Every candidate either takes a non-negative impulse and ends at zero relative normal velocity,
+/// or takes none and separates (normal velocity after the impact `>= 0`, a free leg not moving past its
+/// stopper). A no-slip contact's impulse has a tangential part; a sliding contact's is normal only. If no
+/// combination is consistent the preferred one is used, and the step's contact audit
+/// ([`largest_pull`]) shows the pulling impulse.
+pub(crate) fn plastic_impact(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    forced: ActiveSet,
+    candidates: &[Candidate],
+) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
+    plastic_impact_by(model, (q, qd), forced, candidates, |set| {
+        impulse(model, q, qd, set)
+    })
+}
+
+/// [`plastic_impact`] with the collision equation solved by `solve` for each combination of units (which may
+/// add a row of its own, as the swinging leg's stopper, [`lock_swinging_leg`]).
+pub(crate) fn plastic_impact_by(
+    model: &Model,
+    (q, qd): (&Coords, &Coords),
+    forced: ActiveSet,
+    candidates: &[Candidate],
+    solve: impl Fn(&ActiveSet) -> Result<ImpulseSolution, ContactError>,
+) -> Result<(ActiveSet, ImpulseSolution), ContactError> {
+    let friction = model.params().friction;
+    let level = Level::Impulse {
+        friction: friction.is_finite(),
+    };
+    let found = best_subset(forced, candidates, level, &solve, |set, sol| {
+        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+            (Unit::Contact(leg), Mode::Off) => {
+                model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
+            }
+            (Unit::Contact(leg), Mode::On) => {
+                within_cone(friction, sol.impulses[leg.tangential_row()], sol.normal_impulse(leg))
+            }
+            // A Coulomb impulse leaves the tip moving the way it slips (or at rest).
+            (Unit::Contact(leg), Mode::Slip(s)) => {
+                let v = model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).x;
+                sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL
+                    && f64::from(s) * v >= -COMPLEMENTARITY_TOL
+            }
+            (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
+            (Unit::Stop(leg, stop), Mode::Off) => {
+                stop.sign() * sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+            }
+            (Unit::Stop(leg, stop), _) => sol.stop_impulse(leg, stop) >= -COMPLEMENTARITY_TOL,
+        })
+    })?;
+    match found {
+        Some(found) => Ok(found),
+        None => {
+            let set = preferred_set(forced, candidates);
+            Ok((set, solve(&set)?))
+        }
+    }
+}
+
+/// The active set for continuous motion (the force-level complementarity problem): `forced` units plus the
+/// `candidates` that must push (positive normal force, inward stopper reaction) so that no excluded unit
+/// penetrates (tip accelerating into the ground, leg accelerating past its stopper). Sliding contacts are
+/// tried only under [`ContactInconsistency::Slide`]; under [`ContactInconsistency::Rebound`], when no set is
+/// consistent, the paper's (B2)/(B3) rule decides: contacts with a pulling normal force are released.
+pub(crate) fn consistent_active_set(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    forced: ActiveSet,
+    candidates: &[Candidate],
+) -> Result<Option<(ActiveSet, ConstrainedDynamics)>, ContactError> {
+    let allow_slide = model.params().inconsistent_contact == ContactInconsistency::Slide;
+    let friction = model.params().friction;
+    let solve = |set: &ActiveSet| constrained_dynamics(model, q, qd, set);
+    let level = Level::Force {
+        allow_slide,
+        friction: friction.is_finite(),
+    };
+    let found = best_subset(forced, candidates, level, solve, |set, dynamics| {
+        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+            (Unit::Contact(leg), Mode::Off) => {
+                let tip = model.tip(q, qd, leg.index());
+                (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
+            }
+            // A no-slip contact needs its tip at rest: one that slides (after a frictionless impulse) stays
+            // sliding or leaves; holding it would make the tangential force do work.
+            (Unit::Contact(leg), Mode::On) => {
+                let (lambda_t, lambda_n) = (
+                    dynamics.multipliers[leg.tangential_row()],
+                    dynamics.normal_force(leg),
+                );
+                within_cone(friction, lambda_t, lambda_n)
+                    && model.tip(q, qd, leg.index()).velocity(qd).x.abs() <= STICK_SPEED_TOL
+            }
+            // A slipping tip keeps the direction it moves in; one at rest starts to slip the way it accelerates.
+            (Unit::Contact(leg), Mode::Slip(s)) => {
+                let tip = model.tip(q, qd, leg.index());
+                let v = tip.velocity(qd).x;
+                let along = if v.abs() > STICK_SPEED_TOL {
+                    v.signum() == f64::from(s)
+                } else {
+                    let a = (tip.jacobian * dynamics.qdd + tip.velocity_product).x;
+                    f64::from(s) * a >= -COMPLEMENTARITY_TOL
+                };
+                dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL && along
+            }
+            (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
+            (Unit::Stop(leg, stop), Mode::Off) => {
+                stop.sign() * dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+            }
+            (Unit::Stop(leg, stop), _) => dynamics.stop_reaction(leg, stop) >= -COMPLEMENTARITY_TOL,
+        })
+    })?;
+    if found.is_some() || allow_slide {
+        return Ok(found);
+    }
+    // ContactInconsistency::Rebound: the paper's rule (B2)/(B3) applied literally. Start from the preferred set
+    // and release every contact whose normal force pulls, even if the released tip then falls back at once.
+    let mut set = preferred_set(forced, candidates);
+    let dynamics = solve(&set)?;
+    for c in candidates {
+        if let Unit::Contact(leg) = c.unit {
+            if set.contact(leg) && dynamics.normal_force(leg) < 0.0 {
+                set.set_contact(leg, false);
+            }
+        }
+    }
+    Ok(Some((set, solve(&set)?)))
+}
+
+/// Does a no-slip contact's force (impulse) push and lie in the friction cone, `|lambda_t| <= mu lambda_n`
+/// (within [`COMPLEMENTARITY_TOL`])? Any pushing force does without friction (`mu` infinite).
+fn within_cone(mu: f64, lambda_t: f64, lambda_n: f64) -> bool {
+    lambda_n >= -COMPLEMENTARITY_TOL
+        && (mu == f64::INFINITY || lambda_t.abs() <= mu * lambda_n.max(0.0) + COMPLEMENTARITY_TOL)
+}
