@@ -1,4 +1,4 @@
-//! Coulomb slip in the constrained dynamics (docs/model.md section 11): the KKT system and the impulse problem
+//! Coulomb slip in the constrained dynamics (docs/model.md section 12): the KKT system and the impulse problem
 //! when a ground contact slips with a finite friction coefficient `mu`.
 //!
 //! A slipping contact keeps its normal row `J_n q'' = -(dJ_n/dt) q'` (the tip stays on the ground) and its
@@ -287,11 +287,64 @@ mod tests {
             );
             if f64::from(s) * v.x >= 0.0 && sol.impulses[3] >= 0.0 {
                 consistent += 1;
-                let lost =
-                    model.kinetic_energy(&q, &qd) - model.kinetic_energy(&q, &sol.qd_plus);
+                let lost = model.kinetic_energy(&q, &qd) - model.kinetic_energy(&q, &sol.qd_plus);
                 assert!(lost >= -1e-12, "{lost}");
             }
         }
         assert_eq!(consistent, 1);
+    }
+
+    /// The Painleve case: a tip slipping on a rigid wheel whose effective normal inverse mass with friction,
+    /// `w = J_n P (J_n - s mu J_t)^T` (`P` the inverse mass with the stoppers held), is not positive has no
+    /// force solution, and is named; where `w > 0` the solve succeeds.
+    #[test]
+    fn a_non_positive_effective_normal_inverse_mass_is_the_painleve_case() {
+        use crate::dynamics::{L1, L2, L3};
+        let model = Model::new(&Params {
+            rigid_legs: true,
+            friction: 5.0,
+            ..Params::default()
+        })
+        .unwrap();
+        let mut seen = (0, 0);
+        for i in -12..=12 {
+            let q = Coords::new(0.0, 0.0, 0.1 * f64::from(i), 1.0, 1.0, 0.0);
+            let qd = Coords::new(0.0, 0.0, 0.5, 0.0, 0.0, 0.0);
+            let m = model.mass_matrix(&q);
+            let minv = m.try_inverse().unwrap();
+            let mut g = SMatrix::<f64, 3, NQ>::zeros();
+            for (row, coord) in [L1, L2, L3].into_iter().enumerate() {
+                g[(row, coord)] = 1.0;
+            }
+            let p = minv
+                - minv
+                    * g.transpose()
+                    * (g * minv * g.transpose()).try_inverse().unwrap()
+                    * g
+                    * minv;
+            let j = model.tip(&q, &qd, 0).jacobian;
+            for s in [1i8, -1] {
+                let column = j.row(1) - f64::from(s) * 5.0 * j.row(0);
+                let w = (j.row(1) * p * column.transpose())[0];
+                let mut active = ActiveSet {
+                    lock1: true,
+                    lock2: true,
+                    ..Default::default()
+                };
+                active.set_slipping(Leg::One, s);
+                match constrained_dynamics(&model, &q, &qd, &active) {
+                    Err(ContactError::Painleve(_)) => {
+                        assert!(w <= 1e-12, "theta {i}: w = {w}");
+                        seen.0 += 1;
+                    }
+                    Ok(_) => {
+                        assert!(w > 0.0, "theta {i}: w = {w}");
+                        seen.1 += 1;
+                    }
+                    Err(e) => panic!("theta {i}: {e}"),
+                }
+            }
+        }
+        assert!(seen.0 > 0 && seen.1 > 0, "{seen:?}");
     }
 }

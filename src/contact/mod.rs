@@ -336,8 +336,22 @@ impl std::fmt::Display for ActiveSet {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let mut units = Vec::new();
         for (contact, slide, slip, lock, compression, leg) in [
-            (self.contact1, self.slide1, self.slip1, self.lock1, self.compression1, 1),
-            (self.contact2, self.slide2, self.slip2, self.lock2, self.compression2, 2),
+            (
+                self.contact1,
+                self.slide1,
+                self.slip1,
+                self.lock1,
+                self.compression1,
+                1,
+            ),
+            (
+                self.contact2,
+                self.slide2,
+                self.slip2,
+                self.lock2,
+                self.compression2,
+                2,
+            ),
         ] {
             match (contact, slide, slip.signum()) {
                 (true, false, _) => units.push(format!("Leg {leg} tip fixed")),
@@ -412,7 +426,7 @@ pub(crate) fn largest_pull(
 
 /// Accelerations and multipliers of Eq. (1) with the constraints of `active` (docs/model.md section 3): the KKT
 /// system of the no-slip contacts and stoppers, or, when a contact slips with Coulomb friction, its
-/// non-symmetric form (section 11).
+/// non-symmetric form (section 12).
 ///
 /// Only the active rows enter the no-slip solve; when Leg 1's tip is held (most of the walk) the system is first
 /// reduced to `(theta, L1, L2)`, and `L3` while a leg swings. Same result as the general saddle-point solve on
@@ -431,7 +445,7 @@ pub fn constrained_dynamics(
 }
 
 /// The collision equation (5): `M (q'+ - q'-) = J^T lambda_I`, `J q'+ = 0`, with the units of `active` (a
-/// slipping contact takes a Coulomb impulse, docs/model.md section 11).
+/// slipping contact takes a Coulomb impulse, docs/model.md section 12).
 pub fn impulse(
     model: &Model,
     q: &Coords,
@@ -445,9 +459,17 @@ pub fn impulse(
     }
 }
 
-/// The largest excess `|lambda_t| - mu lambda_n` of a sticking contact of `active` over the friction cone, for
-/// multipliers (forces or impulses) in the fixed stacking; 0 if every one is inside, and always without friction
-/// (`mu` infinite). The friction audit of every step (docs/model.md section 11).
+/// The signed distance of a contact force (or impulse) `(lambda_t, lambda_n)` from the edge of the friction
+/// cone `|lambda_t| <= mu lambda_n` in the force plane, `(|lambda_t| - mu lambda_n) / sqrt(1 + mu^2)`: positive
+/// outside the cone, negative inside (for a pushing force). In newtons whatever `mu`, so that one tolerance
+/// serves a cone of any opening.
+pub(crate) fn cone_distance(mu: f64, lambda_t: f64, lambda_n: f64) -> f64 {
+    (lambda_t.abs() - mu * lambda_n) / (1.0 + mu * mu).sqrt()
+}
+
+/// The largest distance outside the friction cone ([`cone_distance`]) of the force of a sticking contact of
+/// `active`, for multipliers (forces or impulses) in the fixed stacking; 0 if every one is inside, and always
+/// without friction (`mu` infinite). The friction audit of every step (docs/model.md section 12).
 pub(crate) fn cone_excess(multipliers: &Multipliers, active: &ActiveSet, mu: f64) -> f64 {
     if mu == f64::INFINITY {
         return 0.0;
@@ -455,8 +477,11 @@ pub(crate) fn cone_excess(multipliers: &Multipliers, active: &ActiveSet, mu: f64
     let mut excess: f64 = 0.0;
     for leg in Leg::BOTH {
         if active.contact(leg) && !active.slide(leg) {
-            let (t, n) = (multipliers[leg.tangential_row()], multipliers[leg.normal_row()]);
-            excess = excess.max(t.abs() - mu * n);
+            let (t, n) = (
+                multipliers[leg.tangential_row()],
+                multipliers[leg.normal_row()],
+            );
+            excess = excess.max(cone_distance(mu, t, n));
         }
     }
     excess

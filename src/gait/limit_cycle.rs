@@ -5,7 +5,8 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 use super::derivative::{gait_jacobian, newton_jacobian, ParamDerivative};
-use super::step_map::{StepMap, StepOutcome};
+use super::step_map::{DerivativeError, StepMap, StepOutcome};
+use crate::variational::NotDifferentiable;
 use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport};
 
@@ -195,6 +196,11 @@ pub struct Gait {
     /// Estimated error of the Jacobian entries: the largest difference to the exact `DP` at tolerances
     /// [`super::derivative::DERIVATIVE_CHECK_TIGHTENING`] times tighter, or `NaN` if not estimated.
     pub jacobian_error: f64,
+    /// How `DP` was computed where it is not the exact route: `"finite_difference"` (central differences with
+    /// Richardson extrapolation, `jacobian_error` their own estimate) for a walk with Coulomb friction, whose
+    /// slip events the exact derivatives do not cover yet. Absent (`None`) for the exact route.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian_route: Option<&'static str>,
     /// `dP/dp` for the parameter of [`GaitOptions::parameter`], if one was chosen (`dP_dparam` in JSON).
     pub dp_dparam: Option<ParamDerivative>,
     /// Eigenvalues of `DP(s*)` (of `D(P^k)(s*)` for a period-k gait) as `[re, im]`, largest modulus first.
@@ -303,6 +309,23 @@ pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitO
             let mut gait = gait_at(fp, j.jacobian, j.error);
             gait.dp_dparam = j.dparam;
             gait
+        }
+        // Coulomb friction: the finite-difference route, with its own error estimate.
+        Err(DerivativeError::NotDifferentiable(NotDifferentiable::Friction { .. })) => {
+            let on = map.on_section_of(&fp.section);
+            match on.jacobian(&fp.section, options.fd_step) {
+                Ok((dp, error)) => {
+                    let mut gait = gait_at(fp, dp, error);
+                    gait.jacobian_route = Some("finite_difference");
+                    gait
+                }
+                Err(e) => {
+                    let n = on.free_coordinates().len();
+                    let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
+                    gait.jacobian_failure = Some(e.to_string());
+                    gait
+                }
+            }
         }
         Err(e) => {
             let n = map.on_section_of(&fp.section).free_coordinates().len();
@@ -532,6 +555,7 @@ pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) ->
         max_floquet,
         stability: Stability::judge(max_floquet, jacobian_error),
         jacobian_failure: None,
+        jacobian_route: None,
         stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
         rear_held: fp.rear_held,
     }

@@ -413,9 +413,7 @@ mod tests {
         let mut expected: Vec<&str> = all_keys()
             .iter()
             .copied()
-            .filter(|k| {
-                !["rear_stopper", "min_length", "touchdown_length", "friction"].contains(k)
-            })
+            .filter(|k| !["rear_stopper", "min_length", "touchdown_length", "friction"].contains(k))
             .collect();
         written.sort_unstable();
         expected.sort_unstable();

@@ -496,7 +496,8 @@ mod tests {
             let error = config.validate().unwrap_err();
             assert_eq!(key_of(&error), Some("friction"), "{bad}: {error}");
         }
-        let error = Config::from_toml_str("friction = 0.5\ninconsistent_contact = \"rebound\"").unwrap_err();
+        let error = Config::from_toml_str("friction = 0.5\ninconsistent_contact = \"rebound\"")
+            .unwrap_err();
         assert!(error.to_string().contains("rebound"), "{error}");
     }
 }

@@ -86,7 +86,7 @@ pub struct Params {
     /// no-slip contacts, with the frictionless slide of `inconsistent_contact` where no-slip is inconsistent.
     /// Finite: a contact sticks while `|lambda_t| <= mu lambda_n`, slips with `lambda_t = -mu lambda_n
     /// sign(slip velocity)` or is off, and impacts keep their impulses in the cone. Non-negative.
-    /// `docs/model.md` section 11.
+    /// `docs/model.md` section 12.
     #[serde(skip_serializing_if = "is_infinite")]
     pub friction: f64,
 }

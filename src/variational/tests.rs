@@ -110,6 +110,7 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
                 EventKind::Touchdown => "touchdown",
                 EventKind::Fall | EventKind::RollBack => "failure",
                 EventKind::SwingLock | EventKind::SwingLanding => "swinging leg",
+                EventKind::ConeLimit(_) | EventKind::SlipStop(_) => "coulomb friction",
             };
             kinds.insert(name.to_string());
             if end.impacts.len() > 1 {

@@ -1,4 +1,4 @@
-//! The complementarity problems of contacts and stops (docs/model.md sections 4 and 11): the unilateral units,
+//! The complementarity problems of contacts and stops (docs/model.md sections 4 and 12): the unilateral units,
 //! their modes (off, on, a frictionless slide, a Coulomb slip), and the enumeration of active sets at force and
 //! impulse level.
 //!
@@ -11,8 +11,8 @@
 //! one way or the other (the friction force on the cone's edge, against the slip).
 
 use crate::contact::{
-    constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution,
-    Leg, Stop,
+    cone_distance, constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError,
+    ImpulseSolution, Leg, Stop,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
@@ -177,14 +177,22 @@ impl Candidate {
         match (self.role, level) {
             (Role::Closing { allow_slide: true }, _) if contact => &[Mode::On, Mode::Slide],
             (Role::Closing { .. }, _) => &[Mode::On],
-            (Role::Releasing, Level::Force { allow_slide: true, .. }) => &[Mode::Off, Mode::Slide],
+            (
+                Role::Releasing,
+                Level::Force {
+                    allow_slide: true, ..
+                },
+            ) => &[Mode::Off, Mode::Slide],
             (Role::Releasing, _) => &[Mode::Off],
             (Role::Keep, Level::Impulse { .. }) if contact && self.preferred == Mode::Slide => {
                 &[Mode::Off, Mode::Slide]
             }
-            (Role::Keep, Level::Force { allow_slide: true, .. }) if contact => {
-                &[Mode::Off, Mode::On, Mode::Slide]
-            }
+            (
+                Role::Keep,
+                Level::Force {
+                    allow_slide: true, ..
+                },
+            ) if contact => &[Mode::Off, Mode::On, Mode::Slide],
             _ => &[Mode::Off, Mode::On],
         }
     }
@@ -315,9 +323,11 @@ pub(crate) fn plastic_impact_by(
             (Unit::Contact(leg), Mode::Off) => {
                 model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
             }
-            (Unit::Contact(leg), Mode::On) => {
-                within_cone(friction, sol.impulses[leg.tangential_row()], sol.normal_impulse(leg))
-            }
+            (Unit::Contact(leg), Mode::On) => within_cone(
+                friction,
+                sol.impulses[leg.tangential_row()],
+                sol.normal_impulse(leg),
+            ),
             // A Coulomb impulse leaves the tip moving the way it slips (or at rest).
             (Unit::Contact(leg), Mode::Slip(s)) => {
                 let v = model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).x;
@@ -415,5 +425,118 @@ pub(crate) fn consistent_active_set(
 /// (within [`COMPLEMENTARITY_TOL`])? Any pushing force does without friction (`mu` infinite).
 fn within_cone(mu: f64, lambda_t: f64, lambda_n: f64) -> bool {
     lambda_n >= -COMPLEMENTARITY_TOL
-        && (mu == f64::INFINITY || lambda_t.abs() <= mu * lambda_n.max(0.0) + COMPLEMENTARITY_TOL)
+        && (mu == f64::INFINITY
+            || cone_distance(mu, lambda_t, lambda_n.max(0.0)) <= COMPLEMENTARITY_TOL)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::{L1, L2, L3, NQ, X};
+    use crate::params::Params;
+    use nalgebra::{Matrix2, SMatrix, Vector2};
+
+    /// A rigid wheel (its stoppers bilateral) with coefficient `mu` on slope `slope`.
+    fn rigid(mu: f64, slope: f64) -> Model {
+        Model::new(&Params {
+            rigid_legs: true,
+            friction: mu,
+            slope,
+            ..Params::default()
+        })
+        .unwrap()
+    }
+
+    fn bilateral() -> ActiveSet {
+        ActiveSet {
+            lock1: true,
+            lock2: true,
+            ..Default::default()
+        }
+    }
+
+    /// The wheel standing on Leg 1 with its hub straight above the tip along gravity (`theta = -phi`) is in
+    /// equilibrium with a contact force along the leg, `|lambda_t| / lambda_n = tan phi`: it sticks where
+    /// `mu >= tan phi` and slips down the slope (with the friction force on the cone's edge) where not.
+    #[test]
+    fn a_wheel_balanced_on_one_leg_sticks_exactly_up_to_mu_equal_tan_phi() {
+        let slope: f64 = 0.3;
+        for (mu, sticks) in [(slope.tan() * 1.001, true), (slope.tan() * 0.999, false)] {
+            let model = rigid(mu, slope);
+            let q = Coords::new(0.0, 0.0, -slope, 1.0, 1.0, 0.0);
+            let candidates = [Candidate::new(Unit::Contact(Leg::One), Mode::On)];
+            let (set, d) =
+                consistent_active_set(&model, &q, &Coords::zeros(), bilateral(), &candidates)
+                    .unwrap()
+                    .unwrap();
+            let (t, n) = (d.multipliers[0], d.multipliers[1]);
+            if sticks {
+                assert!(set.contact1 && !set.slide1, "{set}");
+                assert!((t / n + slope.tan()).abs() < 1e-12, "{t} {n}");
+                assert!(d.qdd.amax() < 1e-12);
+            } else {
+                assert_eq!(set.slip1, 1, "{set}");
+                assert!((t + mu * n).abs() < 1e-12 * n, "{t} {n}");
+                assert!(d.qdd[X] > 0.0, "the tip slips down the slope: {}", d.qdd[X]);
+            }
+        }
+    }
+
+    /// The plastic impact of one tip with Coulomb friction against its closed form: with `W` the tip's inverse
+    /// mass matrix (tangential, normal rows; the wheel's stoppers held), the impulse sticks, `Lambda = -W^-1 v-`,
+    /// if that lies in the cone; else it slips in the direction `s` for which `Lambda_n = -v_n / (W_nn - s mu
+    /// W_nt)`, `Lambda_t = -s mu Lambda_n` leave the tip moving along `s`. It never adds kinetic energy.
+    #[test]
+    fn an_oblique_landing_takes_the_closed_form_coulomb_impulse() {
+        let q = Coords::new(0.0, 0.0, -0.2, 1.0, 1.0, 0.0);
+        let mut regimes = (0, 0);
+        for mu in [0.05, 0.2, 0.5, 1.0, 1000.0] {
+            for (vx, vz, thetadot) in [(0.3, -0.5, 0.4), (-0.2, -0.7, 1.1), (0.9, -0.2, -0.3)] {
+                let model = rigid(mu, 0.1);
+                let qd = Coords::new(vx, vz, thetadot, 0.0, 0.0, 0.0);
+                let closing = [Candidate::closing(Unit::Contact(Leg::One), &model)];
+                let (set, sol) = plastic_impact(&model, &q, &qd, bilateral(), &closing).unwrap();
+                // W = J P J^T with P the inverse mass with the stoppers held (L1, L2, L3 fixed).
+                let m = model.mass_matrix(&q);
+                let minv = m.try_inverse().unwrap();
+                let mut g = SMatrix::<f64, 3, NQ>::zeros();
+                for (row, coord) in [L1, L2, L3].into_iter().enumerate() {
+                    g[(row, coord)] = 1.0;
+                }
+                let gmg = (g * minv * g.transpose()).try_inverse().unwrap();
+                let p = minv - minv * g.transpose() * gmg * g * minv;
+                let j = model.tip(&q, &qd, 0).jacobian;
+                let w: Matrix2<f64> = j * p * j.transpose();
+                let v: Vector2<f64> = j * qd;
+                let stick = -w.try_inverse().unwrap() * v;
+                let expected = if stick.x.abs() <= mu * stick.y {
+                    regimes.0 += 1;
+                    assert!(set.contact1 && !set.slide1, "mu {mu}: {set}");
+                    stick
+                } else {
+                    regimes.1 += 1;
+                    let slip = [1.0, -1.0].into_iter().find_map(|s: f64| {
+                        let n = -v.y / (w[(1, 1)] - s * mu * w[(1, 0)]);
+                        let t = -s * mu * n;
+                        let vt = v.x + w[(0, 1)] * n + w[(0, 0)] * t;
+                        (n >= 0.0 && s * vt >= 0.0).then_some((s, Vector2::new(t, n)))
+                    });
+                    let (s, impulse) = slip.expect("a consistent slip");
+                    assert_eq!(f64::from(set.slip1), s, "mu {mu}: {set}");
+                    impulse
+                };
+                let got = Vector2::new(sol.impulses[0], sol.impulses[1]);
+                assert!(
+                    (got - expected).amax() < 1e-10,
+                    "mu {mu}: {got} vs {expected}"
+                );
+                let after = model.tip(&q, &qd, 0).velocity(&sol.qd_plus);
+                assert!(after.y.abs() < 1e-12);
+                let lost = model.kinetic_energy(&q, &qd) - model.kinetic_energy(&q, &sol.qd_plus);
+                assert!(lost >= -1e-12, "mu {mu}: energy gained {lost}");
+            }
+        }
+        // Both regimes were met.
+        assert!(regimes.0 > 0 && regimes.1 > 0, "{regimes:?}");
+    }
 }

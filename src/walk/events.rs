@@ -3,7 +3,8 @@
 //! [`APPROACH_GAP`]). The table of event functions is in the [module documentation](super).
 
 use crate::contact::{
-    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics, Leg, Stop,
+    cone_distance, cone_excess, constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics,
+    Leg, Stop,
 };
 use crate::dynamics::{swinging, Coords, Model, L3, THETA};
 use crate::params::SolverOptions;
@@ -31,11 +32,6 @@ pub(crate) const APPROACH_GAP: f64 = 1e-12;
 /// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
 /// however long the steps of a high-order integrator are.
 pub(crate) const EVENT_SAMPLES: usize = 4;
-
-/// The grazing guard of a slip-stop event \[m/s\]: a tip that starts to slip from rest (its speed 0) is armed
-/// to stop once its slip speed exceeds this; one that stops again before, stops when it moves this fast the
-/// other way. The same size as the speed a no-slip contact may hold (`STICK_SPEED_TOL`).
-pub(crate) const SLIP_ARMING_SPEED: f64 = 1e-8;
 
 /// Kinds of events (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -211,7 +207,6 @@ impl<'a> EventSet<'a> {
     fn guard(opts: &SolverOptions, kind: EventKind) -> Option<f64> {
         match kind {
             EventKind::Landing(_) => Some(opts.recontact_gap),
-            EventKind::SlipStop(_) => Some(SLIP_ARMING_SPEED),
             EventKind::StopperHit(_) | EventKind::CompressionHit(_) | EventKind::SwingLock => {
                 Some(opts.stopper_gap)
             }
@@ -267,8 +262,8 @@ impl<'a> EventSet<'a> {
             EventKind::SwingLock => self.model.params().stopper_length - q[L3],
             EventKind::SwingLanding => self.model.tip_height(q, SWING_LEG),
             EventKind::ConeLimit(leg) => force(&|d| {
-                self.model.params().friction * d.normal_force(leg)
-                    - d.multipliers[leg.tangential_row()].abs()
+                let (t, n) = (d.multipliers[leg.tangential_row()], d.normal_force(leg));
+                -cone_distance(self.model.params().friction, t, n)
             }),
             EventKind::SlipStop(leg) => {
                 let v = self.model.tip(q, qd, leg.index()).velocity(qd).x;

@@ -11,8 +11,6 @@ use crate::contact::{
 use crate::dynamics::{Coords, LegIndex, Model, L3, THETA};
 use crate::params::ImpactModel;
 
-use super::error::WalkError;
-
 pub use super::complementarity::Unit;
 pub(crate) use super::complementarity::{
     consistent_active_set, plastic_impact, plastic_impact_by, Candidate, Mode, COMPLEMENTARITY_TOL,
@@ -68,7 +66,6 @@ impl std::fmt::Display for Branch {
         })
     }
 }
-
 
 /// What the touchdown impact produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,7 +144,7 @@ fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
 /// frictionless one when a no-slip impulse would pull, as on a leg that lands behind the hub after a flight.
 /// With Coulomb friction (a finite `friction`) both tips of the (A1) collision take an impulse that sticks
 /// where the cone holds the no-slip impulse and slips with a Coulomb impulse where it does not
-/// (docs/model.md section 11); `lambda_I4` is then the normal impulse of that collision.
+/// (docs/model.md section 12); `lambda_I4` is then the normal impulse of that collision.
 ///
 /// With [`ImpactModel::Traditional`] the indicators are still computed and reported, but the collision is
 /// always the `J_SLS` one. With `rigid_legs` the stoppers act both ways and the exchange is the traditional
@@ -454,43 +451,6 @@ pub(crate) fn lock_swinging_leg(
         loss: model.energy(q, qd) - model.energy(&q_spoke, &qd_plus),
         pull_impulse,
     }))
-}
-
-/// A contact changes at a force-level event: the active set of the motion that follows, with `changing` the
-/// contact's candidate and every other active unit kept. At a lift-off ([`Candidate::releasing`]) the tip
-/// preferably leaves the ground (it slides instead if leaving would drive it into the ground, see
-/// [`crate::params::ContactInconsistency`], or slips with Coulomb friction); with Coulomb friction, at the edge
-/// of the cone ([`Candidate::cone_reached`]) it slips, and where a slip stops it sticks if the cone holds it.
-/// No consistent set is [`WalkError::InconsistentContacts`]; a Painleve case is a [`WalkError::Contact`] whose
-/// source is [`ContactError::Painleve`] (status `painleve`).
-pub(crate) fn release_contact(
-    model: &Model,
-    time: f64,
-    (q, qd): (&Coords, &Coords),
-    active: ActiveSet,
-    changing: Candidate,
-) -> Result<ActiveSet, WalkError> {
-    let phase = active.phase();
-    let forced = bilateral_stoppers(model);
-    let mut candidates = Vec::new();
-    for leg in Leg::BOTH {
-        if active.contact(leg) {
-            candidates.push(if Unit::Contact(leg) == changing.unit {
-                changing
-            } else {
-                Candidate::keep(Unit::Contact(leg), &active)
-            });
-        }
-        for stop in Stop::BOTH {
-            if active.held(leg, stop) && !forced.held(leg, stop) {
-                candidates.push(Candidate::keep(Unit::Stop(leg, stop), &active));
-            }
-        }
-    }
-    let (new_active, _) = consistent_active_set(model, q, qd, forced, &candidates)
-        .map_err(WalkError::contact_at(time, phase))?
-        .ok_or(WalkError::InconsistentContacts { time, phase })?;
-    Ok(new_active)
 }
 
 /// Kinetic energy an impact from `q'` to `sol.qd_plus` takes away \[J\].

@@ -47,6 +47,7 @@
 
 mod audit;
 mod complementarity;
+mod contact_event;
 mod error;
 mod events;
 pub mod impact;

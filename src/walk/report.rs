@@ -102,15 +102,16 @@ pub const CONE_VIOLATION_WARNING: f64 = 1e-6;
 /// pulling normal force, would make it positive.
 pub const SLIP_POWER_WARNING: f64 = 1e-9;
 
-/// The Coulomb friction audit of one step (docs/model.md section 11): the force of a sticking contact stays in
+/// The Coulomb friction audit of one step (docs/model.md section 12): the force of a sticking contact stays in
 /// the cone `|lambda_t| <= mu lambda_n`, an impulse that sticks too, and the friction force of a slipping tip
 /// never does positive work. Each field is 0 when the law holds.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct FrictionAudit {
-    /// The largest `|lambda_t| - mu lambda_n` of a sticking contact seen in the step \[N\] (where the pulling
-    /// force is checked), 0 if none is outside the cone.
+    /// The largest distance outside the friction cone, `(|lambda_t| - mu lambda_n) / sqrt(1 + mu^2)`, of a
+    /// sticking contact's force seen in the step \[N\] (where the pulling force is checked), 0 if none is
+    /// outside.
     pub cone_violation: f64,
-    /// The largest `|Lambda_t| - mu Lambda_n` of a contact that stuck through an impact \[N s\], 0 if none.
+    /// The same for a contact that stuck through an impact \[N s\], 0 if none.
     pub cone_violation_impulse: f64,
     /// The largest power `lambda_t v_t` of the friction force on a slipping tip \[W\] (at the quadrature points
     /// of the friction work), 0 if it never does positive work.

@@ -6,8 +6,9 @@ use crate::dynamics::Model;
 use crate::integrate::DenseStep;
 
 use super::impact::SwingLock;
+use super::impact::{Branch, TouchdownImpact};
 use super::phase::{unpack, NY};
-use super::report::ContactAudit;
+use super::report::{ContactAudit, FrictionAudit};
 use super::zeno::ZenoLock;
 
 /// Bookkeeping of the step in progress.
@@ -34,6 +35,24 @@ pub(super) struct StepTally {
 }
 
 impl StepTally {
+    /// The tally of a step right after its touchdown impact `td`: its loss, a bounce, its pulling impulse and,
+    /// with Coulomb friction, its impulse's excess over the cone.
+    pub(super) fn after_touchdown(model: &Model, td: &TouchdownImpact) -> StepTally {
+        let mut tally = StepTally {
+            impact_loss: td.loss,
+            bounce: td.branch == Branch::Bounce,
+            ..StepTally::default()
+        };
+        tally.audit.pull_impulse = td.pull_impulse;
+        if model.params().has_friction() {
+            tally.audit.friction = Some(FrictionAudit {
+                cone_violation_impulse: td.cone_impulse,
+                ..FrictionAudit::default()
+            });
+        }
+        tally
+    }
+
     /// Account for the slip of some tips over the dense output of `step` up to `until`: the friction work, by
     /// Gauss-Legendre quadrature ([`slip_work`]), to the energy audit, and the largest friction power to the
     /// friction audit.

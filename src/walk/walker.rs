@@ -6,20 +6,21 @@
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::contact::{constrained_dynamics, ActiveSet, Leg, Phase, Stop};
+use crate::contact::{ActiveSet, Leg, Phase, Stop};
 use crate::dynamics::{swinging, Model, L3, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
 
+use super::contact_event::contact_event;
 use super::error::WalkError;
 use super::events::{EventKind, EventSet, Forces, EVENT_SAMPLES};
 use super::impact::{
-    close_unit, consistent_active_set, lock_swinging_leg, post_impact_candidates, release_contact,
-    touchdown_impact, touchdown_leg, Branch, Candidate, Mode, TouchdownImpact, Unit,
+    close_unit, consistent_active_set, lock_swinging_leg, post_impact_candidates, touchdown_impact,
+    touchdown_leg, TouchdownImpact, Unit,
 };
 use super::phase::{pack, unpack, PhaseSystem, WalkState, WalkVector, NY};
 use super::reindex::reindex;
-use super::report::{EnergyAudit, FrictionAudit, StepReport};
+use super::report::{EnergyAudit, StepReport};
 use super::section::SectionState;
 use super::tally::StepTally;
 use super::tape::StepTape;
@@ -212,18 +213,7 @@ impl<'m> Walker<'m> {
         if let Some(tape) = tape.as_deref_mut() {
             tape.impact(td.impulse_set);
         }
-        let mut tally = StepTally {
-            impact_loss: td.loss,
-            bounce: td.branch == Branch::Bounce,
-            ..StepTally::default()
-        };
-        tally.audit.pull_impulse = td.pull_impulse;
-        if model.params().has_friction() {
-            tally.audit.friction = Some(FrictionAudit {
-                cone_violation_impulse: td.cone_impulse,
-                ..FrictionAudit::default()
-            });
-        }
+        let mut tally = StepTally::after_touchdown(model, &td);
         let mut present = start.active;
         present.set_contact(Leg::One, true);
         let (forced, candidates) = post_impact_candidates(
@@ -640,28 +630,10 @@ impl<'a> Phases<'a> {
                 self.active = lock.active;
                 self.y = pack(&lock.q, &lock.qd_plus, self.y[2 * NQ]);
             }
-            EventKind::LiftOff(leg) => {
-                let releasing = Candidate::releasing(leg);
-                self.active = release_contact(model, t, (&q, &qd), self.active, releasing)?;
+            EventKind::LiftOff(leg) | EventKind::ConeLimit(leg) | EventKind::SlipStop(leg) => {
+                self.active = contact_event(model, t, (&q, &qd), self.active, kind)?;
                 self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
                 self.tally.scuffing |= self.active.slide2;
-            }
-            EventKind::ConeLimit(leg) => {
-                // The tip slips against the friction force that reached the edge of the cone.
-                let dynamics = constrained_dynamics(model, &q, &qd, &self.active)
-                    .map_err(WalkError::contact_at(t, phase))?;
-                let direction = if dynamics.multipliers[leg.tangential_row()] > 0.0 {
-                    -1
-                } else {
-                    1
-                };
-                let slipping = Candidate::cone_reached(leg, direction);
-                self.active = release_contact(model, t, (&q, &qd), self.active, slipping)?;
-                self.tally.scuffing |= self.active.slide2;
-            }
-            EventKind::SlipStop(leg) => {
-                let stick = Candidate::new(Unit::Contact(leg), Mode::On);
-                self.active = release_contact(model, t, (&q, &qd), self.active, stick)?;
             }
             EventKind::Unlock(leg) => self.active.set_held(leg, Stop::Extension, false),
             EventKind::CompressionUnlock(leg) => {

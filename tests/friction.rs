@@ -1,0 +1,106 @@
+//! Coulomb friction at the tips (docs/model.md section 12): over a sweep of the friction coefficient and the
+//! viscosity, every step's audits are clean (the friction cone holds for sticking contacts and impulses, the
+//! friction force never does positive work, the energy audit closes with the friction work added, the ground
+//! never pulls), and walks that stop end with a named status. The closed-form checks (the balanced wheel's
+//! stick/slip threshold, the oblique landing's Coulomb impulse, the Painleve case) are unit tests of
+//! `walk::complementarity` and `contact::coulomb`.
+
+use vrw::dynamics::Model;
+use vrw::params::Config;
+use vrw::reference::default_initial;
+use vrw::walk::{simulate, StepReport, WalkError, Walker};
+
+/// Largest distance outside the friction cone of a sticking contact's force \[N\]: slip-start events fire at
+/// `FORCE_EVENT_MARGIN` = 1e-10 N outside.
+const CONE_TOL: f64 = 1e-9;
+/// Largest energy-audit residual \[J\].
+const ENERGY_TOL: f64 = 1e-8;
+
+fn config(overrides: &[String]) -> Config {
+    let mut config = Config::default();
+    for o in overrides {
+        config.apply_override(o).unwrap();
+    }
+    config.validate().unwrap();
+    config
+}
+
+/// The steps of a walk of `steps` from the default start, and how it ended (`None`: every step walked).
+fn walk(overrides: &[String], steps: usize) -> (Vec<StepReport>, Option<WalkError>) {
+    let config = config(overrides);
+    let model = Model::new(&config.params).unwrap();
+    let run = simulate(
+        &model,
+        &config.solver,
+        &default_initial(&config),
+        steps,
+        None,
+    )
+    .unwrap();
+    (run.steps, run.failure)
+}
+
+#[test]
+fn friction_audits_are_clean_over_mu_and_viscosity() {
+    let mut walked = 0;
+    let mut slipped = 0.0_f64;
+    for mu in [0.05, 0.3, 1.0, 1000.0] {
+        for c in [1.0, 20.0, 50.0, 130.0] {
+            let overrides = [format!("friction={mu}"), format!("viscosity={c}")];
+            let (steps, end) = walk(&overrides, 4);
+            if let Some(e) = end {
+                // A walk may stop (it rolls back with little friction), with a named status.
+                assert!(
+                    ["rolled_back", "fell", "rear_leg_in_contact"].contains(&e.kind()),
+                    "{overrides:?}: {e}"
+                );
+            }
+            for s in &steps {
+                let f = s.contact.friction.expect("a friction audit");
+                let what = format!("{overrides:?} step {}: {f:?} {:?}", s.step, s.energy);
+                assert!(f.cone_violation <= CONE_TOL, "{what}");
+                assert!(f.cone_violation_impulse <= CONE_TOL, "{what}");
+                assert_eq!(f.slip_power, 0.0, "{what}");
+                assert!(s.energy.residual.abs() <= ENERGY_TOL, "{what}");
+                assert!(s.contact.pull_force <= 1e-9, "{what}");
+                assert!(s.contact.pull_impulse <= 1e-9, "{what}");
+                assert!(s.audit_warnings().is_empty(), "{what}");
+                let dissipated = s.energy.friction.unwrap();
+                assert!(dissipated >= 0.0, "{what}");
+                slipped = slipped.max(dissipated);
+                walked += 1;
+            }
+        }
+    }
+    // Not vacuous: most walks go on, and tips slip.
+    assert!(walked >= 40, "only {walked} steps");
+    assert!(slipped > 1.0, "largest friction work {slipped} J");
+}
+
+/// Without friction (the default) no step has a friction audit or friction work, and the walk is the
+/// no-slip model's.
+#[test]
+fn no_friction_means_no_friction_audit() {
+    let (steps, end) = walk(&[], 3);
+    assert!(end.is_none());
+    for s in steps {
+        assert!(s.contact.friction.is_none());
+        assert!(s.energy.friction.is_none());
+    }
+}
+
+/// With friction the rear tip slips at the paper's touchdowns: its tangential impulse (10 to 25 N s) is 50 to
+/// 270 times its normal one, so with mu = 0.6 the (A1) collision slips, and the slip shows as friction work
+/// and a Leg 2 whose stick (DLS) ends before its contact does.
+#[test]
+fn the_rear_tip_slips_at_touchdown_with_realistic_friction() {
+    let config = config(&["friction=0.6".to_string()]);
+    let model = Model::new(&config.params).unwrap();
+    let mut walker = Walker::new(&model, &config.solver, &default_initial(&config)).unwrap();
+    for _ in 0..3 {
+        let s = walker.step(None).unwrap();
+        assert!(s.energy.friction.unwrap() > 0.1, "{:?}", s.energy);
+        assert!(s.dls_duration < s.rear_contact_duration, "{s:?}");
+        assert!(s.indicators.lambda_i4 > 0.0);
+    }
+}
