@@ -4,7 +4,8 @@
 //! Run with `cargo bench --bench walk` (add `-- --quick` for a fast estimate).
 //!
 //! - `walking_step`: one `Walker::step` (touchdown impact, the DLS/SLS phases and their events, re-indexing)
-//!   from a state on the gait, reached by first walking `SETTLE_STEPS` steps.
+//!   from a state on the gait, reached by first walking `SETTLE_STEPS` steps; `walking_step_friction_0.6` the
+//!   same with Coulomb friction `mu = 0.6` (the rear tip slips at every touchdown, docs/model.md section 12).
 //! - `rhs/<active set>`: one evaluation of the constrained dynamics (`vrw::contact::constrained_dynamics`,
 //!   the integrator's right-hand side) at a stance state, for the active sets the walk spends its time in.
 //! - `twenty_steps`: `vrw::walk::simulate` for 20 steps from the reference start, without a trajectory.
@@ -52,8 +53,20 @@ const WALK_STEPS: usize = 20;
 
 fn walking_step(c: &mut Criterion) {
     let config = Config::default();
+    walking_step_of(c, &config, "walking_step");
+    // Coulomb friction with a realistic coefficient: the rear tip slips at every touchdown (issue goal: within
+    // twice `walking_step`).
+    let mut friction = Config::default();
+    friction
+        .apply_override("friction=0.6")
+        .expect("a valid friction coefficient");
+    walking_step_of(c, &friction, "walking_step_friction_0.6");
+}
+
+/// One `Walker::step` on the gait of `config`, named `name`.
+fn walking_step_of(c: &mut Criterion, config: &Config, name: &str) {
     let model = Model::new(&config.params).expect("the paper's parameters are valid");
-    let mut walker = Walker::new(&model, &config.solver, &default_initial(&config))
+    let mut walker = Walker::new(&model, &config.solver, &default_initial(config))
         .expect("the reference start is a valid section state");
     for k in 0..SETTLE_STEPS {
         walker
@@ -64,7 +77,7 @@ fn walking_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("walk");
     group.sample_size(20);
     group.measurement_time(Duration::from_secs(5));
-    group.bench_function("walking_step", |b| {
+    group.bench_function(name, |b| {
         b.iter_batched(
             || walker.clone(),
             |mut w| black_box(w.step(None).expect("a step on the gait failed")),

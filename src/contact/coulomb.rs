@@ -24,12 +24,12 @@
 
 use nalgebra::SMatrix;
 
-use super::solve::{constraint_rows, Rows};
+use super::solve::{constraint_rows, Ldl, Rows};
 use super::{
     ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, NROWS,
     REDUNDANCY_TOL,
 };
-use crate::dynamics::{Coords, Model, NQ};
+use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, NQ};
 
 /// Accelerations and multipliers of Eq. (1) with the units of `active`, some of whose contacts slip with
 /// Coulomb friction (`active.slip1`, `active.slip2`); the tangential multiplier of a slipping contact is its
@@ -40,6 +40,15 @@ pub(crate) fn slipping_dynamics(
     qd: &Coords,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
+    if active.contact1 && !active.slide1 && active.slip2 != 0 {
+        // The common slip (the rear tip after a touchdown), reduced as the no-slip solve is.
+        let eom = model.equations_of_motion(q, qd);
+        return if eom.swing {
+            rear_slip::<{ NQ - 2 }>(model, &eom, active)
+        } else {
+            rear_slip::<{ NQ - 3 }>(model, &eom, active)
+        };
+    }
     let (m, h) = model.mass_and_bias(q, qd);
     let (rows, jdq) = constraint_rows(model, q, qd, active);
     let columns = force_columns(model, q, qd, active, &rows);
@@ -48,6 +57,108 @@ pub(crate) fn slipping_dynamics(
         qdd,
         multipliers: with_friction(model, active, multipliers),
     })
+}
+
+/// The KKT system with Leg 1's tip held and Leg 2's tip slipping, reduced to the `R` coordinates
+/// `(theta, L1, L2[, L3])` as the no-slip solve does (`x'' = z'' = 0`; `lambda_1`, `lambda_2` from the `x`, `z`
+/// equations): `M_rr = L D L^T`, and with `W_i = L^-1 a_i` (rows), `V_i = L^-1 b_i` (force columns), the
+/// Schur complement `S_ij = W_i . D^-1 V_j`, eliminated with the slipping row last as in [`eliminate`]. Same
+/// result as the general solve (tested).
+fn rear_slip<const R: usize>(
+    model: &Model,
+    eom: &EquationsOfMotion,
+    active: &ActiveSet,
+) -> Result<ConstrainedDynamics, ContactError> {
+    let (m, h, rear) = (&eom.mass, &eom.bias, &eom.rear_tip);
+    let slip = f64::from(active.slip2) * model.params().friction;
+    let mut chol = Ldl::<R>::zeros(R);
+    for i in 0..R {
+        for j in 0..=i {
+            chol.l[i][j] = m[(2 + i, 2 + j)];
+        }
+    }
+    if !chol.factor() {
+        return Err(ContactError::SingularMass);
+    }
+    let mut g: [f64; R] = std::array::from_fn(|i| -h[2 + i]);
+    chol.forward(&mut g);
+    // The rows (stoppers first, the slipping normal row last), their force columns, right-hand sides and
+    // places in the stacking, each row and column as L^-1 of itself.
+    let mut rows: Vec<([f64; R], [f64; R], f64, usize)> = Vec::with_capacity(3);
+    for (held, coordinate, stacked) in [
+        (active.length_held(Leg::One), L1, 4),
+        (active.length_held(Leg::Two), L2, 5),
+    ] {
+        if held {
+            let mut unit = [0.0; R];
+            unit[coordinate - 2] = 1.0;
+            chol.forward(&mut unit);
+            rows.push((unit, unit, 0.0, stacked));
+        }
+    }
+    let mut normal: [f64; R] = std::array::from_fn(|k| rear.jacobian[(1, 2 + k)]);
+    let mut column: [f64; R] =
+        std::array::from_fn(|k| normal[k] - slip * rear.jacobian[(0, 2 + k)]);
+    chol.forward(&mut normal);
+    chol.forward(&mut column);
+    rows.push((normal, column, -rear.velocity_product.y, 3));
+    let k = rows.len();
+    let dot = |u: &[f64; R], v: &[f64; R]| (0..R).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
+    let mut schur = [[0.0; 3]; 3];
+    let mut lam = [0.0; 3];
+    for i in 0..k {
+        lam[i] = rows[i].2 - dot(&rows[i].0, &g);
+        for j in 0..k {
+            schur[i][j] = dot(&rows[i].0, &rows[j].1);
+        }
+    }
+    // Inactive rows of the stacking (the slipping tip's tangential one at least) are identity rows.
+    let scale = (0..k).map(|i| schur[i][i].abs()).fold(1.0, f64::max);
+    for p in 0..k {
+        let pivot = schur[p][p];
+        if p == k - 1 && pivot <= 0.0 {
+            return Err(ContactError::Painleve(*active));
+        }
+        if pivot.abs() < REDUNDANCY_TOL * scale || pivot.is_nan() {
+            return Err(ContactError::RedundantConstraints(*active));
+        }
+        for r in p + 1..k {
+            let factor = schur[r][p] / pivot;
+            for c in p..k {
+                schur[r][c] -= factor * schur[p][c];
+            }
+            lam[r] -= factor * lam[p];
+        }
+    }
+    for p in (0..k).rev() {
+        for c in p + 1..k {
+            lam[p] -= schur[p][c] * lam[c];
+        }
+        lam[p] /= schur[p][p];
+    }
+    let mut x = g;
+    for (i, row) in rows.iter().enumerate() {
+        for l in 0..R {
+            x[l] += lam[i] * row.1[l];
+        }
+    }
+    chol.backward_scaled(&mut x);
+    let mut qdd = Coords::zeros();
+    let mut multipliers = Multipliers::zeros();
+    for (i, row) in rows.iter().enumerate() {
+        multipliers[row.3] = lam[i];
+    }
+    multipliers[2] = -slip * multipliers[3];
+    for (l, &value) in x.iter().enumerate() {
+        qdd[2 + l] = value;
+    }
+    // x and z equations: every point's rows have the identity in x, z, so (M q'' + h)_{x,z} = lambda_{1,2} +
+    // Leg 2's force (lambda_3, lambda_4), its tangential part the friction force.
+    for axis in 0..2 {
+        let generalized = (0..R).map(|k| m[(axis, 2 + k)] * x[k]).sum::<f64>() + h[axis];
+        multipliers[axis] = generalized - multipliers[2 + axis];
+    }
+    Ok(ConstrainedDynamics { qdd, multipliers })
 }
 
 /// The collision equation (5) with the units of `active`, some of whose contacts slip through the impact with
@@ -236,6 +347,55 @@ mod tests {
             assert_relative_eq!(d.qdd[Z], 0.0, epsilon = 1e-12);
             assert!(d.qdd[THETA].is_finite());
         }
+    }
+
+    /// The reduced solve of a rear slip equals the general one, with and without the stoppers held and with a
+    /// swinging leg.
+    #[test]
+    fn the_reduced_rear_slip_equals_the_general_solve() {
+        let model = model(0.7);
+        let (q, qd) = state(&model);
+        let swinging = (
+            Coords::new(0.0, 0.0, 0.4, 0.93, 1.0, 0.96),
+            Coords::new(0.0, 0.0, 1.4, 0.25, -0.6, 0.3),
+        );
+        let mut compared = 0;
+        for (q, qd) in [(q, qd), swinging] {
+            for (lock1, lock2, s) in [
+                (false, false, 1),
+                (true, false, -1),
+                (false, true, 1),
+                (true, true, -1),
+            ] {
+                let mut active = ActiveSet {
+                    contact1: true,
+                    lock1,
+                    lock2,
+                    ..Default::default()
+                };
+                active.set_slipping(Leg::Two, s);
+                let (m, h) = model.mass_and_bias(&q, &qd);
+                let (rows, jdq) = constraint_rows(&model, &q, &qd, &active);
+                let columns = force_columns(&model, &q, &qd, &active, &rows);
+                let general = solve(&m, &rows, &columns, &active, &(-h), &(-jdq))
+                    .map(|(qdd, lam)| (qdd, with_friction(&model, &active, lam)));
+                match (slipping_dynamics(&model, &q, &qd, &active), general) {
+                    (Ok(fast), Ok((qdd, lam))) => {
+                        assert_relative_eq!(fast.qdd, qdd, epsilon = 1e-10, max_relative = 1e-11);
+                        assert_relative_eq!(
+                            fast.multipliers,
+                            lam,
+                            epsilon = 1e-9,
+                            max_relative = 1e-11
+                        );
+                        compared += 1;
+                    }
+                    (Err(a), Err(b)) => assert_eq!(a, b),
+                    (a, b) => panic!("{active:?}: {a:?} but {b:?}"),
+                }
+            }
+        }
+        assert!(compared >= 6, "{compared}");
     }
 
     /// With `mu = 0` a slip is the frictionless slide, in either direction.
