@@ -122,10 +122,11 @@ fn rear_slip<const R: usize>(
         if pivot.abs() < REDUNDANCY_TOL * scale || pivot.is_nan() {
             return Err(ContactError::RedundantConstraints(*active));
         }
+        let pivot_row = schur[p];
         for r in p + 1..k {
             let factor = schur[r][p] / pivot;
-            for c in p..k {
-                schur[r][c] -= factor * schur[p][c];
+            for (entry, above) in schur[r][p..k].iter_mut().zip(&pivot_row[p..k]) {
+                *entry -= factor * above;
             }
             lam[r] -= factor * lam[p];
         }
@@ -138,8 +139,8 @@ fn rear_slip<const R: usize>(
     }
     let mut x = g;
     for (i, row) in rows.iter().enumerate() {
-        for l in 0..R {
-            x[l] += lam[i] * row.1[l];
+        for (x_l, column_l) in x.iter_mut().zip(&row.1) {
+            *x_l += lam[i] * column_l;
         }
     }
     chol.backward_scaled(&mut x);
