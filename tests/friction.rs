@@ -104,3 +104,32 @@ fn the_rear_tip_slips_at_touchdown_with_realistic_friction() {
         assert!(s.indicators.lambda_i4 > 0.0);
     }
 }
+
+/// `steps.csv` of a walk with friction has the friction work and audit columns (and only such a walk: the
+/// default header is unchanged); each row fills them.
+#[test]
+fn steps_csv_has_the_friction_columns_with_friction_only() {
+    use vrw::output::{steps_header, steps_row, StepsColumns, STEPS_HEADER};
+    let plain = StepsColumns::of(&Config::default().params);
+    assert_eq!(steps_header(plain), STEPS_HEADER.to_vec());
+    let config = config(&["friction=0.6".to_string()]);
+    let columns = StepsColumns::of(&config.params);
+    let header = steps_header(columns);
+    assert_eq!(
+        header[STEPS_HEADER.len()..],
+        [
+            "friction_loss",
+            "cone_violation",
+            "cone_violation_impulse",
+            "slip_power"
+        ]
+    );
+    let (steps, _) = walk(&["friction=0.6".to_string()], 1);
+    let row = steps_row(&steps[0], columns);
+    assert_eq!(row.len(), header.len());
+    let friction_loss = row[STEPS_HEADER.len()].to_csv();
+    assert!(
+        friction_loss.parse::<f64>().unwrap() > 0.1,
+        "{friction_loss}"
+    );
+}

@@ -36,7 +36,7 @@ use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
 use vrw::output::{
     basin_header, basin_row, branch_header, branch_rows, curve_header, curve_row, family_header,
     family_row, map_header, map_rows, orbit_header, orbit_rows, steps_header, steps_row,
-    sweep_header, sweep_row, trajectory_header, trajectory_row_under, Cell,
+    sweep_header, sweep_row, trajectory_header, trajectory_row_under, Cell, StepsColumns,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -416,13 +416,13 @@ fn simulate<'py>(
     let (summary, samples) =
         interruptible(py, &flag, || compute_simulation(&job, trajectory))?.map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
-    let rear_exit = params.config.params.rear_exit;
+    let columns = StepsColumns::of(&params.config.params);
     let rows: Vec<Vec<Cell>> = summary
         .steps
         .iter()
-        .map(|s| steps_row(s, rear_exit))
+        .map(|s| steps_row(s, columns))
         .collect();
-    result.set_item("steps", table(py, &steps_header(rear_exit), &rows)?)?;
+    result.set_item("steps", table(py, &steps_header(columns), &rows)?)?;
     match samples {
         Some(t) => {
             let rows: Vec<Vec<Cell>> = t

@@ -229,8 +229,10 @@ pub(super) fn simulate_into(
     output::write_json(&run.path("summary.json"), &running)?;
     let names: Vec<&str> = files.iter().map(String::as_str).collect();
     run.add_streaming(&names)?;
-    let mut steps_csv =
-        output::StepsCsv::create(&run.path("steps.csv"), job.config.params.rear_exit)?;
+    let mut steps_csv = output::StepsCsv::create(
+        &run.path("steps.csv"),
+        output::StepsColumns::of(&job.config.params),
+    )?;
     let trajectory_path = run.path("trajectory.csv");
     let mut trajectory = if job.trajectory {
         let sink = output::TrajectoryCsv::create(&trajectory_path, job.config.params.rear_exit)?;

@@ -34,7 +34,7 @@ pub(crate) use tables::family::{write_curves_csv, write_family_csv};
 pub(crate) use tables::map::write_map_csv;
 pub use tables::map::{map_header, map_rows};
 pub use tables::steps::{
-    step_row, steps_header, steps_row, write_steps_csv, StepsCsv, STEPS_HEADER,
+    step_row, steps_header, steps_row, write_steps_csv, StepsColumns, StepsCsv, STEPS_HEADER,
 };
 pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
 pub use tables::trajectory::{

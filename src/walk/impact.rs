@@ -1,6 +1,6 @@
 //! Touchdown: re-indexing and the DLS-indicator impact procedure (docs/model.md section 5, paper Sec. 2.2,
 //! algorithm (A1)-(A4), (B1)-(B3)), plus the plastic impacts and unilateral checks used by every other event,
-//! each resolved by the complementarity problems of [`super::complementarity`].
+//! each resolved by the complementarity problems of `walk::complementarity`.
 
 use serde::Serialize;
 
@@ -346,7 +346,7 @@ pub struct UnitImpact {
 /// set is consistent after the impact.
 ///
 /// Only the closing unit must take an impulse (no-slip if that impulse pushes, else, under
-/// [`ContactInconsistency::Slide`], a frictionless one: a no-slip impact can demand a pulling normal impulse,
+/// [`crate::params::ContactInconsistency::Slide`], a frictionless one: a no-slip impact can demand a pulling normal impulse,
 /// the impulsive form of the lift-off inconsistency). Every other unit present (each ground contact, no-slip
 /// or sliding, and each locked stopper) is a candidate of the impulse-level complementarity problem of `plastic_impact`: it takes
 /// a non-negative impulse and ends at zero relative normal velocity, or takes none and separates. Nothing is

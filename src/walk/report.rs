@@ -94,7 +94,7 @@ pub struct ContactAudit {
 }
 
 /// A sticking contact's force farther than this outside the friction cone \[N\] is a warning: the slip-start
-/// event fires [`FORCE_EVENT_MARGIN`](super::events) outside it, and its time is located to `event_time_tol`.
+/// event fires `FORCE_EVENT_MARGIN` (1e-10 N) outside it, and its time is located to `event_time_tol`.
 pub const CONE_VIOLATION_WARNING: f64 = 1e-6;
 
 /// A positive friction power above this \[W\] is a warning: the friction force of a slipping tip opposes its

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{fixed_names, row, Cell, Column};
 use crate::output::{CsvStream, OutputError};
-use crate::params::RearExit;
+use crate::params::{Params, RearExit};
 use crate::walk::StepReport;
 
 use Cell::{Count, Flag, Real, Text};
@@ -166,37 +166,84 @@ pub(crate) const RESET_COLUMN: Column<StepReport> = Column::new(
     |s| Real(s.energy.reset),
 );
 
+/// The columns of `steps.csv` of a walk with Coulomb friction (a finite `friction`, docs/model.md section 12),
+/// after [`STEPS_HEADER`] (only there, so that every other walk's file is as it was before the option
+/// existed).
+const FRICTION_COLUMNS: [Column<StepReport>; 4] = [
+    Column::new(
+        "friction_loss",
+        "Energy the Coulomb friction force dissipated while tips slipped between impacts [J]; energy_residual \
+         subtracts it too.",
+        |s| Real(s.energy.friction.unwrap_or(f64::NAN)),
+    ),
+    Column::new(
+        "cone_violation",
+        "Largest distance of a sticking contact's force outside the friction cone, (|lambda_t| - mu lambda_n) \
+         / sqrt(1 + mu^2), 0 if none [N].",
+        |s| Real(s.contact.friction.map_or(f64::NAN, |f| f.cone_violation)),
+    ),
+    Column::new(
+        "cone_violation_impulse",
+        "The same for an impulse that stuck through an impact, 0 if none [N s].",
+        |s| Real(s.contact.friction.map_or(f64::NAN, |f| f.cone_violation_impulse)),
+    ),
+    Column::new(
+        "slip_power",
+        "Largest power lambda_t v_t of the friction force on a slipping tip, 0 if it never did positive work \
+         [W].",
+        |s| Real(s.contact.friction.map_or(f64::NAN, |f| f.slip_power)),
+    ),
+];
+
 /// One row of `steps.csv`, in the order of [`STEPS_HEADER`].
 pub fn step_row(s: &StepReport) -> Vec<Cell> {
     row(&STEPS, s)
 }
 
-/// The header of `steps.csv` of a walk whose old rear legs leave as `rear_exit` says: [`STEPS_HEADER`], and
-/// the column `reset_energy` last under [`RearExit::Reset`].
-pub fn steps_header(rear_exit: RearExit) -> Vec<&'static str> {
-    let mut header = STEPS_HEADER.to_vec();
-    if rear_exit == RearExit::Reset {
-        header.push(RESET_COLUMN.header_name(&[]));
+/// Which optional columns a walk's `steps.csv` has: the friction audit and work (after [`STEPS_HEADER`]) with
+/// a finite `friction`, and `reset_energy` (last) under `rear_exit = "reset"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepsColumns {
+    friction: bool,
+    reset: bool,
+}
+
+impl StepsColumns {
+    /// The columns of a walk with `params`.
+    pub fn of(params: &Params) -> StepsColumns {
+        StepsColumns {
+            friction: params.has_friction(),
+            reset: params.rear_exit == RearExit::Reset,
+        }
     }
+
+    fn optional(self) -> impl Iterator<Item = &'static Column<StepReport>> {
+        let friction = FRICTION_COLUMNS.iter().filter(move |_| self.friction);
+        friction.chain(std::iter::once(&RESET_COLUMN).filter(move |_| self.reset))
+    }
+}
+
+/// The header of `steps.csv` with `columns`: [`STEPS_HEADER`], then the optional columns.
+pub fn steps_header(columns: StepsColumns) -> Vec<&'static str> {
+    let mut header = STEPS_HEADER.to_vec();
+    header.extend(columns.optional().map(|c| c.header_name(&[])));
     header
 }
 
-/// One row of `steps.csv` under `rear_exit`, in the order of [`steps_header`].
-pub fn steps_row(s: &StepReport, rear_exit: RearExit) -> Vec<Cell> {
+/// One row of `steps.csv` with `columns`, in the order of [`steps_header`].
+pub fn steps_row(s: &StepReport, columns: StepsColumns) -> Vec<Cell> {
     let mut cells = step_row(s);
-    if rear_exit == RearExit::Reset {
-        cells.push((RESET_COLUMN.get)(s));
-    }
+    cells.extend(columns.optional().map(|c| (c.get)(s)));
     cells
 }
 
 /// `steps.csv` written step by step (`CsvStream`).
-pub struct StepsCsv(CsvStream, RearExit);
+pub struct StepsCsv(CsvStream, StepsColumns);
 
 impl StepsCsv {
-    /// Create `path` with the header [`steps_header`] of `rear_exit`.
-    pub(crate) fn create(path: &Path, rear_exit: RearExit) -> Result<StepsCsv, OutputError> {
-        CsvStream::create(path, steps_header(rear_exit)).map(|w| StepsCsv(w, rear_exit))
+    /// Create `path` with the header [`steps_header`] of `columns`.
+    pub(crate) fn create(path: &Path, columns: StepsColumns) -> Result<StepsCsv, OutputError> {
+        CsvStream::create(path, steps_header(columns)).map(|w| StepsCsv(w, columns))
     }
 
     /// Write the row of one step and flush it.
@@ -206,13 +253,13 @@ impl StepsCsv {
     }
 }
 
-/// Write the per-step table `steps.csv` of a walk under `rear_exit`: one row per touchdown (section state
-/// before it, DLS indicators, branch, step measures, flags, the energy audit, and the contact audit).
+/// Write the per-step table `steps.csv` of a walk with `columns`: one row per touchdown (section state before
+/// it, DLS indicators, branch, step measures, flags, the energy audit, and the contact audit).
 pub fn write_steps_csv(
     path: &Path,
     steps: &[StepReport],
-    rear_exit: RearExit,
+    columns: StepsColumns,
 ) -> Result<(), OutputError> {
-    let mut w = StepsCsv::create(path, rear_exit)?;
+    let mut w = StepsCsv::create(path, columns)?;
     steps.iter().try_for_each(|s| w.write(s))
 }

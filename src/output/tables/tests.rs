@@ -159,9 +159,19 @@ fn every_table_reads_back_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let path = |name: &str| dir.path().join(name);
 
-    write_steps_csv(&path("steps.csv"), &f.steps, RearExit::Relock).unwrap();
+    write_steps_csv(
+        &path("steps.csv"),
+        &f.steps,
+        crate::output::StepsColumns::of(&crate::params::Params::default()),
+    )
+    .unwrap();
     check_by_name(&path("steps.csv"), &STEPS, &[], &f.steps);
-    write_trajectory_csv(&path("trajectory.csv"), &f.samples, RearExit::Relock).unwrap();
+    write_trajectory_csv(
+        &path("trajectory.csv"),
+        &f.samples,
+        crate::output::StepsColumns::of(&crate::params::Params::default()),
+    )
+    .unwrap();
     check_by_name(&path("trajectory.csv"), &TRAJECTORY, &[], &f.samples);
 
     let points = sweep_points(&f.gait);
@@ -302,7 +312,12 @@ fn readers_follow_the_declarations() {
     let f = fixture();
     let dir = tempfile::tempdir().unwrap();
     let steps_path = dir.path().join("steps.csv");
-    write_steps_csv(&steps_path, &f.steps, RearExit::Relock).unwrap();
+    write_steps_csv(
+        &steps_path,
+        &f.steps,
+        crate::output::StepsColumns::of(&crate::params::Params::default()),
+    )
+    .unwrap();
     let steps: Vec<StepRow> = read_csv(&steps_path, false).unwrap();
     check("steps.csv", &[&STEPS], &f.steps, &steps);
     let trajectory_path = dir.path().join("trajectory.csv");
@@ -324,7 +339,12 @@ fn readers_hold_the_named_quantities() {
     let f = fixture();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("trajectory.csv");
-    write_trajectory_csv(&path, &f.samples, RearExit::Relock).unwrap();
+    write_trajectory_csv(
+        &path,
+        &f.samples,
+        crate::output::StepsColumns::of(&crate::params::Params::default()),
+    )
+    .unwrap();
     let rows: Vec<TrajectoryRow> = read_csv(&path, false).unwrap();
     for (s, r) in f.samples.iter().zip(&rows) {
         let q = [r.x, r.z, r.theta, r.l1, r.l2];
@@ -351,7 +371,12 @@ fn readers_hold_the_named_quantities() {
         assert_eq!((r.time, r.leg1), (s.time, s.leg1));
     }
     let path = dir.path().join("steps.csv");
-    write_steps_csv(&path, &f.steps, RearExit::Relock).unwrap();
+    write_steps_csv(
+        &path,
+        &f.steps,
+        crate::output::StepsColumns::of(&crate::params::Params::default()),
+    )
+    .unwrap();
     let rows: Vec<StepRow> = read_csv(&path, false).unwrap();
     for (s, r) in f.steps.iter().zip(&rows) {
         let i = &s.indicators;
