@@ -417,6 +417,7 @@ fn simulate<'py>(
         interruptible(py, &flag, || compute_simulation(&job, trajectory))?.map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
     let columns = StepsColumns::of(&params.config.params);
+    let rear_exit = params.config.params.rear_exit;
     let rows: Vec<Vec<Cell>> = summary
         .steps
         .iter()

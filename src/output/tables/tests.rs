@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::attractors::{orbit_columns, OrbitRow, BASIN, BRANCH};
 use super::map::{map_columns, MapPoint};
-use super::steps::STEPS;
+use super::steps::{StepsColumns, STEPS};
 use super::sweep::SWEEP;
 use super::trajectory::{SWING_COLUMNS, TRAJECTORY};
 use super::*;
@@ -25,7 +25,7 @@ use crate::output::{
     write_map_csv, write_orbit_csv, write_steps_csv, write_sweep_csv, write_trajectory_csv,
     STEPS_HEADER, SWEEP_COLUMNS, TRAJECTORY_HEADER,
 };
-use crate::params::{Config, RearExit};
+use crate::params::{Config, Params, RearExit};
 use crate::reference::default_initial;
 use crate::walk::{simulate, Sample, SectionState, StepReport, Trajectory};
 
@@ -162,16 +162,11 @@ fn every_table_reads_back_by_name() {
     write_steps_csv(
         &path("steps.csv"),
         &f.steps,
-        crate::output::StepsColumns::of(&crate::params::Params::default()),
+        StepsColumns::of(&Params::default()),
     )
     .unwrap();
     check_by_name(&path("steps.csv"), &STEPS, &[], &f.steps);
-    write_trajectory_csv(
-        &path("trajectory.csv"),
-        &f.samples,
-        crate::output::StepsColumns::of(&crate::params::Params::default()),
-    )
-    .unwrap();
+    write_trajectory_csv(&path("trajectory.csv"), &f.samples, RearExit::Relock).unwrap();
     check_by_name(&path("trajectory.csv"), &TRAJECTORY, &[], &f.samples);
 
     let points = sweep_points(&f.gait);
@@ -312,12 +307,7 @@ fn readers_follow_the_declarations() {
     let f = fixture();
     let dir = tempfile::tempdir().unwrap();
     let steps_path = dir.path().join("steps.csv");
-    write_steps_csv(
-        &steps_path,
-        &f.steps,
-        crate::output::StepsColumns::of(&crate::params::Params::default()),
-    )
-    .unwrap();
+    write_steps_csv(&steps_path, &f.steps, StepsColumns::of(&Params::default())).unwrap();
     let steps: Vec<StepRow> = read_csv(&steps_path, false).unwrap();
     check("steps.csv", &[&STEPS], &f.steps, &steps);
     let trajectory_path = dir.path().join("trajectory.csv");
@@ -339,12 +329,7 @@ fn readers_hold_the_named_quantities() {
     let f = fixture();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("trajectory.csv");
-    write_trajectory_csv(
-        &path,
-        &f.samples,
-        crate::output::StepsColumns::of(&crate::params::Params::default()),
-    )
-    .unwrap();
+    write_trajectory_csv(&path, &f.samples, RearExit::Relock).unwrap();
     let rows: Vec<TrajectoryRow> = read_csv(&path, false).unwrap();
     for (s, r) in f.samples.iter().zip(&rows) {
         let q = [r.x, r.z, r.theta, r.l1, r.l2];
@@ -371,12 +356,7 @@ fn readers_hold_the_named_quantities() {
         assert_eq!((r.time, r.leg1), (s.time, s.leg1));
     }
     let path = dir.path().join("steps.csv");
-    write_steps_csv(
-        &path,
-        &f.steps,
-        crate::output::StepsColumns::of(&crate::params::Params::default()),
-    )
-    .unwrap();
+    write_steps_csv(&path, &f.steps, StepsColumns::of(&Params::default())).unwrap();
     let rows: Vec<StepRow> = read_csv(&path, false).unwrap();
     for (s, r) in f.steps.iter().zip(&rows) {
         let i = &s.indicators;
