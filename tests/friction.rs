@@ -133,3 +133,22 @@ fn steps_csv_has_the_friction_columns_with_friction_only() {
         "{friction_loss}"
     );
 }
+
+/// Regression: a slip that starts at rest after a stopper impact and reverses at once (its speed within
+/// rounding of 0, the wrong way) is a slip-stop event; it was not, and friction pushed the tip along at up to
+/// 3.3 W (`slip_power`) until the next event (mu = 0.3, c = 106.2, from near that gait).
+#[test]
+fn a_slip_that_reverses_at_once_is_stopped() {
+    let config = config(&["friction=0.3".to_string(), "viscosity=106.2".to_string()]);
+    let model = Model::new(&config.params).unwrap();
+    let start = vrw::walk::SectionState {
+        l2: 0.719334558057652,
+        theta_dot: 0.7787901670716043,
+        l2_dot: -0.2064695963255453,
+    };
+    let mut walker = Walker::new(&model, &config.solver, &start).unwrap();
+    let s = walker.step(None).unwrap();
+    let f = s.contact.friction.unwrap();
+    assert_eq!(f.slip_power, 0.0, "{f:?}");
+    assert!(s.audit_warnings().is_empty(), "{:?}", s.audit_warnings());
+}

@@ -28,6 +28,11 @@ pub(crate) const FORCE_EVENT_MARGIN: f64 = 1e-10;
 /// instead of `stopper_gap` past it, and the overrun does not grow from lock to lock.
 pub(crate) const APPROACH_GAP: f64 = 1e-12;
 
+/// A slip-stop event of a slip that starts at rest fires when its slip speed falls this far below its value at
+/// the start \[m/s\] (one that starts moving fires at 0): small enough that the friction force does no
+/// measurable work on a tip creeping the other way, large enough that rounding (~1e-16 m/s) cannot fire it.
+pub(crate) const SLIP_STOP_MARGIN: f64 = 1e-12;
+
 /// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
 /// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
 /// however long the steps of a high-order integrator are.
@@ -175,7 +180,12 @@ impl<'a> EventSet<'a> {
         let dynamics = set.dynamics_if(needed, &q, &qd);
         for kind in kinds {
             let f0 = || set.raw(kind, &q, &qd, &dynamics);
-            let floor = if Self::needs_forces(kind) {
+            let floor = if matches!(kind, EventKind::SlipStop(_)) {
+                // A slip that starts at rest (or with its speed rounded a hair the other way) stops when it
+                // falls SLIP_STOP_MARGIN below where it started, so that a slip that reverses at once is an
+                // event too, not friction pushing the tip along.
+                f0().min(0.0) - SLIP_STOP_MARGIN
+            } else if Self::needs_forces(kind) {
                 // A force event fires once the force falls FORCE_EVENT_MARGIN below zero, or below its value at
                 // the phase start if that is already (within the complementarity tolerance) negative.
                 f0().min(0.0) - FORCE_EVENT_MARGIN
