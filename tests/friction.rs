@@ -152,3 +152,52 @@ fn a_slip_that_reverses_at_once_is_stopped() {
     assert_eq!(f.slip_power, 0.0, "{f:?}");
     assert!(s.audit_warnings().is_empty(), "{:?}", s.audit_warnings());
 }
+
+/// The README's table "large mu is not the no-slip model": one step from the no-slip gait at c = 37 with
+/// mu = 1e3, 1e4, 1e5 and without friction. The stick phase (DLS) converges to the no-slip one as 1/mu, but
+/// the slip that follows keeps the tangential force mu lambda_n where the no-slip model's slide is
+/// frictionless: Leg 2 touches the ground 0.018 s longer, and friction does 0.017 J of work, however large mu.
+#[test]
+fn large_mu_is_not_the_no_slip_model() {
+    let start = vrw::walk::SectionState {
+        l2: 0.7137607593459316,
+        theta_dot: 1.0210282344433548,
+        l2_dot: -0.4795702983456791,
+    };
+    let step = |mu: &str| {
+        let config = config(&["viscosity=37".to_string(), format!("friction={mu}")]);
+        let model = Model::new(&config.params).unwrap();
+        let mut walker = Walker::new(&model, &config.solver, &start).unwrap();
+        walker.step(None).unwrap()
+    };
+    // (mu, DLS [s], rear contact [s], friction work [J]) as the README states them.
+    let table = [
+        ("inf", 1.788283, 1.826684, f64::NAN),
+        ("1e3", 1.788195, 1.844602, 0.017025),
+        ("1e4", 1.788274, 1.844644, 0.017018),
+        ("1e5", 1.788282, 1.844648, 0.017018),
+    ];
+    let mut dls = Vec::new();
+    for (mu, dls_duration, rear, work) in table {
+        let s = step(mu);
+        println!(
+            "mu {mu}: {} {} {:?}",
+            s.dls_duration, s.rear_contact_duration, s.energy.friction
+        );
+        assert!(
+            (s.dls_duration - dls_duration).abs() < 1e-6,
+            "mu {mu}: {s:?}"
+        );
+        assert!(
+            (s.rear_contact_duration - rear).abs() < 1e-6,
+            "mu {mu}: {s:?}"
+        );
+        if let Some(w) = s.energy.friction {
+            assert!((w - work).abs() < 1e-6, "mu {mu}: {w}");
+        }
+        dls.push(s.dls_duration);
+    }
+    // DLS converges as 1/mu: each tenfold mu cuts the difference tenfold.
+    let (d3, d4) = (dls[0] - dls[1], dls[0] - dls[2]);
+    assert!((8.0..12.0).contains(&(d3 / d4)), "{d3} {d4}");
+}

@@ -153,7 +153,15 @@ impl Config {
         if !Config::numeric_keys().contains(&key) {
             return Err(unknown_numeric_key(key));
         }
-        match self.stored()?.remove(key) {
+        // A key written configurations leave out at its default (`min_length = 0`, `friction = inf`) has its
+        // value in the parameters all the same.
+        let left_out = self
+            .params
+            .keys_left_out_at_defaults()
+            .into_iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, value)| Raw::Stored(value));
+        match self.stored()?.remove(key).or(left_out) {
             Some(Raw::Stored(toml::Value::Float(x))) => Ok(x),
             _ => Err(unknown_numeric_key(key)),
         }
@@ -631,6 +639,13 @@ mod tests {
 
     #[test]
     fn numeric_keys_get_set_round_trip() {
+        // Every numeric key has a value at the defaults, those written configurations leave out included.
+        let defaults = Config::default();
+        for key in Config::numeric_keys() {
+            defaults.get_numeric(key).unwrap();
+        }
+        assert_eq!(defaults.get_numeric("friction").unwrap(), f64::INFINITY);
+        assert_eq!(defaults.get_numeric("min_length").unwrap(), 0.0);
         let keys = Config::numeric_keys();
         assert_eq!(keys.len(), 21);
         assert!(keys.iter().all(|key| all_keys().contains(key)));
