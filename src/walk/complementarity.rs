@@ -539,4 +539,37 @@ mod tests {
         // Both regimes were met.
         assert!(regimes.0 > 0 && regimes.1 > 0, "{regimes:?}");
     }
+
+    /// The Painleve case at force level: a tip sliding with a large `mu` whose free motion would take it into
+    /// the ground (it cannot leave) and whose slip has a non-positive effective normal inverse mass (it cannot
+    /// slip) has no consistent mode: the problem says so by name, and the walk's status is `painleve`.
+    #[test]
+    fn a_sliding_tip_with_no_consistent_mode_is_the_painleve_case() {
+        let model = rigid(5.0, 0.1);
+        let mut found = 0;
+        for i in -12..=12 {
+            let q = Coords::new(0.0, 0.0, 0.1 * f64::from(i), 1.0, 1.0, 0.0);
+            // Sliding down the slope, not turning: gravity pulls the tip into the ground.
+            let qd = Coords::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.0);
+            let mut slipping = bilateral();
+            slipping.set_slipping(Leg::One, 1);
+            if !matches!(
+                crate::contact::constrained_dynamics(&model, &q, &qd, &slipping),
+                Err(ContactError::Painleve(_))
+            ) {
+                continue;
+            }
+            let candidates = [Candidate::keep(Unit::Contact(Leg::One), &slipping)];
+            let result = consistent_active_set(&model, &q, &qd, bilateral(), &candidates);
+            let Err(error) = result else {
+                panic!("theta {i}: {result:?}");
+            };
+            assert!(matches!(error, ContactError::Painleve(_)), "{error}");
+            let walk_error = crate::walk::WalkError::contact_at(1.0, slipping.phase())(error);
+            assert_eq!(walk_error.kind(), "painleve");
+            assert!(walk_error.to_string().contains("Painleve"), "{walk_error}");
+            found += 1;
+        }
+        assert!(found > 0, "no Painleve configuration in the scan");
+    }
 }

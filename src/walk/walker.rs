@@ -708,3 +708,103 @@ impl<'a> Phases<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::{Coords, Z};
+    use crate::params::{Config, Params};
+
+    /// The rigid wheel standing on two legs (`theta = -alpha/2`) is a block on the incline: with both tips
+    /// slipping, its rows fix `z` and `theta`, the normal forces sum to `W cos phi` whatever their split, and
+    /// `x'' = g (sin phi - s mu cos phi)` exactly. Walks the block from `(x, x') = (0, v0)` until `t_end` (the
+    /// step then stalls, as a step without touchdown must) and returns its samples.
+    fn slide_block(mu: f64, slope: f64, v0: f64, t_end: f64) -> Vec<crate::walk::Sample> {
+        let params = Params {
+            rigid_legs: true,
+            friction: mu,
+            slope,
+            ..Params::default()
+        };
+        let model = Model::new(&params).unwrap();
+        let mut opts = Config::default().solver;
+        opts.max_step_time = t_end;
+        let section = SectionState {
+            l2: 1.0,
+            theta_dot: 1.0,
+            l2_dot: 0.0,
+        };
+        let mut walker = Walker::new(&model, &opts, &section).unwrap();
+        let q = Coords::new(0.0, 0.0, -model.alpha() / 2.0, 1.0, 1.0, 0.0);
+        let qd = Coords::new(v0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let mut active = ActiveSet {
+            contact1: true,
+            contact2: true,
+            lock1: true,
+            lock2: true,
+            ..Default::default()
+        };
+        let direction = if v0 > 0.0 || (v0 == 0.0 && slope.tan() > mu) {
+            1
+        } else {
+            -1
+        };
+        active.set_slipping(Leg::One, direction);
+        active.set_slipping(Leg::Two, direction);
+        walker.state = WalkState {
+            q,
+            qd,
+            active,
+            ..walker.state.clone()
+        };
+        let mut trajectory = Trajectory::new(0.01);
+        let start = walker.state.clone();
+        let y = pack(&q, &qd, 0.0);
+        let tally = StepTally::default();
+        let mut phases = Phases::start(
+            &walker,
+            &start,
+            (Some(&mut trajectory), None),
+            tally,
+            active,
+            y,
+        );
+        let end = phases.run();
+        assert!(matches!(end, Err(WalkError::Stalled { .. })), "{end:?}");
+        trajectory.samples
+    }
+
+    /// A block on an incline with Coulomb friction: it slips with the exact acceleration `g (sin phi - mu cos
+    /// phi)` above `tan phi = mu`; below, a block sliding down decelerates at `g (mu cos phi - sin phi)`, stops
+    /// at `t* = v0 / (g (mu cos phi - sin phi))` (a slip-stop event) and stays at rest.
+    #[test]
+    fn a_block_on_an_incline_slips_and_stops_exactly() {
+        let g = 9.81;
+        let slope: f64 = 0.3;
+        // Above tan phi = mu: from rest, down the slope.
+        let mu = 0.2;
+        let a = g * (slope.sin() - mu * slope.cos());
+        let samples = slide_block(mu, slope, 0.0, 1.0);
+        assert!(samples.len() > 90, "{}", samples.len());
+        for s in &samples {
+            assert!((s.q[X] - 0.5 * a * s.time * s.time).abs() < 1e-9, "{s:?}");
+            assert!(s.q[Z].abs() < 1e-12 && s.qd[THETA].abs() < 1e-9);
+        }
+        // Below: sliding down at 1 m/s, it stops at t*.
+        let (mu, v0) = (0.5, 1.0);
+        let decel = g * (mu * slope.cos() - slope.sin());
+        let t_stop = v0 / decel;
+        let x_stop = 0.5 * v0 * t_stop;
+        let samples = slide_block(mu, slope, v0, 1.5 * t_stop + 0.2);
+        assert!(samples.last().unwrap().time > 1.2 * t_stop);
+        assert!(samples.iter().filter(|s| s.time > t_stop).count() > 10);
+        for s in &samples {
+            let x = if s.time < t_stop {
+                v0 * s.time - 0.5 * decel * s.time * s.time
+            } else {
+                x_stop
+            };
+            assert!((s.q[X] - x).abs() < 1e-9, "t {}: {} vs {x}", s.time, s.q[X]);
+        }
+    }
+}
