@@ -136,6 +136,9 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         "contact audit: pull force {:.1e} N, pull impulse {:.1e} N s, penetration {:.1e} m, stopper overrun {:.1e} m; energy residual {:.1e} J",
         c.pull_force, c.pull_impulse, c.penetration, c.stopper_overrun, g.energy_residual
     );
+    if let Some(signature) = &g.signature {
+        println!("sticks and slips: {signature}");
+    }
     if let Some(f) = &c.friction {
         let work: f64 = g.cycle.iter().filter_map(|s| s.energy.friction).sum();
         println!(

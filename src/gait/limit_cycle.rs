@@ -201,6 +201,11 @@ pub struct Gait {
     /// slip events the exact derivatives do not cover yet. Absent (`None`) for the exact route.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub jacobian_route: Option<&'static str>,
+    /// With Coulomb friction, the event sequence of the gait's step (as `branch.csv`'s `signature`, with
+    /// `SLIP1`/`SLIP2` for a tip that slips through the touchdown and `SLIDE`/`STICK` for each slip start and
+    /// stop): where the tips stick and slip. Absent without friction.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub signature: Option<String>,
     /// `dP/dp` for the parameter of [`GaitOptions::parameter`], if one was chosen (`dP_dparam` in JSON).
     pub dp_dparam: Option<ParamDerivative>,
     /// Eigenvalues of `DP(s*)` (of `D(P^k)(s*)` for a period-k gait) as `[re, im]`, largest modulus first.
@@ -317,6 +322,7 @@ pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitO
                 Ok((dp, error)) => {
                     let mut gait = gait_at(fp, dp, error);
                     gait.jacobian_route = Some("finite_difference");
+                    gait.signature = on.eval_signature(&fp.section).ok().map(|o| o.signature);
                     gait
                 }
                 Err(e) => {
@@ -556,6 +562,7 @@ pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) ->
         stability: Stability::judge(max_floquet, jacobian_error),
         jacobian_failure: None,
         jacobian_route: None,
+        signature: None,
         stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
         rear_held: fp.rear_held,
     }

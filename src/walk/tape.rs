@@ -98,17 +98,31 @@ impl StepTape {
     /// the phases follow and, within one change, Leg 1 before Leg 2: `LIFT`/`LAND` (ground contact off/on),
     /// `SLIDE`/`STICK` (a contact starts/stops sliding), `UNLOCK`/`LOCK` (stopper), `UNLOCKMIN`/`LOCKMIN`
     /// (compression stop, `min_length`), each with the leg's number,
-    /// as `TD DLS UNLOCK1 LIFT2 LOCK2`. Two steps with the same signature took the same smooth piece of the
-    /// step map; a family whose signature changes crossed a border between pieces.
+    /// as `TD DLS UNLOCK1 LIFT2 LOCK2`. With Coulomb friction (docs/model.md section 12) a tip that slips through
+    /// the touchdown impact adds `SLIP1`/`SLIP2` right after the branch, and a slip that reverses (a slip stop
+    /// followed by a slip the other way) `REVERSE1`/`REVERSE2`; a frictionless slide has neither, so the
+    /// signatures of `friction = inf` are unchanged. Two steps with the same signature took the same smooth piece
+    /// of the step map; a family whose signature changes crossed a border between pieces.
     pub(crate) fn signature(&self, branch: impl std::fmt::Display) -> String {
         let mut words = vec!["TD".to_string(), branch.to_string()];
+        let number = |leg: Leg| match leg {
+            Leg::One => 1,
+            Leg::Two => 2,
+        };
+        if let Some(first) = self.segments.first() {
+            for leg in Leg::BOTH {
+                if first.active.slip(leg) != 0 {
+                    words.push(format!("SLIP{}", number(leg)));
+                }
+            }
+        }
         for pair in self.segments.windows(2) {
             let (a, b) = (pair[0].active, pair[1].active);
             for leg in Leg::BOTH {
-                let n = match leg {
-                    Leg::One => 1,
-                    Leg::Two => 2,
-                };
+                let n = number(leg);
+                if a.slip(leg) * b.slip(leg) < 0 {
+                    words.push(format!("REVERSE{n}"));
+                }
                 let slide = |s: &ActiveSet| match leg {
                     Leg::One => s.slide1,
                     Leg::Two => s.slide2,
