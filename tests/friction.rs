@@ -201,3 +201,31 @@ fn large_mu_is_not_the_no_slip_model() {
     let (d3, d4) = (dls[0] - dls[1], dls[0] - dls[2]);
     assert!((8.0..12.0).contains(&(d3 / d4)), "{d3} {d4}");
 }
+
+/// Stiff legs chatter on their stoppers, which the Zeno rule locks (docs/model.md section 5); with friction the
+/// tips closing in those locks stick or slip as the cone decides, and the friction audit stays clean. (The
+/// energy audit of such steps closes to 1e-8 J, as without friction.)
+#[test]
+fn zeno_locks_with_friction_keep_the_cone() {
+    let (steps, end) = walk(
+        &[
+            "friction=0.6".to_string(),
+            "viscosity=5".to_string(),
+            "stiffness=3000".to_string(),
+        ],
+        8,
+    );
+    assert!(end.is_none(), "{end:?}");
+    assert!(
+        steps.iter().any(|s| s.contact.zeno_impulse > 0.0),
+        "no Zeno lock"
+    );
+    for s in &steps {
+        let f = s.contact.friction.unwrap();
+        assert!(f.cone_violation <= CONE_TOL, "{f:?}");
+        assert!(f.cone_violation_impulse <= CONE_TOL, "{f:?}");
+        assert_eq!(f.slip_power, 0.0);
+        assert!(s.energy.residual.abs() < 1e-7, "{:?}", s.energy);
+        assert!(s.audit_warnings().is_empty(), "{:?}", s.audit_warnings());
+    }
+}

@@ -83,6 +83,7 @@ impl StepTally {
         self.stopper_loss += lock.loss;
         self.audit.zeno_impulse = self.audit.zeno_impulse.max(lock.impulse);
         self.audit.pull_impulse = self.audit.pull_impulse.max(lock.pull_impulse);
+        self.see_cone_impulse(lock.cone_impulse);
         self.scuffing |= lock.active.slide2;
     }
 

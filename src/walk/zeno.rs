@@ -27,7 +27,9 @@
 //! [`ZENO_IMPULSE_WARNING`] (a tip sliding fast along the ground), then frictionless; the motion goes on with
 //! both tips on the ground.
 
-use crate::contact::{constrained_dynamics, largest_pull, ActiveSet, ContactError, Leg, Stop};
+use crate::contact::{
+    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ContactError, Leg, Stop,
+};
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
 
@@ -62,6 +64,9 @@ pub struct ZenoLock {
     /// The units that took an impulse in each of the locks' plastic impacts, in order (at most one per leg):
     /// what the exact derivatives replay (`crate::variational`).
     pub impulse_sets: Vec<ActiveSet>,
+    /// The largest excess of a sticking contact's impulse over the friction cone in the locks \[N s\], 0 if none
+    /// (and without friction).
+    pub cone_impulse: f64,
 }
 
 /// The units at `(q, q')` under `active` that the Zeno rule closes (as flags of an [`ActiveSet`]): the free legs
@@ -155,11 +160,16 @@ fn zeno_impact_units(
                 forced.set_held(leg, stop, true);
             }
         }
-        if closing.contact(leg) {
+        // With Coulomb friction a closing tip sticks or slips as the cone decides: a closing candidate.
+        let coulomb = closing.contact(leg) && model.params().has_friction();
+        if coulomb {
+            candidates.push(Candidate::closing(Unit::Contact(leg), model));
+        } else if closing.contact(leg) {
             Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(closing));
         }
         for unit in Unit::of(leg) {
-            if unit.mode(active) != Mode::Off && unit.mode(&forced) == Mode::Off {
+            let closed = coulomb && unit == Unit::Contact(leg);
+            if !closed && unit.mode(active) != Mode::Off && unit.mode(&forced) == Mode::Off {
                 candidates.push(Candidate::keep(unit, active));
             }
         }
@@ -191,6 +201,7 @@ pub fn lock_zeno_stoppers(
     let mut pull_impulse: f64 = 0.0;
     let mut zeno_impulse: f64 = 0.0;
     let mut impulse_sets = Vec::new();
+    let mut cone_impulse: f64 = 0.0;
     loop {
         let mut legs =
             zeno_units(model, (q, &qd_now), &active_now, gaps, &locked).map_err(contact_error)?;
@@ -210,9 +221,11 @@ pub fn lock_zeno_stoppers(
                     && !legs.slide(leg)
                     && sol.normal_impulse(leg) < -ZENO_IMPULSE_WARNING
             });
-            if let (Some(leg), ContactInconsistency::Slide) =
-                (pulled, model.params().inconsistent_contact)
-            {
+            if let (Some(leg), ContactInconsistency::Slide, false) = (
+                pulled,
+                model.params().inconsistent_contact,
+                model.params().has_friction(),
+            ) {
                 legs.set_sliding(leg);
                 continue;
             }
@@ -252,6 +265,8 @@ pub fn lock_zeno_stoppers(
             }
         }
         pull_impulse = pull_impulse.max(largest_pull(&sol.impulses, &others, rigid));
+        let mu = model.params().friction;
+        cone_impulse = cone_impulse.max(cone_excess(&sol.impulses, &impulse_set, mu));
         let (forced, candidates) =
             post_impact_candidates(model, q, &sol.qd_plus, &impulse_set, &present, &impulse_set);
         let (next, _) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)
@@ -271,6 +286,7 @@ pub fn lock_zeno_stoppers(
         impulse: zeno_impulse,
         pull_impulse,
         impulse_sets,
+        cone_impulse,
     }))
 }
 
