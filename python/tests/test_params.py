@@ -35,6 +35,11 @@ def test_the_keys_files_leave_out_at_their_defaults_are_keys_too(tmp_path):
     stroke = vrw.Params.from_toml(ROOT / "readings" / "stroke-limited.toml")
     assert stroke["min_length"] == 1.0 and stroke == vrw.Params(**stroke.to_dict())
     assert pickle.loads(pickle.dumps(stroke)) == stroke
+    # friction (infinity, no slip, by default) is such a key too; a finite one round-trips.
+    assert defaults["friction"] == float("inf") and "friction" in vrw.Params.numeric_keys()
+    slippery = vrw.Params(friction=0.6)
+    assert slippery["friction"] == 0.6 and vrw.Params(**slippery.to_dict()) == slippery
+    assert pickle.loads(pickle.dumps(slippery)) == slippery
 
 
 def test_from_toml_equals_keywords(tmp_path):
@@ -69,6 +74,8 @@ def test_replace_and_round_trips():
         ({"min_length": 1.0}, "min_length=1"),
         ({"min_length": -0.5}, "min_length=-0.5"),
         ({"touchdown_length": 0.9}, "touchdown_length=0.9"),
+        ({"friction": -0.1}, "friction=-0.1"),
+        ({"friction": float("nan")}, "friction=nan"),
     ],
 )
 def test_bad_keys_raise_the_command_lines_message(cli, tmp_path, keys, override):
