@@ -329,6 +329,14 @@ pub enum ContactError {
          (no consistent contact force, or several)"
     )]
     Painleve(ActiveSet),
+    /// With Coulomb friction, no choice of modes (off, stick, slip either way) of an impact's units gives impulses
+    /// that satisfy the contact laws (each pushes, sticks inside the cone or slips the way the tip moves after the
+    /// impact): the impulse-level problem has no solution. The units the impact would have preferred.
+    #[error(
+        "no impulse satisfies the contact laws with Coulomb friction (no consistent mode for the impact; preferred \
+         units: {0})"
+    )]
+    InconsistentImpact(ActiveSet),
 }
 
 /// The active units in words, e.g. `Leg 1 tip fixed, Leg 2 tip sliding, Leg 2 stopper locked`.

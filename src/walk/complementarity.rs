@@ -292,7 +292,8 @@ fn preferred_set(forced: ActiveSet, candidates: &[Candidate]) -> ActiveSet {
 /// or takes none and separates (normal velocity after the impact `>= 0`, a free leg not moving past its
 /// stopper). A no-slip contact's impulse has a tangential part; a sliding contact's is normal only. If no
 /// combination is consistent the preferred one is used, and the step's contact audit
-/// ([`largest_pull`]) shows the pulling impulse.
+/// ([`largest_pull`]) shows the pulling impulse; with Coulomb friction (a sticking impulse in the cone, a
+/// slipping one leaving the tip moving its way) that is [`ContactError::InconsistentImpact`] instead.
 pub(crate) fn plastic_impact(
     model: &Model,
     q: &Coords,
@@ -343,6 +344,10 @@ pub(crate) fn plastic_impact_by(
     })?;
     match found {
         Some(found) => Ok(found),
+        // With friction an arbitrary pick would hide that the frictional impact has no solution: say so.
+        None if level.friction() => Err(ContactError::InconsistentImpact(preferred_set(
+            forced, candidates,
+        ))),
         None => {
             let set = preferred_set(forced, candidates);
             Ok((set, solve(&set)?))
@@ -571,5 +576,31 @@ mod tests {
             found += 1;
         }
         assert!(found > 0, "no Painleve configuration in the scan");
+    }
+
+    /// An impact whose closing tip moves away from the ground can only be closed by a pulling impulse: without
+    /// friction the preferred units are applied (the audit shows the pull); with Coulomb friction no mode is
+    /// consistent and the impact says so by name (walk status `inconsistent_impact`), not an arbitrary pick.
+    #[test]
+    fn an_impact_with_no_consistent_mode_is_named_with_friction() {
+        let q = Coords::new(0.0, 0.0, -0.2, 1.0, 1.0, 0.0);
+        let qd = Coords::new(0.1, 0.3, 0.0, 0.0, 0.0, 0.0);
+        let frictionless = rigid(f64::INFINITY, 0.1);
+        let closing = [Candidate::closing(Unit::Contact(Leg::One), &frictionless)];
+        let (_, sol) = plastic_impact(&frictionless, &q, &qd, bilateral(), &closing).unwrap();
+        assert!(
+            sol.normal_impulse(Leg::One) < 0.0,
+            "the closing impulse pulls"
+        );
+        let model = rigid(0.6, 0.1);
+        let closing = [Candidate::closing(Unit::Contact(Leg::One), &model)];
+        let error = plastic_impact(&model, &q, &qd, bilateral(), &closing).unwrap_err();
+        assert!(
+            matches!(error, ContactError::InconsistentImpact(_)),
+            "{error}"
+        );
+        let walk_error =
+            crate::walk::WalkError::contact_at(1.0, crate::contact::Phase::Flight)(error);
+        assert_eq!(walk_error.kind(), "inconsistent_impact");
     }
 }

@@ -239,6 +239,10 @@ impl WalkError {
                 source: ContactError::Painleve(_),
                 ..
             } => "painleve",
+            WalkError::Contact {
+                source: ContactError::InconsistentImpact(_),
+                ..
+            } => "inconsistent_impact",
             WalkError::Contact { .. } => "constraint_failure",
             WalkError::Integration { .. } => "solver_failure",
             WalkError::InvalidSection { .. } => "invalid_section",

@@ -14,6 +14,7 @@ use crate::params::ImpactModel;
 pub use super::complementarity::Unit;
 pub(crate) use super::complementarity::{
     consistent_active_set, plastic_impact, plastic_impact_by, Candidate, Mode, COMPLEMENTARITY_TOL,
+    STICK_SPEED_TOL,
 };
 
 /// The three DLS indicators of the paper (Sec. 2.2): `lambda_I4` from (A1), `lambda_2+`, `lambda_4+` from (B1).

@@ -37,7 +37,7 @@ use super::error::WalkError;
 
 use super::impact::{
     bilateral_stoppers, consistent_active_set, has_stop, plastic_impact, post_impact_candidates,
-    stop_length, Candidate, Mode, Unit, COMPLEMENTARITY_TOL,
+    stop_length, Candidate, Mode, Unit, COMPLEMENTARITY_TOL, STICK_SPEED_TOL,
 };
 
 /// A Zeno lock whose stopper impulse exceeds this \[N s\] is reported as a warning by `vrw simulate`: the rule
@@ -149,6 +149,7 @@ fn union(a: &ActiveSet, b: &ActiveSet) -> ActiveSet {
 /// unit of `active` a candidate of the impulse-level complementarity problem.
 fn zeno_impact_units(
     model: &Model,
+    (q, qd): (&Coords, &Coords),
     closing: &ActiveSet,
     active: &ActiveSet,
 ) -> (ActiveSet, Vec<Candidate>) {
@@ -160,16 +161,18 @@ fn zeno_impact_units(
                 forced.set_held(leg, stop, true);
             }
         }
-        // With Coulomb friction a closing tip sticks or slips as the cone decides: a closing candidate.
-        let coulomb = closing.contact(leg) && model.params().has_friction();
-        if coulomb {
-            candidates.push(Candidate::closing(Unit::Contact(leg), model));
-        } else if closing.contact(leg) {
-            Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(closing));
+        if closing.contact(leg) {
+            // A closing tip is forced, its small pull being the Zeno impulse; with Coulomb friction a tip that
+            // moves along the ground closes slipping that way (a sticking impulse would leave the cone).
+            let v = model.tip(q, qd, leg.index()).velocity(qd).x;
+            if model.params().has_friction() && v.abs() > STICK_SPEED_TOL {
+                forced.set_slipping(leg, if v > 0.0 { 1 } else { -1 });
+            } else {
+                Unit::Contact(leg).apply(&mut forced, Unit::Contact(leg).mode(closing));
+            }
         }
         for unit in Unit::of(leg) {
-            let closed = coulomb && unit == Unit::Contact(leg);
-            if !closed && unit.mode(active) != Mode::Off && unit.mode(&forced) == Mode::Off {
+            if unit.mode(active) != Mode::Off && unit.mode(&forced) == Mode::Off {
                 candidates.push(Candidate::keep(unit, active));
             }
         }
@@ -213,7 +216,7 @@ pub fn lock_zeno_stoppers(
         // itself kicks off too slowly to clear its gap closes in the same impact (two tips that would take turns
         // landing close together, the accumulation point of their sequence).
         let (impulse_set, sol) = loop {
-            let (forced, candidates) = zeno_impact_units(model, &legs, &active_now);
+            let (forced, candidates) = zeno_impact_units(model, (q, &qd_now), &legs, &active_now);
             let (set, sol) =
                 plastic_impact(model, q, &qd_now, forced, &candidates).map_err(contact_error)?;
             let pulled = Leg::BOTH.into_iter().find(|&leg| {
