@@ -34,7 +34,11 @@ pub(crate) fn contact_event(
         }
         EventKind::SlipStop(leg) => Candidate::new(Unit::Contact(leg), Mode::On),
         EventKind::LiftOff(leg) => Candidate::releasing(leg),
-        _ => unreachable!("not a contact's force-level event: {kind:?}"),
+        // Not a contact's force-level event: nothing of the contacts changes.
+        _ => {
+            debug_assert!(false, "not a contact's force-level event: {kind:?}");
+            return Ok(active);
+        }
     };
     release_contact(model, time, (q, qd), active, changing)
 }
