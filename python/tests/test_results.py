@@ -35,6 +35,18 @@ def test_run_tables_convert_to_dataframes_like_the_csv_files(cli, tmp_path):
                 assert frame[column].dtype == csv[column].dtype, column
 
 
+def test_a_run_with_friction_has_the_friction_columns_of_its_steps_csv(cli, tmp_path):
+    cli("simulate", "--steps", 2, "--set", "friction=0.6", "--out", tmp_path)
+    run = vrw.simulate(vrw.Params(friction=0.6), steps=2)
+    frame = run.steps.to_pandas()
+    csv = pd.read_csv(tmp_path / "steps.csv")
+    assert list(frame.columns) == list(csv.columns)
+    assert list(csv.columns[-4:]) == ["friction_loss", "cone_violation", "cone_violation_impulse", "slip_power"]
+    assert np.allclose(frame["friction_loss"], csv["friction_loss"], rtol=1e-12, atol=0)
+    assert (frame["friction_loss"] > 0.1).all() and (frame["slip_power"] == 0).all()
+    assert "friction_loss" not in vrw.simulate(vrw.Params(), steps=1).steps.to_pandas().columns
+
+
 def test_the_stroke_limited_run_says_which_stop_holds_a_leg(cli, tmp_path):
     # lock1 / lock2: 1 on the stopper, 2 on the compression stop (min_length), as trajectory.csv has them.
     params = vrw.Params.from_toml(ROOT / "readings" / "stroke-limited.toml")
