@@ -24,7 +24,7 @@
 
 use nalgebra::SMatrix;
 
-use super::solve::{constraint_rows, Ldl, Rows};
+use super::solve::{complete_held_leg_one, constraint_rows, held_leg_one_system, Rows};
 use super::{
     ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, NROWS,
     REDUNDANCY_TOL,
@@ -62,25 +62,19 @@ pub(crate) fn slipping_dynamics(
 /// The KKT system with Leg 1's tip held and Leg 2's tip slipping, reduced to the `R` coordinates
 /// `(theta, L1, L2[, L3])` as the no-slip solve does (`x'' = z'' = 0`; `lambda_1`, `lambda_2` from the `x`, `z`
 /// equations): `M_rr = L D L^T`, and with `W_i = L^-1 a_i` (rows), `V_i = L^-1 b_i` (force columns), the
-/// Schur complement `S_ij = W_i . D^-1 V_j`, eliminated with the slipping row last as in [`eliminate`]. Same
+/// Schur complement `S_ij = W_i . D^-1 V_j`, eliminated with the slipping row last by [`eliminate`]. Same
 /// result as the general solve (tested).
 fn rear_slip<const R: usize>(
     model: &Model,
     eom: &EquationsOfMotion,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
-    let (m, h, rear) = (&eom.mass, &eom.bias, &eom.rear_tip);
+    let rear = &eom.rear_tip;
     let slip = f64::from(active.slip2) * model.params().friction;
-    let mut chol = Ldl::<R>::zeros(R);
-    for i in 0..R {
-        for j in 0..=i {
-            chol.l[i][j] = m[(2 + i, 2 + j)];
-        }
-    }
+    let (mut chol, mut g) = held_leg_one_system::<R>(eom);
     if !chol.factor() {
         return Err(ContactError::SingularMass);
     }
-    let mut g: [f64; R] = std::array::from_fn(|i| -h[2 + i]);
     chol.forward(&mut g);
     // The rows (stoppers first, the slipping normal row last), their force columns, right-hand sides and
     // places in the stacking, each row and column as L^-1 of itself.
@@ -102,64 +96,28 @@ fn rear_slip<const R: usize>(
     chol.forward(&mut normal);
     chol.forward(&mut column);
     rows.push((normal, column, -rear.velocity_product.y, 3));
-    let k = rows.len();
+    // The Schur complement in the stacking, the inactive rows (the slipping tip's tangential one at least)
+    // identity rows, eliminated in the order of `rows`.
     let dot = |u: &[f64; R], v: &[f64; R]| (0..R).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
-    let mut schur = [[0.0; 3]; 3];
-    let mut lam = [0.0; 3];
-    for i in 0..k {
-        lam[i] = rows[i].2 - dot(&rows[i].0, &g);
-        for j in 0..k {
-            schur[i][j] = dot(&rows[i].0, &rows[j].1);
+    let mut schur = SMatrix::<f64, NROWS, NROWS>::identity();
+    let mut rhs = Multipliers::zeros();
+    for (a_i, _, b_i, i) in &rows {
+        rhs[*i] = b_i - dot(a_i, &g);
+        for (_, v_j, _, j) in &rows {
+            schur[(*i, *j)] = dot(a_i, v_j);
         }
     }
-    // Inactive rows of the stacking (the slipping tip's tangential one at least) are identity rows.
-    let scale = (0..k).map(|i| schur[i][i].abs()).fold(1.0, f64::max);
-    for p in 0..k {
-        let pivot = schur[p][p];
-        if p == k - 1 && pivot <= 0.0 {
-            return Err(ContactError::Painleve(*active));
-        }
-        if pivot.abs() < REDUNDANCY_TOL * scale || pivot.is_nan() {
-            return Err(ContactError::RedundantConstraints(*active));
-        }
-        let pivot_row = schur[p];
-        for r in p + 1..k {
-            let factor = schur[r][p] / pivot;
-            for (entry, above) in schur[r][p..k].iter_mut().zip(&pivot_row[p..k]) {
-                *entry -= factor * above;
-            }
-            lam[r] -= factor * lam[p];
-        }
-    }
-    for p in (0..k).rev() {
-        for c in p + 1..k {
-            lam[p] -= schur[p][c] * lam[c];
-        }
-        lam[p] /= schur[p][p];
-    }
+    let order: Vec<usize> = rows.iter().map(|row| row.3).collect();
+    let mut multipliers = eliminate(schur, rhs, &order, &|i| i == 3, active)?;
     let mut x = g;
-    for (i, row) in rows.iter().enumerate() {
-        for (x_l, column_l) in x.iter_mut().zip(&row.1) {
-            *x_l += lam[i] * column_l;
+    for (_, column, _, stacked) in &rows {
+        for (x_l, column_l) in x.iter_mut().zip(column) {
+            *x_l += multipliers[*stacked] * column_l;
         }
     }
     chol.backward_scaled(&mut x);
-    let mut qdd = Coords::zeros();
-    let mut multipliers = Multipliers::zeros();
-    for (i, row) in rows.iter().enumerate() {
-        multipliers[row.3] = lam[i];
-    }
     multipliers[2] = -slip * multipliers[3];
-    for (l, &value) in x.iter().enumerate() {
-        qdd[2 + l] = value;
-    }
-    // x and z equations: every point's rows have the identity in x, z, so (M q'' + h)_{x,z} = lambda_{1,2} +
-    // Leg 2's force (lambda_3, lambda_4), its tangential part the friction force.
-    for axis in 0..2 {
-        let generalized = (0..R).map(|k| m[(axis, 2 + k)] * x[k]).sum::<f64>() + h[axis];
-        multipliers[axis] = generalized - multipliers[2 + axis];
-    }
-    Ok(ConstrainedDynamics { qdd, multipliers })
+    Ok(complete_held_leg_one(eom, &x, multipliers))
 }
 
 /// The collision equation (5) with the units of `active`, some of whose contacts slip through the impact with

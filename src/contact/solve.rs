@@ -163,14 +163,7 @@ fn solve_with_fixed_leg_one<const R: usize>(
     eom: &EquationsOfMotion,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
-    let (m, h) = (&eom.mass, &eom.bias);
-    let mut m_rr = Ldl::<R>::zeros(R);
-    for i in 0..R {
-        for j in 0..=i {
-            m_rr.l[i][j] = m[(2 + i, 2 + j)];
-        }
-    }
-    let f_r = std::array::from_fn(|i| -h[2 + i]);
+    let (m_rr, f_r) = held_leg_one_system::<R>(eom);
     // Remaining rows (C2, stoppers) restricted to (theta, L1, L2), numbered from 0 after C1's rows.
     let rear = &eom.rear_tip;
     let mask = active.row_mask();
@@ -187,21 +180,45 @@ fn solve_with_fixed_leg_one<const R: usize>(
         }
     }
     let (qdd_r, lam) = solve_active_rows(m_rr, &f_r, &mut rows, active)?;
-    let mut qdd = Coords::zeros();
     let mut multipliers = Multipliers::zeros();
-    for k in 0..R {
-        qdd[2 + k] = qdd_r[k];
-    }
     for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
         multipliers[2 + stacked] = lam[i];
     }
-    // x and z equations: (M q'' + h)_{x,z} = lambda_{1,2} + (other rows)^T lambda, where only (C2)'s rows have
-    // x, z components (the identity, as for every point).
+    Ok(complete_held_leg_one(eom, &qdd_r, multipliers))
+}
+
+/// The reduced KKT system with Leg 1's tip held: `M_rr`, the block of `(theta, L1, L2[, L3])` (to factor), and
+/// `-h_r`.
+pub(super) fn held_leg_one_system<const R: usize>(eom: &EquationsOfMotion) -> (Ldl<R>, [f64; R]) {
+    let (m, h) = (&eom.mass, &eom.bias);
+    let mut m_rr = Ldl::<R>::zeros(R);
+    for i in 0..R {
+        for j in 0..=i {
+            m_rr.l[i][j] = m[(2 + i, 2 + j)];
+        }
+    }
+    (m_rr, std::array::from_fn(|i| -h[2 + i]))
+}
+
+/// The solution of the reduced system completed: `q''` from `q_r''` (`x'' = z'' = 0`), and `lambda_1`,
+/// `lambda_2` from the `x` and `z` equations, `(M q'' + h)_{x,z} = lambda_{1,2} + (other rows)^T lambda`, where
+/// only Leg 2's contact has `x`, `z` components (the identity, as for every point; with slip its tangential
+/// multiplier is the friction force). `multipliers` holds the other rows' already.
+pub(super) fn complete_held_leg_one<const R: usize>(
+    eom: &EquationsOfMotion,
+    qdd_r: &[f64; R],
+    mut multipliers: Multipliers,
+) -> ConstrainedDynamics {
+    let (m, h) = (&eom.mass, &eom.bias);
+    let mut qdd = Coords::zeros();
+    for k in 0..R {
+        qdd[2 + k] = qdd_r[k];
+    }
     for axis in 0..2 {
         let generalized = (0..R).map(|k| m[(axis, 2 + k)] * qdd_r[k]).sum::<f64>() + h[axis];
         multipliers[axis] = generalized - multipliers[2 + axis];
     }
-    Ok(ConstrainedDynamics { qdd, multipliers })
+    ConstrainedDynamics { qdd, multipliers }
 }
 
 /// The row `e_i` of `N` unknowns: a stopper's `dL/dt = 0`, or a coordinate of Leg 1's tip.

@@ -309,6 +309,13 @@ pub fn find_gait(
 /// estimate of [`super::derivative::gait_jacobian`]; where the map is not differentiable at `fp` (or a
 /// perturbed walk fails), the gait without multipliers and the reason in [`Gait::jacobian_failure`].
 pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitOptions) -> Gait {
+    let on = map.on_section_of(&fp.section);
+    let failed = |failure: String| {
+        let n = on.free_coordinates().len();
+        let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
+        gait.jacobian_failure = Some(failure);
+        gait
+    };
     match gait_jacobian(map, &fp.section, options.parameter, options.refine_jacobian) {
         Ok(j) => {
             let mut gait = gait_at(fp, j.jacobian, j.error);
@@ -317,7 +324,6 @@ pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitO
         }
         // Coulomb friction: the finite-difference route, with its own error estimate.
         Err(DerivativeError::NotDifferentiable(NotDifferentiable::Friction { .. })) => {
-            let on = map.on_section_of(&fp.section);
             match on.jacobian(&fp.section, options.fd_step) {
                 Ok((dp, error)) => {
                     let mut gait = gait_at(fp, dp, error);
@@ -325,20 +331,10 @@ pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitO
                     gait.signature = on.eval_signature(&fp.section).ok().map(|o| o.signature);
                     gait
                 }
-                Err(e) => {
-                    let n = on.free_coordinates().len();
-                    let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
-                    gait.jacobian_failure = Some(e.to_string());
-                    gait
-                }
+                Err(e) => failed(e.to_string()),
             }
         }
-        Err(e) => {
-            let n = map.on_section_of(&fp.section).free_coordinates().len();
-            let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
-            gait.jacobian_failure = Some(e.to_string());
-            gait
-        }
+        Err(e) => failed(e.to_string()),
     }
 }
 

@@ -180,15 +180,13 @@ impl<'a> EventSet<'a> {
         let dynamics = set.dynamics_if(needed, &q, &qd);
         for kind in kinds {
             let f0 = || set.raw(kind, &q, &qd, &dynamics);
-            let floor = if matches!(kind, EventKind::SlipStop(_)) {
-                // A slip that starts at rest (or with its speed rounded a hair the other way) stops when it
-                // falls SLIP_STOP_MARGIN below where it started, so that a slip that reverses at once is an
-                // event too, not friction pushing the tip along.
-                f0().min(0.0) - SLIP_STOP_MARGIN
-            } else if Self::needs_forces(kind) {
+            let floor = if let Some(margin) = Self::start_margin(kind) {
                 // A force event fires once the force falls FORCE_EVENT_MARGIN below zero, or below its value at
-                // the phase start if that is already (within the complementarity tolerance) negative.
-                f0().min(0.0) - FORCE_EVENT_MARGIN
+                // the phase start if that is already (within the complementarity tolerance) negative. A slip
+                // that starts at rest (or with its speed rounded a hair the other way) stops when it falls
+                // SLIP_STOP_MARGIN below where it started, so that a slip that reverses at once is an event too,
+                // not friction pushing the tip along.
+                f0().min(0.0) - margin
             } else if let Some(gap) = Self::guard(opts, kind) {
                 // Guarded events start disarmed unless their function already clears the gap. A tip (leg) that
                 // starts at the ground (stopper) already moving into it is not grazing: it fires at once. Nor is
@@ -211,6 +209,18 @@ impl<'a> EventSet<'a> {
             set.events.push(Event { kind, floor });
         }
         set
+    }
+
+    /// The margin below zero, or below its value at the phase start if that is negative, at which an event that
+    /// starts at its zero fires: a force event's [`FORCE_EVENT_MARGIN`], a slip stop's [`SLIP_STOP_MARGIN`].
+    fn start_margin(kind: EventKind) -> Option<f64> {
+        if Self::needs_forces(kind) {
+            Some(FORCE_EVENT_MARGIN)
+        } else if matches!(kind, EventKind::SlipStop(_)) {
+            Some(SLIP_STOP_MARGIN)
+        } else {
+            None
+        }
     }
 
     /// The grazing guard of an event kind, if it has one.
