@@ -89,7 +89,7 @@
 //! let model = Model::new(&config.params).unwrap();
 //!
 //! // Walk five steps from a point of the Poincare section (L2, dtheta/dt, dL2/dt).
-//! let start = SectionState { l2: 0.72, theta_dot: 1.0, l2_dot: 0.0 };
+//! let start = SectionState::at_rest(0.72, 1.0, 0.0);
 //! let run = simulate(&model, &config.solver, &start, 5, None).unwrap();
 //! assert!(run.failure.is_none());
 //! let first = &run.steps[0];

@@ -189,6 +189,7 @@ pub fn default_initial(config: &Config) -> SectionState {
                 1.0
             },
             l2_dot: 0.0,
+            slip: 0.0,
         }
     } else {
         let mass = p.hub_mass + p.legs as f64 * p.leg_mass;
@@ -206,6 +207,7 @@ pub fn default_initial(config: &Config) -> SectionState {
             l2,
             theta_dot: (l2 / tuned).sqrt(),
             l2_dot: 0.0,
+            slip: 0.0,
         }
     }
 }

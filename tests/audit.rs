@@ -82,6 +82,7 @@ fn walk(overrides: &[String], steps: usize) -> Vec<StepReport> {
             l2: config.params.stopper_length,
             theta_dot: 1.5,
             l2_dot: 0.0,
+            slip: 0.0,
         }
     } else {
         start()

@@ -34,6 +34,7 @@ fn rigid_wheel_multiplier_is_eta_squared_to_1e_12() {
         l2: 1.0,
         theta_dot: 1.6,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     let gait = find_gait(&map, &start, &GaitOptions::default(), None).unwrap();
     let [re, im] = gait.floquet_multipliers[0];
@@ -119,6 +120,7 @@ fn the_finite_difference_check_counts_its_noise_on_stiff_legs() {
         l2: 0.999738613076006,
         theta_dot: 2.541822774788133,
         l2_dot: 0.14543688477616845,
+        slip: 0.0,
     };
     let options = GaitOptions {
         transient_steps: 0,
@@ -244,6 +246,7 @@ fn rigid_wheel_parameter_derivatives_match_the_closed_form() {
         l2: config.params.stopper_length,
         theta_dot: omega,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     for (key, value) in [("slope", config.params.slope), ("stopper_length", 1.0)] {
         let exact = map.eval_with_derivatives(&s, Some(key)).unwrap();

@@ -118,6 +118,7 @@ fn steps_csv_has_the_friction_columns_with_friction_only() {
     assert_eq!(
         header[STEPS_HEADER.len()..],
         [
+            "slip",
             "friction_loss",
             "cone_violation",
             "cone_violation_impulse",
@@ -127,7 +128,7 @@ fn steps_csv_has_the_friction_columns_with_friction_only() {
     let (steps, _) = walk(&["friction=0.6".to_string()], 1);
     let row = steps_row(&steps[0], columns);
     assert_eq!(row.len(), header.len());
-    let friction_loss = row[STEPS_HEADER.len()].to_csv();
+    let friction_loss = row[STEPS_HEADER.len() + 1].to_csv();
     assert!(
         friction_loss.parse::<f64>().unwrap() > 0.1,
         "{friction_loss}"
@@ -145,6 +146,7 @@ fn a_slip_that_reverses_at_once_is_stopped() {
         l2: 0.719334558057652,
         theta_dot: 0.7787901670716043,
         l2_dot: -0.2064695963255453,
+        slip: 0.0,
     };
     let mut walker = Walker::new(&model, &config.solver, &start).unwrap();
     let s = walker.step(None).unwrap();
@@ -163,6 +165,7 @@ fn large_mu_is_not_the_no_slip_model() {
         l2: 0.7137607593459316,
         theta_dot: 1.0210282344433548,
         l2_dot: -0.4795702983456791,
+        slip: 0.0,
     };
     let step = |mu: &str| {
         let config = config(&["viscosity=37".to_string(), format!("friction={mu}")]);

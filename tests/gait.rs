@@ -37,6 +37,7 @@ fn rigid_wheel_gait_matches_the_closed_form() {
         l2: 1.0,
         theta_dot: 1.6,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     let gait = find_gait(&map, &start, &GaitOptions::default(), None).unwrap();
     assert!(gait.residual < 1e-10);

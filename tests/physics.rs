@@ -21,6 +21,7 @@ fn default_start() -> SectionState {
         l2: 0.72,
         theta_dot: 1.0,
         l2_dot: 0.0,
+        slip: 0.0,
     }
 }
 
@@ -220,6 +221,7 @@ fn rigid_legs_follow_the_closed_form_step_map() {
         l2: config.params.stopper_length,
         theta_dot: omega,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     let run = simulate(&model, &config.solver, &start, 6, None).unwrap();
     assert!(run.failure.is_none(), "{:?}", run.failure);
@@ -317,6 +319,7 @@ fn section_coordinates_put_both_tips_on_the_ground() {
         l2: 0.8,
         theta_dot: 0.9,
         l2_dot: -0.3,
+        slip: 0.0,
     };
     let (q, qd) = s.to_coords(&model);
     assert_relative_eq!(model.tip_height(&q, 1), 0.0, epsilon = 1e-14);
@@ -392,6 +395,7 @@ fn a_stance_tip_sliding_into_touchdown_is_off_the_section() {
         l2: 0.9,
         theta_dot: 1.5,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     let mut walker = Walker::new(&model, &config.solver, &start).unwrap();
     let mut off = 0;

@@ -410,6 +410,7 @@ fn a_compression_stop_is_validated_where_it_enters() {
         l2: 0.99,
         theta_dot: 2.0,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     let error = below.validate(&model).unwrap_err().to_string();
     assert!(error.contains("min_length"), "{error}");

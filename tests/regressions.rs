@@ -33,6 +33,7 @@ const TUNED_START: SectionState = SectionState {
     l2: 0.72,
     theta_dot: 1.0,
     l2_dot: 0.0,
+    slip: 0.0,
 };
 
 /// Walk `steps` steps from `start`.
@@ -71,6 +72,7 @@ fn short_leg_start_is_refused_instead_of_chattering() {
             l2,
             theta_dot: 1.0,
             l2_dot: 0.0,
+            slip: 0.0,
         };
         let error = vrw::walk::Walker::new(&model, &config.solver, &start).unwrap_err();
         assert!(
@@ -82,6 +84,7 @@ fn short_leg_start_is_refused_instead_of_chattering() {
         l2: 0.71,
         theta_dot: 1.0,
         l2_dot: 0.0,
+        slip: 0.0,
     };
     let run = walk(&config, &start, 5);
     assert!(run.failure.is_none(), "{:?}", run.failure);

@@ -38,7 +38,7 @@ pub(crate) fn animate<'py>(
     py: Python<'py>,
     params: &Params,
     #[pyo3(from_py_with = steps_arg)] steps: usize,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     #[pyo3(from_py_with = sample_dt_arg)] sample_dt: f64,
     #[pyo3(from_py_with = fps_arg)] fps: u32,
     #[pyo3(from_py_with = speed_arg)] speed: f64,
@@ -63,7 +63,7 @@ pub(crate) fn animate<'py>(
         .map_err(|e| animate_error(AppError::Animate(e)))?;
     let job = SimulateJob {
         config: params.config.clone(),
-        initial: section(initial),
+        initial: section(initial)?,
         steps,
         sample_dt,
         trajectory: true,

@@ -35,8 +35,9 @@ use vrw::gait::MAX_SWEEP_POINTS;
 use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
 use vrw::output::{
     basin_header, basin_row, branch_header, branch_rows, curve_header, curve_row, family_header,
-    family_row, map_header, map_rows, orbit_header, orbit_rows, steps_header, steps_row,
-    sweep_header, sweep_row, trajectory_header, trajectory_row_under, Cell, StepsColumns,
+    family_row, friction_columns, map_header, map_rows, orbit_header, orbit_rows, steps_header,
+    steps_row, sweep_header, sweep_row, trajectory_header, trajectory_row_under, Cell,
+    StepsColumns,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::walk::SectionState;
@@ -284,8 +285,29 @@ fn table<'py, H: AsRef<str>>(
     Ok(dict)
 }
 
-fn section(initial: Option<[f64; 3]>) -> Option<SectionState> {
-    initial.map(SectionState::from_array)
+/// The `initial` keyword: `None`, or the section state `[L2, thetadot, L2dot]` or, with Coulomb friction and a
+/// slipping stance tip, `[L2, thetadot, L2dot, slip]` (checked against the model where the job starts).
+pub(crate) fn section(initial: Option<Vec<f64>>) -> PyResult<Option<SectionState>> {
+    initial
+        .map(|values| match values.len() {
+            3 | 4 => Ok(values
+                .iter()
+                .enumerate()
+                .fold(SectionState::at_rest(0.0, 0.0, 0.0), |s, (i, &v)| {
+                    s.with_coordinate(i, v)
+                })),
+            n => Err(WalkError::new_err(format!(
+                "invalid initial state {values:?}: {n} values given (expected [L2, thetadot, L2dot], or \
+                 [L2, thetadot, L2dot, slip] with a slipping stance tip)"
+            ))),
+        })
+        .transpose()
+}
+
+/// A section state as Python gets it: `[L2, thetadot, L2dot]`, with `slip` after them where the tip slips.
+pub(crate) fn section_values(s: &SectionState) -> Vec<f64> {
+    let n = if s.slips() { 4 } else { 3 };
+    (0..n).map(|i| s.coordinate(i)).collect()
 }
 
 /// The `parameter` keyword: `None`, or a key `dP/dp` can be taken for (the command line's `--parameter` rule
@@ -399,13 +421,13 @@ fn simulate<'py>(
     py: Python<'py>,
     params: &Params,
     #[pyo3(from_py_with = steps_arg)] steps: usize,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     trajectory: bool,
     #[pyo3(from_py_with = sample_dt_arg)] sample_dt: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let job = SimulateJob {
         config: params.config.clone(),
-        initial: section(initial),
+        initial: section(initial)?,
         steps,
         sample_dt,
         trajectory,
@@ -450,12 +472,12 @@ fn simulate<'py>(
 fn find_gait<'py>(
     py: Python<'py>,
     params: &Params,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let job = GaitJob {
         config: params.config.clone(),
-        initial: section(initial),
+        initial: section(initial)?,
         options: gait_options(GaitOptions::default(), options)?,
         out_dir: PathBuf::new(),
         check_jacobian: false,
@@ -490,19 +512,20 @@ fn sweep<'py>(
     params: &Params,
     param: &str,
     values: Vec<f64>,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     progress: Option<Py<PyAny>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let options = gait_options(GaitOptions::for_sweeps(), options)?;
     let config = &params.config;
     let progress = Progress::new(progress, values.len());
+    let initial = section(initial)?;
     let result = interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
         compute_sweep(
             config,
             param,
             &values,
-            section(initial),
+            initial,
             &options,
             &|_| progress.tick(),
             &mut |_| Ok(()),
@@ -511,8 +534,13 @@ fn sweep<'py>(
     .map_err(app_error)?;
     let out = PyDict::new(py);
     out.set_item("param", param)?;
-    let rows: Vec<Vec<Cell>> = result.points.iter().map(sweep_row).collect();
-    out.set_item("sweep", table(py, &sweep_header(param), &rows)?)?;
+    let friction = friction_columns(config, &[param]);
+    let rows: Vec<Vec<Cell>> = result
+        .points
+        .iter()
+        .map(|p| sweep_row(p, friction))
+        .collect();
+    out.set_item("sweep", table(py, &sweep_header(param, friction), &rows)?)?;
     out.set_item("thresholds", pythonize(py, &result.thresholds)?)?;
     out.set_item(
         "gaits_found",
@@ -545,7 +573,7 @@ fn basin<'py>(
     #[pyo3(from_py_with = ny_arg)] ny: usize,
     #[pyo3(from_py_with = max_steps_arg)] max_steps: usize,
     #[pyo3(from_py_with = tolerance_arg)] tolerance: f64,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     rows: Option<(usize, usize)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -556,7 +584,7 @@ fn basin<'py>(
     };
     let job = BasinJob {
         config: params.config.clone(),
-        initial: section(initial),
+        initial: section(initial)?,
         coordinates: [coordinate("x", x)?, coordinate("y", y)?],
         ranges: [x_range, y_range],
         points: [nx, ny],
@@ -605,7 +633,7 @@ fn gait_map<'py>(
     #[pyo3(from_py_with = curve_columns_arg)] curve_columns: usize,
     curve_method: &str,
     second_route: bool,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     rows: Option<(usize, usize)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -644,7 +672,7 @@ fn gait_map<'py>(
             x: axis(x, x_range, nx),
             y: axis(y, y_range, ny),
         },
-        initial: section(initial),
+        initial: section(initial)?,
         options: GaitOptions::default(),
         curves,
         curve_columns,
@@ -666,7 +694,9 @@ fn gait_map<'py>(
         })?
         .map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
-    result.set_item("map", table(py, &map_header(x, y), &map_rows(&map))?)?;
+    let friction = friction_columns(&job.config, &[x, y]);
+    let map_table = table(py, &map_header(x, y, friction), &map_rows(&map, friction))?;
+    result.set_item("map", map_table)?;
     Ok(result)
 }
 
@@ -691,7 +721,7 @@ fn orbit<'py>(
     #[pyo3(from_py_with = points_arg)] points: usize,
     #[pyo3(from_py_with = transient_arg)] transient: usize,
     #[pyo3(from_py_with = steps_arg)] steps: usize,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     branch: bool,
     progress: Option<Py<PyAny>>,
     #[pyo3(from_py_with = parts::orbit_part_arg)] part: Option<OrbitJobPart>,
@@ -709,7 +739,7 @@ fn orbit<'py>(
             transient,
             steps,
         },
-        initial: section(initial),
+        initial: section(initial)?,
         branch,
         out_dir: PathBuf::new(),
     };
@@ -774,7 +804,7 @@ fn continue_family<'py>(
     param: &str,
     start: Option<f64>,
     range: Option<(f64, f64)>,
-    initial: Option<[f64; 3]>,
+    initial: Option<Vec<f64>>,
     period: Option<usize>,
     #[pyo3(from_py_with = max_points_arg)] max_points: usize,
     max_step: f64,
@@ -789,7 +819,7 @@ fn continue_family<'py>(
         start,
         from: range.0,
         to: range.1,
-        initial: section(initial),
+        initial: section(initial)?,
         period,
         max_points,
         max_step,

@@ -8,7 +8,7 @@ use vrw::app::OrbitJobPart;
 use vrw::gait::orbit::{OrbitColumn, OrbitPart};
 use vrw::walk::SectionState;
 
-use crate::ConfigError;
+use crate::{section, section_values, ConfigError};
 
 /// `orbit`'s `part`: `"coarse"` (the diagram's coarse pass), `("fill", k, left)` (the values after the `k`-th
 /// coarse value, from `left`, the `(L2, thetadot, L2dot)` its walk ended in, or `None`) or `"branch"`.
@@ -23,16 +23,12 @@ pub(crate) fn orbit_part_arg(value: &Bound<'_, PyAny>) -> PyResult<Option<OrbitJ
             other => Err(invalid(other)),
         };
     }
-    let (name, k, left): (String, usize, Option<[f64; 3]>) =
+    let (name, k, left): (String, usize, Option<Vec<f64>>) =
         value.extract().map_err(|_| invalid(&value.to_string()))?;
     if name != "fill" {
         return Err(invalid(&name));
     }
-    let left = left.map(|[l2, theta_dot, l2_dot]| SectionState {
-        l2,
-        theta_dot,
-        l2_dot,
-    });
+    let left = section(left)?;
     Ok(Some(OrbitJobPart::Diagram(OrbitPart::Fill { k, left })))
 }
 
@@ -43,16 +39,17 @@ fn invalid(part: &str) -> PyErr {
 }
 
 /// What a part of the orbit diagram hands back besides `orbit.json`'s fields and its rows of `orbit.csv`:
-/// `ends`, the state each column's walk ended in (`[L2, thetadot, L2dot]`, `None` where it failed: what the
+/// `ends`, the state each column's walk ended in (`[L2, thetadot, L2dot]`, with `slip` after them where the
+/// stance tip slips, `None` where it failed: what the
 /// coarse pass hands to the fills), and `column_rows`, each column's number of rows in `orbit`.
 pub(crate) fn orbit_part_extras(
     result: &Bound<'_, PyDict>,
     columns: &[OrbitColumn],
     ends: &[Option<SectionState>],
 ) -> PyResult<()> {
-    let ends: Vec<Option<[f64; 3]>> = ends
+    let ends: Vec<Option<Vec<f64>>> = ends
         .iter()
-        .map(|e| e.map(|s| [s.l2, s.theta_dot, s.l2_dot]))
+        .map(|e| e.as_ref().map(section_values))
         .collect();
     result.set_item("ends", ends)?;
     let rows: Vec<usize> = columns.iter().map(|c| c.returns.len().max(1)).collect();

@@ -25,7 +25,7 @@ __all__ = [
 ]
 
 Value = Union[float, int, bool, str]
-Section = Union[Tuple[float, float, float], Sequence[float]]
+Section = Union[Tuple[float, float, float], Tuple[float, float, float, float], Sequence[float]]
 # A job's progress report: called as ``progress(done, total)`` on the calling thread as points finish.
 Progress = Callable[[int, int], object]
 

@@ -176,7 +176,8 @@ fn map_into(
     let clock = std::time::Instant::now();
     let map = map_gaits(&job.config, &job.spec, initial, &job.options, progress)?;
     let gait_seconds = clock.elapsed().as_secs_f64();
-    write_map_csv(&run.path("map.csv"), &map)?;
+    let friction = output::friction_columns(&job.config, &[&job.spec.x.param, &job.spec.y.param]);
+    write_map_csv(&run.path("map.csv"), &map, friction)?;
     run.add("map.csv");
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;

@@ -91,6 +91,7 @@ fn sweep_into(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<SweepSummary, AppError> {
     let csv = run.path("sweep.csv");
+    let friction = output::friction_columns(&job.config, &[&job.spec.param]);
     let result = compute_sweep(
         &job.config,
         &job.spec.param,
@@ -99,7 +100,7 @@ fn sweep_into(
         &job.options,
         progress,
         &mut |points| {
-            output::write_sweep_csv(&csv, &job.spec.param, points)?;
+            output::write_sweep_csv(&csv, &job.spec.param, friction, points)?;
             run.add("sweep.csv");
             Ok(())
         },

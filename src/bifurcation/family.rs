@@ -9,6 +9,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Evaluation, FamilyMap, MapFailure};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
+use crate::gait::step_map::{expand, free_coordinates, reduce};
 use crate::gait::{
     DerivativeError, SignedOutcome, StepMap, DERIVATIVE_CHECK_TIGHTENING, MAX_PERIOD,
 };
@@ -199,30 +200,24 @@ impl<'a> GaitFamily<'a> {
         Ok((c, model))
     }
 
-    /// Does the map act on `dtheta/dt` alone (rigid legs, or Leg 2 held at its compression stop)?
-    fn theta_dot_only(&self) -> bool {
-        self.config.params.rigid_legs || self.rear_held
+    /// The indices of the free coordinates ([`crate::walk::SECTION_COORDINATES`]): `dtheta/dt` alone with rigid
+    /// legs or Leg 2 held at its compression stop, else `(L2, dtheta/dt, dL2/dt)`; and `slip` where Leg 2's tip
+    /// slips at `base` (Coulomb friction).
+    fn free(&self) -> &'static [usize] {
+        free_coordinates(
+            self.config.params.rigid_legs || self.rear_held,
+            self.base.slips(),
+        )
     }
 
     /// The free coordinates of a section state.
     pub fn reduce(&self, s: &SectionState) -> DVector<f64> {
-        if self.theta_dot_only() {
-            DVector::from_element(1, s.theta_dot)
-        } else {
-            DVector::from_column_slice(&s.to_array())
-        }
+        reduce(self.free(), s)
     }
 
     /// The section state of the free coordinates `x`.
     pub fn expand(&self, x: &DVector<f64>) -> SectionState {
-        if self.theta_dot_only() {
-            SectionState {
-                theta_dot: x[0],
-                ..self.base
-            }
-        } else {
-            SectionState::from_array([x[0], x[1], x[2]])
-        }
+        expand(self.free(), &self.base, x)
     }
 
     /// The section state of the free coordinates `x` at the parameter `p`: [`GaitFamily::expand`], except that a
@@ -252,6 +247,7 @@ impl<'a> GaitFamily<'a> {
     {
         StepMap::new(model, &c.solver)
             .with_rear_held(self.rear_held)
+            .with_slip(self.base.slips())
             .iterated(self.period)
             .with_interrupt(self.interrupt)
     }
@@ -291,11 +287,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
     type Info = GaitInfo;
 
     fn dim(&self) -> usize {
-        if self.theta_dot_only() {
-            1
-        } else {
-            3
-        }
+        self.free().len()
     }
 
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<GaitInfo>, MapFailure> {

@@ -71,15 +71,13 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
     bar.finish_and_clear();
     let g = &summary.gait;
     println!(
-        "vrw basin: {} x {} starts on the slice ({}, {}) through the {}gait at (L2, thetadot, L2dot) = ({:.6}, {:.6}, {:.6}); {:.2} s ({:.2} s for the grid)",
+        "vrw basin: {} x {} starts on the slice ({}, {}) through the {}gait at {}; {:.2} s ({:.2} s for the grid)",
         args.nx,
         args.ny,
         args.x.name(),
         args.y.name(),
         if g.period_k > 1 { format!("period-{} ", g.period_k) } else { String::new() },
-        g.section.l2,
-        g.section.theta_dot,
-        g.section.l2_dot,
+        g.section.labelled(Some(6)),
         started.elapsed().as_secs_f64(),
         summary.seconds
     );

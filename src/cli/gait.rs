@@ -104,9 +104,15 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         for r in &g.cycle {
             let (c, i) = (&r.section, &r.indicators);
             println!(
-                "  step {}: (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}); lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
+                "  step {}: {}; lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
                  lambda_4+ = {:.6} N, branch {}, period {:.6} s",
-                r.step, c.l2, c.theta_dot, c.l2_dot, i.lambda_i4, i.lambda_2_plus, i.lambda_4_plus, r.branch, r.period
+                r.step,
+                c.labelled(Some(9)),
+                i.lambda_i4,
+                i.lambda_2_plus,
+                i.lambda_4_plus,
+                r.branch,
+                r.period
             );
         }
         println!(
@@ -115,8 +121,11 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         );
     }
     println!(
-        "gait at (L2, thetadot, L2dot) = ({:.9}, {:.9}, {:.9}), theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
-        s.l2, s.theta_dot, s.l2_dot, g.theta, g.residual, g.iterations
+        "gait at {}, theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
+        s.labelled(Some(9)),
+        g.theta,
+        g.residual,
+        g.iterations
     );
     println!(
         "lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, lambda_4+ = {:.6} N, branch {}{}{}",

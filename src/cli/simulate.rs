@@ -59,13 +59,11 @@ pub(super) fn run(args: SimulateArgs) -> Result<()> {
     .context("simulate")?;
     bar.finish_and_clear();
     println!(
-        "vrw simulate: c = {} N s/m, slope = {} rad, impact = {}; start (L2, thetadot, L2dot) = ({}, {}, {})",
+        "vrw simulate: c = {} N s/m, slope = {} rad, impact = {}; start {}",
         job.config.params.viscosity,
         job.config.params.slope,
         job.config.params.impact,
-        summary.initial.l2,
-        summary.initial.theta_dot,
-        summary.initial.l2_dot
+        summary.initial.labelled(None)
     );
     println!(
         "{} of {} steps in {:.4} s of simulated time; max |energy residual| = {:.2e} J",

@@ -47,7 +47,7 @@ impl Coordinate {
     pub(crate) const ALL: [Coordinate; 3] =
         [Coordinate::L2, Coordinate::ThetaDot, Coordinate::L2Dot];
 
-    /// Index into `SectionState::to_array`.
+    /// Index into `SectionState::coordinate` (`L2`, `thetadot`, `L2dot`).
     pub(crate) fn index(self) -> usize {
         match self {
             Coordinate::L2 => 0,
@@ -233,10 +233,11 @@ pub fn basin_part(
         spec.y.points,
         spec.x.points,
         |cell, _: Option<(usize, &())>| {
-            let mut a = spec.through.to_array();
-            a[spec.x.coordinate.index()] = spec.x.value(cell.col);
-            a[spec.y.coordinate.index()] = spec.y.value(cell.row);
-            let start = SectionState::from_array(a);
+            // The other coordinates (and a slipping tip's `slip`) are the gait's.
+            let start = spec
+                .through
+                .with_coordinate(spec.x.coordinate.index(), spec.x.value(cell.col))
+                .with_coordinate(spec.y.coordinate.index(), spec.y.value(cell.row));
             let point = BasinPoint {
                 ix: cell.col,
                 iy: cell.row,

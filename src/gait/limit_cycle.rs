@@ -225,6 +225,11 @@ pub struct Gait {
     /// its Jacobian and the multipliers are over `dtheta/dt` alone (the other two coordinates are fixed after
     /// one step: their multipliers are 0).
     pub rear_held: bool,
+    /// With Coulomb friction, the coordinates of the section the map acts on, which are the rows and columns
+    /// of `jacobian`: `["L2", "thetadot", "L2dot"]` where Leg 2's tip is at rest at the section, with `"slip"`
+    /// after them where it slips there (docs/model.md section 12.7; `["thetadot"]` / `["thetadot", "slip"]`
+    /// with `rear_held` or rigid legs). Absent without friction.
+    pub section_coordinates: Option<Vec<&'static str>>,
 }
 
 /// The stability verdict of a gait, honest about the Jacobian's error estimate `e`: `Stable` only when the
@@ -310,6 +315,24 @@ pub fn find_gait(
 /// perturbed walk fails), the gait without multipliers and the reason in [`Gait::jacobian_failure`].
 pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitOptions) -> Gait {
     let on = map.on_section_of(&fp.section);
+    let coordinates = map
+        .model()
+        .params()
+        .has_friction()
+        .then(|| on.free_coordinate_names());
+    let gait = gait_with_jacobian_on(map, &on, fp, options);
+    Gait {
+        section_coordinates: coordinates,
+        ..gait
+    }
+}
+
+fn gait_with_jacobian_on(
+    map: &StepMap,
+    on: &StepMap,
+    fp: &FixedPoint,
+    options: &GaitOptions,
+) -> Gait {
     let failed = |failure: String| {
         let n = on.free_coordinates().len();
         let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
@@ -386,10 +409,17 @@ pub(crate) fn solve_fixed_point_asking(
     // there (`L2 = min_length`, `dL2/dt = 0`): one more step takes a start that is not onto that set, and the
     // map then acts on `dtheta/dt` alone (`StepMap::on_section_of`).
     // A step that stays off the held set is the first one Newton's method needs: kept, not walked again.
+    // With Coulomb friction, the same for a start whose stance tip is at rest while the next touchdown's
+    // slips: the map then has the slip velocity as a coordinate (the first step is walked on the map that
+    // has it, which accepts either).
     let mut first_step = None;
-    if map.model().params().min_length > 0.0 && !s.rear_held(map.model()) {
-        if let Ok(first) = map.eval(&s) {
-            if first.next.rear_held(map.model()) {
+    let held_may_start = map.model().params().min_length > 0.0 && !s.rear_held(map.model());
+    let slip_may_start = map.model().params().has_friction() && !s.slips();
+    if held_may_start || slip_may_start {
+        if let Ok(first) = map.clone().with_slip(true).eval(&s) {
+            let held = held_may_start && first.next.rear_held(map.model());
+            let slips = slip_may_start && first.next.slips();
+            if held || slips {
                 s = first.next;
             } else {
                 first_step = Some(first);
@@ -561,6 +591,7 @@ pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) ->
         signature: None,
         stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
         rear_held: fp.rear_held,
+        section_coordinates: None,
     }
 }
 
@@ -597,6 +628,8 @@ struct GaitRecord {
     cycle: Vec<StepReport>,
     jacobian: Vec<Vec<f64>>,
     jacobian_error: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    jacobian_route: Option<&'static str>,
     #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
     dp_dparam: Option<ParamDerivative>,
     floquet_multipliers: Vec<[f64; 2]>,
@@ -609,6 +642,10 @@ struct GaitRecord {
     /// before.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     rear_held: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    section_coordinates: Option<Vec<&'static str>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    signature: Option<String>,
 }
 
 impl From<Gait> for GaitRecord {
@@ -637,6 +674,7 @@ impl From<Gait> for GaitRecord {
             cycle: g.cycle,
             jacobian: g.jacobian,
             jacobian_error: g.jacobian_error,
+            jacobian_route: g.jacobian_route,
             dp_dparam: g.dp_dparam,
             floquet_multipliers: g.floquet_multipliers,
             max_floquet: g.max_floquet,
@@ -644,6 +682,8 @@ impl From<Gait> for GaitRecord {
             jacobian_failure: g.jacobian_failure,
             stable: g.stable,
             rear_held: g.rear_held,
+            section_coordinates: g.section_coordinates,
+            signature: g.signature,
         }
     }
 }

@@ -53,6 +53,7 @@ mod tests {
             l2,
             theta_dot: 1.0,
             l2_dot: 0.0,
+            slip: 0.0,
         }
     }
 
@@ -84,11 +85,13 @@ mod tests {
             l2: 0.7,
             theta_dot: 1.0,
             l2_dot: 0.0,
+            slip: 0.0,
         };
         let b = SectionState {
             l2: 0.71,
             theta_dot: 0.9,
             l2_dot: 0.05,
+            slip: 0.0,
         };
         assert_eq!(a.distance(&b), (1.0f64 - 0.9).abs());
         assert_eq!(a.distance(&b), b.distance(&a));

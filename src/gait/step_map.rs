@@ -32,7 +32,31 @@ use crate::variational::{
 use crate::walk::section::section_coords;
 use crate::walk::tape::StepTape;
 use crate::walk::WalkError;
-use crate::walk::{Branch, SectionState, StepReport, Walker, WorkCounts};
+use crate::walk::{Branch, SectionState, StepReport, Walker, WorkCounts, SECTION_COORDINATES};
+
+/// Indices (into [`SECTION_COORDINATES`]) of a step map's free coordinates: `dtheta/dt` alone with rigid legs
+/// or Leg 2 held at its compression stop (`theta_dot_only`), else `(L2, dtheta/dt, dL2/dt)`; and the slip
+/// velocity where Leg 2's tip slips at the section (`slipping`, Coulomb friction).
+pub(crate) fn free_coordinates(theta_dot_only: bool, slipping: bool) -> &'static [usize] {
+    match (theta_dot_only, slipping) {
+        (true, false) => &[1],
+        (true, true) => &[1, 3],
+        (false, false) => &[0, 1, 2],
+        (false, true) => &[0, 1, 2, 3],
+    }
+}
+
+/// The coordinates `free` of `s` as a vector.
+pub(crate) fn reduce(free: &[usize], s: &SectionState) -> DVector<f64> {
+    DVector::from_iterator(free.len(), free.iter().map(|&i| s.coordinate(i)))
+}
+
+/// `base` with its coordinates `free` replaced by `v`.
+pub(crate) fn expand(free: &[usize], base: &SectionState, v: &DVector<f64>) -> SectionState {
+    free.iter()
+        .enumerate()
+        .fold(*base, |s, (k, &i)| s.with_coordinate(i, v[k]))
+}
 
 /// One evaluation of the step map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,6 +124,9 @@ pub struct StepMap<'m> {
     interrupt: Option<&'m AtomicBool>,
     /// The map acts on states whose Leg 2 is held at its compression stop ([`StepMap::on_section_of`]).
     rear_held: bool,
+    /// The map acts on states whose Leg 2's tip slips (Coulomb friction): `slip` is one of its coordinates
+    /// ([`StepMap::on_section_of`]).
+    slipping: bool,
 }
 
 impl<'m> StepMap<'m> {
@@ -112,6 +139,7 @@ impl<'m> StepMap<'m> {
             work: Arc::default(),
             interrupt: None,
             rear_held: false,
+            slipping: false,
         }
     }
 
@@ -119,8 +147,18 @@ impl<'m> StepMap<'m> {
     /// ([`SectionState::rear_held`]: `L2 = min_length`, `dL2/dt = 0`, as at every touchdown of a walk whose
     /// stance leg is held then), the map acts on `dtheta/dt` alone, as with rigid legs, and an evaluation whose
     /// next touchdown has Leg 2 free fails ([`WalkError::HoldChanged`]); otherwise on all three coordinates.
+    /// Where Leg 2's tip slips at `s` (Coulomb friction, [`SectionState::slips`]), its slip velocity is a
+    /// coordinate too; a map on states whose tip is at rest fails where the next touchdown's slips
+    /// ([`WalkError::SlipAtSection`]).
     pub fn on_section_of(&self, s: &SectionState) -> StepMap<'m> {
-        self.clone().with_rear_held(s.rear_held(self.model))
+        self.clone()
+            .with_rear_held(s.rear_held(self.model))
+            .with_slip(s.slips())
+    }
+
+    /// The map on states whose Leg 2's tip slips (`slipping`: `slip` is a coordinate) or is at rest.
+    pub(crate) fn with_slip(self, slipping: bool) -> StepMap<'m> {
+        StepMap { slipping, ..self }
     }
 
     /// The map on the states whose Leg 2 is held at its compression stop (`held`, see
@@ -139,12 +177,17 @@ impl<'m> StepMap<'m> {
 
     /// `next`, or [`WalkError::HoldChanged`] where this map holds Leg 2 at its compression stop and `next`
     /// does not.
+    /// The same for a map on states whose stance tip is at rest and a `next` whose tip slips
+    /// ([`WalkError::SlipAtSection`]).
     fn check_hold(&self, next: SectionState) -> Result<SectionState, WalkError> {
         if self.rear_held && !next.rear_held(self.model) {
             return Err(WalkError::HoldChanged {
                 length: next.l2,
                 rate: next.l2_dot,
             });
+        }
+        if !self.slipping && next.slips() {
+            return Err(WalkError::SlipAtSection { slip: next.slip });
         }
         Ok(next)
     }
@@ -273,6 +316,8 @@ impl<'m> StepMap<'m> {
             model,
             &mech,
             (unit(0, s.l2), unit(1, s.theta_dot), unit(2, s.l2_dot)),
+            // 0: the exact derivatives refuse Coulomb friction above, and only friction slips.
+            s.slip,
         );
         let mut sens: Sensitivity<D> = sensitivity(&q, &qd);
         let mut cycle = Vec::with_capacity(self.iterate);
@@ -339,31 +384,31 @@ impl<'m> StepMap<'m> {
         })
     }
 
-    /// Indices (into `[L2, dtheta/dt, dL2/dt]`) of the coordinates the map acts on.
+    /// Indices (into [`SECTION_COORDINATES`], `[L2, dtheta/dt, dL2/dt, slip]`) of the coordinates the map acts
+    /// on.
     pub(crate) fn free_coordinates(&self) -> &'static [usize] {
-        if self.model.params().rigid_legs || self.rear_held {
-            &[1]
-        } else {
-            &[0, 1, 2]
-        }
+        free_coordinates(
+            self.model.params().rigid_legs || self.rear_held,
+            self.slipping,
+        )
+    }
+
+    /// The names of the free coordinates (in [`SECTION_COORDINATES`]).
+    pub fn free_coordinate_names(&self) -> Vec<&'static str> {
+        self.free_coordinates()
+            .iter()
+            .map(|&i| SECTION_COORDINATES[i])
+            .collect()
     }
 
     /// The free coordinates of `s` as a vector.
     pub fn reduce(&self, s: &SectionState) -> DVector<f64> {
-        let a = s.to_array();
-        DVector::from_iterator(
-            self.free_coordinates().len(),
-            self.free_coordinates().iter().map(|&i| a[i]),
-        )
+        reduce(self.free_coordinates(), s)
     }
 
     /// `base` with its free coordinates replaced by `v`.
     pub fn expand(&self, base: &SectionState, v: &DVector<f64>) -> SectionState {
-        let mut a = base.to_array();
-        for (k, &i) in self.free_coordinates().iter().enumerate() {
-            a[i] = v[k];
-        }
-        SectionState::from_array(a)
+        expand(self.free_coordinates(), base, v)
     }
 
     /// Central-difference Jacobian `D(h)` of the reduced map at `s`, with relative step `h`.

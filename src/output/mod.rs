@@ -36,7 +36,9 @@ pub use tables::map::{map_header, map_rows};
 pub use tables::steps::{
     step_row, steps_header, steps_row, write_steps_csv, StepsColumns, StepsCsv, STEPS_HEADER,
 };
-pub use tables::sweep::{sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS};
+pub use tables::sweep::{
+    friction_columns, sweep_header, sweep_row, write_sweep_csv, SWEEP_COLUMNS,
+};
 pub use tables::trajectory::{
     trajectory_header, trajectory_row, trajectory_row_under, write_trajectory_csv, TrajectoryCsv,
     TRAJECTORY_HEADER,

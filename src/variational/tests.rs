@@ -26,6 +26,7 @@ fn cases() -> Vec<(Vec<&'static str>, SectionState)> {
         l2,
         theta_dot,
         l2_dot,
+        slip: 0.0,
     };
     vec![
         // The paper's gait: DLS, rear lift-off into a slide, stopper lock of the rear leg.

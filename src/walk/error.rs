@@ -138,6 +138,16 @@ pub enum WalkError {
         /// `dL2/dt` there \[m/s\].
         rate: f64,
     },
+    /// A step map on states whose stance tip is at rest at the section reached a touchdown where it slips
+    /// (Coulomb friction): the walk itself can go on, but the map's coordinates do not hold the slip velocity.
+    #[error(
+        "the stance tip slips at the next touchdown (slip {slip:.3e} m/s) but is at rest at the section the \
+         step map starts from: the map on (L2, thetadot, L2dot) cannot follow"
+    )]
+    SlipAtSection {
+        /// The tip's slip velocity at the touchdown \[m/s\].
+        slip: f64,
+    },
     /// No set of active contacts and stoppers satisfies the unilateral conditions.
     #[error("no consistent contact state at t = {time:.6} s in {phase}")]
     InconsistentContacts {
@@ -167,7 +177,7 @@ pub enum WalkError {
     /// A Poincare-section state the wheel cannot be in.
     #[error("invalid section state: {field} = {}: {reason}", short(*.value))]
     InvalidSection {
-        /// Which component (`L2`, `thetadot`, `L2dot`).
+        /// Which component (`L2`, `thetadot`, `L2dot`, `slip`).
         field: &'static str,
         /// Its value.
         value: f64,
@@ -215,7 +225,9 @@ impl WalkError {
                 IntegrationError::StepSizeTooSmall { time, .. }
                 | IntegrationError::NonFinite { time } => *time,
             }),
-            WalkError::InvalidSection { .. } | WalkError::HoldChanged { .. } => None,
+            WalkError::InvalidSection { .. }
+            | WalkError::HoldChanged { .. }
+            | WalkError::SlipAtSection { .. } => None,
         }
     }
 
@@ -234,6 +246,7 @@ impl WalkError {
             WalkError::SwingAtSection { .. } => "leg_swings_at_section",
             WalkError::OffSection { .. } => "off_section",
             WalkError::HoldChanged { .. } => "hold_changed",
+            WalkError::SlipAtSection { .. } => "slip_at_section",
             WalkError::InconsistentContacts { .. } => "inconsistent_contacts",
             WalkError::Contact {
                 source: ContactError::Painleve(_),

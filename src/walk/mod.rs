@@ -74,7 +74,7 @@ pub use report::{
     SLIP_POWER_WARNING, STOPPER_OVERRUN_WARNING,
 };
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
-pub use section::{ParseSectionError, SectionState};
+pub use section::{ParseSectionError, SectionState, SECTION_COORDINATES};
 pub use trajectory::{Sample, SampleSink, Trajectory};
 pub use walker::{Walker, INTERRUPT_CHECK_STEPS};
 pub use work::{EventCounts, WorkCounts};

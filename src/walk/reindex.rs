@@ -88,7 +88,7 @@ pub(super) fn reindex(
     };
     let q_new = Coords::new(0.0, front.position.y, theta, l_td, l2, swing.0);
     let qd_new = Coords::new(v.x, v.y, qd[THETA], 0.0, l2_dot, swing.1);
-    let before = ActiveSet {
+    let mut before = ActiveSet {
         contact1: false,
         contact2: shift == 1 && active.contact1,
         // It arrives locked on its stopper unless it lands shorter (`touchdown_length`).
@@ -100,6 +100,10 @@ pub(super) fn reindex(
         compression2: shift == 1 && active.compression1,
         ..Default::default()
     };
+    // A tip slipping with Coulomb friction slips on as Leg 2's (the section's `slip` coordinate).
+    if shift == 1 && active.contact1 && active.slip1 != 0 {
+        before.set_slipping(Leg::Two, active.slip1);
+    }
     // Only a free leg is reset: with none, the reset removes nothing, exactly.
     let reset_energy = if (q_reset, qd_reset) == (*q, *qd) {
         0.0

@@ -3,11 +3,16 @@
 //! There `x = z = 0` (the new Leg 1's tip is the origin), `L1 = L0` (the touchdown length), `dL1/dt = 0`, and Leg 2's tip is on the
 //! ground and at rest, so the state reduces to `s = (L2, dtheta/dt, dL2/dt)`: `theta` follows from Leg 2's tip
 //! touching the ground and `(dx, dz)` from Leg 2's tip being at rest.
+//!
+//! With Coulomb friction (a finite `friction`) Leg 2's tip may still slip along the ground at the touchdown: the
+//! section then has a fourth coordinate, the tip's slip velocity `v_s` (its velocity along the slope, `+x` down
+//! it), and `(dx, dz)` give the tip the velocity `(v_s, 0)` (docs/model.md section 12.7). A tip at rest has
+//! `v_s = 0`, the three-coordinate section.
 
 use serde::Serialize;
 
 use super::WalkError;
-use crate::contact::Leg;
+use crate::contact::{ActiveSet, Leg};
 use crate::dynamics::{lit, Coords, CoordsOf, Mechanics, Model, Real, L2, THETA, X, Z};
 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
@@ -22,7 +27,8 @@ pub(crate) const SECTION_GROUND_TOL: f64 = 1e-9;
 /// compression stop \[m, m/s\] ([`SectionState::rear_held`]): a held leg drifts by rounding only.
 pub(crate) const HELD_SECTION_TOL: f64 = 1e-9;
 
-/// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section.
+/// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section; with Coulomb friction, `(L2, dtheta/dt, dL2/dt,
+/// v_s)` where Leg 2's tip slips at the touchdown.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SectionState {
     /// Length of Leg 2 (the stance leg about to become the rear leg) \[m\].
@@ -34,30 +40,83 @@ pub struct SectionState {
     /// Rate of change of the length of Leg 2 \[m/s\].
     #[serde(rename = "L2dot")]
     pub l2_dot: f64,
+    /// Slip velocity of Leg 2's tip along the slope (`+x`, down it) \[m/s\]: 0 where the tip is at rest (always
+    /// without friction); nonzero only with Coulomb friction, where the tip slips at the touchdown. Left out of
+    /// the JSON where 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub slip: f64,
 }
 
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// The names of the section's coordinates, in the order of [`SectionState::coordinate`].
+pub const SECTION_COORDINATES: [&str; 4] = ["L2", "thetadot", "L2dot", "slip"];
+
 impl SectionState {
-    /// The section state as a vector `[L2, dtheta/dt, dL2/dt]`.
+    /// The section state `(L2, dtheta/dt, dL2/dt)` of a tip at rest (`slip = 0`).
+    pub const fn at_rest(l2: f64, theta_dot: f64, l2_dot: f64) -> SectionState {
+        SectionState {
+            l2,
+            theta_dot,
+            l2_dot,
+            slip: 0.0,
+        }
+    }
+
+    /// The `i`-th coordinate of [`SECTION_COORDINATES`] (`L2`, `thetadot`, `L2dot`, `slip`).
+    pub fn coordinate(&self, i: usize) -> f64 {
+        [self.l2, self.theta_dot, self.l2_dot, self.slip][i]
+    }
+
+    /// This state with its `i`-th coordinate of [`SECTION_COORDINATES`] set to `value`.
+    pub fn with_coordinate(&self, i: usize, value: f64) -> SectionState {
+        let mut s = *self;
+        *[&mut s.l2, &mut s.theta_dot, &mut s.l2_dot, &mut s.slip][i] = value;
+        s
+    }
+
+    /// The state as the command line prints it, `(L2, thetadot, L2dot) = (0.72, 1, 0)`, with `slip` where the
+    /// tip slips; with `precision` digits after the point, or the shortest form that reads back exactly.
+    pub fn labelled(&self, precision: Option<usize>) -> String {
+        let n = if self.slips() { 4 } else { 3 };
+        let values: Vec<String> = (0..n)
+            .map(|i| match precision {
+                Some(p) => format!("{:.*}", p, self.coordinate(i)),
+                None => format!("{}", self.coordinate(i)),
+            })
+            .collect();
+        format!(
+            "({}) = ({})",
+            SECTION_COORDINATES[..n].join(", "),
+            values.join(", ")
+        )
+    }
+
+    /// Does Leg 2's tip slip at this touchdown (`slip != 0`, only with Coulomb friction)?
+    pub fn slips(&self) -> bool {
+        self.slip != 0.0
+    }
+
+    /// The three coordinates `[L2, dtheta/dt, dL2/dt]` (without `slip`).
     pub fn to_array(&self) -> [f64; 3] {
         [self.l2, self.theta_dot, self.l2_dot]
     }
 
-    /// The section state from a vector `[L2, dtheta/dt, dL2/dt]`.
+    /// The section state of a tip at rest from a vector `[L2, dtheta/dt, dL2/dt]`.
     pub fn from_array(s: [f64; 3]) -> SectionState {
-        SectionState {
-            l2: s[0],
-            theta_dot: s[1],
-            l2_dot: s[2],
-        }
+        SectionState::at_rest(s[0], s[1], s[2])
     }
 
-    /// Largest coordinate difference between two section states, `max(|dL2|, |dthetadot|, |dL2dot|)`: the
-    /// distance every gait comparison uses (same gait, settled walk, period of the returns).
+    /// Largest coordinate difference between two section states, `max(|dL2|, |dthetadot|, |dL2dot|, |dslip|)`:
+    /// the distance every gait comparison uses (same gait, settled walk, period of the returns).
     pub fn distance(&self, other: &SectionState) -> f64 {
         (self.l2 - other.l2)
             .abs()
             .max((self.theta_dot - other.theta_dot).abs())
             .max((self.l2_dot - other.l2_dot).abs())
+            .max((self.slip - other.slip).abs())
     }
 
     /// Check that this is a state the wheel can be in at touchdown.
@@ -74,6 +133,7 @@ impl SectionState {
             ("L2", self.l2),
             ("thetadot", self.theta_dot),
             ("L2dot", self.l2_dot),
+            ("slip", self.slip),
         ] {
             if !value.is_finite() {
                 return bad(field, value, "must be a finite number");
@@ -94,6 +154,13 @@ impl SectionState {
                 "thetadot",
                 self.theta_dot,
                 "must be positive (the wheel rolls forward)",
+            );
+        }
+        if self.slips() && !model.params().has_friction() {
+            return bad(
+                "slip",
+                self.slip,
+                "must be 0 without Coulomb friction (a finite `friction`): the tip is held at rest",
             );
         }
         let (q, _) = self.to_coords(model);
@@ -158,16 +225,55 @@ impl SectionState {
     /// `L2 = min_length` and `dL2/dt = 0` exactly).
     pub fn to_coords(&self, model: &Model) -> (Coords, Coords) {
         let s = self.pinned(model);
-        section_coords(model, model.mechanics(), (s.l2, s.theta_dot, s.l2_dot))
+        section_coords(
+            model,
+            model.mechanics(),
+            (s.l2, s.theta_dot, s.l2_dot),
+            s.slip,
+        )
     }
 
-    /// The section state of generalized coordinates at the section.
+    /// The section state of generalized coordinates at the section, Leg 2's tip at rest (`slip = 0`).
     pub fn from_coords(q: &Coords, qd: &Coords) -> SectionState {
+        SectionState::at_rest(q[L2], qd[THETA], qd[L2])
+    }
+
+    /// The section state of a walk's state at the section, whose active set is `active`: `slip` is the
+    /// velocity of Leg 2's tip along the slope where that contact slips with Coulomb friction, else 0.
+    pub(crate) fn at_touchdown(
+        model: &Model,
+        q: &Coords,
+        qd: &Coords,
+        active: &ActiveSet,
+    ) -> SectionState {
+        let slip = if active.contact2 && active.slip2 != 0 {
+            model.tip(q, qd, Leg::Two.index()).velocity(qd).x
+        } else {
+            0.0
+        };
         SectionState {
-            l2: q[L2],
-            theta_dot: qd[THETA],
-            l2_dot: qd[L2],
+            slip,
+            ..SectionState::from_coords(q, qd)
         }
+    }
+
+    /// The active set just before the touchdown at this section state: Leg 2's tip on the ground (slipping in
+    /// the direction of `slip` where it slips), Leg 1 in the air and on its stopper unless it lands shorter
+    /// (`touchdown_length`), Leg 2 on its stopper with rigid legs and held at its compression stop where
+    /// [`SectionState::rear_held`].
+    pub(crate) fn active_before(&self, model: &Model) -> ActiveSet {
+        let mut active = ActiveSet {
+            contact1: false,
+            contact2: true,
+            lock1: model.params().lands_on_stopper(),
+            lock2: model.params().rigid_legs,
+            compression2: self.rear_held(model),
+            ..Default::default()
+        };
+        if self.slips() {
+            active.set_slipping(Leg::Two, if self.slip > 0.0 { 1 } else { -1 });
+        }
+        active
     }
 }
 
@@ -175,11 +281,13 @@ impl SectionState {
 /// section's own constraint, docs/model.md section 6): `x = z = 0`, `L1 = L0` (the touchdown length), `dL1/dt = 0`; `theta` puts Leg 2's
 /// tip on the ground, `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2
 /// sin(alpha))`; `(dx, dz)` hold Leg 2's tip at rest (`J_C2 q' = 0`, whose `x`, `z` columns are the identity).
-/// With `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly.
+/// With `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly. A slipping tip (`slip`, Coulomb friction) moves at
+/// `(slip, 0)` instead: `dx` is `slip` more.
 pub(crate) fn section_coords<T: Real>(
     model: &Model,
     mech: &Mechanics<T>,
     (l2, theta_dot, l2_dot): (T, T, T),
+    slip: f64,
 ) -> (CoordsOf<T>, CoordsOf<T>) {
     // Leg 1 has just landed, at the touchdown length (`L0` by default, and always with rigid legs).
     let l0 = mech.spoke_length;
@@ -197,14 +305,22 @@ pub(crate) fn section_coords<T: Real>(
     let v = model
         .tip_with(mech, &q, &qd, Leg::Two.index())
         .velocity(&qd);
-    qd[X] = -v.x;
+    // (`-v.x` itself without slip: the same bits as before the slip coordinate, signed zeros included.)
+    qd[X] = if slip == 0.0 {
+        -v.x
+    } else {
+        lit::<T>(slip) - v.x
+    };
     qd[Z] = -v.y;
     (q, qd)
 }
 
-/// A section state written as `L2,thetadot,L2dot` could not be read.
+/// A section state written as `L2,thetadot,L2dot` (or `L2,thetadot,L2dot,slip`) could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("invalid initial state {text:?}: {reason} (expected three numbers L2,thetadot,L2dot, e.g. 0.72,1.0,0.0)")]
+#[error(
+    "invalid initial state {text:?}: {reason} (expected three numbers L2,thetadot,L2dot, e.g. 0.72,1.0,0.0, or four \
+     with the stance tip's slip velocity, L2,thetadot,L2dot,slip)"
+)]
 pub struct ParseSectionError {
     /// The text given.
     pub text: String,
@@ -221,18 +337,19 @@ impl std::str::FromStr for SectionState {
             reason,
         };
         let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-        if parts.len() != 3 {
+        if !(3..=4).contains(&parts.len()) {
             return Err(err(format!("{} values given", parts.len())));
         }
-        let mut values = [0.0; 3];
-        for (value, (part, name)) in values
-            .iter_mut()
-            .zip(parts.iter().zip(["L2", "thetadot", "L2dot"]))
-        {
-            *value = part
-                .parse::<f64>()
-                .map_err(|_| err(format!("{name} = {part:?} is not a number")))?;
+        let mut state = SectionState::at_rest(0.0, 0.0, 0.0);
+        for (i, part) in parts.iter().enumerate() {
+            let value = part.parse::<f64>().map_err(|_| {
+                err(format!(
+                    "{} = {part:?} is not a number",
+                    SECTION_COORDINATES[i]
+                ))
+            })?;
+            state = state.with_coordinate(i, value);
         }
-        Ok(SectionState::from_array(values))
+        Ok(state)
     }
 }

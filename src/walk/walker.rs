@@ -80,15 +80,7 @@ impl<'m> Walker<'m> {
             time: 0.0,
             q,
             qd,
-            active: ActiveSet {
-                contact1: false,
-                contact2: true,
-                // Leg 1 arrives on its stopper unless it lands shorter (`touchdown_length`).
-                lock1: model.params().lands_on_stopper(),
-                lock2: model.params().rigid_legs,
-                compression2: section.rear_held(model),
-                ..Default::default()
-            },
+            active: section.active_before(model),
             x_origin: 0.0,
             leg1: 0,
         };
@@ -108,16 +100,22 @@ impl<'m> Walker<'m> {
         &self.state
     }
 
-    /// The section coordinates `(L2, thetadot, L2dot)` at the current touchdown, without the check of
-    /// [`Walker::section`]: what a return map or an orbit diagram records. Where the stance tip slides they do
-    /// not hold the whole state, so they must not be used to start a walk there.
+    /// The section coordinates `(L2, thetadot, L2dot, slip)` at the current touchdown, without the check of
+    /// [`Walker::section`]: what a return map or an orbit diagram records. Where the stance tip slides without
+    /// friction they do not hold the whole state, so they must not be used to start a walk there.
     pub(crate) fn touchdown_coordinates(&self) -> SectionState {
-        SectionState::from_coords(&self.state.q, &self.state.qd)
+        SectionState::at_touchdown(
+            self.model,
+            &self.state.q,
+            &self.state.qd,
+            &self.state.active,
+        )
     }
 
     /// The current Poincare-section state, or why the walk cannot continue, or why the wheel is not on the
-    /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest, slides;
-    /// [`WalkError::SwingAtSection`]: the old rear leg still swings).
+    /// section ([`WalkError::OffSection`]: Leg 2's tip, which the section assumes at rest (or slipping along the
+    /// ground with Coulomb friction), slides frictionlessly or leaves the ground; [`WalkError::SwingAtSection`]:
+    /// the old rear leg still swings).
     pub fn section(&self) -> Result<SectionState, WalkError> {
         if let Some(e) = &self.blocked {
             return Err(e.clone());
@@ -130,7 +128,14 @@ impl<'m> Walker<'m> {
                 rate: qd[L3],
             });
         }
-        let speed = self.model.tip(q, qd, Leg::Two.index()).velocity(qd).norm();
+        let v = self.model.tip(q, qd, Leg::Two.index()).velocity(qd);
+        // A tip slipping with Coulomb friction is on the section with its slip velocity: only its normal
+        // velocity must vanish.
+        let speed = if self.state.active.slip2 != 0 {
+            v.y.abs()
+        } else {
+            v.norm()
+        };
         if speed > SECTION_TIP_SPEED_TOL {
             return Err(WalkError::OffSection {
                 time: self.state.time,
@@ -289,7 +294,7 @@ impl<'m> Walker<'m> {
         let report = StepReport {
             step: self.steps_done,
             time: start.time,
-            section: SectionState::from_coords(&start.q, &start.qd),
+            section: SectionState::at_touchdown(model, &start.q, &start.qd, &start.active),
             theta: start.q[THETA],
             indicators: td.indicators,
             branch: td.branch,
@@ -733,6 +738,7 @@ mod tests {
             l2: 1.0,
             theta_dot: 1.0,
             l2_dot: 0.0,
+            slip: 0.0,
         };
         let mut walker = Walker::new(&model, &opts, &section).unwrap();
         let q = Coords::new(0.0, 0.0, -model.alpha() / 2.0, 1.0, 1.0, 0.0);

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::sweep::of_gait;
+use super::sweep::{of_gait, FRICTION_GAIT_COLUMNS};
 use super::{header, row, Cell, Column};
 use crate::gait::{GaitMap, SweepPoint};
 use crate::output::{write_table, OutputError};
@@ -86,26 +86,39 @@ pub(crate) fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
 /// (the stability verdict, or why no gait was found), the impact branch, the gait family (numbered within the
 /// row), `period_k`, the three DLS indicators, period, speed, the largest Floquet multiplier modulus and the stability
 /// verdict; empty gait fields where no gait was found.
-pub(crate) fn write_map_csv(path: &Path, map: &GaitMap) -> Result<(), OutputError> {
+/// With Coulomb friction (`friction`, see [`crate::output::friction_columns`]), each gait's `slip` and stick/slip `signature`
+/// last.
+pub(crate) fn write_map_csv(path: &Path, map: &GaitMap, friction: bool) -> Result<(), OutputError> {
     write_table(
         path,
-        &map_header(&map.spec.x.param, &map.spec.y.param),
-        map_rows(map),
+        &map_header(&map.spec.x.param, &map.spec.y.param, friction),
+        map_rows(map, friction),
     )
 }
 
-/// The header of `map.csv` for a map over `x` and `y`.
-pub fn map_header<'a>(x: &'a str, y: &'a str) -> Vec<&'a str> {
-    header(&map_columns(), &[x, y])
+/// The header of `map.csv` for a map over `x` and `y` (with the columns of Coulomb friction where `friction`,
+/// [`crate::output::friction_columns`]).
+pub fn map_header<'a>(x: &'a str, y: &'a str, friction: bool) -> Vec<&'a str> {
+    let mut names = header(&map_columns(), &[x, y]);
+    if friction {
+        names.extend(header(&FRICTION_GAIT_COLUMNS, &[]));
+    }
+    names
 }
 
 /// The rows of `map.csv`: every point of the map, row by row (`y`), each row along `x`.
-pub fn map_rows(map: &GaitMap) -> Vec<Vec<Cell>> {
+pub fn map_rows(map: &GaitMap, friction: bool) -> Vec<Vec<Cell>> {
     let columns = map_columns();
     map.rows
         .iter()
         .zip(&map.ys)
         .flat_map(|(points, &y)| points.iter().map(move |point| MapPoint { y, point }))
-        .map(|m| row(&columns, &m))
+        .map(|m| {
+            let mut cells = row(&columns, &m);
+            if friction {
+                cells.extend(row(&FRICTION_GAIT_COLUMNS, m.point));
+            }
+            cells
+        })
         .collect()
 }

@@ -169,7 +169,13 @@ pub(crate) const RESET_COLUMN: Column<StepReport> = Column::new(
 /// The columns of `steps.csv` of a walk with Coulomb friction (a finite `friction`, docs/model.md section 12),
 /// after [`STEPS_HEADER`] (only there, so that every other walk's file is as it was before the option
 /// existed).
-const FRICTION_COLUMNS: [Column<StepReport>; 4] = [
+const FRICTION_COLUMNS: [Column<StepReport>; 5] = [
+    Column::new(
+        "slip",
+        "Slip velocity of Leg 2's tip along the slope (+x, down it) just before the touchdown (the section \
+         state's fourth coordinate), 0 where the tip is at rest [m/s].",
+        |s| Real(s.section.slip),
+    ),
     Column::new(
         "friction_loss",
         "Energy the Coulomb friction force dissipated while tips slipped between impacts [J]; energy_residual \

@@ -6,6 +6,7 @@ use std::path::Path;
 use super::{fixed_names, header, row, Cell, Column};
 use crate::gait::{Gait, SweepPoint};
 use crate::output::{write_table, OutputError};
+use crate::params::Config;
 
 use Cell::{Count, Empty, Flag, Real, Text};
 
@@ -121,18 +122,60 @@ pub(crate) const SWEEP: [Column<SweepPoint>; 25] = [
 /// Columns of `sweep.csv` after the parameter column.
 pub const SWEEP_COLUMNS: [&str; 24] = fixed_names(&SWEEP, 1);
 
-/// The header of `sweep.csv` for a sweep of `param`: the parameter, then [`SWEEP_COLUMNS`].
-pub fn sweep_header(param: &str) -> Vec<&str> {
-    header(&SWEEP, &[param])
+/// The columns of `sweep.csv` and `map.csv` with Coulomb friction ([`friction_columns`]), last: only there, so
+/// that every other sweep's and map's file is as it was before the option existed.
+pub(crate) const FRICTION_GAIT_COLUMNS: [Column<SweepPoint>; 2] = [
+    Column::new(
+        "slip",
+        "Slip velocity of Leg 2's tip along the slope at the gait's fixed point, the section's fourth coordinate \
+         (0 where the tip is at rest there) [m/s].",
+        |p| of_gait(p, |g| Real(g.section.slip)),
+    ),
+    Column::new(
+        "signature",
+        "The gait's stick/slip sequence: the events of its step (TD, its branch, SLIP1/SLIP2 for a tip that \
+         slips through the touchdown, SLIDE/STICK/REVERSE for each slip start, stop and reversal, LIFT, LOCK, \
+         ...), empty where it was not recorded.",
+        |p| of_gait(p, |g| g.signature.clone().map_or(Empty, Text)),
+    ),
+];
+
+/// Do the tables of a job over `config` that sweeps the keys `swept` have the columns of Coulomb friction
+/// ([`FRICTION_GAIT_COLUMNS`])? Where its `friction` is finite or swept.
+pub fn friction_columns(config: &Config, swept: &[&str]) -> bool {
+    config.params.has_friction() || swept.contains(&"friction")
+}
+
+/// The header of `sweep.csv` for a sweep of `param`: the parameter, then [`SWEEP_COLUMNS`], then with Coulomb
+/// friction (`friction`, see [`friction_columns`]) `slip` and `signature`.
+pub fn sweep_header(param: &str, friction: bool) -> Vec<&str> {
+    let mut names = header(&SWEEP, &[param]);
+    if friction {
+        names.extend(header(&FRICTION_GAIT_COLUMNS, &[]));
+    }
+    names
 }
 
 /// One row of `sweep.csv`, in the order of [`sweep_header`]: the parameter value, the status and the gait's
 /// scalars ([`Cell::Empty`] where no gait was found).
-pub fn sweep_row(p: &SweepPoint) -> Vec<Cell> {
-    row(&SWEEP, p)
+pub fn sweep_row(p: &SweepPoint, friction: bool) -> Vec<Cell> {
+    let mut cells = row(&SWEEP, p);
+    if friction {
+        cells.extend(row(&FRICTION_GAIT_COLUMNS, p));
+    }
+    cells
 }
 
 /// Write `sweep.csv`: one row per sweep point (see [`sweep_row`]).
-pub fn write_sweep_csv(path: &Path, param: &str, points: &[SweepPoint]) -> Result<(), OutputError> {
-    write_table(path, &sweep_header(param), points.iter().map(sweep_row))
+pub fn write_sweep_csv(
+    path: &Path,
+    param: &str,
+    friction: bool,
+    points: &[SweepPoint],
+) -> Result<(), OutputError> {
+    write_table(
+        path,
+        &sweep_header(param, friction),
+        points.iter().map(|p| sweep_row(p, friction)),
+    )
 }

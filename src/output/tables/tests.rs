@@ -9,7 +9,7 @@ use std::path::Path;
 use super::attractors::{orbit_columns, OrbitRow, BASIN, BRANCH};
 use super::map::{map_columns, MapPoint};
 use super::steps::{StepsColumns, STEPS};
-use super::sweep::SWEEP;
+use super::sweep::{FRICTION_GAIT_COLUMNS, SWEEP};
 use super::trajectory::{SWING_COLUMNS, TRAJECTORY};
 use super::*;
 use crate::dynamics::Model;
@@ -129,7 +129,12 @@ fn rows_match_their_headers() {
     assert_eq!(step_row(&f.steps[0]).len(), STEPS_HEADER.len());
     assert_eq!(trajectory_row(&f.samples[0]).len(), TRAJECTORY_HEADER.len());
     for p in sweep_points(&f.gait) {
-        assert_eq!(sweep_row(&p).len(), sweep_header("c").len());
+        for friction in [false, true] {
+            assert_eq!(
+                sweep_row(&p, friction).len(),
+                sweep_header("c", friction).len()
+            );
+        }
     }
     assert_eq!(Cell::Empty.to_csv(), "");
     assert_eq!(Cell::Real(f64::NAN).to_csv(), "NaN");
@@ -141,8 +146,16 @@ fn rows_match_their_headers() {
 fn python_names_are_the_declared_ones() {
     assert_eq!(STEPS_HEADER.to_vec(), header(&STEPS, &[]));
     assert_eq!(TRAJECTORY_HEADER.to_vec(), header(&TRAJECTORY, &[]));
-    assert_eq!(sweep_header("viscosity"), header(&SWEEP, &["viscosity"]));
-    assert_eq!(sweep_header("viscosity")[1..], SWEEP_COLUMNS);
+    assert_eq!(
+        sweep_header("viscosity", false),
+        header(&SWEEP, &["viscosity"])
+    );
+    assert_eq!(sweep_header("viscosity", false)[1..], SWEEP_COLUMNS);
+    assert_eq!(
+        sweep_header("viscosity", true)[1 + SWEEP_COLUMNS.len()..],
+        header(&FRICTION_GAIT_COLUMNS, &[])
+    );
+    assert_unique("friction columns", &FRICTION_GAIT_COLUMNS, &[]);
     assert_unique("steps.csv", &STEPS, &[]);
     assert_unique("trajectory.csv", &TRAJECTORY, &[]);
     assert_unique("sweep.csv", &SWEEP, &["c"]);
@@ -170,7 +183,7 @@ fn every_table_reads_back_by_name() {
     check_by_name(&path("trajectory.csv"), &TRAJECTORY, &[], &f.samples);
 
     let points = sweep_points(&f.gait);
-    write_sweep_csv(&path("sweep.csv"), "viscosity", &points).unwrap();
+    write_sweep_csv(&path("sweep.csv"), "viscosity", false, &points).unwrap();
     check_by_name(&path("sweep.csv"), &SWEEP, &["viscosity"], &points);
 
     let axis = |param: &str| SweepSpec {
@@ -188,7 +201,7 @@ fn every_table_reads_back_by_name() {
         ys: vec![500.0, 550.0],
         rows: vec![points.to_vec(), points.iter().rev().cloned().collect()],
     };
-    write_map_csv(&path("map.csv"), &map).unwrap();
+    write_map_csv(&path("map.csv"), &map, false).unwrap();
     let map_points: Vec<MapPoint> = map
         .rows
         .iter()
