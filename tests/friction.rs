@@ -235,3 +235,102 @@ fn zeno_locks_with_friction_keep_the_cone() {
         assert!(s.audit_warnings().is_empty(), "{:?}", s.audit_warnings());
     }
 }
+
+/// The gait of `overrides` from the default start (period 1, the command line's search settings).
+fn gait(overrides: &[String]) -> Result<vrw::gait::Gait, vrw::gait::GaitError> {
+    use vrw::gait::{find_gait, GaitOptions, StepMap};
+    let config = config(overrides);
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver);
+    find_gait(
+        &map,
+        &default_initial(&config),
+        &GaitOptions::default(),
+        None,
+    )
+}
+
+/// Just above `tan(slope)` (0.100335) the stance tip still slips at the touchdown: the gait is on the section
+/// with its fourth coordinate, the slip velocity, and it is a property of the model, not of the integrator
+/// (DOP853 and the order-5 pair at tighter tolerances agree); walked from the fixed point, the wheel comes
+/// back to it (the section state holds the whole state at touchdown).
+#[test]
+fn a_gait_whose_stance_tip_slips_at_touchdown_has_the_slip_as_a_coordinate() {
+    let mu = ["friction=0.105".to_string()];
+    let g = gait(&mu).unwrap();
+    assert!(g.section.slip > 0.05, "{:?}", g.section);
+    assert_eq!(
+        g.section_coordinates,
+        Some(vec!["L2", "thetadot", "L2dot", "slip"])
+    );
+    assert_eq!(g.jacobian.len(), 4);
+    assert!(g.stable && g.max_floquet < 0.8, "{}", g.max_floquet);
+    let f = g.contact.friction.unwrap();
+    assert!(f.cone_violation <= CONE_TOL && f.slip_power <= 0.0, "{f:?}");
+    assert!(g.energy_residual.abs() <= ENERGY_TOL);
+
+    let other = [
+        mu[0].clone(),
+        "integrator=dopri5".to_string(),
+        "rtol=1e-12".to_string(),
+        "atol=1e-14".to_string(),
+    ];
+    let h = gait(&other).unwrap();
+    assert!(
+        g.section.distance(&h.section) < 1e-7,
+        "{:?} {:?}",
+        g.section,
+        h.section
+    );
+    assert!((g.period - h.period).abs() < 1e-7);
+
+    let config = config(&mu);
+    let model = Model::new(&config.params).unwrap();
+    let mut walker = Walker::new(&model, &config.solver, &g.section).unwrap();
+    for _ in 0..3 {
+        walker.step(None).unwrap();
+        let s = walker.section().unwrap();
+        assert!(s.distance(&g.section) < 1e-9, "{s:?} vs {:?}", g.section);
+    }
+}
+
+/// Below `tan(slope)` no gait can exist (the ground cannot hold the wheel along the slope with forces inside
+/// the cone): the search says so at once, and the walk confirms it independently, sliding ever faster.
+#[test]
+fn no_gait_below_the_slope_tangent_and_the_wheel_slides_away() {
+    let low = ["friction=0.1".to_string()];
+    let e = gait(&low).unwrap_err();
+    assert_eq!(e.kind(), "friction_below_slope", "{e}");
+    let (steps, end) = walk(&low, 40);
+    assert!(end.is_none(), "{end:?}");
+    // The walk settles into a slide: its internal state repeats (L2 to 1e-12 m) while the tips keep slipping
+    // down the slope, every force and impulse at the cone's edge, so that the momentum balance along the
+    // slope gains `g (sin(slope) - mu cos(slope)) T` of slip velocity per step (4.6 mm/s) exactly.
+    let (g, slope, mu) = (9.81_f64, 0.1_f64, 0.1_f64);
+    for w in steps[34..].windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        assert!((b.section.l2 - a.section.l2).abs() < 1e-10);
+        let gain = g * (slope.sin() - mu * slope.cos()) * a.period;
+        let rise = b.section.slip - a.section.slip;
+        assert!((rise / gain - 1.0).abs() < 1e-6, "{rise} vs {gain}");
+    }
+}
+
+#[test]
+fn a_slip_velocity_is_a_section_coordinate_only_with_friction() {
+    use vrw::walk::SectionState;
+    let s: SectionState = "0.72,1.0,0.0,0.05".parse().unwrap();
+    assert_eq!(s.slip, 0.05);
+    assert_eq!("0.72,1.0,0.0".parse::<SectionState>().unwrap().slip, 0.0);
+    assert!("0.72,1.0,0.0,0.05,1".parse::<SectionState>().is_err());
+    let plain = Model::new(&Config::default().params).unwrap();
+    let e = s.validate(&plain).unwrap_err();
+    assert!(e.to_string().contains("slip"), "{e}");
+    let config = config(&["friction=0.3".to_string()]);
+    let model = Model::new(&config.params).unwrap();
+    s.validate(&model).unwrap();
+    // The tip moves along the ground at `slip` and not across it.
+    let (q, qd) = s.to_coords(&model);
+    let v = model.tip(&q, &qd, 1).velocity(&qd);
+    assert!((v.x - 0.05).abs() < 1e-15 && v.y.abs() < 1e-15, "{v:?}");
+}

@@ -150,3 +150,36 @@ def test_computation_releases_the_gil():
     ran_meanwhile = not done.is_set()
     worker.join()
     assert ran_meanwhile
+
+
+def test_a_slipping_stance_tip_is_the_fourth_section_coordinate(cli, tmp_path):
+    # Just above tan(slope) the stance tip still slips at touchdown: the gait's section has its slip velocity.
+    cli("gait", "--set", "friction=0.105", "--out", tmp_path / "gait")
+    gait = vrw.find_gait(vrw.Params(friction=0.105))
+    assert json_equal(gait, json.loads((tmp_path / "gait" / "gait.json").read_text()))
+    section = gait["section"]
+    assert gait["section_coordinates"] == ["L2", "thetadot", "L2dot", "slip"] and section["slip"] > 0.05
+    assert gait["jacobian"].shape == (4, 4) and gait["signature"].startswith("TD DLS")
+    # A walk started there with the four numbers is the command line's with --initial of four numbers.
+    start = [section[k] for k in ("L2", "thetadot", "L2dot", "slip")]
+    cli("simulate", "--steps", 2, "--initial", ",".join(repr(v) for v in start), "--set", "friction=0.105",
+        "--out", tmp_path / "walk")
+    run = vrw.simulate(vrw.Params(friction=0.105), steps=2, initial=start)
+    assert_table_equals_csv(run["steps"], tmp_path / "walk" / "steps.csv")
+    assert abs(run["steps"]["slip"][1] - section["slip"]) < 1e-9
+    with pytest.raises(vrw.WalkError, match="5 values given"):
+        vrw.simulate(vrw.Params(friction=0.105), steps=1, initial=start + [0.0])
+    with pytest.raises(vrw.WalkError, match="slip"):
+        vrw.simulate(vrw.Params(), steps=1, initial=start)
+
+
+def test_a_sweep_with_friction_has_the_slip_and_signature_columns(cli, tmp_path):
+    cli("sweep", "--set", "friction=0.6", "--from", 30, "--to", 40, "--points", 3, "--out", tmp_path)
+    result = vrw.sweep(vrw.Params(friction=0.6), "viscosity", vrw.linspace(30, 40, 3))
+    assert_table_equals_csv(result["sweep"], tmp_path / "sweep.csv")
+    header, _ = read_csv(tmp_path / "sweep.csv")
+    assert header[-2:] == ["slip", "signature"]
+    assert all(s.startswith("TD DLS SLIP2") for s in result["sweep"]["signature"])
+    # No gait can exist below tan(slope): a status, at every point.
+    low = vrw.sweep(vrw.Params(friction=0.05), "viscosity", [30.0, 40.0])
+    assert list(low["sweep"]["status"]) == ["friction_below_slope"] * 2

@@ -14,6 +14,7 @@ use crate::gait::{
     map_curves, map_gaits, map_gaits_part, GaitMap, GaitOptions, MapSpec, SecondRoute, SweepPoint,
 };
 use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
+use crate::output::signature_plot::write_signature_figure;
 use crate::output::{self, write_map_csv};
 use crate::params::Config;
 use crate::walk::SectionState;
@@ -185,9 +186,13 @@ fn map_into(
     let curves_json = run.path("curves.json");
     output::write_json(&curves_json, &summary)?;
     run.add("curves.json");
-    write_figure(job, &map, &summary.curves)?;
+    write_figure(job, &map, &summary.curves, friction)?;
     run.add("map.svg");
     run.add("map.png");
+    if friction {
+        run.add("signatures.svg");
+        run.add("signatures.png");
+    }
     if job.second_route && job.curves {
         // Everything of the first route is written: nothing is lost if this fails.
         second_route(job, initial, progress, &mut summary)?;
@@ -278,7 +283,13 @@ fn second_route(
     Ok(())
 }
 
-fn write_figure(job: &MapJob, map: &GaitMap, curves: &[ThresholdCurve]) -> Result<(), AppError> {
+/// The map figure, and with Coulomb friction (`friction`) the stick/slip figure.
+fn write_figure(
+    job: &MapJob,
+    map: &GaitMap,
+    curves: &[ThresholdCurve],
+    friction: bool,
+) -> Result<(), AppError> {
     let p = &job.config.params;
     let preload = p.stiffness * (p.spring_natural_length - p.stopper_length);
     let fixed = |key: &str| key == job.spec.x.param || key == job.spec.y.param;
@@ -306,9 +317,17 @@ fn write_figure(job: &MapJob, map: &GaitMap, curves: &[ThresholdCurve]) -> Resul
         y_label: axis_label(&job.spec.y.param),
         title,
     };
-    Ok(write_map_figure(
+    write_map_figure(
         &figure,
         &job.out_dir.join("map.svg"),
         &job.out_dir.join("map.png"),
-    )?)
+    )?;
+    if friction {
+        write_signature_figure(
+            &figure,
+            &job.out_dir.join("signatures.svg"),
+            &job.out_dir.join("signatures.png"),
+        )?;
+    }
+    Ok(())
 }

@@ -231,8 +231,14 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         }
     }
     print_warnings(&summary.warnings, "curves.json");
+    let swept = [job.spec.x.param.as_str(), job.spec.y.param.as_str()];
+    let signatures = if vrw::output::friction_columns(&job.config, &swept) {
+        ", signatures.svg, signatures.png"
+    } else {
+        ""
+    };
     println!(
-        "wrote {}/{{map.csv, curves.json, map.svg, map.png}}",
+        "wrote {}/{{map.csv, curves.json, map.svg, map.png{signatures}}}",
         args.out.display()
     );
     if summary.gaits_found == 0 {

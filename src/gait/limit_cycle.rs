@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use super::derivative::{gait_jacobian, newton_jacobian, ParamDerivative};
 use super::step_map::{DerivativeError, StepMap, StepOutcome};
+use crate::params::{Params, RearExit};
 use crate::variational::NotDifferentiable;
 use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport};
@@ -112,6 +113,19 @@ pub enum GaitError {
         /// The rule broken, naming the setting.
         message: String,
     },
+    /// With Coulomb friction below the slope's tangent no gait exists (a necessary condition, checked before
+    /// any walk; see docs/model.md section 12).
+    #[error(
+        "no gait can exist: friction = {friction} is below tan(slope) = {tan_slope:.6}. Over a period the \
+         ground must push the wheel up the slope by its weight's component M g sin(slope) T, with at most \
+         friction times the normal push M g cos(slope) T (docs/model.md section 12): the wheel slides away"
+    )]
+    FrictionBelowSlope {
+        /// The friction coefficient.
+        friction: f64,
+        /// `tan(|slope|)`.
+        tan_slope: f64,
+    },
     /// `DP - I` is singular (a multiplier at 1: a fold of the gait).
     #[error("DP - I is singular (a Floquet multiplier at 1), residual {residual:e}")]
     SingularJacobian {
@@ -130,6 +144,7 @@ impl GaitError {
             GaitError::SectionIncomplete { .. } => "section_incomplete",
             GaitError::SingularJacobian { .. } => "singular_jacobian",
             GaitError::InvalidOptions { .. } => "invalid_options",
+            GaitError::FrictionBelowSlope { .. } => "friction_below_slope",
         }
     }
 
@@ -227,7 +242,7 @@ pub struct Gait {
     pub rear_held: bool,
     /// With Coulomb friction, the coordinates of the section the map acts on, which are the rows and columns
     /// of `jacobian`: `["L2", "thetadot", "L2dot"]` where Leg 2's tip is at rest at the section, with `"slip"`
-    /// after them where it slips there (docs/model.md section 12.7; `["thetadot"]` / `["thetadot", "slip"]`
+    /// after them where it slips there (docs/model.md section 12; `["thetadot"]` / `["thetadot", "slip"]`
     /// with `rear_held` or rigid legs). Absent without friction.
     pub section_coordinates: Option<Vec<&'static str>>,
 }
@@ -361,6 +376,24 @@ fn gait_with_jacobian_on(
     }
 }
 
+/// Can the parameters have a gait at all, as far as Coulomb friction goes? Over one period of any gait (of any
+/// period `k`) the wheel's momentum returns, so the ground's tangential forces and impulses add up to
+/// `-M g sin(slope) T` and its normal ones to `M g cos(slope) T` (`M` the whole wheel's mass, `T` the period;
+/// stopper impulses are internal). Each force and impulse lies in the friction cone, `|lambda_t| <= mu
+/// lambda_n`, so `tan|slope| <= mu`: below that no gait exists, and the search says so at once
+/// ([`GaitError::FrictionBelowSlope`]) instead of walking a wheel that slides away. Not with `rear_exit =
+/// "reset"`, whose reset of a leaving leg changes the momentum without a force.
+pub(crate) fn friction_admits_gaits(params: &Params) -> Result<(), GaitError> {
+    let tan_slope = params.slope.abs().tan();
+    if params.has_friction() && params.rear_exit != RearExit::Reset && params.friction < tan_slope {
+        return Err(GaitError::FrictionBelowSlope {
+            friction: params.friction,
+            tan_slope,
+        });
+    }
+    Ok(())
+}
+
 /// The fixed point alone (no Jacobian at the end): what threshold searches need.
 pub(crate) fn solve_fixed_point(
     map: &StepMap,
@@ -392,6 +425,7 @@ pub(crate) fn solve_fixed_point_asking(
     options.validate().map_err(|e| GaitError::InvalidOptions {
         message: e.to_string(),
     })?;
+    friction_admits_gaits(map.model().params())?;
     // The transient is one continuous walk (touchdowns on the way may be off the section, see
     // `WalkError::OffSection`); only where it ends must be on the section.
     let mut s = *initial;

@@ -26,7 +26,8 @@
 //! refuses it.
 
 use super::limit_cycle::{
-    find_gait, gait_with_jacobian, solve_fixed_point, FixedPoint, Gait, GaitError, GaitOptions,
+    find_gait, friction_admits_gaits, gait_with_jacobian, solve_fixed_point, FixedPoint, Gait,
+    GaitError, GaitOptions,
 };
 use super::periodicity::SAME_GAIT_TOL;
 pub use super::periodicity::{least_period, MAX_PERIOD};
@@ -70,6 +71,7 @@ pub fn find_periodic_gait(
     options.validate().map_err(|e| GaitError::InvalidOptions {
         message: e.to_string(),
     })?;
+    friction_admits_gaits(map.model().params())?;
     let max_period = max_period.max(1);
     let single = map.iterated(1);
     let walked = options.transient_steps + SETTLE_STEPS.max(max_period + RETURN_WINDOW);

@@ -23,7 +23,7 @@ use super::{ensure_dir, write_json, OutputError, TEMP_MARK};
 pub const MANIFEST: &str = "manifest.json";
 
 /// Every file a vrw job writes into an output directory; a job removes them all before it starts.
-pub const RUN_FILES: [&str; 26] = [
+pub const RUN_FILES: [&str; 28] = [
     MANIFEST,
     // simulate, gait
     "steps.csv",
@@ -40,6 +40,8 @@ pub const RUN_FILES: [&str; 26] = [
     "curves.json",
     "map.svg",
     "map.png",
+    "signatures.svg",
+    "signatures.png",
     // orbit
     "orbit.csv",
     "branch.csv",

@@ -130,12 +130,35 @@ pub(crate) fn curve_style(name: &str) -> (RGBColor, bool, &'static str) {
     }
 }
 
+/// The colours of the most frequent sequences (Okabe and Ito's palette, as every figure's lines).
+pub(crate) const PALETTE: [RGBColor; 7] = [
+    COLOR_BLUE,
+    COLOR_ORANGE,
+    COLOR_GREEN,
+    COLOR_VERMILLION,
+    COLOR_PURPLE,
+    RGBColor(86, 180, 233),
+    RGBColor(240, 228, 66),
+];
+
+/// The colour of a gait whose sequence is `signature` among `list` (the most frequent first): its palette
+/// colour, [`COLOR_MARK`] past the palette or where it was not recorded.
+pub(crate) fn signature_color(list: &[String], signature: Option<&str>) -> RGBColor {
+    signature
+        .and_then(|s| list.iter().position(|l| l == s))
+        .and_then(|i| PALETTE.get(i).copied())
+        .unwrap_or(COLOR_MARK)
+}
+
 /// One heat-map panel's content.
-enum Layer {
+pub(crate) enum Layer<'a> {
     /// A gait quantity on the diverging scale, with its colour-bar description.
     Indicator(&'static str, fn(&crate::gait::Gait) -> f64),
     /// Existence and branch.
     Branch,
+    /// The gait's stick/slip sequence: the colour of its place in the list (the most frequent first, see
+    /// `signature_plot`), [`COLOR_MARK`] past the palette.
+    Signature(&'a [String]),
 }
 
 impl MapFigure<'_> {
@@ -164,7 +187,7 @@ impl MapFigure<'_> {
         (step(&self.map.xs), step(&self.map.ys))
     }
 
-    fn panel<DB: DrawingBackend>(
+    pub(crate) fn panel<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
         layer: &Layer,
@@ -217,7 +240,7 @@ impl MapFigure<'_> {
                 super::chart::finite_range(values)
                     .map_or(-1.0..1.0, |r| r.start.min(0.0)..r.end.max(0.0))
             }
-            Layer::Branch => 0.0..1.0,
+            Layer::Branch | Layer::Signature(_) => 0.0..1.0,
         };
         for (row, &yv) in self.map.rows.iter().zip(&self.map.ys) {
             for p in row {
@@ -232,12 +255,15 @@ impl MapFigure<'_> {
                         }
                     }
                     (Some(g), Layer::Branch) => branch_color(g.branch),
+                    (Some(g), Layer::Signature(list)) => {
+                        signature_color(list, g.signature.as_deref())
+                    }
                 };
                 chart.draw_series(std::iter::once(Rectangle::new(
                     [(p.value - hx, yv - hy), (p.value + hx, yv + hy)],
                     color.filled(),
                 )))?;
-                if let (Some(g), Layer::Branch) = (&p.gait, layer) {
+                if let (Some(g), Layer::Branch | Layer::Signature(_)) = (&p.gait, layer) {
                     if g.stability != Stability::Stable {
                         chart.draw_series(std::iter::once(Circle::new(
                             (p.value, yv),
@@ -491,8 +517,14 @@ pub(crate) fn write_map_figure(
     svg: &Path,
     png: &Path,
 ) -> Result<(), PlotError> {
-    if figure.map.xs.is_empty() || figure.map.ys.is_empty() {
+    has_points(figure.map)?;
+    write_svg_png(figure, svg, png, MAP_SIZE)
+}
+
+/// An error for a map without points (nothing to draw).
+pub(crate) fn has_points(map: &GaitMap) -> Result<(), PlotError> {
+    if map.xs.is_empty() || map.ys.is_empty() {
         return Err(PlotError::Empty("the map has no points".to_string()));
     }
-    write_svg_png(figure, svg, png, MAP_SIZE)
+    Ok(())
 }

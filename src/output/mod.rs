@@ -21,6 +21,7 @@ pub(crate) mod orbit_plot;
 pub(crate) mod plot;
 pub mod read;
 pub mod run_plot;
+pub(crate) mod signature_plot;
 pub mod steps_plot;
 pub mod style;
 pub(crate) mod tables;

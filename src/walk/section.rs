@@ -6,7 +6,7 @@
 //!
 //! With Coulomb friction (a finite `friction`) Leg 2's tip may still slip along the ground at the touchdown: the
 //! section then has a fourth coordinate, the tip's slip velocity `v_s` (its velocity along the slope, `+x` down
-//! it), and `(dx, dz)` give the tip the velocity `(v_s, 0)` (docs/model.md section 12.7). A tip at rest has
+//! it), and `(dx, dz)` give the tip the velocity `(v_s, 0)` (docs/model.md section 12). A tip at rest has
 //! `v_s = 0`, the three-coordinate section.
 
 use serde::Serialize;

@@ -131,11 +131,8 @@ impl<'m> Walker<'m> {
         let v = self.model.tip(q, qd, Leg::Two.index()).velocity(qd);
         // A tip slipping with Coulomb friction is on the section with its slip velocity: only its normal
         // velocity must vanish.
-        let speed = if self.state.active.slip2 != 0 {
-            v.y.abs()
-        } else {
-            v.norm()
-        };
+        let slips = self.state.active.slip2 != 0;
+        let speed = if slips { v.y.abs() } else { v.norm() };
         if speed > SECTION_TIP_SPEED_TOL {
             return Err(WalkError::OffSection {
                 time: self.state.time,

@@ -141,7 +141,7 @@ pub(crate) const FRICTION_GAIT_COLUMNS: [Column<SweepPoint>; 2] = [
 ];
 
 /// Do the tables of a job over `config` that sweeps the keys `swept` have the columns of Coulomb friction
-/// ([`FRICTION_GAIT_COLUMNS`])? Where its `friction` is finite or swept.
+/// (`slip` and `signature`)? Where its `friction` is finite or swept.
 pub fn friction_columns(config: &Config, swept: &[&str]) -> bool {
     config.params.has_friction() || swept.contains(&"friction")
 }
