@@ -632,4 +632,21 @@ mod tests {
             .unwrap();
         assert_eq!(damped, undamped);
     }
+
+    /// A family whose stance tip slips at the section has the slip as a coordinate of its Newton matrix too
+    /// (regression: `DP` was asked of the map at rest, which refused the slipping touchdown, so continuation
+    /// stepped without it and stopped early).
+    #[test]
+    fn a_slipping_family_has_its_newton_matrix() {
+        let mut config = Config::default();
+        config.apply_override("friction=0.105").unwrap();
+        let (from, guess) = family_at(&config, 50.0);
+        assert!(from.section.slips() && guess.is_some());
+        let cont = Continuation::new(&config, "viscosity", &GaitOptions::for_sweeps());
+        let j = cont.jacobian(&from).expect("DP at a slipping gait");
+        assert_eq!((j.nrows(), j.ncols()), (4, 4));
+        assert!(cont
+            .step(&from, 51.0, Some(&j))
+            .is_some_and(|p| p.section.slips()));
+    }
 }

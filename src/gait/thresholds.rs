@@ -250,7 +250,9 @@ fn vanishing_at_end(
     let Ok(model) = Model::new(&c.params) else {
         return Vec::new();
     };
-    let map = StepMap::new(&model, &c.solver).iterated(g.period_k);
+    let map = StepMap::new(&model, &c.solver)
+        .iterated(g.period_k)
+        .with_slip(last.section.slips());
     let Ok(out) = map.eval(&last.section) else {
         return Vec::new();
     };
