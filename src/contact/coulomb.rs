@@ -40,19 +40,33 @@ pub(crate) fn slipping_dynamics(
     qd: &Coords,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
+    slipping_dynamics_with(model, q, qd, active, false)
+}
+
+/// [`slipping_dynamics`] solved through the Painleve case (`through_painleve`): a slipping row with a negative
+/// pivot `w` is eliminated as any other (only a vanishing one is refused, as redundant), so that the caller can
+/// see whether that slip's forces would be consistent (a second solution of the force-level problem).
+pub(crate) fn slipping_dynamics_with(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: &ActiveSet,
+    through_painleve: bool,
+) -> Result<ConstrainedDynamics, ContactError> {
     if active.contact1 && !active.slide1 && active.slip2 != 0 {
         // The common slip (the rear tip after a touchdown), reduced as the no-slip solve is.
         let eom = model.equations_of_motion(q, qd);
         return if eom.swing {
-            rear_slip::<{ NQ - 2 }>(model, &eom, active)
+            rear_slip::<{ NQ - 2 }>(model, &eom, active, through_painleve)
         } else {
-            rear_slip::<{ NQ - 3 }>(model, &eom, active)
+            rear_slip::<{ NQ - 3 }>(model, &eom, active, through_painleve)
         };
     }
     let (m, h) = model.mass_and_bias(q, qd);
     let (rows, jdq) = constraint_rows(model, q, qd, active);
     let columns = force_columns(model, q, qd, active, &rows);
-    let (qdd, multipliers) = solve(&m, &rows, &columns, active, &(-h), &(-jdq))?;
+    let system = (&rows, &columns, active);
+    let (qdd, multipliers) = solve(&m, system, &(-h), &(-jdq), through_painleve)?;
     Ok(ConstrainedDynamics {
         qdd,
         multipliers: with_friction(model, active, multipliers),
@@ -68,6 +82,7 @@ fn rear_slip<const R: usize>(
     model: &Model,
     eom: &EquationsOfMotion,
     active: &ActiveSet,
+    through_painleve: bool,
 ) -> Result<ConstrainedDynamics, ContactError> {
     let rear = &eom.rear_tip;
     let slip = f64::from(active.slip2) * model.params().friction;
@@ -108,7 +123,7 @@ fn rear_slip<const R: usize>(
         }
     }
     let order: Vec<usize> = rows.iter().map(|row| row.3).collect();
-    let mut multipliers = eliminate(schur, rhs, &order, &|i| i == 3, active)?;
+    let mut multipliers = eliminate(schur, rhs, &order, &|i| i == 3, active, through_painleve)?;
     let mut x = g;
     for (_, column, _, stacked) in &rows {
         for (x_l, column_l) in x.iter_mut().zip(column) {
@@ -132,7 +147,8 @@ pub(crate) fn slipping_impulse(
     let (rows, _) = constraint_rows(model, q, qd_minus, active);
     let columns = force_columns(model, q, qd_minus, active, &rows);
     let rhs = -(rows * qd_minus);
-    let (dqd, impulses) = solve(&m, &rows, &columns, active, &Coords::zeros(), &rhs)?;
+    let system = (&rows, &columns, active);
+    let (dqd, impulses) = solve(&m, system, &Coords::zeros(), &rhs, false)?;
     Ok(ImpulseSolution {
         qd_plus: qd_minus + dqd,
         impulses: with_friction(model, active, impulses),
@@ -170,14 +186,14 @@ fn with_friction(model: &Model, active: &ActiveSet, mut lam: Multipliers) -> Mul
     lam
 }
 
-/// Solve `M x = f + B^T lam`, `A x = b` on the active rows of `active` (see the module documentation).
+/// Solve `M x = f + B^T lam`, `A x = b` on the active rows of `active` (`system = (A, B, active)`, see the
+/// module documentation); through the Painleve case where `through_painleve` ([`eliminate`]).
 fn solve(
     m: &SMatrix<f64, NQ, NQ>,
-    rows: &Rows,
-    columns: &Rows,
-    active: &ActiveSet,
+    (rows, columns, active): (&Rows, &Rows, &ActiveSet),
     f: &Coords,
     b: &Multipliers,
+    through_painleve: bool,
 ) -> Result<(Coords, Multipliers), ContactError> {
     let chol = m.cholesky().ok_or(ContactError::SingularMass)?;
     let x_free = chol.solve(f);
@@ -201,23 +217,26 @@ fn solve(
     // Sticking rows first, the slipping normal rows last.
     let mut order: Vec<usize> = (0..NROWS).filter(|&i| !slipping(i)).collect();
     order.extend((0..NROWS).filter(|&i| slipping(i)));
-    let lam = eliminate(schur, rhs, &order, &slipping, active)?;
+    let lam = eliminate(schur, rhs, &order, &slipping, active, through_painleve)?;
     Ok((x_free + minv_bt * lam, lam))
 }
 
 /// Gaussian elimination of `S lam = rhs` with the pivots taken in `order`; a slipping row (`slipping`) whose
-/// pivot is not positive is the Painleve case, a tiny pivot a redundant set.
+/// pivot is not positive is the Painleve case (eliminated all the same where `through_painleve`, unless it
+/// vanishes), a tiny pivot a redundant set.
 fn eliminate(
     mut s: SMatrix<f64, NROWS, NROWS>,
     mut rhs: Multipliers,
     order: &[usize],
     slipping: &dyn Fn(usize) -> bool,
     active: &ActiveSet,
+    through_painleve: bool,
 ) -> Result<Multipliers, ContactError> {
     let scale = s.diagonal().abs().max();
     for (k, &p) in order.iter().enumerate() {
         let pivot = s[(p, p)];
-        if slipping(p) && pivot <= 0.0 {
+        let painleve = slipping(p) && pivot <= 0.0;
+        if painleve && !(through_painleve && pivot.abs() >= REDUNDANCY_TOL * scale) {
             return Err(ContactError::Painleve(*active));
         }
         if pivot.abs() < REDUNDANCY_TOL * scale || pivot.is_nan() {
@@ -336,7 +355,7 @@ mod tests {
                 let (m, h) = model.mass_and_bias(&q, &qd);
                 let (rows, jdq) = constraint_rows(&model, &q, &qd, &active);
                 let columns = force_columns(&model, &q, &qd, &active, &rows);
-                let general = solve(&m, &rows, &columns, &active, &(-h), &(-jdq))
+                let general = solve(&m, (&rows, &columns, &active), &(-h), &(-jdq), false)
                     .map(|(qdd, lam)| (qdd, with_friction(&model, &active, lam)));
                 match (slipping_dynamics(&model, &q, &qd, &active), general) {
                     (Ok(fast), Ok((qdd, lam))) => {

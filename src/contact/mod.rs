@@ -329,6 +329,21 @@ pub enum ContactError {
          (no consistent contact force, or several)"
     )]
     Painleve(ActiveSet),
+    /// A slip in the Painleve case (`w <= 0`) has consistent forces: the force-level problem has that solution
+    /// besides the one preferred (`other`), or only that one, whose normal force holds the tip on the ground
+    /// only because friction drives it into it. Either is the Painleve paradox (non-uniqueness, or a solution
+    /// no smooth contact would reach), reported rather than picked.
+    #[error(
+        "Painleve case: the slip of {slip} has consistent contact forces with a non-positive effective normal inverse          mass{}",
+        other.map_or(" (the only consistent mode, held on the ground by friction alone)".to_string(),
+            |o| format!(", and so has {o}: the force-level problem has two solutions"))
+    )]
+    PainleveSlip {
+        /// The consistent set with the slip in the Painleve case.
+        slip: ActiveSet,
+        /// The consistent set the enumeration would have preferred, if any.
+        other: Option<ActiveSet>,
+    },
     /// With Coulomb friction, no choice of modes (off, stick, slip either way) of an impact's units gives impulses
     /// that satisfy the contact laws (each pushes, sticks inside the cone or slips the way the tip moves after the
     /// impact): the impulse-level problem has no solution. The units the impact would have preferred.
@@ -450,6 +465,18 @@ pub fn constrained_dynamics(
     } else {
         solve::no_slip_dynamics(model, q, qd, active)
     }
+}
+
+/// [`constrained_dynamics`] of a set with a slipping contact, solved through the Painleve case (a slipping
+/// row with a negative effective normal inverse mass eliminated as any other): whether that slip's forces are
+/// consistent tells a second solution of the force-level problem, or the only one, from none.
+pub(crate) fn dynamics_through_painleve(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: &ActiveSet,
+) -> Result<ConstrainedDynamics, ContactError> {
+    coulomb::slipping_dynamics_with(model, q, qd, active, true)
 }
 
 /// The collision equation (5): `M (q'+ - q'-) = J^T lambda_I`, `J q'+ = 0`, with the units of `active` (a

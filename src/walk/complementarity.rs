@@ -11,8 +11,8 @@
 //! one way or the other (the friction force on the cone's edge, against the slip).
 
 use crate::contact::{
-    cone_distance, constrained_dynamics, impulse, ActiveSet, ConstrainedDynamics, ContactError,
-    ImpulseSolution, Leg, Stop,
+    cone_distance, constrained_dynamics, dynamics_through_painleve, impulse, ActiveSet,
+    ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Stop,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
@@ -234,21 +234,31 @@ impl Level {
     }
 }
 
+/// A solve of a set through the Painleve case ([`crate::contact::dynamics_through_painleve`]).
+type SolveThrough<'a, T> = dyn FnMut(&ActiveSet) -> Result<T, ContactError> + 'a;
+
 /// Among `forced` plus every combination of modes of the `candidates`, the consistent set with the best
 /// preference score, or `None` if no combination is consistent. When none is and some combination with a
 /// slipping contact was the Painleve case, that is the error ([`ContactError::Painleve`]): the problem has no
 /// solution because friction made a slip inconsistent, not because the units were chosen wrong.
+///
+/// With `through_painleve` (the force-level problem with friction), every set with a slipping contact is
+/// solved, whatever its score, and a Painleve set is solved again through its non-positive pivot: if its
+/// forces are consistent, the problem has that solution too (or only it), and that is the error
+/// ([`ContactError::PainleveSlip`]) rather than a silent pick of the preferred one.
 fn best_subset<T>(
     forced: ActiveSet,
     candidates: &[Candidate],
     level: Level,
     mut solve: impl FnMut(&ActiveSet) -> Result<T, ContactError>,
     mut consistent: impl FnMut(&ActiveSet, &T) -> bool,
+    mut through_painleve: Option<&mut SolveThrough<T>>,
 ) -> Result<Option<(ActiveSet, T)>, ContactError> {
     let radix: Vec<usize> = candidates.iter().map(|c| c.modes(level).len()).collect();
     let combinations: usize = radix.iter().product();
     let mut best: Option<(usize, ActiveSet, T)> = None;
     let mut painleve = None;
+    let mut painleve_solution = None;
     for mut code in 0..combinations {
         let mut set = forced;
         let mut score = 0;
@@ -258,22 +268,34 @@ fn best_subset<T>(
             c.unit.apply(&mut set, mode);
             score += c.score(mode);
         }
-        if best.as_ref().is_some_and(|(s, _, _)| *s >= score) {
+        let outscored = best.as_ref().is_some_and(|(s, _, _)| *s >= score);
+        if outscored && !(through_painleve.is_some() && set.any_slip()) {
             continue;
         }
         match solve(&set) {
-            Ok(value) if consistent(&set, &value) => best = Some((score, set, value)),
+            Ok(value) if !outscored && consistent(&set, &value) => best = Some((score, set, value)),
             Ok(_) => {}
             // A redundant set is simply not a candidate; other failures are real.
             Err(ContactError::RedundantConstraints(_)) => {}
-            Err(ContactError::Painleve(set)) => painleve = painleve.or(Some(set)),
+            Err(ContactError::Painleve(set)) => {
+                painleve = painleve.or(Some(set));
+                if let Some(again) = through_painleve.as_deref_mut() {
+                    if again(&set).is_ok_and(|value| consistent(&set, &value)) {
+                        painleve_solution = painleve_solution.or(Some(set));
+                    }
+                }
+            }
             Err(e) => return Err(e),
         }
     }
-    match (best, painleve) {
-        (Some((_, set, value)), _) => Ok(Some((set, value))),
-        (None, Some(set)) => Err(ContactError::Painleve(set)),
-        (None, None) => Ok(None),
+    match (best, painleve, painleve_solution) {
+        (best, _, Some(slip)) => Err(ContactError::PainleveSlip {
+            slip,
+            other: best.map(|(_, set, _)| set),
+        }),
+        (Some((_, set, value)), _, None) => Ok(Some((set, value))),
+        (None, Some(set), None) => Err(ContactError::Painleve(set)),
+        (None, None, None) => Ok(None),
     }
 }
 
@@ -319,29 +341,36 @@ pub(crate) fn plastic_impact_by(
     let level = Level::Impulse {
         friction: friction.is_finite(),
     };
-    let found = best_subset(forced, candidates, level, &solve, |set, sol| {
-        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
-            (Unit::Contact(leg), Mode::Off) => {
-                model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
-            }
-            (Unit::Contact(leg), Mode::On) => within_cone(
-                friction,
-                sol.impulses[leg.tangential_row()],
-                sol.normal_impulse(leg),
-            ),
-            // A Coulomb impulse leaves the tip moving the way it slips (or at rest).
-            (Unit::Contact(leg), Mode::Slip(s)) => {
-                let v = model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).x;
-                sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL
-                    && f64::from(s) * v >= -COMPLEMENTARITY_TOL
-            }
-            (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
-            (Unit::Stop(leg, stop), Mode::Off) => {
-                stop.sign() * sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
-            }
-            (Unit::Stop(leg, stop), _) => sol.stop_impulse(leg, stop) >= -COMPLEMENTARITY_TOL,
-        })
-    })?;
+    let found = best_subset(
+        forced,
+        candidates,
+        level,
+        &solve,
+        |set, sol| {
+            candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+                (Unit::Contact(leg), Mode::Off) => {
+                    model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).y >= -COMPLEMENTARITY_TOL
+                }
+                (Unit::Contact(leg), Mode::On) => within_cone(
+                    friction,
+                    sol.impulses[leg.tangential_row()],
+                    sol.normal_impulse(leg),
+                ),
+                // A Coulomb impulse leaves the tip moving the way it slips (or at rest).
+                (Unit::Contact(leg), Mode::Slip(s)) => {
+                    let v = model.tip(q, qd, leg.index()).velocity(&sol.qd_plus).x;
+                    sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL
+                        && f64::from(s) * v >= -COMPLEMENTARITY_TOL
+                }
+                (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
+                (Unit::Stop(leg, stop), Mode::Off) => {
+                    stop.sign() * sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+                }
+                (Unit::Stop(leg, stop), _) => sol.stop_impulse(leg, stop) >= -COMPLEMENTARITY_TOL,
+            })
+        },
+        None,
+    )?;
     match found {
         Some(found) => Ok(found),
         // With friction an arbitrary pick would hide that the frictional impact has no solution: say so.
@@ -374,41 +403,54 @@ pub(crate) fn consistent_active_set(
         allow_slide,
         friction: friction.is_finite(),
     };
-    let found = best_subset(forced, candidates, level, solve, |set, dynamics| {
-        candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
-            (Unit::Contact(leg), Mode::Off) => {
-                let tip = model.tip(q, qd, leg.index());
-                (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
-            }
-            // A no-slip contact needs its tip at rest: one that slides (after a frictionless impulse) stays
-            // sliding or leaves; holding it would make the tangential force do work.
-            (Unit::Contact(leg), Mode::On) => {
-                let (lambda_t, lambda_n) = (
-                    dynamics.multipliers[leg.tangential_row()],
-                    dynamics.normal_force(leg),
-                );
-                within_cone(friction, lambda_t, lambda_n)
-                    && model.tip(q, qd, leg.index()).velocity(qd).x.abs() <= STICK_SPEED_TOL
-            }
-            // A slipping tip keeps the direction it moves in; one at rest starts to slip the way it accelerates.
-            (Unit::Contact(leg), Mode::Slip(s)) => {
-                let tip = model.tip(q, qd, leg.index());
-                let v = tip.velocity(qd).x;
-                let along = if v.abs() > STICK_SPEED_TOL {
-                    v.signum() == f64::from(s)
-                } else {
-                    let a = (tip.jacobian * dynamics.qdd + tip.velocity_product).x;
-                    f64::from(s) * a >= -COMPLEMENTARITY_TOL
-                };
-                dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL && along
-            }
-            (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
-            (Unit::Stop(leg, stop), Mode::Off) => {
-                stop.sign() * dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
-            }
-            (Unit::Stop(leg, stop), _) => dynamics.stop_reaction(leg, stop) >= -COMPLEMENTARITY_TOL,
-        })
-    })?;
+    // With friction, a slip in the Painleve case is solved through it: if its forces are consistent, the
+    // problem is ambiguous (or has only that solution), which is reported, not picked.
+    let mut again = |set: &ActiveSet| dynamics_through_painleve(model, q, qd, set);
+    let through_painleve: Option<&mut SolveThrough<_>> = friction.is_finite().then_some(&mut again);
+    let found = best_subset(
+        forced,
+        candidates,
+        level,
+        solve,
+        |set, dynamics| {
+            candidates.iter().all(|c| match (c.unit, c.unit.mode(set)) {
+                (Unit::Contact(leg), Mode::Off) => {
+                    let tip = model.tip(q, qd, leg.index());
+                    (tip.jacobian * dynamics.qdd + tip.velocity_product).y >= -COMPLEMENTARITY_TOL
+                }
+                // A no-slip contact needs its tip at rest: one that slides (after a frictionless impulse) stays
+                // sliding or leaves; holding it would make the tangential force do work.
+                (Unit::Contact(leg), Mode::On) => {
+                    let (lambda_t, lambda_n) = (
+                        dynamics.multipliers[leg.tangential_row()],
+                        dynamics.normal_force(leg),
+                    );
+                    within_cone(friction, lambda_t, lambda_n)
+                        && model.tip(q, qd, leg.index()).velocity(qd).x.abs() <= STICK_SPEED_TOL
+                }
+                // A slipping tip keeps the direction it moves in; one at rest starts to slip the way it accelerates.
+                (Unit::Contact(leg), Mode::Slip(s)) => {
+                    let tip = model.tip(q, qd, leg.index());
+                    let v = tip.velocity(qd).x;
+                    let along = if v.abs() > STICK_SPEED_TOL {
+                        v.signum() == f64::from(s)
+                    } else {
+                        let a = (tip.jacobian * dynamics.qdd + tip.velocity_product).x;
+                        f64::from(s) * a >= -COMPLEMENTARITY_TOL
+                    };
+                    dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL && along
+                }
+                (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
+                (Unit::Stop(leg, stop), Mode::Off) => {
+                    stop.sign() * dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+                }
+                (Unit::Stop(leg, stop), _) => {
+                    dynamics.stop_reaction(leg, stop) >= -COMPLEMENTARITY_TOL
+                }
+            })
+        },
+        through_painleve,
+    )?;
     if found.is_some() || allow_slide {
         return Ok(found);
     }
@@ -576,6 +618,58 @@ mod tests {
             found += 1;
         }
         assert!(found > 0, "no Painleve configuration in the scan");
+    }
+
+    /// The Painleve case with a solution: a tip slipping with a large `mu` whose effective normal inverse mass is
+    /// negative, on a wheel spinning fast enough that its free motion lifts the tip, has consistent slip forces
+    /// (a pushing normal force that friction turns into a pull toward the ground) besides lift-off: two
+    /// solutions, reported by name (status `painleve`) rather than picked.
+    #[test]
+    fn a_painleve_slip_with_consistent_forces_is_reported_not_picked() {
+        let model = rigid(5.0, 0.1);
+        let (mut found, mut two) = (0, 0);
+        for i in -12..=12 {
+            for spin in [-8.0, -4.0, 4.0, 8.0] {
+                for v in [-0.5, 0.5] {
+                    let q = Coords::new(0.0, 0.0, 0.1 * f64::from(i), 1.0, 1.0, 0.0);
+                    let qd = Coords::new(v, 0.0, spin, 0.0, 0.0, 0.0);
+                    // The tip's velocity along the ground (the x of the tip, with the hub's turn).
+                    let tip_v = model.tip(&q, &qd, 0).velocity(&qd).x;
+                    let mut slipping = bilateral();
+                    slipping.set_slipping(Leg::One, if tip_v > 0.0 { 1 } else { -1 });
+                    let candidates = [Candidate::keep(Unit::Contact(Leg::One), &slipping)];
+                    let result = consistent_active_set(&model, &q, &qd, bilateral(), &candidates);
+                    let Err(error @ ContactError::PainleveSlip { slip, other }) = result else {
+                        continue;
+                    };
+                    assert_eq!(slip.slip1, slipping.slip1);
+                    // The slip's forces through the negative pivot push, and the tip slips its way.
+                    let dynamics =
+                        crate::contact::dynamics_through_painleve(&model, &q, &qd, &slip).unwrap();
+                    assert!(dynamics.normal_force(Leg::One) >= 0.0, "{dynamics:?}");
+                    assert!(matches!(
+                        crate::contact::constrained_dynamics(&model, &q, &qd, &slip),
+                        Err(ContactError::Painleve(_))
+                    ));
+                    let walk_error = crate::walk::WalkError::contact_at(1.0, slip.phase())(error);
+                    assert_eq!(walk_error.kind(), "painleve");
+                    if other.is_some() {
+                        assert!(
+                            walk_error.to_string().contains("two solutions"),
+                            "{walk_error}"
+                        );
+                        two += 1;
+                    }
+                    found += 1;
+                }
+            }
+        }
+        // For one contact the theory says a consistent Painleve slip (w < 0, lambda_n > 0) always has lift-off
+        // beside it (the tip's free normal acceleration is then positive): every case met has two solutions.
+        assert!(
+            found > 0 && two == found,
+            "{found} found, {two} with two solutions"
+        );
     }
 
     /// An impact whose closing tip moves away from the ground can only be closed by a pulling impulse: without

@@ -249,7 +249,7 @@ impl WalkError {
             WalkError::SlipAtSection { .. } => "slip_at_section",
             WalkError::InconsistentContacts { .. } => "inconsistent_contacts",
             WalkError::Contact {
-                source: ContactError::Painleve(_),
+                source: ContactError::Painleve(_) | ContactError::PainleveSlip { .. },
                 ..
             } => "painleve",
             WalkError::Contact {
