@@ -15,8 +15,13 @@ use super::{interrupt_flag, parse_range, progress_bar, ModelArgs};
 pub(super) struct BasinArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Where the gait search starts, `L2,thetadot,L2dot`; default as for simulate.
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    /// Where the gait search starts, `L2,thetadot,L2dot` (with friction, `,slip` after them for a slipping stance
+    /// tip); default as for simulate.
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Horizontal coordinate of the slice: L2, thetadot or L2dot.
     #[arg(long, default_value = "L2")]

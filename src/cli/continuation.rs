@@ -27,8 +27,13 @@ pub(super) struct ContinueArgs {
     /// Upper end of the range.
     #[arg(long, default_value_t = 300.0, allow_hyphen_values = true)]
     to: f64,
-    /// Where the search for the first gait starts, `L2,thetadot,L2dot`; default as for simulate.
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    /// Where the search for the first gait starts, `L2,thetadot,L2dot` (with friction, `,slip` after them for a
+    /// slipping stance tip); default as for simulate.
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Start from a gait of period at most K (the least period the walk settles on, as `vrw gait` finds it;
     /// fixed points of P^k); default: any period up to 8, period 1 first.

@@ -19,8 +19,13 @@ const DEFAULT_TOLERANCE: &str = "1e-10";
 pub(super) struct GaitArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot`; default as for simulate.
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot` (with friction, `,slip` after them for
+    /// a slipping stance tip); default as for simulate.
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Steps walked before Newton's method starts.
     #[arg(long, default_value_t = GaitOptions::default().transient_steps)]

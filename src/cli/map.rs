@@ -42,8 +42,13 @@ pub(super) struct MapArgs {
     /// Number of y values (ends included).
     #[arg(long, default_value_t = 21)]
     ny: usize,
-    /// Where the search at the first point of every row starts, `L2,thetadot,L2dot`; default as for simulate.
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    /// Where the search at the first point of every row starts, `L2,thetadot,L2dot` (with friction, `,slip` after
+    /// them for a slipping stance tip); default as for simulate.
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Mark a point on the heat maps, `X,Y` or `X,Y,LABEL` (repeatable), e.g. `--mark "220,500,paper λ4+ = 0"`.
     #[arg(long, value_name = "X,Y[,LABEL]", allow_hyphen_values = true)]

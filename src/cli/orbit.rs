@@ -34,8 +34,13 @@ pub(super) struct OrbitArgs {
     /// Steps recorded at each value.
     #[arg(long, default_value_t = 64)]
     steps: usize,
-    /// Where the first walk starts, `L2,thetadot,L2dot`; default as for simulate.
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    /// Where the first walk starts, `L2,thetadot,L2dot` (with friction, `,slip` after them for a slipping stance
+    /// tip); default as for simulate.
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Do not compute and draw the period-1 branch.
     #[arg(long)]

@@ -17,10 +17,15 @@ pub(super) struct SimulateArgs {
     /// Number of steps (touchdowns) to walk.
     #[arg(long, default_value_t = 20)]
     steps: usize,
-    /// Initial Poincare-section state `L2,thetadot,L2dot` (m, rad/s, m/s); default: derived from the parameters
+    /// Initial Poincare-section state `L2,thetadot,L2dot` (m, rad/s, m/s), and with friction the stance tip's
+    /// slip velocity `,slip` (m/s) where it slips; default: derived from the parameters
     /// (0.72,1.0,0.0 for Table 1; docs/model.md section 6)
     /// (with rigid_legs: L0 and the rigid wheel's gait speed, from its closed form).
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Output directory for steps.csv, trajectory.csv and summary.json.
     #[arg(long, default_value = "out/simulate")]

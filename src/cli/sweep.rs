@@ -31,8 +31,13 @@ pub(super) struct SweepArgs {
     /// Number of values (ends included).
     #[arg(long, default_value_t = 300)]
     points: usize,
-    /// Where the search at the first point starts, `L2,thetadot,L2dot`; default as for simulate.
-    #[arg(long, value_name = "L2,THETADOT,L2DOT", allow_hyphen_values = true)]
+    /// Where the search at the first point starts, `L2,thetadot,L2dot` (with friction, `,slip` after them for a
+    /// slipping stance tip); default as for simulate.
+    #[arg(
+        long,
+        value_name = "L2,THETADOT,L2DOT[,SLIP]",
+        allow_hyphen_values = true
+    )]
     initial: Option<SectionState>,
     /// Search every threshold again by a second route, the whole sweep with the other integrator (dopri5 for
     /// the default dop853), and say of each whether it is confirmed (in thresholds.json: `second_route`).
