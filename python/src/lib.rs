@@ -600,8 +600,13 @@ fn basin<'py>(
         })?
         .map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
-    let rows: Vec<Vec<Cell>> = grid.iter().flatten().map(basin_row).collect();
-    result.set_item("points", table(py, &basin_header(), &rows)?)?;
+    let friction = friction_columns(&job.config, &[]);
+    let rows: Vec<Vec<Cell>> = grid
+        .iter()
+        .flatten()
+        .map(|p| basin_row(p, friction))
+        .collect();
+    result.set_item("points", table(py, &basin_header(friction), &rows)?)?;
     Ok(result)
 }
 
@@ -757,14 +762,23 @@ fn orbit<'py>(
     if part.is_some() {
         parts::orbit_part_extras(&result, &columns, &ends)?;
     }
+    let friction = friction_columns(&job.config, &[param]);
     result.set_item(
         "orbit",
-        table(py, &orbit_header(param), &orbit_rows(&columns))?,
+        table(
+            py,
+            &orbit_header(param, friction),
+            &orbit_rows(&columns, friction),
+        )?,
     )?;
     if branch {
         result.set_item(
             "branch",
-            table(py, &branch_header(param), &branch_rows(&gaits))?,
+            table(
+                py,
+                &branch_header(param, friction),
+                &branch_rows(&gaits, friction),
+            )?,
         )?;
     }
     Ok(result)
@@ -831,8 +845,12 @@ fn continue_family<'py>(
     };
     let result = interruptible(py, &flag, || compute_continuation(&job))?.map_err(app_error)?;
     let out = pythonize(py, &result.summary)?.downcast_into::<PyDict>()?;
-    let rows: Vec<Vec<Cell>> = family_rows(&result).iter().map(family_row).collect();
-    out.set_item("branch", table(py, &family_header(param), &rows)?)?;
+    let friction = friction_columns(&job.config, &[param]);
+    let rows: Vec<Vec<Cell>> = family_rows(&result)
+        .iter()
+        .map(|r| family_row(r, friction))
+        .collect();
+    out.set_item("branch", table(py, &family_header(param, friction), &rows)?)?;
     if let Some(first) = result.summary.curves.first() {
         let rows: Vec<Vec<Cell>> = curve_rows(&result).iter().map(curve_row).collect();
         let header = curve_header((param, &first.param2));

@@ -245,7 +245,8 @@ fn basin_into(
     let grid = basin(model, &job.config.solver, &gait, &spec, progress);
     let seconds = clock.elapsed().as_secs_f64();
     let outcomes = outcome_counts(&grid);
-    write_basin_csv(&run.path("basin.csv"), &grid)?;
+    let friction = crate::output::friction_columns(&job.config, &[]);
+    write_basin_csv(&run.path("basin.csv"), friction, &grid)?;
     run.add("basin.csv");
     check_interrupted(
         grid.iter().map(Vec::len).sum(),

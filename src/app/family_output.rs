@@ -67,7 +67,8 @@ fn write_continuation(
 ) -> Result<(), AppError> {
     let param = &job.param;
     let rows = family_rows(result);
-    write_family_csv(&run.path("branch.csv"), param, &rows)?;
+    let friction = crate::output::friction_columns(&job.config, &[param]);
+    write_family_csv(&run.path("branch.csv"), param, friction, &rows)?;
     run.add("branch.csv");
     let mut files = vec!["branch.csv".to_string()];
     let figure = diagram(job, result);

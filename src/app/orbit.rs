@@ -201,7 +201,8 @@ fn orbit_into(
     let orbit_seconds = clock.elapsed().as_secs_f64();
     let param = &job.spec.range.param;
     let mut files = vec!["orbit.csv".to_string()];
-    write_orbit_csv(&run.path("orbit.csv"), param, &columns)?;
+    let friction = crate::output::friction_columns(&job.config, &[param]);
+    write_orbit_csv(&run.path("orbit.csv"), param, friction, &columns)?;
     run.add("orbit.csv");
     let total = job.spec.range.points;
     check_interrupted(columns.len(), total, "orbit.csv")?;
@@ -209,7 +210,7 @@ fn orbit_into(
     let branch = period_one_branch(job, initial)?;
     let branch_seconds = clock.elapsed().as_secs_f64();
     if job.branch {
-        write_branch_csv(&run.path("branch.csv"), param, &branch)?;
+        write_branch_csv(&run.path("branch.csv"), param, friction, &branch)?;
         files.push("branch.csv".to_string());
         run.add("branch.csv");
         check_interrupted(branch.len(), total, "branch.csv (and orbit.csv, complete)")?;

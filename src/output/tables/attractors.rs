@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::{header, row, Cell, Column};
+use super::{header_with, row_with, Cell, Column};
 use crate::gait::basin::BasinPoint;
 use crate::gait::orbit::OrbitColumn;
 use crate::gait::Gait;
@@ -84,24 +84,40 @@ pub(crate) fn orbit_columns<'a>() -> [Column<OrbitRow<'a>>; 12] {
     ]
 }
 
+/// The column of `orbit.csv` with Coulomb friction ([`crate::output::friction_columns`]), last.
+fn orbit_slip<'a>() -> Column<OrbitRow<'a>> {
+    Column::new(
+        "slip",
+        "Slip velocity of Leg 2's tip along the slope just before the touchdown (the section's fourth coordinate, \
+         0 where the tip is at rest) [m/s].",
+        |r| of_step(r, |s| Real(s.section.slip)),
+    )
+}
+
 /// Write `orbit.csv` for a diagram along `param`: one row per recorded step; a value whose walk failed
-/// before recording anything has one row with empty step fields.
+/// before recording anything has one row with empty step fields. With `slip` last where `friction`.
 pub(crate) fn write_orbit_csv(
     path: &Path,
     param: &str,
+    friction: bool,
     columns: &[OrbitColumn],
 ) -> Result<(), OutputError> {
-    write_table(path, &orbit_header(param), orbit_rows(columns))
+    write_table(
+        path,
+        &orbit_header(param, friction),
+        orbit_rows(columns, friction),
+    )
 }
 
-/// The header of `orbit.csv` along `param`.
-pub fn orbit_header(param: &str) -> Vec<&str> {
-    header(&orbit_columns(), &[param])
+/// The header of `orbit.csv` along `param` (with `slip` last where `friction`).
+pub fn orbit_header(param: &str, friction: bool) -> Vec<&str> {
+    header_with(&orbit_columns(), &[param], (&[orbit_slip()], friction))
 }
 
-/// The rows of `orbit.csv`: every recorded step of every value (one empty row for a value with none).
-pub fn orbit_rows(columns: &[OrbitColumn]) -> Vec<Vec<Cell>> {
-    let table = orbit_columns();
+/// The rows of `orbit.csv`: every recorded step of every value (one empty row for a value with none), with
+/// `slip` last where `friction`.
+pub fn orbit_rows(columns: &[OrbitColumn], friction: bool) -> Vec<Vec<Cell>> {
+    let (table, slip) = (orbit_columns(), [orbit_slip()]);
     columns
         .iter()
         .flat_map(|column| {
@@ -110,7 +126,7 @@ pub fn orbit_rows(columns: &[OrbitColumn]) -> Vec<Vec<Cell>> {
             let steps = if steps.is_empty() { vec![None] } else { steps };
             steps.into_iter().map(move |step| OrbitRow { column, step })
         })
-        .map(|r| row(&table, &r))
+        .map(|r| row_with(&table, (&slip, friction), &r))
         .collect()
 }
 
@@ -161,23 +177,40 @@ pub(crate) const BRANCH: [Column<(f64, Option<Gait>)>; 9] = [
     ),
 ];
 
-/// Write `branch.csv` for a branch along `param`: the period-1 gait at each value (empty where there is none).
+/// The column of the orbit diagram's `branch.csv` with Coulomb friction, last.
+const BRANCH_SLIP: Column<(f64, Option<Gait>)> = Column::new(
+    "slip",
+    "Slip velocity of Leg 2's tip at the gait's fixed point (the section's fourth coordinate, 0 where the tip is \
+     at rest) [m/s].",
+    |b| of_gait(b, |g| Real(g.section.slip)),
+);
+
+/// Write `branch.csv` for a branch along `param`: the period-1 gait at each value (empty where there is none),
+/// with `slip` last where `friction`.
 pub(crate) fn write_branch_csv(
     path: &Path,
     param: &str,
+    friction: bool,
     branch: &[(f64, Option<Gait>)],
 ) -> Result<(), OutputError> {
-    write_table(path, &branch_header(param), branch_rows(branch))
+    write_table(
+        path,
+        &branch_header(param, friction),
+        branch_rows(branch, friction),
+    )
 }
 
-/// The header of the orbit diagram's `branch.csv` along `param`.
-pub fn branch_header(param: &str) -> Vec<&str> {
-    header(&BRANCH, &[param])
+/// The header of the orbit diagram's `branch.csv` along `param` (with `slip` last where `friction`).
+pub fn branch_header(param: &str, friction: bool) -> Vec<&str> {
+    header_with(&BRANCH, &[param], (&[BRANCH_SLIP], friction))
 }
 
-/// The rows of the orbit diagram's `branch.csv`.
-pub fn branch_rows(branch: &[(f64, Option<Gait>)]) -> Vec<Vec<Cell>> {
-    branch.iter().map(|b| row(&BRANCH, b)).collect()
+/// The rows of the orbit diagram's `branch.csv` (with `slip` last where `friction`).
+pub fn branch_rows(branch: &[(f64, Option<Gait>)], friction: bool) -> Vec<Vec<Cell>> {
+    branch
+        .iter()
+        .map(|b| row_with(&BRANCH, (&[BRANCH_SLIP], friction), b))
+        .collect()
 }
 
 /// A coordinate of the section state where the walk ended, [`Cell::Empty`] if none was reached.
@@ -231,21 +264,40 @@ pub(crate) const BASIN: [Column<BasinPoint>; 11] = [
     ),
 ];
 
-/// The header of `basin.csv`.
-pub fn basin_header() -> Vec<&'static str> {
-    header(&BASIN, &[])
+/// The columns of `basin.csv` with Coulomb friction, last: the slip velocity of the start (the gait's, held on
+/// the slice) and of the end.
+const BASIN_SLIP: [Column<BasinPoint>; 2] = [
+    Column::new(
+        "slip",
+        "Start: slip velocity of Leg 2's tip, the gait's (0 where the tip is at rest) [m/s].",
+        |p| Real(p.start.slip),
+    ),
+    Column::new(
+        "end_slip",
+        "End: slip velocity of Leg 2's tip [m/s].",
+        |p| of_end(p, |e| e.slip),
+    ),
+];
+
+/// The header of `basin.csv` (with `slip` and `end_slip` last where `friction`).
+pub fn basin_header(friction: bool) -> Vec<&'static str> {
+    header_with(&BASIN, &[], (&BASIN_SLIP, friction))
 }
 
-/// One row of `basin.csv`.
-pub fn basin_row(p: &BasinPoint) -> Vec<Cell> {
-    row(&BASIN, p)
+/// One row of `basin.csv` (with `slip` and `end_slip` last where `friction`).
+pub fn basin_row(p: &BasinPoint, friction: bool) -> Vec<Cell> {
+    row_with(&BASIN, (&BASIN_SLIP, friction), p)
 }
 
 /// Write `basin.csv`: one row per grid point, row by row.
-pub(crate) fn write_basin_csv(path: &Path, grid: &[Vec<BasinPoint>]) -> Result<(), OutputError> {
+pub(crate) fn write_basin_csv(
+    path: &Path,
+    friction: bool,
+    grid: &[Vec<BasinPoint>],
+) -> Result<(), OutputError> {
     write_table(
         path,
-        &header(&BASIN, &[]),
-        grid.iter().flatten().map(|p| row(&BASIN, p)),
+        &basin_header(friction),
+        grid.iter().flatten().map(|p| basin_row(p, friction)),
     )
 }

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{header, row, Cell, Column};
+use super::{header, header_with, row, row_with, Cell, Column};
 use crate::bifurcation::{CurvePoint, FamilyPoint, GaitInfo};
 use crate::gait::Stability;
 use crate::output::{write_table, OutputError};
@@ -157,23 +157,39 @@ pub(crate) fn family_columns<'a>() -> [Column<FamilyRow<'a>>; 28] {
 ]
 }
 
-/// The header of `branch.csv` for the parameter `param`.
-pub fn family_header(param: &str) -> Vec<&str> {
-    header(&family_columns(), &[param])
+/// The column of `branch.csv` with Coulomb friction ([`crate::output::friction_columns`]), last: the point's
+/// slip velocity, so that a family whose stance tip slips at the section has its whole section state.
+fn slip_column<'a>() -> Column<FamilyRow<'a>> {
+    Column::new(
+        "slip",
+        "Slip velocity of Leg 2's tip along the slope at the point's section state, the fourth coordinate of a \
+         family whose stance tip slips at touchdown (0 where it is at rest) [m/s].",
+        |r| Real(r.point.info.report.section.slip),
+    )
 }
 
-/// One row of `branch.csv`.
-pub fn family_row(r: &FamilyRow) -> Vec<Cell> {
-    row(&family_columns(), r)
+/// The header of `branch.csv` for the parameter `param` (with `slip` last where `friction`).
+pub fn family_header(param: &str, friction: bool) -> Vec<&str> {
+    header_with(&family_columns(), &[param], (&[slip_column()], friction))
 }
 
-/// Write `branch.csv` for families along `param`.
+/// One row of `branch.csv` (with `slip` last where `friction`).
+pub fn family_row(r: &FamilyRow, friction: bool) -> Vec<Cell> {
+    row_with(&family_columns(), (&[slip_column()], friction), r)
+}
+
+/// Write `branch.csv` for families along `param` (with `slip` last where `friction`).
 pub(crate) fn write_family_csv(
     path: &Path,
     param: &str,
+    friction: bool,
     rows: &[FamilyRow],
 ) -> Result<(), OutputError> {
-    write_table(path, &family_header(param), rows.iter().map(family_row))
+    write_table(
+        path,
+        &family_header(param, friction),
+        rows.iter().map(|r| family_row(r, friction)),
+    )
 }
 
 /// One row of `curves.csv`: a point of a two-parameter curve.

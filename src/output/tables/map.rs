@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::sweep::{of_gait, FRICTION_GAIT_COLUMNS};
-use super::{header, row, Cell, Column};
+use super::{header, optional, row, Cell, Column};
 use crate::gait::{GaitMap, SweepPoint};
 use crate::output::{write_table, OutputError};
 
@@ -100,9 +100,7 @@ pub(crate) fn write_map_csv(path: &Path, map: &GaitMap, friction: bool) -> Resul
 /// [`crate::output::friction_columns`]).
 pub fn map_header<'a>(x: &'a str, y: &'a str, friction: bool) -> Vec<&'a str> {
     let mut names = header(&map_columns(), &[x, y]);
-    if friction {
-        names.extend(header(&FRICTION_GAIT_COLUMNS, &[]));
-    }
+    names.extend(header(optional(&FRICTION_GAIT_COLUMNS, friction), &[]));
     names
 }
 
@@ -115,9 +113,7 @@ pub fn map_rows(map: &GaitMap, friction: bool) -> Vec<Vec<Cell>> {
         .flat_map(|(points, &y)| points.iter().map(move |point| MapPoint { y, point }))
         .map(|m| {
             let mut cells = row(&columns, &m);
-            if friction {
-                cells.extend(row(&FRICTION_GAIT_COLUMNS, m.point));
-            }
+            cells.extend(row(optional(&FRICTION_GAIT_COLUMNS, friction), m.point));
             cells
         })
         .collect()

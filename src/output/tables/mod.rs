@@ -112,6 +112,38 @@ pub(crate) fn row<T>(columns: &[Column<T>], item: &T) -> Vec<Cell> {
     columns.iter().map(|c| (c.get)(item)).collect()
 }
 
+/// The columns a table has with Coulomb friction only (`slip`, ...), after its own: those of `extra` where `on`,
+/// none otherwise (so that every file without friction is as it was before the option existed).
+pub(crate) fn optional<T>(extra: &[Column<T>], on: bool) -> &[Column<T>] {
+    if on {
+        extra
+    } else {
+        &[]
+    }
+}
+
+/// [`header`] of `columns` followed by the [`optional`] `extra` columns where `on`.
+pub(crate) fn header_with<'a, T>(
+    columns: &[Column<T>],
+    params: &[&'a str],
+    (extra, on): (&[Column<T>], bool),
+) -> Vec<&'a str> {
+    let mut names = header(columns, params);
+    names.extend(header(optional(extra, on), params));
+    names
+}
+
+/// [`row`] of `columns` followed by the [`optional`] `extra` columns where `on`.
+pub(crate) fn row_with<T>(
+    columns: &[Column<T>],
+    (extra, on): (&[Column<T>], bool),
+    item: &T,
+) -> Vec<Cell> {
+    let mut cells = row(columns, item);
+    cells.extend(row(optional(extra, on), item));
+    cells
+}
+
 /// The fixed names of `columns[skip..]`, for a `const` header.
 ///
 /// # Panics

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{fixed_names, header, row, Cell, Column};
+use super::{fixed_names, header_with, row_with, Cell, Column};
 use crate::gait::{Gait, SweepPoint};
 use crate::output::{write_table, OutputError};
 use crate::params::Config;
@@ -149,21 +149,13 @@ pub fn friction_columns(config: &Config, swept: &[&str]) -> bool {
 /// The header of `sweep.csv` for a sweep of `param`: the parameter, then [`SWEEP_COLUMNS`], then with Coulomb
 /// friction (`friction`, see [`friction_columns`]) `slip` and `signature`.
 pub fn sweep_header(param: &str, friction: bool) -> Vec<&str> {
-    let mut names = header(&SWEEP, &[param]);
-    if friction {
-        names.extend(header(&FRICTION_GAIT_COLUMNS, &[]));
-    }
-    names
+    header_with(&SWEEP, &[param], (&FRICTION_GAIT_COLUMNS, friction))
 }
 
 /// One row of `sweep.csv`, in the order of [`sweep_header`]: the parameter value, the status and the gait's
 /// scalars ([`Cell::Empty`] where no gait was found).
 pub fn sweep_row(p: &SweepPoint, friction: bool) -> Vec<Cell> {
-    let mut cells = row(&SWEEP, p);
-    if friction {
-        cells.extend(row(&FRICTION_GAIT_COLUMNS, p));
-    }
-    cells
+    row_with(&SWEEP, (&FRICTION_GAIT_COLUMNS, friction), p)
 }
 
 /// Write `sweep.csv`: one row per sweep point (see [`sweep_row`]).

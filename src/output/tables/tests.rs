@@ -156,6 +156,12 @@ fn python_names_are_the_declared_ones() {
         header(&FRICTION_GAIT_COLUMNS, &[])
     );
     assert_unique("friction columns", &FRICTION_GAIT_COLUMNS, &[]);
+    // vrw continue's branch.csv: the slip velocity last, with friction only.
+    let family = crate::output::family_header("viscosity", false);
+    let with_slip = crate::output::family_header("viscosity", true);
+    assert_eq!(with_slip[..family.len()], family[..]);
+    assert_eq!(with_slip[family.len()..], ["slip"]);
+    assert!(!family.contains(&"slip"));
     assert_unique("steps.csv", &STEPS, &[]);
     assert_unique("trajectory.csv", &TRAJECTORY, &[]);
     assert_unique("sweep.csv", &SWEEP, &["c"]);
@@ -228,7 +234,7 @@ fn every_table_reads_back_by_name() {
         continued_from: None,
     };
     let diagram = [walked, failed];
-    write_orbit_csv(&path("orbit.csv"), "viscosity", &diagram).unwrap();
+    write_orbit_csv(&path("orbit.csv"), "viscosity", false, &diagram).unwrap();
     let mut orbit_rows: Vec<OrbitRow> = (diagram[0].returns.iter().enumerate())
         .map(|(n, s)| OrbitRow {
             column: &diagram[0],
@@ -247,7 +253,7 @@ fn every_table_reads_back_by_name() {
     );
 
     let branch = [(50.0, Some(f.gait.clone())), (60.0, None)];
-    write_branch_csv(&path("branch.csv"), "viscosity", &branch).unwrap();
+    write_branch_csv(&path("branch.csv"), "viscosity", false, &branch).unwrap();
     check_by_name(&path("branch.csv"), &BRANCH, &["viscosity"], &branch);
 
     let start = SectionState::from_array([0.7, 1.0, -0.2]);
@@ -266,7 +272,7 @@ fn every_table_reads_back_by_name() {
         point(0, Some(f.gait.section), "other"),
         point(1, None, "fell"),
     ]];
-    write_basin_csv(&path("basin.csv"), &grid).unwrap();
+    write_basin_csv(&path("basin.csv"), false, &grid).unwrap();
     check_by_name(&path("basin.csv"), &BASIN, &[], &grid[0]);
 }
 
