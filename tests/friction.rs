@@ -334,3 +334,36 @@ fn a_slip_velocity_is_a_section_coordinate_only_with_friction() {
     let v = model.tip(&q, &qd, 1).velocity(&qd);
     assert!((v.x - 0.05).abs() < 1e-15 && v.y.abs() < 1e-15, "{v:?}");
 }
+
+/// A sweep across the border where the mu = 0.3 family's stance tip starts to slip at touchdown (near c = 4.65):
+/// Newton's method on the four-coordinate map may land on a state whose slip is exactly 0 (the tip at rest), and
+/// its Newton matrix must still be the map's (regression: it was taken on that state's own three-coordinate
+/// section, and the sweep panicked on the mismatch). The family continues through the border, slipping.
+#[test]
+fn a_sweep_across_the_slip_border_keeps_its_newton_matrix() {
+    use vrw::app::compute_sweep;
+    use vrw::gait::GaitOptions;
+    let config = config(&["friction=0.3".to_string()]);
+    let values: Vec<f64> = (0..21).map(|i| 4.0 + 0.1 * f64::from(i)).collect();
+    let result = compute_sweep(
+        &config,
+        "viscosity",
+        &values,
+        None,
+        &GaitOptions::for_sweeps(),
+        &|_| {},
+        &mut |_| Ok(()),
+    )
+    .unwrap();
+    let found: Vec<_> = result
+        .points
+        .iter()
+        .filter_map(|p| p.gait.as_ref())
+        .collect();
+    assert!(found.len() >= 15, "{} gaits", found.len());
+    assert!(
+        found.iter().any(|g| g.section.slips()),
+        "no slipping gait below c = 4.65"
+    );
+    assert!(found.iter().any(|g| !g.section.slips()));
+}

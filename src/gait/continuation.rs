@@ -343,7 +343,10 @@ impl<'a> Continuation<'a> {
     /// differentiable) of the gait `at`.
     fn jacobian(&self, at: &FamilyPoint) -> Option<DMatrix<f64>> {
         let (c, model) = self.configured_at(at.value).ok()?;
-        let map = StepMap::new(&model, &c.solver).iterated(self.period);
+        // On the section of `at` where its stance tip slips (Coulomb friction): the slip is a coordinate there.
+        let map = StepMap::new(&model, &c.solver)
+            .iterated(self.period)
+            .with_slip(at.section.slips());
         newton_jacobian(&map, &at.section, self.options.fd_step).ok()
     }
 

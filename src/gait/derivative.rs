@@ -99,8 +99,6 @@ pub(crate) fn newton_jacobian(
     s: &SectionState,
     fd_step: f64,
 ) -> Result<DMatrix<f64>, crate::walk::WalkError> {
-    // On the section of `s` where its stance tip slips (Coulomb friction): the slip is a coordinate there.
-    let map = &map.clone().with_slip(s.slips());
     match map.eval_with_derivatives(s, None) {
         Ok(d) => Ok(d.jacobian),
         Err(DerivativeError::Walk(e)) => Err(e),
