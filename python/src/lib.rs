@@ -289,25 +289,16 @@ fn table<'py, H: AsRef<str>>(
 /// slipping stance tip, `[L2, thetadot, L2dot, slip]` (checked against the model where the job starts).
 pub(crate) fn section(initial: Option<Vec<f64>>) -> PyResult<Option<SectionState>> {
     initial
-        .map(|values| match values.len() {
-            3 | 4 => Ok(values
-                .iter()
-                .enumerate()
-                .fold(SectionState::at_rest(0.0, 0.0, 0.0), |s, (i, &v)| {
-                    s.with_coordinate(i, v)
-                })),
-            n => Err(WalkError::new_err(format!(
-                "invalid initial state {values:?}: {n} values given (expected [L2, thetadot, L2dot], or \
-                 [L2, thetadot, L2dot, slip] with a slipping stance tip)"
-            ))),
+        .map(|values| {
+            SectionState::from_values(&values).ok_or_else(|| {
+                WalkError::new_err(format!(
+                    "invalid initial state {values:?}: {} values given (expected [L2, thetadot, L2dot], or \
+                     [L2, thetadot, L2dot, slip] with a slipping stance tip)",
+                    values.len()
+                ))
+            })
         })
         .transpose()
-}
-
-/// A section state as Python gets it: `[L2, thetadot, L2dot]`, with `slip` after them where the tip slips.
-pub(crate) fn section_values(s: &SectionState) -> Vec<f64> {
-    let n = if s.slips() { 4 } else { 3 };
-    (0..n).map(|i| s.coordinate(i)).collect()
 }
 
 /// The `parameter` keyword: `None`, or a key `dP/dp` can be taken for (the command line's `--parameter` rule

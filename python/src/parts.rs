@@ -8,7 +8,7 @@ use vrw::app::OrbitJobPart;
 use vrw::gait::orbit::{OrbitColumn, OrbitPart};
 use vrw::walk::SectionState;
 
-use crate::{section, section_values, ConfigError};
+use crate::{section, ConfigError};
 
 /// `orbit`'s `part`: `"coarse"` (the diagram's coarse pass), `("fill", k, left)` (the values after the `k`-th
 /// coarse value, from `left`, the `(L2, thetadot, L2dot)` its walk ended in, or `None`) or `"branch"`.
@@ -49,7 +49,7 @@ pub(crate) fn orbit_part_extras(
 ) -> PyResult<()> {
     let ends: Vec<Option<Vec<f64>>> = ends
         .iter()
-        .map(|e| e.as_ref().map(section_values))
+        .map(|e| e.as_ref().map(SectionState::values))
         .collect();
     result.set_item("ends", ends)?;
     let rows: Vec<usize> = columns.iter().map(|c| c.returns.len().max(1)).collect();

@@ -80,18 +80,39 @@ impl SectionState {
     /// The state as the command line prints it, `(L2, thetadot, L2dot) = (0.72, 1, 0)`, with `slip` where the
     /// tip slips; with `precision` digits after the point, or the shortest form that reads back exactly.
     pub fn labelled(&self, precision: Option<usize>) -> String {
-        let n = if self.slips() { 4 } else { 3 };
-        let values: Vec<String> = (0..n)
-            .map(|i| match precision {
-                Some(p) => format!("{:.*}", p, self.coordinate(i)),
-                None => format!("{}", self.coordinate(i)),
+        let values = self.values();
+        let shown: Vec<String> = values
+            .iter()
+            .map(|v| match precision {
+                Some(p) => format!("{v:.p$}"),
+                None => format!("{v}"),
             })
             .collect();
         format!(
             "({}) = ({})",
-            SECTION_COORDINATES[..n].join(", "),
-            values.join(", ")
+            SECTION_COORDINATES[..values.len()].join(", "),
+            shown.join(", ")
         )
+    }
+
+    /// The coordinates `[L2, dtheta/dt, dL2/dt]`, with `slip` after them where the tip slips: what the command
+    /// line prints and Python hands back ([`SectionState::from_values`] reads them).
+    pub fn values(&self) -> Vec<f64> {
+        let n = if self.slips() { 4 } else { 3 };
+        (0..n).map(|i| self.coordinate(i)).collect()
+    }
+
+    /// The state of three values `[L2, dtheta/dt, dL2/dt]` (the tip at rest) or four (`slip` last), `None` for
+    /// any other number of values.
+    pub fn from_values(values: &[f64]) -> Option<SectionState> {
+        (3..=4).contains(&values.len()).then(|| {
+            values
+                .iter()
+                .enumerate()
+                .fold(SectionState::at_rest(0.0, 0.0, 0.0), |s, (i, &v)| {
+                    s.with_coordinate(i, v)
+                })
+        })
     }
 
     /// Does Leg 2's tip slip at this touchdown (`slip != 0`, only with Coulomb friction)?
@@ -340,16 +361,15 @@ impl std::str::FromStr for SectionState {
         if !(3..=4).contains(&parts.len()) {
             return Err(err(format!("{} values given", parts.len())));
         }
-        let mut state = SectionState::at_rest(0.0, 0.0, 0.0);
-        for (i, part) in parts.iter().enumerate() {
-            let value = part.parse::<f64>().map_err(|_| {
-                err(format!(
-                    "{} = {part:?} is not a number",
-                    SECTION_COORDINATES[i]
-                ))
-            })?;
-            state = state.with_coordinate(i, value);
-        }
-        Ok(state)
+        let values = parts
+            .iter()
+            .zip(SECTION_COORDINATES)
+            .map(|(part, name)| {
+                part.parse::<f64>()
+                    .map_err(|_| err(format!("{name} = {part:?} is not a number")))
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
+        SectionState::from_values(&values)
+            .ok_or_else(|| err(format!("{} values given", values.len())))
     }
 }
