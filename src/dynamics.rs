@@ -169,13 +169,15 @@ pub(crate) struct Mechanics<T: Real = f64> {
     pub stiffness: T,
     /// `c` \[N s/m\].
     pub viscosity: T,
+    /// `mu`, the Coulomb friction coefficient at the tips (infinite: no slip; only a slipping contact reads it).
+    pub friction: T,
     /// `g (-sin phi, cos phi)`: the negative of the gravity vector in the slope frame \[m/s^2\].
     pub up: Vector2<T>,
 }
 
 /// The numeric keys of [`Params`] the equations of motion depend on smoothly: the parameters `dP/dp` can be
 /// taken for (`gait::StepMap::eval_with_derivatives`, `vrw gait --parameter`).
-pub const DIFFERENTIABLE_KEYS: [&str; 10] = [
+pub const DIFFERENTIABLE_KEYS: [&str; 11] = [
     "hub_mass",
     "hub_inertia",
     "leg_mass",
@@ -186,6 +188,8 @@ pub const DIFFERENTIABLE_KEYS: [&str; 10] = [
     "viscosity",
     "slope",
     "gravity",
+    // Only a slipping tip's force depends on it: `dP/dfriction` is 0 where no tip slips (friction infinite).
+    "friction",
 ];
 
 impl<T: Real> Mechanics<T> {
@@ -210,6 +214,7 @@ impl<T: Real> Mechanics<T> {
             spring_natural_length: value("spring_natural_length", params.spring_natural_length),
             stiffness: value("stiffness", params.stiffness),
             viscosity: value("viscosity", params.viscosity),
+            friction: value("friction", params.friction),
             up: Vector2::new(-slope.sin(), slope.cos()) * gravity,
         }
     }

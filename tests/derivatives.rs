@@ -50,10 +50,11 @@ fn rigid_wheel_multiplier_is_eta_squared_to_1e_12() {
 }
 
 /// On gaits of every branch (DLS with a slide, SLS, SLS_B3, BOUNCE, stiff legs with flight and Zeno locks,
-/// period 2), the exact `DP` agrees with the Richardson finite difference within the two error estimates.
+/// period 2, and with Coulomb friction), the exact `DP` agrees with the Richardson finite difference within the
+/// two error estimates.
 #[test]
 fn exact_jacobian_agrees_with_finite_differences_on_every_branch() {
-    let cases: [(&[&str], &str, usize); 7] = [
+    let cases: [(&[&str], &str, usize); 10] = [
         (&[], "DLS", 1),
         // The stroke-limited leg: Leg 2 held at its compression stop at the section, the map on dtheta/dt.
         (
@@ -82,6 +83,16 @@ fn exact_jacobian_agrees_with_finite_differences_on_every_branch() {
             "SLS",
             2,
         ),
+        // Coulomb friction: slipping impacts, slip phases, slip starts and stops ...
+        (&["friction=0.6"], "DLS", 1),
+        // ... the (B3) parameters, where friction makes the gait DLS, with a slip that reverses ...
+        (
+            &["friction=0.6", "viscosity=80", "stiffness=1450"],
+            "DLS",
+            1,
+        ),
+        // ... and the stance tip slipping at the section (the map on four coordinates).
+        (&["friction=0.105"], "DLS", 1),
     ];
     for (overrides, branch, period) in cases {
         let config = config_of(overrides);
@@ -102,6 +113,14 @@ fn exact_jacobian_agrees_with_finite_differences_on_every_branch() {
             check.difference, check.exact_error, check.finite_difference_error, gait.max_floquet
         );
         assert!(check.agree, "{overrides:?}: {check:?}");
+        // With the stance tip slipping at the section the map has the slip as a fourth coordinate.
+        let on = map.on_section_of(&gait.section);
+        assert_eq!(check.exact.len(), on.free_coordinate_names().len());
+        assert_eq!(
+            gait.section.slips(),
+            check.exact.len() == 4,
+            "{overrides:?}"
+        );
         // The exact route is the more accurate one by orders of magnitude.
         assert!(check.exact_error < 0.1 * check.finite_difference_error);
     }

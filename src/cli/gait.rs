@@ -172,12 +172,8 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         })
         .collect();
     println!(
-        "Floquet multipliers [{}] ({} Jacobian, error ~{:.0e}): {}",
+        "Floquet multipliers [{}] (exact Jacobian, error ~{:.0e}): {}",
         multipliers.join(", "),
-        match g.jacobian_route {
-            Some("finite_difference") => "finite-difference",
-            _ => "exact",
-        },
         g.jacobian_error,
         g.stability
     );

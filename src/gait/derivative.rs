@@ -52,6 +52,8 @@ pub(crate) struct GaitJacobian {
     pub(crate) error: f64,
     /// `dP/dp`.
     pub(crate) dparam: Option<ParamDerivative>,
+    /// The event sequence of the walk ([`super::StepMap::eval_signature`]).
+    pub(crate) signature: String,
 }
 
 /// The exact `DP` of `map` at `s` (and `dP/dp` for `param`), with the error estimate when `estimate_error`.
@@ -89,6 +91,7 @@ pub(crate) fn gait_jacobian(
                 values: values.iter().copied().collect(),
                 error: dparam_error,
             }),
+        signature: at.signature,
     })
 }
 

@@ -5,9 +5,8 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 use super::derivative::{gait_jacobian, newton_jacobian, ParamDerivative};
-use super::step_map::{DerivativeError, StepMap, StepOutcome};
+use super::step_map::{StepMap, StepOutcome};
 use crate::params::{Params, RearExit};
-use crate::variational::NotDifferentiable;
 use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport};
 
@@ -211,11 +210,6 @@ pub struct Gait {
     /// Estimated error of the Jacobian entries: the largest difference to the exact `DP` at tolerances
     /// [`super::derivative::DERIVATIVE_CHECK_TIGHTENING`] times tighter, or `NaN` if not estimated.
     pub jacobian_error: f64,
-    /// How `DP` was computed where it is not the exact route: `"finite_difference"` (central differences with
-    /// Richardson extrapolation, `jacobian_error` their own estimate) for a walk with Coulomb friction, whose
-    /// slip events the exact derivatives do not cover yet. Absent (`None`) for the exact route.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub jacobian_route: Option<&'static str>,
     /// With Coulomb friction, the event sequence of the gait's step (as `branch.csv`'s `signature`, with
     /// `SLIP1`/`SLIP2` for a tip that slips through the touchdown and `SLIDE`/`STICK` for each slip start and
     /// stop): where the tips stick and slip. Absent without friction.
@@ -358,19 +352,8 @@ fn gait_with_jacobian_on(
         Ok(j) => {
             let mut gait = gait_at(fp, j.jacobian, j.error);
             gait.dp_dparam = j.dparam;
+            gait.signature = map.model().params().has_friction().then_some(j.signature);
             gait
-        }
-        // Coulomb friction: the finite-difference route, with its own error estimate.
-        Err(DerivativeError::NotDifferentiable(NotDifferentiable::Friction { .. })) => {
-            match on.jacobian(&fp.section, options.fd_step) {
-                Ok((dp, error)) => {
-                    let mut gait = gait_at(fp, dp, error);
-                    gait.jacobian_route = Some("finite_difference");
-                    gait.signature = on.eval_signature(&fp.section).ok().map(|o| o.signature);
-                    gait
-                }
-                Err(e) => failed(e.to_string()),
-            }
         }
         Err(e) => failed(e.to_string()),
     }
@@ -621,7 +604,6 @@ pub(crate) fn gait_at(fp: &FixedPoint, dp: DMatrix<f64>, jacobian_error: f64) ->
         max_floquet,
         stability: Stability::judge(max_floquet, jacobian_error),
         jacobian_failure: None,
-        jacobian_route: None,
         signature: None,
         stable: Stability::judge(max_floquet, jacobian_error) == Stability::Stable,
         rear_held: fp.rear_held,
@@ -662,8 +644,6 @@ struct GaitRecord {
     cycle: Vec<StepReport>,
     jacobian: Vec<Vec<f64>>,
     jacobian_error: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    jacobian_route: Option<&'static str>,
     #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
     dp_dparam: Option<ParamDerivative>,
     floquet_multipliers: Vec<[f64; 2]>,
@@ -708,7 +688,6 @@ impl From<Gait> for GaitRecord {
             cycle: g.cycle,
             jacobian: g.jacobian,
             jacobian_error: g.jacobian_error,
-            jacobian_route: g.jacobian_route,
             dp_dparam: g.dp_dparam,
             floquet_multipliers: g.floquet_multipliers,
             max_floquet: g.max_floquet,

@@ -26,8 +26,8 @@ use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, THETA};
 use crate::params::ImpactModel;
 use crate::params::SolverOptions;
 use crate::variational::{
-    augmented, replay_step, seeded, sensitivity, Dual, NotDifferentiable, Sensitivity, BORDER_TOL,
-    NC, PARAM,
+    augmented, replay_step, seeded, sensitivity, slip_derivative, Dual, NotDifferentiable,
+    Sensitivity, BORDER_TOL, NC,
 };
 use crate::walk::section::section_coords;
 use crate::walk::tape::StepTape;
@@ -282,10 +282,11 @@ impl<'m> StepMap<'m> {
                 key: key.to_string(),
             });
         }
-        // Three directions (the section state's) without a parameter, four with one.
-        match param {
-            Some(_) => self.derivatives::<4, 5, { augmented(4) }>(s, param),
-            None => self.derivatives::<3, 4, { augmented(3) }>(s, None),
+        // The section state's directions (three, four where the stance tip slips), and the parameter's last.
+        match (self.slipping, param) {
+            (false, None) => self.derivatives::<3, 4, { augmented(3) }>(s, None),
+            (false, Some(_)) | (true, None) => self.derivatives::<4, 5, { augmented(4) }>(s, param),
+            (true, Some(_)) => self.derivatives::<5, 6, { augmented(5) }>(s, param),
         }
     }
 
@@ -297,27 +298,28 @@ impl<'m> StepMap<'m> {
         param: Option<&str>,
     ) -> Result<StepDerivatives, DerivativeError> {
         let model = self.model;
-        if model.params().has_friction() {
-            return Err(NotDifferentiable::Friction {
-                friction: model.params().friction,
-            }
-            .into());
+        if self.slipping && !s.slips() {
+            return Err(NotDifferentiable::SectionAtRest.into());
         }
         let mut walker = self.walker(s)?;
         // The section's own constraint, differentiated: (q, q') as functions of (s, p).
-        let mech = seeded::<D>(model, param, PARAM);
+        let mech = seeded::<D>(model, param, D - 1);
         let unit = |i: usize, value: f64| {
             let mut e = nalgebra::SVector::<f64, D>::zeros();
             e[i] = 1.0;
             crate::variational::dual_of(value, e)
         };
         let s = s.pinned(model);
+        // The slip's own direction where it is a coordinate of the map, a constant where it is not.
+        let slip = s.slips().then(|| match self.slipping {
+            true => unit(3, s.slip),
+            false => crate::dynamics::lit::<Dual<D>>(s.slip),
+        });
         let (q, qd) = section_coords::<Dual<D>>(
             model,
             &mech,
             (unit(0, s.l2), unit(1, s.theta_dot), unit(2, s.l2_dot)),
-            // 0: the exact derivatives refuse Coulomb friction above, and only friction slips.
-            s.slip,
+            slip,
         );
         let mut sens: Sensitivity<D> = sensitivity(&q, &qd);
         let mut cycle = Vec::with_capacity(self.iterate);
@@ -341,16 +343,20 @@ impl<'m> StepMap<'m> {
         }
         let next = self.check_hold(walker.section()?)?;
         let report = cycle[0];
-        // Rows of the next section state (L2, dtheta/dt, dL2/dt) in (q, q').
-        // The sensitivity's rows of L2, dtheta/dt and dL2/dt.
-        let rows = [L2, NC + THETA, NC + L2];
+        // The derivatives of the next section state (L2, dtheta/dt, dL2/dt, slip): the sensitivity's rows of
+        // L2, dtheta/dt and dL2/dt, and the slipping tip's velocity (0 where the tip sticks: the slip stays 0).
+        let end = walker.state();
+        let slip_row = match end.active.contact2 && end.active.slip2 != 0 {
+            true => slip_derivative(model, &mech, (&end.q, &end.qd), &sens),
+            false => nalgebra::SVector::zeros(),
+        };
+        let row = |i: usize, j: usize| match i {
+            3 => slip_row[j],
+            _ => sens[([L2, NC + THETA, NC + L2][i], j)],
+        };
         let free = self.free_coordinates();
-        let jacobian = DMatrix::from_fn(free.len(), free.len(), |i, j| {
-            sens[(rows[free[i]], free[j])]
-        });
-        let dparam = param
-            .filter(|_| D > PARAM)
-            .map(|_| DVector::from_fn(free.len(), |i, _| sens[(rows[free[i]], PARAM)]));
+        let jacobian = DMatrix::from_fn(free.len(), free.len(), |i, j| row(free[i], free[j]));
+        let dparam = param.map(|_| DVector::from_fn(free.len(), |i, _| row(free[i], D - 1)));
         Ok(StepDerivatives {
             outcome: StepOutcome { next, report },
             jacobian,

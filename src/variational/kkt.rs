@@ -8,10 +8,18 @@
 //! of the residual on dual numbers gives `dR/dy` along every direction at once (the equations of motion and
 //! the rows of (C2) differentiated by [`crate::dynamics::Real`]), and one `f64` factorization of `K` solves for
 //! all directions. This is the KKT solve differentiated, without running a factorization on dual numbers.
+//!
+//! **Coulomb slip** (docs/model.md section 12). A slipping contact's tangential force is not a free multiplier but
+//! `lambda_t = -s mu lambda_n`, so the residual's first block is `M q'' + h - A^T lam - J_t^T lambda_t(lambda_n,
+//! mu)`, its derivative in `lam` the force columns `B` (the slipping normal row's `J_n - s mu J_t`), and
+//! `K = [M -B^T; A 0]` is no longer symmetric: [`SlipKkt`] solves it by LU. The residual's derivative gains
+//! `-dJ_t^T lambda_t` (the slipping rear tip's tangential row moves with `q`) and `s lambda_n J_t^T dmu` (the
+//! friction coefficient as a parameter), and the friction force's derivative is
+//! `dlambda_t = -s (mu dlambda_n + lambda_n dmu)`.
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::contact::{ActiveSet, Ldl, NROWS};
+use crate::contact::{ActiveSet, Ldl, Leg, NROWS};
 use crate::dynamics::{
     Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z,
 };
@@ -256,6 +264,148 @@ impl Kkt {
     }
 }
 
+/// Size of the full KKT system `[q''; lam]`.
+const NK: usize = NQ + NROWS;
+
+/// The force columns `B` (as rows) of `active`: its constraint rows `rows`, except that a slipping contact's
+/// normal row carries its friction, `J_n - s mu J_t` (`J_t` is `e_x` for Leg 1, whose tip is the origin).
+fn force_columns(
+    eom: &EquationsOfMotion<f64>,
+    active: &ActiveSet,
+    mu: f64,
+    rows: &SMatrix<f64, NROWS, NQ>,
+) -> SMatrix<f64, NROWS, NQ> {
+    let mut columns = *rows;
+    for leg in Leg::BOTH {
+        let s = f64::from(active.slip(leg));
+        if s != 0.0 && active.contact(leg) {
+            let n = leg.normal_row();
+            match leg {
+                Leg::One => columns[(n, X)] -= s * mu,
+                Leg::Two => {
+                    for j in 0..NQ {
+                        columns[(n, j)] -= s * mu * eom.rear_tip.jacobian[(0, j)];
+                    }
+                }
+            }
+        }
+    }
+    columns
+}
+
+/// The KKT matrix `[M -B^T; A 0]` of an active set with a slipping contact (see the module documentation), its
+/// inactive rows identity rows, factored by LU with partial pivoting: the matrix is not symmetric. nalgebra's
+/// LU rather than an elimination of our own: unlike the walk's solve, the derivative decides nothing from
+/// its pivots, and only frictional walks take this route (the symmetric [`Kkt`] keeps its Schur complement).
+struct SlipKkt {
+    lu: nalgebra::LU<f64, nalgebra::Const<NK>, nalgebra::Const<NK>>,
+    mask: [bool; NROWS],
+}
+
+impl SlipKkt {
+    /// Factor the KKT matrix of `active` with `M` and the rows of `eom` and the friction coefficient `mu`;
+    /// `None` if singular.
+    fn new(eom: &EquationsOfMotion<f64>, active: &ActiveSet, mu: f64) -> Option<SlipKkt> {
+        let (rows, _) = constraint_rows(eom, active);
+        let columns = force_columns(eom, active, mu, &rows);
+        let mask = active.row_mask();
+        let mut k = SMatrix::<f64, NK, NK>::zeros();
+        k.fixed_view_mut::<NQ, NQ>(0, 0).copy_from(&eom.mass);
+        for (i, on) in mask.into_iter().enumerate() {
+            if on {
+                for j in 0..NQ {
+                    k[(j, NQ + i)] = -columns[(i, j)];
+                    k[(NQ + i, j)] = rows[(i, j)];
+                }
+            } else {
+                k[(NQ + i, NQ + i)] = 1.0;
+            }
+        }
+        let lu = k.lu();
+        lu.is_invertible().then_some(SlipKkt { lu, mask })
+    }
+
+    /// Solve `[M -B^T; A 0] [x; lam] = [f; b]` for `D` right-hand sides (inactive rows of `b` are ignored; their
+    /// `lam` is 0).
+    fn solve<const D: usize>(
+        &self,
+        f: &SMatrix<f64, NQ, D>,
+        b: &SMatrix<f64, NROWS, D>,
+    ) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
+        let mut rhs = SMatrix::<f64, NK, D>::zeros();
+        rhs.fixed_rows_mut::<NQ>(0).copy_from(f);
+        for (i, on) in self.mask.into_iter().enumerate() {
+            if on {
+                rhs.row_mut(NQ + i).copy_from(&b.row(i));
+            }
+        }
+        let z = self.lu.solve(&rhs)?;
+        Some((
+            z.fixed_rows::<NQ>(0).into_owned(),
+            z.fixed_rows::<NROWS>(NQ).into_owned(),
+        ))
+    }
+}
+
+/// Solve the KKT system of `active` (friction coefficient `mu`) for `D` right-hand sides: the symmetric [`Kkt`]
+/// without slip, [`SlipKkt`] with it. `None` if singular.
+fn solve_kkt<const D: usize>(
+    eom: &EquationsOfMotion<f64>,
+    active: &ActiveSet,
+    mu: f64,
+    (f, b): (&SMatrix<f64, NQ, D>, &SMatrix<f64, NROWS, D>),
+) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
+    if active.any_slip() {
+        SlipKkt::new(eom, active, mu)?.solve(f, b)
+    } else {
+        Some(Kkt::new(eom, active)?.solve(f, b))
+    }
+}
+
+/// The friction force's part of the residual's derivative, `s lambda_n J_t^T dmu` for each slipping contact
+/// (`friction` carries `dmu`), added to `r1`.
+fn add_friction_parts<const D: usize>(
+    r1: &mut SMatrix<f64, NQ, D>,
+    (eom, active): (&EquationsOfMotion<f64>, &ActiveSet),
+    friction: &Dual<D>,
+    lam: &SVector<f64, NROWS>,
+) {
+    for leg in Leg::BOTH {
+        let s = f64::from(active.slip(leg));
+        if s != 0.0 && active.contact(leg) {
+            let lambda_n = lam[leg.normal_row()];
+            for j in 0..NQ {
+                let jt = match leg {
+                    Leg::One => f64::from(u8::from(j == X)),
+                    Leg::Two => eom.rear_tip.jacobian[(0, j)],
+                };
+                for c in 0..D {
+                    r1[(j, c)] += s * lambda_n * jt * friction.eps[c];
+                }
+            }
+        }
+    }
+}
+
+/// The friction forces' derivatives `dlambda_t = -s (mu dlambda_n + lambda_n dmu)` of the slipping contacts
+/// of `active`, written into their tangential rows of `dlam`.
+fn friction_derivatives<const D: usize>(
+    active: &ActiveSet,
+    friction: &Dual<D>,
+    lam: &SVector<f64, NROWS>,
+    dlam: &mut SMatrix<f64, NROWS, D>,
+) {
+    for leg in Leg::BOTH {
+        let s = f64::from(active.slip(leg));
+        if s != 0.0 && active.contact(leg) {
+            let (t, n) = (leg.tangential_row(), leg.normal_row());
+            for c in 0..D {
+                dlam[(t, c)] = -s * (friction.re * dlam[(n, c)] + lam[n] * friction.eps[c]);
+            }
+        }
+    }
+}
+
 /// Duals over the configuration `(q, q')` and the constants `mech`, `D` directions each.
 type Duals<const D: usize> = (CoordsOf<Dual<D>>, CoordsOf<Dual<D>>, Mechanics<Dual<D>>);
 
@@ -289,16 +439,21 @@ fn residual_parts<const D: usize>(
             }
         }
     }
+    // A slipping rear tip's tangential row carries its friction force in `lam` (`-s mu lambda_n`): it moves
+    // with `q` as the active rows do, but is no constraint (no `r2`).
+    let slipping = active.contact2 && active.slip2 != 0;
     for axis in 0..2 {
         let row = 2 + axis;
-        if !mask[row] {
+        if !(mask[row] || axis == 0 && slipping) {
             continue;
         }
         for j in 0..NQ {
             let dj = &eom.rear_tip.jacobian[(axis, j)].eps;
             for c in 0..D {
                 r1[(j, c)] -= dj[c] * lam[row];
-                r2[(row, c)] += dj[c] * z2[j];
+                if mask[row] {
+                    r2[(row, c)] += dj[c] * z2[j];
+                }
             }
         }
     }
@@ -345,8 +500,10 @@ pub(crate) fn dynamics_derivative<const D: usize>(
             }
         }
     }
-    let kkt = Kkt::new(&real, active)?;
-    Some(kkt.solve(&-r1, &-r2))
+    add_friction_parts(&mut r1, (&real, active), &mech.friction, lam);
+    let (dqdd, mut dlam) = solve_kkt(&real, active, mech.friction.re, (&-r1, &-r2))?;
+    friction_derivatives(active, &mech.friction, lam, &mut dlam);
+    Some((dqdd, dlam))
 }
 
 /// The derivative of `q'+` of the collision equation (5) with the units of `active` along the `D` directions
@@ -363,9 +520,10 @@ pub(crate) fn impulse_derivative<const D: usize>(
     let qd_plus = qd_real + dqd;
     let ResidualParts {
         eom: real,
-        r1,
+        mut r1,
         mut r2,
     } = residual_parts(&eom, active, dqd, &qd_plus, impulses);
+    add_friction_parts(&mut r1, (&real, active), &mech.friction, impulses);
     let (rows, _) = constraint_rows(&real, active);
     let dqd_minus = SMatrix::<f64, NQ, D>::from_fn(|i, c| qd_minus[i].eps[c]);
     let mask = active.row_mask();
@@ -377,8 +535,7 @@ pub(crate) fn impulse_derivative<const D: usize>(
             }
         }
     }
-    let kkt = Kkt::new(&real, active)?;
-    let (ddqd, _) = kkt.solve(&-r1, &-r2);
+    let (ddqd, _) = solve_kkt(&real, active, mech.friction.re, (&-r1, &-r2))?;
     Some(dqd_minus + ddqd)
 }
 
@@ -397,17 +554,61 @@ mod tests {
             hub_inertia: 0.2,
             ..Params::default()
         };
-        let model = Model::new(&params).unwrap();
+        let compared = compare_solve_derivatives(&params, ActiveSet::all(), "stiffness");
+        assert!(compared > 20, "only {compared} active sets compared");
+    }
+
+    /// The same with Coulomb slip (the non-symmetric KKT system): every set whose contacts slip either way,
+    /// along a direction that moves the friction coefficient too.
+    #[test]
+    fn slipping_solve_derivatives_match_finite_differences() {
+        let params = Params {
+            hub_inertia: 0.2,
+            friction: 0.4,
+            ..Params::default()
+        };
+        let slipping = ActiveSet::all().flat_map(|set| {
+            [(1, 0), (-1, 0), (0, 1), (0, -1), (1, -1), (-1, 1)]
+                .into_iter()
+                .filter_map(move |(s1, s2)| {
+                    let mut set = set;
+                    for (leg, s) in [(Leg::One, s1), (Leg::Two, s2)] {
+                        if s != 0 {
+                            if !set.contact(leg) {
+                                return None;
+                            }
+                            set.set_slipping(leg, s);
+                        }
+                    }
+                    Some(set)
+                })
+        });
+        let slipping: Vec<ActiveSet> = slipping.collect();
+        let compared = compare_solve_derivatives(&params, slipping.iter().copied(), "friction");
+        assert!(compared > 20, "only {compared} slipping sets compared");
+    }
+
+    /// The derivatives of `q''`, the multipliers and `q'+` along one direction in `(q, q', key)` against central
+    /// differences, for each of `sets` the walk's solves solve: how many were compared.
+    fn compare_solve_derivatives(
+        params: &Params,
+        sets: impl Iterator<Item = ActiveSet>,
+        key: &'static str,
+    ) -> usize {
+        let model = Model::new(params).unwrap();
         let q = Coords::new(0.01, -0.02, -0.3, 0.97, 0.93, 0.95);
         let qd = Coords::new(0.2, -0.1, 1.0, -0.2, 0.1, 0.3);
         let dir_q = Coords::new(0.3, -0.2, 0.5, 0.1, -0.4, 0.2);
         let dir_qd = Coords::new(-0.5, 0.2, 0.3, 0.6, 0.1, -0.1);
         let h = 1e-6;
         let mut compared = 0;
-        for active in ActiveSet::all() {
+        for active in sets {
             let at = |s: f64| {
                 let mut p = params.clone();
-                p.stiffness += s;
+                match key {
+                    "friction" => p.friction += s,
+                    _ => p.stiffness += s,
+                }
                 let m = Model::new(&p).unwrap();
                 let (q, qd) = (q + dir_q * s, qd + dir_qd * s);
                 (
@@ -418,7 +619,7 @@ mod tests {
             let (Ok(d0), Ok(i0)) = at(0.0) else { continue };
             let (Ok(dp), Ok(ip)) = at(h) else { continue };
             let (Ok(dm), Ok(im)) = at(-h) else { continue };
-            let mech = seeded::<1>(&model, Some("stiffness"), 0);
+            let mech = seeded::<1>(&model, Some(key), 0);
             let one = |x: f64, e: f64| dual(x, SVector::<f64, 1>::new(e));
             let qd_ = CoordsOf::from_fn(|i, _| one(q[i], dir_q[i]));
             let qdd_ = CoordsOf::from_fn(|i, _| one(qd[i], dir_qd[i]));
@@ -440,6 +641,6 @@ mod tests {
             );
             compared += 1;
         }
-        assert!(compared > 20, "only {compared} active sets compared");
+        compared
     }
 }

@@ -20,7 +20,7 @@ mod kkt;
 mod replay;
 
 pub(crate) use dual::{dual as dual_of, seeded, Dual};
-pub(crate) use replay::{augmented, replay_step, sensitivity, Sensitivity, NC, PARAM};
+pub(crate) use replay::{augmented, replay_step, sensitivity, slip_derivative, Sensitivity, NC};
 pub use replay::{COINCIDENT_EVENTS, GRAZING_RATE};
 
 /// A DLS indicator closer to zero than this (\[N s\] for `lambda_I4`, \[N\] for `lambda_2+`, `lambda_4+`) puts
@@ -59,12 +59,23 @@ pub enum NotDifferentiable {
         /// Its value.
         value: f64,
     },
-    /// The walk has Coulomb friction (a finite `friction`), whose slip phases and events the replay does not
-    /// differentiate yet: the finite-difference route gives `DP` there.
-    #[error("no exact derivatives with Coulomb friction (friction = {friction}) yet: finite differences instead")]
-    Friction {
-        /// The friction coefficient.
-        friction: f64,
+    /// The stance tip is at rest at a section state of a map whose section slips (Coulomb friction): the state
+    /// is on the border between the sections of a sticking and a slipping tip, where the map has only one-sided
+    /// derivatives in the slip.
+    #[error("the stance tip is at rest on a map whose section slips: on the border between sticking and slipping, the step map has only one-sided derivatives there")]
+    SectionAtRest,
+    /// With Coulomb friction, an impulse of an impact is on the border between sticking and slipping (a
+    /// sticking impulse on the edge of its cone, or a slipping tip at rest after it) within [`BORDER_TOL`]:
+    /// the step map is not differentiable there.
+    #[error("{what} = {value:e} at the impact at t = {time} s: on the border between a sticking and a slipping impulse, the step map is not differentiable there")]
+    ImpulseBorder {
+        /// Time of the impact \[s\].
+        time: f64,
+        /// `cone_distance` (of a sticking impulse from the edge of its cone \[N s\]) or `slip_after` (a slipping
+        /// tip's velocity after the impact \[m/s\]).
+        what: &'static str,
+        /// Its value.
+        value: f64,
     },
     /// A KKT or collision solve in the replay was singular.
     #[error("singular constraint solve at t = {time} s in the derivative replay")]

@@ -18,13 +18,16 @@
 //! `S+ = [R_y + (f+ - R_y f-) g_y^T / (g_y f-)] S-`. `g_y S` and `g_y f-` come from one evaluation of `g` on
 //! duals carrying `S` and `f-` (`Dual<D + 1>`): so the force guards (a normal force, a stopper reaction
 //! or a compression stop's reaching zero, from the KKT solution) are differentiated through the KKT solve
-//! like the rest. `R` is the identity for a change of active set (lift-off, unlock, slide) and the collision
-//! equation (5) with the recorded units for an impact (touchdown, landing, stopper or compression-stop hit,
-//! Zeno locks), differentiated in duals.
+//! like the rest. `R` is the identity for a change of active set (lift-off, unlock, slide, and with Coulomb
+//! friction a slip's start at the edge of the cone and its stop, whose guard is the tip's velocity along the
+//! slope) and the collision equation (5) with the recorded units for an impact (touchdown, landing, stopper or
+//! compression-stop hit, Zeno locks; a slipping contact's impulse is its Coulomb impulse `-s mu Lambda_n`),
+//! differentiated in duals. Where the stance tip slips at the section, its slip velocity is a fourth
+//! direction of `S`, and the next section's slip (Leg 2's tip velocity after re-indexing) a fourth row.
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::contact::{impulse, ActiveSet};
+use crate::contact::{cone_distance, impulse, ActiveSet, Leg, NROWS};
 use crate::dynamics::{
     swinging, Coords, CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA,
 };
@@ -36,18 +39,16 @@ use crate::walk::{unpack, EventKind, PhaseSystem, WalkVector};
 
 use super::dual::{dual, eps, seeded, Dual};
 use super::kkt::{dynamics_derivative, impulse_derivative};
-use super::NotDifferentiable;
+use super::{NotDifferentiable, BORDER_TOL};
 
-/// Column of the parameter in a sensitivity.
-pub(crate) const PARAM: usize = 3;
 /// The coordinates a sensitivity covers: all but the swinging leg's `L3` (a step of the step map has no
 /// swinging leg: [`replay_step`] refuses one), so that the replay costs what it did before `L3` existed.
 pub(crate) const NC: usize = NQ - 1;
 /// Rows of a sensitivity: `q` and `q'` without `L3`, `dL3/dt` (the velocities from row [`NC`]).
 pub(crate) const NS: usize = 2 * NC;
-/// `d(q, q')/d(L2, dtheta/dt, dL2/dt)` (`D = 3` directions) or `d(q, q')/d(L2, dtheta/dt, dL2/dt, p)`
-/// (`D = 4`, the parameter's column [`PARAM`]): without a parameter the replay carries three directions, a
-/// fifth less work per stage than four.
+/// `d(q, q')/d(L2, dtheta/dt, dL2/dt)` (`D = 3` directions), with the slip velocity's column where the stance
+/// tip slips at the section (Coulomb friction), and the parameter's column last where one is asked for (`D` up
+/// to 5): without a parameter the replay carries a direction less, a fifth less work per stage.
 pub(crate) type Sensitivity<const D: usize> = SMatrix<f64, NS, D>;
 
 /// Size of the walk's state `[q, q', E_damper]`.
@@ -125,6 +126,21 @@ pub(crate) fn sensitivity<const D: usize>(
     })
 }
 
+/// The derivative of the velocity of Leg 2's tip along the slope (a section state's `slip`) at `(q, q')` with
+/// sensitivity `s`, the constants `mech` carrying the parameter's direction.
+pub(crate) fn slip_derivative<const D: usize>(
+    model: &Model,
+    mech: &Mechanics<Dual<D>>,
+    (q, qd): (&Coords, &Coords),
+    s: &Sensitivity<D>,
+) -> SVector<f64, D> {
+    let (q, qd) = duals(&crate::walk::pack(q, qd, 0.0), s);
+    eps(&model
+        .tip_with(mech, &q, &qd, Leg::Two.index())
+        .velocity(&qd)
+        .x)
+}
+
 /// The phase's vector field with its variational equation, on the augmented state `[y, S]`.
 struct Variational<'a, const D: usize, const A: usize> {
     model: &'a Model,
@@ -187,6 +203,7 @@ fn apply_impacts<const D: usize>(
     for set in sets {
         let singular = NotDifferentiable::Singular { time };
         let sol = impulse(model, &q, &qd, set).map_err(|_| singular.clone())?;
+        impulse_border(model, (&q, &sol.qd_plus), set, &sol.impulses, time)?;
         let (q_d, qd_d) = duals(&crate::walk::pack(&q, &qd, 0.0), &s);
         let dqd_plus = impulse_derivative(
             model,
@@ -202,6 +219,38 @@ fn apply_impacts<const D: usize>(
     Ok((qd, s))
 }
 
+/// With Coulomb friction, is an impulse of `set` (`impulses`, the velocity after it `q'+`) on the border between
+/// sticking and slipping: a sticking contact's impulse within [`BORDER_TOL`] of the edge of its cone, or a
+/// slipping tip's velocity after the impact within it of 0? There the impact law switches, and the step map
+/// has no derivative ([`NotDifferentiable::ImpulseBorder`]).
+fn impulse_border(
+    model: &Model,
+    (q, qd_plus): (&Coords, &Coords),
+    set: &ActiveSet,
+    impulses: &SVector<f64, NROWS>,
+    time: f64,
+) -> Result<(), NotDifferentiable> {
+    let mu = model.params().friction;
+    if !model.params().has_friction() {
+        return Ok(());
+    }
+    for leg in Leg::BOTH.into_iter().filter(|&leg| set.contact(leg)) {
+        let (what, value) = if set.slip(leg) != 0 {
+            let v = model.tip(q, qd_plus, leg.index()).velocity(qd_plus).x;
+            ("slip_after", f64::from(set.slip(leg)) * v)
+        } else if !set.slide(leg) {
+            let (t, n) = (impulses[leg.tangential_row()], impulses[leg.normal_row()]);
+            ("cone_distance", cone_distance(mu, t, n))
+        } else {
+            continue;
+        };
+        if value.abs() < BORDER_TOL {
+            return Err(NotDifferentiable::ImpulseBorder { time, what, value });
+        }
+    }
+    Ok(())
+}
+
 /// The derivatives of one step: the sensitivity of the state after the re-indexing at the next touchdown (the
 /// next section).
 pub(crate) struct StepDerivative<const D: usize> {
@@ -211,8 +260,8 @@ pub(crate) struct StepDerivative<const D: usize> {
 
 /// Replays `tape`, a step walked from the state `(q, q')` (at the section, before the touchdown impact) with
 /// sensitivity `s0`: the sensitivity after the re-indexing at the next touchdown. `opts` are the walk's. `D`
-/// directions (4 with a parameter `param`, its column [`PARAM`]; 3 without), `E = D + 1` (the guard's rate
-/// rides along) and `A =` [`augmented`]`(D)`.
+/// directions (the parameter `param`'s, if any, the last), `E = D + 1` (the guard's rate rides along) and
+/// `A =` [`augmented`]`(D)`.
 pub(crate) fn replay_step<const D: usize, const E: usize, const A: usize>(
     model: &Model,
     opts: &SolverOptions,
@@ -221,9 +270,8 @@ pub(crate) fn replay_step<const D: usize, const E: usize, const A: usize>(
     s0: &Sensitivity<D>,
     tape: &StepTape,
 ) -> Result<StepDerivative<D>, NotDifferentiable> {
-    debug_assert!(param.is_none() || D > PARAM, "a parameter needs its column");
-    let mech = seeded::<D>(model, param, PARAM);
-    let mech5 = seeded::<E>(model, param, PARAM);
+    let mech = seeded::<D>(model, param, D - 1);
+    let mech5 = seeded::<E>(model, param, D - 1);
     // The touchdown impact at the section: the recorded collision, then any Zeno locks (no time shift: the
     // section is the touchdown instant).
     let (Some(first), Some(t0)) = (tape.segments.first(), tape.segments.first().map(|s| s.t0))
@@ -324,17 +372,19 @@ fn cross_guard<const D: usize, const E: usize>(
     let (q, qd) = with_rate(y, s, &f);
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
     let singular = NotDifferentiable::Singular { time: end.time };
+    // The multipliers as duals, for a force guard: their derivatives through the KKT solve.
+    let forces = || -> Result<[Dual<E>; NROWS], NotDifferentiable> {
+        let d = dynamics.as_ref().ok_or(singular.clone())?;
+        let duals = (q, qd, *mech);
+        let (_, dlam) =
+            dynamics_derivative(model, &duals, &segment.active, (&d.qdd, &d.multipliers))
+                .ok_or(singular.clone())?;
+        Ok(std::array::from_fn(|row| {
+            dual(d.multipliers[row], dlam.row(row).transpose())
+        }))
+    };
     let guard = match end.kind {
         EventKind::LiftOff(_) | EventKind::Unlock(_) | EventKind::CompressionUnlock(_) => {
-            // A force guard: the multiplier's derivative through the KKT solve.
-            let d = dynamics.ok_or(singular.clone())?;
-            let (_, dlam) = dynamics_derivative(
-                model,
-                &(q, qd, *mech),
-                &segment.active,
-                (&d.qdd, &d.multipliers),
-            )
-            .ok_or(singular.clone())?;
             // The guard is the unit's reaction in its admissible direction: `lambda` for a contact, `-mu` for a
             // stopper, `mu` for a compression stop.
             let (row, sign) = match (end.kind, end.kind.stop_unlock()) {
@@ -342,7 +392,22 @@ fn cross_guard<const D: usize, const E: usize>(
                 (_, Some((leg, stop))) => (leg.stopper_row(), -stop.sign()),
                 _ => unreachable!("a force guard"),
             };
-            dual(sign * d.multipliers[row], dlam.row(row).transpose() * sign)
+            Dual::<E>::lit(sign) * forces()?[row]
+        }
+        EventKind::ConeLimit(leg) => {
+            // With Coulomb friction: `mu lambda_n - |lambda_t|`, the sticking tip's force reaching the edge of
+            // the cone (the walk's event function divided by `sqrt(1 + mu^2)`, which moves neither its zero nor,
+            // there, the zero's derivatives). The sticking force there is the slipping one, so `f+ = f-` and the
+            // saltation is the identity whatever `dt` (as at a lift-off): the guard's derivative serves the
+            // grazing check.
+            let lam = forces()?;
+            let (t, n) = (lam[leg.tangential_row()], lam[leg.normal_row()]);
+            mech.friction * n - Dual::<E>::lit(t.re.signum()) * t
+        }
+        EventKind::SlipStop(leg) => {
+            // The slipping tip comes to rest: its velocity along the slope, signed by the slip.
+            let slip = Dual::<E>::lit(f64::from(segment.active.slip(leg)));
+            slip * model.tip_with(mech, &q, &qd, leg.index()).velocity(&qd).x
         }
         kind => guard(model, mech, (kind, touching), &q).ok_or(singular)?,
     };
@@ -384,7 +449,7 @@ fn guard<T: Real>(
         // Not in a step without a swinging leg (refused in `step_derivative`).
         | EventKind::SwingLock
         | EventKind::SwingLanding
-        // Coulomb friction is refused before the replay (`NotDifferentiable::Friction`).
+        // Crossed in `cross_guard`: a force guard and a velocity guard.
         | EventKind::ConeLimit(_)
         | EventKind::SlipStop(_) => None,
     }

@@ -6,12 +6,14 @@ use std::collections::BTreeSet;
 
 use nalgebra::DMatrix;
 
-use crate::contact::{ActiveSet, Leg};
+use crate::contact::{impulse, ActiveSet, Leg};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
-use crate::gait::StepMap;
+use crate::gait::{DerivativeError, StepMap};
 use crate::params::Config;
 use crate::walk::tape::StepTape;
 use crate::walk::{EventKind, SectionState, Walker};
+
+use super::NotDifferentiable;
 
 /// Relative step of the central differences.
 const FD_STEP: f64 = 1e-5;
@@ -67,6 +69,25 @@ fn cases() -> Vec<(Vec<&'static str>, SectionState)> {
             ],
             s(0.99, 1.2, 0.0),
         ),
+        // Coulomb friction (the gaits of `vrw gait --set friction=...`): both tips slip through the touchdown
+        // impact, stick, slip again at the edge of the cone, lift off while slipping.
+        (
+            vec!["friction=0.3"],
+            s(0.719768087, 1.063339047, -0.335804049),
+        ),
+        // ... a slip that reverses (the (B3) parameters).
+        (
+            vec!["friction=0.6", "viscosity=80", "stiffness=1450"],
+            s(0.946482987, 2.288104242, 0.503231508),
+        ),
+        // ... the stance tip slipping at the section: the map on four coordinates.
+        (
+            vec!["friction=0.105"],
+            SectionState {
+                slip: 0.067750417,
+                ..s(0.726069600, 1.274670977, -0.395701883)
+            },
+        ),
     ]
 }
 
@@ -93,9 +114,24 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
     if tape.impacts.len() > 1 {
         kinds.insert("zeno lock at touchdown".to_string());
     }
+    let slipping_impact = |sets: &[ActiveSet]| sets.iter().any(ActiveSet::any_slip);
+    if slipping_impact(&tape.impacts) {
+        kinds.insert("slipping impact".to_string());
+    }
+    if tape.segments.first().is_some_and(|s| s.active.slip1 != 0) {
+        kinds.insert("slipping section".to_string());
+    }
+    for (segment, next) in tape.segments.iter().zip(tape.segments.iter().skip(1)) {
+        let reversed = |leg| segment.active.slip(leg) * next.active.slip(leg) < 0;
+        if reversed(Leg::One) || reversed(Leg::Two) {
+            kinds.insert("slip reversal".to_string());
+        }
+    }
     for segment in &tape.segments {
         let ActiveSet { slide1, slide2, .. } = segment.active;
-        if slide1 || slide2 {
+        if segment.active.any_slip() {
+            kinds.insert("coulomb slip".to_string());
+        } else if slide1 || slide2 {
             kinds.insert("slide".to_string());
         }
         if let Some(end) = &segment.end {
@@ -111,11 +147,15 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
                 EventKind::Touchdown => "touchdown",
                 EventKind::Fall | EventKind::RollBack => "failure",
                 EventKind::SwingLock | EventKind::SwingLanding => "swinging leg",
-                EventKind::ConeLimit(_) | EventKind::SlipStop(_) => "coulomb friction",
+                EventKind::ConeLimit(_) => "slip start",
+                EventKind::SlipStop(_) => "slip stop",
             };
             kinds.insert(name.to_string());
             if end.impacts.len() > 1 {
                 kinds.insert("zeno lock".to_string());
+            }
+            if slipping_impact(&end.impacts) {
+                kinds.insert("slipping impact".to_string());
             }
         }
     }
@@ -179,6 +219,12 @@ fn saltation_based_jacobian_matches_finite_differences_at_every_event_kind() {
         "zeno lock",
         "compression lock",
         "compression unlock",
+        "slipping impact",
+        "coulomb slip",
+        "slip start",
+        "slip stop",
+        "slip reversal",
+        "slipping section",
     ] {
         assert!(
             covered.contains(kind),
@@ -189,14 +235,24 @@ fn saltation_based_jacobian_matches_finite_differences_at_every_event_kind() {
 
 #[test]
 fn parameter_derivatives_match_finite_differences_for_every_key() {
-    for (overrides, s) in cases().into_iter().take(2) {
+    // Two frictionless walks and two with Coulomb slip (one from a slipping section). Without friction
+    // `dP/dfriction` is 0 (no tip slips) and has no finite difference (friction is infinite).
+    let cases = cases();
+    let frictional = cases
+        .iter()
+        .filter(|(o, _)| o.first().is_some_and(|o| o.starts_with("friction")));
+    for (overrides, s) in cases.iter().take(2).chain(frictional.step_by(2)) {
         // A hub inertia inside its domain, so that both differences exist.
-        let mut config = config_of(&overrides);
+        let mut config = config_of(overrides);
         config.params.hub_inertia = 0.2;
         let model = Model::new(&config.params).unwrap();
-        let map = StepMap::new(&model, &config.solver);
+        let map = StepMap::new(&model, &config.solver).on_section_of(s);
         for key in DIFFERENTIABLE_KEYS {
-            let exact = map.eval_with_derivatives(&s, Some(key)).unwrap();
+            let exact = map.eval_with_derivatives(s, Some(key)).unwrap();
+            if key == "friction" && !config.params.has_friction() {
+                assert!(exact.dparam.unwrap().iter().all(|&d| d == 0.0));
+                continue;
+            }
             let value = |c: &Config| match key {
                 "hub_mass" => c.params.hub_mass,
                 "hub_inertia" => c.params.hub_inertia,
@@ -208,6 +264,7 @@ fn parameter_derivatives_match_finite_differences_for_every_key() {
                 "viscosity" => c.params.viscosity,
                 "slope" => c.params.slope,
                 "gravity" => c.params.gravity,
+                "friction" => c.params.friction,
                 _ => unreachable!(),
             };
             let p0 = value(&config);
@@ -215,8 +272,8 @@ fn parameter_derivatives_match_finite_differences_for_every_key() {
             let at = |p: f64| {
                 let c = config.with(key, p).unwrap();
                 let model = Model::new(&c.params).unwrap();
-                let map = StepMap::new(&model, &c.solver);
-                map.reduce(&map.eval(&s).unwrap().next)
+                let map = StepMap::new(&model, &c.solver).on_section_of(s);
+                map.reduce(&map.eval(s).unwrap().next)
             };
             let fd = (at(p0 + h) - at(p0 - h)) / (2.0 * h);
             let exact = exact.dparam.unwrap();
@@ -225,4 +282,58 @@ fn parameter_derivatives_match_finite_differences_for_every_key() {
             assert_columns_agree(&exact, &fd, &format!("dP/d{key} at {overrides:?}"));
         }
     }
+}
+
+/// With Coulomb friction at the ratio of the paper's no-slip touchdown impulse's tangential to normal part, that
+/// impulse lies on the edge of its cone: the border between a sticking and a slipping impact, where the step map
+/// has no derivative, and the replay says so. Away from the edge the derivative exists.
+#[test]
+fn an_impulse_on_the_edge_of_its_cone_has_no_derivative() {
+    let (overrides, s) = &cases()[0];
+    let config = config_of(overrides);
+    let model = Model::new(&config.params).unwrap();
+    let mut tape = StepTape::default();
+    Walker::new(&model, &config.solver, s)
+        .unwrap()
+        .step_taped(&mut tape)
+        .unwrap();
+    let (q, qd) = s.to_coords(&model);
+    let sol = impulse(&model, &q, &qd, &tape.impacts[0]).unwrap();
+    let ratio = (sol.impulses[2] / sol.impulses[3]).abs();
+    assert!(ratio > 10.0, "the rear tip's impulse ratio {ratio}");
+    let at = |mu: f64| {
+        let c = config.with("friction", mu).unwrap();
+        let model = Model::new(&c.params).unwrap();
+        StepMap::new(&model, &c.solver)
+            .eval_with_derivatives(s, None)
+            .map(|_| ())
+    };
+    match at(ratio * (1.0 + 1e-13)) {
+        Err(DerivativeError::NotDifferentiable(NotDifferentiable::ImpulseBorder { .. })) => {}
+        other => panic!("mu = {ratio}: {other:?}"),
+    }
+    assert_eq!(at(ratio * 1.01), Ok(()));
+    assert_eq!(at(ratio * 0.99), Ok(()));
+}
+
+/// A map whose section slips, evaluated where the stance tip is at rest, is on the border between the sticking
+/// and slipping sections: no derivative (Newton's method takes a finite difference there).
+#[test]
+fn a_slipping_map_at_rest_has_no_derivative() {
+    let (overrides, slipping) = cases().pop().unwrap();
+    assert!(slipping.slips());
+    let config = config_of(&overrides);
+    let model = Model::new(&config.params).unwrap();
+    let map = StepMap::new(&model, &config.solver).on_section_of(&slipping);
+    let at_rest = SectionState {
+        slip: 0.0,
+        ..slipping
+    };
+    assert_eq!(
+        map.eval_with_derivatives(&at_rest, None).err(),
+        Some(DerivativeError::NotDifferentiable(
+            NotDifferentiable::SectionAtRest
+        ))
+    );
+    assert!(map.eval_with_derivatives(&slipping, None).is_ok());
 }

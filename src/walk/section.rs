@@ -250,7 +250,7 @@ impl SectionState {
             model,
             model.mechanics(),
             (s.l2, s.theta_dot, s.l2_dot),
-            s.slip,
+            s.slips().then_some(s.slip),
         )
     }
 
@@ -303,12 +303,12 @@ impl SectionState {
 /// tip on the ground, `L0 cos(theta) = L2 cos(theta + alpha)`, i.e. `tan(theta) = (L2 cos(alpha) - L0) / (L2
 /// sin(alpha))`; `(dx, dz)` hold Leg 2's tip at rest (`J_C2 q' = 0`, whose `x`, `z` columns are the identity).
 /// With `rigid_legs`, `L2 = L0` and `dL2/dt = 0` exactly. A slipping tip (`slip`, Coulomb friction) moves at
-/// `(slip, 0)` instead: `dx` is `slip` more.
+/// `(slip, 0)` instead (`slip` given): `dx` is `slip` more.
 pub(crate) fn section_coords<T: Real>(
     model: &Model,
     mech: &Mechanics<T>,
     (l2, theta_dot, l2_dot): (T, T, T),
-    slip: f64,
+    slip: Option<T>,
 ) -> (CoordsOf<T>, CoordsOf<T>) {
     // Leg 1 has just landed, at the touchdown length (`L0` by default, and always with rigid legs).
     let l0 = mech.spoke_length;
@@ -327,10 +327,9 @@ pub(crate) fn section_coords<T: Real>(
         .tip_with(mech, &q, &qd, Leg::Two.index())
         .velocity(&qd);
     // (`-v.x` itself without slip: the same bits as before the slip coordinate, signed zeros included.)
-    qd[X] = if slip == 0.0 {
-        -v.x
-    } else {
-        lit::<T>(slip) - v.x
+    qd[X] = match slip {
+        None => -v.x,
+        Some(slip) => slip - v.x,
     };
     qd[Z] = -v.y;
     (q, qd)
