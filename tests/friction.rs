@@ -338,7 +338,8 @@ fn a_slip_velocity_is_a_section_coordinate_only_with_friction() {
 /// A sweep across the border where the mu = 0.3 family's stance tip starts to slip at touchdown (near c = 4.65):
 /// Newton's method on the four-coordinate map may land on a state whose slip is exactly 0 (the tip at rest), and
 /// its Newton matrix must still be the map's (regression: it was taken on that state's own three-coordinate
-/// section, and the sweep panicked on the mismatch). The family continues through the border, slipping.
+/// section, and the sweep panicked on the mismatch). The family continues through the border, slipping, and
+/// its end below is reported with the evidence it has.
 #[test]
 fn a_sweep_across_the_slip_border_keeps_its_newton_matrix() {
     use vrw::app::compute_sweep;
@@ -366,4 +367,16 @@ fn a_sweep_across_the_slip_border_keeps_its_newton_matrix() {
         "no slipping gait below c = 4.65"
     );
     assert!(found.iter().any(|g| !g.section.slips()));
+    // The family ends near c = 4.41 with an unstable gait: the walk from it fails whatever lies beyond, so the
+    // note claims no more than that Newton's method stops there.
+    let end = result
+        .thresholds
+        .iter()
+        .find(|t| t.name == "gait_found")
+        .expect("the family's end");
+    let detail = end.detail.as_deref().unwrap_or_default();
+    assert!(
+        detail.contains("where its gait is unstable") && !detail.contains("and not at"),
+        "{detail}"
+    );
 }

@@ -467,7 +467,7 @@ impl<'a> Continuation<'a> {
         }
     }
 
-    /// The real Floquet multiplier closest to +1 of the gait `at` (central-difference `DP`).
+    /// The real Floquet multiplier closest to +1 of the gait `at`.
     fn near_fold(&self, at: &FamilyPoint) -> Option<f64> {
         self.jacobian(at)?
             .complex_eigenvalues()
@@ -475,6 +475,12 @@ impl<'a> Continuation<'a> {
             .filter(|z| z.im.abs() < 1e-9)
             .map(|z| z.re)
             .min_by(|a, b| (a - 1.0).abs().total_cmp(&(b - 1.0).abs()))
+    }
+
+    /// The largest modulus of the Floquet multipliers of the gait `at` (`None` where `DP` cannot be had).
+    pub(crate) fn largest_multiplier(&self, at: &FamilyPoint) -> Option<f64> {
+        let moduli = self.jacobian(at)?.complex_eigenvalues().map(|z| z.norm());
+        Some(moduli.iter().copied().fold(0.0, f64::max))
     }
 
     /// What happens at `beyond`, just past the end of the family whose last gait is `last`: walk from it (see

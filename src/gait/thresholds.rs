@@ -353,9 +353,24 @@ gt.section.distance(&p.section) <= SAME_GAIT_TOL
         EndCause::WalkFails { failure, message } => (
             if upward { "gait_lost" } else { "gait_found" },
             format!(
-                "the gait family exists at {p} = {} and not at {p} = {beyond}; walking from its last gait at \
-                 {p} = {beyond}: {failure} ({message}){}",
-                last.value,
+                "{}; walking from its last gait at {p} = {beyond}: {failure} ({message}){}",
+                // A walk from an unstable gait fails whether or not the family goes on: then the evidence is
+                // Newton's method's alone.
+                if cont.largest_multiplier(&last).is_some_and(|m| m > 1.0) {
+                    format!(
+                        "the gait family is followed to {p} = {}, where its gait is unstable, and Newton's \
+                         method finds none of its gaits at {p} = {beyond} (the walk from an unstable gait fails \
+                         either way: that no gait of the family exists there is not shown)",
+                        last.value,
+                        p = spec.param
+                    )
+                } else {
+                    format!(
+                        "the gait family exists at {p} = {} and not at {p} = {beyond}",
+                        last.value,
+                        p = spec.param
+                    )
+                },
                 if !upward && gait_before {
                     "; the gait is found again"
                 } else {
