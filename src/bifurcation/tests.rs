@@ -292,7 +292,7 @@ fn default_family_ends_where_the_sweep_ends() {
             section,
         },
         140.0,
-        None,
+        (None, None),
     );
     let Followed::Ended { last, .. } = natural else {
         panic!("{natural:?}");
@@ -361,7 +361,7 @@ fn dls_family_ends_at_a_border_collision() {
             section,
         },
         600.0,
-        None,
+        (None, None),
     );
     let Followed::Ended { last, beyond } = natural else {
         panic!("{natural:?}");
@@ -417,7 +417,7 @@ fn border_curve_agrees_with_the_one_parameter_end() {
             section: section4,
         },
         570.0,
-        None,
+        (None, None),
     );
     let Followed::Ended { last, beyond } = natural else {
         panic!("{natural:?}");

@@ -12,6 +12,13 @@
 //! (`Continuation::walk_step`), since the step map is only piecewise smooth. A family of period-k gaits is
 //! followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
 //!
+//! **Predictor.** Each step starts Newton's method from the gait carried along the family's tangent `ds*/dp`
+//! (`Tangent`): given with the first point (`-(DP - I)^-1 dP/dp` from its exact derivatives), then the secant
+//! of the last verified step. The start is then `O(dp^2)` from the gait instead of `O(dp)`, which saves Newton
+//! iterations there and back; a step whose predicted start fails is tried again from the point itself, so that
+//! the predictor never loses a step the plain start would take. Period-1 families only (see
+//! `Continuation::step_predicted`).
+//!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
 //! family at the first parameter value it does not reach (`END_WALK_STEPS` steps). The walk fails (falls,
 //! rolls back, stalls, the rear leg is not relocked, ...), settles on another gait of any period up to
@@ -48,7 +55,7 @@ pub(crate) const SETTLE_TOL: f64 = 1e-11;
 /// Most continuation steps (verified or failed) one [`Continuation::follow`] may try. Following a family to a
 /// neighbouring value, or to its end bracketed to [`PARAM_TOL`], takes a few dozen; approaching an end where
 /// the steps Newton's method takes shrink with the distance to it (the wheel about to roll back, e.g. at
-/// `k = 761.311031 N/m` for `c = 50`) takes about four steps per halving, 100 to 150 from a grid interval of
+/// `k = 761.311033 N/m` for `c = 50`) takes about four steps per halving, 100 to 150 from a grid interval of
 /// 20; a family that only advances in ever tinier steps without end is given up rather than followed for
 /// hours.
 pub(crate) const MAX_FOLLOW_STEPS: usize = 200;
@@ -115,6 +122,50 @@ pub struct FamilyPoint {
     pub value: f64,
     /// The fixed point of the step map.
     pub section: SectionState,
+}
+
+/// The tangent `ds*/dp` of a family at the parameter value `at`, over the section coordinates `[L2,
+/// dtheta/dt, dL2/dt, slip]` ([`crate::walk::SECTION_COORDINATES`]): the predictor of the next step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Tangent {
+    /// Where it holds.
+    pub(crate) at: f64,
+    /// `ds*/dp` per coordinate.
+    pub(crate) rates: [f64; 4],
+}
+
+impl Tangent {
+    /// The secant of a verified step from `a` to `b`, or `None` where the two sections differ in kind (one
+    /// slips and the other does not: the coordinates do not carry over).
+    fn secant(a: &FamilyPoint, b: &FamilyPoint) -> Option<Tangent> {
+        let dp = b.value - a.value;
+        (a.section.slips() == b.section.slips() && dp != 0.0).then(|| Tangent {
+            at: b.value,
+            rates: std::array::from_fn(|i| {
+                (b.section.coordinate(i) - a.section.coordinate(i)) / dp
+            }),
+        })
+    }
+
+    /// The start at `value` predicted from `from` (where the tangent holds, and the state stays of its kind:
+    /// a tip at rest is not set slipping); `None` elsewhere.
+    fn predict(&self, from: &FamilyPoint, value: f64) -> Option<SectionState> {
+        if self.at != from.value {
+            return None;
+        }
+        let dp = value - from.value;
+        let moved = (0..4).fold(from.section, |s, i| {
+            let rate = if i == 3 && !from.section.slips() {
+                0.0
+            } else {
+                self.rates[i]
+            };
+            s.with_coordinate(i, s.coordinate(i) + rate * dp)
+        });
+        // A slip that would change its sign (a border of the map) is not predicted.
+        let kept = moved.slip.signum() == from.section.slip.signum();
+        (kept && self.rates.iter().all(|r| r.is_finite())).then_some(moved)
+    }
 }
 
 /// Where following a family led.
@@ -256,6 +307,34 @@ impl<'a> Continuation<'a> {
         self.step_asking(from, value, guess, false).ok()
     }
 
+    /// [`Continuation::step_asking`] from the start `tangent` predicts (see the module documentation), and
+    /// from the plain start where that fails or no prediction is made.
+    fn step_predicted(
+        &self,
+        from: &FamilyPoint,
+        value: f64,
+        (guess, tangent): (Option<&DMatrix<f64>>, Option<&Tangent>),
+        undamped: bool,
+    ) -> Result<FamilyPoint, StepFailure> {
+        // `min_length` moves a held state with the parameter itself (`carried_start`): no predictor there. Nor
+        // for a period-k family: its fixed points of `P^k` include the period-1 gait where the period-k orbit
+        // collapses onto it (a bounce that vanishes at `lambda_2+ = 0`), and a predicted start carries the
+        // family through that border, so that the change of period would go unreported.
+        let tangent = tangent.filter(|_| self.param != "min_length" && self.period == 1);
+        let predicted = tangent.and_then(|t| {
+            let start = t.predict(from, value)?;
+            let back = Tangent { at: value, ..*t };
+            Some((start, back))
+        });
+        if let Some((start, back)) = predicted {
+            let step = self.step_from(from, value, (guess, undamped), (start, Some(&back)));
+            if step.is_ok() {
+                return step;
+            }
+        }
+        self.step_asking(from, value, guess, undamped)
+    }
+
     /// [`Continuation::step`], failing with [`StepFailure::Start`] where the walk from `from`'s gait at `value`
     /// fails (whatever the Newton matrix), else with [`StepFailure::Newton`]; `undamped`: Newton's method fails
     /// as soon as it must damp a step taken with `DP` at its iterate ([`solve_fixed_point_asking`]).
@@ -266,11 +345,24 @@ impl<'a> Continuation<'a> {
         guess: Option<&DMatrix<f64>>,
         undamped: bool,
     ) -> Result<FamilyPoint, StepFailure> {
+        let start = self.start_from(from, value);
+        self.step_from(from, value, (guess, undamped), (start, None))
+    }
+
+    /// One verified step from `from` to `value` with Newton's method started at `start`, and on the way back at
+    /// the start `back` predicts from the point reached (else that point itself).
+    fn step_from(
+        &self,
+        from: &FamilyPoint,
+        value: f64,
+        (guess, undamped): (Option<&DMatrix<f64>>, bool),
+        (start, back): (SectionState, Option<&Tangent>),
+    ) -> Result<FamilyPoint, StepFailure> {
         // Newton's method asks for its matrix once the map is evaluated at the start.
         let mut started = false;
         let forward = self.solve(
             value,
-            &self.start_from(from, value),
+            &start,
             &mut || {
                 started = true;
                 guess.cloned()
@@ -288,13 +380,11 @@ impl<'a> Continuation<'a> {
             value,
             section: forward.section,
         };
+        let back_start = back
+            .and_then(|t| t.predict(&reached, from.value))
+            .unwrap_or_else(|| self.start_from(&reached, from.value));
         let back = self
-            .solve(
-                from.value,
-                &self.start_from(&reached, from.value),
-                &mut || guess.cloned(),
-                undamped,
-            )
+            .solve(from.value, &back_start, &mut || guess.cloned(), undamped)
             .map_err(|_| StepFailure::Newton)?;
         if back.section.distance(&from.section) <= SAME_GAIT_TOL {
             Ok(reached)
@@ -351,7 +441,8 @@ impl<'a> Continuation<'a> {
     }
 
     /// Follow the family of `from` to `target` in verified steps, until the target is reached or the family's
-    /// end is bracketed to [`PARAM_TOL`]. `guess` is `DP` at `from`, if known. A step whose Newton's method fails
+    /// end is bracketed to [`PARAM_TOL`]. `known` is what is known at `from`: `DP` and the family's [`Tangent`]
+    /// (the predictor of the first step). A step whose Newton's method fails
     /// is retried once with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere;
     /// not a step whose walk fails at its start, where no matrix helps), a retry that fails as soon as it must
     /// damp a Newton step taken with `DP` at its iterate, then halved; a
@@ -362,20 +453,22 @@ impl<'a> Continuation<'a> {
         &self,
         from: FamilyPoint,
         target: f64,
-        guess: Option<&DMatrix<f64>>,
+        known: (Option<&DMatrix<f64>>, Option<Tangent>),
     ) -> Followed {
-        self.follow_to(from, target, guess, PARAM_TOL)
+        self.follow_to(from, target, known, PARAM_TOL)
     }
 
     /// [`Continuation::follow`] with the family's end bracketed to `end_tol` instead of [`PARAM_TOL`] (the
-    /// coarse pass of a split row needs it only to a grid interval).
+    /// coarse pass of a split row needs it only to a grid interval), and the family's tangent at `from` if
+    /// known (the predictor of the first step; the secant of the last verified step after that).
     pub(crate) fn follow_to(
         &self,
         from: FamilyPoint,
         target: f64,
-        guess: Option<&DMatrix<f64>>,
+        (guess, tangent): (Option<&DMatrix<f64>>, Option<Tangent>),
         end_tol: f64,
     ) -> Followed {
+        let mut tangent = tangent;
         let mut current = from;
         let mut steps = 0;
         // The Newton matrix and the parameter value where it was computed.
@@ -404,27 +497,35 @@ impl<'a> Continuation<'a> {
             } else {
                 current.value + h
             };
-            let mut next =
-                match self.step_asking(&current, next_value, jac.as_ref().map(|(_, j)| j), false) {
-                    Ok(p) => Some(p),
-                    // A step that fails in Newton's method with a matrix computed elsewhere is retried with DP at
-                    // `current`, as a quick test: Newton's method must not have to damp a step taken with DP at
-                    // its iterate (`undamped`). Of the 1 338 retries of
-                    // a 100 x 100 map, 1 336 failed, after up to 8 damped iterations each with a new DP; the two
-                    // that worked (and the default map's one) damp none. Not a step whose walk fails at the
-                    // start, where no matrix would help (near an end where the wheel rolls back, most steps of
-                    // the bisection).
-                    Err(StepFailure::Newton)
-                        if jac.as_ref().is_none_or(|(v, _)| *v != current.value) =>
-                    {
-                        self.jacobian(&current).and_then(|j| {
-                            let next = self.step_asking(&current, next_value, Some(&j), true).ok();
-                            jac = Some((current.value, j));
-                            next
-                        })
-                    }
-                    Err(_) => None,
-                };
+            let matrix = jac.as_ref().map(|(_, j)| j);
+            let mut next = match self.step_predicted(
+                &current,
+                next_value,
+                (matrix, tangent.as_ref()),
+                false,
+            ) {
+                Ok(p) => Some(p),
+                // A step that fails in Newton's method with a matrix computed elsewhere is retried with DP at
+                // `current`, as a quick test: Newton's method must not have to damp a step taken with DP at
+                // its iterate (`undamped`). Of the 1 338 retries of
+                // a 100 x 100 map, 1 336 failed, after up to 8 damped iterations each with a new DP; the two
+                // that worked (and the default map's one) damp none. Not a step whose walk fails at the
+                // start, where no matrix would help (near an end where the wheel rolls back, most steps of
+                // the bisection).
+                Err(StepFailure::Newton)
+                    if jac.as_ref().is_none_or(|(v, _)| *v != current.value) =>
+                {
+                    self.jacobian(&current).and_then(|j| {
+                        let predicted = (Some(&j), tangent.as_ref());
+                        let next = self
+                            .step_predicted(&current, next_value, predicted, true)
+                            .ok();
+                        jac = Some((current.value, j));
+                        next
+                    })
+                }
+                Err(_) => None,
+            };
             let at_end = (next_value - current.value).abs() <= end_tol;
             // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and at
             // every WALK_AFTER_FAILURES-th one after that; once a walk works, through every halving of a walking
@@ -443,6 +544,9 @@ impl<'a> Continuation<'a> {
                 walking = walking || next.is_some();
             } else if next.is_some() {
                 walking = false;
+            }
+            if let Some(next) = &next {
+                tangent = Tangent::secant(&current, next);
             }
             match next {
                 Some(next) => {
@@ -603,7 +707,8 @@ mod tests {
         let config = Config::default();
         let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
         let (from, guess) = family_at(&config, 131.0);
-        let Followed::Ended { last, beyond } = cont.follow_to(from, 141.0, guess.as_ref(), 1.0)
+        let Followed::Ended { last, beyond } =
+            cont.follow_to(from, 141.0, (guess.as_ref(), None), 1.0)
         else {
             panic!("the family ends before 141");
         };
@@ -615,7 +720,7 @@ mod tests {
         let Followed::Ended {
             last: fine,
             beyond: fine_beyond,
-        } = cont.follow(near, 136.0, guess.as_ref())
+        } = cont.follow(near, 136.0, (guess.as_ref(), None))
         else {
             panic!("the family ends before 136");
         };

@@ -15,16 +15,17 @@
 
 use std::ops::Range;
 
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::continuation::{Continuation, FamilyPoint, Followed, PARAM_TOL};
+use super::continuation::{Continuation, FamilyPoint, Followed, Tangent, PARAM_TOL};
 use super::grid::{run_rows_part, Evaluated};
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::period_k::{find_gait_any_period, periodic_gait_at};
 use super::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
-use super::step_map::StepMap;
-use crate::dynamics::Model;
+use super::step_map::{free_coordinates, StepMap};
+use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
 use crate::fmt::short;
 use crate::params::{Config, ConfigError, SolverOptions};
 use crate::walk::SectionState;
@@ -223,6 +224,7 @@ pub(crate) fn gait_at_value(
     };
     let solver: &SolverOptions = &c.solver;
     let map = StepMap::new(&model, solver);
+    let options = &with_swept_parameter(options, param);
     let mut attempts = Vec::new();
     let continued = previous.and_then(|p| {
         match follow_gait(config, param, p.value, p.gait, value, options, p.end_tol) {
@@ -262,6 +264,39 @@ pub(crate) fn gait_at_value(
     }
 }
 
+/// The tangent `ds*/dp = (I - DP)^-1 dP/dp` of the family of `g`, the gait at `from`, where its `dP/dp` is for
+/// `param` (a sweep asks for it: [`with_swept_parameter`]): the predictor of the first continuation step.
+pub(crate) fn family_tangent(config: &Config, param: &str, from: f64, g: &Gait) -> Option<Tangent> {
+    let d = g.dp_dparam.as_ref().filter(|d| d.parameter == param)?;
+    let dp = g.jacobian_guess()?;
+    let n = dp.nrows();
+    let free = free_coordinates(config.params.rigid_legs || g.rear_held, g.section.slips());
+    if free.len() != n || d.values.len() != n {
+        return None;
+    }
+    let rates = (DMatrix::identity(n, n) - dp)
+        .lu()
+        .solve(&DVector::from_column_slice(&d.values))?;
+    let mut full = [0.0; 4];
+    for (k, &i) in free.iter().enumerate() {
+        full[i] = rates[k];
+    }
+    Some(Tangent {
+        at: from,
+        rates: full,
+    })
+}
+
+/// The options of a sweep along `param`: with `dP/dp` for it where it is differentiable (and no other
+/// parameter was asked for), whose tangent predicts the next point ([`family_tangent`]).
+fn with_swept_parameter(options: &GaitOptions, param: &str) -> GaitOptions {
+    let key = DIFFERENTIABLE_KEYS.iter().copied().find(|&k| k == param);
+    GaitOptions {
+        parameter: options.parameter.or(key),
+        ..*options
+    }
+}
+
 /// The gait at `value` of the family of `g`, the gait at `from`: the family followed in verified steps
 /// ([`Continuation::follow`]), then the full gait (with `DP`) where it lands. If the family does not reach
 /// `value`, the attempt (for [`SweepPoint::attempts`]); `Err(None)` if it reaches it but the gait there cannot be
@@ -281,7 +316,8 @@ fn follow_gait(
         section: g.section,
     };
     let cont = Continuation::new(config, param, options).with_period(g.period_k);
-    let p = match cont.follow_to(start, value, guess.as_ref(), end_tol) {
+    let tangent = family_tangent(config, param, from, g);
+    let p = match cont.follow_to(start, value, (guess.as_ref(), tangent), end_tol) {
         Followed::Reached(p) => p,
         followed => {
             return Err(Some(FollowAttempt {

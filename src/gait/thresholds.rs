@@ -29,7 +29,7 @@ use super::continuation::{carried_start, Continuation, EndCause, FamilyPoint, Fo
 use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use super::periodicity::SAME_GAIT_TOL;
 use super::step_map::StepMap;
-use super::sweep::{SweepPoint, SweepSpec};
+use super::sweep::{family_tangent, SweepPoint, SweepSpec};
 use crate::dynamics::Model;
 use crate::params::Config;
 use crate::walk::DlsIndicators;
@@ -307,7 +307,11 @@ fn refine_end(
     // that result rather than follow it again (the same computation, see `SweepPoint::attempts`).
     let followed = match toward.attempt_from(&start) {
         Some(f) => f.clone(),
-        None => cont.follow(start, toward.value, guess.as_ref()),
+        // With the sweep's predictor (the tangent of `from`'s gait), so as to follow it as the sweep did.
+        None => {
+            let tangent = family_tangent(config, &spec.param, from.value, g);
+            cont.follow(start, toward.value, (guess.as_ref(), tangent))
+        }
     };
     let (last, beyond) = match followed {
         Followed::Ended { last, beyond } => (last, beyond),
