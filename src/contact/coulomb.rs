@@ -157,7 +157,13 @@ pub(crate) fn slipping_impulse(
 
 /// The force columns `B` (as rows): the constraint rows, except that a slipping contact's normal row carries
 /// its friction, `J_n - s mu J_t`.
-fn force_columns(model: &Model, q: &Coords, qd: &Coords, active: &ActiveSet, rows: &Rows) -> Rows {
+pub(crate) fn force_columns(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: &ActiveSet,
+    rows: &Rows,
+) -> Rows {
     let mu = model.params().friction;
     let mut columns = *rows;
     for leg in Leg::BOTH {

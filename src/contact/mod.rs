@@ -22,6 +22,7 @@ use crate::dynamics::{Coords, Model, L1, L2};
 mod coulomb;
 mod solve;
 
+pub(crate) use coulomb::force_columns;
 pub(crate) use solve::{swing_lock_impulse, Ldl};
 
 /// Number of constraint rows in the fixed stacking order.

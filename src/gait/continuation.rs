@@ -645,16 +645,16 @@ impl<'a> Continuation<'a> {
                 reason: "the walk from the last gait returns to it: the end of the family is numerical"
                     .to_string(),
             },
-            Err(_) if self.near_fold(last).is_some_and(|m| (m - 1.0).abs() < FOLD_TOL) => {
-                EndCause::Fold {
-                    multiplier: self.near_fold(last).unwrap_or(f64::NAN),
+            Err(e) => match self.near_fold(last) {
+                Some(multiplier) if (multiplier - 1.0).abs() < FOLD_TOL => {
+                    EndCause::Fold { multiplier }
                 }
-            }
-            Err(e) => EndCause::Unconfirmed {
-                reason: format!(
-                    "the walk from the last gait neither fails nor settles on a gait of period 1 to \
-                     {MAX_PERIOD} within {END_WALK_STEPS} steps ({e})"
-                ),
+                _ => EndCause::Unconfirmed {
+                    reason: format!(
+                        "the walk from the last gait neither fails nor settles on a gait of period 1 to \
+                         {MAX_PERIOD} within {END_WALK_STEPS} steps ({e})"
+                    ),
+                },
             },
         }
     }

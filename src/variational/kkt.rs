@@ -19,7 +19,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::contact::{ActiveSet, Ldl, Leg, NROWS};
+use crate::contact::{force_columns, ActiveSet, Ldl, Leg, NROWS};
 use crate::dynamics::{
     Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z,
 };
@@ -267,32 +267,6 @@ impl Kkt {
 /// Size of the full KKT system `[q''; lam]`.
 const NK: usize = NQ + NROWS;
 
-/// The force columns `B` (as rows) of `active`: its constraint rows `rows`, except that a slipping contact's
-/// normal row carries its friction, `J_n - s mu J_t` (`J_t` is `e_x` for Leg 1, whose tip is the origin).
-fn force_columns(
-    eom: &EquationsOfMotion<f64>,
-    active: &ActiveSet,
-    mu: f64,
-    rows: &SMatrix<f64, NROWS, NQ>,
-) -> SMatrix<f64, NROWS, NQ> {
-    let mut columns = *rows;
-    for leg in Leg::BOTH {
-        let s = f64::from(active.slip(leg));
-        if s != 0.0 && active.contact(leg) {
-            let n = leg.normal_row();
-            match leg {
-                Leg::One => columns[(n, X)] -= s * mu,
-                Leg::Two => {
-                    for j in 0..NQ {
-                        columns[(n, j)] -= s * mu * eom.rear_tip.jacobian[(0, j)];
-                    }
-                }
-            }
-        }
-    }
-    columns
-}
-
 /// The KKT matrix `[M -B^T; A 0]` of an active set with a slipping contact (see the module documentation), its
 /// inactive rows identity rows, factored by LU with partial pivoting: the matrix is not symmetric. nalgebra's
 /// LU rather than an elimination of our own: unlike the walk's solve, the derivative decides nothing from
@@ -303,11 +277,16 @@ struct SlipKkt {
 }
 
 impl SlipKkt {
-    /// Factor the KKT matrix of `active` with `M` and the rows of `eom` and the friction coefficient `mu`;
-    /// `None` if singular.
-    fn new(eom: &EquationsOfMotion<f64>, active: &ActiveSet, mu: f64) -> Option<SlipKkt> {
+    /// Factor the KKT matrix of `active` at `(q, q')` with `M` and the rows of `eom` and the walk's force
+    /// columns ([`force_columns`]); `None` if singular.
+    fn new(
+        model: &Model,
+        (q, qd): (&Coords, &Coords),
+        eom: &EquationsOfMotion<f64>,
+        active: &ActiveSet,
+    ) -> Option<SlipKkt> {
         let (rows, _) = constraint_rows(eom, active);
-        let columns = force_columns(eom, active, mu, &rows);
+        let columns = force_columns(model, q, qd, active, &rows);
         let mask = active.row_mask();
         let mut k = SMatrix::<f64, NK, NK>::zeros();
         k.fixed_view_mut::<NQ, NQ>(0, 0).copy_from(&eom.mass);
@@ -347,16 +326,15 @@ impl SlipKkt {
     }
 }
 
-/// Solve the KKT system of `active` (friction coefficient `mu`) for `D` right-hand sides: the symmetric [`Kkt`]
-/// without slip, [`SlipKkt`] with it. `None` if singular.
+/// Solve the KKT system of `active` at `(q, q')` (`eom` its equations of motion there) for `D` right-hand
+/// sides: the symmetric [`Kkt`] without slip, [`SlipKkt`] with it. `None` if singular.
 fn solve_kkt<const D: usize>(
-    eom: &EquationsOfMotion<f64>,
-    active: &ActiveSet,
-    mu: f64,
+    (model, q, qd): (&Model, &Coords, &Coords),
+    (eom, active): (&EquationsOfMotion<f64>, &ActiveSet),
     (f, b): (&SMatrix<f64, NQ, D>, &SMatrix<f64, NROWS, D>),
 ) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
     if active.any_slip() {
-        SlipKkt::new(eom, active, mu)?.solve(f, b)
+        SlipKkt::new(model, (q, qd), eom, active)?.solve(f, b)
     } else {
         Some(Kkt::new(eom, active)?.solve(f, b))
     }
@@ -501,7 +479,9 @@ pub(crate) fn dynamics_derivative<const D: usize>(
         }
     }
     add_friction_parts(&mut r1, (&real, active), &mech.friction, lam);
-    let (dqdd, mut dlam) = solve_kkt(&real, active, mech.friction.re, (&-r1, &-r2))?;
+    let (q_real, qd_real) = (q.map(|x| x.re), qd.map(|x| x.re));
+    let at = (model, &q_real, &qd_real);
+    let (dqdd, mut dlam) = solve_kkt(at, (&real, active), (&-r1, &-r2))?;
     friction_derivatives(active, &mech.friction, lam, &mut dlam);
     Some((dqdd, dlam))
 }
@@ -535,7 +515,8 @@ pub(crate) fn impulse_derivative<const D: usize>(
             }
         }
     }
-    let (ddqd, _) = solve_kkt(&real, active, mech.friction.re, (&-r1, &-r2))?;
+    let at = (model, &q.map(|x| x.re), &qd_real);
+    let (ddqd, _) = solve_kkt(at, (&real, active), (&-r1, &-r2))?;
     Some(dqd_minus + ddqd)
 }
 
