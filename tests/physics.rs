@@ -118,6 +118,35 @@ fn energy_is_conserved_without_damping_in_double_support() {
     assert!(drift < ENERGY_DRIFT_TOL, "relative drift {drift:e}");
 }
 
+/// Events do not depend on the integrator's steps being short: with steps up to four times longer
+/// (`max_step = 0.16`) the event functions are still checked every `event_spacing` (0.01 s), so the twenty
+/// default steps meet the same events in the same phases and branches, and the gait agrees to the
+/// integration tolerance.
+#[test]
+fn longer_steps_keep_the_event_resolution() {
+    let config = Config::default();
+    let model = Model::new(&config.params).unwrap();
+    let short = simulate(&model, &config.solver, &default_start(), 20, None).unwrap();
+    let long_opts = SolverOptions {
+        max_step: 0.16,
+        ..config.solver.clone()
+    };
+    let long = simulate(&model, &long_opts, &default_start(), 20, None).unwrap();
+    assert!(short.failure.is_none() && long.failure.is_none());
+    assert!(long.work.accepted < short.work.accepted);
+    assert_eq!(long.work.events, short.work.events);
+    assert_eq!(long.work.crossings, short.work.crossings);
+    for (a, b) in short.steps.iter().zip(&long.steps) {
+        assert_eq!(
+            (a.branch, a.events),
+            (b.branch, b.events),
+            "step {}",
+            a.step
+        );
+        assert!(a.section.distance(&b.section) < 1e-8, "step {}", a.step);
+    }
+}
+
 #[test]
 fn energy_audit_closes_over_twenty_steps() {
     let config = Config::default();

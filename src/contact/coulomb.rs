@@ -194,6 +194,10 @@ fn with_friction(model: &Model, active: &ActiveSet, mut lam: Multipliers) -> Mul
 
 /// Solve `M x = f + B^T lam`, `A x = b` on the active rows of `active` (`system = (A, B, active)`, see the
 /// module documentation); through the Painleve case where `through_painleve` ([`eliminate`]).
+///
+/// `M^-1 B^T` is solved for the active rows' columns only (one Cholesky factor, one solve per active row
+/// rather than a 6 x 6 solve with six right-hand sides), and the elimination runs over the active rows: an
+/// inactive row is an identity row of the Schur complement with a zero right-hand side, whose multiplier is 0.
 fn solve(
     m: &SMatrix<f64, NQ, NQ>,
     (rows, columns, active): (&Rows, &Rows, &ActiveSet),
@@ -203,27 +207,40 @@ fn solve(
 ) -> Result<(Coords, Multipliers), ContactError> {
     let chol = m.cholesky().ok_or(ContactError::SingularMass)?;
     let x_free = chol.solve(f);
-    let minv_bt = chol.solve(&columns.transpose());
-    let mut schur = rows * minv_bt;
-    let mut rhs = b - rows * x_free;
     let mask = active.row_mask();
+    let mut minv_bt = SMatrix::<f64, NQ, NROWS>::zeros();
+    for i in (0..NROWS).filter(|&i| mask[i]) {
+        minv_bt.set_column(i, &chol.solve(&columns.row(i).transpose()));
+    }
+    let mut schur = SMatrix::<f64, NROWS, NROWS>::identity();
+    let mut rhs = Multipliers::zeros();
+    for i in (0..NROWS).filter(|&i| mask[i]) {
+        rhs[i] = b[i] - rows.row(i).dot(&x_free.transpose());
+        for j in (0..NROWS).filter(|&j| mask[j]) {
+            schur[(i, j)] = rows.row(i).dot(&minv_bt.column(j).transpose());
+        }
+    }
     let slipping = |i: usize| {
         Leg::BOTH
             .into_iter()
             .any(|leg| active.slip(leg) != 0 && active.contact(leg) && leg.normal_row() == i)
     };
-    for (i, on) in mask.iter().enumerate() {
-        if !on {
-            schur.row_mut(i).fill(0.0);
-            schur.column_mut(i).fill(0.0);
-            schur[(i, i)] = 1.0;
-            rhs[i] = 0.0;
-        }
-    }
-    // Sticking rows first, the slipping normal rows last.
-    let mut order: Vec<usize> = (0..NROWS).filter(|&i| !slipping(i)).collect();
-    order.extend((0..NROWS).filter(|&i| slipping(i)));
-    let lam = eliminate(schur, rhs, &order, &slipping, active, through_painleve)?;
+    // The active rows, sticking ones first, the slipping normal rows last.
+    let mut order = [0; NROWS];
+    let sticking = (0..NROWS).filter(|&i| mask[i] && !slipping(i));
+    let count = sticking
+        .chain((0..NROWS).filter(|&i| mask[i] && slipping(i)))
+        .zip(order.iter_mut())
+        .map(|(i, place)| *place = i)
+        .count();
+    let lam = eliminate(
+        schur,
+        rhs,
+        &order[..count],
+        &slipping,
+        active,
+        through_painleve,
+    )?;
     Ok((x_free + minv_bt * lam, lam))
 }
 

@@ -37,6 +37,10 @@ use crate::dynamics::Model;
 use crate::params::Config;
 use crate::walk::{SectionState, Walker};
 
+/// The way back of a continuation step ends early where the first step of Newton's method lands this close to
+/// the gait the step came from (`Continuation::first_newton_step`): a tenth of [`SAME_GAIT_TOL`].
+const EARLY_RETURN_TOL: f64 = 1e-7;
+
 /// Tolerance of every threshold in the swept parameter.
 pub(crate) const PARAM_TOL: f64 = 1e-6;
 
@@ -383,6 +387,12 @@ impl<'a> Continuation<'a> {
         let back_start = back
             .and_then(|t| t.predict(&reached, from.value))
             .unwrap_or_else(|| self.start_from(&reached, from.value));
+        if self
+            .first_newton_step(from.value, &back_start, guess)
+            .is_some_and(|landing| landing.distance(&from.section) <= EARLY_RETURN_TOL)
+        {
+            return Ok(reached);
+        }
         let back = self
             .solve(from.value, &back_start, &mut || guess.cloned(), undamped)
             .map_err(|_| StepFailure::Newton)?;
@@ -391,6 +401,34 @@ impl<'a> Continuation<'a> {
         } else {
             Err(StepFailure::Newton)
         }
+    }
+
+    /// Where the first step of Newton's method from `start` at `value` lands with the Newton matrix `guess - I`
+    /// (`start` itself where its residual is already below the tolerance), for the way back of a continuation
+    /// step: landing within [`EARLY_RETURN_TOL`] of the gait the step came from, Newton's method is on its way
+    /// to that gait (a known fixed point there, and the landing far closer to it than the distance between two
+    /// gaits the check tells apart, [`SAME_GAIT_TOL`]), so the rest of its iterations (one evaluation of the map
+    /// each, to confirm a convergence already shown) are not taken. `None` without a matrix of the map's size or
+    /// where the walk fails (the full solve then decides).
+    fn first_newton_step(
+        &self,
+        value: f64,
+        start: &SectionState,
+        guess: Option<&DMatrix<f64>>,
+    ) -> Option<SectionState> {
+        let (c, model) = self.configured_at(value).ok()?;
+        let map = StepMap::new(&model, &c.solver)
+            .iterated(self.period)
+            .on_section_of(start);
+        let n = map.free_coordinates().len();
+        let guess = guess.filter(|g| g.nrows() == n && g.ncols() == n)?;
+        let x = map.reduce(start);
+        let r = map.reduce(&map.eval(start).ok()?.next) - &x;
+        if r.amax() < self.options.tolerance {
+            return Some(*start);
+        }
+        let delta = (guess - DMatrix::identity(n, n)).lu().solve(&(-r))?;
+        Some(map.expand(start, &(x + delta)))
     }
 
     /// The same step by walking, where Newton's method fails (the step map is only piecewise smooth): the wheel
@@ -745,6 +783,73 @@ mod tests {
             .step_asking(&from, 135.2, guess.as_ref(), true)
             .unwrap();
         assert_eq!(damped, undamped);
+    }
+
+    /// The gait at a point where Newton's method converged, taken from the walk of its derivatives, is the one
+    /// `find_gait` gives there, bit for bit (sweeps use it at every continued point); a start that is not a
+    /// fixed point falls back to `find_gait` itself.
+    #[test]
+    fn a_gait_at_a_converged_point_is_find_gaits() {
+        use crate::gait::limit_cycle::gait_at_converged;
+        let config = Config::default();
+        let (from, guess) = family_at(&config, 50.0);
+        let model = Model::new(&config.params).unwrap();
+        let map = StepMap::new(&model, &config.solver);
+        let options = GaitOptions {
+            transient_steps: 0,
+            parameter: Some("viscosity"),
+            ..GaitOptions::default()
+        };
+        let direct = find_gait(&map, &from.section, &options, guess.as_ref()).unwrap();
+        let converged = gait_at_converged(&map, &from.section, &options, guess.as_ref()).unwrap();
+        assert_eq!(direct, converged);
+        assert_eq!(converged.iterations, 0);
+        let mut off = from.section;
+        off.theta_dot += 1e-4;
+        let direct = find_gait(&map, &off, &options, guess.as_ref()).unwrap();
+        let converged = gait_at_converged(&map, &off, &options, guess.as_ref()).unwrap();
+        assert_eq!(direct, converged);
+        assert!(converged.iterations > 0);
+    }
+
+    /// The way back of a step ends after one Newton step where that step lands on the gait the step came from
+    /// (the step's result is the one the full solve back accepts), and not where it lands elsewhere: from a
+    /// start on another gait (the default family's gait at `c = 60`, taken as a start at `c = 50`) the first
+    /// step heads for that gait's neighbourhood, not for the one at `c = 50`.
+    #[test]
+    fn the_way_back_ends_early_only_on_the_gait_it_came_from() {
+        let config = Config::default();
+        let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
+        let (from, guess) = family_at(&config, 50.0);
+        let reached = cont
+            .step(&from, 51.0, guess.as_ref())
+            .expect("a verified step");
+        let back_start = cont.start_from(&reached, 50.0);
+        let landing = cont
+            .first_newton_step(50.0, &back_start, guess.as_ref())
+            .unwrap();
+        assert!(
+            landing.distance(&from.section) <= EARLY_RETURN_TOL,
+            "{landing:?}"
+        );
+        // The full solve back confirms it.
+        let back = cont
+            .solve(50.0, &back_start, &mut || guess.clone(), false)
+            .unwrap();
+        assert!(back.section.distance(&from.section) <= SAME_GAIT_TOL);
+        let (far, _) = family_at(&config, 60.0);
+        let landing = cont
+            .first_newton_step(50.0, &far.section, guess.as_ref())
+            .unwrap();
+        assert!(
+            landing.distance(&from.section) > EARLY_RETURN_TOL,
+            "{landing:?}"
+        );
+        // Without a Newton matrix of the map's size there is no early answer.
+        let wrong = DMatrix::<f64>::zeros(2, 2);
+        assert!(cont
+            .first_newton_step(50.0, &back_start, Some(&wrong))
+            .is_none());
     }
 
     /// A family whose stance tip slips at the section has the slip as a coordinate of its Newton matrix too

@@ -11,7 +11,7 @@
 use nalgebra::DMatrix;
 use serde::Serialize;
 
-use super::step_map::{DerivativeError, StepMap};
+use super::step_map::{DerivativeError, StepMap, StepOutcome};
 use crate::walk::SectionState;
 
 /// The factor between the run's integration tolerances and those of the second computation of `DP` whose
@@ -54,21 +54,29 @@ pub(crate) struct GaitJacobian {
     pub(crate) dparam: Option<ParamDerivative>,
     /// The event sequence of the walk ([`super::StepMap::eval_signature`]).
     pub(crate) signature: String,
+    /// The step map's value at the point: the walk of the derivatives (the one [`StepMap::eval`] takes).
+    pub(crate) outcome: StepOutcome,
 }
 
-/// The exact `DP` of `map` at `s` (and `dP/dp` for `param`), with the error estimate when `estimate_error`.
+/// The exact `DP` of `map` at `s` (and `dP/dp` for `param`), with the error estimate where `estimate.0` (and
+/// of `dP/dp` where `estimate.1` too: `GaitOptions::refine_jacobian` and `refine_dparam`).
 pub(crate) fn gait_jacobian(
     map: &StepMap,
     s: &SectionState,
     param: Option<&'static str>,
-    estimate_error: bool,
+    estimate: (bool, bool),
 ) -> Result<GaitJacobian, DerivativeError> {
     let map = &map.on_section_of(s);
     let other_map = map.with_tolerances_scaled(second_tolerance_factor(map));
+    let other_param = param.filter(|_| estimate.1);
     // The two computations are independent: both cores.
     let (at, other) = rayon::join(
         || map.eval_with_derivatives(s, param),
-        || estimate_error.then(|| other_map.eval_with_derivatives(s, param)),
+        || {
+            estimate
+                .0
+                .then(|| other_map.eval_with_derivatives(s, other_param))
+        },
     );
     let at = at?;
     let (error, dparam_error) = match other.transpose()? {
@@ -92,6 +100,7 @@ pub(crate) fn gait_jacobian(
                 error: dparam_error,
             }),
         signature: at.signature,
+        outcome: at.outcome,
     })
 }
 
@@ -167,7 +176,7 @@ pub fn check_jacobian(
     fd_step: f64,
 ) -> Result<JacobianCheck, DerivativeError> {
     let map = &map.on_section_of(s);
-    let exact = gait_jacobian(map, s, None, true)?;
+    let exact = gait_jacobian(map, s, None, (true, true))?;
     let factor = second_tolerance_factor(map);
     let other = map.with_tolerances_scaled(factor);
     // The two sets of walks are independent: both cores.

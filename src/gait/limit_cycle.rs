@@ -4,7 +4,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
-use super::derivative::{gait_jacobian, newton_jacobian, ParamDerivative};
+use super::derivative::{gait_jacobian, newton_jacobian, GaitJacobian, ParamDerivative};
 use super::step_map::{StepMap, StepOutcome};
 use crate::params::{Params, RearExit};
 use crate::walk::WalkError;
@@ -30,6 +30,10 @@ pub struct GaitOptions {
     /// Also compute `dP/dp` of the gait for this parameter (one of
     /// [`DIFFERENTIABLE_KEYS`](crate::dynamics::DIFFERENTIABLE_KEYS); `gait.json`'s `dP_dparam`). Default none.
     pub parameter: Option<&'static str>,
+    /// With `refine_jacobian`, estimate the error of `dP/dp` the same way (default true); otherwise the second
+    /// computation carries `DP` alone (a direction less; a sweep's own `dP/dp`, which only predicts the next
+    /// point, needs no estimate) and `dP_dparam`'s error is `NaN`.
+    pub refine_dparam: bool,
 }
 
 impl Default for GaitOptions {
@@ -41,6 +45,7 @@ impl Default for GaitOptions {
             fd_step: 1e-4,
             refine_jacobian: true,
             parameter: None,
+            refine_dparam: true,
         }
     }
 }
@@ -50,6 +55,15 @@ impl GaitOptions {
     /// each gait its stability verdict.
     pub fn for_sweeps() -> GaitOptions {
         GaitOptions::default()
+    }
+
+    /// Which error estimates the final `DP` gets: of `DP` (`refine_jacobian`), and of `dP/dp` with it
+    /// (`refine_dparam`).
+    fn estimates(&self) -> (bool, bool) {
+        (
+            self.refine_jacobian,
+            self.refine_jacobian && self.refine_dparam,
+        )
     }
 }
 
@@ -319,43 +333,90 @@ pub fn find_gait(
     Ok(gait_with_jacobian(map, &fp, options))
 }
 
+/// [`find_gait`] from a section state `s` at which Newton's method on this map has just converged (a
+/// continuation step's), without evaluating the map there once more: the walk of the exact derivatives is
+/// that evaluation (the same walk, bit for bit), and the gait is the one [`find_gait`] gives (`iterations` 0)
+/// once its residual is checked. Where that check or the derivatives fail, or the first step of
+/// [`solve_fixed_point`] could move `s` (onto the held set, or onto the slipping section with Coulomb
+/// friction), [`find_gait`] itself.
+pub(crate) fn gait_at_converged(
+    map: &StepMap,
+    s: &SectionState,
+    options: &GaitOptions,
+    jacobian_guess: Option<&DMatrix<f64>>,
+) -> Result<Gait, GaitError> {
+    let params = map.model().params();
+    let may_move = (params.min_length > 0.0 && !s.rear_held(map.model()))
+        || (params.has_friction() && !s.slips());
+    let on = map.on_section_of(s);
+    let converged = (!may_move && options.validate().is_ok())
+        .then(|| gait_jacobian(map, s, options.parameter, options.estimates()).ok())
+        .flatten()
+        .and_then(|j| {
+            let residual = norm(&(on.reduce(&j.outcome.next) - on.reduce(s)));
+            let fp = FixedPoint {
+                section: s.pinned(map.model()),
+                outcome: j.outcome,
+                residual,
+                iterations: 0,
+                rear_held: on.rear_held(),
+            };
+            (residual < options.tolerance).then_some((fp, j))
+        });
+    match converged {
+        Some((fp, j)) => {
+            let gait = gait_from(&fp, Ok(j), params.has_friction());
+            Ok(with_section_coordinates(map, &on, gait))
+        }
+        None => find_gait(map, s, options, jacobian_guess),
+    }
+}
+
 /// The gait at the fixed point `fp` of `map` with its exact `DP` (and `dP/dp` if asked for) and the error
 /// estimate of [`super::derivative::gait_jacobian`]; where the map is not differentiable at `fp` (or a
 /// perturbed walk fails), the gait without multipliers and the reason in [`Gait::jacobian_failure`].
 pub(crate) fn gait_with_jacobian(map: &StepMap, fp: &FixedPoint, options: &GaitOptions) -> Gait {
     let on = map.on_section_of(&fp.section);
+    let jacobian = gait_jacobian(map, &fp.section, options.parameter, options.estimates());
+    let jacobian = jacobian.map_err(|e| (on.free_coordinates().len(), e.to_string()));
+    let friction = map.model().params().has_friction();
+    with_section_coordinates(map, &on, gait_from(fp, jacobian, friction))
+}
+
+/// `gait` with the names of its section coordinates where the model has Coulomb friction (`on` is `map` on
+/// the gait's section).
+fn with_section_coordinates(map: &StepMap, on: &StepMap, gait: Gait) -> Gait {
     let coordinates = map
         .model()
         .params()
         .has_friction()
         .then(|| on.free_coordinate_names());
-    let gait = gait_with_jacobian_on(map, &on, fp, options);
     Gait {
         section_coordinates: coordinates,
         ..gait
     }
 }
 
-fn gait_with_jacobian_on(
-    map: &StepMap,
-    on: &StepMap,
+/// The gait at `fp` with its exact derivatives (and the event sequence of its step where the model has
+/// `friction`), or without multipliers and with the reason the derivatives failed (`(n, reason)`, `n` the
+/// number of free coordinates).
+fn gait_from(
     fp: &FixedPoint,
-    options: &GaitOptions,
+    jacobian: Result<GaitJacobian, (usize, String)>,
+    friction: bool,
 ) -> Gait {
-    let failed = |failure: String| {
-        let n = on.free_coordinates().len();
-        let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
-        gait.jacobian_failure = Some(failure);
-        gait
-    };
-    match gait_jacobian(map, &fp.section, options.parameter, options.refine_jacobian) {
+    match jacobian {
         Ok(j) => {
             let mut gait = gait_at(fp, j.jacobian, j.error);
             gait.dp_dparam = j.dparam;
-            gait.signature = map.model().params().has_friction().then_some(j.signature);
+            gait.signature = friction.then_some(j.signature);
             gait
         }
-        Err(e) => failed(e.to_string()),
+        Err((n, failure)) => {
+            let mut gait = gait_at(fp, DMatrix::from_element(n, n, f64::NAN), f64::NAN);
+            gait.jacobian_failure = Some(failure);
+            gait
+        }
     }
 }
 

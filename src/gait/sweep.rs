@@ -21,7 +21,7 @@ use serde::Serialize;
 
 use super::continuation::{Continuation, FamilyPoint, Followed, Tangent, PARAM_TOL};
 use super::grid::{run_rows_part, Evaluated};
-use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
+use super::limit_cycle::{gait_at_converged, solve_fixed_point, Gait, GaitOptions};
 use super::period_k::{find_gait_any_period, periodic_gait_at};
 use super::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
 use super::step_map::{free_coordinates, StepMap};
@@ -288,12 +288,17 @@ pub(crate) fn family_tangent(config: &Config, param: &str, from: f64, g: &Gait) 
 }
 
 /// The options of a sweep along `param`: with `dP/dp` for it where it is differentiable (and no other
-/// parameter was asked for), whose tangent predicts the next point ([`family_tangent`]).
+/// parameter was asked for), whose tangent predicts the next point ([`family_tangent`]); that `dP/dp` needs
+/// no error estimate.
 fn with_swept_parameter(options: &GaitOptions, param: &str) -> GaitOptions {
     let key = DIFFERENTIABLE_KEYS.iter().copied().find(|&k| k == param);
-    GaitOptions {
-        parameter: options.parameter.or(key),
-        ..*options
+    match (options.parameter, key) {
+        (None, Some(key)) => GaitOptions {
+            parameter: Some(key),
+            refine_dparam: false,
+            ..*options
+        },
+        _ => *options,
     }
 }
 
@@ -335,7 +340,7 @@ fn follow_gait(
         ..*options
     };
     if g.period_k == 1 {
-        return find_gait(&map, &p.section, &opts, guess.as_ref()).map_err(|_| None);
+        return gait_at_converged(&map, &p.section, &opts, guess.as_ref()).map_err(|_| None);
     }
     let fp = solve_fixed_point(&map.iterated(g.period_k), &p.section, &opts, guess.as_ref())
         .map_err(|_| None)?;

@@ -425,7 +425,7 @@ mod tests {
             .collect();
         written.sort_unstable();
         expected.sort_unstable();
-        assert_eq!(written.len(), 25);
+        assert_eq!(written.len(), 26);
         assert_eq!(written, expected);
         assert_eq!(table["inconsistent_contact"].as_str(), Some("rebound"));
         assert_eq!(table["integrator"].as_str(), Some("dopri5"));
@@ -647,7 +647,7 @@ mod tests {
         assert_eq!(defaults.get_numeric("friction").unwrap(), f64::INFINITY);
         assert_eq!(defaults.get_numeric("min_length").unwrap(), 0.0);
         let keys = Config::numeric_keys();
-        assert_eq!(keys.len(), 21);
+        assert_eq!(keys.len(), 22);
         assert!(keys.iter().all(|key| all_keys().contains(key)));
         for key in [
             "legs",

@@ -38,8 +38,8 @@ pub use model::{
 };
 pub use solver::{ContactInconsistency, ImpactModel, RearExit, SolverOptions};
 pub use solver::{
-    ATOL_RANGE, EVENT_TIME_TOL_RANGE, GAP_RANGE, MAX_EVENTS_PER_STEP_LIMIT, MAX_STEP_RANGE,
-    MAX_STEP_TIME_RANGE, RTOL_RANGE,
+    ATOL_RANGE, EVENT_SPACING_RANGE, EVENT_TIME_TOL_RANGE, GAP_RANGE, MAX_EVENTS_PER_STEP_LIMIT,
+    MAX_STEP_RANGE, MAX_STEP_TIME_RANGE, RTOL_RANGE,
 };
 
 /// Everything a run needs: physics ([`Params`]) and numerics ([`SolverOptions`]).

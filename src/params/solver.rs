@@ -145,9 +145,14 @@ pub struct SolverOptions {
     /// Absolute integration tolerance \[state units: m, rad, m/s, rad/s\]. Default 1e-12. In [`ATOL_RANGE`]
     /// (1e-16 to 1e-3).
     pub atol: f64,
-    /// Largest integrator step \[s\]. Default 0.04 (events are still resolved to a quarter of a step, see
-    /// `walk::EVENT_SAMPLES`). In [`MAX_STEP_RANGE`] (1e-6 to 1).
+    /// Largest integrator step \[s\]. Default 0.04. In [`MAX_STEP_RANGE`] (1e-6 to 1). Events do not depend
+    /// on it being small: they are looked for at points `event_spacing` apart at most.
     pub max_step: f64,
+    /// Largest interval between the points of each integrator step's dense output at which every event
+    /// function and the contact audit are evaluated \[s\] (also at least four points per step): an event
+    /// function that dips below zero and back for longer than this is caught. Default 0.01. In
+    /// [`EVENT_SPACING_RANGE`] (1e-6 to 1). `docs/model.md` section 4.
+    pub event_spacing: f64,
     /// Tolerance on located event times (root finding on the dense output) \[s\]. Default 1e-13. In
     /// [`EVENT_TIME_TOL_RANGE`] (1e-15 to 1e-9). `docs/model.md`, events.
     pub event_time_tol: f64,
@@ -182,6 +187,7 @@ impl Default for SolverOptions {
             rtol: 1e-10,
             atol: 1e-12,
             max_step: 0.04,
+            event_spacing: 0.01,
             event_time_tol: 1e-13,
             recontact_gap: 1e-11,
             stopper_gap: 1e-9,
@@ -213,6 +219,11 @@ impl SolverOptions {
         rules.single(within("atol", self.atol, ATOL_RANGE));
         rules.single(within("max_step", self.max_step, MAX_STEP_RANGE));
         rules.single(within(
+            "event_spacing",
+            self.event_spacing,
+            EVENT_SPACING_RANGE,
+        ));
+        rules.single(within(
             "event_time_tol",
             self.event_time_tol,
             EVENT_TIME_TOL_RANGE,
@@ -243,6 +254,9 @@ pub const ATOL_RANGE: [f64; 2] = [1e-16, 1e-3];
 /// Accepted range of `max_step` \[s\]: a step is ~2.7 s of motion; below 1e-6 s a walk takes millions of
 /// integrator steps per touchdown.
 pub const MAX_STEP_RANGE: [f64; 2] = [1e-6, 1.0];
+/// Accepted range of `event_spacing` \[s\]: the same as [`MAX_STEP_RANGE`]; a spacing longer than a step
+/// leaves the four points per step.
+pub const EVENT_SPACING_RANGE: [f64; 2] = [1e-6, 1.0];
 /// Accepted range of `event_time_tol` \[s\]: events are located on the dense output to this; at tip speeds of
 /// order 1 m/s, 1e-9 s is already a position error of the size of the grazing guards ([`GAP_RANGE`]), so a
 /// looser tolerance would change results silently; below 1e-15 s is below the rounding of the time itself.
@@ -294,6 +308,7 @@ mod tests {
             ("rtol", RTOL_RANGE),
             ("atol", ATOL_RANGE),
             ("max_step", MAX_STEP_RANGE),
+            ("event_spacing", EVENT_SPACING_RANGE),
             ("event_time_tol", EVENT_TIME_TOL_RANGE),
             ("recontact_gap", GAP_RANGE),
             ("stopper_gap", GAP_RANGE),

@@ -1,20 +1,16 @@
 //! The contact audit's per-step checks (docs/model.md section 7): the largest pulling force seen, tips below
-//! the ground on the dense output ([`PENETRATION_SAMPLES`] points per integrator step), and legs past their
-//! stoppers or compression stops.
+//! the ground on the dense output (at the event search's points, [`sample_count`] per integrator step), and
+//! legs past their stoppers or compression stops.
 
 use crate::contact::{Leg, Stop};
 use crate::dynamics::{swinging, Model, L3};
 use crate::integrate::DenseStep;
+use crate::params::SolverOptions;
 
-use super::events::{Forces, EVENT_SAMPLES};
+use super::events::{sample_count, Forces};
 use super::impact::{has_stop, has_stopper, stop_length};
 use super::phase::{unpack, WalkVector, NY};
 use super::report::ContactAudit;
-
-/// Number of points per integrator step (besides its start) at which the dense output is checked for tips
-/// below the ground: the event search's points, whose states the audit reuses (up to an event, the part of
-/// the step before it is sampled the same way).
-pub(crate) const PENETRATION_SAMPLES: usize = EVENT_SAMPLES;
 
 impl ContactAudit {
     /// The pulling force (or reaction) and the friction cone's excess seen at some instant of the step.
@@ -48,11 +44,20 @@ impl ContactAudit {
         }
     }
 
-    /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends).
-    pub(crate) fn see_dense(&mut self, model: &Model, step: &DenseStep<NY>, until: f64) {
+    /// Tips below the ground on the dense output of `step` up to `until` (not only at its ends), at points
+    /// `event_spacing` apart at most ([`sample_count`]: the event search's points, whose states the audit
+    /// reuses where no event cuts the step short).
+    pub(crate) fn see_dense(
+        &mut self,
+        model: &Model,
+        step: &DenseStep<NY>,
+        until: f64,
+        opts: &SolverOptions,
+    ) {
         let t0 = step.t0();
-        for i in 1..=PENETRATION_SAMPLES {
-            let t = t0 + (until - t0) * i as f64 / PENETRATION_SAMPLES as f64;
+        let n = sample_count(t0, until, opts.event_spacing);
+        for i in 1..=n {
+            let t = t0 + (until - t0) * i as f64 / n as f64;
             self.see_tips(model, &step.eval(t));
         }
     }

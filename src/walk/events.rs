@@ -33,10 +33,24 @@ pub(crate) const APPROACH_GAP: f64 = 1e-12;
 /// measurable work on a tip creeping the other way, large enough that rounding (~1e-16 m/s) cannot fire it.
 pub(crate) const SLIP_STOP_MARGIN: f64 = 1e-12;
 
-/// Number of equal sub-intervals of an integrator step at whose ends every event function (and the contact
-/// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step,
-/// however long the steps of a high-order integrator are.
+/// Fewest equal sub-intervals of an integrator step at whose ends every event function (and the contact
+/// audit's pulling force) is evaluated on the dense output: events are resolved to a quarter of a step at
+/// least, and to `event_spacing` ([`sample_count`]).
 pub(crate) const EVENT_SAMPLES: usize = 4;
+
+/// The number of equal sub-intervals of `[t0, t1]` at whose ends the event functions and the contact audit are
+/// evaluated: [`EVENT_SAMPLES`], or more where they would be longer than `spacing`.
+pub(crate) fn sample_count(t0: f64, t1: f64, spacing: f64) -> usize {
+    // A step of exactly `EVENT_SAMPLES` spacings (the default `max_step`'s of earlier versions, 0.04 s) keeps its
+    // four points whatever the rounding of the quotient.
+    let needed = ((t1 - t0) / spacing * (1.0 - 1e-12)).ceil();
+    // `t1 - t0 <= max_step <= 1` and `spacing >= 1e-6` (their validated ranges): at most 1e6 points.
+    if needed > EVENT_SAMPLES as f64 {
+        needed as usize
+    } else {
+        EVENT_SAMPLES
+    }
+}
 
 /// Kinds of events (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -366,6 +380,27 @@ impl<'a> EventSet<'a> {
                 e.floor = 0.0;
                 *value = raw;
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Four points per step at least, and none farther apart than the spacing: a step of exactly four spacings
+    /// (the default 0.04 s step at 0.01 s) keeps its four points whatever the rounding of the quotient.
+    #[test]
+    fn samples_are_at_most_a_spacing_apart() {
+        assert_eq!(sample_count(0.0, 0.04, 0.01), 4);
+        assert_eq!(sample_count(1.37, 1.37 + 0.04, 0.01), 4);
+        assert_eq!(sample_count(0.0, 0.001, 0.01), 4);
+        assert_eq!(sample_count(0.0, 0.16, 0.01), 16);
+        assert_eq!(sample_count(0.0, 0.161, 0.01), 17);
+        assert_eq!(sample_count(0.0, 1.0, 1e-6), 1_000_000);
+        for &(t0, t1, spacing) in &[(0.0, 0.3, 0.007), (2.5, 2.63, 0.01), (0.0, 1.0, 0.3)] {
+            let n = sample_count(t0, t1, spacing);
+            assert!(n >= EVENT_SAMPLES && (t1 - t0) / n as f64 <= spacing * (1.0 + 1e-12));
         }
     }
 }

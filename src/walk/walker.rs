@@ -13,7 +13,7 @@ use crate::params::SolverOptions;
 
 use super::contact_event::contact_event;
 use super::error::WalkError;
-use super::events::{EventKind, EventSet, Forces, EVENT_SAMPLES};
+use super::events::{sample_count, EventKind, EventSet, Forces};
 use super::impact::{
     close_unit, consistent_active_set, lock_swinging_leg, post_impact_candidates, touchdown_impact,
     touchdown_leg, TouchdownImpact, Unit,
@@ -382,7 +382,7 @@ struct StepSearch {
     /// The largest pulling force at that point.
     pull_next: Forces,
     /// The states at the sample points (all of them when no event cuts the step short).
-    sampled: [WalkVector; EVENT_SAMPLES],
+    sampled: Vec<WalkVector>,
 }
 
 impl<'a> Phases<'a> {
@@ -509,11 +509,11 @@ impl<'a> Phases<'a> {
             self.tally.see_slip(model, active, &step, t_end);
         }
         match hit {
-            // The same points see_dense would take (t0 + (t1 - t0) i / PENETRATION_SAMPLES), evaluated once.
+            // The same points see_dense would take, evaluated once.
             None => sampled
                 .iter()
                 .for_each(|y| self.tally.audit.see_tips(model, y)),
-            Some(_) => self.tally.audit.see_dense(model, &step, t_end),
+            Some(_) => self.tally.audit.see_dense(model, &step, t_end, self.opts),
         }
         if let Some(tr) = self.trajectory.as_deref_mut() {
             tr.record(model, &step, t_end, active, self.start);
@@ -532,25 +532,26 @@ impl<'a> Phases<'a> {
         }))
     }
 
-    /// The event search of stage 1. Events are looked for on [`EVENT_SAMPLES`] sub-intervals of the step's
-    /// dense output, the first one with a crossing first: an event function that dips below its floor and back
-    /// within a step is still caught if the dip is longer than a sub-interval. The pulling force at the sample
-    /// points before the last one goes to the contact audit.
+    /// The event search of stage 1. Events are looked for on [`sample_count`] equal sub-intervals of the
+    /// step's dense output (at least four, none longer than `event_spacing`), the first one with a crossing
+    /// first: an event function that dips below its floor and back within a step is still caught if the dip is
+    /// longer than a sub-interval. The pulling force at the sample points before the last one goes to the
+    /// contact audit.
     fn search_step(&mut self, step: &DenseStep<NY>) -> StepSearch {
         let opts = self.opts;
         let mut hit: Option<(f64, usize)> = None;
-        let (mut t_a, mut pull_next) = (step.t0(), Forces::NONE);
-        let mut g_next = Vec::new();
+        let (mut t_a, mut pull_next, mut g_next) = (step.t0(), Forces::NONE, Vec::new());
+        let n = sample_count(step.t0(), step.t1(), opts.event_spacing);
         // The states at the sample points, for the penetration audit when no event cuts the step short.
-        let mut sampled = [WalkVector::zeros(); EVENT_SAMPLES];
-        for (i, y_b) in (1..=EVENT_SAMPLES).zip(sampled.iter_mut()) {
-            let t_b = if i == EVENT_SAMPLES {
+        let mut sampled = Vec::with_capacity(n);
+        for i in 1..=n {
+            let t_b = if i == n {
                 step.t1()
             } else {
-                step.t0() + (step.t1() - step.t0()) * i as f64 / EVENT_SAMPLES as f64
+                step.t0() + (step.t1() - step.t0()) * i as f64 / n as f64
             };
-            *y_b = step.eval(t_b);
-            (g_next, pull_next) = self.events.values(y_b);
+            sampled.push(step.eval(t_b));
+            (g_next, pull_next) = self.events.values(&sampled[i - 1]);
             for (k, (&g_a, &g_b)) in self.g_prev.iter().zip(&g_next).enumerate() {
                 if g_a > 0.0 && g_b <= 0.0 {
                     let root_evals = Cell::new(0);
@@ -576,7 +577,7 @@ impl<'a> Phases<'a> {
             if hit.is_some() {
                 break;
             }
-            if i < EVENT_SAMPLES {
+            if i < n {
                 self.tally.audit.see_force(pull_next);
                 self.g_prev = std::mem::take(&mut g_next);
             }
