@@ -4,7 +4,8 @@
 //! A continuation step from the gait `s0` at `v0` to `v1` is accepted only if Newton's method from `s0` converges
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within `SAME_GAIT_TOL`).
 //! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
-//! or the family folds between `v0` and `v1`): a jump is not reversible. A step that fails is halved (and the
+//! or the family folds between `v0` and `v1`): a jump is not reversible. The way back is answered after one
+//! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`Continuation::first_newton_step`). A step that fails is halved (and the
 //! step after a failure that works halves the next, which bisects toward an end), so a family is followed in
 //! shrinking steps until it is reached or its end is bracketed to `PARAM_TOL`. Where Newton's method fails at
 //! the finest step, or `WALK_AFTER_FAILURES` times in a row (and every `WALK_AFTER_FAILURES` failures after
@@ -35,7 +36,7 @@ use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
 use super::step_map::StepMap;
 use crate::dynamics::Model;
 use crate::params::Config;
-use crate::walk::{SectionState, Walker};
+use crate::walk::{SectionState, Walker, SECTION_COORDINATES};
 
 /// The way back of a continuation step ends early where the first step of Newton's method lands this close to
 /// the gait the step came from (`Continuation::first_newton_step`): a tenth of [`SAME_GAIT_TOL`].
@@ -135,7 +136,7 @@ pub(crate) struct Tangent {
     /// Where it holds.
     pub(crate) at: f64,
     /// `ds*/dp` per coordinate.
-    pub(crate) rates: [f64; 4],
+    pub(crate) rates: [f64; SECTION_COORDINATES.len()],
 }
 
 impl Tangent {

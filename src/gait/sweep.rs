@@ -28,7 +28,7 @@ use super::step_map::{free_coordinates, StepMap};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
 use crate::fmt::short;
 use crate::params::{Config, ConfigError, SolverOptions};
-use crate::walk::SectionState;
+use crate::walk::{SectionState, SECTION_COORDINATES};
 
 /// The most points a sweep may have.
 pub const MAX_SWEEP_POINTS: usize = 100_000;
@@ -277,7 +277,7 @@ pub(crate) fn family_tangent(config: &Config, param: &str, from: f64, g: &Gait) 
     let rates = (DMatrix::identity(n, n) - dp)
         .lu()
         .solve(&DVector::from_column_slice(&d.values))?;
-    let mut full = [0.0; 4];
+    let mut full = [0.0; SECTION_COORDINATES.len()];
     for (k, &i) in free.iter().enumerate() {
         full[i] = rates[k];
     }
