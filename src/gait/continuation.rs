@@ -5,11 +5,11 @@
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within `SAME_GAIT_TOL`).
 //! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
 //! or the family folds between `v0` and `v1`): a jump is not reversible. The way back is answered after one
-//! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`Continuation::first_newton_step`). A step that fails is halved (and the
-//! step after a failure that works halves the next, which bisects toward an end), so a family is followed in
-//! shrinking steps until it is reached or its end is bracketed to `PARAM_TOL`. Where Newton's method fails at
-//! the finest step, or `WALK_AFTER_FAILURES` times in a row (and every `WALK_AFTER_FAILURES` failures after
-//! that), steps are also tried by walking instead
+//! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`Continuation::first_newton_step`).
+//! A step that fails is halved (and the step after a failure that works halves the next, which bisects toward
+//! an end), so a family is followed in shrinking steps until it is reached or its end is bracketed to
+//! `PARAM_TOL`. Where Newton's method fails at the finest step, or `WALK_AFTER_FAILURES` times in a row (and
+//! every `WALK_AFTER_FAILURES` failures after that), steps are also tried by walking instead
 //! (`Continuation::walk_step`), since the step map is only piecewise smooth. A family of period-k gaits is
 //! followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
 //!

@@ -349,7 +349,8 @@ pub(crate) fn gait_at_converged(
     let may_move = (params.min_length > 0.0 && !s.rear_held(map.model()))
         || (params.has_friction() && !s.slips());
     let on = map.on_section_of(s);
-    let converged = (!may_move && options.validate().is_ok())
+    let checked = options.validate().is_ok() && friction_admits_gaits(params).is_ok();
+    let converged = (!may_move && checked)
         .then(|| gait_jacobian(map, s, options.parameter, options.estimates()).ok())
         .flatten()
         .and_then(|j| {

@@ -452,8 +452,7 @@ fn sorted(mut pair: [f64; 2]) -> [f64; 2] {
 
 /// Brent on `q(gait(v))` between the sweep points `a` and `b`, continuing from `a`'s gait: Newton's method at
 /// each `v` starts from the gait found at the value nearest to `v` so far (`a`'s at first), carried to `v`, so
-/// that as Brent's brackets shrink its starts come within Newton's tolerance of the gait (an evaluation or two
-/// each instead of three to five).
+/// that as Brent's brackets shrink its starts come closer to the gait.
 fn refine_root(
     config: &Config,
     spec: &SweepSpec,
