@@ -346,8 +346,7 @@ pub(crate) fn gait_at_converged(
     jacobian_guess: Option<&DMatrix<f64>>,
 ) -> Result<Gait, GaitError> {
     let params = map.model().params();
-    let may_move = (params.min_length > 0.0 && !s.rear_held(map.model()))
-        || (params.has_friction() && !s.slips());
+    let may_move = first_step_may_move(map, s) != (false, false);
     let on = map.on_section_of(s);
     let checked = options.validate().is_ok() && friction_admits_gaits(params).is_ok();
     let converged = (!may_move && checked)
@@ -439,6 +438,17 @@ pub(crate) fn friction_admits_gaits(params: &Params) -> Result<(), GaitError> {
     Ok(())
 }
 
+/// May the first step of Newton's method from `s` move it, onto the held set (`s` not held where the model has
+/// a compression stop) or onto the slipping section (`s` at rest where the model has Coulomb friction)? See
+/// [`solve_fixed_point_asking`].
+fn first_step_may_move(map: &StepMap, s: &SectionState) -> (bool, bool) {
+    let params = map.model().params();
+    (
+        params.min_length > 0.0 && !s.rear_held(map.model()),
+        params.has_friction() && !s.slips(),
+    )
+}
+
 /// The fixed point alone (no Jacobian at the end): what threshold searches need.
 pub(crate) fn solve_fixed_point(
     map: &StepMap,
@@ -492,8 +502,7 @@ pub(crate) fn solve_fixed_point_asking(
     // slips: the map then has the slip velocity as a coordinate (the first step is walked on the map that
     // has it, which accepts either).
     let mut first_step = None;
-    let held_may_start = map.model().params().min_length > 0.0 && !s.rear_held(map.model());
-    let slip_may_start = map.model().params().has_friction() && !s.slips();
+    let (held_may_start, slip_may_start) = first_step_may_move(map, &s);
     if held_may_start || slip_may_start {
         if let Ok(first) = map.clone().with_slip(true).eval(&s) {
             let held = held_may_start && first.next.rear_held(map.model());

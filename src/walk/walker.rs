@@ -359,6 +359,9 @@ struct Phases<'a> {
     events: EventSet<'a>,
     /// Event values at the integrator's current point.
     g_prev: Vec<f64>,
+    /// The states at the event search's points of the last integrator step (all of them when no event cut the
+    /// step short), for the penetration audit: one buffer for every step.
+    sampled: Vec<WalkVector>,
     /// Crossings, root evaluations, events and impacts so far (the integrator counts its own work).
     work: WorkCounts,
 }
@@ -381,8 +384,6 @@ struct StepSearch {
     g_next: Vec<f64>,
     /// The largest pulling force at that point.
     pull_next: Forces,
-    /// The states at the sample points (all of them when no event cuts the step short).
-    sampled: Vec<WalkVector>,
 }
 
 impl<'a> Phases<'a> {
@@ -430,6 +431,7 @@ impl<'a> Phases<'a> {
             solver,
             events,
             g_prev,
+            sampled: Vec::new(),
             work: WorkCounts::ZERO,
         }
     }
@@ -496,7 +498,6 @@ impl<'a> Phases<'a> {
             hit,
             mut g_next,
             pull_next,
-            sampled,
         } = self.search_step(&step);
         let t_end = hit.map_or(step.t1(), |(t_hit, _)| t_hit);
         if active.double_support() {
@@ -510,7 +511,8 @@ impl<'a> Phases<'a> {
         }
         match hit {
             // The same points see_dense would take, evaluated once.
-            None => sampled
+            None => self
+                .sampled
                 .iter()
                 .for_each(|y| self.tally.audit.see_tips(model, y)),
             Some(_) => self.tally.audit.see_dense(model, &step, t_end, self.opts),
@@ -542,16 +544,15 @@ impl<'a> Phases<'a> {
         let mut hit: Option<(f64, usize)> = None;
         let (mut t_a, mut pull_next, mut g_next) = (step.t0(), Forces::NONE, Vec::new());
         let n = sample_count(step.t0(), step.t1(), opts.event_spacing);
-        // The states at the sample points, for the penetration audit when no event cuts the step short.
-        let mut sampled = Vec::with_capacity(n);
+        self.sampled.clear();
         for i in 1..=n {
             let t_b = if i == n {
                 step.t1()
             } else {
                 step.t0() + (step.t1() - step.t0()) * i as f64 / n as f64
             };
-            sampled.push(step.eval(t_b));
-            (g_next, pull_next) = self.events.values(&sampled[i - 1]);
+            self.sampled.push(step.eval(t_b));
+            (g_next, pull_next) = self.events.values(&self.sampled[i - 1]);
             for (k, (&g_a, &g_b)) in self.g_prev.iter().zip(&g_next).enumerate() {
                 if g_a > 0.0 && g_b <= 0.0 {
                     let root_evals = Cell::new(0);
@@ -587,7 +588,6 @@ impl<'a> Phases<'a> {
             hit,
             g_next,
             pull_next,
-            sampled,
         }
     }
 
