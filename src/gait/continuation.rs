@@ -8,7 +8,8 @@
 //! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`Continuation::first_newton_step`).
 //! A step that fails is halved (and the step after a failure that works halves the next, which bisects toward
 //! an end), so a family is followed in shrinking steps until it is reached or its end is bracketed to
-//! `PARAM_TOL`. Where Newton's method fails at the finest step, or `WALK_AFTER_FAILURES` times in a row (and
+//! `PARAM_TOL`; where the wheel is about to roll back at the end, the end is extrapolated instead
+//! (`end_search.rs`). Where Newton's method fails at the finest step, or `WALK_AFTER_FAILURES` times in a row (and
 //! every `WALK_AFTER_FAILURES` failures after that), steps are also tried by walking instead
 //! (`Continuation::walk_step`), since the step map is only piecewise smooth. A family of period-k gaits is
 //! followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
@@ -30,6 +31,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::derivative::newton_jacobian;
+use super::end_search::EndSearch;
 use super::limit_cycle::{solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitOptions};
 pub(crate) use super::periodicity::SAME_GAIT_TOL;
 use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
@@ -196,6 +198,14 @@ pub enum Followed {
     },
 }
 
+/// A verified continuation step: the gait reached, and the smallest `dtheta/dt` of its step where the family
+/// is of period 1 (what its end is extrapolated from: [`EndSearch`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Verified {
+    point: FamilyPoint,
+    slowest: Option<f64>,
+}
+
 /// Why a continuation step failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum StepFailure {
@@ -309,7 +319,9 @@ impl<'a> Continuation<'a> {
         value: f64,
         guess: Option<&DMatrix<f64>>,
     ) -> Option<FamilyPoint> {
-        self.step_asking(from, value, guess, false).ok()
+        self.step_asking(from, value, guess, false)
+            .ok()
+            .map(|v| v.point)
     }
 
     /// [`Continuation::step_asking`] from the start `tangent` predicts (see the module documentation), and
@@ -320,7 +332,7 @@ impl<'a> Continuation<'a> {
         value: f64,
         (guess, tangent): (Option<&DMatrix<f64>>, Option<&Tangent>),
         undamped: bool,
-    ) -> Result<FamilyPoint, StepFailure> {
+    ) -> Result<Verified, StepFailure> {
         // `min_length` moves a held state with the parameter itself (`carried_start`): no predictor there. Nor
         // for a period-k family: its fixed points of `P^k` include the period-1 gait where the period-k orbit
         // collapses onto it (a bounce that vanishes at `lambda_2+ = 0`), and a predicted start carries the
@@ -349,7 +361,7 @@ impl<'a> Continuation<'a> {
         value: f64,
         guess: Option<&DMatrix<f64>>,
         undamped: bool,
-    ) -> Result<FamilyPoint, StepFailure> {
+    ) -> Result<Verified, StepFailure> {
         let start = self.start_from(from, value);
         self.step_from(from, value, (guess, undamped), (start, None))
     }
@@ -362,7 +374,7 @@ impl<'a> Continuation<'a> {
         value: f64,
         (guess, undamped): (Option<&DMatrix<f64>>, bool),
         (start, back): (SectionState, Option<&Tangent>),
-    ) -> Result<FamilyPoint, StepFailure> {
+    ) -> Result<Verified, StepFailure> {
         // Newton's method asks for its matrix once the map is evaluated at the start.
         let mut started = false;
         let forward = self.solve(
@@ -385,6 +397,10 @@ impl<'a> Continuation<'a> {
             value,
             section: forward.section,
         };
+        let verified = Verified {
+            point: reached,
+            slowest: (self.period == 1).then_some(forward.outcome.report.slowest),
+        };
         let back_start = back
             .and_then(|t| t.predict(&reached, from.value))
             .unwrap_or_else(|| self.start_from(&reached, from.value));
@@ -392,13 +408,13 @@ impl<'a> Continuation<'a> {
             .first_newton_step(from.value, &back_start, guess)
             .is_some_and(|landing| landing.distance(&from.section) <= EARLY_RETURN_TOL)
         {
-            return Ok(reached);
+            return Ok(verified);
         }
         let back = self
             .solve(from.value, &back_start, &mut || guess.cloned(), undamped)
             .map_err(|_| StepFailure::Newton)?;
         if back.section.distance(&from.section) <= SAME_GAIT_TOL {
-            Ok(reached)
+            Ok(verified)
         } else {
             Err(StepFailure::Newton)
         }
@@ -485,7 +501,8 @@ impl<'a> Continuation<'a> {
     /// is retried once with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere;
     /// not a step whose walk fails at its start, where no matrix helps), a retry that fails as soon as it must
     /// damp a Newton step taken with `DP` at its iterate, then halved; a
-    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end). At
+    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end), unless
+    /// the end is extrapolated from the gaits' smallest `dtheta/dt` ([`EndSearch`]). At
     /// most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
     /// ([`Followed::GaveUp`]).
     pub(crate) fn follow(
@@ -519,6 +536,8 @@ impl<'a> Continuation<'a> {
         let mut newton_failures = 0;
         // Steps tried by walking.
         let mut walks = 0;
+        let mut end = EndSearch::default();
+        end.verified(from.value, None);
         loop {
             let remaining = target - current.value;
             if remaining == 0.0 {
@@ -531,13 +550,13 @@ impl<'a> Continuation<'a> {
                 };
             }
             steps += 1;
-            let next_value = if h.abs() >= remaining.abs() {
-                target
-            } else {
-                current.value + h
+            let next_value = match end.aim(end_tol) {
+                Some(v) => v,
+                None if h.abs() >= remaining.abs() => target,
+                None => current.value + h,
             };
             let matrix = jac.as_ref().map(|(_, j)| j);
-            let mut next = match self.step_predicted(
+            let next = match self.step_predicted(
                 &current,
                 next_value,
                 (matrix, tangent.as_ref()),
@@ -565,6 +584,10 @@ impl<'a> Continuation<'a> {
                 }
                 Err(_) => None,
             };
+            let mut next = next.map(|v| {
+                end.verified(v.point.value, v.slowest);
+                v.point
+            });
             let at_end = (next_value - current.value).abs() <= end_tol;
             // Where Newton's method fails at the finest step, or at WALK_AFTER_FAILURES halvings in a row (and at
             // every WALK_AFTER_FAILURES-th one after that; once a walk works, through every halving of a walking
@@ -579,6 +602,9 @@ impl<'a> Continuation<'a> {
                 && newton_failures % WALK_AFTER_FAILURES == 0;
             if next.is_none() && (walking || at_end || walk_due) {
                 next = self.walk_step(&current, next_value);
+                if let Some(p) = &next {
+                    end.verified(p.value, None);
+                }
                 walks += 1;
                 walking = walking || next.is_some();
             } else if next.is_some() {
@@ -603,6 +629,7 @@ impl<'a> Continuation<'a> {
                     }
                 }
                 None => {
+                    end.failed(next_value);
                     h = 0.5 * (next_value - current.value);
                     failed_before = true;
                 }

@@ -5,6 +5,7 @@
 pub mod basin;
 pub mod continuation;
 pub(crate) mod derivative;
+pub(crate) mod end_search;
 pub(crate) mod grid;
 pub(crate) mod limit_cycle;
 pub mod map;

@@ -1,6 +1,7 @@
 //! The events of a phase (docs/model.md section 4): their kinds, the event functions, the grazing guards that
 //! arm them, and the constants of the event search ([`EVENT_SAMPLES`], [`FORCE_EVENT_MARGIN`],
-//! [`APPROACH_GAP`]). The table of event functions is in the [module documentation](super).
+//! [`APPROACH_GAP`]), and what the search over one integrator step finds ([`StepSearch`], [`Hit`]). The table of
+//! event functions is in the [module documentation](super).
 
 use crate::contact::{
     cone_distance, cone_excess, constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics,
@@ -138,6 +139,26 @@ impl Forces {
         pull: 0.0,
         cone: 0.0,
     };
+}
+
+/// An event located in an integrator step.
+pub(super) struct Hit {
+    /// When \[s\].
+    pub(super) time: f64,
+    /// Which event of the phase's [`EventSet`].
+    pub(super) index: usize,
+    /// The state then, on the step's dense output.
+    pub(super) y: WalkVector,
+}
+
+/// The event search over one integrator step (`Phases::search_step` in `walker.rs`).
+pub(super) struct StepSearch {
+    /// The earliest crossing `(time, event index)`, if any.
+    pub(super) hit: Option<(f64, usize)>,
+    /// Event values at the last sample point evaluated.
+    pub(super) g_next: Vec<f64>,
+    /// The largest pulling force at that point.
+    pub(super) pull_next: Forces,
 }
 
 /// Event functions of one phase.

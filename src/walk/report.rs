@@ -154,6 +154,12 @@ pub struct StepReport {
     /// Contact audit (its fields are flattened into the step's JSON record).
     #[serde(flatten)]
     pub contact: ContactAudit,
+    /// The smallest `dtheta/dt` in the step \[rad/s\]: at a local minimum, the vertex of the parabola through
+    /// the event search's three points around it. Near a family's end where the wheel rolls back, it falls to
+    /// zero as a smooth function of the parameter: the family's ends are extrapolated with it. Not written to
+    /// the outputs.
+    #[serde(skip)]
+    pub slowest: f64,
 }
 
 impl StepReport {

@@ -32,6 +32,54 @@ pub(super) struct StepTally {
     pub(super) friction_loss: f64,
     /// Events handled so far.
     pub(super) events: usize,
+    /// The smallest `dtheta/dt` so far.
+    pub(super) slowest: Slowest,
+}
+
+/// The smallest `dtheta/dt` of a step \[rad/s\], from the points the event search evaluates: at a local minimum
+/// inside a phase, the vertex of the parabola through the lowest point and its two neighbours, so that it is a
+/// smooth function of the start as long as that minimum is (near a family's end where the wheel rolls back, it
+/// falls to zero there; [`crate::walk::StepReport::slowest`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Slowest {
+    /// The smallest value so far.
+    pub(super) value: f64,
+    /// The last two points `(t, dtheta/dt)` of the phase in progress.
+    last: [Option<(f64, f64)>; 2],
+}
+
+impl Default for Slowest {
+    fn default() -> Slowest {
+        Slowest {
+            value: f64::INFINITY,
+            last: [None, None],
+        }
+    }
+}
+
+impl Slowest {
+    /// A phase starts at time `t` with `dtheta/dt = v` (after an impact, `dtheta/dt` may have jumped).
+    pub(super) fn begin_phase(&mut self, t: f64, v: f64) {
+        self.last = [None, None];
+        self.see(t, v);
+    }
+
+    /// The phase in progress has `dtheta/dt = v` at time `t` (later than the points seen before).
+    pub(super) fn see(&mut self, t: f64, v: f64) {
+        self.value = self.value.min(v);
+        if let [Some((t0, v0)), Some((t1, v1))] = self.last {
+            if v1 <= v0 && v1 <= v && t0 < t1 && t1 < t {
+                // p(s) = v1 + b (s - t1) + c (s - t1)^2 through the three points (divided differences).
+                let (d01, d12) = ((v1 - v0) / (t1 - t0), (v - v1) / (t - t1));
+                let c = (d12 - d01) / (t - t0);
+                let b = d01 + c * (t1 - t0);
+                if c > 0.0 {
+                    self.value = self.value.min(v1 - b * b / (4.0 * c));
+                }
+            }
+        }
+        self.last = [self.last[1], Some((t, v))];
+    }
 }
 
 impl StepTally {
@@ -133,4 +181,29 @@ fn slip_work(model: &Model, active: ActiveSet, step: &DenseStep<NY>, until: f64)
         largest = largest.max(power);
     }
     (-half * work, largest.max(0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The smallest value of a parabola sampled off its vertex is its vertex's, exactly (up to rounding), from
+    /// unequally spaced points; a phase that starts after a jump counts with its own points: no parabola is
+    /// drawn across the jump.
+    #[test]
+    fn the_smallest_dtheta_dt_is_refined_to_the_vertex() {
+        let f = |t: f64| 2.0 * (t - 0.337).powi(2) + 0.25;
+        let mut slowest = Slowest::default();
+        slowest.begin_phase(0.0, f(0.0));
+        for t in [0.1, 0.2, 0.31, 0.4, 0.45, 0.6] {
+            slowest.see(t, f(t));
+        }
+        assert!((slowest.value - 0.25).abs() < 1e-15, "{}", slowest.value);
+        let mut jumped = Slowest::default();
+        jumped.begin_phase(0.0, 3.0);
+        jumped.see(0.1, 2.0);
+        jumped.begin_phase(0.2, 1.9);
+        jumped.see(0.3, 2.5);
+        assert_eq!(jumped.value, 1.9);
+    }
 }

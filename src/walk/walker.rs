@@ -13,7 +13,7 @@ use crate::params::SolverOptions;
 
 use super::contact_event::contact_event;
 use super::error::WalkError;
-use super::events::{sample_count, EventKind, EventSet, Forces};
+use super::events::{sample_count, EventKind, EventSet, Forces, Hit, StepSearch};
 use super::impact::{
     close_unit, consistent_active_set, lock_swinging_leg, post_impact_candidates, touchdown_impact,
     touchdown_leg, TouchdownImpact, Unit,
@@ -316,6 +316,7 @@ impl<'m> Walker<'m> {
                 reset: reindexed.as_ref().map_or(0.0, |r| r.3),
             },
             contact: tally.audit,
+            slowest: tally.slowest.value,
         };
         match reindexed {
             Ok((q_new, qd_new, before, _)) => {
@@ -366,26 +367,6 @@ struct Phases<'a> {
     work: WorkCounts,
 }
 
-/// An event located in an integrator step.
-struct Hit {
-    /// When \[s\].
-    time: f64,
-    /// Which event of the phase's [`EventSet`].
-    index: usize,
-    /// The state then, on the step's dense output.
-    y: WalkVector,
-}
-
-/// The event search over one integrator step ([`Phases::search_step`]).
-struct StepSearch {
-    /// The earliest crossing `(time, event index)`, if any.
-    hit: Option<(f64, usize)>,
-    /// Event values at the last sample point evaluated.
-    g_next: Vec<f64>,
-    /// The largest pulling force at that point.
-    pull_next: Forces,
-}
-
 impl<'a> Phases<'a> {
     /// Start the first phase at `(start.time, y)` with `active`, right after the touchdown impact.
     fn start(
@@ -416,6 +397,7 @@ impl<'a> Phases<'a> {
         let (g_prev, pull) = events.values(&y);
         tally.audit.see_force(pull);
         tally.audit.see_tips(model, &y);
+        tally.slowest.begin_phase(t, y[NQ + THETA]);
         Phases {
             model,
             opts,
@@ -578,6 +560,7 @@ impl<'a> Phases<'a> {
             if hit.is_some() {
                 break;
             }
+            self.tally.slowest.see(t_b, self.sampled[i - 1][NQ + THETA]);
             if i < n {
                 self.tally.audit.see_force(pull_next);
                 self.g_prev = std::mem::take(&mut g_next);
@@ -601,6 +584,7 @@ impl<'a> Phases<'a> {
         self.t = t;
         self.y = hit.y;
         let (q, qd) = unpack(&self.y);
+        self.tally.slowest.see(t, qd[THETA]);
         self.tally.audit.see_force(self.events.values(&self.y).1);
         let kind = self.events.events[hit.index].kind;
         self.work.events.count(kind);
@@ -703,6 +687,7 @@ impl<'a> Phases<'a> {
         let pull;
         (self.g_prev, pull) = self.events.values(&self.y);
         self.tally.audit.see_force(pull);
+        self.tally.slowest.begin_phase(self.t, self.y[NQ + THETA]);
         if let Some(tr) = self.trajectory.as_deref_mut() {
             tr.push(model, self.t, &self.y, active, self.start);
         }
