@@ -8,8 +8,8 @@
 //! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`Continuation::first_newton_step`).
 //! A step that fails is halved (and the step after a failure that works halves the next, which bisects toward
 //! an end), so a family is followed in shrinking steps until it is reached or its end is bracketed to
-//! `PARAM_TOL`; where the wheel is about to roll back at the end, the end is extrapolated instead
-//! (`end_search.rs`). Where Newton's method fails at the finest step, or `WALK_AFTER_FAILURES` times in a row (and
+//! `PARAM_TOL`; where the wheel is about to roll back at the end, or a DLS indicator vanishes there, the end is
+//! extrapolated instead (`end_search.rs`). Where Newton's method fails at the finest step, or `WALK_AFTER_FAILURES` times in a row (and
 //! every `WALK_AFTER_FAILURES` failures after that), steps are also tried by walking instead
 //! (`Continuation::walk_step`), since the step map is only piecewise smooth. A family of period-k gaits is
 //! followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
@@ -31,7 +31,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::derivative::newton_jacobian;
-use super::end_search::EndSearch;
+use super::end_search::{gauges, EndSearch, Gauges};
 use super::limit_cycle::{solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitOptions};
 pub(crate) use super::periodicity::SAME_GAIT_TOL;
 use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
@@ -198,12 +198,12 @@ pub enum Followed {
     },
 }
 
-/// A verified continuation step: the gait reached, and the smallest `dtheta/dt` of its step where the family
-/// is of period 1 (what its end is extrapolated from: [`EndSearch`]).
+/// A verified continuation step: the gait reached, and its [`Gauges`] where the family is of period 1 (what
+/// its end is extrapolated from: [`EndSearch`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Verified {
     point: FamilyPoint,
-    slowest: Option<f64>,
+    gauges: Option<Gauges>,
 }
 
 /// Why a continuation step failed.
@@ -399,7 +399,7 @@ impl<'a> Continuation<'a> {
         };
         let verified = Verified {
             point: reached,
-            slowest: (self.period == 1).then_some(forward.outcome.report.slowest),
+            gauges: (self.period == 1).then(|| gauges(&forward.outcome.report)),
         };
         let back_start = back
             .and_then(|t| t.predict(&reached, from.value))
@@ -502,7 +502,7 @@ impl<'a> Continuation<'a> {
     /// not a step whose walk fails at its start, where no matrix helps), a retry that fails as soon as it must
     /// damp a Newton step taken with `DP` at its iterate, then halved; a
     /// step that works lets the next one double, or halve right after a failure (bisecting toward the end), unless
-    /// the end is extrapolated from the gaits' smallest `dtheta/dt` ([`EndSearch`]). At
+    /// the end is extrapolated from the gaits' smallest `dtheta/dt` or DLS indicators ([`EndSearch`]). At
     /// most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
     /// ([`Followed::GaveUp`]).
     pub(crate) fn follow(
@@ -585,7 +585,7 @@ impl<'a> Continuation<'a> {
                 Err(_) => None,
             };
             let mut next = next.map(|v| {
-                end.verified(v.point.value, v.slowest);
+                end.verified(v.point.value, v.gauges);
                 v.point
             });
             let at_end = (next_value - current.value).abs() <= end_tol;

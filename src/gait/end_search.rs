@@ -1,29 +1,54 @@
-//! Where a family ends because the wheel is about to roll back, the end extrapolated from the family's own
-//! gaits instead of bisected (docs/model.md section 6, "Sweeps").
+//! Where a family ends because the wheel is about to roll back, or at a border where a DLS indicator vanishes,
+//! the end extrapolated from the family's own gaits instead of bisected (docs/model.md section 6, "Sweeps").
 //!
-//! Along such a family the smallest `dtheta/dt` of the gait's step, `g` ([`crate::walk::StepReport::slowest`]),
-//! falls to zero at the end: past it the walk rolls back. Near the end it behaves as a power of the distance,
-//! `g ~ A |v_end - v|^p`, with an exponent that depends on how the minimum meets zero (1 for a smooth minimum,
-//! about 0.6 on the default map's ends), so the power law through the last three verified gaits (the secant
-//! through the last two where that fails) estimates `v_end`, and the next continuation step aims just short of
-//! the estimate, by the estimate's own last change. Steps still verify everything: the reported end remains
-//! the last verified gait and the first value not reached, at most the tolerance apart. Where no estimate
-//! falls inside that bracket (the family ends for another reason: a fold, a border where the map jumps), or
-//! after [`MAX_EXTRAPOLATED`] extrapolated steps, the continuation bisects as before.
+//! Such ends are zeros of a quantity every verified gait carries (its [`Gauges`]): the smallest `dtheta/dt` of
+//! the gait's step ([`crate::walk::StepReport::slowest`]) falls to zero where the wheel is about to roll back
+//! (past it the walk rolls back), a DLS indicator where the map changes branch and the family with it (the
+//! period-1 DLS gait ends at `lambda_2+ = 0`, where Leg 1 starts to bounce). Near the end each behaves as a
+//! power of the distance, `g ~ A |v_end - v|^p`, with an exponent that depends on how the quantity meets zero
+//! (1 for an indicator or a smooth minimum, about 0.6 was seen for the smallest `dtheta/dt` on the default
+//! map's ends), so the power law through the last three verified gaits (the secant through the last two where
+//! that fails) estimates `v_end`; the nearest estimate inside the bracket is taken, and the next continuation
+//! step aims just short of it, by the estimate's own last change. Steps still verify everything: the reported
+//! end remains the last verified gait and the first value not reached, at most the tolerance apart. Where no
+//! estimate falls inside that bracket (the family ends for another reason: a fold, a grazing event), or after
+//! [`MAX_EXTRAPOLATED`] extrapolated steps, the continuation bisects as before. An estimate at the zero of an
+//! indicator that does not end the family costs a few steps: the gait past it has the indicator's other sign,
+//! and the indicator no longer counts.
+
+use crate::walk::StepReport;
 
 /// Most continuation steps one [`EndSearch`] aims by extrapolation. Near a roll-back end of the default map
 /// the bracket closes in four to eight of them; an end that has not closed by then is bisected.
 pub(crate) const MAX_EXTRAPOLATED: usize = 12;
 
-/// Where a followed family ends: its last verified gaits with their smallest `dtheta/dt`, the nearest value
-/// past them not reached, and the last estimate of the end (see the module documentation).
+/// How many quantities a gait carries whose zero may end its family.
+const GAUGE_COUNT: usize = 4;
+
+/// The quantities of a gait whose zero may end its family: the smallest `dtheta/dt` of its step \[rad/s\]
+/// and its DLS indicators `lambda_I4`, `lambda_2+`, `lambda_4+` \[N s\].
+pub(crate) type Gauges = [f64; GAUGE_COUNT];
+
+/// The [`Gauges`] of the gait whose step `report` describes.
+pub(crate) fn gauges(report: &StepReport) -> Gauges {
+    let i = &report.indicators;
+    [
+        report.slowest,
+        i.lambda_i4,
+        i.lambda_2_plus,
+        i.lambda_4_plus,
+    ]
+}
+
+/// Where a followed family ends: its last verified gaits with their [`Gauges`], the nearest value past them not
+/// reached, and the last estimate of the end (see the module documentation).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct EndSearch {
     /// The last verified gait's value.
     last: Option<f64>,
-    /// The last verified gaits whose smallest `dtheta/dt` is known, oldest first: `(value, smallest
-    /// dtheta/dt)`, at most three, none before a gait where it is not known.
-    points: Vec<(f64, f64)>,
+    /// The last verified gaits whose gauges are known, oldest first: `(value, gauges)`, at most three, none
+    /// before a gait where they are not known.
+    points: Vec<(f64, Gauges)>,
     /// The nearest value past the last verified gait that a step did not reach.
     beyond: Option<f64>,
     /// The last estimate of the end.
@@ -33,9 +58,9 @@ pub(crate) struct EndSearch {
 }
 
 impl EndSearch {
-    /// A step reached the gait at `value`, whose smallest `dtheta/dt` is `slowest` (`None` where it is not known:
-    /// a step by walking, a period-k family; the gaits before it are then forgotten).
-    pub(crate) fn verified(&mut self, value: f64, slowest: Option<f64>) {
+    /// A step reached the gait at `value`, whose gauges are `gauges` (`None` where they are not known: a step
+    /// by walking, a period-k family; the gaits before it are then forgotten).
+    pub(crate) fn verified(&mut self, value: f64, gauges: Option<Gauges>) {
         if let (Some(a), Some(b)) = (self.last, self.beyond) {
             // A step past a value not reached before (a Newton failure, not an end): the bracket is gone.
             if (value - a) * (b - value) <= 0.0 {
@@ -43,7 +68,7 @@ impl EndSearch {
             }
         }
         self.last = Some(value);
-        match slowest.filter(|g| g.is_finite()) {
+        match gauges {
             Some(g) => {
                 if self.points.len() == 3 {
                     self.points.remove(0);
@@ -80,17 +105,19 @@ impl EndSearch {
             return None;
         }
         let (&(a, _), b) = (self.points.last()?, self.beyond?);
-        if self.last != Some(a) {
+        if self.last != Some(a) || (b - a).abs() <= tol {
             return None;
         }
         let inside = |v: f64| v.is_finite() && (v - a) * (b - v) > 0.0;
-        let e = [self.power_law(b), self.secant()]
-            .into_iter()
-            .flatten()
-            .find(|&v| inside(v))?;
-        if (b - a).abs() <= tol {
-            return None;
-        }
+        let e = (0..GAUGE_COUNT)
+            .filter_map(|k| {
+                let series = self.falling(k)?;
+                [power_law(&series, b), secant(&series)]
+                    .into_iter()
+                    .flatten()
+                    .find(|&v| inside(v))
+            })
+            .min_by(|x, y| (x - a).abs().total_cmp(&(y - a).abs()))?;
         let toward = (b - a).signum();
         let guard = self
             .previous
@@ -106,59 +133,80 @@ impl EndSearch {
         Some(e - toward * short)
     }
 
-    /// The end `e` of the power law `g = A |e - v|^p` through the last three gaits (`g` the smallest
-    /// `dtheta/dt`, falling toward the end), where it lies between the last gait and `b`. Near a roll-back end
-    /// that law holds with an exponent that depends on how the minimum meets zero, so `A`, `p` and `e` are all
-    /// fitted: `e` is the root of `ln(g0/g1) ln((e-v1)/(e-v2)) = ln(g1/g2) ln((e-v0)/(e-v1))`, found by
-    /// bisection (the left side minus the right is `+inf` just past `v2`).
-    fn power_law(&self, b: f64) -> Option<f64> {
-        let [(v0, g0), (v1, g1), (v2, g2)] = self.points[..] else {
-            return None;
-        };
-        let toward = (b - v2).signum();
-        let (x0, x1, x2, xb) = (toward * v0, toward * v1, toward * v2, toward * b);
-        if !(g0 > g1 && g1 > g2 && g2 > 0.0 && x0 < x1 && x1 < x2 && x2 < xb) {
-            return None;
-        }
-        let (l01, l12) = ((g0 / g1).ln(), (g1 / g2).ln());
-        let r = |x: f64| l01 * ((x - x1) / (x - x2)).ln() - l12 * ((x - x0) / (x - x1)).ln();
-        if r(xb).is_nan() || r(xb) >= 0.0 {
-            return None;
-        }
-        let (mut lo, mut hi) = (x2, xb);
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
+    /// The last gaits' `(value, |g|)` for gauge `k`, as many as have the sign it has now and a magnitude that
+    /// falls from gait to gait (toward a zero): two at least, else `None`.
+    fn falling(&self, k: usize) -> Option<Vec<(f64, f64)>> {
+        let sign = self.points.last()?.1[k].signum();
+        let mut series: Vec<(f64, f64)> = Vec::with_capacity(self.points.len());
+        for &(v, g) in self.points.iter().rev() {
+            let g = sign * g[k];
+            if !(g.is_finite() && g > 0.0) || series.last().is_some_and(|&(_, later)| later >= g) {
                 break;
             }
-            if r(mid) > 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
+            series.push((v, g));
         }
-        Some(toward * 0.5 * (lo + hi))
+        series.reverse();
+        (series.len() >= 2).then_some(series)
     }
+}
 
-    /// The zero of the secant through the last two gaits, where their smallest `dtheta/dt` falls toward it.
-    fn secant(&self) -> Option<f64> {
-        let [.., (v0, g0), (v1, g1)] = self.points[..] else {
-            return None;
-        };
-        (g0 > g1 && g1 > 0.0).then(|| v1 - g1 * (v1 - v0) / (g1 - g0))
+/// The end `e` of the power law `g = A |e - v|^p` through three gaits `(v, g)` (`g > 0` falling toward the
+/// end), where it lies between the last gait and `b`: `A`, `p` and `e` are all fitted (the exponent depends on
+/// how the quantity meets zero). `e` is the root of `ln(g0/g1) ln((e-v1)/(e-v2)) = ln(g1/g2) ln((e-v0)/(e-v1))`,
+/// found by bisection (the left side minus the right is `+inf` just past `v2`).
+fn power_law(series: &[(f64, f64)], b: f64) -> Option<f64> {
+    let [(v0, g0), (v1, g1), (v2, g2)] = series[..] else {
+        return None;
+    };
+    let toward = (b - v2).signum();
+    let (x0, x1, x2, xb) = (toward * v0, toward * v1, toward * v2, toward * b);
+    if !(x0 < x1 && x1 < x2 && x2 < xb) {
+        return None;
     }
+    let (l01, l12) = ((g0 / g1).ln(), (g1 / g2).ln());
+    let r = |x: f64| l01 * ((x - x1) / (x - x2)).ln() - l12 * ((x - x0) / (x - x1)).ln();
+    if r(xb).is_nan() || r(xb) >= 0.0 {
+        return None;
+    }
+    let (mut lo, mut hi) = (x2, xb);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if r(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(toward * 0.5 * (lo + hi))
+}
+
+/// The zero of the secant through the last two gaits `(v, g)` of `series` (`g > 0` falling toward it).
+fn secant(series: &[(f64, f64)]) -> Option<f64> {
+    let [.., (v0, g0), (v1, g1)] = series[..] else {
+        return None;
+    };
+    Some(v1 - g1 * (v1 - v0) / (g1 - g0))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// Follow `g(v) = end - v` (scaled) toward `end` the way a continuation does: every aimed value below `end`
-    /// is a verified gait, every one above it a failure.
-    fn bracket(g: impl Fn(f64) -> f64, end: f64, tol: f64) -> (f64, f64, usize) {
+    /// Gauges with `g` as the smallest `dtheta/dt` and indicators that do not change.
+    fn slowest(g: f64) -> Option<Gauges> {
+        Some([g, 1.0, -2.0, 3.0])
+    }
+
+    /// Follow a family toward `end` the way a continuation does, from gaits at `end - 3` and `end - 2` and a
+    /// failure at `end + 1.5`: every aimed value below `end` is a verified gait with gauges `gauges(v)`, every
+    /// one above it a failure. The bracket reached and the steps it took.
+    fn bracket(gauges: &dyn Fn(f64) -> Option<Gauges>, end: f64, tol: f64) -> (f64, f64, usize) {
         let mut search = EndSearch::default();
         for v in [end - 3.0, end - 2.0] {
-            search.verified(v, Some(g(v)));
+            search.verified(v, gauges(v));
         }
         search.failed(end + 1.5);
         let (mut a, mut b, mut steps) = (end - 2.0, end + 1.5, 0);
@@ -166,7 +214,7 @@ mod tests {
             let v = search.aim(tol).unwrap_or(0.5 * (a + b));
             steps += 1;
             if v < end {
-                search.verified(v, Some(g(v)));
+                search.verified(v, gauges(v));
                 a = v;
             } else {
                 search.failed(v);
@@ -177,34 +225,35 @@ mod tests {
         (a, b, steps)
     }
 
-    /// A simple zero (the smallest `dtheta/dt` of a double-support minimum) and a square-root zero (a minimum
-    /// over the top) are both bracketed to the tolerance in a few steps where bisection from a bracket of 3.5
-    /// takes 22.
+    /// A simple zero (a smooth minimum of `dtheta/dt`), a square-root zero (a minimum over the top) and an
+    /// indicator that rises to zero from below (`lambda_2+` of a DLS gait about to bounce) are all bracketed to
+    /// the tolerance in a few steps, where bisection from a bracket of 3.5 takes 22.
     #[test]
-    fn roll_back_ends_are_bracketed_in_a_few_steps() {
+    fn ends_at_a_zero_are_bracketed_in_a_few_steps() {
         let end = 54.061_868_59;
-        for g in [
-            &(|v: f64| 0.3 * (end - v) + 0.02 * (end - v).powi(2)) as &dyn Fn(f64) -> f64,
-            &|v: f64| (end - v).max(0.0).sqrt(),
-        ] {
-            let (a, b, steps) = bracket(g, end, 1e-6);
+        let smooth = |v: f64| slowest(0.3 * (end - v) + 0.02 * (end - v).powi(2));
+        let root = |v: f64| slowest((end - v).max(0.0).sqrt());
+        let indicator = |v: f64| Some([2.0, 1.0, -40.0 * (end - v), 3.0]);
+        for gauges in [&smooth as &dyn Fn(f64) -> Option<Gauges>, &root, &indicator] {
+            let (a, b, steps) = bracket(gauges, end, 1e-6);
             assert!(a < end && end <= b && b - a <= 1e-6, "[{a}, {b}]");
             assert!(steps <= 10, "{steps} steps");
         }
+        assert_eq!(bracket(&|_| slowest(1.0), end, 1e-6).2, 22);
     }
 
-    /// Without a falling `dtheta/dt` (another kind of end) there is no estimate, and a step past the value not
-    /// reached forgets it.
+    /// Without a gauge falling toward zero (another kind of end) there is no estimate, and a step past the value
+    /// not reached forgets it. Of two gauges falling toward zero, the nearer zero is aimed at.
     #[test]
     fn other_ends_are_bisected() {
         let mut search = EndSearch::default();
-        search.verified(1.0, Some(1.0));
-        search.verified(2.0, Some(1.1));
+        search.verified(1.0, slowest(1.0));
+        search.verified(2.0, slowest(1.1));
         search.failed(3.0);
         assert_eq!(search.aim(1e-6), None);
-        search.verified(2.5, Some(0.3));
-        assert!(search.aim(1e-6).is_some_and(|v| v > 2.5 && v < 3.0));
-        search.verified(3.5, Some(0.8));
+        search.verified(2.5, Some([0.3, 0.5, -2.0, 3.0]));
+        assert!(search.aim(1e-6).is_some_and(|v| v > 2.5 && v < 2.6875));
+        search.verified(3.5, slowest(0.8));
         assert_eq!(search.beyond, None);
         assert_eq!(search.aim(1e-6), None);
         search.verified(4.0, None);
