@@ -9,7 +9,7 @@
 //! (1 for an indicator or a smooth minimum, about 0.6 was seen for the smallest `dtheta/dt` on the default
 //! map's ends), so the power law through the last three verified gaits (the secant through the last two where
 //! that fails) estimates `v_end`; the nearest estimate inside the bracket is taken, and the next continuation
-//! step aims just short of it, by the estimate's own last change. Steps still verify everything: the reported
+//! step aims just short of it, by half the estimate's last change. Steps still verify everything: the reported
 //! end remains the last verified gait and the first value not reached, at most the tolerance apart. Where no
 //! estimate falls inside that bracket (the family ends for another reason: a fold, a grazing event), or after
 //! [`MAX_EXTRAPOLATED`] extrapolated steps, the continuation bisects as before. An estimate at the zero of an
@@ -97,7 +97,7 @@ impl EndSearch {
 
     /// The value the next step from the last verified gait should aim at, where an estimate of the end falls
     /// strictly between it and the nearest value not reached, and that bracket is wider than `tol`: just
-    /// short of the estimate by its last change (by a quarter of the distance to it for a first estimate, by
+    /// short of the estimate by half its last change (by a quarter of the distance to it for a first estimate, by
     /// at least `tol / 2`), or `tol` past the last gait where the estimate is within `tol` of it (a step
     /// expected to fail, which closes the bracket). `None` otherwise: the caller bisects.
     pub(crate) fn aim(&mut self, tol: f64) -> Option<f64> {
@@ -119,9 +119,11 @@ impl EndSearch {
             })
             .min_by(|x, y| (x - a).abs().total_cmp(&(y - a).abs()))?;
         let toward = (b - a).signum();
+        // Half the last change: on the default map's 81 ends 1 475 steps in all, against 1 515 with the whole
+        // change (too cautious) and 1 559 with a quarter (too many steps past the end, each failing).
         let guard = self
             .previous
-            .map_or(0.25 * (e - a).abs(), |p| (e - p).abs());
+            .map_or(0.25 * (e - a).abs(), |p| 0.5 * (e - p).abs());
         self.previous = Some(e);
         self.extrapolated += 1;
         // Just inside the tolerance, so that the step counts as the finest one whatever the rounding of `a + tol`.
