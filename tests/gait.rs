@@ -450,3 +450,44 @@ fn a_gait_at_the_edge_of_existence_is_kept_when_its_jacobian_needs_a_smaller_ste
     assert_eq!(points[8].family, points[0].family);
     assert!(edge.jacobian_guess().is_some() || edge.jacobian_failure.is_some());
 }
+
+/// Along the stiffness at c = 240.2 the family that comes down from k = 540 ends near k = 503.60186, where its
+/// step lasts the whole of max_step_time (60 s: the wheel creeps over the top of its step with dtheta/dt ~
+/// 5e-4 rad/s) and the walk past it stalls. The end's detail says the limit cut the family; with a limit twice
+/// as long the family goes on past that value.
+#[test]
+fn a_family_cut_by_the_step_time_limit_says_so() {
+    let mut config = Config::default();
+    config.params.viscosity = 240.2;
+    let start = default_initial(&config);
+    let spec = SweepSpec {
+        param: "stiffness".into(),
+        from: 480.0,
+        to: 540.0,
+        points: 3,
+    };
+    let options = GaitOptions::default();
+    let points = sweep(&config, &spec, &start, &options, &|_| {}).unwrap();
+    let thresholds = find_thresholds(&config, &spec, &points, &options);
+    let end = thresholds
+        .iter()
+        .find(|t| t.name == "gait_found")
+        .unwrap_or_else(|| panic!("{thresholds:#?}"));
+    assert!((end.value - 503.60186).abs() < 1e-5, "{end:?}");
+    let detail = end.detail.as_deref().unwrap();
+    assert!(
+        detail.contains("stalled") && detail.contains("cut by that limit"),
+        "{detail}"
+    );
+    let mut longer = config.clone();
+    longer.solver.max_step_time = 120.0;
+    let points = sweep(&longer, &spec, &start, &options, &|_| {}).unwrap();
+    let thresholds = find_thresholds(&longer, &spec, &points, &options);
+    assert!(
+        thresholds
+            .iter()
+            .filter(|t| t.name == "gait_found")
+            .all(|t| t.value < 503.6),
+        "{thresholds:#?}"
+    );
+}

@@ -9,10 +9,10 @@
 //! A step that fails is halved (and the step after a failure that works halves the next, which bisects toward
 //! an end), so a family is followed in shrinking steps until it is reached or its end is bracketed to
 //! `PARAM_TOL`; where the wheel is about to roll back at the end, or a DLS indicator vanishes there, the end is
-//! extrapolated instead (`end_search.rs`). Where Newton's method fails at the finest step, or `WALK_AFTER_FAILURES` times in a row (and
-//! every `WALK_AFTER_FAILURES` failures after that), steps are also tried by walking instead
-//! (`Continuation::walk_step`), since the step map is only piecewise smooth. A family of period-k gaits is
-//! followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
+//! extrapolated instead (`end_search.rs`). Where Newton's method fails at the finest step, or
+//! `WALK_AFTER_FAILURES` times in a row (and every `WALK_AFTER_FAILURES` failures after that), steps are also
+//! tried by walking instead (`Continuation::walk_step`), since the step map is only piecewise smooth. A family
+//! of period-k gaits is followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
 //!
 //! **Predictor.** Each step starts Newton's method from the gait carried along the family's tangent `ds*/dp`
 //! (`Tangent`): given with the first point (`-(DP - I)^-1 dP/dp` from its exact derivatives), then the secant
@@ -501,9 +501,9 @@ impl<'a> Continuation<'a> {
     /// is retried once with `DP` recomputed at the current point (if the Newton matrix was computed elsewhere;
     /// not a step whose walk fails at its start, where no matrix helps), a retry that fails as soon as it must
     /// damp a Newton step taken with `DP` at its iterate, then halved; a
-    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end), unless
-    /// the end is extrapolated from the gaits' smallest `dtheta/dt` or DLS indicators ([`EndSearch`]). At
-    /// most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
+    /// step that works lets the next one double, or halve right after a failure (bisecting toward the end),
+    /// unless the end is extrapolated from the gaits' smallest `dtheta/dt` or DLS indicators ([`EndSearch`]).
+    /// At most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
     /// ([`Followed::GaveUp`]).
     pub(crate) fn follow(
         &self,
@@ -635,6 +635,15 @@ impl<'a> Continuation<'a> {
                 }
             }
         }
+    }
+
+    /// The longest step of the gait `at` \[s\] (of the `k` steps of a period-k gait); `None` where the walk
+    /// fails.
+    pub(crate) fn longest_step(&self, at: &FamilyPoint) -> Option<f64> {
+        let (c, model) = self.configured_at(at.value).ok()?;
+        let map = StepMap::new(&model, &c.solver).iterated(self.period);
+        let walked = map.eval_signature(&at.section).ok()?;
+        walked.cycle.iter().map(|r| r.period).reduce(f64::max)
     }
 
     /// The real Floquet multiplier closest to +1 of the gait `at`.

@@ -381,7 +381,7 @@ gt.section.distance(&p.section) <= SAME_GAIT_TOL
                     ""
                 },
                 p = spec.param,
-            ),
+            ) + &cut_by_step_limit(config, spec, &cont, (&last, beyond), failure),
         ),
         EndCause::OtherGait {
             steps,
@@ -431,6 +431,34 @@ gt.section.distance(&p.section) <= SAME_GAIT_TOL
     let vanishing = vanishing_at_end(config, spec, from, &last, &end);
     std::iter::once(end).chain(vanishing).collect()
 }
+
+/// Where the walk past a family's end stalls (no touchdown within `max_step_time`) and the family's last gait
+/// has a step within [`STEP_LIMIT_SHARE`] of that limit, the family is cut by the limit rather than ended by the
+/// physics (the wheel creeps ever more slowly over the top of its step): that, in words, for the end's detail;
+/// an empty string otherwise.
+fn cut_by_step_limit(
+    config: &Config,
+    spec: &SweepSpec,
+    cont: &Continuation,
+    (last, beyond): (&FamilyPoint, f64),
+    failure: &str,
+) -> String {
+    let Ok(c) = config.with(&spec.param, beyond) else {
+        return String::new();
+    };
+    let limit = c.solver.max_step_time;
+    match cont.longest_step(last) {
+        Some(step) if failure == "stalled" && step >= STEP_LIMIT_SHARE * limit => format!(
+            "; the last gait's step lasts {step:.6} s of the max_step_time = {limit} s a step may last: the \
+             family is cut by that limit, not ended by the dynamics (a larger max_step_time follows it further)"
+        ),
+        _ => String::new(),
+    }
+}
+
+/// A family whose last gait's step lasts at least this share of `max_step_time` and whose walk past the end
+/// stalls is cut by that limit ([`cut_by_step_limit`]).
+const STEP_LIMIT_SHARE: f64 = 0.9;
 
 /// A family end that could not be located, reported over its grid interval with the reason.
 fn unconfirmed(grid_bracket: [f64; 2], detail: String) -> Threshold {
