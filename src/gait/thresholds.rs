@@ -443,12 +443,16 @@ fn cut_by_step_limit(
     (last, beyond): (&FamilyPoint, f64),
     failure: &str,
 ) -> String {
+    // Only a stalled walk asks for the last gait's step (a walk of up to max_step_time of motion).
+    if failure != "stalled" {
+        return String::new();
+    }
     let Ok(c) = config.with(&spec.param, beyond) else {
         return String::new();
     };
     let limit = c.solver.max_step_time;
     match cont.longest_step(last) {
-        Some(step) if failure == "stalled" && step >= STEP_LIMIT_SHARE * limit => format!(
+        Some(step) if step >= STEP_LIMIT_SHARE * limit => format!(
             "; the last gait's step lasts {step:.6} s of the max_step_time = {limit} s a step may last: the \
              family is cut by that limit, not ended by the dynamics (a larger max_step_time follows it further)"
         ),
