@@ -25,6 +25,8 @@ use num_traits::{One, Zero};
 
 use crate::params::{ConfigError, Params};
 
+mod force;
+
 /// A real scalar the kinematics and the equations of motion are written for: `f64` for the walk, and the dual
 /// numbers of [`crate::variational`] that carry derivatives through the very same code (forward-mode automatic
 /// differentiation, docs/model.md section 10). STYLE.md asks for concrete `f64`; this is the one exception, so
@@ -265,6 +267,63 @@ impl<T: Real, const C: usize> PointSums<T, C> {
     }
 }
 
+/// The hub's kinematics at one state, which every point of the wheel shares ([`Model::equations_of_motion_with`],
+/// [`Model::generalized_force_with`]): `C` length columns as for [`PointSums`].
+struct Wheel<T: Real, const C: usize> {
+    /// `sin theta`, `cos theta`.
+    st: T,
+    ct: T,
+    /// `dtheta/dt`.
+    w: T,
+    /// The hub's Jacobian columns: `b_theta = (L1 c, -L1 s)`, `b_L1 = (s, c)`, the others 0.
+    hub_b: [Vector2<T>; C],
+    /// The hub's `dJ/dt q'`.
+    hub_vp: Vector2<T>,
+    /// The hub's position.
+    hub_position: Vector2<T>,
+}
+
+impl<T: Real, const C: usize> Wheel<T, C> {
+    fn new(q: &CoordsOf<T>, qd: &CoordsOf<T>) -> Self {
+        let two = lit::<T>(2.0);
+        let (st, ct) = q[THETA].sin_cos();
+        let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
+        let mut hub_b = [Vector2::zeros(); C];
+        hub_b[0] = Vector2::new(l1 * ct, -l1 * st);
+        hub_b[1] = Vector2::new(st, ct);
+        let hub_vp = Vector2::new(
+            two * dl1 * ct * w - l1 * st * w * w,
+            -two * dl1 * st * w - l1 * ct * w * w,
+        );
+        Wheel {
+            st,
+            ct,
+            w,
+            hub_b,
+            hub_vp,
+            hub_position: Vector2::new(q[X] + l1 * st, q[Z] + l1 * ct),
+        }
+    }
+
+    /// `e(psi)` and `e_psi = de/dpsi` for `psi = theta + j alpha` given `(sin j alpha, cos j alpha)`:
+    /// `e = (-sin psi, -cos psi)`, `e_psi = (-cos psi, sin psi)`.
+    fn directions(&self, (sj, cj): (f64, f64)) -> (Vector2<T>, Vector2<T>) {
+        let (sj, cj) = (lit::<T>(sj), lit::<T>(cj));
+        let (st, ct) = (self.st, self.ct);
+        let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
+        (Vector2::new(-sp, -cp), Vector2::new(-cp, sp))
+    }
+}
+
+/// The locked legs' sums of [`Model::equations_of_motion_with`]: their number `n`, the distance `d = L0 - a`
+/// of their masses from the hub, `sum_j e(psi_j)` and `sum_j e_psi(psi_j)`.
+struct Locked<T: Real> {
+    n: T,
+    d: T,
+    sum_e: Vector2<T>,
+    sum_e_psi: Vector2<T>,
+}
+
 /// The validated model: parameters plus precomputed leg-angle offsets.
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -459,6 +518,73 @@ impl Model {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// A point of leg `j` (length `q[slot + 2]`, its column `slot` of `b`) at distance `from_tip` from its tip:
+    /// its Jacobian columns `b`, `dJ/dt q'` and position.
+    fn leg_point<T: Real, const C: usize>(
+        &self,
+        wheel: &Wheel<T, C>,
+        q: &CoordsOf<T>,
+        qd: &CoordsOf<T>,
+        j: LegIndex,
+        slot: usize,
+        from_tip: T,
+    ) -> ([Vector2<T>; C], Vector2<T>, Vector2<T>) {
+        let two = lit::<T>(2.0);
+        let (e, e_psi) = wheel.directions(self.offsets[j]);
+        let (length, dlength) = (q[THETA + slot], qd[THETA + slot]);
+        let w = wheel.w;
+        let d = length - from_tip;
+        let mut b = wheel.hub_b;
+        b[0] += e_psi * d;
+        b[slot] += e;
+        let vp = wheel.hub_vp + e_psi * (two * dlength * w) - e * (d * w * w);
+        (b, vp, wheel.hub_position + e * d)
+    }
+
+    /// The locked legs' sums (every leg but Legs 1 and 2, and but the swinging leg while one `swing`s).
+    fn locked<T: Real, const C: usize>(
+        &self,
+        wheel: &Wheel<T, C>,
+        p: &Mechanics<T>,
+        swing: bool,
+    ) -> Locked<T> {
+        let (mut locked, (mut ss, mut sc)) = (self.legs() - 2, self.locked_offsets);
+        if swing {
+            locked -= 1;
+            (ss, sc) = (ss - self.offsets[2].0, sc - self.offsets[2].1);
+        }
+        let (st, ct) = (wheel.st, wheel.ct);
+        let (ss, sc) = (lit::<T>(ss), lit::<T>(sc));
+        let (sum_sin, sum_cos) = (st * sc + ct * ss, ct * sc - st * ss);
+        Locked {
+            n: lit::<T>(locked as f64),
+            d: p.spoke_length - p.leg_mass_offset,
+            sum_e: Vector2::new(-sum_sin, -sum_cos),
+            sum_e_psi: Vector2::new(-sum_cos, sum_sin),
+        }
+    }
+
+    /// The kinematics of Leg 2's tip (the rows of (C2)).
+    fn rear_tip<T: Real, const C: usize>(
+        &self,
+        wheel: &Wheel<T, C>,
+        q: &CoordsOf<T>,
+        qd: &CoordsOf<T>,
+    ) -> PointKinematics<T> {
+        let (b, velocity_product, position) = self.leg_point(wheel, q, qd, 1, 2, T::zero());
+        let mut jacobian = PointJacobian::<T>::zeros();
+        jacobian[(0, X)] = T::one();
+        jacobian[(1, Z)] = T::one();
+        for (k, column) in b.iter().enumerate() {
+            jacobian.set_column(THETA + k, column);
+        }
+        PointKinematics {
+            position,
+            jacobian,
+            velocity_product,
+        }
+    }
+
     /// Mass matrix `M(q)` and bias vector `h(q, q')` of Eq. (1): Coriolis/centrifugal terms, gravity, the leg
     /// springs `k (Lstar - L)` and dampers `c dL/dt` of Legs 1 and 2 (docs/model.md section 2).
     ///
@@ -507,58 +633,26 @@ impl Model {
         let swing = C == 4;
         let p = mech;
         let two = lit::<T>(2.0);
-        let (st, ct) = q[THETA].sin_cos();
-        let (l1, dl1, l2, dl2, w) = (q[L1], qd[L1], q[L2], qd[L2], qd[THETA]);
-        // Hub: b_theta = (L1 c, -L1 s), b_L1 = (s, c), b_L2 = 0; dJ/dt q' as in `hub`.
-        let mut hub_b = [Vector2::zeros(); C];
-        hub_b[0] = Vector2::new(l1 * ct, -l1 * st);
-        hub_b[1] = Vector2::new(st, ct);
-        let hub_vp = Vector2::new(
-            two * dl1 * ct * w - l1 * st * w * w,
-            -two * dl1 * st * w - l1 * ct * w * w,
-        );
-        // psi = theta + j alpha; e = (-sin psi, -cos psi), e_psi = de/dpsi = (-cos psi, sin psi)
-        let directions = |(sj, cj): (f64, f64)| {
-            let (sj, cj) = (lit::<T>(sj), lit::<T>(cj));
-            let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
-            (Vector2::new(-sp, -cp), Vector2::new(-cp, sp))
-        };
-        let hub_position = Vector2::new(q[X] + l1 * st, q[Z] + l1 * ct);
-        // Leg j with length L and rate dL/dt, its length column b_L in `slot`: a point of it at distance
-        // `from_tip` from its tip, as Jacobian columns b, dJ/dt q' and position.
-        let leg = |j: usize, length: T, dlength: T, slot: usize| {
-            let (e, e_psi) = directions(self.offsets[j]);
-            move |from_tip: T| {
-                let d = length - from_tip;
-                let mut b = hub_b;
-                b[0] += e_psi * d;
-                b[slot] += e;
-                let vp = hub_vp + e_psi * (two * dlength * w) - e * (d * w * w);
-                (b, vp, hub_position + e * d)
-            }
-        };
-        let (leg_one, leg_two) = (leg(0, l1, dl1, 1), leg(1, l2, dl2, 2));
+        let wheel = Wheel::<T, C>::new(q, qd);
+        let (hub_b, hub_vp, w) = (wheel.hub_b, wheel.hub_vp, wheel.w);
         let mut sums = PointSums::<T, C>::zero();
         sums.add(p.hub_mass, &hub_b, hub_vp + p.up);
-        for point in [leg_one, leg_two] {
-            let (b, vp, _) = point(p.leg_mass_offset);
+        for (j, slot) in [(0, 1), (1, 2)] {
+            let (b, vp, _) = self.leg_point(&wheel, q, qd, j, slot, p.leg_mass_offset);
             sums.add(p.leg_mass, &b, vp + p.up);
         }
         // The swinging leg j = 2, point by point, and the locked legs: j = 2..N, or j = 3..N while a leg swings,
         // all of the spoke length (see above).
-        let (mut locked, (mut ss, mut sc)) = (self.legs() - 2, self.locked_offsets);
         if swing {
-            let (b, vp, _) = leg(2, q[L3], qd[L3], 3)(p.leg_mass_offset);
+            let (b, vp, _) = self.leg_point(&wheel, q, qd, 2, 3, p.leg_mass_offset);
             sums.add(p.leg_mass, &b, vp + p.up);
-            locked -= 1;
-            (ss, sc) = (ss - self.offsets[2].0, sc - self.offsets[2].1);
         }
-        let n = lit::<T>(locked as f64);
-        let d = p.spoke_length - p.leg_mass_offset;
-        let (ss, sc) = (lit::<T>(ss), lit::<T>(sc));
-        let (sum_sin, sum_cos) = (st * sc + ct * ss, ct * sc - st * ss);
-        let sum_e = Vector2::new(-sum_sin, -sum_cos);
-        let sum_e_psi = Vector2::new(-sum_cos, sum_sin);
+        let Locked {
+            n,
+            d,
+            sum_e,
+            sum_e_psi,
+        } = self.locked(&wheel, p, swing);
         let a = hub_vp + p.up;
         let m = p.leg_mass;
         sums.mass += n * m;
@@ -601,21 +695,10 @@ impl Model {
             mass[(L3, L3)] = T::one();
         }
 
-        let (b, velocity_product, position) = leg_two(T::zero());
-        let mut jacobian = PointJacobian::<T>::zeros();
-        jacobian[(0, X)] = T::one();
-        jacobian[(1, Z)] = T::one();
-        for (k, column) in b.iter().enumerate() {
-            jacobian.set_column(THETA + k, column);
-        }
         EquationsOfMotion {
             mass,
             bias,
-            rear_tip: PointKinematics {
-                position,
-                jacobian,
-                velocity_product,
-            },
+            rear_tip: self.rear_tip(&wheel, q, qd),
             swing,
         }
     }
@@ -735,6 +818,53 @@ mod tests {
             let (m_ref, h_ref) = model.mass_and_bias_reference(&q, &qd);
             assert_relative_eq!(m, m_ref, epsilon = 1e-12, max_relative = 1e-13);
             assert_relative_eq!(h, h_ref, epsilon = 1e-11, max_relative = 1e-13);
+        }
+    }
+
+    /// `M z + h` without forming `M` (what the derivatives of the dynamics differentiate) equals the assembled
+    /// `M z + h` for any number of legs, with and without a swinging leg, in `f64` and along a direction of
+    /// every coordinate and of a parameter on dual numbers; Leg 2's tip is the assembled one.
+    #[test]
+    fn generalized_force_equals_the_assembled_equations_of_motion() {
+        use crate::variational::{dual_of as dual, seeded, Dual};
+        for legs in [3, 6, 11] {
+            let params = Params {
+                legs,
+                hub_inertia: 0.3,
+                ..Params::default()
+            };
+            let model = Model::new(&params).unwrap();
+            for (k, (q, qd)) in random_states(12).into_iter().enumerate() {
+                let z = Coords::from_fn(|i, _| {
+                    if i == L3 && !swinging(&q) {
+                        0.0
+                    } else {
+                        (i as f64 + 1.3 * k as f64).sin()
+                    }
+                });
+                let eom = model.equations_of_motion(&q, &qd);
+                let (force, tip) = model.generalized_force_with(model.mechanics(), &q, &qd, &z);
+                assert_relative_eq!(force, eom.mass * z + eom.bias, epsilon = 1e-11);
+                assert_eq!(tip, eom.rear_tip);
+                // Along one direction in (q, q') and the stiffness: the derivative parts agree too.
+                let mech = seeded::<1>(&model, Some("stiffness"), 0);
+                // `L3` carries no direction where no leg swings (it is not a coordinate there).
+                let along = |x: f64, i: usize| {
+                    let e = if x == 0.0 { 0.0 } else { 0.1 + 0.07 * i as f64 };
+                    dual(x, nalgebra::SVector::<f64, 1>::new(e))
+                };
+                let qs = CoordsOf::<Dual<1>>::from_fn(|i, _| along(q[i], i));
+                let qds = CoordsOf::<Dual<1>>::from_fn(|i, _| along(qd[i], 7 + i));
+                let eom = model.equations_of_motion_with(&mech, &qs, &qds);
+                let assembled = CoordsOf::<Dual<1>>::from_fn(|i, _| {
+                    (0..NQ).fold(eom.bias[i], |sum, j| sum + eom.mass[(i, j)] * lit(z[j]))
+                });
+                let (force, _) = model.generalized_force_with(&mech, &qs, &qds, &z);
+                for i in 0..NQ {
+                    assert_relative_eq!(force[i].re, assembled[i].re, epsilon = 1e-11);
+                    assert_relative_eq!(force[i].eps[0], assembled[i].eps[0], epsilon = 1e-10);
+                }
+            }
         }
     }
 

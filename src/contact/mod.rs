@@ -17,7 +17,7 @@
 use nalgebra::SVector;
 use serde::Serialize;
 
-use crate::dynamics::{Coords, Model, L1, L2};
+use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2};
 
 mod coulomb;
 mod solve;
@@ -465,6 +465,23 @@ pub fn constrained_dynamics(
         coulomb::slipping_dynamics(model, q, qd, active)
     } else {
         solve::no_slip_dynamics(model, q, qd, active)
+    }
+}
+
+/// [`constrained_dynamics`] with the equations of motion at the state, which the derivatives of the dynamics
+/// factor again (`crate::variational`): the same solve, its `M` and `h` not computed twice.
+pub(crate) fn constrained_dynamics_and_eom(
+    model: &Model,
+    q: &Coords,
+    qd: &Coords,
+    active: &ActiveSet,
+) -> (Result<ConstrainedDynamics, ContactError>, EquationsOfMotion) {
+    if active.any_slip() {
+        let d = coulomb::slipping_dynamics(model, q, qd, active);
+        (d, model.equations_of_motion(q, qd))
+    } else {
+        let eom = model.equations_of_motion(q, qd);
+        (solve::no_slip_dynamics_of(&eom, active), eom)
     }
 }
 

@@ -102,13 +102,20 @@ pub(super) fn no_slip_dynamics(
     qd: &Coords,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
-    let eom = model.equations_of_motion(q, qd);
+    no_slip_dynamics_of(&model.equations_of_motion(q, qd), active)
+}
+
+/// [`no_slip_dynamics`] from the equations of motion `eom` at the state.
+pub(super) fn no_slip_dynamics_of(
+    eom: &EquationsOfMotion,
+    active: &ActiveSet,
+) -> Result<ConstrainedDynamics, ContactError> {
     if active.contact1 && !active.slide1 {
         // `(theta, L1, L2)`, and `L3` while a leg swings: a constant size, so that the small loops unroll.
         return if eom.swing {
-            solve_with_fixed_leg_one::<{ NQ - 2 }>(&eom, active)
+            solve_with_fixed_leg_one::<{ NQ - 2 }>(eom, active)
         } else {
-            solve_with_fixed_leg_one::<{ NQ - 3 }>(&eom, active)
+            solve_with_fixed_leg_one::<{ NQ - 3 }>(eom, active)
         };
     }
     // The general case (Leg 1 sliding or off the ground): all the coordinates.

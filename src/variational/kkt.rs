@@ -21,7 +21,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::contact::{force_columns, ActiveSet, Ldl, Leg, NROWS};
 use crate::dynamics::{
-    Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, Real, L1, L2, NQ, X, Z,
+    Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, PointJacobian, Real, L1, L2, NQ, X, Z,
 };
 
 use super::dual::Dual;
@@ -399,6 +399,35 @@ struct ResidualParts<const D: usize> {
     r2: SMatrix<f64, NROWS, D>,
 }
 
+/// The rows of (C2) differentiated, `-dJ_C2^T lam_C2` into `r1` and `dJ_C2 z2` into `r2` (active rows), from
+/// the dual Jacobian of Leg 2's tip.
+fn add_rear_tip_parts<const D: usize>(
+    jacobian: &PointJacobian<Dual<D>>,
+    active: &ActiveSet,
+    (z2, lam): (&Coords, &SVector<f64, NROWS>),
+    (r1, r2): (&mut SMatrix<f64, NQ, D>, &mut SMatrix<f64, NROWS, D>),
+) {
+    let mask = active.row_mask();
+    // A slipping rear tip's tangential row carries its friction force in `lam` (`-s mu lambda_n`): it moves
+    // with `q` as the active rows do, but is no constraint (no `r2`).
+    let slipping = active.contact2 && active.slip2 != 0;
+    for axis in 0..2 {
+        let row = 2 + axis;
+        if !(mask[row] || axis == 0 && slipping) {
+            continue;
+        }
+        for j in 0..NQ {
+            let dj = &jacobian[(axis, j)].eps;
+            for c in 0..D {
+                r1[(j, c)] -= dj[c] * lam[row];
+                if mask[row] {
+                    r2[(row, c)] += dj[c] * z2[j];
+                }
+            }
+        }
+    }
+}
+
 fn residual_parts<const D: usize>(
     eom: &EquationsOfMotion<Dual<D>>,
     active: &ActiveSet,
@@ -406,7 +435,6 @@ fn residual_parts<const D: usize>(
     z2: &Coords,
     lam: &SVector<f64, NROWS>,
 ) -> ResidualParts<D> {
-    let mask = active.row_mask();
     let mut r1 = SMatrix::<f64, NQ, D>::zeros();
     let mut r2 = SMatrix::<f64, NROWS, D>::zeros();
     for i in 0..NQ {
@@ -417,24 +445,12 @@ fn residual_parts<const D: usize>(
             }
         }
     }
-    // A slipping rear tip's tangential row carries its friction force in `lam` (`-s mu lambda_n`): it moves
-    // with `q` as the active rows do, but is no constraint (no `r2`).
-    let slipping = active.contact2 && active.slip2 != 0;
-    for axis in 0..2 {
-        let row = 2 + axis;
-        if !(mask[row] || axis == 0 && slipping) {
-            continue;
-        }
-        for j in 0..NQ {
-            let dj = &eom.rear_tip.jacobian[(axis, j)].eps;
-            for c in 0..D {
-                r1[(j, c)] -= dj[c] * lam[row];
-                if mask[row] {
-                    r2[(row, c)] += dj[c] * z2[j];
-                }
-            }
-        }
-    }
+    add_rear_tip_parts(
+        &eom.rear_tip.jacobian,
+        active,
+        (z2, lam),
+        (&mut r1, &mut r2),
+    );
     let re = |x: &Dual<D>| x.re;
     let eom = EquationsOfMotion {
         mass: eom.mass.map(|x| re(&x)),
@@ -455,33 +471,27 @@ fn residual_parts<const D: usize>(
 pub(crate) fn dynamics_derivative<const D: usize>(
     model: &Model,
     (q, qd, mech): &Duals<D>,
-    active: &ActiveSet,
+    (real, active): (&EquationsOfMotion<f64>, &ActiveSet),
     (qdd, lam): (&Coords, &SVector<f64, NROWS>),
 ) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
-    let eom = model.equations_of_motion_with(mech, q, qd);
-    // R = [M q'' + h - J^T lam; J q'' + dJ/dt q'] with (q'', lam) held.
-    let ResidualParts {
-        eom: real,
-        mut r1,
-        mut r2,
-    } = residual_parts(&eom, active, qdd, qdd, lam);
+    // R = [M q'' + h - J^T lam; J q'' + dJ/dt q'] with (q'', lam) held: `M q'' + h` on duals without forming M
+    // (`Model::generalized_force_with`), the rows of (C2) from Leg 2's tip.
+    let (force, rear_tip) = model.generalized_force_with(mech, q, qd, qdd);
+    let mut r1 = SMatrix::<f64, NQ, D>::from_fn(|i, c| force[i].eps[c]);
+    let mut r2 = SMatrix::<f64, NROWS, D>::zeros();
+    add_rear_tip_parts(&rear_tip.jacobian, active, (qdd, lam), (&mut r1, &mut r2));
     let mask = active.row_mask();
-    for i in 0..NQ {
-        for c in 0..D {
-            r1[(i, c)] += eom.bias[i].eps[c];
-        }
-    }
     for axis in 0..2 {
         if mask[2 + axis] {
             for c in 0..D {
-                r2[(2 + axis, c)] += eom.rear_tip.velocity_product[axis].eps[c];
+                r2[(2 + axis, c)] += rear_tip.velocity_product[axis].eps[c];
             }
         }
     }
-    add_friction_parts(&mut r1, (&real, active), &mech.friction, lam);
     let (q_real, qd_real) = (q.map(|x| x.re), qd.map(|x| x.re));
+    add_friction_parts(&mut r1, (real, active), &mech.friction, lam);
     let at = (model, &q_real, &qd_real);
-    let (dqdd, mut dlam) = solve_kkt(at, (&real, active), (&-r1, &-r2))?;
+    let (dqdd, mut dlam) = solve_kkt(at, (real, active), (&-r1, &-r2))?;
     friction_derivatives(active, &mech.friction, lam, &mut dlam);
     Some((dqdd, dlam))
 }
@@ -605,8 +615,10 @@ mod tests {
             let qd_ = CoordsOf::from_fn(|i, _| one(q[i], dir_q[i]));
             let qdd_ = CoordsOf::from_fn(|i, _| one(qd[i], dir_qd[i]));
             let duals = (qd_, qdd_, mech);
+            let eom = model.equations_of_motion(&q, &qd);
             let (dqdd, dlam) =
-                dynamics_derivative(&model, &duals, &active, (&d0.qdd, &d0.multipliers)).unwrap();
+                dynamics_derivative(&model, &duals, (&eom, &active), (&d0.qdd, &d0.multipliers))
+                    .unwrap();
             let fd_qdd = (dp.qdd - dm.qdd) / (2.0 * h);
             let fd_lam = (dp.multipliers - dm.multipliers) / (2.0 * h);
             let scale = 1.0 + fd_qdd.amax() + fd_lam.amax();

@@ -170,11 +170,12 @@ impl<const D: usize, const A: usize> OdeSystem<A> for Variational<'_, D, A> {
         let (y, s) = Self::split(a);
         // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
         let phase = PhaseSystem::at(self.model, self.active, &y);
-        let (fy, dynamics) = phase.rhs_and_dynamics(&y);
+        let (fy, dynamics, eom) = phase.rhs_dynamics_and_eom(&y);
         let (q, qd) = duals(&y, &s);
         let derivative = dynamics.and_then(|d| {
             let duals = (q, qd, *self.mech);
-            dynamics_derivative(self.model, &duals, &self.active, (&d.qdd, &d.multipliers))
+            let solution = (&d.qdd, &d.multipliers);
+            dynamics_derivative(self.model, &duals, (&eom, &self.active), solution)
         });
         let Some((dqdd, _)) = derivative else {
             return Augmented::<A>::repeat(f64::NAN);
@@ -368,7 +369,8 @@ fn cross_guard<const D: usize, const E: usize>(
     s: &Sensitivity<D>,
 ) -> Result<(Sensitivity<D>, SVector<f64, D>), NotDifferentiable> {
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
-    let (f, dynamics) = PhaseSystem::at(model, segment.active, y).rhs_and_dynamics(y);
+    let (f, dynamics, eom) = PhaseSystem::at(model, segment.active, y).rhs_dynamics_and_eom(y);
+    let eom = &eom;
     let (q, qd) = with_rate(y, s, &f);
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
     let singular = NotDifferentiable::Singular { time: end.time };
@@ -376,9 +378,13 @@ fn cross_guard<const D: usize, const E: usize>(
     let forces = || -> Result<[Dual<E>; NROWS], NotDifferentiable> {
         let d = dynamics.as_ref().ok_or(singular.clone())?;
         let duals = (q, qd, *mech);
-        let (_, dlam) =
-            dynamics_derivative(model, &duals, &segment.active, (&d.qdd, &d.multipliers))
-                .ok_or(singular.clone())?;
+        let (_, dlam) = dynamics_derivative(
+            model,
+            &duals,
+            (eom, &segment.active),
+            (&d.qdd, &d.multipliers),
+        )
+        .ok_or(singular.clone())?;
         Ok(std::array::from_fn(|row| {
             dual(d.multipliers[row], dlam.row(row).transpose())
         }))

@@ -4,8 +4,11 @@
 
 use nalgebra::SVector;
 
-use crate::contact::{constrained_dynamics, ActiveSet, ConstrainedDynamics};
-use crate::dynamics::{swinging, Coords, Model, L1, L2, L3, NQ};
+use crate::contact::{
+    constrained_dynamics, constrained_dynamics_and_eom, ActiveSet, ConstrainedDynamics,
+    ContactError,
+};
+use crate::dynamics::{swinging, Coords, EquationsOfMotion, Model, L1, L2, L3, NQ};
 use crate::integrate::OdeSystem;
 
 /// Size of the integrated state `[q, q', E_damper]`.
@@ -58,11 +61,32 @@ impl<'a> PhaseSystem<'a> {
         y: &WalkVector,
     ) -> (WalkVector, Option<ConstrainedDynamics>) {
         let (q, qd) = unpack(y);
-        match constrained_dynamics(self.model, &q, &qd, &self.active) {
+        self.field(&qd, constrained_dynamics(self.model, &q, &qd, &self.active))
+    }
+
+    /// [`PhaseSystem::rhs_and_dynamics`] with the equations of motion at `y` (the same numbers; the derivatives
+    /// of the dynamics factor their `M` again).
+    pub(crate) fn rhs_dynamics_and_eom(
+        &self,
+        y: &WalkVector,
+    ) -> (WalkVector, Option<ConstrainedDynamics>, EquationsOfMotion) {
+        let (q, qd) = unpack(y);
+        let (dynamics, eom) = constrained_dynamics_and_eom(self.model, &q, &qd, &self.active);
+        let (f, dynamics) = self.field(&qd, dynamics);
+        (f, dynamics, eom)
+    }
+
+    /// The vector field from the constrained dynamics at a state with velocities `qd`.
+    fn field(
+        &self,
+        qd: &Coords,
+        dynamics: Result<ConstrainedDynamics, ContactError>,
+    ) -> (WalkVector, Option<ConstrainedDynamics>) {
+        match dynamics {
             Ok(d) => {
                 let c = self.model.params().viscosity;
                 let power = qd[L1] * qd[L1] + qd[L2] * qd[L2] + qd[L3] * qd[L3];
-                let f = pack(&qd, &d.qdd, c * power);
+                let f = pack(qd, &d.qdd, c * power);
                 (f, Some(d))
             }
             // The integrator reports a non-finite derivative as an error with its time.
