@@ -281,6 +281,8 @@ struct Wheel<T: Real, const C: usize> {
     hub_vp: Vector2<T>,
     /// The hub's position.
     hub_position: Vector2<T>,
+    /// `e` and `e_psi` of Legs 1 and 2 ([`Wheel::directions`]).
+    legs: [(Vector2<T>, Vector2<T>); 2],
 }
 
 impl<T: Real, const C: usize> Wheel<T, C> {
@@ -302,7 +304,27 @@ impl<T: Real, const C: usize> Wheel<T, C> {
             hub_b,
             hub_vp,
             hub_position: Vector2::new(q[X] + l1 * st, q[Z] + l1 * ct),
+            legs: [(Vector2::zeros(), Vector2::zeros()); 2],
         }
+    }
+
+    /// A point of a leg with directions `(e, e_psi)`, length and rate `(L, dL/dt)` and its length column `slot`
+    /// of `b`, at distance `from_tip` from its tip: its Jacobian columns `b`, `dJ/dt q'` and position.
+    fn point(
+        &self,
+        (e, e_psi): (Vector2<T>, Vector2<T>),
+        (length, dlength): (T, T),
+        slot: usize,
+        from_tip: T,
+    ) -> ([Vector2<T>; C], Vector2<T>, Vector2<T>) {
+        let two = lit::<T>(2.0);
+        let w = self.w;
+        let d = length - from_tip;
+        let mut b = self.hub_b;
+        b[0] += e_psi * d;
+        b[slot] += e;
+        let vp = self.hub_vp + e_psi * (two * dlength * w) - e * (d * w * w);
+        (b, vp, self.hub_position + e * d)
     }
 
     /// `e(psi)` and `e_psi = de/dpsi` for `psi = theta + j alpha` given `(sin j alpha, cos j alpha)`:
@@ -518,29 +540,6 @@ impl Model {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// A point of leg `j` (length `q[slot + 2]`, its column `slot` of `b`) at distance `from_tip` from its tip:
-    /// its Jacobian columns `b`, `dJ/dt q'` and position.
-    fn leg_point<T: Real, const C: usize>(
-        &self,
-        wheel: &Wheel<T, C>,
-        q: &CoordsOf<T>,
-        qd: &CoordsOf<T>,
-        j: LegIndex,
-        slot: usize,
-        from_tip: T,
-    ) -> ([Vector2<T>; C], Vector2<T>, Vector2<T>) {
-        let two = lit::<T>(2.0);
-        let (e, e_psi) = wheel.directions(self.offsets[j]);
-        let (length, dlength) = (q[THETA + slot], qd[THETA + slot]);
-        let w = wheel.w;
-        let d = length - from_tip;
-        let mut b = wheel.hub_b;
-        b[0] += e_psi * d;
-        b[slot] += e;
-        let vp = wheel.hub_vp + e_psi * (two * dlength * w) - e * (d * w * w);
-        (b, vp, wheel.hub_position + e * d)
-    }
-
     /// The locked legs' sums (every leg but Legs 1 and 2, and but the swinging leg while one `swing`s).
     fn locked<T: Real, const C: usize>(
         &self,
@@ -564,6 +563,16 @@ impl Model {
         }
     }
 
+    /// The hub's kinematics at `(q, q')` with the directions of Legs 1 and 2.
+    fn wheel<T: Real, const C: usize>(&self, q: &CoordsOf<T>, qd: &CoordsOf<T>) -> Wheel<T, C> {
+        let mut wheel = Wheel::<T, C>::new(q, qd);
+        wheel.legs = [
+            wheel.directions(self.offsets[0]),
+            wheel.directions(self.offsets[1]),
+        ];
+        wheel
+    }
+
     /// The kinematics of Leg 2's tip (the rows of (C2)).
     fn rear_tip<T: Real, const C: usize>(
         &self,
@@ -571,7 +580,8 @@ impl Model {
         q: &CoordsOf<T>,
         qd: &CoordsOf<T>,
     ) -> PointKinematics<T> {
-        let (b, velocity_product, position) = self.leg_point(wheel, q, qd, 1, 2, T::zero());
+        let (b, velocity_product, position) =
+            wheel.point(wheel.legs[1], (q[L2], qd[L2]), 2, T::zero());
         let mut jacobian = PointJacobian::<T>::zeros();
         jacobian[(0, X)] = T::one();
         jacobian[(1, Z)] = T::one();
@@ -633,18 +643,20 @@ impl Model {
         let swing = C == 4;
         let p = mech;
         let two = lit::<T>(2.0);
-        let wheel = Wheel::<T, C>::new(q, qd);
+        let wheel = self.wheel::<T, C>(q, qd);
         let (hub_b, hub_vp, w) = (wheel.hub_b, wheel.hub_vp, wheel.w);
         let mut sums = PointSums::<T, C>::zero();
         sums.add(p.hub_mass, &hub_b, hub_vp + p.up);
-        for (j, slot) in [(0, 1), (1, 2)] {
-            let (b, vp, _) = self.leg_point(&wheel, q, qd, j, slot, p.leg_mass_offset);
+        for (k, slot) in [(0, 1), (1, 2)] {
+            let length = (q[THETA + slot], qd[THETA + slot]);
+            let (b, vp, _) = wheel.point(wheel.legs[k], length, slot, p.leg_mass_offset);
             sums.add(p.leg_mass, &b, vp + p.up);
         }
         // The swinging leg j = 2, point by point, and the locked legs: j = 2..N, or j = 3..N while a leg swings,
         // all of the spoke length (see above).
         if swing {
-            let (b, vp, _) = self.leg_point(&wheel, q, qd, 2, 3, p.leg_mass_offset);
+            let directions = wheel.directions(self.offsets[2]);
+            let (b, vp, _) = wheel.point(directions, (q[L3], qd[L3]), 3, p.leg_mass_offset);
             sums.add(p.leg_mass, &b, vp + p.up);
         }
         let Locked {

@@ -23,7 +23,7 @@ mod coulomb;
 mod solve;
 
 pub(crate) use coulomb::force_columns;
-pub(crate) use solve::{swing_lock_impulse, Ldl};
+pub(crate) use solve::{factor_no_slip, swing_lock_impulse, NoSlipKkt, NoSlipSystem};
 
 /// Number of constraint rows in the fixed stacking order.
 pub(crate) const NROWS: usize = 6;
@@ -468,20 +468,36 @@ pub fn constrained_dynamics(
     }
 }
 
-/// [`constrained_dynamics`] with the equations of motion at the state, which the derivatives of the dynamics
-/// factor again (`crate::variational`): the same solve, its `M` and `h` not computed twice.
-pub(crate) fn constrained_dynamics_and_eom(
+/// What the derivatives of the dynamics (`crate::variational`) reuse of the walk's solve at a state: its
+/// equations of motion and, without slip, its factored KKT system.
+pub(crate) struct Solved {
+    /// `M`, `h` and Leg 2's tip.
+    pub(crate) eom: EquationsOfMotion,
+    /// The factored system ([`NoSlipKkt`]; `None` with a slipping contact, or where it did not factor).
+    pub(crate) kkt: Option<NoSlipKkt>,
+}
+
+/// [`constrained_dynamics`] with what its solve computed on the way ([`Solved`]): the same numbers.
+pub(crate) fn constrained_dynamics_solved(
     model: &Model,
     q: &Coords,
     qd: &Coords,
     active: &ActiveSet,
-) -> (Result<ConstrainedDynamics, ContactError>, EquationsOfMotion) {
+) -> (Result<ConstrainedDynamics, ContactError>, Solved) {
+    let eom = model.equations_of_motion(q, qd);
     if active.any_slip() {
         let d = coulomb::slipping_dynamics(model, q, qd, active);
-        (d, model.equations_of_motion(q, qd))
-    } else {
-        let eom = model.equations_of_motion(q, qd);
-        (solve::no_slip_dynamics_of(&eom, active), eom)
+        return (d, Solved { eom, kkt: None });
+    }
+    match factor_no_slip(&eom, active) {
+        Ok(kkt) => (
+            Ok(kkt.dynamics(&eom)),
+            Solved {
+                eom,
+                kkt: Some(kkt),
+            },
+        ),
+        Err(e) => (Err(e), Solved { eom, kkt: None }),
     }
 }
 

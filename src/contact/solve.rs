@@ -120,6 +120,46 @@ pub(super) fn no_slip_dynamics_of(
     }
     // The general case (Leg 1 sliding or off the ground): all the coordinates.
     let mut rows = ActiveRows::<NQ, NROWS>::default();
+    let m = general_rows(eom, active, &mut rows);
+    let f = std::array::from_fn(|i| -eom.bias[i]);
+    let (x, lam) = solve_active_rows(m, &f, &mut rows, active)?;
+    let mut multipliers = Multipliers::zeros();
+    for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
+        multipliers[stacked] = lam[i];
+    }
+    Ok(ConstrainedDynamics {
+        qdd: Coords::from(x),
+        multipliers,
+    })
+}
+
+/// The KKT system when Leg 1's tip is held (no-slip (C1), most of the walk): its rows are `e_x`, `e_z` with
+/// `dJ/dt q' = 0`, so `x'' = z'' = 0` and the system reduces exactly to the three coordinates
+/// `(theta, L1, L2[, L3])` with the remaining active rows ((C2), stoppers); `lambda_1`, `lambda_2` then follow from
+/// the `x` and `z` equations. Same result as [`solve_saddle`] (tested), at a fraction of the cost.
+fn solve_with_fixed_leg_one<const R: usize>(
+    eom: &EquationsOfMotion,
+    active: &ActiveSet,
+) -> Result<ConstrainedDynamics, ContactError> {
+    let (m_rr, f_r) = held_leg_one_system::<R>(eom);
+    let mut rows = ActiveRows::<R, { NROWS - 2 }>::default();
+    held_rows(eom, active, &mut rows);
+    let (qdd_r, lam) = solve_active_rows(m_rr, &f_r, &mut rows, active)?;
+    let mut multipliers = Multipliers::zeros();
+    for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
+        multipliers[2 + stacked] = lam[i];
+    }
+    Ok(complete_held_leg_one(eom, &qdd_r, multipliers))
+}
+
+/// The rows of the general case (Leg 1 sliding or off the ground) over all the coordinates, and `M` to factor
+/// (`L3` left out while no leg swings).
+#[inline(always)]
+fn general_rows(
+    eom: &EquationsOfMotion,
+    active: &ActiveSet,
+    rows: &mut ActiveRows<NQ, NROWS>,
+) -> Ldl<NQ> {
     let mask = active.row_mask();
     let rear = &eom.rear_tip;
     // Leg 1's tip is the point (x, z): constant rows, dJ/dt q' = 0.
@@ -150,31 +190,19 @@ pub(super) fn no_slip_dynamics_of(
             m.l[i][j] = eom.mass[(i, j)];
         }
     }
-    let f = std::array::from_fn(|i| -eom.bias[i]);
-    let (x, lam) = solve_active_rows(m, &f, &mut rows, active)?;
-    let mut multipliers = Multipliers::zeros();
-    for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
-        multipliers[stacked] = lam[i];
-    }
-    Ok(ConstrainedDynamics {
-        qdd: Coords::from(x),
-        multipliers,
-    })
+    m
 }
 
-/// The KKT system when Leg 1's tip is held (no-slip (C1), most of the walk): its rows are `e_x`, `e_z` with
-/// `dJ/dt q' = 0`, so `x'' = z'' = 0` and the system reduces exactly to the three coordinates
-/// `(theta, L1, L2[, L3])` with the remaining active rows ((C2), stoppers); `lambda_1`, `lambda_2` then follow from
-/// the `x` and `z` equations. Same result as [`solve_saddle`] (tested), at a fraction of the cost.
-fn solve_with_fixed_leg_one<const R: usize>(
+/// The rows with Leg 1's tip held ((C2), stoppers) restricted to `(theta, L1, L2[, L3])`, numbered from 0 after
+/// (C1)'s rows.
+#[inline(always)]
+fn held_rows<const R: usize>(
     eom: &EquationsOfMotion,
     active: &ActiveSet,
-) -> Result<ConstrainedDynamics, ContactError> {
-    let (m_rr, f_r) = held_leg_one_system::<R>(eom);
-    // Remaining rows (C2, stoppers) restricted to (theta, L1, L2), numbered from 0 after C1's rows.
+    rows: &mut ActiveRows<R, { NROWS - 2 }>,
+) {
     let rear = &eom.rear_tip;
     let mask = active.row_mask();
-    let mut rows = ActiveRows::<R, { NROWS - 2 }>::default();
     for axis in 0..2 {
         if mask[2 + axis] {
             let row = std::array::from_fn(|k| rear.jacobian[(axis, 2 + k)]);
@@ -186,12 +214,107 @@ fn solve_with_fixed_leg_one<const R: usize>(
             rows.push(unit_row(coordinate - 2), 0.0, stacked);
         }
     }
-    let (qdd_r, lam) = solve_active_rows(m_rr, &f_r, &mut rows, active)?;
-    let mut multipliers = Multipliers::zeros();
-    for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
-        multipliers[2 + stacked] = lam[i];
+}
+
+/// The KKT system of [`no_slip_dynamics`] factored (see [`Factored`]), with the stacked position of each of
+/// its rows (in the stacking of all [`NROWS`]) and their right-hand sides `-dJ/dt q'`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NoSlipSystem<const N: usize, const K: usize> {
+    /// `M` (or its block of the coordinates from `theta` on) with the active rows.
+    pub(crate) factored: Factored<N, K>,
+    /// The position of row `i` in the stacking.
+    pub(crate) stacked: [usize; K],
+    /// `b_i` of `a_i . q'' = b_i`.
+    rhs: [f64; K],
+}
+
+/// The no-slip KKT system of an active set at one state, factored as the walk factors it: what
+/// [`no_slip_dynamics`] solves once and the derivatives of the dynamics (`crate::variational`) solve again for
+/// their right-hand sides, with the walk's factors. (The walk's own path, `solve_active_rows`, factors and
+/// solves in place, without keeping the factors: the same arithmetic.)
+#[derive(Debug, Clone)]
+pub(crate) enum NoSlipKkt {
+    /// Leg 1's tip sliding or off the ground: all the coordinates (`L3` left out while no leg swings); boxed,
+    /// since it is three times the size of the others and rare.
+    General(Box<NoSlipSystem<NQ, NROWS>>),
+    /// Leg 1's tip held: `(theta, L1, L2)` with the rows of (C2) and the stoppers (see
+    /// `solve_with_fixed_leg_one`).
+    Held(NoSlipSystem<{ NQ - 3 }, { NROWS - 2 }>),
+    /// As `Held`, with `L3` while a leg swings.
+    HeldSwinging(NoSlipSystem<{ NQ - 2 }, { NROWS - 2 }>),
+}
+
+/// Factor the no-slip KKT system of `active` with the equations of motion `eom`: an error where the walk's
+/// solve fails (`M` not positive definite, redundant rows).
+pub(crate) fn factor_no_slip(
+    eom: &EquationsOfMotion,
+    active: &ActiveSet,
+) -> Result<NoSlipKkt, ContactError> {
+    if active.contact1 && !active.slide1 {
+        return Ok(if eom.swing {
+            NoSlipKkt::HeldSwinging(held_system(eom, active)?)
+        } else {
+            NoSlipKkt::Held(held_system(eom, active)?)
+        });
     }
-    Ok(complete_held_leg_one(eom, &qdd_r, multipliers))
+    let mut rows = ActiveRows::<NQ, NROWS>::default();
+    let m = general_rows(eom, active, &mut rows);
+    Ok(NoSlipKkt::General(Box::new(NoSlipSystem {
+        factored: Factored::checked(m, &rows.rows[..rows.len], active)?,
+        stacked: rows.stacked,
+        rhs: rows.rhs,
+    })))
+}
+
+/// [`factor_no_slip`] with Leg 1's tip held.
+fn held_system<const R: usize>(
+    eom: &EquationsOfMotion,
+    active: &ActiveSet,
+) -> Result<NoSlipSystem<R, { NROWS - 2 }>, ContactError> {
+    let (m_rr, _) = held_leg_one_system::<R>(eom);
+    let mut rows = ActiveRows::<R, { NROWS - 2 }>::default();
+    held_rows(eom, active, &mut rows);
+    Ok(NoSlipSystem {
+        factored: Factored::checked(m_rr, &rows.rows[..rows.len], active)?,
+        stacked: rows.stacked.map(|i| 2 + i),
+        rhs: rows.rhs,
+    })
+}
+
+impl NoSlipKkt {
+    /// The accelerations and multipliers of Eq. (1), bit for bit the walk's ([`no_slip_dynamics`]).
+    pub(super) fn dynamics(&self, eom: &EquationsOfMotion) -> ConstrainedDynamics {
+        let mut multipliers = Multipliers::zeros();
+        match self {
+            NoSlipKkt::General(system) => {
+                let f = std::array::from_fn(|i| -eom.bias[i]);
+                let (x, lam) = system.factored.solve(&f, &system.rhs);
+                for (i, &stacked) in system.stacked[..system.factored.k].iter().enumerate() {
+                    multipliers[stacked] = lam[i];
+                }
+                ConstrainedDynamics {
+                    qdd: Coords::from(x),
+                    multipliers,
+                }
+            }
+            NoSlipKkt::Held(system) => held_dynamics(eom, system),
+            NoSlipKkt::HeldSwinging(system) => held_dynamics(eom, system),
+        }
+    }
+}
+
+/// The accelerations and multipliers with Leg 1's tip held, from the factored reduced system.
+fn held_dynamics<const R: usize>(
+    eom: &EquationsOfMotion,
+    system: &NoSlipSystem<R, { NROWS - 2 }>,
+) -> ConstrainedDynamics {
+    let f_r = std::array::from_fn(|i| -eom.bias[2 + i]);
+    let (qdd_r, lam) = system.factored.solve(&f_r, &system.rhs);
+    let mut multipliers = Multipliers::zeros();
+    for (i, &stacked) in system.stacked[..system.factored.k].iter().enumerate() {
+        multipliers[stacked] = lam[i];
+    }
+    complete_held_leg_one(eom, &qdd_r, multipliers)
 }
 
 /// The reduced KKT system with Leg 1's tip held: `M_rr`, the block of `(theta, L1, L2[, L3])` (to factor), and
@@ -326,6 +449,106 @@ fn solve_active_rows<const N: usize, const K: usize>(
     Ok((x, lam))
 }
 
+/// Which factorization of [`Factored`] failed: `M`'s or the Schur complement's.
+enum Failed {
+    Mass,
+    Schur,
+}
+
+/// A KKT system `[M -A^T; A 0]` over `N` unknowns with `k <= K` rows `a_i`, factored through the Schur
+/// complement: `M = L D L^T`, `W_i = L^-1 a_i`, `S = A M^-1 A^T = W D^-1 W^T = L_S D_S L_S^T`. Solves for any
+/// right-hand side ([`Factored::solve`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Factored<const N: usize, const K: usize> {
+    /// `M = L D L^T`.
+    chol: Ldl<N>,
+    /// `W_i = L^-1 a_i`.
+    w: [[f64; N]; K],
+    /// The number of rows.
+    pub(crate) k: usize,
+    /// `S = L_S D_S L_S^T`.
+    schur: Ldl<K>,
+}
+
+impl<const N: usize, const K: usize> Factored<N, K> {
+    /// Factor `M` (`chol`, filled in and not factored) with the rows `rows` (at most `K`) of `active`: an error
+    /// where `M` is not positive definite or the rows are redundant. The test for redundancy sees the Schur
+    /// complement of all `K` stacked rows of which the inactive ones are identity rows, so when some row of
+    /// the stacking is inactive, its pivot 1 enters the largest diagonal and the smallest pivot (the same
+    /// algorithm as [`solve_saddle`] / [`solve_schur`], on the active rows only).
+    fn checked(chol: Ldl<N>, rows: &[[f64; N]], active: &ActiveSet) -> Result<Self, ContactError> {
+        let redundant = ContactError::RedundantConstraints(*active);
+        let (factored, scale) = Self::factor(chol, rows).map_err(|failed| match failed {
+            Failed::Mass => ContactError::SingularMass,
+            Failed::Schur => redundant,
+        })?;
+        let k = factored.k;
+        let (diagonal, pivot) = if k < K {
+            (1.0, 1.0)
+        } else {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        };
+        let scale = scale.max(diagonal);
+        // A rank-deficient Schur complement can still factor with a rounding-sized pivot: reject tiny pivots.
+        let min_pivot = factored.schur.d[..k].iter().copied().fold(pivot, f64::min);
+        if min_pivot < REDUNDANCY_TOL * scale {
+            return Err(redundant);
+        }
+        Ok(factored)
+    }
+
+    /// The factors and the largest diagonal entry of the Schur complement, or which factorization failed.
+    fn factor(mut chol: Ldl<N>, rows: &[[f64; N]]) -> Result<(Self, f64), Failed> {
+        let k = rows.len();
+        if !chol.factor() {
+            return Err(Failed::Mass);
+        }
+        let mut w = [[0.0; N]; K];
+        for (w_i, row) in w.iter_mut().zip(rows) {
+            *w_i = *row;
+            chol.forward(w_i);
+        }
+        let scaled_dot =
+            |u: &[f64; N], v: &[f64; N]| (0..N).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
+        let mut schur = Ldl::<K>::zeros(k);
+        for i in 0..k {
+            for j in 0..=i {
+                schur.l[i][j] = scaled_dot(&w[i], &w[j]);
+            }
+        }
+        let scale = (0..k)
+            .map(|i| schur.l[i][i])
+            .fold(f64::NEG_INFINITY, f64::max);
+        if !schur.factor() {
+            return Err(Failed::Schur);
+        }
+        Ok((Factored { chol, w, k, schur }, scale))
+    }
+
+    /// Solve `[M -A^T; A 0] [x; lam] = [f; b]` (`b` beyond the `k` rows ignored): with `g = L^-1 f`,
+    /// `S lam = b - W D^-1 g` and `x = M^-1 (f + A^T lam) = L^-T D^-1 (g + sum_i lam_i W_i)`.
+    pub(crate) fn solve(&self, f: &[f64; N], b: &[f64; K]) -> ([f64; N], [f64; K]) {
+        let chol = &self.chol;
+        let mut g = *f;
+        chol.forward(&mut g);
+        let mut lam = [0.0; K];
+        for i in 0..self.k {
+            let wg: f64 = (0..N).map(|l| self.w[i][l] * g[l] * chol.d_inv[l]).sum();
+            lam[i] = b[i] - wg;
+        }
+        self.schur.forward(&mut lam);
+        self.schur.backward_scaled(&mut lam);
+        let mut x = g;
+        for (lam_i, w_i) in lam.iter().zip(&self.w).take(self.k) {
+            for (x_l, w_l) in x.iter_mut().zip(w_i) {
+                *x_l += lam_i * w_l;
+            }
+        }
+        chol.backward_scaled(&mut x);
+        (x, lam)
+    }
+}
+
 /// `A = L D L^T` of a small symmetric positive definite matrix (`L` unit lower triangular), stored in `N x N`
 /// arrays of which the leading `n x n` block is used.
 ///
@@ -333,6 +556,7 @@ fn solve_active_rows<const N: usize, const K: usize>(
 /// factorizations and solves of size 1 to 5, where nalgebra's generic code (column views, `axpy`, square roots)
 /// costs several times these plain loops; [`solve_saddle`] keeps the nalgebra version as the reference. The
 /// factorization works in place (fill `l` with `A`, then [`Ldl::factor`]) so that no matrix is moved around.
+#[derive(Debug, Clone, Copy)]
 pub(crate) struct Ldl<const N: usize> {
     /// `A` before [`Ldl::factor`] (its lower triangle is read), `L` below the diagonal after.
     pub(crate) l: [[f64; N]; N],

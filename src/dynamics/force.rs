@@ -1,9 +1,7 @@
 //! `M(q) z + h(q, q')` without forming `M`: what the derivatives of the constrained dynamics differentiate
 //! (`crate::variational`, docs/model.md section 10).
 
-use super::{
-    lit, swinging, Coords, CoordsOf, Locked, Mechanics, Model, PointKinematics, Real, Wheel,
-};
+use super::{lit, swinging, Coords, CoordsOf, Locked, Mechanics, Model, PointKinematics, Real};
 use super::{L1, L2, L3, THETA, X, Z};
 use nalgebra::Vector2;
 
@@ -39,7 +37,7 @@ impl Model {
         z: &Coords,
     ) -> (CoordsOf<T>, PointKinematics<T>) {
         let swing = C == 4;
-        let wheel = Wheel::<T, C>::new(q, qd);
+        let wheel = self.wheel::<T, C>(q, qd);
         let zc: [T; C] = std::array::from_fn(|k| lit::<T>(z[THETA + k]));
         let z_xz = Vector2::new(lit::<T>(z[X]), lit::<T>(z[Z]));
         let mut force = CoordsOf::<T>::zeros();
@@ -58,12 +56,14 @@ impl Model {
             u
         };
         let hub_u = add(p.hub_mass, &wheel.hub_b, wheel.hub_vp + p.up);
-        for (j, slot) in [(0, 1), (1, 2)] {
-            let (b, vp, _) = self.leg_point(&wheel, q, qd, j, slot, p.leg_mass_offset);
+        for (k, slot) in [(0, 1), (1, 2)] {
+            let length = (q[THETA + slot], qd[THETA + slot]);
+            let (b, vp, _) = wheel.point(wheel.legs[k], length, slot, p.leg_mass_offset);
             add(p.leg_mass, &b, vp + p.up);
         }
         if swing {
-            let (b, vp, _) = self.leg_point(&wheel, q, qd, 2, 3, p.leg_mass_offset);
+            let directions = wheel.directions(self.offsets[2]);
+            let (b, vp, _) = wheel.point(directions, (q[L3], qd[L3]), 3, p.leg_mass_offset);
             add(p.leg_mass, &b, vp + p.up);
         }
         let Locked {

@@ -19,7 +19,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::contact::{force_columns, ActiveSet, Ldl, Leg, NROWS};
+use crate::contact::{
+    factor_no_slip, force_columns, ActiveSet, Leg, NoSlipKkt, NoSlipSystem, Solved, NROWS,
+};
 use crate::dynamics::{
     Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, PointJacobian, Real, L1, L2, NQ, X, Z,
 };
@@ -51,139 +53,20 @@ fn constraint_rows<T: Real>(
     (rows, jdq)
 }
 
-/// A saddle-point system `[A -B^T; B 0]` over `N` unknowns with up to [`NROWS`] rows `B`, factored through the
-/// Schur complement `B A^-1 B^T` with the walk's `LDL^T` ([`Ldl`]).
-struct Saddle<const N: usize> {
-    /// `A = L D L^T`.
-    a: Ldl<N>,
-    /// `W_i = L^-1 b_i` for the rows `b_i`.
-    w: [[f64; N]; NROWS],
-    /// Number of rows.
-    k: usize,
-    /// `S = W^T D^-1 W = L_S D_S L_S^T`.
-    schur: Ldl<NROWS>,
-}
-
-impl<const N: usize> Saddle<N> {
-    /// Factor `A` (its lower triangle given by `entry(i, j)`, `j <= i`) with the rows `rows[..k]`.
-    fn new(entry: impl Fn(usize, usize) -> f64, rows: &[[f64; N]]) -> Option<Saddle<N>> {
-        let mut a = Ldl::<N>::zeros(N);
-        for i in 0..N {
-            for j in 0..=i {
-                a.l[i][j] = entry(i, j);
-            }
-        }
-        if !a.factor() {
-            return None;
-        }
-        let k = rows.len();
-        let mut w = [[0.0; N]; NROWS];
-        for (w_i, row) in w.iter_mut().zip(rows) {
-            *w_i = *row;
-            a.forward(w_i);
-        }
-        let mut schur = Ldl::<NROWS>::zeros(k);
-        for i in 0..k {
-            for j in 0..=i {
-                schur.l[i][j] = (0..N).map(|l| w[i][l] * w[j][l] * a.d_inv[l]).sum();
-            }
-        }
-        schur.factor().then_some(Saddle { a, w, k, schur })
-    }
-
-    /// Solve `[A -B^T; B 0] [x; lam] = [f; b]`.
-    fn solve(&self, f: [f64; N], b: &[f64; NROWS]) -> ([f64; N], [f64; NROWS]) {
-        let mut g = f;
-        self.a.forward(&mut g);
-        let mut lam = [0.0; NROWS];
-        for i in 0..self.k {
-            let wg: f64 = (0..N).map(|l| self.w[i][l] * g[l] * self.a.d_inv[l]).sum();
-            lam[i] = b[i] - wg;
-        }
-        self.schur.forward(&mut lam);
-        self.schur.backward_scaled(&mut lam);
-        for (lam_i, w_i) in lam.iter().zip(&self.w).take(self.k) {
-            for (g_l, w_l) in g.iter_mut().zip(w_i) {
-                *g_l += lam_i * w_l;
-            }
-        }
-        self.a.backward_scaled(&mut g);
-        (g, lam)
-    }
-}
-
-/// The KKT matrix `[M -J^T; J 0]` of the active rows of `active` at one configuration, factored in `f64`:
-/// solves for many right-hand sides. When Leg 1's tip is held (no-slip (C1), most of the walk) its rows `e_x`,
-/// `e_z` fix `x`, `z` and the system is reduced to `(theta, L1, L2, L3)`, as the walk's own solve does.
-pub(crate) struct Kkt {
-    /// `M`.
-    mass: SMatrix<f64, NQ, NQ>,
+/// The KKT matrix `[M -J^T; J 0]` of the active rows of an active set at one configuration, factored in `f64`
+/// as the walk's solve factors it ([`NoSlipKkt`]): solves for many right-hand sides. When Leg 1's tip is held
+/// (no-slip (C1), most of the walk) its rows `e_x`, `e_z` fix `x`, `z` and the system is reduced to
+/// `(theta, L1, L2, L3)`, as the walk's own solve does.
+pub(crate) struct Kkt<'a> {
+    /// `M` and the rows of (C2).
+    eom: &'a EquationsOfMotion<f64>,
     /// The rows `J` in the fixed stacking (zero where inactive).
     rows: SMatrix<f64, NROWS, NQ>,
-    /// The stacked positions of the rows of the saddle system (those of (C1) excluded when held).
-    stacked: [usize; NROWS],
-    /// The factored system: over all six coordinates, or over `(theta, L1, L2, L3)` with (C1) held.
-    saddle: Reduced,
+    /// The factored system.
+    system: &'a NoSlipKkt,
 }
 
-/// [`Kkt`]'s saddle system (the variants differ in size by two rows of `W`; one lives per solve).
-#[allow(clippy::large_enum_variant)]
-enum Reduced {
-    /// Over `(x, z, theta, L1, L2)`.
-    General(Saddle<NQ>),
-    /// Over `(theta, L1, L2)`, with `x`, `z` fixed by (C1).
-    Held(Saddle<{ NQ - 3 }>),
-    /// Over `(theta, L1, L2, L3)`, with `x`, `z` fixed by (C1), while a leg swings.
-    HeldSwinging(Saddle<{ NQ - 2 }>),
-}
-
-/// The rows `stacked` of `rows` restricted to the `R` coordinates from column `first` on (`x` for the general
-/// solve, `theta` where (C1) holds `x`, `z`).
-fn rows_from<const R: usize>(
-    rows: &SMatrix<f64, NROWS, NQ>,
-    stacked: &[usize],
-    first: usize,
-) -> Vec<[f64; R]> {
-    stacked
-        .iter()
-        .map(|&i| std::array::from_fn(|l| rows[(i, first + l)]))
-        .collect()
-}
-
-impl Kkt {
-    /// Factor the KKT matrix of `active` with `M` and the rows of `eom`; `None` if singular.
-    fn new(eom: &EquationsOfMotion<f64>, active: &ActiveSet) -> Option<Kkt> {
-        let (rows, _) = constraint_rows(eom, active);
-        let held = active.contact1 && !active.slide1;
-        let first = if held { 2 } else { 0 };
-        let mut stacked = [0; NROWS];
-        let mut k = 0;
-        for (i, on) in active.row_mask().into_iter().enumerate().skip(first) {
-            if on {
-                stacked[k] = i;
-                k += 1;
-            }
-        }
-        let m = &eom.mass;
-        let reduced = |i: usize, j: usize| m[(2 + i, 2 + j)];
-        let saddle = if held && eom.swing {
-            Reduced::HeldSwinging(Saddle::new(reduced, &rows_from(&rows, &stacked[..k], 2))?)
-        } else if held {
-            Reduced::Held(Saddle::new(reduced, &rows_from(&rows, &stacked[..k], 2))?)
-        } else {
-            Reduced::General(Saddle::new(
-                |i, j| m[(i, j)],
-                &rows_from(&rows, &stacked[..k], 0),
-            )?)
-        };
-        Some(Kkt {
-            mass: eom.mass,
-            rows,
-            stacked,
-            saddle,
-        })
-    }
-
+impl Kkt<'_> {
     /// Solve `[M -J^T; J 0] [x; lam] = [f; b]` for `D` right-hand sides (inactive rows of `b` are ignored; their
     /// `lam` is 0).
     fn solve<const D: usize>(
@@ -194,26 +77,29 @@ impl Kkt {
         let mut x = SMatrix::<f64, NQ, D>::zeros();
         let mut lam = SMatrix::<f64, NROWS, D>::zeros();
         for c in 0..D {
-            match &self.saddle {
-                Reduced::General(saddle) => {
+            match self.system {
+                NoSlipKkt::General(system) => {
+                    let system = &**system;
+                    let k = system.factored.k;
                     let b_c = std::array::from_fn(|i| {
-                        if i < saddle.k {
-                            b[(self.stacked[i], c)]
+                        if i < k {
+                            b[(system.stacked[i], c)]
                         } else {
                             0.0
                         }
                     });
-                    let (x_c, l_c) = saddle.solve(std::array::from_fn(|l| f[(l, c)]), &b_c);
+                    let f_c = std::array::from_fn(|l| f[(l, c)]);
+                    let (x_c, l_c) = system.factored.solve(&f_c, &b_c);
                     for l in 0..NQ {
                         x[(l, c)] = x_c[l];
                     }
-                    for i in 0..saddle.k {
-                        lam[(self.stacked[i], c)] = l_c[i];
+                    for i in 0..k {
+                        lam[(system.stacked[i], c)] = l_c[i];
                     }
                 }
-                Reduced::Held(saddle) => self.solve_held(saddle, (f, b), c, (&mut x, &mut lam)),
-                Reduced::HeldSwinging(saddle) => {
-                    self.solve_held(saddle, (f, b), c, (&mut x, &mut lam))
+                NoSlipKkt::Held(system) => self.solve_held(system, (f, b), c, (&mut x, &mut lam)),
+                NoSlipKkt::HeldSwinging(system) => {
+                    self.solve_held(system, (f, b), c, (&mut x, &mut lam))
                 }
             }
         }
@@ -224,39 +110,41 @@ impl Kkt {
     /// from `theta` on.
     fn solve_held<const R: usize, const D: usize>(
         &self,
-        saddle: &Saddle<R>,
+        system: &NoSlipSystem<R, { NROWS - 2 }>,
         (f, b): (&SMatrix<f64, NQ, D>, &SMatrix<f64, NROWS, D>),
         c: usize,
         (x, lam): (&mut SMatrix<f64, NQ, D>, &mut SMatrix<f64, NROWS, D>),
     ) {
+        let mass = &self.eom.mass;
+        let k = system.factored.k;
         let xz = [b[(0, c)], b[(1, c)]];
         let f_r = std::array::from_fn(|l| {
-            f[(2 + l, c)] - self.mass[(2 + l, 0)] * xz[0] - self.mass[(2 + l, 1)] * xz[1]
+            f[(2 + l, c)] - mass[(2 + l, 0)] * xz[0] - mass[(2 + l, 1)] * xz[1]
         });
         let b_c = std::array::from_fn(|i| {
-            if i < saddle.k {
-                let row = self.stacked[i];
+            if i < k {
+                let row = system.stacked[i];
                 b[(row, c)] - self.rows[(row, 0)] * xz[0] - self.rows[(row, 1)] * xz[1]
             } else {
                 0.0
             }
         });
-        let (x_r, l_c) = saddle.solve(f_r, &b_c);
+        let (x_r, l_c) = system.factored.solve(&f_r, &b_c);
         x[(0, c)] = xz[0];
         x[(1, c)] = xz[1];
         for l in 0..R {
             x[(2 + l, c)] = x_r[l];
         }
-        for i in 0..saddle.k {
-            lam[(self.stacked[i], c)] = l_c[i];
+        for i in 0..k {
+            lam[(system.stacked[i], c)] = l_c[i];
         }
         // lambda_1, lambda_2 from the x and z equations: (M x - f - J_o^T lam_o)_{x,z}.
         for axis in 0..2 {
             let mut v = -f[(axis, c)];
             for j in 0..NQ {
-                v += self.mass[(axis, j)] * x[(j, c)];
+                v += mass[(axis, j)] * x[(j, c)];
             }
-            for (&row, l_i) in self.stacked.iter().zip(&l_c).take(saddle.k) {
+            for (&row, l_i) in system.stacked.iter().zip(&l_c).take(k) {
                 v -= self.rows[(row, axis)] * l_i;
             }
             lam[(axis, c)] = v;
@@ -330,14 +218,23 @@ impl SlipKkt {
 /// sides: the symmetric [`Kkt`] without slip, [`SlipKkt`] with it. `None` if singular.
 fn solve_kkt<const D: usize>(
     (model, q, qd): (&Model, &Coords, &Coords),
-    (eom, active): (&EquationsOfMotion<f64>, &ActiveSet),
+    (eom, active, system): (&EquationsOfMotion<f64>, &ActiveSet, Option<&NoSlipKkt>),
     (f, b): (&SMatrix<f64, NQ, D>, &SMatrix<f64, NROWS, D>),
 ) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
     if active.any_slip() {
-        SlipKkt::new(model, (q, qd), eom, active)?.solve(f, b)
-    } else {
-        Some(Kkt::new(eom, active)?.solve(f, b))
+        return SlipKkt::new(model, (q, qd), eom, active)?.solve(f, b);
     }
+    // The walk's factors where it gave them, else factored here (an impact's set).
+    let factored;
+    let system = match system {
+        Some(system) => system,
+        None => {
+            factored = factor_no_slip(eom, active).ok()?;
+            &factored
+        }
+    };
+    let (rows, _) = constraint_rows(eom, active);
+    Some(Kkt { eom, rows, system }.solve(f, b))
 }
 
 /// The friction force's part of the residual's derivative, `s lambda_n J_t^T dmu` for each slipping contact
@@ -471,7 +368,7 @@ fn residual_parts<const D: usize>(
 pub(crate) fn dynamics_derivative<const D: usize>(
     model: &Model,
     (q, qd, mech): &Duals<D>,
-    (real, active): (&EquationsOfMotion<f64>, &ActiveSet),
+    (solved, active): (&Solved, &ActiveSet),
     (qdd, lam): (&Coords, &SVector<f64, NROWS>),
 ) -> Option<(SMatrix<f64, NQ, D>, SMatrix<f64, NROWS, D>)> {
     // R = [M q'' + h - J^T lam; J q'' + dJ/dt q'] with (q'', lam) held: `M q'' + h` on duals without forming M
@@ -489,9 +386,10 @@ pub(crate) fn dynamics_derivative<const D: usize>(
         }
     }
     let (q_real, qd_real) = (q.map(|x| x.re), qd.map(|x| x.re));
-    add_friction_parts(&mut r1, (real, active), &mech.friction, lam);
+    add_friction_parts(&mut r1, (&solved.eom, active), &mech.friction, lam);
     let at = (model, &q_real, &qd_real);
-    let (dqdd, mut dlam) = solve_kkt(at, (real, active), (&-r1, &-r2))?;
+    let system = (&solved.eom, active, solved.kkt.as_ref());
+    let (dqdd, mut dlam) = solve_kkt(at, system, (&-r1, &-r2))?;
     friction_derivatives(active, &mech.friction, lam, &mut dlam);
     Some((dqdd, dlam))
 }
@@ -526,14 +424,14 @@ pub(crate) fn impulse_derivative<const D: usize>(
         }
     }
     let at = (model, &q.map(|x| x.re), &qd_real);
-    let (ddqd, _) = solve_kkt(at, (&real, active), (&-r1, &-r2))?;
+    let (ddqd, _) = solve_kkt(at, (&real, active, None), (&-r1, &-r2))?;
     Some(dqd_minus + ddqd)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::{constrained_dynamics, impulse};
+    use crate::contact::{constrained_dynamics, constrained_dynamics_solved, impulse};
     use crate::params::Params;
     use crate::variational::dual::{dual, seeded};
 
@@ -615,10 +513,14 @@ mod tests {
             let qd_ = CoordsOf::from_fn(|i, _| one(q[i], dir_q[i]));
             let qdd_ = CoordsOf::from_fn(|i, _| one(qd[i], dir_qd[i]));
             let duals = (qd_, qdd_, mech);
-            let eom = model.equations_of_motion(&q, &qd);
-            let (dqdd, dlam) =
-                dynamics_derivative(&model, &duals, (&eom, &active), (&d0.qdd, &d0.multipliers))
-                    .unwrap();
+            let (_, solved) = constrained_dynamics_solved(&model, &q, &qd, &active);
+            let (dqdd, dlam) = dynamics_derivative(
+                &model,
+                &duals,
+                (&solved, &active),
+                (&d0.qdd, &d0.multipliers),
+            )
+            .unwrap();
             let fd_qdd = (dp.qdd - dm.qdd) / (2.0 * h);
             let fd_lam = (dp.multipliers - dm.multipliers) / (2.0 * h);
             let scale = 1.0 + fd_qdd.amax() + fd_lam.amax();

@@ -170,12 +170,12 @@ impl<const D: usize, const A: usize> OdeSystem<A> for Variational<'_, D, A> {
         let (y, s) = Self::split(a);
         // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
         let phase = PhaseSystem::at(self.model, self.active, &y);
-        let (fy, dynamics, eom) = phase.rhs_dynamics_and_eom(&y);
+        let (fy, dynamics, solved) = phase.rhs_dynamics_solved(&y);
         let (q, qd) = duals(&y, &s);
         let derivative = dynamics.and_then(|d| {
             let duals = (q, qd, *self.mech);
             let solution = (&d.qdd, &d.multipliers);
-            dynamics_derivative(self.model, &duals, (&eom, &self.active), solution)
+            dynamics_derivative(self.model, &duals, (&solved, &self.active), solution)
         });
         let Some((dqdd, _)) = derivative else {
             return Augmented::<A>::repeat(f64::NAN);
@@ -369,8 +369,7 @@ fn cross_guard<const D: usize, const E: usize>(
     s: &Sensitivity<D>,
 ) -> Result<(Sensitivity<D>, SVector<f64, D>), NotDifferentiable> {
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
-    let (f, dynamics, eom) = PhaseSystem::at(model, segment.active, y).rhs_dynamics_and_eom(y);
-    let eom = &eom;
+    let (f, dynamics, solved) = PhaseSystem::at(model, segment.active, y).rhs_dynamics_solved(y);
     let (q, qd) = with_rate(y, s, &f);
     let touching = touchdown_leg(model, &y.fixed_rows::<NQ>(0).into_owned());
     let singular = NotDifferentiable::Singular { time: end.time };
@@ -381,7 +380,7 @@ fn cross_guard<const D: usize, const E: usize>(
         let (_, dlam) = dynamics_derivative(
             model,
             &duals,
-            (eom, &segment.active),
+            (&solved, &segment.active),
             (&d.qdd, &d.multipliers),
         )
         .ok_or(singular.clone())?;

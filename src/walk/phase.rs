@@ -5,10 +5,10 @@
 use nalgebra::SVector;
 
 use crate::contact::{
-    constrained_dynamics, constrained_dynamics_and_eom, ActiveSet, ConstrainedDynamics,
-    ContactError,
+    constrained_dynamics, constrained_dynamics_solved, ActiveSet, ConstrainedDynamics,
+    ContactError, Solved,
 };
-use crate::dynamics::{swinging, Coords, EquationsOfMotion, Model, L1, L2, L3, NQ};
+use crate::dynamics::{swinging, Coords, Model, L1, L2, L3, NQ};
 use crate::integrate::OdeSystem;
 
 /// Size of the integrated state `[q, q', E_damper]`.
@@ -64,16 +64,16 @@ impl<'a> PhaseSystem<'a> {
         self.field(&qd, constrained_dynamics(self.model, &q, &qd, &self.active))
     }
 
-    /// [`PhaseSystem::rhs_and_dynamics`] with the equations of motion at `y` (the same numbers; the derivatives
-    /// of the dynamics factor their `M` again).
-    pub(crate) fn rhs_dynamics_and_eom(
+    /// [`PhaseSystem::rhs_and_dynamics`] with what the solve computed on the way (the same numbers; the
+    /// derivatives of the dynamics solve the same KKT system again).
+    pub(crate) fn rhs_dynamics_solved(
         &self,
         y: &WalkVector,
-    ) -> (WalkVector, Option<ConstrainedDynamics>, EquationsOfMotion) {
+    ) -> (WalkVector, Option<ConstrainedDynamics>, Solved) {
         let (q, qd) = unpack(y);
-        let (dynamics, eom) = constrained_dynamics_and_eom(self.model, &q, &qd, &self.active);
+        let (dynamics, solved) = constrained_dynamics_solved(self.model, &q, &qd, &self.active);
         let (f, dynamics) = self.field(&qd, dynamics);
-        (f, dynamics, eom)
+        (f, dynamics, solved)
     }
 
     /// The vector field from the constrained dynamics at a state with velocities `qd`.
