@@ -470,6 +470,7 @@ pub fn constrained_dynamics(
 
 /// What the derivatives of the dynamics (`crate::variational`) reuse of the walk's solve at a state: its
 /// equations of motion and, without slip, its factored KKT system.
+#[derive(Debug)]
 pub(crate) struct Solved {
     /// `M`, `h` and Leg 2's tip.
     pub(crate) eom: EquationsOfMotion,
@@ -484,20 +485,35 @@ pub(crate) fn constrained_dynamics_solved(
     qd: &Coords,
     active: &ActiveSet,
 ) -> (Result<ConstrainedDynamics, ContactError>, Solved) {
-    let eom = model.equations_of_motion(q, qd);
+    let mut solved = Solved {
+        eom: model.equations_of_motion(q, qd),
+        kkt: None,
+    };
+    let dynamics = solve_into(model, (q, qd), active, &mut solved);
+    (dynamics, solved)
+}
+
+/// [`constrained_dynamics`] at `(q, q')` given its equations of motion in `solved.eom`, the factored KKT system
+/// written into `solved.kkt` (in place: a log of the walk's evaluations keeps them, see `crate::walk`).
+pub(crate) fn solve_into(
+    model: &Model,
+    (q, qd): (&Coords, &Coords),
+    active: &ActiveSet,
+    solved: &mut Solved,
+) -> Result<ConstrainedDynamics, ContactError> {
     if active.any_slip() {
-        let d = coulomb::slipping_dynamics(model, q, qd, active);
-        return (d, Solved { eom, kkt: None });
+        solved.kkt = None;
+        return coulomb::slipping_dynamics(model, q, qd, active);
     }
-    match factor_no_slip(&eom, active) {
-        Ok(kkt) => (
-            Ok(kkt.dynamics(&eom)),
-            Solved {
-                eom,
-                kkt: Some(kkt),
-            },
-        ),
-        Err(e) => (Err(e), Solved { eom, kkt: None }),
+    match factor_no_slip(&solved.eom, active) {
+        Ok(kkt) => {
+            let kkt = solved.kkt.insert(kkt);
+            Ok(kkt.dynamics(&solved.eom))
+        }
+        Err(e) => {
+            solved.kkt = None;
+            Err(e)
+        }
     }
 }
 

@@ -326,7 +326,7 @@ impl<'m> StepMap<'m> {
         let mut words = Vec::with_capacity(self.iterate);
         for _ in 0..self.iterate {
             let start = walker.state().clone();
-            let mut tape = StepTape::default();
+            let mut tape = StepTape::logging();
             let step = walker.step_taped(&mut tape)?;
             words.push(tape.signature(step.branch));
             on_border(model, &step)?;

@@ -10,7 +10,8 @@
 //! augmented state `[y, S]` is integrated with the very steps the walk accepted (`Integrator::fixed_step`, the
 //! same stages and dense output): internal numerical differentiation (Bock), so the state part reproduces the
 //! walk bit for bit and its error control is the walk's, untouched; `S` is the exact derivative of that
-//! discretization.
+//! discretization. At each stage the state's vector field, accelerations, multipliers and factored KKT matrix
+//! are the walk's own, found in the step's log of its evaluations (`StageLog`) rather than computed again.
 //!
 //! **Events.** An event with guard `g(y, p) = 0`, reset `R` and vector fields `f-`, `f+` before and after moves
 //! the time of the event by `dt = -(g_y S + g_p) / (g_y f-)`; the sensitivity after it is
@@ -25,6 +26,8 @@
 //! differentiated in duals. Where the stance tip slips at the section, its slip velocity is a fourth
 //! direction of `S`, and the next section's slip (Leg 2's tip velocity after re-indexing) a fourth row.
 
+use std::cell::Cell;
+
 use nalgebra::{SMatrix, SVector};
 
 use crate::contact::{cone_distance, impulse, ActiveSet, Leg, NROWS};
@@ -34,8 +37,9 @@ use crate::dynamics::{
 use crate::integrate::{Integrator, OdeSystem};
 use crate::params::SolverOptions;
 use crate::walk::impact::touchdown_leg;
+
 use crate::walk::tape::{Segment, StepTape};
-use crate::walk::{unpack, EventKind, PhaseSystem, WalkVector};
+use crate::walk::{unpack, EventKind, PhaseSystem, StageLog, WalkVector};
 
 use super::dual::{dual, eps, seeded, Dual};
 use super::kkt::{dynamics_derivative, impulse_derivative};
@@ -146,6 +150,8 @@ struct Variational<'a, const D: usize, const A: usize> {
     model: &'a Model,
     mech: &'a Mechanics<Dual<D>>,
     active: ActiveSet,
+    /// The walk's evaluations of the vector field, and how far the replay has come through them.
+    log: (Option<&'a StageLog>, &'a Cell<usize>),
 }
 
 impl<const D: usize, const A: usize> Variational<'_, D, A> {
@@ -168,14 +174,24 @@ impl<const D: usize, const A: usize> Variational<'_, D, A> {
 impl<const D: usize, const A: usize> OdeSystem<A> for Variational<'_, D, A> {
     fn rhs(&self, _t: f64, a: &Augmented<A>) -> Augmented<A> {
         let (y, s) = Self::split(a);
-        // The state's derivative by the walk's own code, so the state part is the walk's bit for bit.
-        let phase = PhaseSystem::at(self.model, self.active, &y);
-        let (fy, dynamics, solved) = phase.rhs_dynamics_solved(&y);
+        // The state's derivative as the walk computed it at this very state (from its log, else by the walk's
+        // own code), so the state part is the walk's bit for bit.
+        let (log, cursor) = self.log;
+        let logged = log.and_then(|log| log.find(cursor, &self.active, &y));
+        let computed;
+        let (fy, dynamics, solved) = match &logged {
+            Some(stage) => (stage.f, stage.dynamics, &stage.solved),
+            None => {
+                let phase = PhaseSystem::at(self.model, self.active, &y);
+                computed = phase.rhs_dynamics_solved(&y);
+                (computed.0, computed.1, &computed.2)
+            }
+        };
         let (q, qd) = duals(&y, &s);
         let derivative = dynamics.and_then(|d| {
             let duals = (q, qd, *self.mech);
             let solution = (&d.qdd, &d.multipliers);
-            dynamics_derivative(self.model, &duals, (&solved, &self.active), solution)
+            dynamics_derivative(self.model, &duals, (solved, &self.active), solution)
         });
         let Some((dqdd, _)) = derivative else {
             return Augmented::<A>::repeat(f64::NAN);
@@ -283,11 +299,13 @@ pub(crate) fn replay_step<const D: usize, const E: usize, const A: usize>(
     let (_, mut s) = apply_impacts(model, &mech, &y_section, s0, &tape.impacts, t0)?;
     let mut y0 = first.y0;
     let mut last_event: Option<f64> = None;
+    let log = (tape.stages.as_ref(), &Cell::new(0));
     for (k, segment) in tape.segments.iter().enumerate() {
         if swinging(&unpack(&segment.y0).0) {
             return Err(NotDifferentiable::Swinging { time: segment.t0 });
         }
-        let (y_minus, s_minus) = integrate_segment::<D, A>(model, opts, &mech, segment, &y0, &s)?;
+        let (y_minus, s_minus) =
+            integrate_segment::<D, A>((model, opts, &mech), segment, (&y0, &s), log)?;
         let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
         if last_event.is_some_and(|t| (end.time - t).abs() < COINCIDENT_EVENTS) {
             return Err(NotDifferentiable::CoincidentEvents { time: end.time });
@@ -324,18 +342,17 @@ fn rate_outer<const D: usize>(f: &WalkVector, dt: &SVector<f64, D>) -> Sensitivi
 
 /// Integrate the variational equations over the recorded steps of `segment` from `(y0, s0)`: the state and
 /// sensitivity at the event that ends it.
-fn integrate_segment<const D: usize, const A: usize>(
-    model: &Model,
-    opts: &SolverOptions,
-    mech: &Mechanics<Dual<D>>,
+fn integrate_segment<'a, const D: usize, const A: usize>(
+    (model, opts, mech): (&'a Model, &SolverOptions, &'a Mechanics<Dual<D>>),
     segment: &Segment,
-    y0: &WalkVector,
-    s0: &Sensitivity<D>,
+    (y0, s0): (&WalkVector, &Sensitivity<D>),
+    log: (Option<&'a StageLog>, &'a Cell<usize>),
 ) -> Result<(WalkVector, Sensitivity<D>), NotDifferentiable> {
     let sys = Variational::<D, A> {
         model,
         mech,
         active: segment.active,
+        log,
     };
     let end = segment.end.as_ref().ok_or(NotDifferentiable::Incomplete)?;
     let mut t = segment.t0;

@@ -284,6 +284,45 @@ fn parameter_derivatives_match_finite_differences_for_every_key() {
     }
 }
 
+/// The replay takes the state's vector field from the walk's log of its evaluations ([`StepTape::logging`])
+/// instead of solving the constrained dynamics again: on walks that meet every kind of event it finds every
+/// state there, the walk is the same with and without the log, and so are the sensitivities, bit for bit.
+#[test]
+fn the_replay_finds_every_state_in_the_walks_log() {
+    use super::{augmented, replay_step, Sensitivity};
+    for (overrides, s) in cases() {
+        let config = config_of(&overrides);
+        let model = Model::new(&config.params).unwrap();
+        let (q, qd) = s.to_coords(&model);
+        let s0 = Sensitivity::<3>::from_fn(|i, j| ((i + 3 * j) as f64).sin());
+        let replay = |tape: &StepTape| {
+            replay_step::<3, 4, { augmented(3) }>(
+                &model,
+                &config.solver,
+                None,
+                (&q, &qd),
+                &s0,
+                tape,
+            )
+            .map(|d| d.sensitivity)
+        };
+        let (mut plain, mut logged) = (StepTape::default(), StepTape::logging());
+        let walk = |tape: &mut StepTape| {
+            let mut walker = Walker::new(&model, &config.solver, &s).unwrap();
+            let report = walker.step_taped(tape).unwrap();
+            (report, walker.state().clone())
+        };
+        assert_eq!(walk(&mut plain), walk(&mut logged), "{overrides:?}");
+        let (without, with) = (replay(&plain), replay(&logged));
+        assert_eq!(without, with, "{overrides:?}");
+        let (found, missed) = logged.stages.as_ref().unwrap().lookups();
+        assert!(
+            found > 100 && missed == 0,
+            "{overrides:?}: {found} found, {missed} missed"
+        );
+    }
+}
+
 /// With Coulomb friction at the ratio of the paper's no-slip touchdown impulse's tangential to normal part, that
 /// impulse lies on the edge of its cone: the border between a sticking and a slipping impact, where the step map
 /// has no derivative, and the replay says so. Away from the edge the derivative exists.

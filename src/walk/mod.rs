@@ -66,7 +66,7 @@ mod zeno;
 pub use error::WalkError;
 pub(crate) use events::EventKind;
 pub use impact::{Branch, DlsIndicators};
-pub(crate) use phase::{pack, unpack};
+pub(crate) use phase::{pack, unpack, StageLog};
 pub use phase::{PhaseSystem, WalkState, WalkVector};
 pub use report::{
     ContactAudit, EnergyAudit, FrictionAudit, StepReport, CONE_VIOLATION_WARNING,

@@ -6,16 +6,23 @@
 use crate::contact::{ActiveSet, Leg, Stop};
 
 use super::events::EventKind;
-use super::phase::WalkVector;
+use super::phase::{StageLog, WalkVector};
 
 /// One step as the walker took it ([`super::Walker::step_taped`]).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default)]
 pub(crate) struct StepTape {
     /// The units that took an impulse at the touchdown impact: the collision the procedure applied, then the
     /// Zeno locks that followed it, in order.
     pub(crate) impacts: Vec<ActiveSet>,
     /// The phases of the step, in order; the last ends at the next touchdown.
     pub(crate) segments: Vec<Segment>,
+    /// The walk's evaluations of the vector field, kept for the replay where asked for ([`StepTape::logging`]).
+    pub(crate) stages: Option<StageLog>,
+}
+
+/// The log of `tape`, if it keeps one.
+pub(crate) fn log_of<'t>(tape: &'t Option<&mut StepTape>) -> Option<&'t StageLog> {
+    tape.as_deref().and_then(|t| t.stages.as_ref())
 }
 
 /// One phase of constrained motion.
@@ -48,6 +55,14 @@ pub(crate) struct SegmentEnd {
 }
 
 impl StepTape {
+    /// An empty tape that also keeps the walk's evaluations of the vector field ([`StageLog`]).
+    pub(crate) fn logging() -> StepTape {
+        StepTape {
+            stages: Some(StageLog::reserved()),
+            ..StepTape::default()
+        }
+    }
+
     /// Start a phase at `(t0, y0)` with `active`.
     pub(crate) fn begin(&mut self, active: ActiveSet, t0: f64, y0: WalkVector) {
         self.segments.push(Segment {

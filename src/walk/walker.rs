@@ -23,7 +23,7 @@ use super::reindex::reindex;
 use super::report::{EnergyAudit, StepReport};
 use super::section::SectionState;
 use super::tally::StepTally;
-use super::tape::StepTape;
+use super::tape::{log_of, StepTape};
 use super::trajectory::Trajectory;
 use super::work::WorkCounts;
 use super::zeno::lock_zeno_stoppers;
@@ -388,7 +388,7 @@ impl<'a> Phases<'a> {
         let t_limit = start.time + opts.max_step_time;
         let solver = Integrator::new(
             opts.integrator,
-            &PhaseSystem::at(model, active, &y),
+            &PhaseSystem::at(model, active, &y).logging(log_of(&tape)),
             t,
             y,
             walker.tolerances(),
@@ -468,7 +468,7 @@ impl<'a> Phases<'a> {
                 phase,
             });
         }
-        let sys = PhaseSystem::at(model, active, &self.y);
+        let sys = PhaseSystem::at(model, active, &self.y).logging(log_of(&self.tape));
         let step = self
             .solver
             .step(&sys, self.t_limit)
@@ -681,7 +681,7 @@ impl<'a> Phases<'a> {
     /// new active set, and the trajectory takes a sample there.
     fn restart_phase(&mut self) {
         let (model, active) = (self.model, self.active);
-        let sys = PhaseSystem::at(model, active, &self.y);
+        let sys = PhaseSystem::at(model, active, &self.y).logging(log_of(&self.tape));
         self.solver.restart(&sys, self.t, self.y);
         self.events = EventSet::new(model, self.opts, active, &self.y);
         let pull;
