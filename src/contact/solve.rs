@@ -284,11 +284,11 @@ fn held_system<const R: usize>(
 impl NoSlipKkt {
     /// The accelerations and multipliers of Eq. (1), bit for bit the walk's ([`no_slip_dynamics`]).
     pub(super) fn dynamics(&self, eom: &EquationsOfMotion) -> ConstrainedDynamics {
-        let mut multipliers = Multipliers::zeros();
         match self {
             NoSlipKkt::General(system) => {
                 let f = std::array::from_fn(|i| -eom.bias[i]);
                 let (x, lam) = system.factored.solve(&f, &system.rhs);
+                let mut multipliers = Multipliers::zeros();
                 for (i, &stacked) in system.stacked[..system.factored.k].iter().enumerate() {
                     multipliers[stacked] = lam[i];
                 }

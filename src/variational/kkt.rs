@@ -5,9 +5,11 @@
 //! rows): Eq. (1) with the constraints, `z = (q'', lam)`, and Eq. (5), `z = (q'+ - q'-, lam_I)`. Written as a
 //! residual `R(y, z) = 0`, the solution's derivative along a direction of `y` is `dz = -K^-1 (dR/dy)`, the
 //! residual differentiated with `z` held at its value. So the walk's own `f64` solve gives `z`, one evaluation
-//! of the residual on dual numbers gives `dR/dy` along every direction at once (the equations of motion and
-//! the rows of (C2) differentiated by [`crate::dynamics::Real`]), and one `f64` factorization of `K` solves for
-//! all directions. This is the KKT solve differentiated, without running a factorization on dual numbers.
+//! of the residual on dual numbers gives `dR/dy` along every direction at once (`M q'' + h` without forming `M`,
+//! `Model::generalized_force_with`, and the rows of (C2), differentiated by [`crate::dynamics::Real`]), and
+//! one `f64` factorization of `K` solves for all directions: the walk's own where its solve kept it
+//! (`contact::NoSlipKkt`, found in the step's log), else one made here the same way (an impact's set). This is
+//! the KKT solve differentiated, without running a factorization on dual numbers.
 //!
 //! **Coulomb slip** (docs/model.md section 12). A slipping contact's tangential force is not a free multiplier but
 //! `lambda_t = -s mu lambda_n`, so the residual's first block is `M q'' + h - A^T lam - J_t^T lambda_t(lambda_n,

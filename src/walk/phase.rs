@@ -207,12 +207,15 @@ impl StageLog {
                 kkt: None,
             },
         });
-        let Some(stage) = stages.last_mut() else {
-            unreachable!("an evaluation was just pushed")
-        };
-        let dynamics = solve_into(phase.model, (&q, &qd), &phase.active, &mut stage.solved);
-        (stage.f, stage.dynamics) = phase.field(&qd, dynamics);
-        stage.f
+        match stages.last_mut() {
+            Some(stage) => {
+                let dynamics = solve_into(phase.model, (&q, &qd), &phase.active, &mut stage.solved);
+                (stage.f, stage.dynamics) = phase.field(&qd, dynamics);
+                stage.f
+            }
+            // Not reached: an evaluation was just pushed.
+            None => phase.rhs_and_dynamics(y).0,
+        }
     }
 
     /// The first evaluation at or after `cursor` (within [`LOOKAHEAD`]) of the state `y` (bit for bit) with
