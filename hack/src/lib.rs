@@ -1,0 +1,1 @@
+//! Feature unification for the vrw workspace: no code. See `Cargo.toml`.
