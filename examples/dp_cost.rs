@@ -1,7 +1,7 @@
 //! The cost of one gait's exact `DP` against one step of the map, for an instruction counter (README, Speed):
 //!
 //! ```sh
-//! cargo build --release --example dp_cost
+//! CARGO_PROFILE_RELEASE_DEBUG=1 cargo build --release --example dp_cost   # source lines for callgrind_annotate
 //! valgrind --tool=callgrind target/release/examples/dp_cost dp 40
 //! valgrind --tool=callgrind target/release/examples/dp_cost eval 40
 //! ```

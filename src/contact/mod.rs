@@ -505,11 +505,12 @@ pub(crate) fn solve_into(
         solved.kkt = None;
         return coulomb::slipping_dynamics(model, q, qd, active);
     }
-    match factor_no_slip(&solved.eom, active) {
-        Ok(kkt) => {
-            let kkt = solved.kkt.insert(kkt);
-            Ok(kkt.dynamics(&solved.eom))
-        }
+    // Filled in and factored where it is kept (a log's slot), not moved there afterwards.
+    let kkt = solved
+        .kkt
+        .insert(NoSlipKkt::unfactored(&solved.eom, active));
+    match kkt.factor_dynamics(&solved.eom, active) {
+        Ok(dynamics) => Ok(dynamics),
         Err(e) => {
             solved.kkt = None;
             Err(e)

@@ -93,7 +93,7 @@ fn solve_schur<const K: usize>(
 
 /// Accelerations and multipliers of Eq. (1) with the constraints of `active` (docs/model.md section 3).
 ///
-/// Only the active rows enter the solve (see `solve_active_rows`); when Leg 1's tip is held (most of the walk)
+/// Only the active rows enter the solve (see [`Factored`]); when Leg 1's tip is held (most of the walk)
 /// the system is first reduced to `(theta, L1, L2)`, and `L3` while a leg swings (`solve_with_fixed_leg_one`).
 /// Same result as `solve_saddle` on the full stacking (tested for every active set).
 pub(super) fn no_slip_dynamics(
@@ -119,18 +119,7 @@ pub(super) fn no_slip_dynamics_of(
         };
     }
     // The general case (Leg 1 sliding or off the ground): all the coordinates.
-    let mut rows = ActiveRows::<NQ, NROWS>::default();
-    let m = general_rows(eom, active, &mut rows);
-    let f = std::array::from_fn(|i| -eom.bias[i]);
-    let (x, lam) = solve_active_rows(m, &f, &mut rows, active)?;
-    let mut multipliers = Multipliers::zeros();
-    for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
-        multipliers[stacked] = lam[i];
-    }
-    Ok(ConstrainedDynamics {
-        qdd: Coords::from(x),
-        multipliers,
-    })
+    general_system(eom, active).general_dynamics(eom, active)
 }
 
 /// The KKT system when Leg 1's tip is held (no-slip (C1), most of the walk): its rows are `e_x`, `e_z` with
@@ -141,25 +130,13 @@ fn solve_with_fixed_leg_one<const R: usize>(
     eom: &EquationsOfMotion,
     active: &ActiveSet,
 ) -> Result<ConstrainedDynamics, ContactError> {
-    let (m_rr, f_r) = held_leg_one_system::<R>(eom);
-    let mut rows = ActiveRows::<R, { NROWS - 2 }>::default();
-    held_rows(eom, active, &mut rows);
-    let (qdd_r, lam) = solve_active_rows(m_rr, &f_r, &mut rows, active)?;
-    let mut multipliers = Multipliers::zeros();
-    for (i, &stacked) in rows.stacked[..rows.len].iter().enumerate() {
-        multipliers[2 + stacked] = lam[i];
-    }
-    Ok(complete_held_leg_one(eom, &qdd_r, multipliers))
+    held_dynamics(eom, &mut held_system::<R>(eom, active), active)
 }
 
-/// The rows of the general case (Leg 1 sliding or off the ground) over all the coordinates, and `M` to factor
-/// (`L3` left out while no leg swings).
+/// The KKT system of the general case (Leg 1 sliding or off the ground) over all the coordinates, not yet
+/// factored: `M` (`L3` left out while no leg swings) and the active rows.
 #[inline(always)]
-fn general_rows(
-    eom: &EquationsOfMotion,
-    active: &ActiveSet,
-    rows: &mut ActiveRows<NQ, NROWS>,
-) -> Ldl<NQ> {
+fn general_system(eom: &EquationsOfMotion, active: &ActiveSet) -> NoSlipSystem<NQ, NROWS> {
     let mask = active.row_mask();
     let rear = &eom.rear_tip;
     // Leg 1's tip is the point (x, z): constant rows, dJ/dt q' = 0.
@@ -177,11 +154,6 @@ fn general_rows(
         (unit_row(L1), 0.0),
         (unit_row(L2), 0.0),
     ];
-    for (stacked, (row, rhs)) in candidates.into_iter().enumerate() {
-        if mask[stacked] {
-            rows.push(row, rhs, stacked);
-        }
-    }
     // Without a swinging leg `L3` is left out (its row of M is the identity's, with no force).
     let n = if eom.swing { NQ } else { NQ - 1 };
     let mut m = Ldl::<NQ>::zeros(n);
@@ -190,34 +162,42 @@ fn general_rows(
             m.l[i][j] = eom.mass[(i, j)];
         }
     }
-    m
+    let mut system = NoSlipSystem::new(m);
+    for (stacked, (row, rhs)) in candidates.into_iter().enumerate() {
+        if mask[stacked] {
+            system.push(row, rhs, stacked);
+        }
+    }
+    system
 }
 
-/// The rows with Leg 1's tip held ((C2), stoppers) restricted to `(theta, L1, L2[, L3])`, numbered from 0 after
-/// (C1)'s rows.
+/// The KKT system with Leg 1's tip held, not yet factored: `M_rr`, the block of `(theta, L1, L2[, L3])`, and the
+/// rows of (C2) and the stoppers restricted to those coordinates.
 #[inline(always)]
-fn held_rows<const R: usize>(
+fn held_system<const R: usize>(
     eom: &EquationsOfMotion,
     active: &ActiveSet,
-    rows: &mut ActiveRows<R, { NROWS - 2 }>,
-) {
+) -> NoSlipSystem<R, { NROWS - 2 }> {
+    let mut system = NoSlipSystem::new(held_leg_one_system::<R>(eom).0);
     let rear = &eom.rear_tip;
     let mask = active.row_mask();
     for axis in 0..2 {
         if mask[2 + axis] {
             let row = std::array::from_fn(|k| rear.jacobian[(axis, 2 + k)]);
-            rows.push(row, -rear.velocity_product[axis], axis);
+            system.push(row, -rear.velocity_product[axis], 2 + axis);
         }
     }
-    for (stacked, coordinate) in [(2, L1), (3, L2)] {
-        if mask[2 + stacked] {
-            rows.push(unit_row(coordinate - 2), 0.0, stacked);
+    for (stacked, coordinate) in [(4, L1), (5, L2)] {
+        if mask[stacked] {
+            system.push(unit_row(coordinate - 2), 0.0, stacked);
         }
     }
+    system
 }
 
-/// The KKT system of [`no_slip_dynamics`] factored (see [`Factored`]), with the stacked position of each of
-/// its rows (in the stacking of all [`NROWS`]) and their right-hand sides `-dJ/dt q'`.
+/// The KKT system of [`no_slip_dynamics`] (see [`Factored`]: filled in, then factored in place), with the
+/// stacked position of each of its rows (in the stacking of all [`NROWS`]) and their right-hand sides
+/// `-dJ/dt q'`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct NoSlipSystem<const N: usize, const K: usize> {
     /// `M` (or its block of the coordinates from `theta` on) with the active rows.
@@ -228,10 +208,62 @@ pub(crate) struct NoSlipSystem<const N: usize, const K: usize> {
     rhs: [f64; K],
 }
 
+impl<const N: usize, const K: usize> NoSlipSystem<N, K> {
+    /// The system with `M` (filled in, not factored: `chol`) and no rows yet.
+    #[inline(always)]
+    fn new(chol: Ldl<N>) -> Self {
+        NoSlipSystem {
+            factored: Factored {
+                chol,
+                w: [[0.0; N]; K],
+                k: 0,
+                schur: Ldl::zeros(0),
+            },
+            stacked: [0; K],
+            rhs: [0.0; K],
+        }
+    }
+
+    /// Add the row `a . x = rhs`, row `stacked` of the stacking.
+    #[inline(always)]
+    fn push(&mut self, a: [f64; N], rhs: f64, stacked: usize) {
+        let k = self.factored.k;
+        self.factored.w[k] = a;
+        self.rhs[k] = rhs;
+        self.stacked[k] = stacked;
+        self.factored.k += 1;
+    }
+
+    /// The multipliers `lam` of the rows in the stacking of all [`NROWS`] (0 for the inactive ones).
+    fn multipliers(&self, lam: &[f64; K]) -> Multipliers {
+        let mut multipliers = Multipliers::zeros();
+        for (i, &stacked) in self.stacked[..self.factored.k].iter().enumerate() {
+            multipliers[stacked] = lam[i];
+        }
+        multipliers
+    }
+}
+
+impl NoSlipSystem<NQ, NROWS> {
+    /// Factor the general case in place and solve it: the accelerations and multipliers.
+    fn general_dynamics(
+        &mut self,
+        eom: &EquationsOfMotion,
+        active: &ActiveSet,
+    ) -> Result<ConstrainedDynamics, ContactError> {
+        let f = std::array::from_fn(|i| -eom.bias[i]);
+        let (x, lam) = self.factored.factor_solve(&f, &self.rhs, active)?;
+        Ok(ConstrainedDynamics {
+            qdd: Coords::from(x),
+            multipliers: self.multipliers(&lam),
+        })
+    }
+}
+
 /// The no-slip KKT system of an active set at one state, factored as the walk factors it: what
 /// [`no_slip_dynamics`] solves once and the derivatives of the dynamics (`crate::variational`) solve again for
-/// their right-hand sides, with the walk's factors. (The walk's own path, `solve_active_rows`, factors and
-/// solves in place, without keeping the factors: the same arithmetic.)
+/// their right-hand sides, with the walk's factors. (The walk's own path, [`no_slip_dynamics_of`], builds the
+/// same system on its stack and drops it after the solve.)
 #[derive(Debug, Clone)]
 pub(crate) enum NoSlipKkt {
     /// Leg 1's tip sliding or off the ground: all the coordinates (`L3` left out while no leg swings); boxed,
@@ -250,71 +282,50 @@ pub(crate) fn factor_no_slip(
     eom: &EquationsOfMotion,
     active: &ActiveSet,
 ) -> Result<NoSlipKkt, ContactError> {
-    if active.contact1 && !active.slide1 {
-        return Ok(if eom.swing {
-            NoSlipKkt::HeldSwinging(held_system(eom, active)?)
-        } else {
-            NoSlipKkt::Held(held_system(eom, active)?)
-        });
-    }
-    let mut rows = ActiveRows::<NQ, NROWS>::default();
-    let m = general_rows(eom, active, &mut rows);
-    Ok(NoSlipKkt::General(Box::new(NoSlipSystem {
-        factored: Factored::checked(m, &rows.rows[..rows.len], active)?,
-        stacked: rows.stacked,
-        rhs: rows.rhs,
-    })))
-}
-
-/// [`factor_no_slip`] with Leg 1's tip held.
-fn held_system<const R: usize>(
-    eom: &EquationsOfMotion,
-    active: &ActiveSet,
-) -> Result<NoSlipSystem<R, { NROWS - 2 }>, ContactError> {
-    let (m_rr, _) = held_leg_one_system::<R>(eom);
-    let mut rows = ActiveRows::<R, { NROWS - 2 }>::default();
-    held_rows(eom, active, &mut rows);
-    Ok(NoSlipSystem {
-        factored: Factored::checked(m_rr, &rows.rows[..rows.len], active)?,
-        stacked: rows.stacked.map(|i| 2 + i),
-        rhs: rows.rhs,
-    })
+    let mut kkt = NoSlipKkt::unfactored(eom, active);
+    kkt.factor_dynamics(eom, active)?;
+    Ok(kkt)
 }
 
 impl NoSlipKkt {
-    /// The accelerations and multipliers of Eq. (1), bit for bit the walk's ([`no_slip_dynamics`]).
-    pub(super) fn dynamics(&self, eom: &EquationsOfMotion) -> ConstrainedDynamics {
-        match self {
-            NoSlipKkt::General(system) => {
-                let f = std::array::from_fn(|i| -eom.bias[i]);
-                let (x, lam) = system.factored.solve(&f, &system.rhs);
-                let mut multipliers = Multipliers::zeros();
-                for (i, &stacked) in system.stacked[..system.factored.k].iter().enumerate() {
-                    multipliers[stacked] = lam[i];
-                }
-                ConstrainedDynamics {
-                    qdd: Coords::from(x),
-                    multipliers,
-                }
+    /// The no-slip KKT system of `active` with the equations of motion `eom`, filled in, not yet factored.
+    pub(crate) fn unfactored(eom: &EquationsOfMotion, active: &ActiveSet) -> NoSlipKkt {
+        if active.contact1 && !active.slide1 {
+            if eom.swing {
+                NoSlipKkt::HeldSwinging(held_system(eom, active))
+            } else {
+                NoSlipKkt::Held(held_system(eom, active))
             }
-            NoSlipKkt::Held(system) => held_dynamics(eom, system),
-            NoSlipKkt::HeldSwinging(system) => held_dynamics(eom, system),
+        } else {
+            NoSlipKkt::General(Box::new(general_system(eom, active)))
+        }
+    }
+
+    /// Factor in place ([`Factored::factor_solve`]) and solve: the accelerations and multipliers of Eq. (1),
+    /// bit for bit the walk's ([`no_slip_dynamics`], which does the same on its stack).
+    pub(crate) fn factor_dynamics(
+        &mut self,
+        eom: &EquationsOfMotion,
+        active: &ActiveSet,
+    ) -> Result<ConstrainedDynamics, ContactError> {
+        match self {
+            NoSlipKkt::General(system) => system.general_dynamics(eom, active),
+            NoSlipKkt::Held(system) => held_dynamics(eom, system, active),
+            NoSlipKkt::HeldSwinging(system) => held_dynamics(eom, system, active),
         }
     }
 }
 
-/// The accelerations and multipliers with Leg 1's tip held, from the factored reduced system.
+/// The accelerations and multipliers with Leg 1's tip held: the reduced system factored in place and solved.
+#[inline(always)]
 fn held_dynamics<const R: usize>(
     eom: &EquationsOfMotion,
-    system: &NoSlipSystem<R, { NROWS - 2 }>,
-) -> ConstrainedDynamics {
+    system: &mut NoSlipSystem<R, { NROWS - 2 }>,
+    active: &ActiveSet,
+) -> Result<ConstrainedDynamics, ContactError> {
     let f_r = std::array::from_fn(|i| -eom.bias[2 + i]);
-    let (qdd_r, lam) = system.factored.solve(&f_r, &system.rhs);
-    let mut multipliers = Multipliers::zeros();
-    for (i, &stacked) in system.stacked[..system.factored.k].iter().enumerate() {
-        multipliers[stacked] = lam[i];
-    }
-    complete_held_leg_one(eom, &qdd_r, multipliers)
+    let (qdd_r, lam) = system.factored.factor_solve(&f_r, &system.rhs, active)?;
+    Ok(complete_held_leg_one(eom, &qdd_r, system.multipliers(&lam)))
 }
 
 /// The reduced KKT system with Leg 1's tip held: `M_rr`, the block of `(theta, L1, L2[, L3])` (to factor), and
@@ -356,113 +367,15 @@ fn unit_row<const N: usize>(i: usize) -> [f64; N] {
     std::array::from_fn(|k| if k == i { 1.0 } else { 0.0 })
 }
 
-/// The active constraint rows of a KKT system over `N` unknowns whose constraints stack `K` rows, compacted:
-/// row `a_i`, right-hand side `b_i` (of `a_i . x = b_i`) and the position of the row in the stacking.
-#[derive(Debug, Clone, Copy)]
-struct ActiveRows<const N: usize, const K: usize> {
-    rows: [[f64; N]; K],
-    rhs: [f64; K],
-    stacked: [usize; K],
-    len: usize,
-}
-
-impl<const N: usize, const K: usize> Default for ActiveRows<N, K> {
-    fn default() -> Self {
-        ActiveRows {
-            rows: [[0.0; N]; K],
-            rhs: [0.0; K],
-            stacked: [0; K],
-            len: 0,
-        }
-    }
-}
-
-impl<const N: usize, const K: usize> ActiveRows<N, K> {
-    fn push(&mut self, row: [f64; N], rhs: f64, stacked: usize) {
-        self.rows[self.len] = row;
-        self.rhs[self.len] = rhs;
-        self.stacked[self.len] = stacked;
-        self.len += 1;
-    }
-}
-
-/// Solve `[M -A^T; A 0] [x; lam] = [f; b]` for the active rows `A`, `b` of `rows` through the Schur complement
-/// `S = A M^-1 A^T`, returning `x` and `lam` in the order of `rows` (whose rows it overwrites).
-///
-/// The same algorithm as [`solve_saddle`] / [`solve_schur`], on the active rows only: the redundancy test sees
-/// the Schur complement of all `K` stacked rows of which the inactive ones are identity rows, so when some row
-/// of the stacking is inactive, its pivot 1 enters the largest diagonal and the smallest pivot as there.
-fn solve_active_rows<const N: usize, const K: usize>(
-    mut chol: Ldl<N>,
-    f: &[f64; N],
-    rows: &mut ActiveRows<N, K>,
-    active: &ActiveSet,
-) -> Result<([f64; N], [f64; K]), ContactError> {
-    let k = rows.len;
-    if !chol.factor() {
-        return Err(ContactError::SingularMass);
-    }
-    // M = L D L^T; with g = L^-1 f and W_i = L^-1 a_i: a_i . M^-1 f = W_i . D^-1 g, S_ij = W_i . D^-1 W_j.
-    let mut g = *f;
-    chol.forward(&mut g);
-    // W_i = L^-1 a_i, in place of a_i.
-    let w = &mut rows.rows;
-    for w_i in &mut w[..k] {
-        chol.forward(w_i);
-    }
-    let scaled_dot =
-        |u: &[f64; N], v: &[f64; N]| (0..N).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
-    let mut schur = Ldl::<K>::zeros(k);
-    let mut lam = [0.0; K];
-    for i in 0..k {
-        lam[i] = rows.rhs[i] - scaled_dot(&w[i], &g);
-        for j in 0..=i {
-            schur.l[i][j] = scaled_dot(&w[i], &w[j]);
-        }
-    }
-    // The identity rows of the inactive units, if any, as `solve_schur` sees them.
-    let (diagonal, pivot) = if k < K {
-        (1.0, 1.0)
-    } else {
-        (f64::NEG_INFINITY, f64::INFINITY)
-    };
-    let scale = (0..k).map(|i| schur.l[i][i]).fold(diagonal, f64::max);
-    let redundant = ContactError::RedundantConstraints(*active);
-    if !schur.factor() {
-        return Err(redundant);
-    }
-    // A rank-deficient Schur complement can still factor with a rounding-sized pivot: reject tiny pivots.
-    let min_pivot = schur.d[..k].iter().copied().fold(pivot, f64::min);
-    if min_pivot < REDUNDANCY_TOL * scale {
-        return Err(redundant);
-    }
-    schur.forward(&mut lam);
-    schur.backward_scaled(&mut lam);
-    // x = M^-1 (f + A^T lam) = L^-T D^-1 (g + sum_i lam_i W_i)
-    let mut x = g;
-    for i in 0..k {
-        for l in 0..N {
-            x[l] += lam[i] * w[i][l];
-        }
-    }
-    chol.backward_scaled(&mut x);
-    Ok((x, lam))
-}
-
-/// Which factorization of [`Factored`] failed: `M`'s or the Schur complement's.
-enum Failed {
-    Mass,
-    Schur,
-}
-
 /// A KKT system `[M -A^T; A 0]` over `N` unknowns with `k <= K` rows `a_i`, factored through the Schur
-/// complement: `M = L D L^T`, `W_i = L^-1 a_i`, `S = A M^-1 A^T = W D^-1 W^T = L_S D_S L_S^T`. Solves for any
-/// right-hand side ([`Factored::solve`]).
+/// complement: `M = L D L^T`, `W_i = L^-1 a_i`, `S = A M^-1 A^T = W D^-1 W^T = L_S D_S L_S^T`. Filled in
+/// ([`NoSlipSystem`]) and factored in place ([`Factored::factor_solve`]), so that neither the walk's solve nor the
+/// log of its evaluations moves it; solves for any right-hand side ([`Factored::solve`]).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Factored<const N: usize, const K: usize> {
-    /// `M = L D L^T`.
+    /// `M` before [`Factored::factor_solve`], `M = L D L^T` after.
     chol: Ldl<N>,
-    /// `W_i = L^-1 a_i`.
+    /// The rows `a_i` before, `W_i = L^-1 a_i` after.
     w: [[f64; N]; K],
     /// The number of rows.
     pub(crate) k: usize,
@@ -471,62 +384,85 @@ pub(crate) struct Factored<const N: usize, const K: usize> {
 }
 
 impl<const N: usize, const K: usize> Factored<N, K> {
-    /// Factor `M` (`chol`, filled in and not factored) with the rows `rows` (at most `K`) of `active`: an error
-    /// where `M` is not positive definite or the rows are redundant. The test for redundancy sees the Schur
-    /// complement of all `K` stacked rows of which the inactive ones are identity rows, so when some row of
-    /// the stacking is inactive, its pivot 1 enters the largest diagonal and the smallest pivot (the same
-    /// algorithm as [`solve_saddle`] / [`solve_schur`], on the active rows only).
-    fn checked(chol: Ldl<N>, rows: &[[f64; N]], active: &ActiveSet) -> Result<Self, ContactError> {
-        let redundant = ContactError::RedundantConstraints(*active);
-        let (factored, scale) = Self::factor(chol, rows).map_err(|failed| match failed {
-            Failed::Mass => ContactError::SingularMass,
-            Failed::Schur => redundant,
-        })?;
-        let k = factored.k;
+    /// Factor in place and solve `[M -A^T; A 0] [x; lam] = [f; b]` (`b` beyond the `k` rows ignored) in the same
+    /// pass, as the walk needs both: an error where `M` is not positive definite or the rows (of `active`) are
+    /// redundant. The test for redundancy sees the Schur complement of all `K` stacked rows of which the
+    /// inactive ones are identity rows, so when some row of the stacking is inactive, its pivot 1 enters the
+    /// largest diagonal and the smallest pivot (the same algorithm as [`solve_saddle`] / [`solve_schur`], on
+    /// the active rows only). The solution is the one [`Factored::solve`] gives with the factors, bit for bit
+    /// (the same operations, fused here with the factorization's loops).
+    #[inline(always)]
+    fn factor_solve(
+        &mut self,
+        f: &[f64; N],
+        b: &[f64; K],
+        active: &ActiveSet,
+    ) -> Result<([f64; N], [f64; K]), ContactError> {
+        let Factored { chol, w, k, schur } = self;
+        let k = *k;
+        if !chol.factor() {
+            return Err(ContactError::SingularMass);
+        }
+        // M = L D L^T; with g = L^-1 f and W_i = L^-1 a_i: a_i . M^-1 f = W_i . D^-1 g, S_ij = W_i . D^-1 W_j.
+        let mut g = *f;
+        chol.forward(&mut g);
+        for w_i in &mut w[..k] {
+            chol.forward(w_i);
+        }
+        let scaled_dot =
+            |u: &[f64; N], v: &[f64; N]| (0..N).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
+        // The leading `k x k` block of the Schur complement: its lower triangle is all `factor` reads.
+        schur.n = k;
+        let mut lam = [0.0; K];
+        for i in 0..k {
+            lam[i] = b[i] - scaled_dot(&w[i], &g);
+            for j in 0..=i {
+                schur.l[i][j] = scaled_dot(&w[i], &w[j]);
+            }
+        }
+        // The identity rows of the inactive units, if any, as `solve_schur` sees them.
         let (diagonal, pivot) = if k < K {
             (1.0, 1.0)
         } else {
             (f64::NEG_INFINITY, f64::INFINITY)
         };
-        let scale = scale.max(diagonal);
+        let scale = (0..k).map(|i| schur.l[i][i]).fold(diagonal, f64::max);
+        let redundant = ContactError::RedundantConstraints(*active);
+        if !schur.factor() {
+            return Err(redundant);
+        }
         // A rank-deficient Schur complement can still factor with a rounding-sized pivot: reject tiny pivots.
-        let min_pivot = factored.schur.d[..k].iter().copied().fold(pivot, f64::min);
+        let min_pivot = schur.d[..k].iter().copied().fold(pivot, f64::min);
         if min_pivot < REDUNDANCY_TOL * scale {
             return Err(redundant);
         }
-        Ok(factored)
+        schur.forward(&mut lam);
+        schur.backward_scaled(&mut lam);
+        Ok((Self::combine(chol, w, k, g, &lam), lam))
     }
 
-    /// The factors and the largest diagonal entry of the Schur complement, or which factorization failed.
-    fn factor(mut chol: Ldl<N>, rows: &[[f64; N]]) -> Result<(Self, f64), Failed> {
-        let k = rows.len();
-        if !chol.factor() {
-            return Err(Failed::Mass);
-        }
-        let mut w = [[0.0; N]; K];
-        for (w_i, row) in w.iter_mut().zip(rows) {
-            *w_i = *row;
-            chol.forward(w_i);
-        }
-        let scaled_dot =
-            |u: &[f64; N], v: &[f64; N]| (0..N).map(|l| u[l] * v[l] * chol.d_inv[l]).sum::<f64>();
-        let mut schur = Ldl::<K>::zeros(k);
-        for i in 0..k {
-            for j in 0..=i {
-                schur.l[i][j] = scaled_dot(&w[i], &w[j]);
+    /// `x = M^-1 (f + A^T lam) = L^-T D^-1 (g + sum_i lam_i W_i)`.
+    #[inline(always)]
+    fn combine(
+        chol: &Ldl<N>,
+        w: &[[f64; N]; K],
+        k: usize,
+        g: [f64; N],
+        lam: &[f64; K],
+    ) -> [f64; N] {
+        let mut x = g;
+        for (lam_i, w_i) in lam.iter().zip(w).take(k) {
+            for (x_l, w_l) in x.iter_mut().zip(w_i) {
+                *x_l += lam_i * w_l;
             }
         }
-        let scale = (0..k)
-            .map(|i| schur.l[i][i])
-            .fold(f64::NEG_INFINITY, f64::max);
-        if !schur.factor() {
-            return Err(Failed::Schur);
-        }
-        Ok((Factored { chol, w, k, schur }, scale))
+        chol.backward_scaled(&mut x);
+        x
     }
 
     /// Solve `[M -A^T; A 0] [x; lam] = [f; b]` (`b` beyond the `k` rows ignored): with `g = L^-1 f`,
     /// `S lam = b - W D^-1 g` and `x = M^-1 (f + A^T lam) = L^-T D^-1 (g + sum_i lam_i W_i)`.
+    #[inline(always)]
     pub(crate) fn solve(&self, f: &[f64; N], b: &[f64; K]) -> ([f64; N], [f64; K]) {
         let chol = &self.chol;
         let mut g = *f;
@@ -538,14 +474,7 @@ impl<const N: usize, const K: usize> Factored<N, K> {
         }
         self.schur.forward(&mut lam);
         self.schur.backward_scaled(&mut lam);
-        let mut x = g;
-        for (lam_i, w_i) in lam.iter().zip(&self.w).take(self.k) {
-            for (x_l, w_l) in x.iter_mut().zip(w_i) {
-                *x_l += lam_i * w_l;
-            }
-        }
-        chol.backward_scaled(&mut x);
-        (x, lam)
+        (Self::combine(chol, &self.w, self.k, g, &lam), lam)
     }
 }
 
