@@ -286,7 +286,9 @@ struct Wheel<T: Real, const C: usize> {
 }
 
 impl<T: Real, const C: usize> Wheel<T, C> {
-    fn new(q: &CoordsOf<T>, qd: &CoordsOf<T>) -> Self {
+    /// The kinematics at `(q, q')`, with Legs 1 and 2 at the angular offsets `(sin j alpha, cos j alpha)` of
+    /// `legs`.
+    fn new(q: &CoordsOf<T>, qd: &CoordsOf<T>, legs: [(f64, f64); 2]) -> Self {
         let two = lit::<T>(2.0);
         let (st, ct) = q[THETA].sin_cos();
         let (l1, dl1, w) = (q[L1], qd[L1], qd[THETA]);
@@ -304,7 +306,7 @@ impl<T: Real, const C: usize> Wheel<T, C> {
             hub_b,
             hub_vp,
             hub_position: Vector2::new(q[X] + l1 * st, q[Z] + l1 * ct),
-            legs: [(Vector2::zeros(), Vector2::zeros()); 2],
+            legs: legs.map(|offset| directions(st, ct, offset)),
         }
     }
 
@@ -327,13 +329,54 @@ impl<T: Real, const C: usize> Wheel<T, C> {
         (b, vp, self.hub_position + e * d)
     }
 
-    /// `e(psi)` and `e_psi = de/dpsi` for `psi = theta + j alpha` given `(sin j alpha, cos j alpha)`:
-    /// `e = (-sin psi, -cos psi)`, `e_psi = (-cos psi, sin psi)`.
-    fn directions(&self, (sj, cj): (f64, f64)) -> (Vector2<T>, Vector2<T>) {
-        let (sj, cj) = (lit::<T>(sj), lit::<T>(cj));
-        let (st, ct) = (self.st, self.ct);
-        let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
-        (Vector2::new(-sp, -cp), Vector2::new(-cp, sp))
+    /// [`directions`] of the leg at the offset `(sin j alpha, cos j alpha)`.
+    fn directions(&self, offset: (f64, f64)) -> (Vector2<T>, Vector2<T>) {
+        directions(self.st, self.ct, offset)
+    }
+
+    /// Legs 1 and 2 and, while one swings, the swinging leg (`C = 4`), point by point with the constants `p`:
+    /// `add(m, b, dJ/dt q' + g_n)` for each leg's point mass.
+    #[inline(always)]
+    fn each_leg_point(
+        &self,
+        p: &Mechanics<T>,
+        (q, qd): (&CoordsOf<T>, &CoordsOf<T>),
+        swinging: Option<(f64, f64)>,
+        mut add: impl FnMut(T, &[Vector2<T>; C], Vector2<T>),
+    ) {
+        for (k, slot) in [(0, 1), (1, 2)] {
+            let length = (q[THETA + slot], qd[THETA + slot]);
+            let (b, vp, _) = self.point(self.legs[k], length, slot, p.leg_mass_offset);
+            add(p.leg_mass, &b, vp + p.up);
+        }
+        if let Some(offset) = swinging {
+            let directions = self.directions(offset);
+            let (b, vp, _) = self.point(directions, (q[L3], qd[L3]), 3, p.leg_mass_offset);
+            add(p.leg_mass, &b, vp + p.up);
+        }
+    }
+}
+
+/// `e(psi)` and `e_psi = de/dpsi` for `psi = theta + j alpha` given `(sin theta, cos theta)` and
+/// `(sin j alpha, cos j alpha)`: `e = (-sin psi, -cos psi)`, `e_psi = (-cos psi, sin psi)`.
+fn directions<T: Real>(st: T, ct: T, (sj, cj): (f64, f64)) -> (Vector2<T>, Vector2<T>) {
+    let (sj, cj) = (lit::<T>(sj), lit::<T>(cj));
+    let (sp, cp) = (st * cj + ct * sj, ct * cj - st * sj);
+    (Vector2::new(-sp, -cp), Vector2::new(-cp, sp))
+}
+
+/// The springs and dampers of the legs' lengths, `-k (L0 - L) + c dL/dt`, added to the rows of `L1`, `L2` and,
+/// while a leg swings, `L3` of `force`.
+#[inline(always)]
+fn add_leg_forces<T: Real>(
+    p: &Mechanics<T>,
+    (q, qd): (&CoordsOf<T>, &CoordsOf<T>),
+    swing: bool,
+    force: &mut CoordsOf<T>,
+) {
+    let lengths: &[usize] = if swing { &[L1, L2, L3] } else { &[L1, L2] };
+    for &l in lengths {
+        force[l] += -p.stiffness * (p.spring_natural_length - q[l]) + p.viscosity * qd[l];
     }
 }
 
@@ -565,12 +608,12 @@ impl Model {
 
     /// The hub's kinematics at `(q, q')` with the directions of Legs 1 and 2.
     fn wheel<T: Real, const C: usize>(&self, q: &CoordsOf<T>, qd: &CoordsOf<T>) -> Wheel<T, C> {
-        let mut wheel = Wheel::<T, C>::new(q, qd);
-        wheel.legs = [
-            wheel.directions(self.offsets[0]),
-            wheel.directions(self.offsets[1]),
-        ];
-        wheel
+        Wheel::new(q, qd, [self.offsets[0], self.offsets[1]])
+    }
+
+    /// The angular offset of the swinging leg while one swings (`C = 4`), for [`Wheel::each_leg_point`].
+    fn swinging_offset<const C: usize>(&self) -> Option<(f64, f64)> {
+        (C == 4).then(|| self.offsets[2])
     }
 
     /// The kinematics of Leg 2's tip (the rows of (C2)).
@@ -647,18 +690,11 @@ impl Model {
         let (hub_b, hub_vp, w) = (wheel.hub_b, wheel.hub_vp, wheel.w);
         let mut sums = PointSums::<T, C>::zero();
         sums.add(p.hub_mass, &hub_b, hub_vp + p.up);
-        for (k, slot) in [(0, 1), (1, 2)] {
-            let length = (q[THETA + slot], qd[THETA + slot]);
-            let (b, vp, _) = wheel.point(wheel.legs[k], length, slot, p.leg_mass_offset);
-            sums.add(p.leg_mass, &b, vp + p.up);
-        }
-        // The swinging leg j = 2, point by point, and the locked legs: j = 2..N, or j = 3..N while a leg swings,
-        // all of the spoke length (see above).
-        if swing {
-            let directions = wheel.directions(self.offsets[2]);
-            let (b, vp, _) = wheel.point(directions, (q[L3], qd[L3]), 3, p.leg_mass_offset);
-            sums.add(p.leg_mass, &b, vp + p.up);
-        }
+        // Legs 1 and 2 and the swinging leg j = 2, point by point, and the locked legs: j = 2..N, or j = 3..N
+        // while a leg swings, all of the spoke length (see above).
+        wheel.each_leg_point(p, (q, qd), self.swinging_offset::<C>(), |m, b, a| {
+            sums.add(m, b, a)
+        });
         let Locked {
             n,
             d,
@@ -698,11 +734,8 @@ impl Model {
             }
         }
         mass[(THETA, THETA)] += p.hub_inertia;
-        bias[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
-        bias[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
-        if swing {
-            bias[L3] += -p.stiffness * (p.spring_natural_length - q[L3]) + p.viscosity * qd[L3];
-        } else {
+        add_leg_forces(p, (q, qd), swing, &mut bias);
+        if !swing {
             // No leg swings: `L3` is left out, with the identity's row so that M stays regular and `L3'' = 0`.
             mass[(L3, L3)] = T::one();
         }

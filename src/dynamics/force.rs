@@ -1,8 +1,11 @@
 //! `M(q) z + h(q, q')` without forming `M`: what the derivatives of the constrained dynamics differentiate
 //! (`crate::variational`, docs/model.md section 10).
 
-use super::{lit, swinging, Coords, CoordsOf, Locked, Mechanics, Model, PointKinematics, Real};
-use super::{L1, L2, L3, THETA, X, Z};
+use super::{
+    add_leg_forces, lit, swinging, Coords, CoordsOf, Locked, Mechanics, Model, PointKinematics,
+    Real,
+};
+use super::{L1, L3, THETA, X, Z};
 use nalgebra::Vector2;
 
 impl Model {
@@ -56,16 +59,9 @@ impl Model {
             u
         };
         let hub_u = add(p.hub_mass, &wheel.hub_b, wheel.hub_vp + p.up);
-        for (k, slot) in [(0, 1), (1, 2)] {
-            let length = (q[THETA + slot], qd[THETA + slot]);
-            let (b, vp, _) = wheel.point(wheel.legs[k], length, slot, p.leg_mass_offset);
-            add(p.leg_mass, &b, vp + p.up);
-        }
-        if swing {
-            let directions = wheel.directions(self.offsets[2]);
-            let (b, vp, _) = wheel.point(directions, (q[L3], qd[L3]), 3, p.leg_mass_offset);
-            add(p.leg_mass, &b, vp + p.up);
-        }
+        wheel.each_leg_point(p, (q, qd), self.swinging_offset::<C>(), |m, b, a| {
+            add(m, b, a);
+        });
         let Locked {
             n,
             d,
@@ -80,11 +76,8 @@ impl Model {
             m * (wheel.hub_b[0].dot(&sum_u) + d * sum_e_psi.dot(&hub_u) + n * d * d * z_theta);
         force[L1] += m * wheel.hub_b[1].dot(&sum_u);
         force[THETA] += p.hub_inertia * z_theta;
-        force[L1] += -p.stiffness * (p.spring_natural_length - q[L1]) + p.viscosity * qd[L1];
-        force[L2] += -p.stiffness * (p.spring_natural_length - q[L2]) + p.viscosity * qd[L2];
-        if swing {
-            force[L3] += -p.stiffness * (p.spring_natural_length - q[L3]) + p.viscosity * qd[L3];
-        } else {
+        add_leg_forces(p, (q, qd), swing, &mut force);
+        if !swing {
             force[L3] += lit::<T>(z[L3]);
         }
         (force, self.rear_tip(&wheel, q, qd))
