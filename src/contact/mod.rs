@@ -509,13 +509,11 @@ pub(crate) fn solve_into(
     let kkt = solved
         .kkt
         .insert(NoSlipKkt::unfactored(&solved.eom, active));
-    match kkt.factor_dynamics(&solved.eom, active) {
-        Ok(dynamics) => Ok(dynamics),
-        Err(e) => {
-            solved.kkt = None;
-            Err(e)
-        }
+    let dynamics = kkt.factor_dynamics(&solved.eom, active);
+    if dynamics.is_err() {
+        solved.kkt = None;
     }
+    dynamics
 }
 
 /// [`constrained_dynamics`] of a set with a slipping contact, solved through the Painleve case (a slipping
