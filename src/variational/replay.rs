@@ -37,7 +37,6 @@ use crate::dynamics::{
 use crate::integrate::{Integrator, OdeSystem};
 use crate::params::SolverOptions;
 use crate::walk::impact::touchdown_leg;
-
 use crate::walk::tape::{Segment, StepTape};
 use crate::walk::{unpack, EventKind, PhaseSystem, StageLog, WalkVector};
 

@@ -197,7 +197,7 @@ impl StageLog {
             return phase.rhs_and_dynamics(y).0;
         }
         let (q, qd) = unpack(y);
-        stages.push(Stage {
+        let stage = stages.push_mut(Stage {
             active: phase.active,
             y: *y,
             f: WalkVector::zeros(),
@@ -207,15 +207,9 @@ impl StageLog {
                 kkt: None,
             },
         });
-        match stages.last_mut() {
-            Some(stage) => {
-                let dynamics = solve_into(phase.model, (&q, &qd), &phase.active, &mut stage.solved);
-                (stage.f, stage.dynamics) = phase.field(&qd, dynamics);
-                stage.f
-            }
-            // Not reached: an evaluation was just pushed.
-            None => phase.rhs_and_dynamics(y).0,
-        }
+        let dynamics = solve_into(phase.model, (&q, &qd), &phase.active, &mut stage.solved);
+        (stage.f, stage.dynamics) = phase.field(&qd, dynamics);
+        stage.f
     }
 
     /// The first evaluation at or after `cursor` (within [`LOOKAHEAD`]) of the state `y` (bit for bit) with
