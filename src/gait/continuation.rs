@@ -17,8 +17,9 @@
 //! **Predictor.** Each step starts Newton's method from the gait carried along the family's tangent `ds*/dp`
 //! (`Tangent`): given with the first point (`-(DP - I)^-1 dP/dp` from its exact derivatives), then the secant
 //! of the last verified step. The start is then `O(dp^2)` from the gait instead of `O(dp)`, which saves Newton
-//! iterations there and back; a step whose predicted start fails is tried again from the point itself, so that
-//! the predictor never loses a step the plain start would take. Period-1 families only (see
+//! iterations there and back; a step whose predicted start fails is tried again from the point itself (damped to
+//! the end at the finest step, a quick test on a longer one, which is halved if it fails), so that the predictor
+//! never ends a family the plain start would continue. Period-1 families only (see
 //! `Continuation::step_predicted`).
 //!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
