@@ -17,9 +17,9 @@
 //! **Predictor.** Each step starts Newton's method from the gait carried along the family's tangent `ds*/dp`
 //! (`Tangent`): given with the first point (`-(DP - I)^-1 dP/dp` from its exact derivatives), then the secant
 //! of the last verified step. The start is then `O(dp^2)` from the gait instead of `O(dp)`, which saves Newton
-//! iterations there and back; a step whose predicted start fails is tried again from the point itself (damped to
-//! the end at the finest step, a quick test on a longer one, which is halved if it fails), so that the predictor
-//! never ends a family the plain start would continue. Period-1 families only (see
+//! iterations there and back; a step whose predicted start fails is tried again from the point itself: at the
+//! finest step, whose failure ends the family, with Newton's method damped to the end as without a predictor;
+//! on a longer step as a quick test (the step is halved if it fails). Period-1 families only (see
 //! `Continuation::step_predicted`).
 //!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
@@ -353,12 +353,14 @@ impl<'a> Continuation<'a> {
                 return step;
             }
             // Where a longer step's prediction fails, its plain start is a quick test (`undamped`): the step
-            // is halved anyway if it fails, and the halves start closer to the family. Skipping the plain start
-            // there would lose steps: on the default map's row `k = 1500` only a plain start 15 N s/m long
-            // carries the family across `lambda_2+ = 0` to two more grid points. Damped to the end, the plain
-            // starts after a failed prediction cost 9.8 evaluations each and worked for none of 175 on ten
-            // rows of the 100 x 100 map (a quarter of their evaluations). At the finest step, whose failure
-            // ends the family, the plain start is damped as before.
+            // is halved anyway if it fails, and the halves start closer to the family. Damped to the end, the
+            // plain starts after a failed prediction cost 9.8 evaluations each and worked for none of 175 on
+            // ten rows of the 100 x 100 map (a quarter of their evaluations). Skipping them would lose steps:
+            // on the default map's row `k = 1500` only a plain start 15 N s/m long carries the family across
+            // `lambda_2+ = 0` to two more grid points, which shorter steps cannot reach. The quick test keeps
+            // that crossing, and every gait of the default and the 100 x 100 maps, but a crossing that needs
+            // damping would be lost. At the finest step, whose failure ends the family, the plain start is
+            // damped as before.
             plain_undamped = undamped || !finest;
         }
         self.step_asking(from, value, guess, plain_undamped)
