@@ -31,6 +31,7 @@ fn default_run(dir: &std::path::Path) -> RunData {
         sample_dt: DEFAULT_SAMPLE_DT,
         trajectory: true,
         out_dir: dir.to_path_buf(),
+        overwrite: false,
         interrupt: None,
     };
     run_simulate(&job, &mut |_| {}).expect("the default run walks");

@@ -314,6 +314,7 @@ fn gait_job(c: &mut Criterion) {
         initial: None,
         options: GaitOptions::default(),
         out_dir: Default::default(),
+        overwrite: false,
         check_jacobian: false,
         interrupt: None,
     };

@@ -23,9 +23,41 @@ pub fn short(v: f64) -> String {
     }
 }
 
+/// The most characters of a user's input a message quotes ([`clip`]).
+pub const QUOTED_INPUT_CHARS: usize = 200;
+
+/// A user's input as a message quotes it: whole up to [`QUOTED_INPUT_CHARS`] characters, else its first
+/// [`QUOTED_INPUT_CHARS`] and how long it is (a value of a megabyte must not become a message of a megabyte).
+pub fn clip(input: &str) -> String {
+    let total = input.chars().count();
+    if total <= QUOTED_INPUT_CHARS {
+        return input.to_string();
+    }
+    let head: String = input.chars().take(QUOTED_INPUT_CHARS).collect();
+    format!("{head}… ({total} characters in all)")
+}
+
+/// Every line of `text` (e.g. a parser's message, which quotes the input's line) [`clip`]ped.
+pub fn clip_lines(text: &str) -> String {
+    text.lines().map(clip).collect::<Vec<_>>().join("\n")
+}
+
 #[cfg(test)]
 mod tests {
-    use super::short;
+    use super::{clip, short};
+
+    #[test]
+    fn long_input_is_clipped_short_input_kept() {
+        assert_eq!(clip("viscosity=50"), "viscosity=50");
+        let long = "é".repeat(1000);
+        let clipped = clip(&long);
+        assert!(clipped.starts_with(&"é".repeat(200)), "{clipped}");
+        assert!(clipped.ends_with("… (1000 characters in all)"), "{clipped}");
+        assert_eq!(
+            clipped.chars().count(),
+            200 + "… (1000 characters in all)".chars().count()
+        );
+    }
 
     #[test]
     fn short_numbers() {

@@ -5,7 +5,15 @@ mod cli;
 use clap::Parser;
 
 fn main() {
-    let args = cli::Cli::parse();
+    let args = match cli::Cli::try_parse() {
+        Ok(args) => args,
+        // Help and version print as clap prints them; an error quotes at most 200 characters of each input.
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            eprint!("{}", clipped_quotes(&e.render().to_string()));
+            std::process::exit(e.exit_code());
+        }
+    };
     if let Err(e) = cli::run(args) {
         // The library's messages already quote their causes; print each cause only once.
         let mut message = e.to_string();
@@ -17,4 +25,20 @@ fn main() {
         eprintln!("Error: {message}");
         std::process::exit(1);
     }
+}
+
+/// `text` with every run of characters between single quotes [`vrw::fmt::clip`]ped (clap quotes the argument
+/// it could not read whole, however long).
+fn clipped_quotes(text: &str) -> String {
+    text.split('\'')
+        .enumerate()
+        .map(|(i, part)| {
+            if i % 2 == 1 {
+                vrw::fmt::clip(part)
+            } else {
+                part.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("'")
 }

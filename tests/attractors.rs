@@ -140,6 +140,7 @@ fn basin_job(dir: &Path) -> BasinJob {
         max_steps: 30,
         tolerance: TOLERANCE,
         out_dir: dir.to_path_buf(),
+        overwrite: false,
     }
 }
 
@@ -193,7 +194,9 @@ fn orbit_job_writes_its_files() {
         },
         initial: None,
         branch: true,
+        plot: "lambda_I4".to_string(),
         out_dir: dir.path().to_path_buf(),
+        overwrite: false,
     };
     let summary = run_orbit(&job, &|_| {}).unwrap();
     assert_eq!(summary.outcomes.values().sum::<usize>(), 3);

@@ -577,8 +577,13 @@ fn end_time_of_a_run_failing_in_its_first_step_is_the_failure_time() {
 fn simulate_streams_and_no_trajectory_skips_file() {
     // A trajectory.csv of an earlier run would not match: it goes.
     let dir = temp_dir_with(&[]);
-    fs::create_dir(dir.path().join("out")).unwrap();
-    fs::write(dir.path().join("out/trajectory.csv"), "stale").unwrap();
+    let earlier = Command::new(env!("CARGO_BIN_EXE_vrw"))
+        .args(["simulate", "--steps", "1", "--out", "out"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(earlier.status.success());
+    assert!(dir.path().join("out/trajectory.csv").exists());
     let run = simulate_in(dir, &["--steps", "4", "--no-trajectory"]);
     assert_eq!(run.code(), Some(0), "stderr:\n{}", run.stderr());
     assert!(!run.out.join("trajectory.csv").exists());
@@ -710,9 +715,13 @@ fn rigid_legs_default_start_walks() {
 fn sweep_without_gait_lists_only_what_it_wrote_and_removes_an_old_figure() {
     let dir = temp_dir_with(&[]);
     let path = dir.path().join("out");
-    fs::create_dir(&path).unwrap();
-    fs::write(path.join("fig2.png"), "an earlier sweep's figure").unwrap();
-    fs::write(path.join("fig2.svg"), "<svg/>").unwrap();
+    let earlier = Command::new(env!("CARGO_BIN_EXE_vrw"))
+        .args(["sweep", "--points", "3", "--out", "out"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(earlier.status.success());
+    assert!(path.join("fig2.png").exists() && path.join("fig2.svg").exists());
     // Uphill the wheel cannot walk, whatever the viscosity.
     let run = command_in(
         dir,

@@ -133,6 +133,25 @@ fn set_viscosity_1e9_is_refused_as_too_stiff_and_1e5_warns() {
     );
 }
 
+/// `--config` naming a FIFO waited for a writer for ever: it is refused before it is opened.
+#[test]
+fn config_fifo_is_refused_without_waiting() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("params.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        return; // no mkfifo here: nothing to check
+    }
+    let (send, receive) = std::sync::mpsc::channel();
+    let path = fifo.clone();
+    std::thread::spawn(move || send.send(Config::from_file(&path).map(|_| ())));
+    let error = receive
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("reading a FIFO as --config hangs")
+        .unwrap_err();
+    assert!(error.to_string().contains("a pipe"), "{error}");
+}
+
 /// `--config /dev/zero` read forever (6.7 GB after 8 s): only a regular file of at most
 /// `MAX_CONFIG_BYTES` is read.
 #[test]

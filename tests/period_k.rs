@@ -103,6 +103,7 @@ fn gait_job_writes_the_period_two_gait() {
         initial: None,
         options: GaitOptions::default(),
         out_dir: dir.path().to_path_buf(),
+        overwrite: false,
         check_jacobian: false,
         interrupt: None,
     })

@@ -8,8 +8,6 @@
 //! walk.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -30,7 +28,8 @@ use super::{
 /// The options are the command line's (`from_` is `--from`), with its defaults, ranges and messages: an
 /// option out of range, more than `MAX_ANIMATION_FRAMES` frames or a time window outside the walk raises
 /// `vrw.ConfigError` (before the walk, where the options alone tell). The GIL is released while the walk is
-/// computed and drawn; Ctrl-C raises `KeyboardInterrupt` (once the drawing, which is not interrupted, ends).
+/// computed and drawn; Ctrl-C raises `KeyboardInterrupt` (the walk stops at once, the drawing between two
+/// chunks of frames).
 #[pyfunction]
 #[pyo3(signature = (params, steps = 20, initial = None, sample_dt = 0.005, *, fps = 25, speed = 1.0, from_ = None, to = None, width = 640, height = 360, horizontal = false, still = None))]
 #[allow(clippy::too_many_arguments)]
@@ -68,10 +67,12 @@ pub(crate) fn animate<'py>(
         sample_dt,
         trajectory: true,
         out_dir: PathBuf::new(),
-        interrupt: Some(Arc::new(AtomicBool::new(false))),
+        overwrite: false,
+        interrupt: None,
     };
-    let flag = job.interrupt.clone().unwrap_or_default();
-    let bytes = interruptible(py, &flag, || draw(&job, &options, still))?.map_err(animate_error)?;
+    // The library's flag: the walk and the encoding of the frames both read it.
+    let flag = vrw::gait::interrupt_flag();
+    let bytes = interruptible(py, flag, || draw(&job, &options, still))?.map_err(animate_error)?;
     Ok(PyBytes::new(py, &bytes))
 }
 

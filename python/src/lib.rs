@@ -195,15 +195,14 @@ impl Params {
         Config::numeric_keys().to_vec()
     }
 
-    fn __getnewargs_ex__<'py>(
+    fn __reduce__<'py>(
         &self,
         py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        // Pickle as `Params(**to_dict())`: the keys are re-read as the constructor reads them.
-        Ok((
-            pyo3::types::PyTuple::empty(py).into_any(),
-            self.to_dict(py)?,
-        ))
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyAny>,))> {
+        // Pickle as `_params_from_dict(to_dict())`, for every protocol (`__getnewargs_ex__` served only
+        // protocols 2 and up): the keys are re-read as the constructor reads them.
+        let rebuild = py.import("vrw._vrw")?.getattr("_params_from_dict")?;
+        Ok((rebuild, (self.to_dict(py)?,)))
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
@@ -423,6 +422,7 @@ fn simulate<'py>(
         sample_dt,
         trajectory,
         out_dir: PathBuf::new(),
+        overwrite: false,
         interrupt: Some(Arc::new(AtomicBool::new(false))),
     };
     let flag = job.interrupt.clone().unwrap_or_default();
@@ -471,6 +471,7 @@ fn find_gait<'py>(
         initial: section(initial)?,
         options: gait_options(GaitOptions::default(), options)?,
         out_dir: PathBuf::new(),
+        overwrite: false,
         check_jacobian: false,
         interrupt: Some(Arc::new(AtomicBool::new(false))),
     };
@@ -582,6 +583,7 @@ fn basin<'py>(
         max_steps,
         tolerance,
         out_dir: PathBuf::new(),
+        overwrite: false,
     };
     let part = rows.map(|(start, end)| start..end);
     let progress = Progress::new(progress, nx * part.as_ref().map_or(ny, |p| p.len()));
@@ -676,6 +678,7 @@ fn gait_map<'py>(
         second_route,
         marks: Vec::new(),
         out_dir: PathBuf::new(),
+        overwrite: false,
     };
     let part = rows.map(|(start, end)| start..end);
     let points = nx * part.as_ref().map_or(ny, |p| p.len());
@@ -737,7 +740,9 @@ fn orbit<'py>(
         },
         initial: section(initial)?,
         branch,
+        plot: "lambda_I4".to_string(),
         out_dir: PathBuf::new(),
+        overwrite: false,
     };
     let progress = Progress::new(progress, points);
     let (summary, columns, ends, gaits) =
@@ -831,6 +836,7 @@ fn continue_family<'py>(
         switch,
         plot: "thetadot".to_string(),
         out_dir: PathBuf::new(),
+        overwrite: false,
         interrupt: Some(Arc::clone(&flag)),
         two_param,
     };
@@ -873,6 +879,12 @@ fn max_steps_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
 /// `basin`'s `tolerance`, named in its errors.
 fn tolerance_arg(value: &Bound<'_, PyAny>) -> PyResult<f64> {
     real("tolerance", value)
+}
+
+/// `Params(**keys)`: how a pickled `Params` is rebuilt (`Params.__reduce__`).
+#[pyfunction]
+fn _params_from_dict(keys: &Bound<'_, PyDict>) -> PyResult<Params> {
+    Params::new(Some(keys))
 }
 
 /// Run `work` with the GIL released, Ctrl-C stopping it ([`progress::interruptible_with`] without a progress
@@ -922,6 +934,7 @@ fn linspace(start: f64, stop: f64, points: &Bound<'_, PyAny>) -> PyResult<Vec<f6
 fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<Params>()?;
+    m.add_function(wrap_pyfunction!(_params_from_dict, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(find_gait, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;

@@ -53,7 +53,9 @@ def test_replace_and_round_trips():
     q = p.replace(stiffness=600)
     assert q == vrw.Params(viscosity=37, stiffness=600) and p == vrw.Params(viscosity=37)
     assert vrw.Params(**q.to_dict()) == q
-    assert pickle.loads(pickle.dumps(q)) == q
+    # Every protocol (0 and 1 used to fail: only __getnewargs_ex__ was defined).
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        assert pickle.loads(pickle.dumps(q, protocol=protocol)) == q, protocol
     assert repr(q) == "Params(stiffness=600.0, viscosity=37.0)"
 
 

@@ -13,6 +13,7 @@ __all__ = [
     "Params",
     "WalkError",
     "__version__",
+    "_params_from_dict",
     "animate",
     "basin",
     "continue_family",
@@ -46,6 +47,9 @@ class ConfigError(ValueError):
 class WalkError(RuntimeError):
     """A walk that cannot start (e.g. an invalid initial section state); the command line's message."""
 
+def _params_from_dict(keys: Dict[str, Value]) -> "Params":
+    """``Params(**keys)``: how a pickled ``Params`` is rebuilt."""
+
 @final
 class Params:
     """The model's parameters and the solver's settings: every key of a vrw TOML file.
@@ -64,8 +68,8 @@ class Params:
     def replace(self, **keys: Value) -> "Params":
         """A copy with the given keys changed (validated as in the constructor)."""
     def __getitem__(self, key: str, /) -> Value: ...
-    def __getnewargs_ex__(self) -> Tuple[Tuple[()], Dict[str, Value]]:
-        """Pickle as ``Params(**to_dict())``."""
+    def __reduce__(self) -> Tuple[Callable[[Dict[str, Value]], "Params"], Tuple[Dict[str, Value]]]:
+        """Pickle as ``Params(**to_dict())``, for every pickle protocol."""
     @staticmethod
     def numeric_keys() -> List[str]:
         """The keys holding a real number (what a sweep or a grid can vary)."""

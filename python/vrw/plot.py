@@ -65,7 +65,9 @@ _THRESHOLDS = {
     "lambda_4_plus = 0": (r"$\lambda_4^+ = 0$", VERMILLION, False),
     "lambda_2_plus = 0": (r"$\lambda_2^+ = 0$", BLUE, False),
     "lambda_I4 = 0": (r"$\lambda_{I4} = 0$", GREEN, False),
-    "stability_lost": ("stability lost", PURPLE, True), "branch_switch": ("branch switch", ORANGE, True),
+    "stability_lost": ("stability lost", PURPLE, True),
+    "stability_regained": ("stability regained", PURPLE, True),
+    "period_doubling": ("period doubling", PURPLE, True), "branch_switch": ("branch switch", ORANGE, True),
     "fold": ("fold", BLACK, True)}
 _UNCONFIRMED = ("end, unconfirmed", MARK, True)
 

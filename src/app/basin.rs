@@ -15,7 +15,7 @@ use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{check_interrupted, in_run, prepared, AppError};
+use super::{check_interrupted, check_phase_interrupted, in_run, prepared, AppError};
 use crate::output::manifest::RunDir;
 use crate::output::write_basin_csv;
 
@@ -53,6 +53,9 @@ pub struct BasinJob {
     pub tolerance: f64,
     /// Where `basin.csv`, `basin.json` and `basin.png` go.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
 }
 
 /// `basin.json`.
@@ -136,7 +139,7 @@ pub fn run_basin(
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<BasinSummary, AppError> {
     let (model, gait, spec) = prepare_basin(job)?;
-    in_run(&job.out_dir, "basin", |run| {
+    in_run(&job.out_dir, job.overwrite, "basin", |run| {
         basin_into(job, &model, gait, spec, run, progress).map(|s| (s, None))
     })
 }
@@ -203,13 +206,12 @@ fn prepare_basin(job: &BasinJob) -> Result<(crate::dynamics::Model, Gait, BasinS
     job.validate()?;
     let (model, initial) = prepared(&job.config, job.initial)?;
     let map = StepMap::new(&model, &job.config.solver);
-    let gait =
-        find_gait_any_period(&map, &initial, &GaitOptions::default(), MAX_PERIOD).map_err(|e| {
-            AppError::InvalidOption {
-                option: "basin",
-                reason: format!("no gait to draw the basin of: {e}"),
-            }
-        })?;
+    let gait = find_gait_any_period(&map, &initial, &GaitOptions::default(), MAX_PERIOD);
+    check_phase_interrupted(None, "while searching the gait", "nothing is computed yet")?;
+    let gait = gait.map_err(|e| AppError::InvalidOption {
+        option: "basin",
+        reason: format!("no gait to draw the basin of: {e}"),
+    })?;
     let through = gait.section.to_array();
     let axis = |k: usize| {
         let c = job.coordinates[k];
@@ -267,7 +269,7 @@ fn basin_into(
             job.config.params.viscosity,
             job.config.params.slope,
             job.config.params.impact
-        ),
+        ) + &super::settings_note(&job.config, &["viscosity", "slope", "impact"]),
         x_label: spec.x.coordinate.label().to_string(),
         y_label: spec.y.coordinate.label().to_string(),
         xs: (0..spec.x.points).map(|i| spec.x.value(i)).collect(),

@@ -10,20 +10,22 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use super::family_curves::{self, two_param_curves, CurveRecord};
-use super::family_records::{special_record, EndRecord, FamilyRecord, SpecialRecord};
+use super::family_records::{
+    point_stability, special_record, EndRecord, FamilyRecord, SpecialRecord,
+};
+use super::family_switch::{same_as_followed, switched_families, Followed};
 use super::{prepared, AppError};
-use crate::bifurcation::corrector::solve_on_hyperplane;
-use crate::bifurcation::special::JUMP_TOL;
 use crate::bifurcation::Curve;
 use crate::bifurcation::{
-    continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
-    ContinuationOptions, Family, FamilyEnd, FamilyMap, GaitFamily, GaitInfo, SpecialKind,
+    continue_family, ContinuationError, ContinuationOptions, Family, FamilyEnd, FamilyMap,
+    GaitFamily, GaitInfo,
 };
 use crate::gait::continuation::{Continuation, EndCause, FamilyPoint as GaitPoint};
 use crate::gait::MAX_PERIOD;
 use crate::gait::{find_gait_any_period, find_periodic_gait, GaitOptions, Stability, StepMap};
 use crate::params::Config;
 use crate::walk::SectionState;
+
 /// The quantities the bifurcation diagram can draw against the parameter (`--plot`).
 pub const DIAGRAM_QUANTITIES: [&str; 10] = [
     "thetadot",
@@ -37,11 +39,6 @@ pub const DIAGRAM_QUANTITIES: [&str; 10] = [
     "speed",
     "dls_duration",
 ];
-
-/// Within this of the unit circle, a point's stability verdict uses the error estimate of its `DP` (a second
-/// `DP` at tighter tolerances); farther out the exact `DP`'s error (below `1e-6` wherever it was estimated)
-/// cannot change it.
-pub const STABILITY_BAND: f64 = 1e-3;
 
 /// Most families one job follows (the start's and those switched to at period doublings).
 pub const MAX_FAMILIES: usize = 8;
@@ -77,6 +74,9 @@ pub struct ContinueJob {
     pub plot: String,
     /// Where `branch.csv`, `special_points.json` and `bifurcation.{svg,png}` go.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
     /// Stops the walks when set.
     pub interrupt: Option<Arc<AtomicBool>>,
     /// Follow the curve of every located special point (indicator border collisions, folds, period doublings,
@@ -108,6 +108,9 @@ pub struct ContinueSummary {
     pub curves: Vec<CurveRecord>,
     /// Audit warnings of the families' gaits, and families that could not be followed.
     pub warnings: Vec<String>,
+    /// Where the interrupt flag (Ctrl-C) stopped the job and what is kept, in words (`None`: it did not).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<String>,
     /// The files written.
     pub files: Vec<String>,
     /// Wall time \[s\].
@@ -129,7 +132,7 @@ pub struct ContinueResult {
 
 impl ContinueJob {
     /// Checks the settings that are not model parameters.
-    fn validate(&self) -> Result<f64, AppError> {
+    pub(super) fn validate(&self) -> Result<f64, AppError> {
         let invalid =
             |option: &'static str, reason: String| AppError::InvalidOption { option, reason };
         if !Config::numeric_keys().contains(&self.param.as_str()) {
@@ -137,7 +140,7 @@ impl ContinueJob {
                 "param",
                 format!(
                     "unknown parameter {:?}: expected one of {}",
-                    self.param,
+                    crate::fmt::clip(&self.param),
                     Config::numeric_keys().join(", ")
                 ),
             ));
@@ -147,7 +150,7 @@ impl ContinueJob {
                 "plot",
                 format!(
                     "unknown quantity {:?}: expected one of {}",
-                    self.plot,
+                    crate::fmt::clip(&self.plot),
                     DIAGRAM_QUANTITIES.join(", ")
                 ),
             ));
@@ -184,6 +187,9 @@ impl ContinueJob {
                 ));
             }
         }
+        if let Some(second) = &self.two_param {
+            family_curves::check_two_param(&self.param, &self.config, second)?;
+        }
         let start = match self.start {
             Some(v) => v,
             None => self.config.get_numeric(&self.param)?,
@@ -208,25 +214,19 @@ impl ContinueJob {
 }
 
 /// The work of [`run_continuation`](super::run_continuation) without writing anything.
+///
+/// When the interrupt flag (the job's or the library's) stops the work, the result keeps what was complete
+/// and says so in [`ContinueSummary::interrupted`]: the points followed before it (verified gaits), the ends
+/// reached before it, the special points located before it; a family cut short ends with
+/// [`FamilyEnd::Interrupted`], no family is switched to and no curve is followed after it. Stopped before the
+/// first gait is found, it is [`AppError::Interrupted`].
 pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppError> {
     let clock = std::time::Instant::now();
     let start = job.validate()?;
     let config = job.config.with(&job.param, start)?;
     let (model, initial) = prepared(&config, job.initial)?;
     let flag = job.interrupt.as_deref();
-    let map = StepMap::new(&model, &config.solver).with_interrupt(flag);
-    let gait_options = GaitOptions {
-        refine_jacobian: false,
-        ..GaitOptions::default()
-    };
-    let gait = match job.period {
-        None => find_gait_any_period(&map, &initial, &gait_options, MAX_PERIOD),
-        Some(k) => find_periodic_gait(&map, &initial, &gait_options, k),
-    }
-    .map_err(|e| AppError::InvalidOption {
-        option: "start",
-        reason: format!("no gait at {} = {start} to start from: {e}", job.param),
-    })?;
+    let gait = first_gait(job, &model, &config, &initial, start)?;
     // The step map P itself (every family's map is an iterate of it), and the first family's P^k.
     let base_map = GaitFamily::new(&config, &job.param, gait.section)
         .map_err(|e| AppError::InvalidOption {
@@ -234,51 +234,209 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
             reason: e.message,
         })?
         .with_interrupt(flag);
-    let family_map = base_map.iterated(gait.period_k);
     let options = job.options();
+    let followed = follow_families(job, &config, base_map, &gait, start, &options)?;
+    let (mut families, mut warnings) = (followed.families, followed.warnings);
+    let mut interrupted = followed.interrupted;
+    if interrupted.is_some() {
+        drop_unlocated(&mut families, &mut warnings);
+    }
+    let (records, special_points, stability) = family_records(job, &families, &mut warnings);
+    if stopped(flag) {
+        let note = "the stability verdicts within 1e-3 of the unit circle judged after it are `uncertain` \
+                    (their DP's error estimate was not computed)";
+        interrupted = Some(match interrupted {
+            Some(words) => format!("{words}; {note}"),
+            None => format!("while judging the families' stability: {note}"),
+        });
+    }
+    let (curve_records, curves) = match (&job.two_param, &interrupted) {
+        (Some(second), None) => {
+            let followed = family_curves::FollowedParam {
+                param: &job.param,
+                from: job.from,
+                to: job.to,
+            };
+            let maps: Vec<_> = families.iter().map(|f| (&f.family, f.map)).collect();
+            let curves = two_param_curves(&followed, &config, second, &maps, &mut warnings)?;
+            if stopped(flag) {
+                interrupted =
+                    Some("while following the two-parameter curves: none is kept".to_string());
+                (Vec::new(), Vec::new())
+            } else {
+                curves
+            }
+        }
+        _ => (Vec::new(), Vec::new()),
+    };
+    let summary = ContinueSummary {
+        curves: curve_records,
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        config: config.clone(),
+        param: job.param.clone(),
+        start,
+        initial: gait.section,
+        options,
+        families: records,
+        special_points,
+        warnings,
+        interrupted,
+        files: Vec::new(),
+        seconds: clock.elapsed().as_secs_f64(),
+    };
+    Ok(ContinueResult {
+        summary,
+        families: families.into_iter().map(|f| f.family).collect(),
+        stability,
+        curves,
+    })
+}
+
+/// Is the job's interrupt flag or the library's set?
+fn stopped(flag: Option<&AtomicBool>) -> bool {
+    flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst)) || crate::walk::interrupted()
+}
+
+/// The gait the first family is followed from (period at most `job.period`, or any up to [`MAX_PERIOD`]); an
+/// interrupted search is [`AppError::Interrupted`], a failed one a bad `start`.
+fn first_gait(
+    job: &ContinueJob,
+    model: &crate::dynamics::Model,
+    config: &Config,
+    initial: &SectionState,
+    start: f64,
+) -> Result<crate::gait::Gait, AppError> {
+    let map = StepMap::new(model, &config.solver).with_interrupt(job.interrupt.as_deref());
+    let gait_options = GaitOptions {
+        refine_jacobian: false,
+        ..GaitOptions::default()
+    };
+    let gait = match job.period {
+        None => find_gait_any_period(&map, initial, &gait_options, MAX_PERIOD),
+        Some(k) => find_periodic_gait(&map, initial, &gait_options, k),
+    };
+    super::check_phase_interrupted(
+        job.interrupt.as_deref(),
+        "while searching the first gait",
+        "nothing is kept",
+    )?;
+    gait.map_err(|e| AppError::InvalidOption {
+        option: "start",
+        reason: format!("no gait at {} = {start} to start from: {e}", job.param),
+    })
+}
+
+/// The families [`follow_families`] followed, the warnings on the way, and where the interrupt flag stopped it
+/// (in words; `None` if it did not).
+struct FollowedFamilies<'a> {
+    families: Vec<Followed<'a>>,
+    warnings: Vec<String>,
+    interrupted: Option<String>,
+}
+
+/// Follow the family of `gait` from `start`, then breadth first: each family's ends explained by a walk past
+/// them, then (with `switch`) the period-2 family of each of its located period doublings and the family of
+/// each gait a walk past an end settles on. Once the interrupt flag is set, what the step under way computed
+/// is dropped (the causes of a family's ends, the families born from it) and nothing more is followed.
+fn follow_families<'a>(
+    job: &ContinueJob,
+    config: &Config,
+    base_map: GaitFamily<'a>,
+    gait: &crate::gait::Gait,
+    start: f64,
+    options: &ContinuationOptions,
+) -> Result<FollowedFamilies<'a>, AppError> {
+    let flag = job.interrupt.as_deref();
+    let family_map = base_map.iterated(gait.period_k);
     let first = continue_family(
         &family_map,
         &family_map.reduce(&gait.section),
         start,
-        &options,
+        options,
     )
     .map_err(|e| continuation_error(e, &job.param))?;
-    let mut families = vec![Followed {
-        family: first,
-        origin: "start".to_string(),
-        map: family_map,
-        ends: None,
-    }];
-    let mut warnings = Vec::new();
-    // Breadth first: each family's ends explained by a walk past them, then (with `switch`) the period-2
-    // family of each of its located period doublings and the family of each gait a walk past an end settles
-    // on.
+    let mut followed = FollowedFamilies {
+        families: vec![Followed {
+            family: first,
+            origin: "start".to_string(),
+            map: family_map,
+            ends: None,
+        }],
+        warnings: Vec::new(),
+        interrupted: None,
+    };
+    let families = &mut followed.families;
     let mut next = 0;
-    while next < families.len() {
+    while next < families.len() && !stopped(flag) {
         let ends = families[next].family.ends.clone().map(|end| {
-            let cause = end_cause(&config, &job.param, &families[next], &end);
+            let cause = end_cause(config, &job.param, &families[next], &end);
             EndRecord { end, cause }
         });
+        if stopped(flag) {
+            break;
+        }
         families[next].ends = Some(ends.clone());
-        if job.switch {
-            let born = switched_families(job, next, &families, base_map, &ends, &options);
-            for outcome in born {
-                match outcome {
-                    Ok(f) if same_as_followed(&families, &f) => warnings.push(format!(
-                        "the family from {} is one already followed (same period and ends): left out",
-                        f.origin
-                    )),
-                    Ok(f) if families.len() < MAX_FAMILIES => families.push(f),
-                    Ok(f) => warnings.push(format!(
-                        "more families than the {MAX_FAMILIES} one job follows: the one from {} not followed",
-                        f.origin
-                    )),
-                    Err(w) => warnings.push(w),
-                }
+        let born = if job.switch {
+            switched_families(&job.param, next, families, base_map, &ends, options)
+        } else {
+            Vec::new()
+        };
+        if stopped(flag) {
+            break;
+        }
+        for outcome in born {
+            match outcome {
+                Ok(f) if same_as_followed(families, &f) => followed.warnings.push(format!(
+                    "the family from {} is one already followed (same period and ends): left out",
+                    f.origin
+                )),
+                Ok(f) if families.len() < MAX_FAMILIES => families.push(f),
+                Ok(f) => followed.warnings.push(format!(
+                    "more families than the {MAX_FAMILIES} one job follows: the one from {} not followed",
+                    f.origin
+                )),
+                Err(w) => followed.warnings.push(w),
             }
         }
         next += 1;
     }
+    if stopped(flag) {
+        followed.interrupted = Some(format!(
+            "while following family {} of {}: the points, ends and special points found before it are \
+             kept; families not followed to their ends end as `interrupted`, and no family born after it \
+             is followed",
+            (next + 1).min(families.len()),
+            families.len()
+        ));
+    }
+    Ok(followed)
+}
+
+/// In an interrupted job: drop the special points that were not located (their location may have been cut
+/// short), with a warning.
+fn drop_unlocated(families: &mut [Followed], warnings: &mut Vec<String>) {
+    for (k, f) in families.iter_mut().enumerate() {
+        let before = f.family.special.len();
+        f.family.special.retain(|sp| sp.located);
+        let dropped = before - f.family.special.len();
+        if dropped > 0 {
+            warnings.push(format!(
+                "family {}: {dropped} special points detected but not located are left out (the job was \
+                 interrupted)",
+                k + 1
+            ));
+        }
+    }
+}
+
+/// The families' records, their special points and their points' stability verdicts; the audit warnings of
+/// their gaits go to `warnings`. A family whose ends were not explained (the job was interrupted first) has
+/// its ends without causes.
+fn family_records(
+    job: &ContinueJob,
+    families: &[Followed],
+    warnings: &mut Vec<String>,
+) -> (Vec<FamilyRecord>, Vec<SpecialRecord>, Vec<Vec<Stability>>) {
     let mut records = Vec::new();
     let mut special_points = Vec::new();
     let mut stability = Vec::new();
@@ -289,10 +447,12 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
             period_k: family.period,
             points: family.points.len(),
             origin: f.origin.clone(),
-            ends: f
-                .ends
-                .clone()
-                .expect("every family's ends are explained above"),
+            ends: f.ends.clone().unwrap_or_else(|| {
+                family
+                    .ends
+                    .clone()
+                    .map(|end| EndRecord { end, cause: None })
+            }),
         });
         special_points.extend(family.special.iter().map(|s| special_record(k + 1, s)));
         stability.push(
@@ -312,240 +472,8 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
             );
         }
     }
-    let (curve_records, curves) = match &job.two_param {
-        Some(second) => {
-            let followed = family_curves::FollowedParam {
-                param: &job.param,
-                from: job.from,
-                to: job.to,
-            };
-            let maps: Vec<_> = families.iter().map(|f| (&f.family, f.map)).collect();
-            two_param_curves(&followed, &config, second, &maps, &mut warnings)?
-        }
-        None => (Vec::new(), Vec::new()),
-    };
-    let summary = ContinueSummary {
-        curves: curve_records,
-        vrw_version: env!("CARGO_PKG_VERSION"),
-        config: config.clone(),
-        param: job.param.clone(),
-        start,
-        initial: gait.section,
-        options,
-        families: records,
-        special_points,
-        warnings,
-        files: Vec::new(),
-        seconds: clock.elapsed().as_secs_f64(),
-    };
-    Ok(ContinueResult {
-        summary,
-        families: families.into_iter().map(|f| f.family).collect(),
-        stability,
-        curves,
-    })
+    (records, special_points, stability)
 }
-
-/// A family being followed: where it came from, its map and its ends with their causes.
-struct Followed<'a> {
-    family: Family<GaitInfo>,
-    origin: String,
-    map: GaitFamily<'a>,
-    ends: Option<[EndRecord; 2]>,
-}
-
-/// The families born from family `k` (branch switching): the period-2 family of each of its located period
-/// doublings, the other piece's family at each border collision where it ends, and the family of each gait that a walk past one of its `ends` settles on (unless a family
-/// already followed passes through that gait). A family that cannot be started is a warning.
-fn switched_families<'a>(
-    job: &ContinueJob,
-    k: usize,
-    families: &[Followed<'a>],
-    base_map: GaitFamily<'a>,
-    ends: &[EndRecord; 2],
-    options: &ContinuationOptions,
-) -> Vec<Result<Followed<'a>, String>> {
-    let parent = &families[k];
-    let mut born = Vec::new();
-    for (i, pd) in parent.family.special.iter().enumerate() {
-        if pd.kind != SpecialKind::PeriodDoubling || !pd.located {
-            continue;
-        }
-        born.push(
-            switch_at_period_doubling(&parent.map, pd, options)
-                .map(|family| Followed {
-                    family,
-                    origin: format!("family {} special point {i} (PD)", k + 1),
-                    map: parent.map.iterated(2),
-                    ends: None,
-                })
-                .map_err(|e| {
-                    format!(
-                        "family {} PD at {} = {}: no period-2 family followed: {e}",
-                        k + 1,
-                        job.param,
-                        pd.param
-                    )
-                }),
-        );
-    }
-    for (i, bc) in parent.family.special.iter().enumerate() {
-        // Where the map jumps across the border, no fixed point of the other piece is near: the walk past
-        // the end (below) looks for what takes over.
-        if bc.kind != SpecialKind::BorderCollision
-            || !bc.ends_family
-            || !bc.located
-            || bc.jump.is_nan()
-            || bc.jump > JUMP_TOL
-        {
-            continue;
-        }
-        born.push(
-            switch_at_border(&parent.map, bc, options)
-                .map(|family| Followed {
-                    family,
-                    origin: format!(
-                        "family {} special point {i} (BC: the other piece's fixed points)",
-                        k + 1
-                    ),
-                    map: parent.map,
-                    ends: None,
-                })
-                .map_err(|e| {
-                    format!(
-                        "family {} BC at {} = {}: no family of the other piece followed: {e}",
-                        k + 1,
-                        job.param,
-                        bc.param
-                    )
-                }),
-        );
-    }
-    for end in ends {
-        let (
-            Some(EndCause::OtherGait {
-                section, period_k, ..
-            }),
-            FamilyEnd::Ended { beyond, .. },
-        ) = (&end.cause, &end.end)
-        else {
-            continue;
-        };
-        // The walk's period may be a multiple of the gait's least period (its detection compares states
-        // within the walk's tolerance): the family is followed as P^j for the least period j of its fixed
-        // point at the walk's parameter.
-        let walked = base_map.iterated(*period_k);
-        let x = walked.reduce(section);
-        let least = solve_on_parameter(&walked, &x, *beyond, options)
-            .and_then(|fixed| walked.value_with_info(&fixed, *beyond).ok())
-            .map_or(*period_k, |info| info.least_period());
-        let period_k = &least;
-        let map = base_map.iterated(*period_k);
-        if known_gait(families, base_map, *period_k, &x, *beyond) {
-            continue;
-        }
-        if !(options.from..=options.to).contains(beyond) {
-            continue;
-        }
-        born.push(
-            continue_family(&map, &x, *beyond, options)
-                .map(|family| Followed {
-                    family,
-                    origin: format!(
-                        "family {} end at {} = {} (the gait a walk past it settles on)",
-                        k + 1,
-                        job.param,
-                        beyond
-                    ),
-                    map,
-                    ends: None,
-                })
-                .map_err(|e| {
-                    format!(
-                        "family {} end at {} = {}: the period-{period_k} gait past it could not be followed: {e}",
-                        k + 1,
-                        job.param,
-                        beyond
-                    )
-                }),
-        );
-    }
-    born
-}
-
-/// The fixed point of `map` at `p` by Newton's method from `x` (`None` if it does not converge).
-fn solve_on_parameter(
-    map: &GaitFamily,
-    x: &nalgebra::DVector<f64>,
-    p: f64,
-    options: &ContinuationOptions,
-) -> Option<nalgebra::DVector<f64>> {
-    let sigma = options.param_scale;
-    let n = x.len();
-    let mut z = x.clone().insert_row(n, p / sigma);
-    let mut row = nalgebra::DVector::zeros(n + 1);
-    row[n] = 1.0;
-    z = solve_on_hyperplane(map, &z, &row, options).ok()?;
-    Some(z.rows(0, n).into_owned())
-}
-
-/// Does a family already followed pass through the period-`k` gait `x` at `p` (any of its `k` phases)? Each
-/// family of period `k` is interpolated linearly at `p` between its successive points that bracket `p`, and
-/// compared with the phases within [`KNOWN_GAIT_TOL`] (the interpolation's error over a continuation step).
-fn known_gait(
-    families: &[Followed],
-    base_map: GaitFamily,
-    k: usize,
-    x: &nalgebra::DVector<f64>,
-    p: f64,
-) -> bool {
-    let mut phases = vec![x.clone()];
-    for _ in 1..k {
-        match phases.last().map(|y| base_map.value(y, p)) {
-            Some(Ok(y)) => phases.push(y),
-            _ => break,
-        }
-    }
-    families
-        .iter()
-        .filter(|f| f.map.period() == k)
-        .flat_map(|f| f.family.points.windows(2))
-        .filter(|w| (w[0].param - p) * (w[1].param - p) <= 0.0 && w[0].param != w[1].param)
-        .any(|w| {
-            let t = (p - w[0].param) / (w[1].param - w[0].param);
-            let at = &w[0].x + t * (&w[1].x - &w[0].x);
-            phases.iter().any(|y| (&at - y).amax() < KNOWN_GAIT_TOL)
-        })
-}
-
-/// Is `new` a family already followed: the same period, and both its ends within [`SAME_END_TOL`] times
-/// `max(1, |p|)` in the parameter of that family's ends (a walk past an end can settle on another phase of a
-/// known orbit, where [`known_gait`]'s interpolation misses it)?
-fn same_as_followed(families: &[Followed], new: &Followed) -> bool {
-    let ends = |f: &Family<GaitInfo>| -> Option<[f64; 2]> {
-        Some([f.points.first()?.param, f.points.last()?.param])
-    };
-    let Some(mut a) = ends(&new.family) else {
-        return false;
-    };
-    a.sort_by(f64::total_cmp);
-    families.iter().any(|f| {
-        f.family.period == new.family.period
-            && ends(&f.family).is_some_and(|mut b| {
-                b.sort_by(f64::total_cmp);
-                a.iter()
-                    .zip(b)
-                    .all(|(x, y)| (x - y).abs() <= SAME_END_TOL * y.abs().max(1.0))
-            })
-    })
-}
-
-/// Two families whose ends lie this close (relative to the parameter) are taken as one: ends are bracketed to
-/// far less.
-pub const SAME_END_TOL: f64 = 1e-6;
-
-/// Two gaits closer than this on the section (interpolated) are taken as one ([`known_gait`]).
-pub const KNOWN_GAIT_TOL: f64 = 1e-3;
 
 /// A continuation error as the job's error.
 fn continuation_error(e: ContinuationError, param: &str) -> AppError {
@@ -553,19 +481,6 @@ fn continuation_error(e: ContinuationError, param: &str) -> AppError {
         option: "start",
         reason: format!("the family in {param} could not be started: {e}"),
     }
-}
-
-/// The stability verdict of a family point: from its multipliers, with the error estimate of its `DP`
-/// within [`STABILITY_BAND`] of the unit circle; uncertain without derivatives.
-fn point_stability(map: &GaitFamily, p: &crate::bifurcation::FamilyPoint<GaitInfo>) -> Stability {
-    let max = p.max_multiplier();
-    if !p.has_derivatives() || !max.is_finite() {
-        return Stability::Uncertain;
-    }
-    if (max - 1.0).abs() > STABILITY_BAND {
-        return Stability::judge(max, 0.0);
-    }
-    Stability::judge(max, map.jacobian_error(&p.x, p.param, &p.jacobian))
 }
 
 /// What the walk from the last gait does just past an end where the map failed ([`Continuation::end_cause`]).

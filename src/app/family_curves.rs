@@ -45,6 +45,31 @@ pub(super) struct FollowedParam<'s> {
     pub to: f64,
 }
 
+/// Checks `--two-param` before anything is computed: a real-valued key other than the followed `param`, and a
+/// finite range `from < to` that holds its configured value (returned).
+pub(super) fn check_two_param(
+    param: &str,
+    config: &Config,
+    (name, from, to): &(String, f64, f64),
+) -> Result<f64, AppError> {
+    let invalid = |reason: String| AppError::InvalidOption {
+        option: "two_param",
+        reason,
+    };
+    if !Config::numeric_keys().contains(&name.as_str()) || name == param {
+        return Err(invalid(format!(
+            "{name:?} must be a real-valued key other than the followed parameter {param:?}"
+        )));
+    }
+    let q0 = config.get_numeric(name)?;
+    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
+        return Err(invalid(format!(
+            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
+        )));
+    }
+    Ok(q0)
+}
+
 /// The curves of every located special point of `families` (each with its map) in the second parameter
 /// (`name`, from, to), a border collision's followed on its family's side of the border (docs/model.md
 /// section 11, "Two-parameter curves").
@@ -55,22 +80,7 @@ pub(super) fn two_param_curves(
     families: &[(&Family<GaitInfo>, GaitFamily)],
     warnings: &mut Vec<String>,
 ) -> Result<(Vec<CurveRecord>, Vec<Curve<GaitInfo>>), AppError> {
-    let invalid = |reason: String| AppError::InvalidOption {
-        option: "two_param",
-        reason,
-    };
-    if !Config::numeric_keys().contains(&name.as_str()) || *name == job.param {
-        return Err(invalid(format!(
-            "{name:?} must be a real-valued key other than the followed parameter {:?}",
-            job.param
-        )));
-    }
-    let q0 = config.get_numeric(name)?;
-    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
-        return Err(invalid(format!(
-            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
-        )));
-    }
+    let q0 = check_two_param(job.param, config, &(name.clone(), *from, *to))?;
     let options = CurveOptions::for_ranges((job.from, job.to), (*from, *to));
     let mut records = Vec::new();
     let mut curves = Vec::new();

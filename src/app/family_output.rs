@@ -14,11 +14,27 @@ use crate::output::{write_curves_csv, write_family_csv, write_json, CurveRow, Fa
 
 /// Run `vrw continue`: [`compute_continuation`], then write `branch.csv`, `special_points.json` and the
 /// diagram.
+///
+/// The options and the output directory are checked before anything is computed. Interrupted (Ctrl-C,
+/// [`ContinueSummary::interrupted`](super::ContinueSummary::interrupted)), it writes
+/// `branch.csv` and `special_points.json` with what was complete, no figure, and returns
+/// [`AppError::Interrupted`] (the manifest says `interrupted`).
 pub fn run_continuation(job: &ContinueJob) -> Result<ContinueResult, AppError> {
+    job.validate()?;
+    RunDir::check(&job.out_dir, "continue", job.overwrite)?;
     let mut result = compute_continuation(job)?;
-    in_run(&job.out_dir, "continue", |run| {
+    in_run(&job.out_dir, job.overwrite, "continue", |run| {
         write_continuation(job, &mut result, run)?;
-        Ok((result, None))
+        match result.summary.interrupted.clone() {
+            Some(during) => Err(AppError::Interrupted {
+                during,
+                kept: format!(
+                    "{} hold what was complete",
+                    result.summary.files.join(" and ")
+                ),
+            }),
+            None => Ok((result, None)),
+        }
     })
 }
 
@@ -71,6 +87,14 @@ fn write_continuation(
     write_family_csv(&run.path("branch.csv"), param, friction, &rows)?;
     run.add("branch.csv");
     let mut files = vec!["branch.csv".to_string()];
+    if result.summary.interrupted.is_some() {
+        // No figure of an interrupted job: it would draw cut families as if they ended there.
+        files.push("special_points.json".to_string());
+        result.summary.files = files;
+        write_json(&run.path("special_points.json"), &result.summary)?;
+        run.add("special_points.json");
+        return Ok(());
+    }
     let figure = diagram(job, result);
     write_svg_png(
         &figure,
@@ -111,7 +135,11 @@ fn write_continuation(
 /// The two-parameter curves in the plane of the two parameters.
 fn curves_figure(job: &ContinueJob, result: &ContinueResult, param2: &str) -> BifurcationFigure {
     BifurcationFigure {
-        title: format!("Curves of special points in ({}, {param2})", job.param),
+        title: format!(
+            "Curves of special points in ({}, {param2}){}",
+            job.param,
+            super::settings_note(&job.config, &[&job.param, param2])
+        ),
         param_label: axis_label(&job.param),
         y_label: axis_label(param2),
         // The curves' extent in the followed parameter, with a margin (a fold's curve may span a sliver of
@@ -245,9 +273,10 @@ fn diagram(job: &ContinueJob, result: &ContinueResult) -> BifurcationFigure {
         .collect();
     BifurcationFigure {
         title: format!(
-            "Gait families in {} (period of the start: {})",
+            "Gait families in {} (period of the start: {}){}",
             job.param,
-            result.families.first().map_or(1, |f| f.period)
+            result.families.first().map_or(1, |f| f.period),
+            super::settings_note(&job.config, &[&job.param])
         ),
         param_label: axis_label(&job.param),
         y_label: quantity_label(&job.plot),

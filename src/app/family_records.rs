@@ -4,8 +4,9 @@
 use serde::Serialize;
 
 use crate::bifurcation::special::Side;
-use crate::bifurcation::{FamilyEnd, GaitInfo, SpecialKind, SpecialPoint};
+use crate::bifurcation::{FamilyEnd, GaitFamily, GaitInfo, SpecialKind, SpecialPoint};
 use crate::gait::continuation::EndCause;
+use crate::gait::Stability;
 
 /// How a family ends at one side, with the physical cause found by walking just past it.
 #[derive(Debug, Clone, Serialize)]
@@ -138,3 +139,24 @@ pub(crate) fn special_record(family: usize, s: &SpecialPoint<GaitInfo>) -> Speci
         note: s.note.clone(),
     }
 }
+
+/// The stability verdict of a family point: from its multipliers, with the error estimate of its `DP`
+/// within [`STABILITY_BAND`] of the unit circle; uncertain without derivatives.
+pub(super) fn point_stability(
+    map: &GaitFamily,
+    p: &crate::bifurcation::FamilyPoint<GaitInfo>,
+) -> Stability {
+    let max = p.max_multiplier();
+    if !p.has_derivatives() || !max.is_finite() {
+        return Stability::Uncertain;
+    }
+    if (max - 1.0).abs() > STABILITY_BAND {
+        return Stability::judge(max, 0.0);
+    }
+    Stability::judge(max, map.jacobian_error(&p.x, p.param, &p.jacobian))
+}
+
+/// Within this of the unit circle, a point's stability verdict uses the error estimate of its `DP` (a second
+/// `DP` at tighter tolerances); farther out the exact `DP`'s error (below `1e-6` wherever it was estimated)
+/// cannot change it.
+pub const STABILITY_BAND: f64 = 1e-3;

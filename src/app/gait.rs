@@ -32,6 +32,9 @@ pub struct GaitJob {
     pub options: GaitOptions,
     /// Where `gait.json` goes, and one period of the gait in the files of `vrw simulate`.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
     /// Check the exact `DP` of the gait found against finite differences ([`check_jacobian`]).
     pub check_jacobian: bool,
     /// Stops the search inside a step when set (e.g. by Ctrl-C from Python); the search then ends with the
@@ -72,19 +75,29 @@ pub const MIN_GAIT_TOLERANCE: f64 = TOLERANCE_RANGE[0];
 /// `k <= MAX_PERIOD`) and write `gait.json` (also when no gait is found, with the reason), and
 /// for a gait found, one period of it as `steps.csv`, `trajectory.csv` and `summary.json`
 /// (`write_gait_period`).
+///
+/// The options and the output directory are checked before the search; an interrupted search
+/// ([`AppError::Interrupted`]) writes nothing.
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
+    job.options.validate()?;
+    job.config.validate()?;
+    RunDir::check(&job.out_dir, "gait", job.overwrite)?;
     let summary = compute_gait(job)?;
-    in_run(&job.out_dir, "gait", |run| {
+    in_run(&job.out_dir, job.overwrite, "gait", |run| {
         output::write_json(&run.path("gait.json"), &summary)?;
         run.add("gait.json");
-        let mut interrupted = None;
         if let Some(gait) = &summary.gait {
             let period = write_gait_period(job, gait, run)?;
-            interrupted = (period.status == "interrupted")
-                .then_some(period.message)
-                .flatten();
+            if period.status == "interrupted" {
+                return Err(AppError::Interrupted {
+                    during: "while walking the gait's period".to_string(),
+                    kept: "gait.json holds the gait (complete); the period's tables hold its complete \
+                           steps"
+                        .to_string(),
+                });
+            }
         }
-        Ok((summary, interrupted))
+        Ok((summary, None))
     })
 }
 
@@ -98,6 +111,9 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     initial.validate(&model)?;
     let map = StepMap::new(&model, &job.config.solver).with_interrupt(job.interrupt.as_deref());
     let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
+    let flag = job.interrupt.as_deref();
+    let nothing = "nothing is written";
+    super::check_phase_interrupted(flag, "while searching the gait", nothing)?;
     let jacobian_check = match (&result, job.check_jacobian) {
         (Ok(gait), true) => Some(
             check_jacobian(
@@ -109,6 +125,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
         ),
         _ => None,
     };
+    super::check_phase_interrupted(flag, "while checking the Jacobian", nothing)?;
     let summary = GaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         config: job.config.clone(),
@@ -144,6 +161,7 @@ pub fn write_gait_period(
         sample_dt: DEFAULT_SAMPLE_DT,
         trajectory: true,
         out_dir: job.out_dir.clone(),
+        overwrite: job.overwrite,
         interrupt: None,
     };
     let model = Model::new(&job.config.params)?;

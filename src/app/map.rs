@@ -19,7 +19,10 @@ use crate::output::{self, write_map_csv};
 use crate::params::Config;
 use crate::walk::SectionState;
 
-use super::{axis_label, check_interrupted, in_run, second_route_config, short_name, AppError};
+use super::{
+    axis_label, check_interrupted, check_phase_interrupted, in_run, second_route_config,
+    short_name, AppError,
+};
 use crate::output::manifest::RunDir;
 use crate::reference::default_initial;
 
@@ -48,6 +51,9 @@ pub struct MapJob {
     pub marks: Vec<MapMark>,
     /// Where `map.csv`, `curves.json`, `map.svg` and `map.png` go.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
 }
 
 /// `curves.json`: the map's parameters, its curves and the 1-D thresholds they pass through.
@@ -88,7 +94,7 @@ pub fn run_map(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<MapSummary, AppError> {
     let initial = checked_initial(job)?;
-    in_run(&job.out_dir, "map", |run| {
+    in_run(&job.out_dir, job.overwrite, "map", |run| {
         map_into(job, &initial, run, progress).map(|s| (s, None))
     })
 }
@@ -146,6 +152,7 @@ fn summarized_rows(
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
     let summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
+    check_curves_interrupted("every point of the map is complete")?;
     Ok((summary, map))
 }
 
@@ -183,6 +190,7 @@ fn map_into(
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;
     let mut summary = map_summary(job, &map, gait_seconds);
+    check_curves_interrupted("map.csv holds every point of the map")?;
     let curves_json = run.path("curves.json");
     output::write_json(&curves_json, &summary)?;
     run.add("curves.json");
@@ -199,6 +207,16 @@ fn map_into(
         output::write_json(&curves_json, &summary)?;
     }
     Ok(summary)
+}
+
+/// The error of a map whose curves (or the summary's searches) the interrupt flag cut short: none of them is
+/// kept, the gaits are (`kept`).
+fn check_curves_interrupted(kept: &str) -> Result<(), AppError> {
+    check_phase_interrupted(
+        None,
+        "while tracing the threshold curves",
+        &format!("{kept}; no curve is kept"),
+    )
 }
 
 /// The curves of `map` (with `job.curves`) and the summary of the map and its curves.
@@ -265,12 +283,12 @@ fn second_route(
     let clock = std::time::Instant::now();
     let (second_config, route) = second_route_config(&job.config);
     let second_map = map_gaits(&second_config, &job.spec, initial, &job.options, progress)?;
-    check_interrupted(
-        second_map.rows.iter().map(Vec::len).sum(),
-        summary.points,
-        "map.csv (first route; the second route is dropped)",
-    )?;
+    let kept =
+        "map.csv, curves.json and the heat maps of the first route are complete; no threshold is \
+                confirmed by a second route";
+    check_phase_interrupted(None, &format!("during the second route ({route})"), kept)?;
     let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
+    check_phase_interrupted(None, &format!("during the second route ({route})"), kept)?;
     for t in &mut summary.thresholds {
         let same_line = second
             .thresholds
@@ -304,10 +322,22 @@ fn write_figure(
     }
     context.push(format!("impact {}", p.impact));
     let title = format!(
-        "Gaits over ({}, {}), {}",
+        "Gaits over ({}, {}), {}{}",
         short_name(&job.spec.x.param),
         short_name(&job.spec.y.param),
-        context.join(", ")
+        context.join(", "),
+        super::settings_note(
+            &job.config,
+            &[
+                &job.spec.x.param,
+                &job.spec.y.param,
+                "slope",
+                "impact",
+                "stiffness",
+                "spring_natural_length",
+                "stopper_length",
+            ]
+        )
     );
     let figure = MapFigure {
         map,

@@ -12,6 +12,7 @@ mod family;
 mod family_curves;
 mod family_output;
 mod family_records;
+mod family_switch;
 mod figures;
 mod gait;
 mod map;
@@ -24,11 +25,14 @@ pub use basin::{
 };
 pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
-    MAX_FAMILIES, MAX_FAMILY_POINTS, STABILITY_BAND,
+    MAX_FAMILIES, MAX_FAMILY_POINTS,
 };
 pub use family_curves::CurveRecord;
 pub use family_output::{curve_rows, family_rows, run_continuation};
-pub use family_records::{EndRecord, FamilyRecord, SectionRecord, SideRecord, SpecialRecord};
+pub use family_records::{
+    EndRecord, FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND,
+};
+pub use family_switch::{KNOWN_GAIT_TOL, SAME_END_TOL};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
     MAX_ANIMATION_FRAMES,
@@ -39,7 +43,7 @@ pub use gait::{
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
-    OrbitSummary,
+    OrbitSummary, ORBIT_QUANTITIES,
 };
 pub use simulate::{
     compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
@@ -86,18 +90,13 @@ pub enum AppError {
         /// What is wrong, and what to do.
         reason: String,
     },
-    /// The library's interrupt flag (Ctrl-C) stopped the job; what was complete is written.
-    #[error(
-        "interrupted (Ctrl-C) after {done} of {total} points; {kept} holds the complete ones \
-         (manifest.json: interrupted)"
-    )]
+    /// The interrupt flag (Ctrl-C) stopped the job; what was complete is written (and named in `kept`).
+    #[error("interrupted (Ctrl-C) {during}; {kept} (manifest.json: interrupted)")]
     Interrupted {
-        /// Points computed.
-        done: usize,
-        /// Points asked for.
-        total: usize,
-        /// The file that holds them.
-        kept: &'static str,
+        /// Where the job was: `after 12 of 300 points`, `while locating the thresholds`.
+        during: String,
+        /// What the output directory holds, in words: `sweep.csv holds the complete points`.
+        kept: String,
     },
     /// A bad job setting that is not a model parameter.
     #[error("invalid {option}: {reason}")]
@@ -123,15 +122,16 @@ fn prepared(
     Ok((model, initial))
 }
 
-/// Run `body` as a job `command` writing into `dir` ([`RunDir::start`]: the directory is checked and
-/// cleared, the manifest says `running`), then write the manifest's final status: `completed`, `interrupted`
+/// Run `body` as a job `command` writing into `dir` ([`RunDir::start`]: the directory is checked and the
+/// earlier run it holds removed, with `overwrite` also another command's; the manifest says `running`), then write the manifest's final status: `completed`, `interrupted`
 /// (when `body` returns an interruption reason, or [`AppError::Interrupted`]) or `failed` with the error.
 fn in_run<T>(
     dir: &std::path::Path,
+    overwrite: bool,
     command: &str,
     body: impl FnOnce(&mut RunDir) -> Result<(T, Option<String>), AppError>,
 ) -> Result<T, AppError> {
-    let mut run = RunDir::start(dir, command)?;
+    let mut run = RunDir::start(dir, command, overwrite)?;
     match body(&mut run) {
         Ok((value, None)) => {
             run.finish(RunStatus::Completed, None)?;
@@ -156,8 +156,30 @@ fn in_run<T>(
 /// The error of a grid job cut short by the interrupt flag, once its complete points are in `kept`; `Ok` if it
 /// was not.
 fn check_interrupted(done: usize, total: usize, kept: &'static str) -> Result<(), AppError> {
-    if crate::gait::grid::interrupted() {
-        Err(AppError::Interrupted { done, total, kept })
+    if crate::walk::interrupted() {
+        Err(AppError::Interrupted {
+            during: format!("after {done} of {total} points"),
+            kept: format!("{kept} holds the complete ones"),
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// The error of a job whose phase `during` (`while locating the thresholds`) was cut short by the interrupt
+/// flag (the library's, or the job's own `flag`), its earlier phases' files being complete (`kept`); `Ok` if it
+/// was not. What the phase computed is discarded by the caller.
+fn check_phase_interrupted(
+    flag: Option<&std::sync::atomic::AtomicBool>,
+    during: &str,
+    kept: &str,
+) -> Result<(), AppError> {
+    let job_flag = flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst));
+    if job_flag || crate::walk::interrupted() {
+        Err(AppError::Interrupted {
+            during: during.to_string(),
+            kept: kept.to_string(),
+        })
     } else {
         Ok(())
     }
@@ -172,6 +194,47 @@ pub(crate) fn second_route_config(config: &Config) -> (Config, String) {
     (second, route)
 }
 
+/// The most non-default keys a figure's title names ([`settings_note`]); the rest are counted.
+const TITLE_KEYS: usize = 5;
+
+/// The keys a figure's title names besides those it shows already (`shown`: the varied parameters, and those
+/// the title names itself): every key of `config` whose value differs from the default (a reading's rules,
+/// `friction`, `impact`, `legs`, ...), as ` [friction = 0.105, impact traditional]`; empty when there is
+/// none. So a figure always says what it was made with.
+pub(crate) fn settings_note(config: &Config, shown: &[&str]) -> String {
+    let (Ok(serde_json::Value::Object(now)), Ok(serde_json::Value::Object(default))) = (
+        serde_json::to_value(config),
+        serde_json::to_value(Config::default()),
+    ) else {
+        return String::new();
+    };
+    let changed: Vec<String> = now
+        .iter()
+        .filter(|(key, value)| !shown.contains(&key.as_str()) && default.get(*key) != Some(*value))
+        .map(|(key, value)| match value {
+            serde_json::Value::Number(n) => match n.as_f64() {
+                Some(v) => format!("{} = {}", short_name(key), crate::fmt::short(v)),
+                None => format!("{key} = {n}"),
+            },
+            serde_json::Value::String(text) => format!("{key} {text}"),
+            other => format!("{key} = {other}"),
+        })
+        .collect();
+    if changed.is_empty() {
+        return String::new();
+    }
+    let mut words = changed
+        .iter()
+        .take(TITLE_KEYS)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if changed.len() > TITLE_KEYS {
+        words += &format!(" and {} more non-default keys", changed.len() - TITLE_KEYS);
+    }
+    format!(" [{words}]")
+}
+
 /// Short symbol of a parameter for labels (`c` for viscosity, ...).
 fn short_name(param: &str) -> &str {
     match param {
@@ -180,6 +243,7 @@ fn short_name(param: &str) -> &str {
         "slope" => "φ",
         "hub_mass" => "mH",
         "leg_mass" => "m",
+        "friction" => "μ",
         other => other,
     }
 }

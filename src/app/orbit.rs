@@ -29,8 +29,37 @@ pub struct OrbitJob {
     pub initial: Option<SectionState>,
     /// Draw the period-1 branch (a sweep with continuation over the same values).
     pub branch: bool,
+    /// The DLS indicator the diagram's second panel draws (one of [`ORBIT_QUANTITIES`]).
+    pub plot: String,
     /// Where `orbit.csv`, `branch.csv`, `orbit.json` and `orbit.png` go.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
+}
+
+/// The DLS indicators the orbit diagram's second panel can draw (`vrw orbit --plot`).
+pub const ORBIT_QUANTITIES: [&str; 3] = ["lambda_I4", "lambda_2_plus", "lambda_4_plus"];
+
+/// The kinds of walk failure that are no failure of the walk: it goes on, but its touchdown is not on the
+/// Poincare section the diagram records (`WalkError::leaves_section`).
+const LEAVES_SECTION: [&str; 2] = ["off_section", "leg_swings_at_section"];
+
+impl OrbitJob {
+    /// Checks the settings that are not model parameters or the spec's (`plot`).
+    fn validate(&self) -> Result<(), AppError> {
+        if ORBIT_QUANTITIES.contains(&self.plot.as_str()) {
+            return Ok(());
+        }
+        Err(AppError::InvalidOption {
+            option: "plot",
+            reason: format!(
+                "unknown quantity {:?}: expected one of {}",
+                crate::fmt::clip(&self.plot),
+                ORBIT_QUANTITIES.join(", ")
+            ),
+        })
+    }
 }
 
 /// `orbit.json`.
@@ -61,7 +90,8 @@ pub fn run_orbit(
 ) -> Result<OrbitSummary, AppError> {
     let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
-    in_run(&job.out_dir, "orbit", |run| {
+    job.validate()?;
+    in_run(&job.out_dir, job.overwrite, "orbit", |run| {
         orbit_into(job, &initial, run, progress).map(|s| (s, None))
     })
 }
@@ -78,6 +108,7 @@ pub fn compute_orbit(
 ) -> Result<(OrbitSummary, Vec<OrbitColumn>, Branch), AppError> {
     let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
+    job.validate()?;
     let clock = std::time::Instant::now();
     let columns = orbit_diagram(&job.config, &job.spec, &initial, progress)?;
     let orbit_seconds = clock.elapsed().as_secs_f64();
@@ -121,6 +152,7 @@ pub fn compute_orbit_part(
 ) -> Result<OrbitPartResult, AppError> {
     let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
+    job.validate()?;
     let total = job.spec.range.points;
     let (columns, ends, branch) = match part {
         OrbitJobPart::Diagram(p) => {
@@ -245,13 +277,26 @@ fn orbit_figure(
 ) -> OrbitFigure {
     type Pick = fn(&StepReport) -> f64;
     type OfGait = fn(&Gait) -> f64;
+    let indicator: (&str, Pick, OfGait) = match job.plot.as_str() {
+        "lambda_2_plus" => (
+            "λ₂⁺ [N]",
+            |r| r.indicators.lambda_2_plus,
+            |g| g.lambda_2_plus,
+        ),
+        "lambda_4_plus" => (
+            "λ₄⁺ [N]",
+            |r| r.indicators.lambda_4_plus,
+            |g| g.lambda_4_plus,
+        ),
+        _ => ("λI4 [N s]", |r| r.indicators.lambda_i4, |g| g.lambda_i4),
+    };
     let panels: [(&str, Pick, OfGait); 2] = [
         (
             "dθ/dt before touchdown [rad/s]",
             |r| r.section.theta_dot,
             |g| g.section.theta_dot,
         ),
-        ("λI4 [N s]", |r| r.indicators.lambda_i4, |g| g.lambda_i4),
+        indicator,
     ];
     let p = &job.config.params;
     let range = &job.spec.range;
@@ -263,7 +308,11 @@ fn orbit_figure(
         .map(|c| {
             (
                 (c.value - half)..(c.value + half),
-                format!("walk fails: {}", c.status.replace('_', " ")),
+                if LEAVES_SECTION.contains(&c.status.as_str()) {
+                    format!("walk leaves the section: {}", c.status.replace('_', " "))
+                } else {
+                    format!("walk fails: {}", c.status.replace('_', " "))
+                },
             )
         })
         .collect();
@@ -283,6 +332,9 @@ fn orbit_figure(
             .map(|(_, fixed)| fixed)
             .collect::<String>(),
             p.impact
+        ) + &super::settings_note(
+            &job.config,
+            &[&range.param, "viscosity", "stiffness", "slope", "impact"],
         ),
         param_label: axis_label(&range.param),
         x: range.from.min(range.to)..range.from.max(range.to),

@@ -53,6 +53,9 @@ pub struct SimulateJob {
     pub trajectory: bool,
     /// Where `steps.csv`, `trajectory.csv` and `summary.json` go.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
     /// Set it (e.g. from a Ctrl-C handler) to stop the walk at the next touchdown; the results so far are
     /// written with the status `interrupted`.
     pub interrupt: Option<Arc<AtomicBool>>,
@@ -200,7 +203,7 @@ pub fn run_simulate(
     observe: &mut dyn FnMut(SimulateEvent),
 ) -> Result<SimulateSummary, AppError> {
     let (model, initial) = simulation_setup(job)?;
-    in_run(&job.out_dir, "simulate", |run| {
+    in_run(&job.out_dir, job.overwrite, "simulate", |run| {
         let summary = simulate_into(job, &model, initial, run, observe)?;
         let interrupted = (summary.status == "interrupted").then(|| summary.message.clone());
         Ok((summary, interrupted.flatten()))
@@ -352,6 +355,7 @@ mod tests {
             sample_dt: 0.005,
             trajectory,
             out_dir: dir.to_path_buf(),
+            overwrite: false,
             interrupt: None,
         }
     }

@@ -17,7 +17,8 @@ use crate::params::Config;
 use crate::walk::SectionState;
 
 use super::{
-    axis_label, check_interrupted, in_run, prepared, second_route_config, short_name, AppError,
+    axis_label, check_interrupted, check_phase_interrupted, in_run, prepared, second_route_config,
+    short_name, AppError,
 };
 use crate::output::manifest::RunDir;
 
@@ -38,6 +39,9 @@ pub struct SweepJob {
     pub second_route: bool,
     /// Where `sweep.csv`, `thresholds.json`, `fig2.svg` and `fig2.png` go.
     pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    pub overwrite: bool,
 }
 
 /// `thresholds.json`.
@@ -78,7 +82,7 @@ pub fn run_sweep(
 ) -> Result<SweepSummary, AppError> {
     let (_, initial) = prepared(&job.config, job.initial)?;
     job.spec.validate(&job.config)?;
-    in_run(&job.out_dir, "sweep", |run| {
+    in_run(&job.out_dir, job.overwrite, "sweep", |run| {
         sweep_into(job, initial, run, progress).map(|s| (s, None))
     })
 }
@@ -149,7 +153,17 @@ fn sweep_into(
             &job.options,
             progress,
             &mut |_| Ok(()),
-        )?;
+        )
+        .map_err(|e| match e {
+            AppError::Interrupted { .. } => AppError::Interrupted {
+                during: format!("during the second route ({route})"),
+                kept: format!(
+                    "{} are complete; the thresholds are not confirmed by a second route",
+                    summary.files.join(", ")
+                ),
+            },
+            other => other,
+        })?;
         for t in &mut summary.thresholds {
             t.second_route = Some(SecondRoute::check(t, &second.thresholds, &route));
         }
@@ -199,6 +213,12 @@ pub fn compute_sweep(
     };
     let clock = std::time::Instant::now();
     let mut thresholds = find_thresholds(config, &spec, &points, options);
+    // Thresholds searched while the flag was set are not results (their walks were cut short).
+    check_phase_interrupted(
+        None,
+        "while locating the thresholds",
+        "sweep.csv holds every point; no threshold is kept",
+    )?;
     let threshold_seconds = clock.elapsed().as_secs_f64();
     thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
     Ok(SweepResult {
@@ -226,6 +246,7 @@ fn write_fig2(
                 scuffing: g.scuffing,
                 family: p.family,
                 period: g.period,
+                period_k: g.period_k,
                 max_floquet: g.max_floquet,
             },
             None => IndicatorPoint {
@@ -236,6 +257,7 @@ fn write_fig2(
                 scuffing: false,
                 family: None,
                 period: f64::NAN,
+                period_k: 1,
                 max_floquet: f64::NAN,
             },
         })
@@ -244,7 +266,9 @@ fn write_fig2(
         "lambda_4_plus = 0" => "λ₄⁺ = 0",
         "lambda_2_plus = 0" => "λ₂⁺ = 0",
         "lambda_I4 = 0" => "λI4 = 0",
-        "stability_lost" => "unstable",
+        "stability_lost" => "unstable above",
+        "stability_regained" => "stable above",
+        "period_doubling" => "period doubling",
         "gait_lost" => "gait lost",
         "gait_found"
             if t.detail
@@ -273,9 +297,20 @@ fn write_fig2(
         .collect();
     let no_gait = no_gait_spans(points, thresholds);
     let title = format!(
-        "Gaits along {}: {} (hollow: scuffing of Leg 2; grey: no gait)",
+        "Gaits along {}: {}{} (hollow: scuffing of Leg 2; grey: no gait)",
         short_name(&job.spec.param),
-        fixed_parameters(&job.config, &job.spec.param)
+        fixed_parameters(&job.config, &job.spec.param),
+        super::settings_note(
+            &job.config,
+            &[
+                &job.spec.param,
+                "viscosity",
+                "stiffness",
+                "slope",
+                "impact",
+                "rigid_legs"
+            ]
+        )
     );
     let label = axis_label(&job.spec.param);
     let (lo, hi) = (

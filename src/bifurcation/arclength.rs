@@ -67,6 +67,13 @@ pub enum FamilyEnd {
     Closed,
     /// [`ContinuationOptions::max_points`] points were followed.
     MaxPoints,
+    /// Following was stopped from outside (the interrupt flag: a map failure
+    /// [`MapFailure::interrupted`](super::MapFailure::interrupted)) after the point at `param`: the family goes
+    /// on for all that is known, and nothing was searched past that point.
+    Interrupted {
+        /// The parameter at the last point followed.
+        param: f64,
+    },
     /// The step fell below [`ContinuationOptions::min_step`]: the family cannot be followed further. `failure`
     /// is the last failure of the map (the walk rolls back, falls, ...); where the map never failed, `border`
     /// if a border collision was found at the end (a special point), else the corrector's or the step
@@ -193,6 +200,18 @@ fn follow<M: FamilyMap>(
     let mut map_failure: Option<(MapFailure, f64)> = None;
     let mut travelled = 0.0;
     while points.len() < options.max_points {
+        // An interrupted evaluation says nothing of the family: stop at once, without bracketing an end.
+        if last_failure.as_ref().is_some_and(MapFailure::interrupted)
+            || map_failure.as_ref().is_some_and(|(f, _)| f.interrupted())
+        {
+            return Followed {
+                points,
+                special,
+                end: FamilyEnd::Interrupted {
+                    param: current.param,
+                },
+            };
+        }
         if h < options.min_step {
             let end = match map_failure {
                 Some((failure, at)) => {

@@ -93,7 +93,8 @@ impl<'a> GaitFamily<'a> {
             return Err(MapFailure {
                 kind: "unknown_parameter".to_string(),
                 message: format!(
-                    "unknown parameter {param:?}: expected one of {}",
+                    "unknown parameter {:?}: expected one of {}",
+                    crate::fmt::clip(param),
                     Config::numeric_keys().join(", ")
                 ),
             });

@@ -53,10 +53,22 @@ pub struct Evaluation<I> {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{message}")]
 pub struct MapFailure {
-    /// What kind of failure (the walk's failure kind for the VRW).
+    /// What kind of failure (the walk's failure kind for the VRW); [`MapFailure::INTERRUPTED`] when the work
+    /// was stopped from outside.
     pub kind: String,
     /// The failure in words.
     pub message: String,
+}
+
+impl MapFailure {
+    /// The kind of a failure that is no property of the map: its evaluation was stopped from outside (the
+    /// interrupt flag, Ctrl-C). Continuation stops there with [`FamilyEnd::Interrupted`], never a family end.
+    pub const INTERRUPTED: &'static str = "interrupted";
+
+    /// Was the evaluation stopped from outside?
+    pub fn interrupted(&self) -> bool {
+        self.kind == Self::INTERRUPTED
+    }
 }
 
 /// A one-parameter family of maps `P(x; p)` of `R^n` whose fixed points are followed.

@@ -45,6 +45,7 @@ pub(super) struct AnimateArgs {
 
 /// Run `vrw animate` and print its summary.
 pub(super) fn run(args: AnimateArgs) -> Result<()> {
+    super::interrupt_flag();
     let job = AnimateJob {
         dir: args.dir,
         options: AnimateOptions {

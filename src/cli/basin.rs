@@ -51,6 +51,10 @@ pub(super) struct BasinArgs {
     /// Output directory for basin.csv, basin.json and basin.png.
     #[arg(long, default_value = "out/basin")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Run `vrw basin` and print its summary.
@@ -64,6 +68,7 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
         max_steps: args.max_steps,
         tolerance: args.tolerance,
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
     };
     // Ctrl-C stops the grid between points; what is complete is written.
     interrupt_flag();
@@ -72,6 +77,7 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
         "{bar:40} {pos}/{len} starts [{elapsed_precise}, eta {eta}]",
     );
     let started = std::time::Instant::now();
+    super::check_out(&job.out_dir, "basin", job.overwrite)?;
     let summary = run_basin(&job, &|_| bar.inc(1)).context("basin")?;
     bar.finish_and_clear();
     let g = &summary.gait;

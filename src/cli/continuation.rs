@@ -63,6 +63,10 @@ pub(super) struct ContinueArgs {
     /// Output directory for branch.csv, special_points.json and bifurcation.{svg,png}.
     #[arg(long, default_value = "out/continue")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Help of `continue --plot`.
@@ -79,6 +83,9 @@ fn end_words(end: &FamilyEnd) -> String {
         FamilyEnd::LeftRange { bound } => format!("reaches the end of the range at {bound}"),
         FamilyEnd::Closed => "closes on itself".to_string(),
         FamilyEnd::MaxPoints => "followed to --max-points".to_string(),
+        FamilyEnd::Interrupted { param } => {
+            format!("followed to {param:.9} when the job was interrupted (not an end)")
+        }
         FamilyEnd::Ended {
             failure, message, ..
         } if failure == "border" => format!("ends at a border collision, {message}"),
@@ -113,6 +120,7 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
         switch: !args.no_switch,
         plot: args.plot.clone(),
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
         interrupt: Some(flag),
         two_param: args
             .two_param
@@ -120,6 +128,7 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
             .zip(args.two_range)
             .map(|(name, (a, b))| (name, a, b)),
     };
+    super::check_out(&job.out_dir, "continue", job.overwrite)?;
     let result = run_continuation(&job)
         .map_err(flagged)
         .context("continue")?;

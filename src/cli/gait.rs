@@ -45,6 +45,10 @@ pub(super) struct GaitArgs {
     /// Output directory for gait.json and one period of the gait (steps.csv, trajectory.csv, summary.json).
     #[arg(long, default_value = "out/gait")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// A parameter `dP/dp` can be taken for ([`DIFFERENTIABLE_KEYS`]).
@@ -55,7 +59,8 @@ fn parse_parameter(key: &str) -> Result<&'static str, String> {
         .copied()
         .ok_or_else(|| {
             format!(
-                "no derivative with respect to {key:?}: the parameter must be one of {}",
+                "no derivative with respect to {:?}: the parameter must be one of {}",
+                vrw::fmt::clip(key),
                 DIFFERENTIABLE_KEYS.join(", ")
             )
         })
@@ -73,9 +78,11 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
             ..GaitOptions::default()
         },
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
         check_jacobian: args.check_jacobian,
-        interrupt: None,
+        interrupt: Some(super::interrupt_flag()),
     };
+    super::check_out(&job.out_dir, "gait", job.overwrite)?;
     let bar = progress_bar(
         None,
         "{spinner} searching the gait ({msg}) [{elapsed_precise}]",
@@ -94,7 +101,7 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
         p.viscosity, p.slope, p.impact
     );
     let Some(g) = &summary.gait else {
-        println!("wrote {}/gait.json", args.out.display());
+        super::print_wrote(&args.out);
         bail!(
             "no gait found: {}",
             summary.message.as_deref().unwrap_or("unknown reason")
@@ -199,7 +206,7 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
-    println!("wrote {}/gait.json", args.out.display());
+    super::print_wrote(&args.out);
     check.map(|_| ())
 }
 

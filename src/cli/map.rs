@@ -74,6 +74,10 @@ pub(super) struct MapArgs {
     /// Output directory for map.csv, curves.json, map.svg and map.png.
     #[arg(long, default_value = "out/map")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// `--mark X,Y[,LABEL]`.
@@ -131,6 +135,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         second_route: args.second_route,
         marks: args.mark.into_iter().map(|m| m.0).collect(),
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
     };
     let routes = if args.second_route { 2 } else { 1 };
     let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
@@ -141,6 +146,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",
     );
     let started = std::time::Instant::now();
+    super::check_out(&job.out_dir, "map", job.overwrite)?;
     let summary = run_map(&job, &|_| bar.inc(1)).context("map")?;
     bar.finish_and_clear();
     println!(

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -151,16 +151,21 @@ fn progress_bar(len: Option<u64>, template: &str) -> ProgressBar {
     bar
 }
 
-/// A flag set by Ctrl-C, which also sets the library's interrupt flag (the grid runner of `sweep`, `map`,
-/// `orbit` and `basin` then stops between points, and the job writes what is complete); a second Ctrl-C exits
-/// at once with code 130.
+/// A flag set by Ctrl-C, which also sets the library's interrupt flag (every walk of every phase then stops
+/// within a fraction of a second, the grid runner between points, and the job writes what is complete); a
+/// second Ctrl-C marks the run under way `interrupted` in its manifest and exits at once with code 130.
 fn interrupt_flag() -> Arc<AtomicBool> {
     let flag = Arc::new(AtomicBool::new(false));
     let handler_flag = Arc::clone(&flag);
     let installed = ctrlc::set_handler(move || {
         vrw::gait::interrupt_flag().store(true, Ordering::SeqCst);
         if handler_flag.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
+            // The run under way, if any, says it was interrupted, never `running`.
+            eprintln!("\ninterrupted again: quit at once (manifest.json: interrupted)");
+            vrw::output::manifest::quit_interrupted(
+                "quit at once by a second Ctrl-C: the files listed are complete up to their last row",
+                130,
+            );
         }
         eprintln!("\ninterrupted: finishing the work under way and writing what is complete (Ctrl-C again to quit at once)");
     });
@@ -170,15 +175,50 @@ fn interrupt_flag() -> Arc<AtomicBool> {
     flag
 }
 
+/// Check `--out` before the job computes anything (the job checks it again when it starts writing), and say
+/// which files of another command's run `--overwrite` will remove.
+fn check_out(out: &std::path::Path, command: &str, overwrite: bool) -> Result<()> {
+    if !out.exists() {
+        // Nothing to replace; the job creates it once its options are checked.
+        return Ok(());
+    }
+    let replaced = vrw::output::manifest::check_out_dir(out, command, overwrite)
+        .with_context(|| command.to_string())?;
+    if let Some(r) = replaced.filter(|r| r.command != command) {
+        eprintln!(
+            "--overwrite: the `vrw {}` run in {} is replaced; removing {}",
+            r.command,
+            out.display(),
+            if r.files.is_empty() {
+                "only its manifest".to_string()
+            } else {
+                r.files.join(", ")
+            }
+        );
+    }
+    Ok(())
+}
+
+/// Print the files of the run in `out` as its manifest lists them, the manifest first: `wrote
+/// out/gait/{manifest.json, gait.json, ...}`.
+fn print_wrote(out: &std::path::Path) {
+    let mut files = vec![vrw::output::manifest::MANIFEST.to_string()];
+    if let Ok(m) = vrw::output::manifest::Manifest::read(out) {
+        files.extend(m.files);
+    }
+    println!("wrote {}/{{{}}}", out.display(), files.join(", "));
+}
+
 /// A range `A,B` of two numbers.
 fn parse_range(s: &str) -> std::result::Result<(f64, f64), String> {
     let (a, b) = s
         .split_once(',')
-        .ok_or_else(|| format!("'{s}' is not a range A,B"))?;
+        .ok_or_else(|| format!("'{}' is not a range A,B", vrw::fmt::clip(s)))?;
     let parse = |v: &str| {
-        v.trim()
-            .parse::<f64>()
-            .map_err(|_| format!("'{}' in the range '{s}' is not a number", v.trim()))
+        v.trim().parse::<f64>().map_err(|_| {
+            let (v, s) = (vrw::fmt::clip(v.trim()), vrw::fmt::clip(s));
+            format!("'{v}' in the range '{s}' is not a number")
+        })
     };
     Ok((parse(a)?, parse(b)?))
 }

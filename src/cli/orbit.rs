@@ -45,9 +45,16 @@ pub(super) struct OrbitArgs {
     /// Do not compute and draw the period-1 branch.
     #[arg(long)]
     no_branch: bool,
+    /// The DLS indicator the second panel draws.
+    #[arg(long, default_value = "lambda_I4", value_parser = vrw::app::ORBIT_QUANTITIES)]
+    plot: String,
     /// Output directory for orbit.csv, branch.csv, orbit.json and orbit.png.
     #[arg(long, default_value = "out/orbit")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Run `vrw orbit` and print its summary.
@@ -66,7 +73,9 @@ pub(super) fn run(args: OrbitArgs) -> Result<()> {
         },
         initial: args.initial,
         branch: !args.no_branch,
+        plot: args.plot.clone(),
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
     };
     // Ctrl-C stops the grid between points; what is complete is written.
     interrupt_flag();
@@ -75,6 +84,7 @@ pub(super) fn run(args: OrbitArgs) -> Result<()> {
         "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
     );
     let started = std::time::Instant::now();
+    super::check_out(&job.out_dir, "orbit", job.overwrite)?;
     let summary = run_orbit(&job, &|c| {
         bar.set_message(format!("{} = {:.4}: {}", args.param, c.value, c.status));
         bar.inc(1);

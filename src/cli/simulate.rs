@@ -30,6 +30,10 @@ pub(super) struct SimulateArgs {
     /// Output directory for steps.csv, trajectory.csv and summary.json.
     #[arg(long, default_value = "out/simulate")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
     /// Sampling interval of trajectory.csv, in seconds of simulated time.
     #[arg(long, default_value_t = DEFAULT_SAMPLE_DT)]
     sample_dt: f64,
@@ -47,12 +51,14 @@ pub(super) fn run(args: SimulateArgs) -> Result<()> {
         sample_dt: args.sample_dt,
         trajectory: !args.no_trajectory,
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
         interrupt: Some(interrupt_flag()),
     };
     let bar = progress_bar(
         Some(args.steps as u64),
         "{bar:40} {pos}/{len} steps {msg} [{elapsed_precise}, eta {eta}]",
     );
+    super::check_out(&job.out_dir, "simulate", job.overwrite)?;
     let summary = run_simulate(&job, &mut |event| match event {
         SimulateEvent::Step(report) => {
             bar.set_message(format!("t = {:.1} s", report.time + report.period));
@@ -96,11 +102,7 @@ pub(super) fn run(args: SimulateArgs) -> Result<()> {
             if last.bounce { ", bounce" } else { "" },
         );
     }
-    println!(
-        "wrote {}/{{{}}}",
-        args.out.display(),
-        summary.files.join(", ")
-    );
+    super::print_wrote(&args.out);
     if summary.warnings_total > summary.warnings.len() {
         eprintln!(
             "warning: {} warnings in all ({} listed in summary.json)",

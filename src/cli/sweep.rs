@@ -46,6 +46,10 @@ pub(super) struct SweepArgs {
     /// Output directory for sweep.csv, thresholds.json, fig2.svg and fig2.png.
     #[arg(long, default_value = "out/sweep")]
     out: PathBuf,
+    /// Replace a run of another vrw command in the output directory (its files are removed and listed);
+    /// without it such a directory is refused. A directory with files vrw did not write is always refused.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 /// Help of `sweep --param`: the keys that can be swept, from [`Config::numeric_keys`].
@@ -70,6 +74,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         options: GaitOptions::for_sweeps(),
         second_route: args.second_route,
         out_dir: args.out.clone(),
+        overwrite: args.overwrite,
     };
     let routes = if args.second_route { 2 } else { 1 };
     // Ctrl-C stops the grid between points; what is complete is written.
@@ -79,6 +84,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         "{bar:40} {pos}/{len} {msg} [{elapsed_precise}]",
     );
     let started = std::time::Instant::now();
+    super::check_out(&job.out_dir, "sweep", job.overwrite)?;
     let summary = run_sweep(&job, &|p| {
         bar.set_message(format!("{} = {:.4}: {}", args.param, p.value, p.status));
         bar.inc(1);
@@ -98,14 +104,22 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         summary.seconds[1]
     );
     for t in &summary.thresholds {
+        // A threshold whose search failed has no value: its bracket and the reason instead of NaN.
+        let at = if t.value.is_finite() {
+            format!("{} = {:.6}", args.param, t.value)
+        } else {
+            format!("{} not located", args.param)
+        };
+        let residual = if t.residual.is_finite() {
+            format!(", residual {:.1e}", t.residual)
+        } else {
+            String::new()
+        };
         println!(
-            "  {:<18} {} = {:.6}  (bracket [{:.7}, {:.7}], residual {:.1e}){}{}",
+            "  {:<18} {at}  (bracket [{:.7}, {:.7}]{residual}){}{}",
             t.name,
-            args.param,
-            t.value,
             t.bracket[0],
             t.bracket[1],
-            t.residual,
             t.detail
                 .as_deref()
                 .map(|d| format!(": {d}"))

@@ -24,9 +24,10 @@
 //! do not depend on the number of threads or on the order in which rayon runs the work.
 //!
 //! **Interruption.** The runner checks the library's interrupt flag ([`interrupt_flag`], set by the command
-//! line's Ctrl-C handler and by the Python binding's signal watcher) before every point. Once it is set, no
-//! new point starts; the points under way finish, and every row is cut to its complete prefix (the points
-//! from its first up to the first one not evaluated), so what is returned is exactly what an uninterrupted
+//! line's Ctrl-C handler and by the Python binding's signal watcher) before every point and after it. Once it
+//! is set, no new point starts; the points under way stop (their walks read the flag too) and are dropped,
+//! and every row is cut to its complete prefix (the points from its first up to the first one not evaluated
+//! before the flag was set), so what is returned is exactly what an uninterrupted
 //! run returns, minus the rows' tails. A job that sees [`interrupted`] after the runner keeps those points and
 //! says it was interrupted.
 //!
@@ -39,24 +40,7 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-/// The library's interrupt flag (see the module documentation): the grid runner stops starting points once it
-/// is set. Whoever sets it clears it before the next job ([`clear_interrupt`]).
-static INTERRUPT: AtomicBool = AtomicBool::new(false);
-
-/// The library's interrupt flag, for a signal handler to set.
-pub fn interrupt_flag() -> &'static AtomicBool {
-    &INTERRUPT
-}
-
-/// Has the interrupt flag been set (the last grid run may be cut short)?
-pub fn interrupted() -> bool {
-    INTERRUPT.load(Ordering::SeqCst)
-}
-
-/// Clear the interrupt flag (before a new job, in a process that outlives an interruption).
-pub fn clear_interrupt() {
-    INTERRUPT.store(false, Ordering::SeqCst);
-}
+pub use crate::walk::interrupt::{clear_interrupt, interrupt_flag, interrupted};
 
 /// Stride of the coarse continuation pass along a row.
 pub(crate) const COARSE_STRIDE: usize = 10;
@@ -89,7 +73,7 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    run_rows_until(rows, cols, &INTERRUPT, eval)
+    run_rows_until(rows, cols, interrupt_flag(), eval)
 }
 
 /// [`run_rows`] stopped by `stop` instead of the library's interrupt flag.
@@ -112,7 +96,7 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    run_part_until(part, rows, cols, &INTERRUPT, eval)
+    run_part_until(part, rows, cols, interrupt_flag(), eval)
 }
 
 fn run_part_until<P, C, F>(
@@ -138,6 +122,9 @@ where
         .collect()
 }
 
+/// Has the run been stopped? Checked before a point starts and again after it returns: a point whose
+/// evaluation overlapped the flag may have had its walks cut short (they read the library's flag too), so it
+/// is dropped with the rest of its row, never kept as a result.
 fn stopped(stop: &AtomicBool) -> bool {
     stop.load(Ordering::Relaxed)
 }
@@ -154,6 +141,9 @@ where
             break;
         }
         let e = eval(Cell { row, col }, last.as_ref().map(|(j, c)| (*j, c)));
+        if stopped(stop) {
+            break;
+        }
         points.push(e.point);
         last = e.carry.map(|c| (col, c));
     }
@@ -208,7 +198,7 @@ pub(crate) fn coarse_pass<P, C, F>(row: usize, cols: usize, eval: &F) -> (Vec<P>
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
-    coarse_pass_until(row, cols, &INTERRUPT, eval)
+    coarse_pass_until(row, cols, interrupt_flag(), eval)
 }
 
 fn coarse_pass_until<P, C, F>(
@@ -248,6 +238,9 @@ where
             .and_then(|c| c.as_ref().map(|c| (col - COARSE_STRIDE, c)));
         let start = Instant::now();
         let e = eval(Cell { row, col }, from);
+        if stopped(stop) {
+            break;
+        }
         took.push(start.elapsed());
         points.push(e.point);
         carries.push(e.carry);
@@ -261,7 +254,7 @@ pub(crate) fn fill<P, C, F>(row: usize, cols: usize, k: usize, left: Option<&C>,
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
-    fill_until(row, cols, k, left, &INTERRUPT, eval)
+    fill_until(row, cols, k, left, interrupt_flag(), eval)
 }
 
 fn fill_until<P, C, F>(
@@ -287,6 +280,9 @@ where
             Some((j, c)) => c.as_ref().map(|c| (*j, c)),
         };
         let e = eval(Cell { row, col }, from);
+        if stopped(stop) {
+            break;
+        }
         points.push(e.point);
         last = Some((col, e.carry));
     }
@@ -330,8 +326,8 @@ mod tests {
         }
     }
 
-    /// A stop flag set during the run cuts every row to its complete prefix, for one row (split) and for
-    /// several.
+    /// A stop flag set during the run cuts every row to its complete prefix, without the point under way, for
+    /// one row (split) and for several.
     #[test]
     fn interrupted_grid_keeps_complete_prefixes() {
         let cols = 3 * COARSE_STRIDE + 4;
@@ -349,6 +345,8 @@ mod tests {
             for row in &grid {
                 assert!(row.len() < cols, "{rows} rows: {row:?}");
                 assert!(row.iter().copied().eq(0..row.len()), "{rows} rows: {row:?}");
+                // The point under way when the flag was set is not a result.
+                assert!(row.len() <= 2 * COARSE_STRIDE + 5, "{rows} rows: {row:?}");
             }
         }
         let stop = AtomicBool::new(true);

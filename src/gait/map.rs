@@ -317,6 +317,9 @@ pub struct MapCurves {
 pub(crate) fn curve_name(threshold: &str) -> &str {
     match threshold {
         "gait_lost" | "gait_found" => "existence_end",
+        // One curve where the largest multiplier crosses the unit circle, whichever side is stable along a
+        // line (rows and columns cross it in different directions); it keeps its established name.
+        "stability_regained" | "period_doubling" => "stability_lost",
         other => other,
     }
 }

@@ -461,7 +461,7 @@ pub(crate) struct GaitRow {
 /// parallel, and the results are bitwise identical for any number of threads. `progress` is called after every
 /// point. A row's values that leave the valid domain give points with the status `invalid_parameter`. Once the
 /// library's [`interrupt_flag`](super::grid::interrupt_flag) is set, each row is cut to its complete prefix,
-/// without the backward fill and the family numbers.
+/// without the backward fill and the family numbers (also where the flag was set during them).
 pub fn gait_rows(
     rows: &[GaitRow],
     initial: &SectionState,
@@ -522,10 +522,16 @@ pub(crate) fn gait_rows_part(
         .zip(points.par_iter_mut())
         .map(|(row, points)| {
             let mut points: Vec<SweepPoint> = points.drain(..).flatten().collect();
-            // An interrupted row keeps its points as computed (no further searches).
-            if !super::grid::interrupted() {
-                backfill(&row.config, &row.param, &mut points, options);
-                number_families(&row.config, &row.param, &mut points, options);
+            // An interrupted row keeps its points as computed (no further searches); so does a row whose
+            // backward fill or family numbers the flag cut short (their walks stop with it).
+            if crate::walk::interrupted() {
+                return points;
+            }
+            let computed = points.clone();
+            backfill(&row.config, &row.param, &mut points, options);
+            number_families(&row.config, &row.param, &mut points, options);
+            if crate::walk::interrupted() {
+                return computed;
             }
             points
         })

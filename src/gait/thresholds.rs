@@ -1,6 +1,8 @@
 //! Parameter values where something changes along a sweep, found by root finding in the parameter (never read
 //! off the grid): the DLS indicators crossing zero (the paper's `c = 220` for `lambda_4+` and `c = 4.0` for
-//! `lambda_2+`), the loss of stability (`max |multiplier| = 1`), and the ends of gait families.
+//! `lambda_2+`), the changes of stability (`max |multiplier| = 1`: `stability_lost` or `stability_regained` in
+//! the direction of increasing parameter, `period_doubling` where a multiplier crosses -1), and the ends of gait
+//! families.
 //!
 //! Sign changes between neighbouring sweep points of one gait family are refined by Brent's method (the `roots`
 //! crate) on the indicator of the gait continued from the left neighbour, to [`PARAM_TOL`] in the parameter.
@@ -40,9 +42,11 @@ const MAX_BRENT_ITERATIONS: usize = 100;
 /// A located threshold.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Threshold {
-    /// What crosses: `lambda_4_plus = 0`, `lambda_2_plus = 0`, `lambda_I4 = 0`, `stability_lost` (largest
-    /// Floquet multiplier modulus = 1), or an end of a gait family: `gait_lost`, `gait_found`,
-    /// `branch_switch`, `fold` or `unconfirmed` (see the module documentation).
+    /// What crosses: `lambda_4_plus = 0`, `lambda_2_plus = 0`, `lambda_I4 = 0`, a change of stability (the
+    /// largest Floquet multiplier's modulus crosses 1: `stability_lost` where the gaits below are stable,
+    /// `stability_regained` where those above are, `period_doubling` where a multiplier crosses -1, the
+    /// stable side then in `detail`), or an end of a gait family: `gait_lost`, `gait_found`, `branch_switch`,
+    /// `fold` or `unconfirmed` (see the module documentation).
     pub name: String,
     /// The parameter value \[unit of the parameter\]; `NaN` if the search failed.
     pub value: f64,
@@ -509,6 +513,8 @@ fn refine_root(
         section: start.section,
     }]);
     let failure: Cell<Option<String>> = Cell::new(None);
+    // The gait of the last evaluation (stability only): at the root, its critical multiplier names the change.
+    let last_gait: std::cell::RefCell<Option<Gait>> = std::cell::RefCell::new(None);
     let (lo, hi) = (Cell::new(a.value), Cell::new(b.value));
     let f_a = q.of(start);
     let f = |v: f64| -> f64 {
@@ -532,7 +538,10 @@ fn refine_root(
             let (y, section) = if q == Quantity::Stability {
                 let g =
                     find_gait(&map, &s, &continued, guess.as_ref()).map_err(|e| e.to_string())?;
-                (q.of(&g), g.section)
+                let y = q.of(&g);
+                let section = g.section;
+                *last_gait.borrow_mut() = Some(g);
+                (y, section)
             } else {
                 let fp = solve_fixed_point(&map, &s, &continued, guess.as_ref())
                     .map_err(|e| e.to_string())?;
@@ -574,8 +583,30 @@ fn refine_root(
     } else {
         f64::NAN
     };
+    let mut name = q.name().to_string();
+    if q == Quantity::Stability {
+        let (stable_side, words) = stability_change(a.value, b.value, f_a);
+        name = words.to_string();
+        let root_gait = last_gait.borrow();
+        let critical = root_gait
+            .as_ref()
+            .filter(|_| value.is_finite())
+            .and_then(|g| critical_multiplier(&g.floquet_multipliers));
+        if let Some([re, im]) =
+            critical.filter(|[re, im]| *re < 0.0 && im.abs() <= REAL_MULTIPLIER_TOL)
+        {
+            name = "period_doubling".to_string();
+            let note = format!(
+                "a multiplier crosses -1 ({re:.6}{im:+.1e}i at the root): a period doubling, stable {stable_side}"
+            );
+            detail = Some(detail.map_or(note.clone(), |d| format!("{note}; {d}")));
+        } else if value.is_finite() {
+            let note = format!("stable {stable_side}");
+            detail = Some(detail.map_or(note.clone(), |d| format!("{note}; {d}")));
+        }
+    }
     Threshold {
-        name: q.name().to_string(),
+        name,
         value,
         bracket: sorted([lo.get(), hi.get()]),
         grid_bracket: [a.value, b.value],
@@ -583,6 +614,30 @@ fn refine_root(
         detail,
         second_route: None,
     }
+}
+
+/// A multiplier whose imaginary part is at most this is real (the eigenvalue solver's rounding).
+const REAL_MULTIPLIER_TOL: f64 = 1e-9;
+
+/// Which side of a stability change between the grid points at `a` and `b` (with `max |multiplier| - 1` equal
+/// to `f_a` at `a`) is stable, in words (`below` or `above` the threshold), and the threshold's name in the
+/// direction of increasing parameter: `stability_lost` when the gaits below are stable, `stability_regained`
+/// when those above are.
+fn stability_change(a: f64, b: f64, f_a: f64) -> (&'static str, &'static str) {
+    let stable_below = (f_a < 0.0) == (a < b);
+    if stable_below {
+        ("below", "stability_lost")
+    } else {
+        ("above", "stability_regained")
+    }
+}
+
+/// The multiplier of largest modulus, `[re, im]` (`None` without multipliers).
+fn critical_multiplier(multipliers: &[[f64; 2]]) -> Option<[f64; 2]> {
+    multipliers
+        .iter()
+        .copied()
+        .max_by(|x, y| x[0].hypot(x[1]).total_cmp(&y[0].hypot(y[1])))
 }
 
 #[cfg(test)]

@@ -1,13 +1,16 @@
 //! `manifest.json`: which files of an output directory belong to the run that wrote it, and whether that run
 //! finished.
 //!
-//! Every job ([`RunDir::start`]) first checks that it can write the directory (it creates it and writes and
-//! removes a probe file), removes what an earlier run of any job left there ([`RUN_FILES`], temporary files of
-//! a killed run; never a file vrw does not write), and writes the manifest with the status `running`. At the
-//! end it writes the manifest again with the files that belong to the run and the status `completed`,
-//! `interrupted` (Ctrl-C: the files hold the complete part) or `failed` (with the reason). `vrw plot` and
-//! `vrw animate` add the figures they write. The content is deterministic (no timestamps), so a repeated run
-//! writes the same bytes.
+//! Every job first checks that it may write the directory ([`check_out_dir`]: it creates it and writes and
+//! removes a probe file; a directory of files vrw did not write is refused, and so is another command's run
+//! unless the job is asked to replace it), then ([`RunDir::start`]) removes the earlier run it replaces (the
+//! files its manifest lists and those its command writes, [`COMMAND_FILES`], with temporary files of a killed
+//! run; never a file vrw does not write), and writes the manifest with the status `running`. At the end it
+//! writes the manifest again with the files that belong to the run and the status `completed`, `interrupted`
+//! (Ctrl-C: the files hold the complete part) or `failed` (with the reason). `vrw plot` and `vrw animate` add
+//! the figures they write. The content is deterministic (no timestamps), so a repeated run writes the same
+//! bytes. A second Ctrl-C quits through [`quit_interrupted`], which leaves the run `interrupted`, never
+//! `running`.
 //!
 //! The tables that stream rows while a walk runs (`steps.csv`, `trajectory.csv`) are written in place, not
 //! under a temporary name: they are listed in the `running` manifest as soon as they are created, so after a
@@ -22,36 +25,53 @@ use super::{ensure_dir, write_json, OutputError, TEMP_MARK};
 /// The manifest's file name.
 pub const MANIFEST: &str = "manifest.json";
 
-/// Every file a vrw job writes into an output directory; a job removes them all before it starts.
-pub const RUN_FILES: [&str; 28] = [
-    MANIFEST,
-    // simulate, gait
+/// The files each command writes into its output directory (with the figures `plot` and `animate` add to a run
+/// of `simulate` or `gait`). A run of a command replaces an earlier run of the same command in its directory:
+/// it removes the files the earlier manifest lists and these (a killed run may not have listed them).
+pub const COMMAND_FILES: [(&str, &[&str]); 7] = [
+    ("simulate", &RUN_FIGURES_OF_WALKS),
+    ("gait", &RUN_FIGURES_OF_WALKS),
+    (
+        "sweep",
+        &["sweep.csv", "thresholds.json", "fig2.svg", "fig2.png"],
+    ),
+    (
+        "map",
+        &[
+            "map.csv",
+            "curves.json",
+            "map.svg",
+            "map.png",
+            "signatures.svg",
+            "signatures.png",
+        ],
+    ),
+    (
+        "orbit",
+        &["orbit.csv", "branch.csv", "orbit.json", "orbit.png"],
+    ),
+    ("basin", &["basin.csv", "basin.json", "basin.png"]),
+    (
+        "continue",
+        &[
+            "branch.csv",
+            "special_points.json",
+            "bifurcation.svg",
+            "bifurcation.png",
+            "curves.csv",
+            "curves.svg",
+            "curves.png",
+        ],
+    ),
+];
+
+/// The files of a run of `simulate` or `gait` (`gait.json` only for `gait`), with the figures of `plot` and
+/// `animate`.
+const RUN_FIGURES_OF_WALKS: [&str; 10] = [
     "steps.csv",
     "trajectory.csv",
     "summary.json",
     "gait.json",
-    // sweep
-    "sweep.csv",
-    "thresholds.json",
-    "fig2.svg",
-    "fig2.png",
-    // map
-    "map.csv",
-    "curves.json",
-    "map.svg",
-    "map.png",
-    "signatures.svg",
-    "signatures.png",
-    // orbit
-    "orbit.csv",
-    "branch.csv",
-    "orbit.json",
-    "orbit.png",
-    // basin
-    "basin.csv",
-    "basin.json",
-    "basin.png",
-    // plot, animate
     "run.png",
     "run.svg",
     "steps.png",
@@ -59,6 +79,23 @@ pub const RUN_FILES: [&str; 28] = [
     "walk.gif",
     "walk-frame.png",
 ];
+
+/// The files `command` writes ([`COMMAND_FILES`]; none for a command vrw does not know).
+pub fn command_files(command: &str) -> &'static [&'static str] {
+    COMMAND_FILES
+        .iter()
+        .find(|(c, _)| *c == command)
+        .map_or(&[], |(_, files)| *files)
+}
+
+/// The earlier run a new one replaces in its directory: its command and the files removed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Replaced {
+    /// The earlier run's command.
+    pub command: String,
+    /// The files removed (the manifest itself not counted), in the directory's order.
+    pub files: Vec<String>,
+}
 
 /// How the run that wrote a directory ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -88,6 +125,9 @@ pub struct Manifest {
     pub reason: Option<String>,
     /// The files of the run (and the figures `plot`/`animate` made of it), in the order written.
     pub files: Vec<String>,
+    /// The earlier run of another command this one replaced (`--overwrite`), with the files removed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replaced: Option<Replaced>,
 }
 
 /// Reading `manifest.json` failed.
@@ -147,16 +187,29 @@ pub struct RunDir {
 }
 
 impl RunDir {
-    /// Start a run of `command` in `dir`: create the directory, check that a file can be written there, remove
-    /// every file an earlier run left ([`RUN_FILES`] and temporary files), and write the manifest with the
-    /// status `running`.
+    /// Check, before a job of `command` computes anything, that it may write `dir` (see [`check_out_dir`]);
+    /// the earlier run it would replace, if any.
     ///
     /// # Errors
-    /// [`OutputError`] naming the directory (or the stale file) when it cannot be created, written or cleared.
-    pub fn start(dir: &Path, command: &str) -> Result<RunDir, OutputError> {
-        ensure_dir(dir)?;
-        probe(dir)?;
-        clear(dir)?;
+    /// As [`check_out_dir`].
+    pub fn check(
+        dir: &Path,
+        command: &str,
+        overwrite: bool,
+    ) -> Result<Option<Replaced>, OutputError> {
+        check_out_dir(dir, command, overwrite)
+    }
+
+    /// Start a run of `command` in `dir`: check it ([`check_out_dir`]), remove the earlier run it replaces (the
+    /// files its manifest lists, the files its command writes, and temporary files of a killed run; never a
+    /// file vrw does not write), and write the manifest with the status `running`.
+    ///
+    /// # Errors
+    /// [`OutputError`] naming the directory (or the stale file) when it cannot be created, written or cleared,
+    /// or when it holds files vrw did not write, or another command's run without `overwrite`.
+    pub fn start(dir: &Path, command: &str, overwrite: bool) -> Result<RunDir, OutputError> {
+        check_out_dir(dir, command, overwrite)?;
+        let replaced = clear(dir)?;
         let run = RunDir {
             dir: dir.to_path_buf(),
             manifest: Manifest {
@@ -165,6 +218,7 @@ impl RunDir {
                 status: RunStatus::Running,
                 reason: None,
                 files: Vec::new(),
+                replaced: replaced.filter(|r| r.command != command),
             },
         };
         run.write()?;
@@ -212,10 +266,171 @@ impl RunDir {
         self.write()
     }
 
-    /// Rewrite the manifest as it stands (after [`RunDir::add`] on a reopened run).
+    /// Rewrite the manifest as it stands (after [`RunDir::add`] on a reopened run). A run under way is
+    /// recorded for [`quit_interrupted`], which waits for this write to end.
     pub fn write(&self) -> Result<(), OutputError> {
+        let mut active = ACTIVE.lock();
+        *active = (self.manifest.status == RunStatus::Running)
+            .then(|| (self.dir.clone(), self.manifest.clone()));
         write_json(&self.dir.join(MANIFEST), &self.manifest)
     }
+
+    /// The earlier run of another command this one replaced (with `overwrite`), if any.
+    pub fn replaced(&self) -> Option<&Replaced> {
+        self.manifest.replaced.as_ref()
+    }
+}
+
+/// The run under way in this process (its directory and manifest as last written), for
+/// [`quit_interrupted`]; its lock is held while the manifest is written, so that a quitting process never
+/// leaves one half written or overwrites the last word.
+struct ActiveRun(std::sync::Mutex<Option<(PathBuf, Manifest)>>);
+
+type ActiveGuard<'a> = std::sync::MutexGuard<'a, Option<(PathBuf, Manifest)>>;
+
+impl ActiveRun {
+    /// The record, locked (a panic elsewhere does not make it unusable).
+    fn lock(&self) -> ActiveGuard<'_> {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+}
+
+static ACTIVE: ActiveRun = ActiveRun(std::sync::Mutex::new(None));
+
+/// Quit the process at once with exit `code` (a second Ctrl-C): the manifest of the run under way, if any, is
+/// rewritten with the status `interrupted` and `reason`, listing the files complete so far (and the streamed
+/// tables, whose rows are complete), and every temporary file being written is removed
+/// (`output::remove_temporaries`). The process exits holding the locks, so no other thread writes a
+/// manifest after it.
+pub fn quit_interrupted(reason: &str, code: i32) -> ! {
+    let _held = abandon(&ACTIVE, reason);
+    super::remove_temporaries();
+    std::process::exit(code)
+}
+
+/// Rewrite the run recorded in `active` as `interrupted` (see [`quit_interrupted`]) and remove its temporary
+/// files; the record stays locked while the guard lives.
+fn abandon<'a>(active: &'a ActiveRun, reason: &str) -> ActiveGuard<'a> {
+    let mut guard = active.lock();
+    if let Some((dir, mut manifest)) = guard.take() {
+        manifest.status = RunStatus::Interrupted;
+        manifest.reason = Some(reason.to_string());
+        let _ = write_json(&dir.join(MANIFEST), &manifest);
+        if let Ok(entries) = std::fs::read_dir(&dir) {
+            for entry in entries.flatten() {
+                if is_temporary(&entry.file_name().to_string_lossy()) {
+                    let _ = std::fs::remove_file(entry.path());
+                }
+            }
+        }
+    }
+    guard
+}
+
+/// Is `name` a temporary file of a vrw job (written there, then renamed into place)?
+fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.contains(TEMP_MARK)
+}
+
+/// The most file names an error or a message lists before it says how many more there are.
+const LISTED_FILES: usize = 10;
+
+/// `files` in words: the first ten names and how many more.
+pub fn file_list(files: &[String]) -> String {
+    let mut words = files
+        .iter()
+        .take(LISTED_FILES)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if files.len() > LISTED_FILES {
+        words += &format!(" and {} more", files.len() - LISTED_FILES);
+    }
+    words
+}
+
+/// Check that a job of `command` may write into `dir` before it computes anything: the directory can be
+/// created and written (a probe file is written and removed), and it holds nothing that the run would remove
+/// without being asked:
+///
+/// - no `manifest.json` and no files (subdirectories and temporary files of vrw aside): fine;
+/// - files but no manifest (or one that cannot be read): refused, naming the files (vrw did not write them,
+///   or cannot tell);
+/// - the manifest of a run of `command`: fine, the new run replaces it;
+/// - the manifest of another command's run: refused unless `overwrite`, naming the files that would be
+///   removed.
+///
+/// Returns the earlier run the new one replaces, with the files it would remove.
+///
+/// # Errors
+/// [`OutputError::Io`] when the directory cannot be created or written, [`OutputError::NotVrwDir`] and
+/// [`OutputError::OtherRun`] for the refusals.
+pub fn check_out_dir(
+    dir: &Path,
+    command: &str,
+    overwrite: bool,
+) -> Result<Option<Replaced>, OutputError> {
+    ensure_dir(dir)?;
+    probe(dir)?;
+    let files = plain_files(dir)?;
+    let manifest = match Manifest::read(dir) {
+        Ok(m) => m,
+        Err(ManifestError::Missing { .. }) if files.is_empty() => return Ok(None),
+        Err(e) => {
+            return Err(OutputError::NotVrwDir {
+                dir: dir.to_path_buf(),
+                files: file_list(&files),
+                why: match e {
+                    ManifestError::Missing { .. } => "it has no manifest.json".to_string(),
+                    other => other.to_string(),
+                },
+            })
+        }
+    };
+    let removed = files_of_run(&manifest, &files);
+    let replaced = Replaced {
+        command: manifest.command.clone(),
+        files: removed,
+    };
+    if manifest.command != command && !overwrite {
+        return Err(OutputError::OtherRun {
+            dir: dir.to_path_buf(),
+            command: manifest.command,
+            files: file_list(&replaced.files),
+        });
+    }
+    Ok(Some(replaced))
+}
+
+/// The regular files in `dir` (not its subdirectories, nor vrw's temporary files), by name.
+fn plain_files(dir: &Path) -> Result<Vec<String>, OutputError> {
+    let io = |source| OutputError::Io {
+        path: dir.to_path_buf(),
+        source,
+    };
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let entry = entry.map_err(io)?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !entry.file_type().map_err(io)?.is_dir() && !is_temporary(&name) {
+            files.push(name);
+        }
+    }
+    files.sort();
+    Ok(files)
+}
+
+/// Of the `files` in a directory whose manifest is `manifest`, those of its run: listed in it, or written by
+/// its command (a killed run may not have listed them); the manifest itself not counted.
+fn files_of_run(manifest: &Manifest, files: &[String]) -> Vec<String> {
+    let ours = command_files(&manifest.command);
+    files
+        .iter()
+        .filter(|f| *f != MANIFEST && (manifest.lists(f) || ours.contains(&f.as_str())))
+        .cloned()
+        .collect()
 }
 
 /// Write and remove a probe file in `dir`: a read-only directory or a full disk is found before the work.
@@ -229,19 +444,50 @@ fn probe(dir: &Path) -> Result<(), OutputError> {
     std::fs::remove_file(&path).map_err(io)
 }
 
-/// Remove every file of an earlier run from `dir`.
-fn clear(dir: &Path) -> Result<(), OutputError> {
+/// Remove the earlier run in `dir` (checked by [`check_out_dir`]): the files of its run, its manifest and
+/// temporary files of vrw. Returns what was removed.
+fn clear(dir: &Path) -> Result<Option<Replaced>, OutputError> {
+    let manifest = match Manifest::read(dir) {
+        Ok(m) => m,
+        Err(ManifestError::Missing { .. }) => {
+            remove_temporary(dir)?;
+            return Ok(None);
+        }
+        Err(e) => {
+            return Err(OutputError::NotVrwDir {
+                dir: dir.to_path_buf(),
+                files: String::new(),
+                why: e.to_string(),
+            })
+        }
+    };
+    let files = files_of_run(&manifest, &plain_files(dir)?);
+    for name in files.iter().map(String::as_str).chain([MANIFEST]) {
+        let path = dir.join(name);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(OutputError::Io { path, source: e })
+            }
+            _ => {}
+        }
+    }
+    remove_temporary(dir)?;
+    Ok(Some(Replaced {
+        command: manifest.command,
+        files,
+    }))
+}
+
+/// Remove vrw's temporary files from `dir` (a killed run's).
+fn remove_temporary(dir: &Path) -> Result<(), OutputError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |source| OutputError::Io { path, source }
     };
-    let entries = std::fs::read_dir(dir).map_err(io(dir))?;
-    for entry in entries {
+    for entry in std::fs::read_dir(dir).map_err(io(dir))? {
         let entry = entry.map_err(io(dir))?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        let ours = RUN_FILES.contains(&name.as_str())
-            || (name.starts_with('.') && name.contains(TEMP_MARK));
-        if ours && entry.file_type().map_err(io(dir))?.is_file() {
+        if is_temporary(&name) && entry.file_type().map_err(io(dir))?.is_file() {
             let path = entry.path();
             match std::fs::remove_file(&path) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(io(&path)(e)),
@@ -256,31 +502,138 @@ fn clear(dir: &Path) -> Result<(), OutputError> {
 mod tests {
     use super::*;
 
-    /// A new run removes what any earlier job wrote, and nothing else.
-    #[test]
-    fn start_clears_earlier_runs_only() {
-        let dir = tempfile::tempdir().unwrap();
-        for f in ["gait.json", "run.png", ".run.vrw-tmp.png", "notes.txt"] {
-            std::fs::write(dir.path().join(f), "x").unwrap();
-        }
-        let mut run = RunDir::start(dir.path(), "sweep").unwrap();
-        let left: Vec<String> = std::fs::read_dir(dir.path())
+    fn names(dir: &Path) -> Vec<String> {
+        let mut left: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
-        let mut left = left;
         left.sort();
-        assert_eq!(left, ["manifest.json", "notes.txt"]);
+        left
+    }
+
+    fn write(dir: &Path, files: &[&str]) {
+        for f in files {
+            std::fs::write(dir.join(f), "x").unwrap();
+        }
+    }
+
+    /// A run of `command` in `dir` that wrote `files` and finished.
+    fn finished_run(dir: &Path, command: &str, files: &[&str]) {
+        let mut run = RunDir::start(dir, command, false).unwrap();
+        write(dir, files);
+        for f in files {
+            run.add(f);
+        }
+        run.finish(RunStatus::Completed, None).unwrap();
+    }
+
+    /// A directory of files vrw did not write (no manifest) is refused, naming them, and nothing is removed
+    /// (a user's `fig2.png`, `map.csv`, `basin.png` and `run.svg` were deleted by `vrw gait --out mydir`).
+    #[test]
+    fn files_without_a_manifest_are_refused_and_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let mine = ["basin.png", "fig2.png", "map.csv", "run.svg"];
+        write(dir.path(), &mine);
+        for command in ["gait", "sweep"] {
+            for overwrite in [false, true] {
+                let e = RunDir::start(dir.path(), command, overwrite).unwrap_err();
+                assert!(matches!(e, OutputError::NotVrwDir { .. }), "{e}");
+                assert!(
+                    e.to_string()
+                        .contains("basin.png, fig2.png, map.csv, run.svg"),
+                    "{e}"
+                );
+            }
+        }
+        assert_eq!(names(dir.path()), mine);
+        // Subdirectories and vrw's own temporary files are no reason to refuse.
+        let empty = tempfile::tempdir().unwrap();
+        std::fs::create_dir(empty.path().join("sub")).unwrap();
+        write(empty.path(), &[".run.vrw-tmp.png"]);
+        RunDir::start(empty.path(), "gait", false).unwrap();
+        assert_eq!(names(empty.path()), ["manifest.json", "sub"]);
+    }
+
+    /// A run replaces the same command's earlier run (the files its manifest lists and the files the command
+    /// writes, which a killed run may not have listed), and leaves every other file.
+    #[test]
+    fn a_run_replaces_its_own_commands_run_only() {
+        let dir = tempfile::tempdir().unwrap();
+        finished_run(
+            dir.path(),
+            "sweep",
+            &["sweep.csv", "thresholds.json", "fig2.png"],
+        );
+        write(dir.path(), &["notes.txt", "fig2.svg", ".fig2.vrw-tmp.svg"]);
+        let run = RunDir::start(dir.path(), "sweep", false).unwrap();
+        assert_eq!(run.replaced(), None);
+        assert_eq!(names(dir.path()), ["manifest.json", "notes.txt"]);
         assert_eq!(
             Manifest::read(dir.path()).unwrap().status,
             RunStatus::Running
         );
-        run.add("sweep.csv");
+    }
+
+    /// Another command's run is refused without `overwrite` (`vrw sweep --out s; vrw gait --out s` removed
+    /// the sweep without a word); with it, its files are removed and listed in the new manifest.
+    #[test]
+    fn another_commands_run_needs_overwrite() {
+        let dir = tempfile::tempdir().unwrap();
+        finished_run(dir.path(), "sweep", &["sweep.csv", "thresholds.json"]);
+        write(dir.path(), &["notes.txt"]);
+        let e = RunDir::start(dir.path(), "gait", false).unwrap_err();
+        assert!(matches!(e, OutputError::OtherRun { .. }), "{e}");
+        assert!(e.to_string().contains("sweep.csv, thresholds.json"), "{e}");
+        assert_eq!(
+            names(dir.path()),
+            ["manifest.json", "notes.txt", "sweep.csv", "thresholds.json"]
+        );
+        let checked = check_out_dir(dir.path(), "gait", true).unwrap().unwrap();
+        let mut run = RunDir::start(dir.path(), "gait", true).unwrap();
+        let replaced = Replaced {
+            command: "sweep".to_string(),
+            files: vec!["sweep.csv".to_string(), "thresholds.json".to_string()],
+        };
+        assert_eq!(
+            (checked, run.replaced()),
+            (replaced.clone(), Some(&replaced))
+        );
+        assert_eq!(names(dir.path()), ["manifest.json", "notes.txt"]);
         run.finish(RunStatus::Completed, None).unwrap();
+        assert_eq!(Manifest::read(dir.path()).unwrap().replaced, Some(replaced));
+    }
+
+    /// A manifest that cannot be read does not say which files are vrw's: refused.
+    #[test]
+    fn an_unreadable_manifest_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join(MANIFEST), "{ not json").unwrap();
+        write(dir.path(), &["sweep.csv"]);
+        let e = RunDir::start(dir.path(), "sweep", true).unwrap_err();
+        assert!(matches!(e, OutputError::NotVrwDir { .. }), "{e}");
+        assert_eq!(names(dir.path()), ["manifest.json", "sweep.csv"]);
+    }
+
+    /// A second Ctrl-C leaves the run under way `interrupted`, never `running`, and no temporary file.
+    #[test]
+    fn an_abandoned_run_says_interrupted() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut run = RunDir::start(dir.path(), "simulate", false).unwrap();
+        run.add_streaming(&["steps.csv"]).unwrap();
+        write(dir.path(), &["steps.csv", ".summary.vrw-tmp.json"]);
+        // The process's record is shared by the tests running beside this one: a record of its own.
+        let active = ActiveRun(std::sync::Mutex::new(None));
+        *active.lock() = Some((run.dir.clone(), run.manifest.clone()));
+        drop(abandon(&active, "quit at once"));
         let m = Manifest::read(dir.path()).unwrap();
         assert_eq!(
-            (m.status, m.files),
-            (RunStatus::Completed, vec!["sweep.csv".to_string()])
+            (m.status, m.reason.as_deref(), m.files),
+            (
+                RunStatus::Interrupted,
+                Some("quit at once"),
+                vec!["steps.csv".to_string()]
+            )
         );
+        assert_eq!(names(dir.path()), ["manifest.json", "steps.csv"]);
     }
 }

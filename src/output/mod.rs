@@ -85,6 +85,33 @@ pub enum OutputError {
         /// Why.
         source: serde_json::Error,
     },
+    /// The output directory holds files and no readable manifest: vrw did not write them (or cannot tell), and
+    /// removes nothing it did not write.
+    #[error(
+        "output directory {dir} holds files vrw did not write ({why}): {files}; choose another --out (vrw \
+         never removes a file it did not write)"
+    )]
+    NotVrwDir {
+        /// The directory.
+        dir: PathBuf,
+        /// Its files, in words.
+        files: String,
+        /// Why they are not vrw's (no manifest, or an unreadable one).
+        why: String,
+    },
+    /// The output directory holds a run of another command.
+    #[error(
+        "output directory {dir} holds a run of `vrw {command}` ({files}): give --overwrite to replace it, or \
+         choose another --out"
+    )]
+    OtherRun {
+        /// The directory.
+        dir: PathBuf,
+        /// The other run's command.
+        command: String,
+        /// The files that would be removed, in words.
+        files: String,
+    },
 }
 
 /// A number as written in CSV: the shortest text that reads back to the same `f64`, in scientific notation
@@ -169,6 +196,7 @@ pub fn write_atomic<T, E: From<OutputError>>(
     write: impl FnOnce(&Path) -> Result<T, E>,
 ) -> Result<T, E> {
     let temp = temp_path(path);
+    let _registered = Temporary::register(&temp);
     match write(&temp) {
         Ok(value) => {
             std::fs::rename(&temp, path).map_err(|source| {
@@ -184,6 +212,43 @@ pub fn write_atomic<T, E: From<OutputError>>(
             let _ = std::fs::remove_file(&temp);
             Err(e)
         }
+    }
+}
+
+/// The temporary files being written in this process ([`write_atomic`]), for [`remove_temporaries`].
+static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// A temporary file registered in [`TEMPORARIES`] while it exists; unregistered when dropped.
+struct Temporary(PathBuf);
+
+impl Temporary {
+    fn register(path: &Path) -> Temporary {
+        if let Ok(mut all) = TEMPORARIES.lock() {
+            all.push(path.to_path_buf());
+        }
+        Temporary(path.to_path_buf())
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        if let Ok(mut all) = TEMPORARIES.lock() {
+            if let Some(i) = all.iter().position(|p| *p == self.0) {
+                all.swap_remove(i);
+            }
+        }
+    }
+}
+
+/// Remove every temporary file this process is writing (a second Ctrl-C, just before the process exits, so
+/// that no half-written file is left behind). Best effort: a file whose writer creates it after this call
+/// (within the instant before the process exits) stays.
+pub(crate) fn remove_temporaries() {
+    let all = TEMPORARIES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    for path in all.iter() {
+        let _ = std::fs::remove_file(path);
     }
 }
 

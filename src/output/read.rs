@@ -796,6 +796,7 @@ mod tests {
             sample_dt: 0.01,
             trajectory: true,
             out_dir: dir.path().to_path_buf(),
+            overwrite: false,
             interrupt: None,
         };
         run_simulate(&job, &mut |_| {}).unwrap();

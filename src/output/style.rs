@@ -40,6 +40,8 @@ impl From<super::OutputError> for PlotError {
             | super::OutputError::Csv { path, .. }
             | super::OutputError::Json { path, .. }
             | super::OutputError::NotADirectory { path } => path.display().to_string(),
+            super::OutputError::NotVrwDir { dir, .. }
+            | super::OutputError::OtherRun { dir, .. } => dir.display().to_string(),
         };
         PlotError::Draw {
             path,

@@ -279,8 +279,8 @@ fn file_table(path: &Path) -> Result<Table, ConfigError> {
         path: shown.clone(),
         reason,
     };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let kind = file.metadata().map_err(io)?.file_type();
+    // The kind is read before the file is opened: opening a FIFO waits for a writer, for ever.
+    let kind = std::fs::metadata(path).map_err(io)?.file_type();
     if !kind.is_file() {
         return Err(refused(format!(
             "it is not a regular file (it is {})",
@@ -291,6 +291,7 @@ fn file_table(path: &Path) -> Result<Table, ConfigError> {
             }
         )));
     }
+    let file = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
     file.take(MAX_CONFIG_BYTES + 1)
         .read_to_end(&mut bytes)

@@ -26,7 +26,7 @@
 
 use std::fmt;
 
-use crate::fmt::short;
+use crate::fmt::{clip, clip_lines, short};
 
 mod de;
 pub(crate) mod load;
@@ -157,7 +157,7 @@ impl<'a> Rules<'a> {
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     /// A key that is not a field of [`Params`] or [`SolverOptions`].
-    #[error("unknown key `{key}` (known keys: {known})")]
+    #[error("unknown key `{}` (known keys: {known})", clip(.key))]
     UnknownKey {
         /// The key as given.
         key: String,
@@ -165,7 +165,7 @@ pub enum ConfigError {
         known: String,
     },
     /// A value of the right type that breaks a rule.
-    #[error("invalid value {value} for `{key}`: {reason}")]
+    #[error("invalid value {} for `{}`: {reason}", clip(.value), clip(.key))]
     InvalidValue {
         /// The offending key.
         key: String,
@@ -175,7 +175,7 @@ pub enum ConfigError {
         reason: String,
     },
     /// A value whose type does not fit the key (a string for a number, a float for an integer, ...).
-    #[error("wrong type for `{key}`: expected {expected}, found {found}")]
+    #[error("wrong type for `{}`: expected {expected}, found {}", clip(.key), clip(.found))]
     WrongType {
         /// The offending key.
         key: String,
@@ -185,13 +185,13 @@ pub enum ConfigError {
         found: String,
     },
     /// A `--set` override that is not of the form `key=value`.
-    #[error("malformed override `{assignment}`: expected key=value")]
+    #[error("malformed override `{}`: expected key=value", clip(.assignment))]
     MalformedOverride {
         /// The override as given.
         assignment: String,
     },
     /// A TOML document that does not parse.
-    #[error("malformed TOML in {path}: {message}")]
+    #[error("malformed TOML in {path}: {}", clip_lines(.message))]
     Toml {
         /// The file, or `"<string>"` for [`Config::from_toml_str`].
         path: String,

@@ -51,6 +51,7 @@ mod contact_event;
 mod error;
 mod events;
 pub mod impact;
+pub mod interrupt;
 mod phase;
 mod reindex;
 pub(crate) mod report;
@@ -66,6 +67,7 @@ mod zeno;
 pub use error::WalkError;
 pub(crate) use events::EventKind;
 pub use impact::{Branch, DlsIndicators};
+pub use interrupt::{clear_interrupt, interrupt_flag, interrupted};
 pub(crate) use phase::{pack, unpack, StageLog};
 pub use phase::{PhaseSystem, WalkState, WalkVector};
 pub use report::{
@@ -74,7 +76,7 @@ pub use report::{
     SLIP_POWER_WARNING, STOPPER_OVERRUN_WARNING,
 };
 pub use run::{simulate, simulate_streaming, WalkEnd, WalkRun};
-pub use section::{ParseSectionError, SectionState, SECTION_COORDINATES};
+pub use section::{ParseSectionError, SectionState, MAX_SECTION_SPEED, SECTION_COORDINATES};
 pub use trajectory::{Sample, SampleSink, Trajectory};
 pub use walker::{Walker, INTERRUPT_CHECK_STEPS};
 pub use work::{EventCounts, WorkCounts};

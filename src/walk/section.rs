@@ -27,6 +27,11 @@ pub(crate) const SECTION_GROUND_TOL: f64 = 1e-9;
 /// compression stop \[m, m/s\] ([`SectionState::rear_held`]): a held leg drifts by rounding only.
 pub(crate) const HELD_SECTION_TOL: f64 = 1e-9;
 
+/// The largest speed a section state may start with, in units of `sqrt(g L0)` (the speed of a fall from half a
+/// leg length): hub speeds `thetadot L0` and leg rates `|L2dot|` beyond it are refused (`--initial 0.72,1,1e5`
+/// ran 72 s before it failed).
+pub const MAX_SECTION_SPEED: f64 = 100.0;
+
 /// A point `s = (L2, dtheta/dt, dL2/dt)` on the Poincare section; with Coulomb friction, `(L2, dtheta/dt, dL2/dt,
 /// v_s)` where Leg 2's tip slips at the touchdown.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -168,6 +173,23 @@ impl SectionState {
                 "L2",
                 self.l2,
                 "must be at least min_length (the compression stop)",
+            );
+        }
+        let speed_limit = MAX_SECTION_SPEED * (model.params().gravity.abs() * l0).sqrt();
+        if self.theta_dot * l0 > speed_limit {
+            return bad(
+                "thetadot",
+                self.theta_dot,
+                "must be at most 100 sqrt(g L0) / L0 (a hub speed of 100 sqrt(g L0), ~280 m/s with the paper's \
+                 legs: no walk starts faster, and the impacts of such a start take minutes to integrate)",
+            );
+        }
+        if self.l2_dot.abs() > speed_limit {
+            return bad(
+                "L2dot",
+                self.l2_dot,
+                "must be at most 100 sqrt(g L0) in size (~280 m/s with the paper's legs: no walk starts \
+                 faster, and the impacts of such a start take minutes to integrate)",
             );
         }
         if self.theta_dot <= 0.0 {
@@ -338,8 +360,10 @@ pub(crate) fn section_coords<T: Real>(
 /// A section state written as `L2,thetadot,L2dot` (or `L2,thetadot,L2dot,slip`) could not be read.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
-    "invalid initial state {text:?}: {reason} (expected three numbers L2,thetadot,L2dot, e.g. 0.72,1.0,0.0, or four \
-     with the stance tip's slip velocity, L2,thetadot,L2dot,slip)"
+    "invalid initial state {:?}: {} (expected three numbers L2,thetadot,L2dot, e.g. 0.72,1.0,0.0, or four \
+     with the stance tip's slip velocity, L2,thetadot,L2dot,slip)",
+    crate::fmt::clip(.text),
+    crate::fmt::clip(.reason)
 )]
 pub struct ParseSectionError {
     /// The text given.

@@ -4,7 +4,7 @@
 //! re-indexing of the legs.
 
 use std::cell::Cell;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use crate::contact::{ActiveSet, Leg, Phase, Stop};
 use crate::dynamics::{swinging, Model, L3, NQ, THETA, X};
@@ -48,8 +48,8 @@ pub struct Walker<'m> {
     interrupt: Option<&'m AtomicBool>,
 }
 
-/// A walker with an interrupt flag reads it every this many accepted integrator steps (and before the
-/// first): stiff legs take millions of integrator steps per walking step, so touchdowns alone are too rare.
+/// A walker reads its interrupt flags (its own and the library's) every this many accepted integrator steps
+/// (and before the first): stiff legs take millions of integrator steps per walking step, so touchdowns alone are too rare.
 pub const INTERRUPT_CHECK_STEPS: usize = 1000;
 
 /// Where the phases of a step end: the touchdown event, with what the step's report needs.
@@ -184,8 +184,9 @@ impl<'m> Walker<'m> {
         reached.map(|touchdown| self.finish_step(&start, touchdown))
     }
 
-    /// Stops a step in progress when `flag` is set (e.g. by Ctrl-C): the flag is read every
-    /// [`INTERRUPT_CHECK_STEPS`] integrator steps, and the step then fails with [`WalkError::Interrupted`].
+    /// Stops a step in progress when `flag` is set (e.g. by Ctrl-C), as the library's own flag
+    /// ([`super::interrupt`]) always does: the flags are read every [`INTERRUPT_CHECK_STEPS`] integrator
+    /// steps, and the step then fails with [`WalkError::Interrupted`].
     pub fn with_interrupt(mut self, flag: Option<&'m AtomicBool>) -> Walker<'m> {
         self.interrupt = flag;
         self
@@ -459,9 +460,7 @@ impl<'a> Phases<'a> {
             .stats()
             .accepted
             .is_multiple_of(INTERRUPT_CHECK_STEPS)
-            && self
-                .interrupt
-                .is_some_and(|flag| flag.load(Ordering::Relaxed))
+            && super::interrupt::stop_requested(self.interrupt)
         {
             return Err(WalkError::Interrupted {
                 time: self.t,

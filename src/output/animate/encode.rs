@@ -120,6 +120,13 @@ pub(super) fn write_gif(
 
     let mut previous: Option<Vec<u8>> = None;
     for (c, chunk) in frames.chunks(RENDER_CHUNK).enumerate() {
+        // A chunk takes well under a second to draw: Ctrl-C is answered between two.
+        if crate::walk::interrupted() {
+            return Err(AnimateError::Interrupted {
+                frames: c * RENDER_CHUNK,
+                total: frames.len(),
+            });
+        }
         let indexed: Vec<Vec<u8>> = chunk
             .par_iter()
             .map_init(

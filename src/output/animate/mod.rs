@@ -122,6 +122,14 @@ pub enum AnimateError {
         /// Why.
         message: String,
     },
+    /// The library's interrupt flag (Ctrl-C) stopped the encoding after `frames` frames; nothing is written.
+    #[error("interrupted (Ctrl-C) after {frames} of {total} frames: no animation is written")]
+    Interrupted {
+        /// Frames encoded.
+        frames: usize,
+        /// Frames planned.
+        total: usize,
+    },
 }
 
 impl AnimateOptions {
@@ -362,6 +370,7 @@ mod tests {
             sample_dt: 0.01,
             trajectory: true,
             out_dir: PathBuf::new(),
+            overwrite: false,
             interrupt: None,
         };
         let (summary, trajectory) = crate::app::compute_simulation(&job, true).unwrap();

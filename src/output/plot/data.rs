@@ -19,6 +19,9 @@ const COLOR_I4: RGBColor = COLOR_BLACK;
 const COLOR_2: RGBColor = COLOR_BLUE;
 const COLOR_4: RGBColor = COLOR_VERMILLION;
 
+/// `(param, value, scuffing)` of the points one line joins.
+type Run = Vec<(f64, f64, bool)>;
+
 /// One plotted indicator: its finite samples sorted by parameter, split into
 /// runs that are not interrupted by points without a gait.
 pub(super) struct Series {
@@ -30,6 +33,8 @@ pub(super) struct Series {
     pub(super) shape: Marker,
     /// Runs of `(param, value, scuffing)` joined by a line.
     pub(super) runs: Vec<Vec<(f64, f64, bool)>>,
+    /// Whether each run's gaits have a period of several steps (drawn dashed).
+    pub(super) multi_step: Vec<bool>,
 }
 
 impl Series {
@@ -40,26 +45,31 @@ impl Series {
         sorted: &[&IndicatorPoint],
         value: fn(&IndicatorPoint) -> f64,
     ) -> Self {
-        let mut runs: Vec<Vec<(f64, f64, bool)>> = vec![Vec::new()];
+        // Each run with whether its gaits have several steps per period.
+        let mut runs: Vec<(Run, bool)> = vec![(Vec::new(), false)];
         let mut family = None;
         for p in sorted {
             let v = value(p);
             // A new run after a point without a value, and at every change of gait family (two families are
             // never joined by a line).
-            if (!v.is_finite() || p.family != family) && !runs.last().unwrap().is_empty() {
-                runs.push(Vec::new());
+            if (!v.is_finite() || p.family != family) && !runs.last().unwrap().0.is_empty() {
+                runs.push((Vec::new(), false));
             }
             if v.is_finite() {
-                runs.last_mut().unwrap().push((p.param, v, p.scuffing));
+                let run = runs.last_mut().unwrap();
+                run.0.push((p.param, v, p.scuffing));
+                run.1 = p.period_k > 1;
                 family = p.family;
             }
         }
-        runs.retain(|r| !r.is_empty());
+        runs.retain(|r| !r.0.is_empty());
+        let (runs, multi_step) = runs.into_iter().unzip();
         Series {
             name,
             color,
             shape,
             runs,
+            multi_step,
         }
     }
 
@@ -69,6 +79,10 @@ impl Series {
 
     pub(super) fn any_scuffing(&self) -> bool {
         self.samples().any(|s| s.2)
+    }
+
+    pub(super) fn any_multi_step(&self) -> bool {
+        self.multi_step.iter().any(|&m| m)
     }
 }
 

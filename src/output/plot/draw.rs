@@ -52,6 +52,12 @@ const LEGEND: LegendLayout = LegendLayout::new(16, 56, 12, 40, 6);
 
 const SCUFF_NOTE: &str = "scuffing of Leg 2";
 
+/// The legend of the dashed lines of period-k gaits.
+const MULTI_STEP_NOTE: &str = "period k > 1";
+
+/// Dash and gap of a period-k gait's line \[px\].
+const MULTI_STEP_DASH: (f64, f64) = (8.0, 5.0);
+
 /// Assigns each threshold label a row of the label strip (row 0 is next to
 /// the plot). `labels` holds each line's x and its text's x interval. A label
 /// must not overlap another label in its row, its text must not be crossed by
@@ -174,10 +180,19 @@ fn draw_panel<DB: DrawingBackend>(
     }
     // Lines, then markers on top.
     for s in series {
-        for run in &s.runs {
+        for (run, &multi) in s.runs.iter().zip(&s.multi_step) {
             let pts: Vec<(i32, i32)> = run.iter().map(|&(a, b, _)| plot.rel((a, b))).collect();
-            plot.clip
-                .draw_path(&plot.area, &pts, s.color.stroke_width(2))?;
+            if multi {
+                plot.clip.draw_dashed(
+                    &plot.area,
+                    &pts,
+                    s.color.stroke_width(2),
+                    MULTI_STEP_DASH,
+                )?;
+            } else {
+                plot.clip
+                    .draw_path(&plot.area, &pts, s.color.stroke_width(2))?;
+            }
         }
     }
     for s in series {
@@ -233,6 +248,17 @@ fn draw_panel<DB: DrawingBackend>(
                 r: 7,
             },
             label: Label::Plain(SCUFF_NOTE),
+        });
+    }
+    if series.iter().any(Series::any_multi_step) {
+        rows.push(LegendRow {
+            sample: Sample::Line {
+                color: BLACK,
+                stroke: Stroke::Dashed,
+                width: 2,
+                marker: None,
+            },
+            label: Label::Plain(MULTI_STEP_NOTE),
         });
     }
     draw_legend_rows(root, &rows, &LEGEND, NOTE_FONT, (px.end + 28, py.start + 6))?;

@@ -45,6 +45,8 @@ pub(crate) struct IndicatorPoint {
     pub family: Option<usize>,
     /// Step period of the gait \[s\]; NaN when there is no gait.
     pub period: f64,
+    /// Steps per period of the gait (a period-k gait, `k > 1`, is drawn dashed); 1 without a gait.
+    pub period_k: usize,
     /// Largest Floquet multiplier modulus of the gait; NaN when there is no gait.
     pub max_floquet: f64,
 }
@@ -129,6 +131,7 @@ mod tests {
                     scuffing: c < 30.0,
                     family: Some(0),
                     period: 2.0 + c / 100.0,
+                    period_k: 1,
                     max_floquet: 0.1 + c / 1000.0,
                 }
             })
