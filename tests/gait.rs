@@ -491,3 +491,72 @@ fn a_family_cut_by_the_step_time_limit_says_so() {
         "{thresholds:#?}"
     );
 }
+
+/// A change of stability is named in the direction of increasing parameter, and a multiplier crossing -1 as a
+/// period doubling (with `mu = 0.3` the family is stable above c = 5.673929, which the first version named
+/// `stability_lost`).
+#[test]
+fn stability_thresholds_say_which_side_is_stable() {
+    let mut config = Config::default();
+    config.apply_override("friction=0.3").unwrap();
+    config.validate().unwrap();
+    let start = default_initial(&config);
+    let spec = SweepSpec {
+        param: "viscosity".into(),
+        from: 5.0,
+        to: 6.5,
+        points: 4,
+    };
+    let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
+    let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+    let change = thresholds
+        .iter()
+        .find(|t| (t.value - 5.673929).abs() < 1e-6)
+        .unwrap_or_else(|| panic!("no stability change at c = 5.673929: {thresholds:#?}"));
+    assert_eq!(change.name, "period_doubling", "{change:#?}");
+    assert!(
+        change
+            .detail
+            .as_deref()
+            .unwrap_or_default()
+            .contains("stable above"),
+        "{change:#?}"
+    );
+    assert!(thresholds.iter().all(|t| t.name != "stability_lost"));
+}
+
+/// Every change of the family number between neighbouring points gets a threshold or an entry saying why none
+/// was bracketed (along the stiffness at c = 20, the period-4 family at k = 634 and the period-1 family from
+/// k = 636 had none between them).
+#[test]
+fn every_change_of_family_is_named() {
+    let mut config = Config::default();
+    config.apply_override("viscosity=20").unwrap();
+    config.validate().unwrap();
+    let start = default_initial(&config);
+    let spec = SweepSpec {
+        param: "stiffness".into(),
+        from: 550.0,
+        to: 700.0,
+        points: 76,
+    };
+    let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
+    let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+    let mut changes = 0;
+    for pair in points.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        if a.gait.is_none() || b.gait.is_none() || a.family == b.family {
+            continue;
+        }
+        changes += 1;
+        let named = thresholds
+            .iter()
+            .any(|t| t.grid_bracket.contains(&a.value) && t.grid_bracket.contains(&b.value));
+        assert!(
+            named,
+            "no threshold between {} and {}: {thresholds:#?}",
+            a.value, b.value
+        );
+    }
+    assert!(changes >= 4, "{changes} changes of family");
+}

@@ -842,6 +842,8 @@ fn continue_family<'py>(
     };
     let result = interruptible(py, &flag, || compute_continuation(&job))?.map_err(app_error)?;
     let out = pythonize(py, &result.summary)?.downcast_into::<PyDict>()?;
+    // Wall time: not in special_points.json (reproducible files), but the result says it.
+    out.set_item("seconds", result.summary.seconds)?;
     let friction = friction_columns(&job.config, &[param]);
     let rows: Vec<Vec<Cell>> = family_rows(&result)
         .iter()

@@ -113,7 +113,8 @@ pub struct ContinueSummary {
     pub interrupted: Option<String>,
     /// The files written.
     pub files: Vec<String>,
-    /// Wall time \[s\].
+    /// Wall time \[s\] (printed, not written: `special_points.json` is reproducible).
+    #[serde(skip)]
     pub seconds: f64,
 }
 

@@ -215,14 +215,19 @@ pub fn find_thresholds(
                     }
                 }
             }
-            (Some(_), Some(_)) => tasks.push(Task::End(a, b)),
+            // A change of family: where the left one ends and where the right one begins (they may coexist,
+            // or meet at one point, e.g. a border collision).
+            (Some(_), Some(_)) => {
+                tasks.push(Task::End(a, b));
+                tasks.push(Task::End(b, a));
+            }
             (Some(_), None) => tasks.push(Task::End(a, b)),
             (None, Some(_)) => tasks.push(Task::End(b, a)),
             (None, None) => {}
         }
     }
     let gait_before = |v: f64| points.iter().any(|p| p.gait.is_some() && p.value < v);
-    tasks
+    let found: Vec<Threshold> = tasks
         .par_iter()
         .flat_map_iter(|task| match task {
             Task::Root(q, a, b) => vec![refine_root(config, spec, *q, a, b, options)],
@@ -230,7 +235,65 @@ pub fn find_thresholds(
                 refine_end(config, spec, from, toward, options, gait_before(from.value))
             }
         })
-        .collect()
+        .collect();
+    every_family_change_named(spec, points, without_repeats(found))
+}
+
+/// `thresholds` without the repeats of one end found from both sides (the same name within [`PARAM_TOL`] in
+/// the same grid interval), the first kept.
+fn without_repeats(thresholds: Vec<Threshold>) -> Vec<Threshold> {
+    let mut kept: Vec<Threshold> = Vec::with_capacity(thresholds.len());
+    for t in thresholds {
+        let repeat = kept.iter().any(|k| {
+            k.name == t.name
+                && k.grid_bracket == t.grid_bracket
+                && (k.value - t.value).abs() <= PARAM_TOL
+        });
+        if !repeat {
+            kept.push(t);
+        }
+    }
+    kept
+}
+
+/// `thresholds` with an entry for every pair of neighbouring points where the family number changes and no
+/// threshold lies: the family change was seen but neither family's end could be bracketed between them (the
+/// reason in `detail`, the grid interval as the bracket, no value).
+fn every_family_change_named(
+    spec: &SweepSpec,
+    points: &[SweepPoint],
+    mut thresholds: Vec<Threshold>,
+) -> Vec<Threshold> {
+    for pair in points.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        let (Some(ga), Some(gb)) = (&a.gait, &b.gait) else {
+            continue;
+        };
+        let interval = sorted([a.value, b.value]);
+        let named = thresholds
+            .iter()
+            .any(|t| sorted(t.grid_bracket) == interval);
+        if a.family == b.family || named {
+            continue;
+        }
+        let mut entry = unconfirmed(
+            interval,
+            format!(
+                "the family changes between {p} = {} (period {}) and {p} = {} (period {}), but neither \
+                 family's end is bracketed between them: each family, followed toward the other point, reaches \
+                 it as the other's gait (a change of least period, e.g. period doublings, within one family of \
+                 fixed points of P^k)",
+                a.value,
+                ga.period_k,
+                b.value,
+                gb.period_k,
+                p = spec.param
+            ),
+        );
+        entry.name = "family_change".to_string();
+        thresholds.push(entry);
+    }
+    thresholds
 }
 
 /// The DLS indicators that vanish where a gait family ends: the family's end is then the indicator's zero (a
