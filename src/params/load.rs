@@ -150,31 +150,53 @@ impl Config {
 
     /// The value of the real-valued key `key` (one of [`Config::numeric_keys`]).
     pub(crate) fn get_numeric(&self, key: &str) -> Result<f64, ConfigError> {
-        if !Config::numeric_keys().contains(&key) {
-            return Err(unknown_numeric_key(key));
-        }
-        // A key written configurations leave out at its default (`min_length = 0`, `friction = inf`) has its
-        // value in the parameters all the same.
-        let left_out = self
-            .params
-            .keys_left_out_at_defaults()
-            .into_iter()
-            .find(|(k, _)| *k == key)
-            .map(|(_, value)| Raw::Stored(value));
-        match self.stored()?.remove(key).or(left_out) {
-            Some(Raw::Stored(toml::Value::Float(x))) => Ok(x),
-            _ => Err(unknown_numeric_key(key)),
-        }
+        self.clone()
+            .numeric_field(key)
+            .map(|v| *v)
+            .ok_or_else(|| unknown_numeric_key(key))
     }
 
     /// Sets the real-valued key `key` (one of [`Config::numeric_keys`]) to `value`, as a sweep does.
     ///
     /// Does not validate: call [`Config::validate`] afterwards.
     pub fn set_numeric(&mut self, key: &str, value: f64) -> Result<(), ConfigError> {
-        if !Config::numeric_keys().contains(&key) {
-            return Err(unknown_numeric_key(key));
-        }
-        self.merge(key, Raw::Stored(toml::Value::Float(value)))
+        *self
+            .numeric_field(key)
+            .ok_or_else(|| unknown_numeric_key(key))? = value;
+        Ok(())
+    }
+
+    /// The field of the real-valued key `key`, set and read in place: a sweep's or a continuation's change of
+    /// one key costs an assignment, not a round trip of the whole configuration through TOML. The match is
+    /// kept equal to [`Config::numeric_keys`] (derived from serde) by the test
+    /// `numeric_fields_are_the_numeric_keys`.
+    fn numeric_field(&mut self, key: &str) -> Option<&mut f64> {
+        let (p, s) = (&mut self.params, &mut self.solver);
+        Some(match key {
+            "hub_mass" => &mut p.hub_mass,
+            "hub_inertia" => &mut p.hub_inertia,
+            "leg_mass" => &mut p.leg_mass,
+            "leg_mass_offset" => &mut p.leg_mass_offset,
+            "stopper_length" => &mut p.stopper_length,
+            "spring_natural_length" => &mut p.spring_natural_length,
+            "stiffness" => &mut p.stiffness,
+            "viscosity" => &mut p.viscosity,
+            "slope" => &mut p.slope,
+            "gravity" => &mut p.gravity,
+            "min_length" => &mut p.min_length,
+            "touchdown_length" => &mut p.touchdown_length,
+            "friction" => &mut p.friction,
+            "rtol" => &mut s.rtol,
+            "atol" => &mut s.atol,
+            "max_step" => &mut s.max_step,
+            "event_spacing" => &mut s.event_spacing,
+            "event_time_tol" => &mut s.event_time_tol,
+            "recontact_gap" => &mut s.recontact_gap,
+            "stopper_gap" => &mut s.stopper_gap,
+            "fall_hub_height" => &mut s.fall_hub_height,
+            "max_step_time" => &mut s.max_step_time,
+            _ => return None,
+        })
     }
 
     /// Sets `key` to `value`, read by serde with every other key as it is now; on error nothing changes.
@@ -636,6 +658,33 @@ mod tests {
             config.params.slope, 0.08,
             "keys not overridden keep the file's value"
         );
+    }
+
+    /// The typed fields `set_numeric` writes are exactly the numeric keys serde reads, and writing one in place
+    /// is writing it through the configuration's TOML (the way every key was set before).
+    #[test]
+    fn numeric_fields_are_the_numeric_keys() {
+        for key in all_keys() {
+            let numeric = Config::numeric_keys().contains(key);
+            assert_eq!(
+                Config::default().numeric_field(key).is_some(),
+                numeric,
+                "{key}"
+            );
+            if !numeric {
+                continue;
+            }
+            for value in [0.123456789, 7.0, f64::INFINITY] {
+                let mut in_place = Config::default();
+                in_place.set_numeric(key, value).unwrap();
+                let mut through_toml = Config::default();
+                through_toml
+                    .merge(key, Raw::Stored(toml::Value::Float(value)))
+                    .unwrap();
+                assert_eq!(in_place, through_toml, "{key} = {value}");
+                assert_eq!(in_place.get_numeric(key).unwrap(), value, "{key}");
+            }
+        }
     }
 
     #[test]
