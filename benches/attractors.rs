@@ -16,11 +16,12 @@ use criterion::{criterion_group, criterion_main, Criterion};
 
 use vrw::app::default_basin_range;
 use vrw::dynamics::Model;
-use vrw::gait::basin::{basin, Axis, BasinSpec, Coordinate};
-use vrw::gait::orbit::{orbit_diagram, OrbitSpec};
-use vrw::gait::{find_gait, GaitOptions, StepMap, SweepSpec};
+use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::reference::default_initial;
+use vrw::study::basin::{basin, Axis, BasinSpec, Coordinate};
+use vrw::study::orbit::{orbit_diagram, OrbitSpec};
+use vrw::study::SweepSpec;
 
 fn orbit(c: &mut Criterion) {
     let config = Config::default();

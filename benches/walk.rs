@@ -32,17 +32,16 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 use vrw::app::{compute_gait, GaitJob};
-use vrw::bifurcation::map_curves::continue_map_curves;
 use vrw::bifurcation::{continue_family, ContinuationOptions, GaitFamily};
 use vrw::contact::{constrained_dynamics, ActiveSet};
 use vrw::dynamics::{Coords, Model};
-use vrw::gait::map::DEFAULT_CURVE_COLUMNS;
-use vrw::gait::{
-    find_gait, map_curves as map_curves_of, map_gaits, CurveMethod, GaitOptions, MapSpec, StepMap,
-    SweepSpec,
-};
+use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::reference::default_initial;
+use vrw::study::map::DEFAULT_CURVE_COLUMNS;
+use vrw::study::map_curves as map_curves_of;
+use vrw::study::map_curves::continue_map_curves;
+use vrw::study::{map_gaits, CurveMethod, MapSpec, SweepSpec};
 use vrw::walk::{simulate, Walker};
 
 /// Steps walked from the reference start before timing a single step, so that the step timed is on the
@@ -266,7 +265,7 @@ fn family(c: &mut Criterion) {
 }
 
 /// `map_curves/continued_21x21`: the indicator curves of the default 21 x 21 map followed by continuation
-/// (`vrw::bifurcation::map_curves`: the seeds' row families, the curves across the map, each row's and column's
+/// (`vrw::study::map_curves`: the seeds' row families, the curves across the map, each row's and column's
 /// crossing solved for on the curve), given the map's gaits and crossings (computed once, outside the timing).
 fn map_curves(c: &mut Criterion) {
     let config = Config::default();

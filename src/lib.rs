@@ -20,8 +20,9 @@
 //! | the hybrid walk: phases, events, the DLS-indicator impact procedure | [`walk`], [`walk::impact`] |
 //! | exact derivatives of the step map: variational equations, saltation matrices | [`variational`] |
 //! | reference problems with known answers, the default start | [`reference`](mod@reference) |
-//! | step map, gait, Floquet multipliers, sweeps, maps, orbits, basins, thresholds | [`gait`] |
+//! | step map, its exact derivatives, gaits (period 1 and k), Floquet multipliers, natural continuation | [`gait`] |
 //! | gait families by pseudo-arclength continuation, special points, branch switching | [`bifurcation`] |
+//! | studies over parameters: the grid runner, sweeps, thresholds, maps and their curves, orbits, basins | [`study`] |
 //! | tables and figures | [`output`] |
 //! | the command-line jobs | [`app`] |
 //!
@@ -47,10 +48,10 @@
 //!   [`reference::default_initial`].
 //! - **The gait**: the step map [`gait::StepMap`]; [`gait::find_gait`] with [`gait::GaitOptions`], giving a
 //!   [`gait::Gait`] (or a [`gait::GaitError`]); period-k gaits [`gait::find_periodic_gait`] and
-//!   [`gait::find_gait_any_period`]; parameter sweeps [`gait::sweep`] over a [`gait::SweepSpec`] and their
-//!   thresholds [`gait::find_thresholds`]; two-parameter maps [`gait::map_gaits`] and [`gait::map_curves`];
-//!   orbit diagrams [`gait::orbit::orbit_diagram`]; basins of attraction [`gait::basin::basin`]; families of
-//!   gaits [`gait::continuation`].
+//!   [`gait::find_gait_any_period`]; families of gaits by natural continuation [`gait::continuation`].
+//! - **Studies over parameters**: sweeps [`study::sweep()`] over a [`study::SweepSpec`] and their thresholds
+//!   [`study::find_thresholds`]; two-parameter maps [`study::map_gaits`] and [`study::map_curves()`]; orbit
+//!   diagrams [`study::orbit::orbit_diagram`]; basins of attraction [`study::basin::basin`].
 //! - **Bifurcation analysis**: [`bifurcation::continue_family`] over any [`bifurcation::FamilyMap`] (the VRW's
 //!   is [`bifurcation::GaitFamily`]) with [`bifurcation::ContinuationOptions`], giving a
 //!   [`bifurcation::Family`] of [`bifurcation::FamilyPoint`]s with its [`bifurcation::SpecialPoint`]s and
@@ -119,5 +120,6 @@ pub mod integrate;
 pub mod output;
 pub mod params;
 pub mod reference;
+pub mod study;
 pub mod variational;
 pub mod walk;

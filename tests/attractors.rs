@@ -5,13 +5,14 @@ use std::path::Path;
 
 use vrw::app::{run_basin, run_orbit, BasinJob, OrbitJob};
 use vrw::dynamics::Model;
-use vrw::gait::basin::{basin, Axis, BasinSpec, Coordinate};
 use vrw::gait::continuation::section_distance;
-use vrw::gait::orbit::{orbit_diagram, OrbitSpec};
-use vrw::gait::{find_gait, GaitOptions, StepMap, SweepSpec};
+use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::reference::default_initial;
 use vrw::reference::period_two_config;
+use vrw::study::basin::{basin, Axis, BasinSpec, Coordinate};
+use vrw::study::orbit::{orbit_diagram, OrbitSpec};
+use vrw::study::SweepSpec;
 use vrw::walk::simulate;
 
 /// The basin's distance to the gait.

@@ -3,11 +3,12 @@
 use approx::assert_relative_eq;
 
 use vrw::dynamics::Model;
-use vrw::gait::{find_gait, find_thresholds, sweep, GaitOptions, StepMap, SweepSpec};
+use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::integrate::Method;
 use vrw::params::Config;
 use vrw::reference::default_initial;
 use vrw::reference::RigidRimlessWheel;
+use vrw::study::{find_thresholds, sweep, SweepSpec};
 use vrw::walk::SectionState;
 
 /// Agreement of the finite-difference Floquet multiplier with the closed form of the rigid wheel.
@@ -129,7 +130,7 @@ fn a_parameter_set_without_gait_says_why() {
     assert_eq!(err.kind(), "rolled_back", "{err}");
 }
 
-fn small_sweep() -> Vec<vrw::gait::SweepPoint> {
+fn small_sweep() -> Vec<vrw::study::SweepPoint> {
     let config = Config::default();
     let spec = SweepSpec {
         param: "viscosity".into(),

@@ -6,9 +6,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use vrw::dynamics::Model;
-use vrw::gait::{find_gait, sweep_values, GaitError, GaitOptions, StepMap};
+use vrw::gait::{find_gait, GaitError, GaitOptions, StepMap};
 use vrw::params::{Config, ConfigError, MAX_CONFIG_BYTES};
 use vrw::reference::default_initial;
+use vrw::study::sweep_values;
 
 /// `vrw <args>` in a fresh temporary directory (kept alive by the returned guard).
 fn vrw(args: &[&str]) -> (Output, tempfile::TempDir) {

@@ -38,6 +38,7 @@ const PIPELINE: &[&str] = &[
     "reference",
     "gait",
     "bifurcation",
+    "study",
     "output",
     "app",
     BIN,

@@ -1,9 +1,10 @@
 //! Maps over two parameters (docs/model.md section 6): rows are sweeps, curves are refined 1-D thresholds.
 
-use vrw::gait::map::{Along, DEFAULT_CURVE_COLUMNS};
-use vrw::gait::{find_thresholds, map_curves, map_gaits, sweep, GaitOptions, MapSpec, SweepSpec};
+use vrw::gait::GaitOptions;
 use vrw::params::Config;
 use vrw::reference::default_initial;
+use vrw::study::map::{Along, DEFAULT_CURVE_COLUMNS};
+use vrw::study::{find_thresholds, map_curves, map_gaits, sweep, MapSpec, SweepSpec};
 
 /// Tolerance of every threshold in its parameter (the 1-D refinement's tolerance).
 const CURVE_TOL: f64 = 1e-6;
@@ -35,7 +36,7 @@ fn options() -> GaitOptions {
 
 /// The points as JSON: shortest round-trip numbers, so equal text is equal bits (and NaN, e.g. an unrefined
 /// Jacobian's error, compares equal to itself as `null`).
-fn same_bits(points: &[vrw::gait::SweepPoint]) -> String {
+fn same_bits(points: &[vrw::study::SweepPoint]) -> String {
     serde_json::to_string(points).unwrap()
 }
 
@@ -199,9 +200,9 @@ fn curves_on_fewer_columns_keep_every_row_crossing() {
     let map = map_gaits(&config, &spec(), &start, &options(), &|_| {}).unwrap();
     let all = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS);
     let few = map_curves(&config, &map, &options(), 3);
-    let refined = vrw::gait::map::curve_columns(map.xs.len(), 3);
+    let refined = vrw::study::map::curve_columns(map.xs.len(), 3);
     assert_eq!(refined, [0, 2, 4]);
-    let rows = |c: &vrw::gait::MapCurves| -> Vec<String> {
+    let rows = |c: &vrw::study::MapCurves| -> Vec<String> {
         c.thresholds
             .iter()
             .filter(|t| t.along == Along::X)

@@ -159,10 +159,10 @@ fn no_spurious_period_k_gait_where_the_walk_has_period_one() {
 }
 
 /// The paper's parameters at `c = 20 N s/m`, with the stiffness swept from `from` to `to` over `points` values.
-fn stiffness_sweep(from: f64, to: f64, points: usize) -> (Config, vrw::gait::SweepSpec) {
+fn stiffness_sweep(from: f64, to: f64, points: usize) -> (Config, vrw::study::SweepSpec) {
     let mut config = Config::default();
     config.set_numeric("viscosity", 20.0).unwrap();
-    let spec = vrw::gait::SweepSpec {
+    let spec = vrw::study::SweepSpec {
         param: "stiffness".into(),
         from,
         to,
@@ -187,7 +187,7 @@ fn period_two_gaits_are_continued_as_one_family() {
     let (config, spec) = stiffness_sweep(596.0, 604.0, 5);
     let options = GaitOptions::default();
     let points =
-        vrw::gait::sweep(&config, &spec, &default_initial(&config), &options, &|_| {}).unwrap();
+        vrw::study::sweep(&config, &spec, &default_initial(&config), &options, &|_| {}).unwrap();
     for (i, p) in points.iter().enumerate() {
         let g = p
             .gait
@@ -216,8 +216,9 @@ fn lambda_two_plus_vanishes_where_the_period_one_family_gives_way_to_period_two(
         let (config, spec) = stiffness_sweep(from, to, points);
         let options = GaitOptions::default();
         let points =
-            vrw::gait::sweep(&config, &spec, &default_initial(&config), &options, &|_| {}).unwrap();
-        let thresholds = vrw::gait::find_thresholds(&config, &spec, &points, &options);
+            vrw::study::sweep(&config, &spec, &default_initial(&config), &options, &|_| {})
+                .unwrap();
+        let thresholds = vrw::study::find_thresholds(&config, &spec, &points, &options);
         let zero = thresholds
             .iter()
             .find(|t| t.name == "lambda_2_plus = 0")

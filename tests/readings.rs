@@ -3,9 +3,10 @@
 //! touchdown (docs/model.md section 5).
 
 use vrw::dynamics::{Model, L1, L2};
-use vrw::gait::{sweep_values, GaitOptions};
+use vrw::gait::GaitOptions;
 use vrw::params::{Config, RearExit};
 use vrw::reference::default_initial;
+use vrw::study::sweep_values;
 use vrw::walk::{simulate, StepReport, Trajectory, WalkError, WalkRun};
 
 /// Stiff legs where the old rear leg bounces on its stopper and is still free (within a micrometre of `L0`)
@@ -51,7 +52,7 @@ fn walk_into(config: &Config, steps: usize, trajectory: Option<&mut Trajectory>)
 }
 
 /// The gaits along `param` at `values`, as a sweep follows them from the default start.
-fn sweep(config: &Config, param: &str, values: &[f64]) -> Vec<vrw::gait::SweepPoint> {
+fn sweep(config: &Config, param: &str, values: &[f64]) -> Vec<vrw::study::SweepPoint> {
     sweep_values(
         config,
         param,

@@ -29,10 +29,7 @@ use vrw::app::{
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
-use vrw::gait::basin::Coordinate;
-use vrw::gait::orbit::OrbitSpec;
-use vrw::gait::MAX_SWEEP_POINTS;
-use vrw::gait::{GaitOptions, MapSpec, SweepSpec};
+use vrw::gait::GaitOptions;
 use vrw::output::{
     basin_header, basin_row, branch_header, branch_rows, curve_header, curve_row, family_header,
     family_row, friction_columns, map_header, map_rows, orbit_header, orbit_rows, steps_header,
@@ -40,6 +37,10 @@ use vrw::output::{
     StepsColumns,
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
+use vrw::study::basin::Coordinate;
+use vrw::study::orbit::OrbitSpec;
+use vrw::study::MAX_SWEEP_POINTS;
+use vrw::study::{MapSpec, SweepSpec};
 use vrw::walk::SectionState;
 use vrw::walk::WalkError as LibWalkError;
 

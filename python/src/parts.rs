@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyStringMethods};
 
 use vrw::app::OrbitJobPart;
-use vrw::gait::orbit::{OrbitColumn, OrbitPart};
+use vrw::study::orbit::{OrbitColumn, OrbitPart};
 use vrw::walk::SectionState;
 
 use crate::{section, ConfigError};

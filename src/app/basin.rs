@@ -8,11 +8,12 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::fmt::short;
-use crate::gait::basin::{basin, basin_part, Axis, BasinPoint, BasinSpec, Coordinate};
-use crate::gait::{check_part, find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
+use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
 use crate::output;
 use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::params::Config;
+use crate::study::basin::{basin, basin_part, Axis, BasinPoint, BasinSpec, Coordinate};
+use crate::study::check_part;
 use crate::walk::SectionState;
 
 use super::{check_interrupted, check_phase_interrupted, in_run, prepared, AppError};

@@ -6,17 +6,18 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use crate::bifurcation::map_curves::continue_map_curves;
 use crate::dynamics::Model;
 use crate::fmt::short;
-use crate::gait::map::{LineThreshold, ThresholdCurve};
-use crate::gait::{
-    map_curves, map_gaits, map_gaits_part, GaitMap, GaitOptions, MapSpec, SecondRoute, SweepPoint,
-};
+use crate::gait::GaitOptions;
 use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
 use crate::output::signature_plot::write_signature_figure;
 use crate::output::{self, write_map_csv};
 use crate::params::Config;
+use crate::study::map::{LineThreshold, ThresholdCurve};
+use crate::study::map_curves::continue_map_curves;
+use crate::study::{
+    map_curves, map_gaits, map_gaits_part, GaitMap, MapSpec, SecondRoute, SweepPoint,
+};
 use crate::walk::SectionState;
 
 use super::{
@@ -39,10 +40,10 @@ pub struct MapJob {
     pub options: GaitOptions,
     /// Trace the threshold curves (`curves.json`, lines on the heat maps).
     pub curves: bool,
-    /// The most columns the curves are refined on ([`crate::gait::map::curve_columns`]; every row is).
+    /// The most columns the curves are refined on ([`crate::study::map::curve_columns`]; every row is).
     pub curve_columns: usize,
     /// Follow the indicator, fold and stability curves by continuation from the lines' crossings
-    /// ([`crate::bifurcation::map_curves`]); false: every curve through the refined crossings.
+    /// ([`mod@crate::study::map_curves`]); false: every curve through the refined crossings.
     pub continue_curves: bool,
     /// Search every threshold again by a second route (the whole map with the other integrator) and record in
     /// each whether it is confirmed ([`SecondRoute`]); only with `curves`.

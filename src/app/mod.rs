@@ -271,7 +271,7 @@ fn axis_label(param: &str) -> String {
 /// step of every gait), each prefixed with where the gait is (`where_` names a point, e.g. `viscosity = 50`).
 /// A gait whose step breaks a law of the model is not to be trusted, so its numbers never go out unsaid.
 pub(crate) fn gait_warnings<'a>(
-    points: impl IntoIterator<Item = (String, &'a crate::gait::SweepPoint)>,
+    points: impl IntoIterator<Item = (String, &'a crate::study::SweepPoint)>,
 ) -> Vec<String> {
     points
         .into_iter()

@@ -7,11 +7,12 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::fmt::short;
-use crate::gait::orbit::{orbit_diagram, orbit_part, OrbitColumn, OrbitPart, OrbitSpec};
-use crate::gait::{sweep, Gait, GaitOptions, Stability};
+use crate::gait::{Gait, GaitOptions, Stability};
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
 use crate::params::Config;
+use crate::study::orbit::{orbit_diagram, orbit_part, OrbitColumn, OrbitPart, OrbitSpec};
+use crate::study::sweep;
 use crate::walk::{SectionState, StepReport};
 
 use super::{axis_label, check_interrupted, in_run, prepared, AppError};

@@ -6,14 +6,13 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use crate::fmt::short;
-use crate::gait::{
-    find_thresholds, sweep_values, GaitOptions, SecondRoute, SweepPoint, SweepSpec, Threshold,
-};
+use crate::gait::GaitOptions;
 use crate::output;
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
 };
 use crate::params::Config;
+use crate::study::{find_thresholds, sweep_values, SecondRoute, SweepPoint, SweepSpec, Threshold};
 use crate::walk::SectionState;
 
 use super::{

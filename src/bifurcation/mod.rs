@@ -15,7 +15,6 @@ pub mod arclength;
 pub mod corrector;
 pub mod curve;
 pub mod family;
-pub mod map_curves;
 pub mod special;
 pub mod switch;
 #[cfg(test)]

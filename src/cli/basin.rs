@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use vrw::app::{run_basin, BasinJob};
-use vrw::gait::basin::Coordinate;
+use vrw::study::basin::Coordinate;
 use vrw::walk::SectionState;
 
 use super::{interrupt_flag, parse_range, progress_bar, ModelArgs};

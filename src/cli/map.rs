@@ -6,8 +6,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use vrw::app::{run_map, MapJob};
-use vrw::gait::{CurveMethod, GaitOptions, MapSpec, SecondRoute, SweepSpec};
+use vrw::gait::GaitOptions;
 use vrw::output::map_plot::MapMark;
+use vrw::study::{CurveMethod, MapSpec, SecondRoute, SweepSpec};
 use vrw::walk::SectionState;
 
 use super::{
@@ -58,7 +59,7 @@ pub(super) struct MapArgs {
     no_curves: bool,
     /// Refine the curves' crossings on at most this many columns, evenly spread with both ends (every row is
     /// refined); at least 2, and a value of --nx or more refines every column.
-    #[arg(long, default_value_t = vrw::gait::map::DEFAULT_CURVE_COLUMNS as u64,
+    #[arg(long, default_value_t = vrw::study::map::DEFAULT_CURVE_COLUMNS as u64,
           value_parser = clap::value_parser!(u64).range(2..))]
     curve_columns: u64,
     /// How the indicator curves (lambda = 0), folds and losses of stability are traced: `continuation`
@@ -222,15 +223,15 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
             };
             if let Some(r) = t.threshold.second_route.as_ref().filter(shown) {
                 let param = match t.along {
-                    vrw::gait::map::Along::X => &args.x,
-                    vrw::gait::map::Along::Y => &args.y,
+                    vrw::study::map::Along::X => &args.x,
+                    vrw::study::map::Along::Y => &args.y,
                 };
                 println!(
                     "    {} {} = {:.6} on {} {}: {}",
                     t.threshold.name,
                     param,
                     t.threshold.value,
-                    if t.along == vrw::gait::map::Along::X {
+                    if t.along == vrw::study::map::Along::X {
                         "row"
                     } else {
                         "column"

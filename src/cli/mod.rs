@@ -22,8 +22,8 @@ use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use vrw::app::AppError;
-use vrw::gait::{SecondRoute, Threshold, SECOND_ROUTE_TOL};
 use vrw::params::{Config, ConfigError};
+use vrw::study::{SecondRoute, Threshold, SECOND_ROUTE_TOL};
 
 /// Passive dynamic walking of a viscoelastic-legged rimless wheel, with the DLS indicators.
 #[derive(Debug, Parser)]

@@ -6,8 +6,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use vrw::app::{run_orbit, OrbitJob};
-use vrw::gait::orbit::OrbitSpec;
-use vrw::gait::SweepSpec;
+use vrw::study::orbit::OrbitSpec;
+use vrw::study::SweepSpec;
 use vrw::walk::SectionState;
 
 use super::{interrupt_flag, progress_bar, ModelArgs};

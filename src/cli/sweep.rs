@@ -6,8 +6,9 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use vrw::app::{run_sweep, SweepJob};
-use vrw::gait::{GaitOptions, SweepSpec};
+use vrw::gait::GaitOptions;
 use vrw::params::Config;
+use vrw::study::SweepSpec;
 use vrw::walk::SectionState;
 
 use super::{

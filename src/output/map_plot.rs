@@ -4,7 +4,7 @@
 //! Four panels share the axes: `lambda_I4`, `lambda_2+` and `lambda_4+` of the gait at every grid point, on a
 //! diverging colour scale that is white at zero (blue below, red above, each side scaled to its own extreme, so
 //! the sign is what shows), and the existence of a gait with its impact branch (unstable gaits dotted). Points
-//! without a gait are grey. The threshold curves ([`crate::gait::map`]) are polylines through refined crossings,
+//! without a gait are grey. The threshold curves ([`crate::study::map`]) are polylines through refined crossings,
 //! drawn with a white halo over every panel; marked points (e.g. the paper's thresholds) are white circles with a
 //! label.
 //!
@@ -25,7 +25,8 @@ use super::style::{
     draw_box, font, house_mesh, tick_label, LegendLayout, PlotError, COLOR_BLACK, COLOR_BLUE,
     COLOR_FRAME, COLOR_GREEN, COLOR_MARK, COLOR_ORANGE, COLOR_PURPLE, COLOR_VERMILLION,
 };
-use crate::gait::{GaitMap, Stability, ThresholdCurve};
+use crate::gait::Stability;
+use crate::study::{GaitMap, ThresholdCurve};
 use crate::walk::Branch;
 
 /// A labelled point on the map.

@@ -13,7 +13,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::chart::{titled, write_svg_png, DrawResult, Figure, LEGEND_FONT, TICK_FONT};
 use super::map_plot::{has_points, Layer, MapFigure, COLOR_NO_GAIT, PALETTE};
 use super::style::{draw_box, font, PlotError, COLOR_MARK};
-use crate::gait::GaitMap;
+use crate::study::GaitMap;
 
 /// Size of the figure \[px\]: the panel on the left, the sequences' legend on the right.
 const SIZE: (u32, u32) = (2800, 1300);

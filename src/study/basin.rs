@@ -19,9 +19,9 @@ use std::ops::Range;
 use serde::Serialize;
 
 use super::grid::{run_rows_part, Evaluated};
-use super::limit_cycle::Gait;
-use super::periodicity::{least_period, MAX_PERIOD};
 use crate::dynamics::Model;
+use crate::gait::limit_cycle::Gait;
+use crate::gait::periodicity::{least_period, MAX_PERIOD};
 use crate::params::SolverOptions;
 use crate::walk::{SectionState, Walker};
 

@@ -28,7 +28,7 @@
 //! is set, no new point starts; the points under way stop (their walks read the flag too) and are dropped,
 //! and every row is cut to its complete prefix (the points from its first up to the first one not evaluated
 //! before the flag was set), so what is returned is exactly what an uninterrupted
-//! run returns, minus the rows' tails. A job that sees [`interrupted`] after the runner keeps those points and
+//! run returns, minus the rows' tails. A job that sees [`crate::walk::interrupted`] after the runner keeps those points and
 //! says it was interrupted.
 //!
 //! The example of a running sum along each row is the test `running_sum_along_rows` below (the runner is
@@ -40,7 +40,7 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-pub use crate::walk::interrupt::{clear_interrupt, interrupt_flag, interrupted};
+use crate::walk::interrupt::interrupt_flag;
 
 /// Stride of the coarse continuation pass along a row.
 pub(crate) const COARSE_STRIDE: usize = 10;
@@ -87,7 +87,7 @@ where
 }
 
 /// The rows `part` of a grid of `rows` rows (a chunk of a study spread over processes, see
-/// [`crate::gait::map::map_gaits_part`]): every point of these rows exactly as [`run_rows`] computes it for the
+/// [`super::map::map_gaits_part`]): every point of these rows exactly as [`run_rows`] computes it for the
 /// whole grid (the schedule is the whole grid's: a grid of one row is split, the rows of a larger one run in
 /// order), returned in the order of `part`. `part` must lie within `0..rows`.
 pub fn run_rows_part<P, C, F>(part: Range<usize>, rows: usize, cols: usize, eval: F) -> Vec<Vec<P>>

@@ -1,26 +1,26 @@
 //! The curves of a map followed by continuation (docs/model.md section 11, "Curves of a map"; `vrw map`): each
 //! indicator curve `lambda = 0`, fold and loss of stability is traced across the map from a crossing that a row
 //! (or column) found, as the solutions of `P(x; x_param, y_param) = x` together with its condition
-//! ([`super::curve`]), instead of joining the crossings of neighbouring grid lines. Every other crossing of the
+//! ([`crate::bifurcation::curve`]), instead of joining the crossings of neighbouring grid lines. Every other crossing of the
 //! same threshold within one grid cell of the curve is solved for on the curve at its line and compared with
 //! the line's refined threshold: the lines are the curve's second route, and the crossings on it are covered
 //! by it. Crossings that no continued curve covers (a period-k gait, a continuation that failed, another
-//! border nearby) keep their curves through the crossings ([`crate::gait::CurveMethod::Crossings`]).
+//! border nearby) keep their curves through the crossings ([`crate::study::CurveMethod::Crossings`]).
 
 use rayon::prelude::*;
 
-use super::curve::{
+use super::map::NearMiss;
+use super::map::{Along, LineThreshold, RefinedOn};
+use super::{
+    ContinuedCurve, CurveMethod, GaitMap, MapCurves, SweepSpec, ThresholdCurve, LINE_CHECK_TOL,
+};
+use crate::bifurcation::curve::{
     border_curve_seed, continue_curve, curve_at, Curve, CurveEnd, CurveOptions, CurveProblem,
     CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
-use super::special::{test_function, test_name};
-use super::{
+use crate::bifurcation::special::{test_function, test_name};
+use crate::bifurcation::{
     continue_family, ContinuationOptions, Evaluation, GaitFamily, GaitInfo, MapFailure, SpecialKind,
-};
-use crate::gait::map::NearMiss;
-use crate::gait::map::{Along, LineThreshold, RefinedOn};
-use crate::gait::{
-    ContinuedCurve, CurveMethod, GaitMap, MapCurves, SweepSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
 use crate::params::Config;
 
@@ -393,7 +393,7 @@ fn crossings_at(
     which: usize,
     value: f64,
 ) -> impl Iterator<Item = f64> + '_ {
-    let split = move |p: &super::CurvePoint<GaitInfo>| {
+    let split = move |p: &crate::bifurcation::CurvePoint<GaitInfo>| {
         if which == 0 {
             (p.p1, p.p2)
         } else {

@@ -8,15 +8,15 @@
 //! instead of jumping between coexisting ones. The first value, and a value after a walk that failed, start
 //! from the job's initial state with `FRESH_TRANSIENT_FACTOR` times the transient.
 //!
-//! The period of the recorded returns ([`super::periodicity::least_period`]) is reported per value: a period-1
+//! The period of the recorded returns ([`crate::gait::periodicity::least_period`]) is reported per value: a period-1
 //! gait shows as one point, a period-k gait as `k`, anything else as a cloud.
 
 use serde::Serialize;
 
 use super::grid::{coarse_pass, fill, run_rows, Cell, Evaluated, COARSE_STRIDE};
-use super::periodicity::{least_period, MAX_PERIOD};
 use super::sweep::{RangeNames, SweepSpec};
 use crate::dynamics::Model;
+use crate::gait::periodicity::{least_period, MAX_PERIOD};
 use crate::params::{Config, ConfigError};
 use crate::walk::{SectionState, StepReport, Walker};
 

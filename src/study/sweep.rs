@@ -1,7 +1,7 @@
 //! Parameter sweeps with continuation (docs/model.md section 6, the paper's Fig. 2).
 //!
 //! Every point follows its neighbour's gait family in verified continuation steps (see
-//! [`super::continuation`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach
+//! [`crate::gait::continuation`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach
 //! is searched from the sweep's initial state with a full transient, and so are the points after it until a gait
 //! is found again. Gaits found that way are then followed backwards to fill in points the search from the
 //! initial state missed, and every gait gets a family number: points of one family are connected by
@@ -19,14 +19,14 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::continuation::{Continuation, FamilyPoint, Followed, Tangent, PARAM_TOL};
 use super::grid::{run_rows_part, Evaluated};
-use super::limit_cycle::{gait_at_converged, solve_fixed_point, Gait, GaitOptions};
-use super::period_k::{find_gait_any_period, periodic_gait_at};
-use super::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
-use super::step_map::{free_coordinates, StepMap};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
 use crate::fmt::short;
+use crate::gait::continuation::{Continuation, FamilyPoint, Followed, Tangent, PARAM_TOL};
+use crate::gait::limit_cycle::{gait_at_converged, solve_fixed_point, Gait, GaitOptions};
+use crate::gait::period_k::{find_gait_any_period, periodic_gait_at};
+use crate::gait::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
+use crate::gait::step_map::{free_coordinates, StepMap};
 use crate::params::{Config, ConfigError, SolverOptions};
 use crate::walk::{SectionState, SECTION_COORDINATES};
 
@@ -143,7 +143,7 @@ pub struct SweepPoint {
     /// The gait, if found.
     pub gait: Option<Gait>,
     /// Index of the sweep point this gait was continued from (verified from both sides, see
-    /// [`super::continuation`]); `None` if it was found from the sweep's initial state.
+    /// [`crate::gait::continuation`]); `None` if it was found from the sweep's initial state.
     #[serde(skip)]
     pub continued_from: Option<usize>,
     /// Gait family: points with the same number are connected by continuation; numbered from 0 in parameter

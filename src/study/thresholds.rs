@@ -7,7 +7,7 @@
 //! Sign changes between neighbouring sweep points of one gait family are refined by Brent's method (the `roots`
 //! crate) on the indicator of the gait continued from the left neighbour, to [`PARAM_TOL`] in the parameter.
 //! Ends of families are followed in verified continuation steps to [`PARAM_TOL`] and their physical cause is
-//! looked for just past the end ([`super::continuation`]):
+//! looked for just past the end ([`crate::gait::continuation`]):
 //!
 //! | threshold | where |
 //! |---|---|
@@ -26,13 +26,13 @@ use rayon::prelude::*;
 use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 
-pub(crate) use super::continuation::PARAM_TOL;
-use super::continuation::{carried_start, Continuation, EndCause, FamilyPoint, Followed};
-use super::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
-use super::periodicity::SAME_GAIT_TOL;
-use super::step_map::StepMap;
 use super::sweep::{family_tangent, SweepPoint, SweepSpec};
 use crate::dynamics::Model;
+pub(crate) use crate::gait::continuation::PARAM_TOL;
+use crate::gait::continuation::{carried_start, Continuation, EndCause, FamilyPoint, Followed};
+use crate::gait::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
+use crate::gait::periodicity::SAME_GAIT_TOL;
+use crate::gait::step_map::StepMap;
 use crate::params::Config;
 use crate::walk::DlsIndicators;
 
@@ -391,8 +391,8 @@ fn refine_end(
                     from.value,
                     last.value,
                     toward.value,
-                    super::continuation::MAX_FOLLOW_STEPS,
-                    super::continuation::MAX_FOLLOW_WALKS,
+                    crate::gait::continuation::MAX_FOLLOW_STEPS,
+                    crate::gait::continuation::MAX_FOLLOW_WALKS,
                     p = spec.param,
                 ),
             )]

@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use super::{header_with, row_with, Cell, Column};
-use crate::gait::basin::BasinPoint;
-use crate::gait::orbit::OrbitColumn;
 use crate::gait::Gait;
 use crate::output::{write_table, OutputError};
+use crate::study::basin::BasinPoint;
+use crate::study::orbit::OrbitColumn;
 use crate::walk::{SectionState, StepReport};
 
 use Cell::{Count, Empty, Real, Text};

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use super::sweep::{of_gait, FRICTION_GAIT_COLUMNS};
 use super::{header, optional, row, Cell, Column};
-use crate::gait::{GaitMap, SweepPoint};
 use crate::output::{write_table, OutputError};
+use crate::study::{GaitMap, SweepPoint};
 
 use Cell::{Count, Empty, Flag, Real, Text};
 

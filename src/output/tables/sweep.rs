@@ -4,9 +4,10 @@
 use std::path::Path;
 
 use super::{fixed_names, header_with, row_with, Cell, Column};
-use crate::gait::{Gait, SweepPoint};
+use crate::gait::Gait;
 use crate::output::{write_table, OutputError};
 use crate::params::Config;
+use crate::study::SweepPoint;
 
 use Cell::{Count, Empty, Flag, Real, Text};
 

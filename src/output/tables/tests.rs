@@ -13,12 +13,7 @@ use super::sweep::{FRICTION_GAIT_COLUMNS, SWEEP};
 use super::trajectory::{SWING_COLUMNS, TRAJECTORY};
 use super::*;
 use crate::dynamics::Model;
-use crate::gait::basin::{BasinPoint, Outcome};
-use crate::gait::orbit::OrbitColumn;
-use crate::gait::{
-    find_gait_any_period, Gait, GaitMap, GaitOptions, MapSpec, StepMap, SweepPoint, SweepSpec,
-    MAX_PERIOD,
-};
+use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
 use crate::output::read::{read_csv, StepRow, TrajectoryRow};
 use crate::output::{
     step_row, sweep_header, sweep_row, trajectory_row, write_basin_csv, write_branch_csv,
@@ -27,6 +22,9 @@ use crate::output::{
 };
 use crate::params::{Config, Params, RearExit};
 use crate::reference::default_initial;
+use crate::study::basin::{BasinPoint, Outcome};
+use crate::study::orbit::OrbitColumn;
+use crate::study::{GaitMap, MapSpec, SweepPoint, SweepSpec};
 use crate::walk::{simulate, Sample, SectionState, StepReport, Trajectory};
 
 /// A short walk with its trajectory, and the gait of the default parameters.
