@@ -32,9 +32,10 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
 use vrw::app::{compute_gait, GaitJob};
-use vrw::bifurcation::{continue_family, ContinuationOptions, GaitFamily};
 use vrw::contact::{constrained_dynamics, ActiveSet};
+use vrw::continuation::{continue_family, ContinuationOptions};
 use vrw::dynamics::{Coords, Model};
+use vrw::family::GaitFamily;
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::reference::default_initial;
@@ -229,7 +230,7 @@ fn jacobian_routes(c: &mut Criterion) {
     group.finish();
 }
 
-/// `family/300_points`: pseudo-arclength continuation of the default family (`vrw::bifurcation`) from the gait
+/// `family/300_points`: pseudo-arclength continuation of the default family (`vrw::continuation`) from the gait
 /// at c = 50, 150 points each way with steps of at most 0.01 (c from about 3 to 98), special points
 /// detected: the "one family of 300 points".
 fn family(c: &mut Criterion) {

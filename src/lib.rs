@@ -14,6 +14,7 @@
 //! | stage | module |
 //! |---|---|
 //! | numerical integration with event location | [`integrate`] |
+//! | (beside the pipeline, importing none of the wheel) the continuation engine | [`continuation`] |
 //! | parameters and options | [`params`] |
 //! | equations of motion, Eq. (1) | [`dynamics`] |
 //! | contacts, stoppers, KKT and impulse solves, Eqs. (2), (5) | [`contact`] |
@@ -21,7 +22,7 @@
 //! | exact derivatives of the step map: variational equations, saltation matrices | [`variational`] |
 //! | reference problems with known answers, the default start | [`reference`](mod@reference) |
 //! | step map, its exact derivatives, gaits (period 1 and k), Floquet multipliers, natural continuation | [`gait`] |
-//! | gait families by pseudo-arclength continuation, special points, branch switching | [`bifurcation`] |
+//! | the wheel's gait as a function of one parameter (its step map as a family) | [`family`] |
 //! | studies over parameters: the grid runner, sweeps, thresholds, maps and their curves, orbits, basins | [`study`] |
 //! | tables and figures | [`output`] |
 //! | the command-line jobs | [`app`] |
@@ -52,11 +53,11 @@
 //! - **Studies over parameters**: sweeps [`study::sweep()`] over a [`study::SweepSpec`] and their thresholds
 //!   [`study::find_thresholds`]; two-parameter maps [`study::map_gaits`] and [`study::map_curves()`]; orbit
 //!   diagrams [`study::orbit::orbit_diagram`]; basins of attraction [`study::basin::basin`].
-//! - **Bifurcation analysis**: [`bifurcation::continue_family`] over any [`bifurcation::FamilyMap`] (the VRW's
-//!   is [`bifurcation::GaitFamily`]) with [`bifurcation::ContinuationOptions`], giving a
-//!   [`bifurcation::Family`] of [`bifurcation::FamilyPoint`]s with its [`bifurcation::SpecialPoint`]s and
-//!   [`bifurcation::FamilyEnd`]s; branch switching [`bifurcation::switch_at_period_doubling`] and
-//!   [`bifurcation::switch_at_border`].
+//! - **Bifurcation analysis**: [`continuation::continue_family`] over any [`continuation::FamilyMap`] (the
+//!   VRW's is [`family::GaitFamily`]) with [`continuation::ContinuationOptions`], giving a
+//!   [`continuation::Family`] of [`continuation::FamilyPoint`]s with its [`continuation::SpecialPoint`]s and
+//!   [`continuation::FamilyEnd`]s; branch switching [`continuation::switch_at_period_doubling`] and
+//!   [`continuation::switch_at_border`].
 //! - **Output**: the tables [`output::write_steps_csv`], [`output::write_trajectory_csv`] (and the streaming
 //!   [`output::StepsCsv`], [`output::TrajectoryCsv`]), [`output::write_sweep_csv`], their headers and rows;
 //!   reading a run directory back with [`output::read::read_run`]; the figures
@@ -111,9 +112,10 @@
 #![warn(missing_docs, unnameable_types)]
 
 pub mod app;
-pub mod bifurcation;
 pub mod contact;
+pub mod continuation;
 pub mod dynamics;
+pub mod family;
 pub mod fmt;
 pub mod gait;
 pub mod integrate;

@@ -238,7 +238,7 @@ pub fn period_two_config() -> Config {
 /// meet at the fold `p = -1/4` (`x = -1/2`, multiplier +1); the upper one loses stability by period doubling at
 /// `p = 3/4` (`x = 1/2`, multiplier -1), where the period-2 orbit `x = (1 ± sqrt(4p - 3)) / 2` is born, which
 /// doubles again at `p = 5/4` (the multiplier of `P^2` there is `4 x1 x2 = 4 (1 - p) = -1`). The reference
-/// of the continuation tests (`crate::bifurcation`).
+/// of the continuation tests (`crate::continuation`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct QuadraticFamily;
 

@@ -30,6 +30,7 @@ const ENFORCE_FILE_SIZE: bool = true;
 const PIPELINE: &[&str] = &[
     "fmt",
     "integrate",
+    "continuation",
     "params",
     "dynamics",
     "contact",
@@ -37,7 +38,7 @@ const PIPELINE: &[&str] = &[
     "variational",
     "reference",
     "gait",
-    "bifurcation",
+    "family",
     "study",
     "output",
     "app",

@@ -15,11 +15,11 @@ use super::family_records::{
 };
 use super::family_switch::{same_as_followed, switched_families, Followed};
 use super::{prepared, AppError};
-use crate::bifurcation::Curve;
-use crate::bifurcation::{
+use crate::continuation::Curve;
+use crate::continuation::{
     continue_family, ContinuationError, ContinuationOptions, Family, FamilyEnd, FamilyMap,
-    GaitFamily, GaitInfo,
 };
+use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::continuation::{Continuation, EndCause, FamilyPoint as GaitPoint};
 use crate::gait::MAX_PERIOD;
 use crate::gait::{find_gait_any_period, find_periodic_gait, GaitOptions, Stability, StepMap};

@@ -4,14 +4,14 @@
 use serde::Serialize;
 
 use super::AppError;
-use crate::bifurcation::curve::{
+use crate::continuation::curve::{
     border_curve_seed, CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
-use crate::bifurcation::special::{test_function, test_name};
-use crate::bifurcation::{
-    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, GaitFamily, GaitInfo,
-    SpecialKind,
+use crate::continuation::special::{test_function, test_name};
+use crate::continuation::{
+    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, SpecialKind,
 };
+use crate::family::{GaitFamily, GaitInfo};
 use crate::params::Config;
 
 /// One two-parameter curve in `special_points.json`.
@@ -140,7 +140,8 @@ pub(super) fn two_param_curves(
             let observe =
                 |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
             let condition = jacobian_test.map_or(CurveTest::Border(&border), CurveTest::Jacobian);
-            let test = |ev: &crate::bifurcation::Evaluation<GaitInfo>| condition.of(family_map, ev);
+            let test =
+                |ev: &crate::continuation::Evaluation<GaitInfo>| condition.of(family_map, ev);
             let problem = CurveProblem {
                 eval: &eval,
                 observe: (!condition.needs_derivatives()).then_some(&observe),

@@ -3,7 +3,7 @@
 
 use super::family::{compute_continuation, ContinueJob, ContinueResult};
 use super::{axis_label, in_run, AppError};
-use crate::bifurcation::FamilyEnd;
+use crate::continuation::FamilyEnd;
 use crate::gait::Stability;
 use crate::output::bifurcation_plot::{
     BifurcationFigure, DiagramFamily, DiagramSpecial, BIFURCATION_SIZE,

@@ -3,8 +3,9 @@
 
 use serde::Serialize;
 
-use crate::bifurcation::special::Side;
-use crate::bifurcation::{FamilyEnd, GaitFamily, GaitInfo, SpecialKind, SpecialPoint};
+use crate::continuation::special::Side;
+use crate::continuation::{FamilyEnd, SpecialKind, SpecialPoint};
+use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::continuation::EndCause;
 use crate::gait::Stability;
 
@@ -144,7 +145,7 @@ pub(crate) fn special_record(family: usize, s: &SpecialPoint<GaitInfo>) -> Speci
 /// within [`STABILITY_BAND`] of the unit circle; uncertain without derivatives.
 pub(super) fn point_stability(
     map: &GaitFamily,
-    p: &crate::bifurcation::FamilyPoint<GaitInfo>,
+    p: &crate::continuation::FamilyPoint<GaitInfo>,
 ) -> Stability {
     let max = p.max_multiplier();
     if !p.has_derivatives() || !max.is_finite() {

@@ -3,12 +3,13 @@
 //! the gait a walk past an end settles on), and whether a family was followed already.
 
 use super::family_records::EndRecord;
-use crate::bifurcation::corrector::solve_on_hyperplane;
-use crate::bifurcation::special::JUMP_TOL;
-use crate::bifurcation::{
+use crate::continuation::corrector::solve_on_hyperplane;
+use crate::continuation::special::JUMP_TOL;
+use crate::continuation::{
     continue_family, switch_at_border, switch_at_period_doubling, ContinuationOptions, Family,
-    FamilyEnd, FamilyMap, GaitFamily, GaitInfo, SpecialKind,
+    FamilyEnd, FamilyMap, SpecialKind,
 };
+use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::continuation::EndCause;
 
 /// A family being followed: where it came from, its map and its ends with their causes.

@@ -6,7 +6,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use vrw::app::{run_continuation, ContinueJob, DIAGRAM_QUANTITIES};
-use vrw::bifurcation::{CurveEnd, CurvePoint, FamilyEnd, GaitInfo};
+use vrw::continuation::{CurveEnd, CurvePoint, FamilyEnd};
+use vrw::family::GaitInfo;
 use vrw::walk::SectionState;
 
 use super::{flagged, interrupt_flag, print_warnings, ModelArgs};

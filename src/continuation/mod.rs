@@ -1,11 +1,12 @@
-//! Bifurcation analysis of gait families (docs/model.md section 11): families of fixed points of a map
-//! `P(x; p)` followed by pseudo-arclength continuation through folds ([`arclength`], with its [`corrector`]), branch
-//! switching at period doublings ([`switch`]), their special points
-//! detected by test functions and located by solving an extended system ([`special`]), and the step map of
-//! the VRW as such a family ([`family`]).
+//! The continuation engine (docs/model.md section 11), free of the wheel (it imports no module of it): families
+//! of fixed points of a map `P(x; p)` followed by pseudo-arclength continuation through folds ([`arclength`],
+//! with its [`corrector`]), branch switching at period doublings and border collisions ([`switch`]), special
+//! points detected by test functions and located by solving an extended system ([`special`]), and the curves
+//! of special points in two parameters ([`curve`]). The wheel's step map as such a family is
+//! `crate::family::GaitFamily`.
 //!
 //! Everything here works on any [`FamilyMap`]: a map of `R^n` with one parameter that gives its value, its
-//! Jacobian `DP` and `dP/dp` (the VRW's come from [`crate::gait::StepMap::eval_with_derivatives`]), and,
+//! Jacobian `DP` and `dP/dp` (the VRW's come from its step map's exact derivatives), and,
 //! optionally, the smooth functions whose zeros are the borders between its smooth pieces and a name for the
 //! piece a point lies on. The reference families of [`crate::reference`] (the quadratic map, with a fold and a
 //! period-doubling cascade in closed form, and the delayed logistic map, with a Neimark-Sacker point) are
@@ -14,7 +15,6 @@
 pub mod arclength;
 pub mod corrector;
 pub mod curve;
-pub mod family;
 pub mod special;
 pub mod switch;
 #[cfg(test)]
@@ -27,7 +27,6 @@ pub use corrector::{ContinuationOptions, FamilyPoint};
 pub use curve::{
     continue_curve, curve_at, curve_at_p2, Curve, CurveEnd, CurveOptions, CurvePoint, CurveProblem,
 };
-pub use family::{GaitFamily, GaitInfo};
 pub use special::{SpecialKind, SpecialPoint};
 pub use switch::{switch_at_border, switch_at_period_doubling};
 

@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{Evaluation, FamilyMap, MapFailure};
+use crate::continuation::{Evaluation, FamilyMap, MapFailure};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
 use crate::gait::step_map::{expand, free_coordinates, reduce};
 use crate::gait::{
@@ -125,7 +125,7 @@ impl<'a> GaitFamily<'a> {
     }
 
     /// `P(x; p, q)` with `DP` and `dP/dp`: this family in the configuration with the key `second` at `q` (a
-    /// two-parameter curve's map, [`super::curve`]).
+    /// two-parameter curve's map, [`crate::continuation::curve`]).
     pub fn eval_with(
         &self,
         second: &str,
@@ -142,7 +142,7 @@ impl<'a> GaitFamily<'a> {
     }
 
     /// `P(x; p, q)` and what the map records, without derivatives (`jacobian` and `dparam` empty, `exact`
-    /// false): a two-parameter curve's [`super::CurveProblem::observe`].
+    /// false): a two-parameter curve's [`crate::continuation::CurveProblem::observe`].
     pub fn observe_with(
         &self,
         second: &str,
@@ -405,3 +405,6 @@ impl<'a> FamilyMap for GaitFamily<'a> {
 /// root of the distance to the branch point); a change of least period between two points of a family whose
 /// longer orbit has its phases farther apart than this is a jump to another family.
 pub const PHASE_MERGE_TOL: f64 = 0.05;
+
+#[cfg(test)]
+mod tests;

@@ -1,7 +1,7 @@
 //! The curves of a map followed by continuation (docs/model.md section 11, "Curves of a map"; `vrw map`): each
 //! indicator curve `lambda = 0`, fold and loss of stability is traced across the map from a crossing that a row
 //! (or column) found, as the solutions of `P(x; x_param, y_param) = x` together with its condition
-//! ([`crate::bifurcation::curve`]), instead of joining the crossings of neighbouring grid lines. Every other crossing of the
+//! ([`crate::continuation::curve`]), instead of joining the crossings of neighbouring grid lines. Every other crossing of the
 //! same threshold within one grid cell of the curve is solved for on the curve at its line and compared with
 //! the line's refined threshold: the lines are the curve's second route, and the crossings on it are covered
 //! by it. Crossings that no continued curve covers (a period-k gait, a continuation that failed, another
@@ -14,14 +14,15 @@ use super::map::{Along, LineThreshold, RefinedOn};
 use super::{
     ContinuedCurve, CurveMethod, GaitMap, MapCurves, SweepSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
-use crate::bifurcation::curve::{
+use crate::continuation::curve::{
     border_curve_seed, continue_curve, curve_at, Curve, CurveEnd, CurveOptions, CurveProblem,
     CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
-use crate::bifurcation::special::{test_function, test_name};
-use crate::bifurcation::{
-    continue_family, ContinuationOptions, Evaluation, GaitFamily, GaitInfo, MapFailure, SpecialKind,
+use crate::continuation::special::{test_function, test_name};
+use crate::continuation::{
+    continue_family, ContinuationOptions, Evaluation, MapFailure, SpecialKind,
 };
+use crate::family::{GaitFamily, GaitInfo};
 use crate::params::Config;
 
 /// What a continued curve of a map solves for with the fixed point.
@@ -393,7 +394,7 @@ fn crossings_at(
     which: usize,
     value: f64,
 ) -> impl Iterator<Item = f64> + '_ {
-    let split = move |p: &crate::bifurcation::CurvePoint<GaitInfo>| {
+    let split = move |p: &crate::continuation::CurvePoint<GaitInfo>| {
         if which == 0 {
             (p.p1, p.p2)
         } else {

@@ -2,7 +2,7 @@
 //! point to point, bitwise identical for any thread count), the sweep of one parameter and its thresholds, the
 //! map over two parameters and its curves (`map`, `map_curves`), the orbit diagram and the basin of
 //! attraction. They are built on the step map and its fixed points ([`crate::gait`]) and the families of
-//! [`crate::bifurcation`].
+//! [`crate::continuation`].
 
 pub mod basin;
 pub(crate) mod grid;

@@ -4,7 +4,8 @@
 use std::path::Path;
 
 use super::{header, header_with, row, row_with, Cell, Column};
-use crate::bifurcation::{CurvePoint, FamilyPoint, GaitInfo};
+use crate::continuation::{CurvePoint, FamilyPoint};
+use crate::family::GaitInfo;
 use crate::gait::Stability;
 use crate::output::{write_table, OutputError};
 
