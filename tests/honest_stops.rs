@@ -302,3 +302,44 @@ fn continue_checks_its_second_parameter_first() {
     );
     assert!(!tmp.path().join("out/continue/manifest.json").exists());
 }
+
+/// Every figure's title names the keys that differ from the defaults (Fig. 2 of a sweep with friction said
+/// nothing of mu), and the orbit diagram draws the indicator asked for.
+#[test]
+fn figures_say_what_they_were_made_with() {
+    let tmp = tempfile::tempdir().unwrap();
+    ok(&vrw(
+        &[
+            "sweep",
+            "--set",
+            "friction=0.6",
+            "--points",
+            "3",
+            "--out",
+            "s",
+        ],
+        tmp.path(),
+    ));
+    let svg = fs::read_to_string(tmp.path().join("s/fig2.svg")).unwrap();
+    assert!(svg.contains("μ = 0.6"), "no μ in Fig. 2's title");
+    let orbit = [
+        "orbit",
+        "--points",
+        "3",
+        "--transient",
+        "2",
+        "--steps",
+        "2",
+        "--no-branch",
+    ];
+    ok(&vrw(
+        &[&orbit[..], &["--plot", "lambda_4_plus", "--out", "o"]].concat(),
+        tmp.path(),
+    ));
+    let refused = vrw(
+        &[&orbit[..], &["--plot", "speed", "--out", "o2"]].concat(),
+        tmp.path(),
+    );
+    assert!(!refused.status.success());
+    assert!(stderr(&refused).contains("lambda_2_plus, lambda_4_plus"));
+}

@@ -271,3 +271,49 @@ fn interrupt_stops_a_step_in_progress_not_only_at_touchdowns() {
     assert!(matches!(error, WalkError::Interrupted { .. }), "{error}");
     assert_eq!(error.kind(), "interrupted");
 }
+
+/// A start with absurd rates is refused before the walk (`--initial 0.72,1,1e5` ran 72 s before it failed).
+#[test]
+fn initial_rates_beyond_any_walk_are_refused() {
+    for (initial, field) in [("0.72,1,1e5", "L2dot"), ("0.72,1e5,0", "thetadot")] {
+        let (output, _dir) = vrw(&["simulate", "--steps", "1", "--initial", initial]);
+        assert_refused(&output, &[field, "100 sqrt(g L0)"]);
+    }
+    // Below the bound, the rate is the walk's to judge.
+    let (output, _dir) = vrw(&["simulate", "--steps", "1", "--initial", "0.72,1,-50"]);
+    assert!(!String::from_utf8_lossy(&output.stderr).contains("sqrt(g L0)"));
+}
+
+/// A message quotes at most 200 characters of what the user typed, however long (clap's and vrw's own).
+#[test]
+fn long_inputs_are_quoted_clipped() {
+    let long = "9".repeat(5000);
+    let cases = [
+        vec![
+            "simulate".to_string(),
+            "--set".into(),
+            format!("viscosity=x{long}"),
+        ],
+        vec!["simulate".to_string(), "--set".into(), format!("{long}=1")],
+        vec![
+            "simulate".to_string(),
+            "--initial".into(),
+            format!("0.7,{long}x"),
+        ],
+        vec!["basin".to_string(), "--x-range".into(), format!("1;{long}")],
+        vec!["continue".to_string(), "--plot".into(), format!("q{long}")],
+    ];
+    for case in cases {
+        let args: Vec<&str> = case.iter().map(String::as_str).collect();
+        let (output, _dir) = vrw(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_ne!(output.status.code(), Some(0), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(
+            stderr.len() < 2500 && stderr.contains("characters in all"),
+            "{} characters: {}",
+            stderr.len(),
+            &stderr[..stderr.len().min(600)]
+        );
+    }
+}
