@@ -42,6 +42,21 @@ pub fn clip_lines(text: &str) -> String {
     text.lines().map(clip).collect::<Vec<_>>().join("\n")
 }
 
+/// The first `most` of `items`, comma-separated, and how many more there are (`a, b, c and 4 more{what}`, with
+/// `what` e.g. ` files`): a list in a message that stays short however long the list.
+pub fn first_of(items: &[String], most: usize, what: &str) -> String {
+    let mut words = items
+        .iter()
+        .take(most)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if items.len() > most {
+        words += &format!(" and {} more{what}", items.len() - most);
+    }
+    words
+}
+
 #[cfg(test)]
 mod tests {
     use super::{clip, short};

@@ -223,16 +223,10 @@ pub(crate) fn settings_note(config: &Config, shown: &[&str]) -> String {
     if changed.is_empty() {
         return String::new();
     }
-    let mut words = changed
-        .iter()
-        .take(TITLE_KEYS)
-        .cloned()
-        .collect::<Vec<_>>()
-        .join(", ");
-    if changed.len() > TITLE_KEYS {
-        words += &format!(" and {} more non-default keys", changed.len() - TITLE_KEYS);
-    }
-    format!(" [{words}]")
+    format!(
+        " [{}]",
+        crate::fmt::first_of(&changed, TITLE_KEYS, " non-default keys")
+    )
 }
 
 /// Short symbol of a parameter for labels (`c` for viscosity, ...).

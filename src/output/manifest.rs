@@ -339,16 +339,7 @@ const LISTED_FILES: usize = 10;
 
 /// `files` in words: the first ten names and how many more.
 pub fn file_list(files: &[String]) -> String {
-    let mut words = files
-        .iter()
-        .take(LISTED_FILES)
-        .cloned()
-        .collect::<Vec<_>>()
-        .join(", ");
-    if files.len() > LISTED_FILES {
-        words += &format!(" and {} more", files.len() - LISTED_FILES);
-    }
-    words
+    crate::fmt::first_of(files, LISTED_FILES, "")
 }
 
 /// Check that a job of `command` may write into `dir` before it computes anything: the directory can be
