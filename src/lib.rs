@@ -21,8 +21,8 @@
 //! | the hybrid walk: phases, events, the DLS-indicator impact procedure | [`walk`], [`walk::impact`] |
 //! | exact derivatives of the step map: variational equations, saltation matrices | [`variational`] |
 //! | reference problems with known answers, the default start | [`reference`](mod@reference) |
-//! | step map, its exact derivatives, gaits (period 1 and k), Floquet multipliers, natural continuation | [`gait`] |
-//! | the wheel's gait as a function of one parameter (its step map as a family) | [`family`] |
+//! | step map, its exact derivatives, gaits (period 1 and k), Floquet multipliers | [`gait`] |
+//! | the wheel's gait as a function of one parameter: its step map as a family, natural continuation | [`family`] |
 //! | studies over parameters: the grid runner, sweeps, thresholds, maps and their curves, orbits, basins | [`study`] |
 //! | tables and figures | [`output`] |
 //! | the command-line jobs | [`app`] |
@@ -49,7 +49,9 @@
 //!   [`reference::default_initial`].
 //! - **The gait**: the step map [`gait::StepMap`]; [`gait::find_gait`] with [`gait::GaitOptions`], giving a
 //!   [`gait::Gait`] (or a [`gait::GaitError`]); period-k gaits [`gait::find_periodic_gait`] and
-//!   [`gait::find_gait_any_period`]; families of gaits by natural continuation [`gait::continuation`].
+//!   [`gait::find_gait_any_period`].
+//! - **Families of gaits**: the step map as a family in one parameter [`family::GaitFamily`] (for the engine
+//!   below), and the verified natural continuation the sweeps use, [`family::natural`].
 //! - **Studies over parameters**: sweeps [`study::sweep()`] over a [`study::SweepSpec`] and their thresholds
 //!   [`study::find_thresholds`]; two-parameter maps [`study::map_gaits`] and [`study::map_curves()`]; orbit
 //!   diagrams [`study::orbit::orbit_diagram`]; basins of attraction [`study::basin::basin`].

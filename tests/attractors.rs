@@ -5,7 +5,7 @@ use std::path::Path;
 
 use vrw::app::{run_basin, run_orbit, BasinJob, OrbitJob};
 use vrw::dynamics::Model;
-use vrw::gait::continuation::section_distance;
+use vrw::family::natural::section_distance;
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::reference::default_initial;

@@ -16,7 +16,7 @@ const P2_RESIDUAL_TOL: f64 = 1e-10;
 const DISTINCT: f64 = 1e-3;
 
 fn distance(a: &SectionState, b: &SectionState) -> f64 {
-    vrw::gait::continuation::section_distance(a, b)
+    vrw::family::natural::section_distance(a, b)
 }
 
 /// The reference parameters with a period-2 gait and their model.

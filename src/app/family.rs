@@ -19,8 +19,8 @@ use crate::continuation::Curve;
 use crate::continuation::{
     continue_family, ContinuationError, ContinuationOptions, Family, FamilyEnd, FamilyMap,
 };
+use crate::family::natural::{EndCause, GaitPoint, NaturalContinuation};
 use crate::family::{GaitFamily, GaitInfo};
-use crate::gait::continuation::{Continuation, EndCause, FamilyPoint as GaitPoint};
 use crate::gait::MAX_PERIOD;
 use crate::gait::{find_gait_any_period, find_periodic_gait, GaitOptions, Stability, StepMap};
 use crate::params::Config;
@@ -484,7 +484,7 @@ fn continuation_error(e: ContinuationError, param: &str) -> AppError {
     }
 }
 
-/// What the walk from the last gait does just past an end where the map failed ([`Continuation::end_cause`]).
+/// What the walk from the last gait does just past an end where the map failed (`NaturalContinuation::end_cause`).
 fn end_cause(
     config: &Config,
     param: &str,
@@ -507,7 +507,7 @@ fn end_cause(
         .find(|p| p.param == *at)
         .or(family.points.last())?;
     let continuation =
-        Continuation::new(config, param, &GaitOptions::default()).with_period(map.period());
+        NaturalContinuation::new(config, param, &GaitOptions::default()).with_period(map.period());
     Some(continuation.end_cause(
         &GaitPoint {
             value: last.param,

@@ -5,8 +5,8 @@ use serde::Serialize;
 
 use crate::continuation::special::Side;
 use crate::continuation::{FamilyEnd, SpecialKind, SpecialPoint};
+use crate::family::natural::EndCause;
 use crate::family::{GaitFamily, GaitInfo};
-use crate::gait::continuation::EndCause;
 use crate::gait::Stability;
 
 /// How a family ends at one side, with the physical cause found by walking just past it.

@@ -9,8 +9,8 @@ use crate::continuation::{
     continue_family, switch_at_border, switch_at_period_doubling, ContinuationOptions, Family,
     FamilyEnd, FamilyMap, SpecialKind,
 };
+use crate::family::natural::EndCause;
 use crate::family::{GaitFamily, GaitInfo};
-use crate::gait::continuation::EndCause;
 
 /// A family being followed: where it came from, its map and its ends with their causes.
 pub(super) struct Followed<'a> {

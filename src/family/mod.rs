@@ -3,6 +3,9 @@
 //! ([`StepMap::eval_with_derivatives`]), the DLS indicators as the borders between its smooth pieces, and the
 //! event sequence of the step as the piece.
 
+pub(crate) mod end_search;
+pub mod natural;
+
 use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DMatrix, DVector};

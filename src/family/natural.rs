@@ -5,14 +5,14 @@
 //! at `v1` to some `s1` **and** Newton's method from `s1` back at `v0` returns to `s0` (within `SAME_GAIT_TOL`).
 //! The second condition is what keeps a step from silently jumping to another gait family (two gaits coexist,
 //! or the family folds between `v0` and `v1`): a jump is not reversible. The way back is answered after one
-//! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`Continuation::first_newton_step`).
+//! Newton step where that step lands within `EARLY_RETURN_TOL` of `s0` (`NaturalContinuation::first_newton_step`).
 //! A step that fails is halved (and the step after a failure that works halves the next, which bisects toward
 //! an end), so a family is followed in shrinking steps until it is reached or its end is bracketed to
 //! `PARAM_TOL`; where the wheel is about to roll back at the end, or a DLS indicator vanishes there, the end is
 //! extrapolated instead (`end_search.rs`). Where Newton's method fails at the finest step, or
 //! `WALK_AFTER_FAILURES` times in a row (and every `WALK_AFTER_FAILURES` failures after that), steps are also
-//! tried by walking instead (`Continuation::walk_step`), since the step map is only piecewise smooth. A family
-//! of period-k gaits is followed the same way, as fixed points of `P^k` (`Continuation::with_period`).
+//! tried by walking instead (`NaturalContinuation::walk_step`), since the step map is only piecewise smooth. A family
+//! of period-k gaits is followed the same way, as fixed points of `P^k` (`NaturalContinuation::with_period`).
 //!
 //! **Predictor.** Each step starts Newton's method from the gait carried along the family's tangent `ds*/dp`
 //! (`Tangent`): given with the first point (`-(DP - I)^-1 dP/dp` from its exact derivatives), then the secant
@@ -20,7 +20,7 @@
 //! iterations there and back; a step whose predicted start fails is tried again from the point itself: at the
 //! finest step, whose failure ends the family, with Newton's method damped to the end as without a predictor;
 //! on a longer step as a quick test (the step is halved if it fails). Period-1 families only (see
-//! `Continuation::step_predicted`).
+//! `NaturalContinuation::step_predicted`).
 //!
 //! Where a family ends, the cause is looked for just past the end: the wheel is walked from the last gait of the
 //! family at the first parameter value it does not reach (`END_WALK_STEPS` steps). The walk fails (falls,
@@ -31,18 +31,20 @@
 use nalgebra::DMatrix;
 use serde::Serialize;
 
-use super::derivative::newton_jacobian;
 use super::end_search::{gauges, EndSearch, Gauges};
-use super::limit_cycle::{solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitOptions};
-pub(crate) use super::periodicity::SAME_GAIT_TOL;
-use super::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
-use super::step_map::StepMap;
 use crate::dynamics::Model;
+use crate::gait::derivative::newton_jacobian;
+use crate::gait::limit_cycle::{
+    solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitOptions,
+};
+pub(crate) use crate::gait::periodicity::SAME_GAIT_TOL;
+use crate::gait::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
+use crate::gait::step_map::StepMap;
 use crate::params::Config;
 use crate::walk::{SectionState, Walker, SECTION_COORDINATES};
 
 /// The way back of a continuation step ends early where the first step of Newton's method lands this close to
-/// the gait the step came from (`Continuation::first_newton_step`): a tenth of [`SAME_GAIT_TOL`].
+/// the gait the step came from (`NaturalContinuation::first_newton_step`): a tenth of [`SAME_GAIT_TOL`].
 const EARLY_RETURN_TOL: f64 = 1e-7;
 
 /// Tolerance of every threshold in the swept parameter.
@@ -54,13 +56,13 @@ pub(crate) const STEP_NEWTON_ITERATIONS: usize = 8;
 /// Steps a walk may take to settle on a gait in a continuation step by walking.
 pub(crate) const SETTLE_STEPS: usize = 200;
 
-/// Most steps one [`Continuation::follow`] may try by walking (each walks up to twice [`SETTLE_STEPS`] steps):
+/// Most steps one [`NaturalContinuation::follow`] may try by walking (each walks up to twice [`SETTLE_STEPS`] steps):
 /// where only walking carries the family on, it is given up after these, as after [`MAX_FOLLOW_STEPS`].
 pub(crate) const MAX_FOLLOW_WALKS: usize = 60;
 
 /// A walk has settled when two successive section states differ by less than this.
 pub(crate) const SETTLE_TOL: f64 = 1e-11;
-/// Most continuation steps (verified or failed) one [`Continuation::follow`] may try. Following a family to a
+/// Most continuation steps (verified or failed) one [`NaturalContinuation::follow`] may try. Following a family to a
 /// neighbouring value, or to its end bracketed to [`PARAM_TOL`], takes a few dozen; approaching an end where
 /// the steps Newton's method takes shrink with the distance to it (the wheel about to roll back, e.g. at
 /// `k = 761.311033 N/m` for `c = 50`) takes about four steps per halving, 100 to 150 from a grid interval of
@@ -69,7 +71,7 @@ pub(crate) const SETTLE_TOL: f64 = 1e-11;
 pub(crate) const MAX_FOLLOW_STEPS: usize = 200;
 
 /// After Newton's method fails this many continuation steps in a row (each half the one before), steps are
-/// also tried by walking ([`Continuation::walk_step`]): near a border of the map's smooth pieces (a DLS
+/// also tried by walking ([`NaturalContinuation::walk_step`]): near a border of the map's smooth pieces (a DLS
 /// indicator near zero) the map's pieces differ across the border and Newton's method fails at every step
 /// length, while the walk follows the stable gait.
 ///
@@ -91,9 +93,9 @@ pub fn section_distance(a: &SectionState, b: &SectionState) -> f64 {
 }
 
 /// Follows gait families of one configuration along one parameter: fixed points of the step map `P`, or of
-/// `P^k` for a family of period-k gaits ([`Continuation::with_period`]).
+/// `P^k` for a family of period-k gaits ([`NaturalContinuation::with_period`]).
 #[derive(Debug, Clone)]
-pub(crate) struct Continuation<'a> {
+pub(crate) struct NaturalContinuation<'a> {
     config: &'a Config,
     param: &'a str,
     options: GaitOptions,
@@ -101,13 +103,13 @@ pub(crate) struct Continuation<'a> {
     period: usize,
 }
 
-/// The gait `from` of a family in `param` of `config` as a start at `value` (see `Continuation::start_from`):
+/// The gait `from` of a family in `param` of `config` as a start at `value` (see `NaturalContinuation::start_from`):
 /// its section state, or, where `param` is `min_length` and Leg 2 is held at its compression stop there, the
 /// state held at the stop of `value`.
 pub(crate) fn carried_start(
     config: &Config,
     param: &str,
-    from: &FamilyPoint,
+    from: &GaitPoint,
     value: f64,
 ) -> SectionState {
     if param != "min_length" {
@@ -125,7 +127,7 @@ pub(crate) fn carried_start(
 
 /// A point of a family: the parameter value and the gait's section state there.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FamilyPoint {
+pub struct GaitPoint {
     /// The parameter value.
     pub value: f64,
     /// The fixed point of the step map.
@@ -145,7 +147,7 @@ pub(crate) struct Tangent {
 impl Tangent {
     /// The secant of a verified step from `a` to `b`, or `None` where the two sections differ in kind (one
     /// slips and the other does not: the coordinates do not carry over).
-    fn secant(a: &FamilyPoint, b: &FamilyPoint) -> Option<Tangent> {
+    fn secant(a: &GaitPoint, b: &GaitPoint) -> Option<Tangent> {
         let dp = b.value - a.value;
         (a.section.slips() == b.section.slips() && dp != 0.0).then(|| Tangent {
             at: b.value,
@@ -157,7 +159,7 @@ impl Tangent {
 
     /// The start at `value` predicted from `from` (where the tangent holds, and the state stays of its kind:
     /// a tip at rest is not set slipping); `None` elsewhere.
-    fn predict(&self, from: &FamilyPoint, value: f64) -> Option<SectionState> {
+    fn predict(&self, from: &GaitPoint, value: f64) -> Option<SectionState> {
         if self.at != from.value {
             return None;
         }
@@ -178,14 +180,14 @@ impl Tangent {
 
 /// Where following a family led.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Followed {
+pub enum FollowOutcome {
     /// The family reaches the target value.
-    Reached(FamilyPoint),
+    Reached(GaitPoint),
     /// The family ends between `last.value` and `beyond` (`|beyond - last.value| <= PARAM_TOL`, or the
     /// tolerance the coarse pass of a sweep gives, one grid interval).
     Ended {
         /// The last point of the family.
-        last: FamilyPoint,
+        last: GaitPoint,
         /// The first value it does not reach.
         beyond: f64,
     },
@@ -193,7 +195,7 @@ pub enum Followed {
     /// followed to `last` and given up there.
     GaveUp {
         /// The last point of the family reached.
-        last: FamilyPoint,
+        last: GaitPoint,
         /// The value being followed to.
         target: f64,
     },
@@ -203,7 +205,7 @@ pub enum Followed {
 /// its end is extrapolated from: [`EndSearch`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Verified {
-    point: FamilyPoint,
+    point: GaitPoint,
     gauges: Option<Gauges>,
 }
 
@@ -251,14 +253,14 @@ pub enum EndCause {
     },
 }
 
-impl<'a> Continuation<'a> {
-    /// Continuation of `param` in `config`, with Newton settings from `options`.
+impl<'a> NaturalContinuation<'a> {
+    /// NaturalContinuation of `param` in `config`, with Newton settings from `options`.
     pub(crate) fn new(
         config: &'a Config,
         param: &'a str,
         options: &GaitOptions,
-    ) -> Continuation<'a> {
-        Continuation {
+    ) -> NaturalContinuation<'a> {
+        NaturalContinuation {
             config,
             param,
             options: GaitOptions {
@@ -272,8 +274,8 @@ impl<'a> Continuation<'a> {
     }
 
     /// The same continuation for a family of period-`k` gaits: fixed points of `P^k` (`k = 0` is taken as 1).
-    pub(crate) fn with_period(self, k: usize) -> Continuation<'a> {
-        Continuation {
+    pub(crate) fn with_period(self, k: usize) -> NaturalContinuation<'a> {
+        NaturalContinuation {
             period: k.max(1),
             ..self
         }
@@ -293,7 +295,7 @@ impl<'a> Continuation<'a> {
     /// parameter is `min_length` and Leg 2 is held at its compression stop there, it is held at the stop of
     /// `value` (`L2 = value`, `dL2/dt = 0`): the stop moves with the parameter and the held leg with it (the
     /// section state at the old stop would be below the new one, or off it).
-    fn start_from(&self, from: &FamilyPoint, value: f64) -> SectionState {
+    fn start_from(&self, from: &GaitPoint, value: f64) -> SectionState {
         carried_start(self.config, self.param, from, value)
     }
 
@@ -316,22 +318,22 @@ impl<'a> Continuation<'a> {
     /// documentation).
     pub(crate) fn step(
         &self,
-        from: &FamilyPoint,
+        from: &GaitPoint,
         value: f64,
         guess: Option<&DMatrix<f64>>,
-    ) -> Option<FamilyPoint> {
+    ) -> Option<GaitPoint> {
         self.step_asking(from, value, guess, false)
             .ok()
             .map(|v| v.point)
     }
 
-    /// [`Continuation::step_asking`] from the start `tangent` predicts (see the module documentation), and
+    /// [`NaturalContinuation::step_asking`] from the start `tangent` predicts (see the module documentation), and
     /// from the plain start where that fails or no prediction is made. `undamped` as for
-    /// [`Continuation::step_asking`]; `finest`: the step is the shortest [`Continuation::follow_to`] takes (its
+    /// [`NaturalContinuation::step_asking`]; `finest`: the step is the shortest [`NaturalContinuation::follow_to`] takes (its
     /// failure would end the family).
     fn step_predicted(
         &self,
-        from: &FamilyPoint,
+        from: &GaitPoint,
         value: f64,
         (guess, tangent): (Option<&DMatrix<f64>>, Option<&Tangent>),
         (undamped, finest): (bool, bool),
@@ -366,12 +368,12 @@ impl<'a> Continuation<'a> {
         self.step_asking(from, value, guess, plain_undamped)
     }
 
-    /// [`Continuation::step`], failing with [`StepFailure::Start`] where the walk from `from`'s gait at `value`
+    /// [`NaturalContinuation::step`], failing with [`StepFailure::Start`] where the walk from `from`'s gait at `value`
     /// fails (whatever the Newton matrix), else with [`StepFailure::Newton`]; `undamped`: Newton's method fails
     /// as soon as it must damp a step taken with `DP` at its iterate ([`solve_fixed_point_asking`]).
     fn step_asking(
         &self,
-        from: &FamilyPoint,
+        from: &GaitPoint,
         value: f64,
         guess: Option<&DMatrix<f64>>,
         undamped: bool,
@@ -384,7 +386,7 @@ impl<'a> Continuation<'a> {
     /// the start `back` predicts from the point reached (else that point itself).
     fn step_from(
         &self,
-        from: &FamilyPoint,
+        from: &GaitPoint,
         value: f64,
         (guess, undamped): (Option<&DMatrix<f64>>, bool),
         (start, back): (SectionState, Option<&Tangent>),
@@ -407,7 +409,7 @@ impl<'a> Continuation<'a> {
                 StepFailure::Start
             }
         })?;
-        let reached = FamilyPoint {
+        let reached = GaitPoint {
             value,
             section: forward.section,
         };
@@ -465,14 +467,14 @@ impl<'a> Continuation<'a> {
     /// The same step by walking, where Newton's method fails (the step map is only piecewise smooth): the wheel
     /// walked from the gait at `value` settles on a gait, and walked from that one at `from.value` comes back to
     /// `from` (a stable family followed the way an experiment would).
-    pub(crate) fn walk_step(&self, from: &FamilyPoint, value: f64) -> Option<FamilyPoint> {
+    pub(crate) fn walk_step(&self, from: &GaitPoint, value: f64) -> Option<GaitPoint> {
         let forward = self.settle(value, &self.start_from(from, value))?;
-        let reached = FamilyPoint {
+        let reached = GaitPoint {
             value,
             section: forward,
         };
         let back = self.settle(from.value, &self.start_from(&reached, from.value))?;
-        (back.distance(&from.section) <= SAME_GAIT_TOL).then_some(FamilyPoint {
+        (back.distance(&from.section) <= SAME_GAIT_TOL).then_some(GaitPoint {
             value,
             section: forward,
         })
@@ -500,7 +502,7 @@ impl<'a> Continuation<'a> {
 
     /// `DP` (`D(P^k)` for a period-k family; exact, or a central difference where the map is not
     /// differentiable) of the gait `at`.
-    fn jacobian(&self, at: &FamilyPoint) -> Option<DMatrix<f64>> {
+    fn jacobian(&self, at: &GaitPoint) -> Option<DMatrix<f64>> {
         let (c, model) = self.configured_at(at.value).ok()?;
         // On the section of `at` where its stance tip slips (Coulomb friction): the slip is a coordinate there.
         let map = StepMap::new(&model, &c.solver)
@@ -518,26 +520,26 @@ impl<'a> Continuation<'a> {
     /// step that works lets the next one double, or halve right after a failure (bisecting toward the end),
     /// unless the end is extrapolated from the gaits' smallest `dtheta/dt` or DLS indicators ([`EndSearch`]).
     /// At most [`MAX_FOLLOW_STEPS`] steps, [`MAX_FOLLOW_WALKS`] of them by walking, are tried
-    /// ([`Followed::GaveUp`]).
+    /// ([`FollowOutcome::GaveUp`]).
     pub(crate) fn follow(
         &self,
-        from: FamilyPoint,
+        from: GaitPoint,
         target: f64,
         known: (Option<&DMatrix<f64>>, Option<Tangent>),
-    ) -> Followed {
+    ) -> FollowOutcome {
         self.follow_to(from, target, known, PARAM_TOL)
     }
 
-    /// [`Continuation::follow`] with the family's end bracketed to `end_tol` instead of [`PARAM_TOL`] (the
+    /// [`NaturalContinuation::follow`] with the family's end bracketed to `end_tol` instead of [`PARAM_TOL`] (the
     /// coarse pass of a split row needs it only to a grid interval), and the family's tangent at `from` if
     /// known (the predictor of the first step; the secant of the last verified step after that).
     pub(crate) fn follow_to(
         &self,
-        from: FamilyPoint,
+        from: GaitPoint,
         target: f64,
         (guess, tangent): (Option<&DMatrix<f64>>, Option<Tangent>),
         end_tol: f64,
-    ) -> Followed {
+    ) -> FollowOutcome {
         let mut tangent = tangent;
         let mut current = from;
         let mut steps = 0;
@@ -555,10 +557,10 @@ impl<'a> Continuation<'a> {
         loop {
             let remaining = target - current.value;
             if remaining == 0.0 {
-                return Followed::Reached(current);
+                return FollowOutcome::Reached(current);
             }
             if steps == MAX_FOLLOW_STEPS || walks == MAX_FOLLOW_WALKS {
-                return Followed::GaveUp {
+                return FollowOutcome::GaveUp {
                     last: current,
                     target,
                 };
@@ -637,7 +639,7 @@ impl<'a> Continuation<'a> {
                     failed_before = false;
                 }
                 None if at_end => {
-                    return Followed::Ended {
+                    return FollowOutcome::Ended {
                         last: current,
                         beyond: next_value,
                     }
@@ -653,7 +655,7 @@ impl<'a> Continuation<'a> {
 
     /// The longest step of the gait `at` \[s\] (of the `k` steps of a period-k gait); `None` where the walk
     /// fails.
-    pub(crate) fn longest_step(&self, at: &FamilyPoint) -> Option<f64> {
+    pub(crate) fn longest_step(&self, at: &GaitPoint) -> Option<f64> {
         let (c, model) = self.configured_at(at.value).ok()?;
         let map = StepMap::new(&model, &c.solver).iterated(self.period);
         let walked = map.eval_signature(&at.section).ok()?;
@@ -661,7 +663,7 @@ impl<'a> Continuation<'a> {
     }
 
     /// The real Floquet multiplier closest to +1 of the gait `at`.
-    fn near_fold(&self, at: &FamilyPoint) -> Option<f64> {
+    fn near_fold(&self, at: &GaitPoint) -> Option<f64> {
         self.jacobian(at)?
             .complex_eigenvalues()
             .iter()
@@ -671,14 +673,14 @@ impl<'a> Continuation<'a> {
     }
 
     /// The largest modulus of the Floquet multipliers of the gait `at` (`None` where `DP` cannot be had).
-    pub(crate) fn largest_multiplier(&self, at: &FamilyPoint) -> Option<f64> {
+    pub(crate) fn largest_multiplier(&self, at: &GaitPoint) -> Option<f64> {
         let moduli = self.jacobian(at)?.complex_eigenvalues().map(|z| z.norm());
         Some(moduli.iter().copied().fold(0.0, f64::max))
     }
 
     /// What happens at `beyond`, just past the end of the family whose last gait is `last`: walk from it (see
     /// [`EndCause`]).
-    pub(crate) fn end_cause(&self, last: &FamilyPoint, beyond: f64) -> EndCause {
+    pub(crate) fn end_cause(&self, last: &GaitPoint, beyond: f64) -> EndCause {
         let (c, model) = match self.configured_at(beyond) {
             Ok(x) => x,
             Err(message) => {
@@ -777,12 +779,12 @@ mod tests {
 
     /// The default family in `viscosity` (it ends where the wheel rolls back, near `c = 135.489237`) and a
     /// continuation of it.
-    fn family_at(config: &Config, c: f64) -> (FamilyPoint, Option<DMatrix<f64>>) {
+    fn family_at(config: &Config, c: f64) -> (GaitPoint, Option<DMatrix<f64>>) {
         let at = config.with("viscosity", c).unwrap();
         let model = Model::new(&at.params).unwrap();
         let map = StepMap::new(&model, &at.solver);
         let g = find_gait(&map, &default_initial(&at), &GaitOptions::default(), None).unwrap();
-        let point = FamilyPoint {
+        let point = GaitPoint {
             value: c,
             section: g.section,
         };
@@ -794,9 +796,9 @@ mod tests {
     #[test]
     fn a_coarse_end_tolerance_brackets_the_same_end() {
         let config = Config::default();
-        let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
+        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default());
         let (from, guess) = family_at(&config, 131.0);
-        let Followed::Ended { last, beyond } =
+        let FollowOutcome::Ended { last, beyond } =
             cont.follow_to(from, 141.0, (guess.as_ref(), None), 1.0)
         else {
             panic!("the family ends before 141");
@@ -806,7 +808,7 @@ mod tests {
             "{last:?} {beyond}"
         );
         let (near, guess) = family_at(&config, 135.0);
-        let Followed::Ended {
+        let FollowOutcome::Ended {
             last: fine,
             beyond: fine_beyond,
         } = cont.follow(near, 136.0, (guess.as_ref(), None))
@@ -823,7 +825,7 @@ mod tests {
     #[test]
     fn steps_tell_a_failing_start_from_a_failing_newton() {
         let config = Config::default();
-        let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
+        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default());
         let (from, guess) = family_at(&config, 135.0);
         let beyond = cont.step_asking(&from, 137.0, guess.as_ref(), false);
         assert_eq!(beyond, Err(StepFailure::Start));
@@ -870,7 +872,7 @@ mod tests {
     #[test]
     fn the_way_back_ends_early_only_on_the_gait_it_came_from() {
         let config = Config::default();
-        let cont = Continuation::new(&config, "viscosity", &GaitOptions::default());
+        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default());
         let (from, guess) = family_at(&config, 50.0);
         let reached = cont
             .step(&from, 51.0, guess.as_ref())
@@ -912,7 +914,7 @@ mod tests {
         config.apply_override("friction=0.105").unwrap();
         let (from, guess) = family_at(&config, 50.0);
         assert!(from.section.slips() && guess.is_some());
-        let cont = Continuation::new(&config, "viscosity", &GaitOptions::for_sweeps());
+        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::for_sweeps());
         let j = cont.jacobian(&from).expect("DP at a slipping gait");
         assert_eq!((j.nrows(), j.ncols()), (4, 4));
         assert!(cont

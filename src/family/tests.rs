@@ -12,7 +12,7 @@ fn of_kind<I>(family: &Family<I>, kind: SpecialKind) -> Vec<&SpecialPoint<I>> {
 }
 
 use crate::dynamics::Model;
-use crate::gait::continuation::{Continuation, FamilyPoint as GaitPoint, Followed};
+use crate::family::natural::{FollowOutcome, GaitPoint, NaturalContinuation};
 use crate::gait::{find_gait, GaitOptions, StepMap};
 use crate::params::Config;
 use crate::reference::default_initial;
@@ -62,7 +62,7 @@ fn default_family_ends_where_the_sweep_ends() {
     let FamilyEnd::Ended { param, beyond, .. } = family.ends[1].clone() else {
         panic!("{:?}", family.ends);
     };
-    let natural = Continuation::new(&config, "viscosity", &GaitOptions::default()).follow(
+    let natural = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default()).follow(
         GaitPoint {
             value: 130.0,
             section,
@@ -70,7 +70,7 @@ fn default_family_ends_where_the_sweep_ends() {
         140.0,
         (None, None),
     );
-    let Followed::Ended { last, .. } = natural else {
+    let FollowOutcome::Ended { last, .. } = natural else {
         panic!("{natural:?}");
     };
     assert!((param - last.value).abs() < 1e-6, "{param} {}", last.value);
@@ -131,7 +131,7 @@ fn dls_family_ends_at_a_border_collision() {
     let bc = bc[0];
     assert_eq!(bc.border.as_deref(), Some("lambda_2_plus"));
     assert!(bc.located && bc.test_value.abs() < 1e-6);
-    let natural = Continuation::new(&config, "stiffness", &GaitOptions::default()).follow(
+    let natural = NaturalContinuation::new(&config, "stiffness", &GaitOptions::default()).follow(
         GaitPoint {
             value: 590.0,
             section,
@@ -139,7 +139,7 @@ fn dls_family_ends_at_a_border_collision() {
         600.0,
         (None, None),
     );
-    let Followed::Ended { last, beyond } = natural else {
+    let FollowOutcome::Ended { last, beyond } = natural else {
         panic!("{natural:?}");
     };
     assert!(
@@ -187,7 +187,7 @@ fn border_curve_agrees_with_the_one_parameter_end() {
     let at4 = curve_at_p2(&problem, &curve, 4.0, &curve_options).expect("the curve crosses c = 4");
     // Natural continuation along the stiffness at c = 4, as a sweep does.
     let (config4, section4) = vrw_gait(&[("viscosity", 4.0), ("stiffness", 560.0)]);
-    let natural = Continuation::new(&config4, "stiffness", &GaitOptions::default()).follow(
+    let natural = NaturalContinuation::new(&config4, "stiffness", &GaitOptions::default()).follow(
         GaitPoint {
             value: 560.0,
             section: section4,
@@ -195,7 +195,7 @@ fn border_curve_agrees_with_the_one_parameter_end() {
         570.0,
         (None, None),
     );
-    let Followed::Ended { last, beyond } = natural else {
+    let FollowOutcome::Ended { last, beyond } = natural else {
         panic!("{natural:?}");
     };
     assert!(

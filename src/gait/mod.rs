@@ -1,11 +1,9 @@
-//! Gait analysis (docs/model.md section 6): the step map and its exact derivatives, its fixed points (limit
-//! cycles, period-k gaits) and their stability, and the verified natural continuation of a gait in one
-//! parameter. The studies built on them (sweeps, thresholds, maps, orbit diagrams, basins) are in
-//! [`crate::study`].
+//! Gait analysis (docs/model.md section 6): the step map and its exact derivatives, and its fixed points
+//! (limit cycles, period-k gaits) with their stability. A gait as a function of one parameter (the natural and
+//! the pseudo-arclength continuation) is in [`crate::family`], the studies built on them (sweeps, thresholds,
+//! maps, orbit diagrams, basins) in [`crate::study`].
 
-pub mod continuation;
 pub(crate) mod derivative;
-pub(crate) mod end_search;
 pub(crate) mod limit_cycle;
 pub mod options;
 pub mod period_k;

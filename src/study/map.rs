@@ -290,7 +290,7 @@ pub struct NearMiss {
 /// A continued curve agrees with the lines' refined thresholds when none differs by more than this: a line's
 /// threshold is the middle of a bracket at most `PARAM_TOL` wide, and the curve lies `offset / |grad border|`
 /// (about `1e-7`) from the border.
-pub const LINE_CHECK_TOL: f64 = 2.0 * crate::gait::continuation::PARAM_TOL;
+pub const LINE_CHECK_TOL: f64 = 2.0 * crate::family::natural::PARAM_TOL;
 
 /// A 1-D threshold of a row or a column.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -1,7 +1,7 @@
 //! Parameter sweeps with continuation (docs/model.md section 6, the paper's Fig. 2).
 //!
 //! Every point follows its neighbour's gait family in verified continuation steps (see
-//! [`crate::gait::continuation`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach
+//! [`crate::family::natural`]), with the neighbour's `DP` as the Newton matrix. A point the family does not reach
 //! is searched from the sweep's initial state with a full transient, and so are the points after it until a gait
 //! is found again. Gaits found that way are then followed backwards to fill in points the search from the
 //! initial state missed, and every gait gets a family number: points of one family are connected by
@@ -21,8 +21,8 @@ use serde::Serialize;
 
 use super::grid::{run_rows_part, Evaluated};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
+use crate::family::natural::{FollowOutcome, GaitPoint, NaturalContinuation, Tangent, PARAM_TOL};
 use crate::fmt::short;
-use crate::gait::continuation::{Continuation, FamilyPoint, Followed, Tangent, PARAM_TOL};
 use crate::gait::limit_cycle::{gait_at_converged, solve_fixed_point, Gait, GaitOptions};
 use crate::gait::period_k::{find_gait_any_period, periodic_gait_at};
 use crate::gait::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
@@ -143,7 +143,7 @@ pub struct SweepPoint {
     /// The gait, if found.
     pub gait: Option<Gait>,
     /// Index of the sweep point this gait was continued from (verified from both sides, see
-    /// [`crate::gait::continuation`]); `None` if it was found from the sweep's initial state.
+    /// [`crate::family::natural`]); `None` if it was found from the sweep's initial state.
     #[serde(skip)]
     pub continued_from: Option<usize>,
     /// Gait family: points with the same number are connected by continuation; numbered from 0 in parameter
@@ -157,23 +157,23 @@ pub struct SweepPoint {
 }
 
 /// A continuation that did not reach its target: where it started, where it was going and where it led (the
-/// family's end bracketed to `PARAM_TOL`, or given up). `Continuation::follow` is a
+/// family's end bracketed to `PARAM_TOL`, or given up). `NaturalContinuation::follow` is a
 /// deterministic function of its start, target and Newton matrix, so a threshold search that would follow the
 /// same family from the same start to the same target takes this result as it is.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FollowAttempt {
     /// The gait followed from.
-    pub from: FamilyPoint,
+    pub from: GaitPoint,
     /// The value followed to.
     pub target: f64,
-    /// Where it led (never [`Followed::Reached`]).
-    pub followed: Followed,
+    /// Where it led (never [`FollowOutcome::Reached`]).
+    pub followed: FollowOutcome,
 }
 
 impl SweepPoint {
     /// The recorded continuation toward this point from `from` (same value and bitwise the same section state),
     /// if there is one.
-    pub(crate) fn attempt_from(&self, from: &FamilyPoint) -> Option<&Followed> {
+    pub(crate) fn attempt_from(&self, from: &GaitPoint) -> Option<&FollowOutcome> {
         self.attempts
             .iter()
             .find(|a| a.from == *from && a.target == self.value)
@@ -190,7 +190,7 @@ pub(crate) struct Previous<'a> {
     pub value: f64,
     /// The gait.
     pub gait: &'a Gait,
-    /// How closely a family end met on the way is bracketed ([`Continuation::follow_to`]).
+    /// How closely a family end met on the way is bracketed ([`NaturalContinuation::follow_to`]).
     pub end_tol: f64,
 }
 
@@ -303,7 +303,7 @@ fn with_swept_parameter(options: &GaitOptions, param: &str) -> GaitOptions {
 }
 
 /// The gait at `value` of the family of `g`, the gait at `from`: the family followed in verified steps
-/// ([`Continuation::follow`]), then the full gait (with `DP`) where it lands. If the family does not reach
+/// ([`NaturalContinuation::follow`]), then the full gait (with `DP`) where it lands. If the family does not reach
 /// `value`, the attempt (for [`SweepPoint::attempts`]); `Err(None)` if it reaches it but the gait there cannot be
 /// completed.
 fn follow_gait(
@@ -316,14 +316,14 @@ fn follow_gait(
     end_tol: f64,
 ) -> Result<Gait, Option<FollowAttempt>> {
     let guess = g.jacobian_guess();
-    let start = FamilyPoint {
+    let start = GaitPoint {
         value: from,
         section: g.section,
     };
-    let cont = Continuation::new(config, param, options).with_period(g.period_k);
+    let cont = NaturalContinuation::new(config, param, options).with_period(g.period_k);
     let tangent = family_tangent(config, param, from, g);
     let p = match cont.follow_to(start, value, (guess.as_ref(), tangent), end_tol) {
-        Followed::Reached(p) => p,
+        FollowOutcome::Reached(p) => p,
         followed => {
             return Err(Some(FollowAttempt {
                 from: start,
@@ -418,11 +418,11 @@ pub(crate) fn number_families(
         if ga.period_k != gb.period_k {
             continue;
         }
-        let start = FamilyPoint {
+        let start = GaitPoint {
             value: a.value,
             section: ga.section,
         };
-        let connected = Continuation::new(config, param, options)
+        let connected = NaturalContinuation::new(config, param, options)
             .with_period(ga.period_k)
             .step(&start, b.value, ga.jacobian_guess().as_ref())
             .is_some_and(|p| p.section.distance(&gb.section) <= SAME_GAIT_TOL);

@@ -7,7 +7,7 @@
 //! Sign changes between neighbouring sweep points of one gait family are refined by Brent's method (the `roots`
 //! crate) on the indicator of the gait continued from the left neighbour, to [`PARAM_TOL`] in the parameter.
 //! Ends of families are followed in verified continuation steps to [`PARAM_TOL`] and their physical cause is
-//! looked for just past the end ([`crate::gait::continuation`]):
+//! looked for just past the end ([`crate::family::natural`]):
 //!
 //! | threshold | where |
 //! |---|---|
@@ -28,8 +28,10 @@ use serde::Serialize;
 
 use super::sweep::{family_tangent, SweepPoint, SweepSpec};
 use crate::dynamics::Model;
-pub(crate) use crate::gait::continuation::PARAM_TOL;
-use crate::gait::continuation::{carried_start, Continuation, EndCause, FamilyPoint, Followed};
+pub(crate) use crate::family::natural::PARAM_TOL;
+use crate::family::natural::{
+    carried_start, EndCause, FollowOutcome, GaitPoint, NaturalContinuation,
+};
 use crate::gait::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use crate::gait::periodicity::SAME_GAIT_TOL;
 use crate::gait::step_map::StepMap;
@@ -305,7 +307,7 @@ fn vanishing_at_end(
     config: &Config,
     spec: &SweepSpec,
     from: &SweepPoint,
-    last: &FamilyPoint,
+    last: &GaitPoint,
     end: &Threshold,
 ) -> Vec<Threshold> {
     let Some(g) = from.gait.as_ref() else {
@@ -363,8 +365,8 @@ fn refine_end(
     gait_before: bool,
 ) -> Vec<Threshold> {
     let g = from.gait.as_ref().expect("an end starts at a gait");
-    let cont = Continuation::new(config, &spec.param, options).with_period(g.period_k);
-    let start = FamilyPoint {
+    let cont = NaturalContinuation::new(config, &spec.param, options).with_period(g.period_k);
+    let start = GaitPoint {
         value: from.value,
         section: g.section,
     };
@@ -381,8 +383,8 @@ fn refine_end(
         }
     };
     let (last, beyond) = match followed {
-        Followed::Ended { last, beyond } => (last, beyond),
-        Followed::GaveUp { last, .. } => {
+        FollowOutcome::Ended { last, beyond } => (last, beyond),
+        FollowOutcome::GaveUp { last, .. } => {
             return vec![unconfirmed(
                 grid_bracket,
                 format!(
@@ -391,13 +393,13 @@ fn refine_end(
                     from.value,
                     last.value,
                     toward.value,
-                    crate::gait::continuation::MAX_FOLLOW_STEPS,
-                    crate::gait::continuation::MAX_FOLLOW_WALKS,
+                    crate::family::natural::MAX_FOLLOW_STEPS,
+                    crate::family::natural::MAX_FOLLOW_WALKS,
                     p = spec.param,
                 ),
             )]
         }
-        Followed::Reached(p) => {
+        FollowOutcome::Reached(p) => {
             let same = toward.gait.as_ref().is_some_and(|gt| {
 gt.section.distance(&p.section) <= SAME_GAIT_TOL
             });
@@ -506,8 +508,8 @@ gt.section.distance(&p.section) <= SAME_GAIT_TOL
 fn cut_by_step_limit(
     config: &Config,
     spec: &SweepSpec,
-    cont: &Continuation,
-    (last, beyond): (&FamilyPoint, f64),
+    cont: &NaturalContinuation,
+    (last, beyond): (&GaitPoint, f64),
     failure: &str,
 ) -> String {
     // Only a stalled walk asks for the last gait's step (a walk of up to max_step_time of motion).
@@ -571,7 +573,7 @@ fn refine_root(
     };
     let guess = start.jacobian_guess();
     // The gaits found so far (the family's points in the bracket).
-    let found = std::cell::RefCell::new(vec![FamilyPoint {
+    let found = std::cell::RefCell::new(vec![GaitPoint {
         value: a.value,
         section: start.section,
     }]);
@@ -610,7 +612,7 @@ fn refine_root(
                     .map_err(|e| e.to_string())?;
                 (q.of_indicators(&fp.outcome.report.indicators), fp.section)
             };
-            found.borrow_mut().push(FamilyPoint { value: v, section });
+            found.borrow_mut().push(GaitPoint { value: v, section });
             Ok::<f64, String>(y)
         })();
         match value {

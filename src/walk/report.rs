@@ -157,7 +157,7 @@ pub struct StepReport {
     /// The smallest `dtheta/dt` in the step \[rad/s\]: at a local minimum, the vertex of the parabola through
     /// the event search's three points around it. Near a family's end where the wheel rolls back, it falls to
     /// zero as a power of the distance to the end in the parameter: the family's ends are extrapolated with it
-    /// (`gait/end_search.rs`). Not written to the outputs.
+    /// (`family/end_search.rs`). Not written to the outputs.
     #[serde(skip)]
     pub slowest: f64,
 }
