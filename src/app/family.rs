@@ -10,16 +10,12 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use super::family_curves::{self, two_param_curves, CurveRecord};
-use super::family_records::{
-    point_stability, special_record, EndRecord, FamilyRecord, SpecialRecord,
-};
-use super::family_switch::{same_as_followed, switched_families, Followed};
+use super::family_records::{point_stability, special_record, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
-use crate::continuation::Curve;
-use crate::continuation::{
-    continue_family, ContinuationError, ContinuationOptions, Family, FamilyEnd, FamilyMap,
+use crate::continuation::{ContinuationError, ContinuationOptions, Curve, Family};
+use crate::family::diagram::{
+    drop_unlocated, follow_families, stopped, DiagramSettings, EndRecord, FollowedFamily,
 };
-use crate::family::natural::{EndCause, GaitPoint, NaturalContinuation};
 use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::MAX_PERIOD;
 use crate::gait::{find_gait_any_period, find_periodic_gait, GaitOptions, Stability, StepMap};
@@ -39,9 +35,6 @@ pub const DIAGRAM_QUANTITIES: [&str; 10] = [
     "speed",
     "dls_duration",
 ];
-
-/// Most families one job follows (the start's and those switched to at period doublings).
-pub const MAX_FAMILIES: usize = 8;
 
 /// Most points one family may have in each direction (`max_points`).
 pub const MAX_FAMILY_POINTS: usize = 10_000;
@@ -68,7 +61,8 @@ pub struct ContinueJob {
     pub max_points: usize,
     /// Largest continuation step (scaled unknowns).
     pub max_step: f64,
-    /// Follow the period-2 family born at every located period doubling (up to [`MAX_FAMILIES`] families).
+    /// Follow the period-2 family born at every located period doubling (up to
+    /// [`MAX_FAMILIES`](crate::family::diagram::MAX_FAMILIES) families).
     pub switch: bool,
     /// The quantity the diagram draws (one of [`DIAGRAM_QUANTITIES`]).
     pub plot: String,
@@ -219,8 +213,8 @@ impl ContinueJob {
 /// When the interrupt flag (the job's or the library's) stops the work, the result keeps what was complete
 /// and says so in [`ContinueSummary::interrupted`]: the points followed before it (verified gaits), the ends
 /// reached before it, the special points located before it; a family cut short ends with
-/// [`FamilyEnd::Interrupted`], no family is switched to and no curve is followed after it. Stopped before the
-/// first gait is found, it is [`AppError::Interrupted`].
+/// [`FamilyEnd::Interrupted`](crate::continuation::FamilyEnd::Interrupted), no family is switched to and no
+/// curve is followed after it. Stopped before the first gait is found, it is [`AppError::Interrupted`].
 pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppError> {
     let clock = std::time::Instant::now();
     let start = job.validate()?;
@@ -236,7 +230,13 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         })?
         .with_interrupt(flag);
     let options = job.options();
-    let followed = follow_families(job, &config, base_map, &gait, start, &options)?;
+    let settings = DiagramSettings {
+        param: &job.param,
+        switch: job.switch,
+        interrupt: flag,
+    };
+    let followed = follow_families(&settings, &config, base_map, &gait, start, &options)
+        .map_err(|e| continuation_error(e, &job.param))?;
     let (mut families, mut warnings) = (followed.families, followed.warnings);
     let mut interrupted = followed.interrupted;
     if interrupted.is_some() {
@@ -293,11 +293,6 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
     })
 }
 
-/// Is the job's interrupt flag or the library's set?
-fn stopped(flag: Option<&AtomicBool>) -> bool {
-    flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst)) || crate::walk::interrupted()
-}
-
 /// The gait the first family is followed from (period at most `job.period`, or any up to [`MAX_PERIOD`]); an
 /// interrupted search is [`AppError::Interrupted`], a failed one a bad `start`.
 fn first_gait(
@@ -327,115 +322,12 @@ fn first_gait(
     })
 }
 
-/// The families [`follow_families`] followed, the warnings on the way, and where the interrupt flag stopped it
-/// (in words; `None` if it did not).
-struct FollowedFamilies<'a> {
-    families: Vec<Followed<'a>>,
-    warnings: Vec<String>,
-    interrupted: Option<String>,
-}
-
-/// Follow the family of `gait` from `start`, then breadth first: each family's ends explained by a walk past
-/// them, then (with `switch`) the period-2 family of each of its located period doublings and the family of
-/// each gait a walk past an end settles on. Once the interrupt flag is set, what the step under way computed
-/// is dropped (the causes of a family's ends, the families born from it) and nothing more is followed.
-fn follow_families<'a>(
-    job: &ContinueJob,
-    config: &Config,
-    base_map: GaitFamily<'a>,
-    gait: &crate::gait::Gait,
-    start: f64,
-    options: &ContinuationOptions,
-) -> Result<FollowedFamilies<'a>, AppError> {
-    let flag = job.interrupt.as_deref();
-    let family_map = base_map.iterated(gait.period_k);
-    let first = continue_family(
-        &family_map,
-        &family_map.reduce(&gait.section),
-        start,
-        options,
-    )
-    .map_err(|e| continuation_error(e, &job.param))?;
-    let mut followed = FollowedFamilies {
-        families: vec![Followed {
-            family: first,
-            origin: "start".to_string(),
-            map: family_map,
-            ends: None,
-        }],
-        warnings: Vec::new(),
-        interrupted: None,
-    };
-    let families = &mut followed.families;
-    let mut next = 0;
-    while next < families.len() && !stopped(flag) {
-        let ends = families[next].family.ends.clone().map(|end| {
-            let cause = end_cause(config, &job.param, &families[next], &end);
-            EndRecord { end, cause }
-        });
-        if stopped(flag) {
-            break;
-        }
-        families[next].ends = Some(ends.clone());
-        let born = if job.switch {
-            switched_families(&job.param, next, families, base_map, &ends, options)
-        } else {
-            Vec::new()
-        };
-        if stopped(flag) {
-            break;
-        }
-        for outcome in born {
-            match outcome {
-                Ok(f) if same_as_followed(families, &f) => followed.warnings.push(format!(
-                    "the family from {} is one already followed (same period and ends): left out",
-                    f.origin
-                )),
-                Ok(f) if families.len() < MAX_FAMILIES => families.push(f),
-                Ok(f) => followed.warnings.push(format!(
-                    "more families than the {MAX_FAMILIES} one job follows: the one from {} not followed",
-                    f.origin
-                )),
-                Err(w) => followed.warnings.push(w),
-            }
-        }
-        next += 1;
-    }
-    if stopped(flag) {
-        followed.interrupted = Some(format!(
-            "while following family {} of {}: the points, ends and special points found before it are \
-             kept; families not followed to their ends end as `interrupted`, and no family born after it \
-             is followed",
-            (next + 1).min(families.len()),
-            families.len()
-        ));
-    }
-    Ok(followed)
-}
-
-/// In an interrupted job: drop the special points that were not located (their location may have been cut
-/// short), with a warning.
-fn drop_unlocated(families: &mut [Followed], warnings: &mut Vec<String>) {
-    for (k, f) in families.iter_mut().enumerate() {
-        let before = f.family.special.len();
-        f.family.special.retain(|sp| sp.located);
-        let dropped = before - f.family.special.len();
-        if dropped > 0 {
-            warnings.push(format!(
-                "family {}: {dropped} special points detected but not located are left out (the job was \
-                 interrupted)",
-                k + 1
-            ));
-        }
-    }
-}
-
 /// The families' records, their special points and their points' stability verdicts; the audit warnings of
 /// their gaits go to `warnings`. A family whose ends were not explained (the job was interrupted first) has
 /// its ends without causes.
 fn family_records(
     job: &ContinueJob,
-    families: &[Followed],
+    families: &[FollowedFamily],
     warnings: &mut Vec<String>,
 ) -> (Vec<FamilyRecord>, Vec<SpecialRecord>, Vec<Vec<Stability>>) {
     let mut records = Vec::new();
@@ -482,37 +374,4 @@ fn continuation_error(e: ContinuationError, param: &str) -> AppError {
         option: "start",
         reason: format!("the family in {param} could not be started: {e}"),
     }
-}
-
-/// What the walk from the last gait does just past an end where the map failed (`NaturalContinuation::end_cause`).
-fn end_cause(
-    config: &Config,
-    param: &str,
-    followed: &Followed,
-    end: &FamilyEnd,
-) -> Option<EndCause> {
-    let (family, map) = (&followed.family, &followed.map);
-    let FamilyEnd::Ended {
-        param: at, beyond, ..
-    } = end
-    else {
-        return None;
-    };
-    if !beyond.is_finite() {
-        return None;
-    }
-    let last = family
-        .points
-        .iter()
-        .find(|p| p.param == *at)
-        .or(family.points.last())?;
-    let continuation =
-        NaturalContinuation::new(config, param, &GaitOptions::default()).with_period(map.period());
-    Some(continuation.end_cause(
-        &GaitPoint {
-            value: last.param,
-            section: map.section_at(&last.x, last.param),
-        },
-        *beyond,
-    ))
 }

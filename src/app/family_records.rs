@@ -4,21 +4,10 @@
 use serde::Serialize;
 
 use crate::continuation::special::Side;
-use crate::continuation::{FamilyEnd, SpecialKind, SpecialPoint};
-use crate::family::natural::EndCause;
+use crate::continuation::{SpecialKind, SpecialPoint};
+use crate::family::diagram::EndRecord;
 use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::Stability;
-
-/// How a family ends at one side, with the physical cause found by walking just past it.
-#[derive(Debug, Clone, Serialize)]
-pub struct EndRecord {
-    /// How following it stopped.
-    #[serde(flatten)]
-    pub end: FamilyEnd,
-    /// What the walk from the last gait does just past the end (where the map failed).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub cause: Option<EndCause>,
-}
 
 /// One family in `special_points.json`.
 #[derive(Debug, Clone, Serialize)]

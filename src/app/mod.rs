@@ -12,7 +12,6 @@ mod family;
 mod family_curves;
 mod family_output;
 mod family_records;
-mod family_switch;
 mod figures;
 mod gait;
 mod map;
@@ -20,19 +19,17 @@ mod orbit;
 mod simulate;
 mod sweep;
 
+pub use crate::family::diagram::{EndRecord, KNOWN_GAIT_TOL, MAX_FAMILIES, SAME_END_TOL};
 pub use basin::{
     compute_basin, compute_basin_part, default_basin_range, run_basin, BasinJob, BasinSummary,
 };
 pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
-    MAX_FAMILIES, MAX_FAMILY_POINTS,
+    MAX_FAMILY_POINTS,
 };
 pub use family_curves::CurveRecord;
 pub use family_output::{curve_rows, family_rows, run_continuation};
-pub use family_records::{
-    EndRecord, FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND,
-};
-pub use family_switch::{KNOWN_GAIT_TOL, SAME_END_TOL};
+pub use family_records::{FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
     MAX_ANIMATION_FRAMES,

@@ -1,36 +1,58 @@
-//! Branch switching for `vrw continue` (docs/model.md section 11): the families born from a followed family
-//! (the period-2 family of a period doubling, the other piece's family at a border collision, the family of
-//! the gait a walk past an end settles on), and whether a family was followed already.
+//! The bifurcation diagram of the wheel's gaits in one parameter (docs/model.md section 11; `vrw continue`):
+//! the family of a gait followed by the continuation engine, then breadth first the families born from each
+//! family followed (the period-2 family of a period doubling, the other piece's family at a border collision,
+//! the family of the gait a walk past an end settles on), each end explained by a walk past it, and whether a
+//! family was followed already.
 
-use super::family_records::EndRecord;
+use std::sync::atomic::AtomicBool;
+
+use serde::Serialize;
+
 use crate::continuation::corrector::solve_on_hyperplane;
 use crate::continuation::special::JUMP_TOL;
 use crate::continuation::{
-    continue_family, switch_at_border, switch_at_period_doubling, ContinuationOptions, Family,
-    FamilyEnd, FamilyMap, SpecialKind,
+    continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
+    ContinuationOptions, Family, FamilyEnd, FamilyMap, SpecialKind,
 };
-use crate::family::natural::EndCause;
+use crate::family::natural::{EndCause, GaitPoint, NaturalContinuation};
 use crate::family::{GaitFamily, GaitInfo};
+use crate::gait::GaitOptions;
+use crate::params::Config;
 
-/// A family being followed: where it came from, its map and its ends with their causes.
-pub(super) struct Followed<'a> {
+/// How a family ends at one side, with the physical cause found by walking just past it.
+#[derive(Debug, Clone, Serialize)]
+pub struct EndRecord {
+    /// How following it stopped.
+    #[serde(flatten)]
+    pub end: FamilyEnd,
+    /// What the walk from the last gait does just past the end (where the map failed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cause: Option<EndCause>,
+}
+
+/// A family of the diagram: where it came from, its map and its ends with their causes.
+pub struct FollowedFamily<'a> {
+    /// The family followed.
     pub family: Family<GaitInfo>,
+    /// Where it came from: `start`, or the special point or end it was switched to from.
     pub origin: String,
+    /// Its map (`P^k` for a family of period k).
     pub map: GaitFamily<'a>,
+    /// Its ends with their causes (`None` until explained; an interrupted diagram may leave it so).
     pub ends: Option<[EndRecord; 2]>,
 }
 
 /// The families born from family `k` (branch switching): the period-2 family of each of its located period
 /// doublings, the other piece's family at each border collision where it ends, and the family of each gait that a walk past one of its `ends` settles on (unless a family
 /// already followed passes through that gait). A family that cannot be started is a warning.
-pub(super) fn switched_families<'a>(
+fn switched_families<'a>(
     param: &str,
     k: usize,
-    families: &[Followed<'a>],
+    families: &[FollowedFamily<'a>],
     base_map: GaitFamily<'a>,
     ends: &[EndRecord; 2],
     options: &ContinuationOptions,
-) -> Vec<Result<Followed<'a>, String>> {
+) -> Vec<Result<FollowedFamily<'a>, String>> {
     let parent = &families[k];
     let mut born = Vec::new();
     for (i, pd) in parent.family.special.iter().enumerate() {
@@ -39,7 +61,7 @@ pub(super) fn switched_families<'a>(
         }
         born.push(
             switch_at_period_doubling(&parent.map, pd, options)
-                .map(|family| Followed {
+                .map(|family| FollowedFamily {
                     family,
                     origin: format!("family {} special point {i} (PD)", k + 1),
                     map: parent.map.iterated(2),
@@ -68,7 +90,7 @@ pub(super) fn switched_families<'a>(
         }
         born.push(
             switch_at_border(&parent.map, bc, options)
-                .map(|family| Followed {
+                .map(|family| FollowedFamily {
                     family,
                     origin: format!(
                         "family {} special point {i} (BC: the other piece's fixed points)",
@@ -115,7 +137,7 @@ pub(super) fn switched_families<'a>(
         }
         born.push(
             continue_family(&map, &x, *beyond, options)
-                .map(|family| Followed {
+                .map(|family| FollowedFamily {
                     family,
                     origin: format!(
                         "family {} end at {} = {} (the gait a walk past it settles on)",
@@ -159,7 +181,7 @@ fn solve_on_parameter(
 /// family of period `k` is interpolated linearly at `p` between its successive points that bracket `p`, and
 /// compared with the phases within [`KNOWN_GAIT_TOL`] (the interpolation's error over a continuation step).
 fn known_gait(
-    families: &[Followed],
+    families: &[FollowedFamily],
     base_map: GaitFamily,
     k: usize,
     x: &nalgebra::DVector<f64>,
@@ -187,7 +209,7 @@ fn known_gait(
 /// Is `new` a family already followed: the same period, and both its ends within [`SAME_END_TOL`] times
 /// `max(1, |p|)` in the parameter of that family's ends (a walk past an end can settle on another phase of a
 /// known orbit, where [`known_gait`]'s interpolation misses it)?
-pub(super) fn same_as_followed(families: &[Followed], new: &Followed) -> bool {
+fn same_as_followed(families: &[FollowedFamily], new: &FollowedFamily) -> bool {
     let ends = |f: &Family<GaitInfo>| -> Option<[f64; 2]> {
         Some([f.points.first()?.param, f.points.last()?.param])
     };
@@ -212,3 +234,163 @@ pub const SAME_END_TOL: f64 = 1e-6;
 
 /// Two gaits closer than this on the section (interpolated) are taken as one (`known_gait`).
 pub const KNOWN_GAIT_TOL: f64 = 1e-3;
+
+/// The families [`follow_families`] followed, the warnings on the way, and where the interrupt flag stopped it
+/// (in words; `None` if it did not).
+pub struct Diagram<'a> {
+    /// The families, in the order they were found (the start's first).
+    pub families: Vec<FollowedFamily<'a>>,
+    /// Families that could not be followed, or were left out.
+    pub warnings: Vec<String>,
+    /// Where the interrupt flag stopped the work, in words.
+    pub interrupted: Option<String>,
+}
+
+/// What [`follow_families`] follows besides the start: the parameter, whether to switch to the families born
+/// at special points and ends, and the job's interrupt flag (the library's is read too).
+pub struct DiagramSettings<'s> {
+    /// The parameter followed (a key of the configuration).
+    pub param: &'s str,
+    /// Follow the families born at period doublings, border collisions and ends (up to [`MAX_FAMILIES`]).
+    pub switch: bool,
+    /// The job's own interrupt flag.
+    pub interrupt: Option<&'s AtomicBool>,
+}
+
+/// Most families one diagram follows (the start's and those switched to).
+pub const MAX_FAMILIES: usize = 8;
+
+/// Follow the family of `gait` from `start`, then breadth first: each family's ends explained by a walk past
+/// them, then (with `switch`) the period-2 family of each of its located period doublings and the family of
+/// each gait a walk past an end settles on. Once the interrupt flag is set, what the step under way computed
+/// is dropped (the causes of a family's ends, the families born from it) and nothing more is followed.
+///
+/// # Errors
+/// The first family could not be started.
+pub fn follow_families<'a>(
+    settings: &DiagramSettings,
+    config: &Config,
+    base_map: GaitFamily<'a>,
+    gait: &crate::gait::Gait,
+    start: f64,
+    options: &ContinuationOptions,
+) -> Result<Diagram<'a>, ContinuationError> {
+    let flag = settings.interrupt;
+    let family_map = base_map.iterated(gait.period_k);
+    let first = continue_family(
+        &family_map,
+        &family_map.reduce(&gait.section),
+        start,
+        options,
+    )?;
+    let mut followed = Diagram {
+        families: vec![FollowedFamily {
+            family: first,
+            origin: "start".to_string(),
+            map: family_map,
+            ends: None,
+        }],
+        warnings: Vec::new(),
+        interrupted: None,
+    };
+    let families = &mut followed.families;
+    let mut next = 0;
+    while next < families.len() && !stopped(flag) {
+        let ends = families[next].family.ends.clone().map(|end| {
+            let cause = end_cause(config, settings.param, &families[next], &end);
+            EndRecord { end, cause }
+        });
+        if stopped(flag) {
+            break;
+        }
+        families[next].ends = Some(ends.clone());
+        let born = if settings.switch {
+            switched_families(settings.param, next, families, base_map, &ends, options)
+        } else {
+            Vec::new()
+        };
+        if stopped(flag) {
+            break;
+        }
+        for outcome in born {
+            match outcome {
+                Ok(f) if same_as_followed(families, &f) => followed.warnings.push(format!(
+                    "the family from {} is one already followed (same period and ends): left out",
+                    f.origin
+                )),
+                Ok(f) if families.len() < MAX_FAMILIES => families.push(f),
+                Ok(f) => followed.warnings.push(format!(
+                    "more families than the {MAX_FAMILIES} one job follows: the one from {} not followed",
+                    f.origin
+                )),
+                Err(w) => followed.warnings.push(w),
+            }
+        }
+        next += 1;
+    }
+    if stopped(flag) {
+        followed.interrupted = Some(format!(
+            "while following family {} of {}: the points, ends and special points found before it are \
+             kept; families not followed to their ends end as `interrupted`, and no family born after it \
+             is followed",
+            (next + 1).min(families.len()),
+            families.len()
+        ));
+    }
+    Ok(followed)
+}
+
+/// In an interrupted job: drop the special points that were not located (their location may have been cut
+/// short), with a warning.
+pub fn drop_unlocated(families: &mut [FollowedFamily], warnings: &mut Vec<String>) {
+    for (k, f) in families.iter_mut().enumerate() {
+        let before = f.family.special.len();
+        f.family.special.retain(|sp| sp.located);
+        let dropped = before - f.family.special.len();
+        if dropped > 0 {
+            warnings.push(format!(
+                "family {}: {dropped} special points detected but not located are left out (the job was \
+                 interrupted)",
+                k + 1
+            ));
+        }
+    }
+}
+
+/// Is the job's interrupt flag or the library's set?
+pub(crate) fn stopped(flag: Option<&AtomicBool>) -> bool {
+    flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst)) || crate::walk::interrupted()
+}
+
+/// What the walk from the last gait does just past an end where the map failed (`NaturalContinuation::end_cause`).
+fn end_cause(
+    config: &Config,
+    param: &str,
+    followed: &FollowedFamily,
+    end: &FamilyEnd,
+) -> Option<EndCause> {
+    let (family, map) = (&followed.family, &followed.map);
+    let FamilyEnd::Ended {
+        param: at, beyond, ..
+    } = end
+    else {
+        return None;
+    };
+    if !beyond.is_finite() {
+        return None;
+    }
+    let last = family
+        .points
+        .iter()
+        .find(|p| p.param == *at)
+        .or(family.points.last())?;
+    let continuation =
+        NaturalContinuation::new(config, param, &GaitOptions::default()).with_period(map.period());
+    Some(continuation.end_cause(
+        &GaitPoint {
+            value: last.param,
+            section: map.section_at(&last.x, last.param),
+        },
+        *beyond,
+    ))
+}
