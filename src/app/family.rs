@@ -9,10 +9,10 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
-use super::family_curves::{self, two_param_curves, CurveRecord};
 use super::family_records::{point_stability, special_record, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
 use crate::continuation::{ContinuationError, ContinuationOptions, Curve, Family};
+use crate::family::curves::{two_param_curves, CurveRecord, FollowedParam};
 use crate::family::diagram::{
     drop_unlocated, follow_families, stopped, DiagramSettings, EndRecord, FollowedFamily,
 };
@@ -183,7 +183,7 @@ impl ContinueJob {
             }
         }
         if let Some(second) = &self.two_param {
-            family_curves::check_two_param(&self.param, &self.config, second)?;
+            check_two_param(&self.param, &self.config, second)?;
         }
         let start = match self.start {
             Some(v) => v,
@@ -253,13 +253,14 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
     }
     let (curve_records, curves) = match (&job.two_param, &interrupted) {
         (Some(second), None) => {
-            let followed = family_curves::FollowedParam {
+            let followed = FollowedParam {
                 param: &job.param,
                 from: job.from,
                 to: job.to,
             };
+            let q0 = check_two_param(&job.param, &config, second)?;
             let maps: Vec<_> = families.iter().map(|f| (&f.family, f.map)).collect();
-            let curves = two_param_curves(&followed, &config, second, &maps, &mut warnings)?;
+            let curves = two_param_curves(&followed, second, q0, &maps, &mut warnings);
             if stopped(flag) {
                 interrupted =
                     Some("while following the two-parameter curves: none is kept".to_string());
@@ -374,4 +375,29 @@ fn continuation_error(e: ContinuationError, param: &str) -> AppError {
         option: "start",
         reason: format!("the family in {param} could not be started: {e}"),
     }
+}
+
+/// Checks `--two-param` before anything is computed: a real-valued key other than the followed `param`, and a
+/// finite range `from < to` that holds its configured value (returned).
+fn check_two_param(
+    param: &str,
+    config: &Config,
+    (name, from, to): &(String, f64, f64),
+) -> Result<f64, AppError> {
+    let invalid = |reason: String| AppError::InvalidOption {
+        option: "two_param",
+        reason,
+    };
+    if !Config::numeric_keys().contains(&name.as_str()) || name == param {
+        return Err(invalid(format!(
+            "{name:?} must be a real-valued key other than the followed parameter {param:?}"
+        )));
+    }
+    let q0 = config.get_numeric(name)?;
+    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
+        return Err(invalid(format!(
+            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
+        )));
+    }
+    Ok(q0)
 }

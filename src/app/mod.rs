@@ -9,7 +9,6 @@
 
 mod basin;
 mod family;
-mod family_curves;
 mod family_output;
 mod family_records;
 mod figures;
@@ -19,6 +18,7 @@ mod orbit;
 mod simulate;
 mod sweep;
 
+pub use crate::family::curves::CurveRecord;
 pub use crate::family::diagram::{EndRecord, KNOWN_GAIT_TOL, MAX_FAMILIES, SAME_END_TOL};
 pub use basin::{
     compute_basin, compute_basin_part, default_basin_range, run_basin, BasinJob, BasinSummary,
@@ -27,7 +27,6 @@ pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
     MAX_FAMILY_POINTS,
 };
-pub use family_curves::CurveRecord;
 pub use family_output::{curve_rows, family_rows, run_continuation};
 pub use family_records::{FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND};
 pub use figures::{

@@ -1,9 +1,8 @@
-//! `vrw continue --two-param`: the curves of the families' special points in a second parameter
-//! (docs/model.md section 11, "Two-parameter curves"), and their records in `special_points.json`.
+//! The curves of the families' special points in a second parameter (docs/model.md section 11, "Two-parameter
+//! curves"; `vrw continue --two-param`), and their records in `special_points.json`.
 
 use serde::Serialize;
 
-use super::AppError;
 use crate::continuation::curve::{
     border_curve_seed, CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
@@ -12,7 +11,6 @@ use crate::continuation::{
     continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, SpecialKind,
 };
 use crate::family::{GaitFamily, GaitInfo};
-use crate::params::Config;
 
 /// One two-parameter curve in `special_points.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -38,49 +36,27 @@ pub struct CurveRecord {
     pub method: String,
 }
 
-/// The followed parameter and its range: `vrw continue`'s `--param`, `--from`, `--to`.
-pub(super) struct FollowedParam<'s> {
+/// The followed parameter and its range (`vrw continue`'s `--param`, `--from`, `--to`).
+pub struct FollowedParam<'s> {
+    /// The parameter the families were followed in.
     pub param: &'s str,
+    /// The lower end of its range.
     pub from: f64,
+    /// The upper end.
     pub to: f64,
 }
 
-/// Checks `--two-param` before anything is computed: a real-valued key other than the followed `param`, and a
-/// finite range `from < to` that holds its configured value (returned).
-pub(super) fn check_two_param(
-    param: &str,
-    config: &Config,
-    (name, from, to): &(String, f64, f64),
-) -> Result<f64, AppError> {
-    let invalid = |reason: String| AppError::InvalidOption {
-        option: "two_param",
-        reason,
-    };
-    if !Config::numeric_keys().contains(&name.as_str()) || name == param {
-        return Err(invalid(format!(
-            "{name:?} must be a real-valued key other than the followed parameter {param:?}"
-        )));
-    }
-    let q0 = config.get_numeric(name)?;
-    if !(from.is_finite() && to.is_finite() && from < to && (*from..=*to).contains(&q0)) {
-        return Err(invalid(format!(
-            "the range [{from}, {to}] must hold {name} = {q0} with from < to"
-        )));
-    }
-    Ok(q0)
-}
-
 /// The curves of every located special point of `families` (each with its map) in the second parameter
-/// (`name`, from, to), a border collision's followed on its family's side of the border (docs/model.md
-/// section 11, "Two-parameter curves").
-pub(super) fn two_param_curves(
+/// (`name`, from, to; its value in the configuration `q0`, checked to lie in the range), a border collision's
+/// followed on its family's side of the border (docs/model.md section 11, "Two-parameter curves"). A curve that
+/// cannot be followed is a warning.
+pub fn two_param_curves(
     job: &FollowedParam,
-    config: &Config,
     (name, from, to): &(String, f64, f64),
+    q0: f64,
     families: &[(&Family<GaitInfo>, GaitFamily)],
     warnings: &mut Vec<String>,
-) -> Result<(Vec<CurveRecord>, Vec<Curve<GaitInfo>>), AppError> {
-    let q0 = check_two_param(job.param, config, &(name.clone(), *from, *to))?;
+) -> (Vec<CurveRecord>, Vec<Curve<GaitInfo>>) {
     let options = CurveOptions::for_ranges((job.from, job.to), (*from, *to));
     let mut records = Vec::new();
     let mut curves = Vec::new();
@@ -175,5 +151,5 @@ pub(super) fn two_param_curves(
             }
         }
     }
-    Ok((records, curves))
+    (records, curves)
 }

@@ -3,6 +3,7 @@
 //! ([`StepMap::eval_with_derivatives`]), the DLS indicators as the borders between its smooth pieces, and the
 //! event sequence of the step as the piece.
 
+pub mod curves;
 pub mod diagram;
 pub(crate) mod end_search;
 pub mod natural;
