@@ -21,7 +21,7 @@ mod animate;
 mod parts;
 mod progress;
 
-use progress::{interruptible_with, Progress};
+use progress::{interruptible_keeping, interruptible_with, Progress};
 use vrw::app::{
     compute_basin_part, compute_continuation, compute_gait, compute_map, compute_map_part,
     compute_orbit, compute_orbit_part, compute_simulation, compute_sweep, curve_rows, family_rows,
@@ -684,18 +684,42 @@ fn gait_map<'py>(
     let part = rows.map(|(start, end)| start..end);
     let points = nx * part.as_ref().map_or(ny, |p| p.len());
     let progress = Progress::new(progress, points * if second_route { 2 } else { 1 });
-    let (summary, map) =
-        interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
+    let (computed, raised) =
+        interruptible_keeping(py, vrw::gait::interrupt_flag(), Some(&progress), || {
             let tick = |_: &_| progress.tick();
             match part {
                 Some(part) => compute_map_part(&job, part, &tick),
                 None => compute_map(&job, &tick),
             }
-        })?
-        .map_err(app_error)?;
-    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
-    let friction = friction_columns(&job.config, &[x, y]);
-    let map_table = table(py, &map_header(x, y, friction), &map_rows(&map, friction))?;
+        });
+    let (summary, map) = match (computed, raised) {
+        (Ok(Ok(result)), raised) if result.0.interrupted.is_some() => {
+            // Ctrl-C while the curves were traced: the complete gaits go with the exception, as `partial`.
+            let e = raised.unwrap_or_else(|| {
+                let during = result.0.interrupted.clone().unwrap_or_default();
+                pyo3::exceptions::PyKeyboardInterrupt::new_err(during)
+            });
+            let partial = map_result(py, &result.0, &result.1, &job.config, (x, y))?;
+            e.value(py).setattr("partial", partial)?;
+            return Err(e);
+        }
+        (_, Some(e)) => return Err(e),
+        (computed, None) => computed?.map_err(app_error)?,
+    };
+    map_result(py, &summary, &map, &job.config, (x, y))
+}
+
+/// What `vrw.map` returns: the fields of `curves.json` and the columns of `map.csv` as `map`.
+fn map_result<'py>(
+    py: Python<'py>,
+    summary: &vrw::app::MapSummary,
+    map: &vrw::study::GaitMap,
+    config: &Config,
+    (x, y): (&str, &str),
+) -> PyResult<Bound<'py, PyDict>> {
+    let result = pythonize(py, summary)?.downcast_into::<PyDict>()?;
+    let friction = friction_columns(config, &[x, y]);
+    let map_table = table(py, &map_header(x, y, friction), &map_rows(map, friction))?;
     result.set_item("map", map_table)?;
     Ok(result)
 }

@@ -63,6 +63,22 @@ pub(crate) fn interruptible_with<T: Send>(
     progress: Option<&Progress>,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    let (value, raised) = interruptible_keeping(py, flag, progress, work);
+    match raised {
+        Some(e) => Err(e),
+        None => value,
+    }
+}
+
+/// [`interruptible_with`] that keeps what `work` returned even when an exception was raised meanwhile: the
+/// value (or the panic, as `RuntimeError`) and the exception, for a job whose complete part is handed on with
+/// its `KeyboardInterrupt` (`vrw.map`).
+pub(crate) fn interruptible_keeping<T: Send>(
+    py: Python<'_>,
+    flag: &AtomicBool,
+    progress: Option<&Progress>,
+    work: impl FnOnce() -> T + Send,
+) -> (PyResult<T>, Option<PyErr>) {
     flag.store(false, Ordering::SeqCst);
     py.allow_threads(|| {
         std::thread::scope(|scope| {
@@ -92,10 +108,7 @@ pub(crate) fn interruptible_with<T: Send>(
             // The last count (the whole job's, unless it was cut short).
             poll(&mut raised, &mut reported);
             flag.store(false, Ordering::SeqCst);
-            match raised {
-                Some(e) => Err(e),
-                None => value,
-            }
+            (value, raised)
         })
     })
 }

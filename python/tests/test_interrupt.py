@@ -87,3 +87,30 @@ def test_progress_true_draws_a_tqdm_bar(capsys):
     result = vrw.sweep(vrw.Params(), "viscosity", vrw.linspace(40, 60, 5), progress=True)
     assert result["gaits_found"] == 5
     assert "5/5" in capsys.readouterr().err
+
+
+def test_ctrl_c_while_a_maps_curves_are_traced_keeps_its_gaits():
+    """The map's gaits are complete when its curves are traced: Ctrl-C then hands them on with the
+    KeyboardInterrupt (as ``partial``, without curves), instead of throwing them away."""
+    import numpy as np
+
+    grid = dict(nx=21, ny=21)
+    started = []
+
+    def progress(done, total):
+        # When the last gait is in, the curves (four fifths of the work) follow: interrupt them.
+        if done == total and not started:
+            started.append(True)
+            threading.Timer(0.3, _thread.interrupt_main).start()
+
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        vrw.map(vrw.Params(), progress=progress, **grid)
+    partial = stopped.value.partial
+    assert "interrupted" in partial and partial["curves"] == []
+    whole = vrw.map(vrw.Params(), curves=False, **grid)
+    for column in ("status", "lambda_4_plus", "max_floquet"):
+        a, b = np.asarray(partial["map"][column]), np.asarray(whole["map"][column])
+        if a.dtype.kind == "f":
+            assert np.array_equal(a, b, equal_nan=True), column
+        else:
+            assert list(a) == list(b), column

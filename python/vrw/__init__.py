@@ -11,8 +11,9 @@ orbit diagrams, basins and grids of sweeps over a Dask cluster. Computation runs
 **Long jobs.** ``sweep``, ``map``, ``orbit`` and ``basin`` take ``progress``: a callable ``progress(done,
 total)`` called on the calling thread as points finish, or ``True`` for a tqdm bar (``pip install tqdm``).
 Ctrl-C (``KeyboardInterrupt``) stops any job within about a second: the job stops starting points, the
-points under way finish, and what was computed is discarded (a result is whole or not returned at all); the
-next call runs normally. An exception raised by the ``progress`` callable stops the job the same way. To keep
+points under way stop, and what was computed is discarded (a result is whole or not returned at all), but for
+``map`` stopped while its curves are traced: its gaits are complete, and the exception carries them as
+``partial`` (the result without curves, with ``interrupted`` saying so). The next call runs normally. An exception raised by the ``progress`` callable stops the job the same way. To keep
 what a long study has computed, split it into several calls (e.g. a map in parts of rows, ``rows=``).
 
 >>> import vrw

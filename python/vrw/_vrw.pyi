@@ -170,7 +170,9 @@ def map(
     fields of ``curves.json`` and ``map``, the columns of ``map.csv``. ``x_range`` and ``y_range`` default to
     the command line's ``(1, 300)`` and ``(300, 1500)``; ``curve_method`` is ``"continuation"`` or
     ``"crossings"``. ``rows=(start, end)`` computes only those rows' gaits (with ``curves=False``), each point
-    as the whole map has it; ``progress(done, total)`` is called on this thread as points finish."""
+    as the whole map has it; ``progress(done, total)`` is called on this thread as points finish. Ctrl-C
+    while the curves are traced raises ``KeyboardInterrupt`` with the complete gaits as its ``partial`` (this
+    result without curves, with ``interrupted``)."""
 
 def orbit(
     params: Params,

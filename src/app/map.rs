@@ -84,6 +84,10 @@ pub struct MapSummary {
     /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
     #[serde(skip)]
     pub second_route_seconds: f64,
+    /// Where the interrupt flag stopped the job and what is kept ([`compute_map`]: the gaits without curves);
+    /// `None` (and not written) when it did not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<String>,
     /// Every audit value above its tolerance in the steps of the gaits found (empty when every law holds).
     pub warnings: Vec<String>,
 }
@@ -102,12 +106,28 @@ pub fn run_map(
 
 /// The work of [`run_map`] without writing anything: the summary (`curves.json`'s fields) and the map's
 /// gaits (`map.csv`'s rows). The Python front's `vrw.map`.
+///
+/// Interrupted while the curves are traced (the gaits being complete), it returns the gaits with no curve and
+/// says so in [`MapSummary::interrupted`] (the Python front hands them on with its `KeyboardInterrupt`);
+/// interrupted among the gaits, it is [`AppError::Interrupted`].
 pub fn compute_map(
     job: &MapJob,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<(MapSummary, GaitMap), AppError> {
     let initial = checked_initial(job)?;
     let (mut summary, map) = summarized_rows(job, &initial, 0..job.spec.y.points, progress)?;
+    if let Err(AppError::Interrupted { during, kept }) =
+        check_curves_interrupted("the map's gaits are complete")
+    {
+        // The summary of the gaits alone (no curve, none of the curves' warnings).
+        let gaits_only = MapJob {
+            curves: false,
+            ..job.clone()
+        };
+        let mut gaits = map_summary(&gaits_only, &map, summary.seconds[0]);
+        gaits.interrupted = Some(format!("{during}; {kept}"));
+        return Ok((gaits, map));
+    }
     second_route(job, &initial, progress, &mut summary)?;
     Ok((summary, map))
 }
@@ -153,7 +173,6 @@ fn summarized_rows(
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
     let summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
-    check_curves_interrupted("every point of the map is complete")?;
     Ok((summary, map))
 }
 
@@ -253,6 +272,7 @@ fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> MapSummary {
         seconds: [gait_seconds, curve_seconds],
         continuation_seconds,
         second_route_seconds: 0.0,
+        interrupted: None,
         warnings: super::gait_warnings(map.ys.iter().zip(&map.rows).flat_map(|(y, row)| {
             row.iter().map(move |p| {
                 let at = format!(
