@@ -404,7 +404,7 @@ fn sweep_points_carry_their_family_and_an_honest_stability_verdict() {
         match &p.gait {
             Some(g) => {
                 assert_eq!(p.family, Some(0), "one family on this range: {p:?}");
-                assert_eq!(p.status, g.stability.to_string());
+                assert_eq!(p.status, vrw::study::PointStatus::Gait(g.stability));
                 assert!(g.jacobian_error.is_finite());
                 assert_eq!(
                     g.stable,

@@ -17,7 +17,7 @@ pub use map::{
     MapCurves, MapSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
 pub use sweep::{
-    check_values, sweep, sweep_values, FollowAttempt, RangeNames, SweepPoint, SweepSpec,
-    MAX_SWEEP_POINTS, SWEEP_RANGE,
+    check_values, sweep, sweep_values, FollowAttempt, PointStatus, RangeNames, SweepPoint,
+    SweepSpec, MAX_SWEEP_POINTS, SWEEP_RANGE,
 };
 pub use thresholds::{find_thresholds, SecondRoute, Threshold, SECOND_ROUTE_TOL};

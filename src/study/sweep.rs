@@ -23,7 +23,9 @@ use super::grid::{run_rows_part, Evaluated};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
 use crate::family::natural::{FollowOutcome, GaitPoint, NaturalContinuation, Tangent, PARAM_TOL};
 use crate::fmt::short;
-use crate::gait::limit_cycle::{gait_at_converged, solve_fixed_point, Gait, GaitOptions};
+use crate::gait::limit_cycle::{
+    gait_at_converged, solve_fixed_point, Gait, GaitOptions, Stability,
+};
 use crate::gait::period_k::{find_gait_any_period, periodic_gait_at};
 use crate::gait::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
 use crate::gait::step_map::{free_coordinates, StepMap};
@@ -130,14 +132,42 @@ impl SweepSpec {
     }
 }
 
+/// What a sweep point found: a gait with its stability verdict, or why there is none. A value until it is
+/// written: its text (`stable`, `rolled_back`, `invalid_parameter`, ...) is the `status` of the tables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointStatus {
+    /// A gait, with its stability verdict.
+    Gait(Stability),
+    /// No gait: the kind of the search's failure ([`crate::gait::GaitError::kind`]: `rolled_back`,
+    /// `no_convergence`, ...).
+    NoGait(&'static str),
+    /// The value leaves the parameter's valid domain.
+    InvalidParameter,
+}
+
+impl std::fmt::Display for PointStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PointStatus::Gait(stability) => stability.fmt(f),
+            PointStatus::NoGait(kind) => f.write_str(kind),
+            PointStatus::InvalidParameter => f.write_str("invalid_parameter"),
+        }
+    }
+}
+
+impl Serialize for PointStatus {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
 /// The result at one parameter value.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SweepPoint {
     /// The parameter value.
     pub value: f64,
-    /// The gait's stability verdict (`stable`, `unstable`, `uncertain`), or why no gait was found
-    /// (`invalid_parameter`, `rolled_back`, ...).
-    pub status: String,
+    /// The gait's stability verdict, or why no gait was found.
+    pub status: PointStatus,
     /// The failure, in words.
     pub message: Option<String>,
     /// The gait, if found.
@@ -213,7 +243,7 @@ pub(crate) fn gait_at_value(
         Err(e) => {
             return SweepPoint {
                 value,
-                status: "invalid_parameter".to_string(),
+                status: PointStatus::InvalidParameter,
                 message: Some(e.to_string()),
                 gait: None,
                 continued_from: None,
@@ -245,7 +275,7 @@ pub(crate) fn gait_at_value(
     match result {
         Ok(g) => SweepPoint {
             value,
-            status: g.stability.to_string(),
+            status: PointStatus::Gait(g.stability),
             message: None,
             gait: Some(g),
             continued_from,
@@ -254,7 +284,7 @@ pub(crate) fn gait_at_value(
         },
         Err(e) => SweepPoint {
             value,
-            status: e.kind().to_string(),
+            status: PointStatus::NoGait(e.kind()),
             message: Some(e.to_string()),
             gait: None,
             continued_from: None,
@@ -367,12 +397,12 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
         let (None, Some(gb)) = (&a.gait, continuable(b)) else {
             continue;
         };
-        if a.status == "invalid_parameter" {
+        if a.status == PointStatus::InvalidParameter {
             continue;
         }
         match follow_gait(config, param, b.value, gb, a.value, options, PARAM_TOL) {
             Ok(g) => {
-                a.status = g.stability.to_string();
+                a.status = PointStatus::Gait(g.stability);
                 a.message = None;
                 a.gait = Some(g);
                 a.continued_from = Some(i);

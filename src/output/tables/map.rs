@@ -32,7 +32,7 @@ pub(crate) fn map_columns<'a>() -> [Column<MapPoint<'a>>; 15] {
         Column::new(
             "status",
             "The gait's stability verdict (stable, unstable, uncertain), or why no gait was found.",
-            |m| Text(m.point.status.clone()),
+            |m| Text(m.point.status.to_string()),
         ),
         Column::new("branch", "Branch of the impact procedure.", |m| {
             of_gait(m.point, |g| Text(g.branch.to_string()))

@@ -27,7 +27,7 @@ pub(crate) const SWEEP: [Column<SweepPoint>; 25] = [
     Column::new(
         "status",
         "The gait's stability verdict (stable, unstable, uncertain), or why no gait was found.",
-        |p| Text(p.status.clone()),
+        |p| Text(p.status.to_string()),
     ),
     Column::new(
         "L2",

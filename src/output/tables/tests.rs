@@ -24,7 +24,7 @@ use crate::params::{Config, Params, RearExit};
 use crate::reference::default_initial;
 use crate::study::basin::{BasinPoint, Outcome};
 use crate::study::orbit::OrbitColumn;
-use crate::study::{GaitMap, MapSpec, SweepPoint, SweepSpec};
+use crate::study::{GaitMap, MapSpec, PointStatus, SweepPoint, SweepSpec};
 use crate::walk::{simulate, Sample, SectionState, StepReport, Trajectory};
 
 /// A short walk with its trajectory, and the gait of the default parameters.
@@ -53,7 +53,7 @@ fn fixture() -> Fixture {
 fn sweep_points(gait: &Gait) -> [SweepPoint; 2] {
     let found = SweepPoint {
         value: 50.0,
-        status: gait.stability.to_string(),
+        status: PointStatus::Gait(gait.stability),
         message: None,
         gait: Some(gait.clone()),
         continued_from: None,
@@ -62,7 +62,7 @@ fn sweep_points(gait: &Gait) -> [SweepPoint; 2] {
     };
     let lost = SweepPoint {
         value: 60.0,
-        status: "rolled_back".to_string(),
+        status: PointStatus::NoGait("rolled_back"),
         message: Some("rolled back".to_string()),
         gait: None,
         continued_from: None,
