@@ -98,7 +98,7 @@ fn orbit_diagram_sits_on_the_period_one_gait() {
     let columns = orbit_diagram(&config, &spec, &default_initial(&config), &|_| {}).unwrap();
     assert_eq!(columns.len(), 3);
     for c in &columns {
-        assert_eq!(c.status, "walking");
+        assert_eq!(c.status, vrw::study::orbit::WalkStatus::Walking);
         assert_eq!(c.period_k, Some(1));
         assert_eq!(c.returns.len(), 8);
         let mut at = config.clone();

@@ -11,7 +11,9 @@ use crate::gait::{Gait, GaitOptions, Stability};
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
 use crate::params::Config;
-use crate::study::orbit::{orbit_diagram, orbit_part, OrbitColumn, OrbitPart, OrbitSpec};
+use crate::study::orbit::{
+    orbit_diagram, orbit_part, OrbitColumn, OrbitPart, OrbitSpec, WalkStatus,
+};
 use crate::study::sweep;
 use crate::walk::{SectionState, StepReport};
 
@@ -199,10 +201,10 @@ fn orbit_summary(
 ) -> OrbitSummary {
     let mut outcomes = BTreeMap::new();
     for c in columns {
-        let key = match (c.status.as_str(), c.period_k) {
-            ("walking", Some(k)) => format!("period_{k}"),
-            ("walking", None) => "not_settled".to_string(),
-            (kind, _) => kind.to_string(),
+        let key = match (c.status, c.period_k) {
+            (WalkStatus::Walking, Some(k)) => format!("period_{k}"),
+            (WalkStatus::Walking, None) => "not_settled".to_string(),
+            (failed, _) => failed.to_string(),
         };
         *outcomes.entry(key).or_insert(0) += 1;
     }
@@ -305,16 +307,16 @@ fn orbit_figure(
     let half = 0.5 * (range.to - range.from).abs() / (range.points.max(2) - 1) as f64;
     let failed = columns
         .iter()
-        .filter(|c| c.status != "walking")
+        .filter(|c| c.status.failed())
         .map(|c| {
-            (
-                (c.value - half)..(c.value + half),
-                if LEAVES_SECTION.contains(&c.status.as_str()) {
-                    format!("walk leaves the section: {}", c.status.replace('_', " "))
-                } else {
-                    format!("walk fails: {}", c.status.replace('_', " "))
-                },
-            )
+            let words = c.status.to_string().replace('_', " ");
+            let label = match c.status {
+                WalkStatus::Failed(kind) if LEAVES_SECTION.contains(&kind) => {
+                    format!("walk leaves the section: {words}")
+                }
+                _ => format!("walk fails: {words}"),
+            };
+            ((c.value - half)..(c.value + half), label)
         })
         .collect();
     OrbitFigure {

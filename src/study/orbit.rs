@@ -97,14 +97,48 @@ impl OrbitSpec {
     }
 }
 
+/// How the walk at one value of an orbit diagram went. A value until it is written: its text (`walking`,
+/// `rolled_back`, `invalid_parameter`, ...) is the `status` of `orbit.csv`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WalkStatus {
+    /// Every step was walked.
+    Walking,
+    /// The walk failed: its kind ([`crate::walk::WalkError::kind`]: `rolled_back`, `fell`, ...).
+    Failed(&'static str),
+    /// The value leaves the parameter's valid domain.
+    InvalidParameter,
+}
+
+impl WalkStatus {
+    /// Did the walk fail (or never start)?
+    pub fn failed(self) -> bool {
+        self != WalkStatus::Walking
+    }
+}
+
+impl std::fmt::Display for WalkStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            WalkStatus::Walking => "walking",
+            WalkStatus::Failed(kind) => kind,
+            WalkStatus::InvalidParameter => "invalid_parameter",
+        })
+    }
+}
+
+impl Serialize for WalkStatus {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
 /// The walk at one parameter value.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrbitColumn {
     /// The parameter value.
     pub value: f64,
-    /// `walking` when every step was walked, otherwise the failure kind (`rolled_back`, `fell`, ...,
-    /// `invalid_parameter`).
-    pub status: String,
+    /// How the walk went.
+    pub status: WalkStatus,
     /// The failure in words.
     pub message: Option<String>,
     /// The recorded steps (their section states, indicators and branches), in order; fewer than asked if the
@@ -129,7 +163,7 @@ fn walk_column(
 ) -> (OrbitColumn, Option<SectionState>) {
     let mut column = OrbitColumn {
         value,
-        status: "walking".to_string(),
+        status: WalkStatus::Walking,
         message: None,
         returns: Vec::with_capacity(steps),
         period_k: None,
@@ -141,7 +175,7 @@ fn walk_column(
     let (c, model) = match configured {
         Ok(x) => x,
         Err(e) => {
-            column.status = "invalid_parameter".to_string();
+            column.status = WalkStatus::InvalidParameter;
             column.message = Some(e.to_string());
             return (column, None);
         }
@@ -171,7 +205,7 @@ fn walk_column(
             (column, Some(end))
         }
         Err(e) => {
-            column.status = e.kind().to_string();
+            column.status = WalkStatus::Failed(e.kind());
             column.message = Some(e.to_string());
             (column, None)
         }

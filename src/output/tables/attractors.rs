@@ -37,7 +37,7 @@ pub(crate) fn orbit_columns<'a>() -> [Column<OrbitRow<'a>>; 12] {
         Column::new(
             "status",
             "walking when every step was walked, otherwise the failure kind.",
-            |r| Text(r.column.status.clone()),
+            |r| Text(r.column.status.to_string()),
         ),
         Column::new(
             "period_k",

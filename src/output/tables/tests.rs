@@ -217,7 +217,7 @@ fn every_table_reads_back_by_name() {
 
     let walked = OrbitColumn {
         value: 50.0,
-        status: "walking".to_string(),
+        status: crate::study::orbit::WalkStatus::Walking,
         message: None,
         returns: f.steps.clone(),
         period_k: Some(1),
@@ -225,7 +225,7 @@ fn every_table_reads_back_by_name() {
     };
     let failed = OrbitColumn {
         value: 60.0,
-        status: "fell".to_string(),
+        status: crate::study::orbit::WalkStatus::Failed("fell"),
         message: Some("fell".to_string()),
         returns: Vec::new(),
         period_k: None,
@@ -413,7 +413,7 @@ fn shared_names_mean_the_same_quantity() {
     let [found, _] = sweep_points(&f.gait);
     let column = OrbitColumn {
         value: 50.0,
-        status: "walking".to_string(),
+        status: crate::study::orbit::WalkStatus::Walking,
         message: None,
         returns: vec![*step],
         period_k: Some(1),
