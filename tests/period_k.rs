@@ -108,7 +108,7 @@ fn gait_job_writes_the_period_two_gait() {
         interrupt: None,
     })
     .unwrap();
-    assert_eq!(summary.status, "found");
+    assert_eq!(summary.status, vrw::app::SearchEnded::Found);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("gait.json")).unwrap())
             .unwrap();

@@ -84,7 +84,12 @@ fn draw(
 ) -> Result<Vec<u8>, AppError> {
     let (summary, trajectory) = compute_simulation(job, true)?;
     let samples = trajectory.map(|t| t.samples).unwrap_or_default();
-    let run = run_from_walk(&job.config, &summary.status, &summary.steps, &samples)?;
+    let run = run_from_walk(
+        &job.config,
+        &summary.status.to_string(),
+        &summary.steps,
+        &samples,
+    )?;
     Ok(match still {
         Some(time) => still_png(&run, options, time, Path::new("walk-frame.png"))?,
         None => {

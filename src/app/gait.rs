@@ -53,8 +53,8 @@ pub struct GaitSummary {
     pub options: GaitOptions,
     /// Initial section state of the search.
     pub initial: SectionState,
-    /// `found`, or the failure kind.
-    pub status: String,
+    /// Whether the search found a gait (written `found`), or the failure's kind.
+    pub status: SearchEnded,
     /// The failure, in words, if any.
     pub message: Option<String>,
     /// The gait, if found (its fields are also flattened into the top level of the JSON).
@@ -66,6 +66,31 @@ pub struct GaitSummary {
     /// What makes the gait untrustworthy: every audit value of its steps above its tolerance
     /// ([`StepReport::audit_warnings`](crate::walk::StepReport::audit_warnings)); empty when every law holds.
     pub warnings: Vec<String>,
+}
+
+/// How the gait search of `vrw gait` ended. A value until it is written: `gait.json`'s `status` is `found` or
+/// the failure's kind (`rolled_back`, `no_convergence`, ...).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchEnded {
+    /// A gait was found.
+    Found,
+    /// No gait: the kind of the failure ([`crate::gait::GaitError::kind`]).
+    Failed(&'static str),
+}
+
+impl std::fmt::Display for SearchEnded {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SearchEnded::Found => "found",
+            SearchEnded::Failed(kind) => kind,
+        })
+    }
+}
+
+impl Serialize for SearchEnded {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
 }
 
 /// The smallest Newton tolerance `vrw gait` accepts: the lower end of [`TOLERANCE_RANGE`], which says why.
@@ -88,7 +113,7 @@ pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
         run.add("gait.json");
         if let Some(gait) = &summary.gait {
             let period = write_gait_period(job, gait, run)?;
-            if period.status == "interrupted" {
+            if period.status == super::WalkEnded::Interrupted {
                 return Err(AppError::Interrupted {
                     during: "while walking the gait's period".to_string(),
                     kept: "gait.json holds the gait (complete); the period's tables hold its complete \
@@ -133,8 +158,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
         initial,
         status: result
             .as_ref()
-            .map_or_else(|e| e.kind(), |_| "found")
-            .to_string(),
+            .map_or_else(|e| SearchEnded::Failed(e.kind()), |_| SearchEnded::Found),
         message: result.as_ref().err().map(ToString::to_string),
         warnings: result.as_ref().map_or_else(
             |_| Vec::new(),

@@ -34,7 +34,8 @@ pub use figures::{
     MAX_ANIMATION_FRAMES,
 };
 pub use gait::{
-    compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, MIN_GAIT_TOLERANCE,
+    compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
+    MIN_GAIT_TOLERANCE,
 };
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
@@ -42,7 +43,7 @@ pub use orbit::{
     OrbitSummary, ORBIT_QUANTITIES,
 };
 pub use simulate::{
-    compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary,
+    compute_simulation, run_simulate, SimulateEvent, SimulateJob, SimulateSummary, WalkEnded,
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};

@@ -91,6 +91,37 @@ impl SimulateJob {
     }
 }
 
+/// How a walk of `vrw simulate` (or a gait's period) ended. A value until it is written: its text (`running`,
+/// `completed`, `interrupted`, or the failure kind `fell`, `stalled`, ...) is `summary.json`'s `status`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WalkEnded {
+    /// Still walking (the summary written at the start).
+    Running,
+    /// Every step asked for was walked.
+    Completed,
+    /// The interrupt flag (Ctrl-C) stopped it.
+    Interrupted,
+    /// The walk failed: its kind ([`WalkError::kind`](crate::walk::WalkError::kind)).
+    Failed(&'static str),
+}
+
+impl std::fmt::Display for WalkEnded {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            WalkEnded::Running => "running",
+            WalkEnded::Completed => "completed",
+            WalkEnded::Interrupted => "interrupted",
+            WalkEnded::Failed(kind) => kind,
+        })
+    }
+}
+
+impl Serialize for WalkEnded {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
 /// `summary.json`: the parameters used, how the run ended, aggregates over every step, and the records of the
 /// last `SUMMARY_STEPS` steps (`steps.csv` has every step).
 #[derive(Debug, Clone, Serialize)]
@@ -105,8 +136,8 @@ pub struct SimulateSummary {
     pub steps_requested: usize,
     /// Steps completed.
     pub steps_completed: usize,
-    /// `completed`, `interrupted` (Ctrl-C), or the failure kind (`fell`, `stalled`, ...).
-    pub status: String,
+    /// How the walk ended.
+    pub status: WalkEnded,
     /// The failure or the interruption, in words, if any.
     pub message: Option<String>,
     /// Simulated time reached \[s\]: the last touchdown, or the time of the failure.
@@ -140,7 +171,7 @@ impl SimulateSummary {
             initial,
             steps_requested: job.steps,
             steps_completed: 0,
-            status: String::new(),
+            status: WalkEnded::Running,
             message: None,
             end_time: 0.0,
             max_abs_energy_residual: 0.0,
@@ -205,7 +236,8 @@ pub fn run_simulate(
     let (model, initial) = simulation_setup(job)?;
     in_run(&job.out_dir, job.overwrite, "simulate", |run| {
         let summary = simulate_into(job, &model, initial, run, observe)?;
-        let interrupted = (summary.status == "interrupted").then(|| summary.message.clone());
+        let interrupted =
+            (summary.status == WalkEnded::Interrupted).then(|| summary.message.clone());
         Ok((summary, interrupted.flatten()))
     })
 }
@@ -227,7 +259,7 @@ pub(super) fn simulate_into(
     }
     files.push("summary.json".to_string());
     let mut running = SimulateSummary::new(job, initial);
-    running.status = "running".to_string();
+    running.status = WalkEnded::Running;
     running.files.clone_from(&files);
     output::write_json(&run.path("summary.json"), &running)?;
     let names: Vec<&str> = files.iter().map(String::as_str).collect();
@@ -327,15 +359,15 @@ fn walk_job(
     summary.end_time = end.time;
     summary.steps = last.into();
     (summary.status, summary.message) = match (&end.failure, end.interrupted) {
-        (Some(e), _) => (e.kind().to_string(), Some(e.to_string())),
+        (Some(e), _) => (WalkEnded::Failed(e.kind()), Some(e.to_string())),
         (None, true) => (
-            "interrupted".to_string(),
+            WalkEnded::Interrupted,
             Some(format!(
                 "interrupted after {} of {} steps",
                 end.steps, job.steps
             )),
         ),
-        (None, false) => ("completed".to_string(), None),
+        (None, false) => (WalkEnded::Completed, None),
     };
     Ok(summary)
 }
@@ -382,7 +414,7 @@ mod tests {
             }
         })
         .unwrap();
-        assert_eq!(summary.status, "interrupted");
+        assert_eq!(summary.status, WalkEnded::Interrupted);
         assert_eq!(summary.steps_completed, 3);
         assert_eq!(rows(&dir.path().join("steps.csv")), 3);
         let written: serde_json::Value = serde_json::from_str(
@@ -400,7 +432,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let steps = SUMMARY_STEPS + 7;
         let summary = run_simulate(&job(dir.path(), steps, false), &mut |_| {}).unwrap();
-        assert_eq!(summary.status, "completed");
+        assert_eq!(summary.status, WalkEnded::Completed);
         assert_eq!(summary.steps.len(), SUMMARY_STEPS);
         assert_eq!(summary.steps[0].step, 8);
         assert_eq!(summary.steps.last().unwrap().step, steps);

@@ -111,7 +111,7 @@ pub(super) fn run(args: SimulateArgs) -> Result<()> {
         );
     }
     match &summary.message {
-        Some(_) if summary.status == "interrupted" => bail!(
+        Some(_) if summary.status == vrw::app::WalkEnded::Interrupted => bail!(
             "interrupted (Ctrl-C) after {} of {} steps; the results so far are written",
             summary.steps_completed,
             summary.steps_requested

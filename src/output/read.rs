@@ -803,7 +803,13 @@ mod tests {
         let files = read_run(dir.path()).unwrap();
         let (summary, trajectory) = compute_simulation(&job, true).unwrap();
         let samples = trajectory.unwrap().samples;
-        let memory = run_from_walk(&job.config, &summary.status, &summary.steps, &samples).unwrap();
+        let memory = run_from_walk(
+            &job.config,
+            &summary.status.to_string(),
+            &summary.steps,
+            &samples,
+        )
+        .unwrap();
         assert_eq!(memory.geometry, files.geometry);
         assert_eq!(memory.status, files.status);
         assert_eq!(memory.samples, files.samples);

@@ -375,9 +375,13 @@ mod tests {
         };
         let (summary, trajectory) = crate::app::compute_simulation(&job, true).unwrap();
         let samples = trajectory.unwrap().samples;
-        let run =
-            super::super::read::run_from_walk(&config, &summary.status, &summary.steps, &samples)
-                .unwrap();
+        let run = super::super::read::run_from_walk(
+            &config,
+            &summary.status.to_string(),
+            &summary.steps,
+            &samples,
+        )
+        .unwrap();
         let opts = AnimateOptions {
             fps: 5,
             width: 160,
