@@ -23,6 +23,15 @@ pub fn short(v: f64) -> String {
     }
 }
 
+/// Serialize a value as its text ([`std::fmt::Display`]): a status is an enum inside the library and its
+/// name in a file (`#[serde(serialize_with = "crate::fmt::as_text")]`).
+pub fn as_text<T: std::fmt::Display, S: serde::Serializer>(
+    value: &T,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    serializer.collect_str(value)
+}
+
 /// The most characters of a user's input a message quotes ([`clip`]).
 pub const QUOTED_INPUT_CHARS: usize = 200;
 

@@ -54,6 +54,7 @@ pub struct GaitSummary {
     /// Initial section state of the search.
     pub initial: SectionState,
     /// Whether the search found a gait (written `found`), or the failure's kind.
+    #[serde(serialize_with = "crate::fmt::as_text")]
     pub status: SearchEnded,
     /// The failure, in words, if any.
     pub message: Option<String>,
@@ -84,12 +85,6 @@ impl std::fmt::Display for SearchEnded {
             SearchEnded::Found => "found",
             SearchEnded::Failed(kind) => kind,
         })
-    }
-}
-
-impl Serialize for SearchEnded {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
     }
 }
 

@@ -116,12 +116,6 @@ impl std::fmt::Display for WalkEnded {
     }
 }
 
-impl Serialize for WalkEnded {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
-    }
-}
-
 /// `summary.json`: the parameters used, how the run ended, aggregates over every step, and the records of the
 /// last `SUMMARY_STEPS` steps (`steps.csv` has every step).
 #[derive(Debug, Clone, Serialize)]
@@ -137,6 +131,7 @@ pub struct SimulateSummary {
     /// Steps completed.
     pub steps_completed: usize,
     /// How the walk ended.
+    #[serde(serialize_with = "crate::fmt::as_text")]
     pub status: WalkEnded,
     /// The failure or the interruption, in words, if any.
     pub message: Option<String>,

@@ -126,18 +126,13 @@ impl std::fmt::Display for WalkStatus {
     }
 }
 
-impl Serialize for WalkStatus {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
-    }
-}
-
 /// The walk at one parameter value.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OrbitColumn {
     /// The parameter value.
     pub value: f64,
     /// How the walk went.
+    #[serde(serialize_with = "crate::fmt::as_text")]
     pub status: WalkStatus,
     /// The failure in words.
     pub message: Option<String>,

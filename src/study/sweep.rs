@@ -155,18 +155,13 @@ impl std::fmt::Display for PointStatus {
     }
 }
 
-impl Serialize for PointStatus {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.collect_str(self)
-    }
-}
-
 /// The result at one parameter value.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SweepPoint {
     /// The parameter value.
     pub value: f64,
     /// The gait's stability verdict, or why no gait was found.
+    #[serde(serialize_with = "crate::fmt::as_text")]
     pub status: PointStatus,
     /// The failure, in words.
     pub message: Option<String>,
