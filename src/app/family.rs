@@ -14,12 +14,13 @@ use super::{prepared, AppError};
 use crate::continuation::{ContinuationError, ContinuationOptions, Curve, Family};
 use crate::family::curves::{two_param_curves, CurveRecord, FollowedParam};
 use crate::family::diagram::{
-    drop_unlocated, follow_families, stopped, DiagramSettings, EndRecord, FollowedFamily,
+    drop_unlocated, follow_families, DiagramSettings, EndRecord, FollowedFamily,
 };
 use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::MAX_PERIOD;
 use crate::gait::{find_gait_any_period, find_periodic_gait, GaitOptions, Stability, StepMap};
 use crate::params::Config;
+use crate::walk::interrupt::stop_requested;
 use crate::walk::SectionState;
 
 /// The quantities the bifurcation diagram can draw against the parameter (`--plot`).
@@ -243,7 +244,7 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         drop_unlocated(&mut families, &mut warnings);
     }
     let (records, special_points, stability) = family_records(job, &families, &mut warnings);
-    if stopped(flag) {
+    if stop_requested(flag) {
         let note = "the stability verdicts within 1e-3 of the unit circle judged after it are `uncertain` \
                     (their DP's error estimate was not computed)";
         interrupted = Some(match interrupted {
@@ -261,7 +262,7 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
             let q0 = check_two_param(&job.param, &config, second)?;
             let maps: Vec<_> = families.iter().map(|f| (&f.family, f.map)).collect();
             let curves = two_param_curves(&followed, second, q0, &maps, &mut warnings);
-            if stopped(flag) {
+            if stop_requested(flag) {
                 interrupted =
                     Some("while following the two-parameter curves: none is kept".to_string());
                 (Vec::new(), Vec::new())

@@ -171,8 +171,7 @@ fn check_phase_interrupted(
     during: &str,
     kept: &str,
 ) -> Result<(), AppError> {
-    let job_flag = flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst));
-    if job_flag || crate::walk::interrupted() {
+    if crate::walk::interrupt::stop_requested(flag) {
         Err(AppError::Interrupted {
             during: during.to_string(),
             kept: kept.to_string(),

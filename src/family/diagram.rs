@@ -18,6 +18,7 @@ use crate::family::natural::{EndCause, GaitPoint, NaturalContinuation};
 use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::GaitOptions;
 use crate::params::Config;
+use crate::walk::interrupt::stop_requested;
 
 /// How a family ends at one side, with the physical cause found by walking just past it.
 #[derive(Debug, Clone, Serialize)]
@@ -295,12 +296,12 @@ pub fn follow_families<'a>(
     };
     let families = &mut followed.families;
     let mut next = 0;
-    while next < families.len() && !stopped(flag) {
+    while next < families.len() && !stop_requested(flag) {
         let ends = families[next].family.ends.clone().map(|end| {
             let cause = end_cause(config, settings.param, &families[next], &end);
             EndRecord { end, cause }
         });
-        if stopped(flag) {
+        if stop_requested(flag) {
             break;
         }
         families[next].ends = Some(ends.clone());
@@ -309,7 +310,7 @@ pub fn follow_families<'a>(
         } else {
             Vec::new()
         };
-        if stopped(flag) {
+        if stop_requested(flag) {
             break;
         }
         for outcome in born {
@@ -328,7 +329,7 @@ pub fn follow_families<'a>(
         }
         next += 1;
     }
-    if stopped(flag) {
+    if stop_requested(flag) {
         followed.interrupted = Some(format!(
             "while following family {} of {}: the points, ends and special points found before it are \
              kept; families not followed to their ends end as `interrupted`, and no family born after it \
@@ -355,11 +356,6 @@ pub fn drop_unlocated(families: &mut [FollowedFamily], warnings: &mut Vec<String
             ));
         }
     }
-}
-
-/// Is the job's interrupt flag or the library's set?
-pub(crate) fn stopped(flag: Option<&AtomicBool>) -> bool {
-    flag.is_some_and(|f| f.load(std::sync::atomic::Ordering::SeqCst)) || crate::walk::interrupted()
 }
 
 /// What the walk from the last gait does just past an end where the map failed (`NaturalContinuation::end_cause`).
