@@ -21,7 +21,7 @@ use crate::output::{write_curves_csv, write_family_csv, write_json, CurveRow, Fa
 /// [`AppError::Interrupted`] (the manifest says `interrupted`).
 pub fn run_continuation(job: &ContinueJob) -> Result<ContinueResult, AppError> {
     job.validate()?;
-    RunDir::check(&job.out_dir, "continue", job.overwrite)?;
+    crate::output::manifest::check_out_dir(&job.out_dir, "continue", job.overwrite)?;
     let mut result = compute_continuation(job)?;
     in_run(&job.out_dir, job.overwrite, "continue", |run| {
         write_continuation(job, &mut result, run)?;

@@ -101,7 +101,7 @@ pub const MIN_GAIT_TOLERANCE: f64 = TOLERANCE_RANGE[0];
 pub fn run_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     job.options.validate()?;
     job.config.validate()?;
-    RunDir::check(&job.out_dir, "gait", job.overwrite)?;
+    crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
     let summary = compute_gait(job)?;
     in_run(&job.out_dir, job.overwrite, "gait", |run| {
         output::write_json(&run.path("gait.json"), &summary)?;

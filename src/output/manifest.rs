@@ -187,19 +187,6 @@ pub struct RunDir {
 }
 
 impl RunDir {
-    /// Check, before a job of `command` computes anything, that it may write `dir` (see [`check_out_dir`]);
-    /// the earlier run it would replace, if any.
-    ///
-    /// # Errors
-    /// As [`check_out_dir`].
-    pub fn check(
-        dir: &Path,
-        command: &str,
-        overwrite: bool,
-    ) -> Result<Option<Replaced>, OutputError> {
-        check_out_dir(dir, command, overwrite)
-    }
-
     /// Start a run of `command` in `dir`: check it ([`check_out_dir`]), remove the earlier run it replaces (the
     /// files its manifest lists, the files its command writes, and temporary files of a killed run; never a
     /// file vrw does not write), and write the manifest with the status `running`.
@@ -208,8 +195,8 @@ impl RunDir {
     /// [`OutputError`] naming the directory (or the stale file) when it cannot be created, written or cleared,
     /// or when it holds files vrw did not write, or another command's run without `overwrite`.
     pub fn start(dir: &Path, command: &str, overwrite: bool) -> Result<RunDir, OutputError> {
-        check_out_dir(dir, command, overwrite)?;
-        let replaced = clear(dir)?;
+        let replaced = check_out_dir(dir, command, overwrite)?;
+        clear(dir, replaced.as_ref())?;
         let run = RunDir {
             dir: dir.to_path_buf(),
             manifest: Manifest {
@@ -435,38 +422,21 @@ fn probe(dir: &Path) -> Result<(), OutputError> {
     std::fs::remove_file(&path).map_err(io)
 }
 
-/// Remove the earlier run in `dir` (checked by [`check_out_dir`]): the files of its run, its manifest and
-/// temporary files of vrw. Returns what was removed.
-fn clear(dir: &Path) -> Result<Option<Replaced>, OutputError> {
-    let manifest = match Manifest::read(dir) {
-        Ok(m) => m,
-        Err(ManifestError::Missing { .. }) => {
-            remove_temporary(dir)?;
-            return Ok(None);
-        }
-        Err(e) => {
-            return Err(OutputError::NotVrwDir {
-                dir: dir.to_path_buf(),
-                files: String::new(),
-                why: e.to_string(),
-            })
-        }
-    };
-    let files = files_of_run(&manifest, &plain_files(dir)?);
-    for name in files.iter().map(String::as_str).chain([MANIFEST]) {
-        let path = dir.join(name);
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(OutputError::Io { path, source: e })
+/// Remove the earlier run `replaced` in `dir` ([`check_out_dir`]'s answer: the files of its run, and its
+/// manifest) and vrw's temporary files.
+fn clear(dir: &Path, replaced: Option<&Replaced>) -> Result<(), OutputError> {
+    if let Some(replaced) = replaced {
+        for name in replaced.files.iter().map(String::as_str).chain([MANIFEST]) {
+            let path = dir.join(name);
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(OutputError::Io { path, source: e })
+                }
+                _ => {}
             }
-            _ => {}
         }
     }
-    remove_temporary(dir)?;
-    Ok(Some(Replaced {
-        command: manifest.command,
-        files,
-    }))
+    remove_temporary(dir)
 }
 
 /// Remove vrw's temporary files from `dir` (a killed run's).
