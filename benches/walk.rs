@@ -244,7 +244,8 @@ fn family(c: &mut Criterion) {
         None,
     )
     .expect("the gait");
-    let family_map = GaitFamily::new(&config, "viscosity", gait.section).expect("a numeric key");
+    let parameter = vrw::family::Parameter::named(&config, "viscosity").expect("a numeric key");
+    let family_map = GaitFamily::new(parameter, gait.section);
     let x0 = family_map.reduce(&gait.section);
     let options = ContinuationOptions {
         max_points: 150,
@@ -287,7 +288,8 @@ fn map_curves(c: &mut Criterion) {
     let options = GaitOptions::default();
     let map = map_gaits(&config, &spec, &default_initial(&config), &options, &|_| {})
         .expect("the default map");
-    let crossings = map_curves_of(&config, &map, &options, DEFAULT_CURVE_COLUMNS);
+    let crossings =
+        map_curves_of(&config, &map, &options, DEFAULT_CURVE_COLUMNS).expect("valid keys");
     let mut group = c.benchmark_group("map_curves");
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(15));

@@ -3,6 +3,7 @@
 use approx::assert_relative_eq;
 
 use vrw::dynamics::Model;
+use vrw::family::Parameter;
 use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::integrate::Method;
 use vrw::params::Config;
@@ -292,7 +293,11 @@ fn sweep_thresholds_do_not_depend_on_the_grid() {
             points,
         };
         let sweep_points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
-        let thresholds = find_thresholds(&config, &spec, &sweep_points, &GaitOptions::default());
+        let thresholds = find_thresholds(
+            Parameter::named(&config, &spec.param).unwrap(),
+            &sweep_points,
+            &GaitOptions::default(),
+        );
         let names: Vec<&str> = thresholds.iter().map(|t| t.name.as_str()).collect();
         assert_eq!(names, ["gait_lost"], "{points} points: {thresholds:?}");
         let t = &thresholds[0];
@@ -333,7 +338,11 @@ fn gait_and_thresholds_do_not_depend_on_the_integrator() {
         let model = Model::new(&config.params).unwrap();
         gaits.push(paper_gait(&StepMap::new(&model, &config.solver), &config));
         let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
-        let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+        let thresholds = find_thresholds(
+            Parameter::named(&config, &spec.param).unwrap(),
+            &points,
+            &GaitOptions::default(),
+        );
         assert_eq!(thresholds.len(), 1, "{method}: {thresholds:?}");
         ends.push(thresholds[0].value);
     }
@@ -372,7 +381,11 @@ fn stiffness_sweep_follows_the_gait_to_where_it_rolls_back() {
             points,
         };
         let sweep_points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
-        let thresholds = find_thresholds(&config, &spec, &sweep_points, &GaitOptions::default());
+        let thresholds = find_thresholds(
+            Parameter::named(&config, &spec.param).unwrap(),
+            &sweep_points,
+            &GaitOptions::default(),
+        );
         let lost = thresholds
             .iter()
             .find(|t| t.name == "gait_lost")
@@ -416,7 +429,11 @@ fn sweep_points_carry_their_family_and_an_honest_stability_verdict() {
         }
     }
     // The start of the family (the slope below which the wheel rolls back) is a `gait_found`, not a loss.
-    let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+    let thresholds = find_thresholds(
+        Parameter::named(&config, &spec.param).unwrap(),
+        &points,
+        &GaitOptions::default(),
+    );
     assert_eq!(thresholds.len(), 1, "{thresholds:?}");
     assert_eq!(thresholds[0].name, "gait_found");
 }
@@ -469,7 +486,11 @@ fn a_family_cut_by_the_step_time_limit_says_so() {
     };
     let options = GaitOptions::default();
     let points = sweep(&config, &spec, &start, &options, &|_| {}).unwrap();
-    let thresholds = find_thresholds(&config, &spec, &points, &options);
+    let thresholds = find_thresholds(
+        Parameter::named(&config, &spec.param).unwrap(),
+        &points,
+        &options,
+    );
     let end = thresholds
         .iter()
         .find(|t| t.name == "gait_found")
@@ -483,7 +504,11 @@ fn a_family_cut_by_the_step_time_limit_says_so() {
     let mut longer = config.clone();
     longer.solver.max_step_time = 120.0;
     let points = sweep(&longer, &spec, &start, &options, &|_| {}).unwrap();
-    let thresholds = find_thresholds(&longer, &spec, &points, &options);
+    let thresholds = find_thresholds(
+        Parameter::named(&longer, &spec.param).unwrap(),
+        &points,
+        &options,
+    );
     assert!(
         thresholds
             .iter()
@@ -509,7 +534,11 @@ fn stability_thresholds_say_which_side_is_stable() {
         points: 4,
     };
     let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
-    let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+    let thresholds = find_thresholds(
+        Parameter::named(&config, &spec.param).unwrap(),
+        &points,
+        &GaitOptions::default(),
+    );
     let change = thresholds
         .iter()
         .find(|t| (t.value - 5.673929).abs() < 1e-6)
@@ -542,7 +571,11 @@ fn every_change_of_family_is_named() {
         points: 76,
     };
     let points = sweep(&config, &spec, &start, &GaitOptions::default(), &|_| {}).unwrap();
-    let thresholds = find_thresholds(&config, &spec, &points, &GaitOptions::default());
+    let thresholds = find_thresholds(
+        Parameter::named(&config, &spec.param).unwrap(),
+        &points,
+        &GaitOptions::default(),
+    );
     let mut changes = 0;
     for pair in points.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);

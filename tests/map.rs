@@ -1,5 +1,6 @@
 //! Maps over two parameters (docs/model.md section 6): rows are sweeps, curves are refined 1-D thresholds.
 
+use vrw::family::Parameter;
 use vrw::gait::GaitOptions;
 use vrw::params::Config;
 use vrw::reference::default_initial;
@@ -48,7 +49,7 @@ fn map_rows_and_curves_agree_with_one_dimensional_sweeps() {
     let start = default_initial(&config);
     let spec = spec();
     let map = map_gaits(&config, &spec, &start, &options(), &|_| {}).unwrap();
-    let curves = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS);
+    let curves = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS).unwrap();
     assert!(
         curves.curves.iter().any(|c| c.name == "existence_end"),
         "{:?}",
@@ -76,11 +77,15 @@ fn map_rows_and_curves_agree_with_one_dimensional_sweeps() {
                 "row {line} of the map is the sweep along x"
             );
         }
-        let mut expected: Vec<f64> = find_thresholds(&line_config, &line_spec, &points, &options())
-            .iter()
-            .map(|t| t.value)
-            .filter(|v| v.is_finite())
-            .collect();
+        let mut expected: Vec<f64> = find_thresholds(
+            Parameter::named(&line_config, &line_spec.param).unwrap(),
+            &points,
+            &options(),
+        )
+        .iter()
+        .map(|t| t.value)
+        .filter(|v| v.is_finite())
+        .collect();
         expected.sort_by(f64::total_cmp);
         let coordinate = usize::from(along == Along::Y);
         let mut on_line: Vec<f64> = curves
@@ -178,12 +183,20 @@ fn thresholds_reuse_the_sweeps_failed_continuations_exactly() {
         points.iter().any(|p| !p.attempts.is_empty()),
         "the sweep recorded the continuation that did not reach the point past the end"
     );
-    let reused = find_thresholds(&config, &spec, &points, &options());
+    let reused = find_thresholds(
+        Parameter::named(&config, &spec.param).unwrap(),
+        &points,
+        &options(),
+    );
     let mut cleared = points.clone();
     for p in &mut cleared {
         p.attempts.clear();
     }
-    let afresh = find_thresholds(&config, &spec, &cleared, &options());
+    let afresh = find_thresholds(
+        Parameter::named(&config, &spec.param).unwrap(),
+        &cleared,
+        &options(),
+    );
     assert!(reused.iter().any(|t| t.name == "gait_lost"), "{reused:?}");
     assert_eq!(
         serde_json::to_string(&reused).unwrap(),
@@ -198,8 +211,8 @@ fn curves_on_fewer_columns_keep_every_row_crossing() {
     let config = Config::default();
     let start = default_initial(&config);
     let map = map_gaits(&config, &spec(), &start, &options(), &|_| {}).unwrap();
-    let all = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS);
-    let few = map_curves(&config, &map, &options(), 3);
+    let all = map_curves(&config, &map, &options(), DEFAULT_CURVE_COLUMNS).unwrap();
+    let few = map_curves(&config, &map, &options(), 3).unwrap();
     let refined = vrw::study::map::curve_columns(map.xs.len(), 3);
     assert_eq!(refined, [0, 2, 4]);
     let rows = |c: &vrw::study::MapCurves| -> Vec<String> {

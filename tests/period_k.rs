@@ -218,7 +218,11 @@ fn lambda_two_plus_vanishes_where_the_period_one_family_gives_way_to_period_two(
         let points =
             vrw::study::sweep(&config, &spec, &default_initial(&config), &options, &|_| {})
                 .unwrap();
-        let thresholds = vrw::study::find_thresholds(&config, &spec, &points, &options);
+        let thresholds = vrw::study::find_thresholds(
+            vrw::family::Parameter::named(&config, &spec.param).unwrap(),
+            &points,
+            &options,
+        );
         let zero = thresholds
             .iter()
             .find(|t| t.name == "lambda_2_plus = 0")

@@ -16,7 +16,7 @@ use crate::family::curves::{two_param_curves, CurveRecord, FollowedParam};
 use crate::family::diagram::{
     drop_unlocated, follow_families, DiagramSettings, EndRecord, FollowedFamily,
 };
-use crate::family::{GaitFamily, GaitInfo};
+use crate::family::{GaitFamily, GaitInfo, Parameter};
 use crate::gait::MAX_PERIOD;
 use crate::gait::{find_gait_any_period, find_periodic_gait, GaitOptions, Stability, StepMap};
 use crate::params::Config;
@@ -224,19 +224,17 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
     let flag = job.interrupt.as_deref();
     let gait = first_gait(job, &model, &config, &initial, start)?;
     // The step map P itself (every family's map is an iterate of it), and the first family's P^k.
-    let base_map = GaitFamily::new(&config, &job.param, gait.section)
-        .map_err(|e| AppError::InvalidOption {
-            option: "param",
-            reason: e.message,
-        })?
-        .with_interrupt(flag);
+    let parameter = Parameter::named(&config, &job.param).map_err(|e| AppError::InvalidOption {
+        option: "param",
+        reason: e.to_string(),
+    })?;
+    let base_map = GaitFamily::new(parameter, gait.section).with_interrupt(flag);
     let options = job.options();
     let settings = DiagramSettings {
-        param: &job.param,
         switch: job.switch,
         interrupt: flag,
     };
-    let followed = follow_families(&settings, &config, base_map, &gait, start, &options)
+    let followed = follow_families(&settings, base_map, &gait, start, &options)
         .map_err(|e| continuation_error(e, &job.param))?;
     let (mut families, mut warnings) = (followed.families, followed.warnings);
     let mut interrupted = followed.interrupted;

@@ -124,7 +124,7 @@ pub fn compute_map(
             curves: false,
             ..job.clone()
         };
-        let mut gaits = map_summary(&gaits_only, &map, summary.seconds[0]);
+        let mut gaits = map_summary(&gaits_only, &map, summary.seconds[0])?;
         gaits.interrupted = Some(format!("{during}; {kept}"));
         return Ok((gaits, map));
     }
@@ -172,7 +172,7 @@ fn summarized_rows(
     )?;
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
-    let summary = map_summary(job, &map, clock.elapsed().as_secs_f64());
+    let summary = map_summary(job, &map, clock.elapsed().as_secs_f64())?;
     Ok((summary, map))
 }
 
@@ -209,7 +209,7 @@ fn map_into(
     run.add("map.csv");
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;
-    let mut summary = map_summary(job, &map, gait_seconds);
+    let mut summary = map_summary(job, &map, gait_seconds)?;
     check_curves_interrupted("map.csv holds every point of the map")?;
     let curves_json = run.path("curves.json");
     output::write_json(&curves_json, &summary)?;
@@ -240,12 +240,12 @@ fn check_curves_interrupted(kept: &str) -> Result<(), AppError> {
 }
 
 /// The curves of `map` (with `job.curves`) and the summary of the map and its curves.
-fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> MapSummary {
+fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> Result<MapSummary, AppError> {
     let clock = std::time::Instant::now();
     let mut curve_warnings = Vec::new();
     let mut continuation_seconds = 0.0;
     let (curves, thresholds) = if job.curves {
-        let mut c = map_curves(&job.config, map, &job.options, job.curve_columns);
+        let mut c = map_curves(&job.config, map, &job.options, job.curve_columns)?;
         if job.continue_curves {
             let clock = std::time::Instant::now();
             curve_warnings = continue_map_curves(&job.config, map, &mut c);
@@ -287,7 +287,7 @@ fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> MapSummary {
         })),
     };
     summary.warnings.extend(curve_warnings);
-    summary
+    Ok(summary)
 }
 
 /// With `job.second_route` (and curves): the whole map again with the other integrator, each threshold of
@@ -308,7 +308,7 @@ fn second_route(
         "map.csv, curves.json and the heat maps of the first route are complete; no threshold is \
                 confirmed by a second route";
     check_phase_interrupted(None, &format!("during the second route ({route})"), kept)?;
-    let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns);
+    let second = map_curves(&second_config, &second_map, &job.options, job.curve_columns)?;
     check_phase_interrupted(None, &format!("during the second route ({route})"), kept)?;
     for t in &mut summary.thresholds {
         let same_line = second

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
+use crate::family::Parameter;
 use crate::fmt::short;
 use crate::gait::GaitOptions;
 use crate::output;
@@ -203,15 +204,8 @@ pub fn compute_sweep(
     let sweep_seconds = clock.elapsed().as_secs_f64();
     swept(&points)?;
     check_interrupted(points.len(), values.len(), "sweep.csv")?;
-    // The thresholds read the parameter's name from the spec; the range is the values' span.
-    let spec = SweepSpec {
-        param: param.to_string(),
-        from: values.first().copied().unwrap_or(f64::NAN),
-        to: values.last().copied().unwrap_or(f64::NAN),
-        points: values.len(),
-    };
     let clock = std::time::Instant::now();
-    let mut thresholds = find_thresholds(config, &spec, &points, options);
+    let mut thresholds = find_thresholds(Parameter::named(config, param)?, &points, options);
     // Thresholds searched while the flag was set are not results (their walks were cut short).
     check_phase_interrupted(
         None,

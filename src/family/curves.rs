@@ -1,14 +1,16 @@
 //! The curves of the families' special points in a second parameter (docs/model.md section 11, "Two-parameter
 //! curves"; `vrw continue --two-param`), and their records in `special_points.json`.
 
+use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 use crate::continuation::curve::{
     border_curve_seed, CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
 };
-use crate::continuation::special::{test_function, test_name};
+use crate::continuation::special::{test_function, test_name, SpecialPoint};
 use crate::continuation::{
-    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Family, SpecialKind,
+    continue_curve, Curve, CurveEnd, CurveOptions, CurveProblem, Evaluation, Family, MapFailure,
+    SpecialKind,
 };
 use crate::family::{GaitFamily, GaitInfo};
 
@@ -60,96 +62,163 @@ pub fn two_param_curves(
     let options = CurveOptions::for_ranges((job.from, job.to), (*from, *to));
     let mut records = Vec::new();
     let mut curves = Vec::new();
-    let mut index = 0;
-    for (k, (family, family_map)) in families.iter().enumerate() {
-        for sp in &family.special {
-            let this = index;
-            index += 1;
-            if !sp.located {
-                continue;
+    let located = families
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (family, map))| family.special.iter().map(move |sp| (k, *family, *map, sp)));
+    for (index, (k, family, map, sp)) in located.enumerate() {
+        if !sp.located {
+            continue;
+        }
+        let at = format!(
+            "family {} {} at {} = {}",
+            k + 1,
+            sp.kind,
+            job.param,
+            sp.param
+        );
+        let Some(seed) = CurveSeed::of(sp, family, map, &at, warnings) else {
+            continue;
+        };
+        let followed = seed.with_problem(map, name, |problem| {
+            seed.follow(problem, (seed.p, q0), &options)
+        });
+        match followed {
+            Ok(curve) => {
+                records.push(CurveRecord {
+                    curve: records.len() + 1,
+                    family: k + 1,
+                    special_point: index,
+                    kind: sp.kind,
+                    condition: seed.condition.clone(),
+                    param2: name.clone(),
+                    points: curve.points.len(),
+                    ends: curve.ends.clone(),
+                    method: seed.method(),
+                });
+                curves.push(curve);
             }
-            let map = *family_map;
-            let at = format!(
-                "family {} {} at {} = {}",
-                k + 1,
-                sp.kind,
-                job.param,
-                sp.param
-            );
-            // What is followed, from where: an indicator border on the family's side of it, from the family's
-            // point nearest the collision clearly on that side; a fold, period doubling or Neimark-Sacker point
-            // by its test function of `DP`, from the located point.
-            let (jacobian_test, offset, start, border) = match sp.kind {
-                SpecialKind::BorderCollision => {
-                    let Some(border) = sp.border.clone().filter(|b| b != "event sequence") else {
-                        continue;
-                    };
-                    let Some((before, side)) =
-                        border_curve_seed(family_map, family, sp.arclength, &border)
-                    else {
-                        warnings.push(format!(
-                            "{at} ({border}): no point of the family lies clearly on one side of the \
-                             border; no curve followed"
-                        ));
-                        continue;
-                    };
-                    (
-                        None,
-                        BORDER_OFFSET.copysign(side),
-                        (before.x.clone(), before.param),
-                        border,
-                    )
-                }
-                kind => {
-                    let Some(test) = test_function(kind) else {
-                        continue;
-                    };
-                    (
-                        Some(test),
-                        0.0,
-                        (sp.x.clone(), sp.param),
-                        test_name(kind).to_string(),
-                    )
-                }
-            };
-            let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.eval_with(name, x, p, q);
-            let observe =
-                |x: &nalgebra::DVector<f64>, p: f64, q: f64| map.observe_with(name, x, p, q);
-            let condition = jacobian_test.map_or(CurveTest::Border(&border), CurveTest::Jacobian);
-            let test =
-                |ev: &crate::continuation::Evaluation<GaitInfo>| condition.of(family_map, ev);
-            let problem = CurveProblem {
-                eval: &eval,
-                observe: (!condition.needs_derivatives()).then_some(&observe),
-                test: &test,
-                offset,
-            };
-            match continue_curve(&problem, &start.0, (start.1, q0), &options) {
-                Ok(curve) => {
-                    let aim = if offset == 0.0 {
-                        String::new()
-                    } else {
-                        format!(
-                            " (the family's side), steps at {:e}, polished",
-                            offset * FOLLOW_OFFSET_FACTOR
-                        )
-                    };
-                    records.push(CurveRecord {
-                        curve: records.len() + 1,
-                        family: k + 1,
-                        special_point: this,
-                        kind: sp.kind,
-                        condition: border.clone(),
-                        param2: name.clone(),
-                        points: curve.points.len(),
-                        ends: curve.ends.clone(),
-                        method: format!("pseudo-arclength on P(x) = x, {border} = {offset:e}{aim}"),
-                    });
-                    curves.push(curve);
-                }
-                Err(e) => warnings.push(format!("{at}: no curve in {name}: {}", e.message)),
-            }
+            Err(e) => warnings.push(format!("{at}: no curve in {name}: {}", e.message)),
         }
     }
     (records, curves)
+}
+
+/// What a special point's curve follows, and from where: an indicator border on the family's side of it, from
+/// the family's point nearest the collision clearly on that side; a fold, period doubling or Neimark-Sacker
+/// point by its test function of `DP`, from the located point.
+pub(crate) struct CurveSeed {
+    /// The test function of `DP` (`None` for a border).
+    jacobian_test: Option<fn(&DMatrix<f64>) -> f64>,
+    /// The offset from the border that is followed (0 for a test function).
+    pub offset: f64,
+    /// The start's free coordinates.
+    x: DVector<f64>,
+    /// The start's value of the family's parameter.
+    pub p: f64,
+    /// The function that is zero along the curve ([`CurveRecord::condition`]).
+    pub condition: String,
+}
+
+impl CurveSeed {
+    /// The seed of the curve of `sp`, a special point of `family` (with its map), named `at` in warnings; `None`
+    /// where no curve is followed (a border collision of the event sequence, or without a point clearly on
+    /// one side of the border: a warning).
+    fn of(
+        sp: &SpecialPoint<GaitInfo>,
+        family: &Family<GaitInfo>,
+        map: GaitFamily,
+        at: &str,
+        warnings: &mut Vec<String>,
+    ) -> Option<CurveSeed> {
+        if sp.kind != SpecialKind::BorderCollision {
+            return CurveSeed::at_special(sp);
+        }
+        let border = sp.border.as_deref().filter(|b| *b != "event sequence")?;
+        let seed = CurveSeed::at_border(&map, family, sp.arclength, border);
+        if seed.is_none() {
+            warnings.push(format!(
+                "{at} ({border}): no point of the family lies clearly on one side of the border; no curve \
+                 followed"
+            ));
+        }
+        seed
+    }
+
+    /// The curve of the special point `sp` (a fold, period doubling or Neimark-Sacker point) by its test
+    /// function, from the located point (`None` for a border collision).
+    pub(crate) fn at_special(sp: &SpecialPoint<GaitInfo>) -> Option<CurveSeed> {
+        Some(CurveSeed {
+            jacobian_test: Some(test_function(sp.kind)?),
+            offset: 0.0,
+            x: sp.x.clone(),
+            p: sp.param,
+            condition: test_name(sp.kind).to_string(),
+        })
+    }
+
+    /// The curve of `border` on the side of `family` (of `map`) where its points near the arclength `s` lie,
+    /// from the one nearest `s` clearly on that side ([`border_curve_seed`]); `None` without such a point.
+    pub(crate) fn at_border(
+        map: &GaitFamily,
+        family: &Family<GaitInfo>,
+        s: f64,
+        border: &str,
+    ) -> Option<CurveSeed> {
+        let (before, side) = border_curve_seed(map, family, s, border)?;
+        Some(CurveSeed {
+            jacobian_test: None,
+            offset: BORDER_OFFSET.copysign(side),
+            x: before.x.clone(),
+            p: before.param,
+            condition: border.to_string(),
+        })
+    }
+
+    /// `f` of the curve problem of this seed in the configuration of `map`, with the second parameter `second`:
+    /// the fixed point of `P(x; p, q)` and the seed's condition.
+    pub(crate) fn with_problem<R>(
+        &self,
+        map: GaitFamily,
+        second: &str,
+        f: impl FnOnce(&CurveProblem<'_, GaitInfo>) -> R,
+    ) -> R {
+        let eval = |x: &DVector<f64>, p: f64, q: f64| map.eval_with(second, x, p, q);
+        let observe = |x: &DVector<f64>, p: f64, q: f64| map.observe_with(second, x, p, q);
+        let condition = self
+            .jacobian_test
+            .map_or(CurveTest::Border(&self.condition), CurveTest::Jacobian);
+        let test = |ev: &Evaluation<GaitInfo>| condition.of(&map, ev);
+        f(&CurveProblem {
+            eval: &eval,
+            observe: (!condition.needs_derivatives()).then_some(&observe),
+            test: &test,
+            offset: self.offset,
+        })
+    }
+
+    /// The curve of `problem` (this seed's, [`CurveSeed::with_problem`]) from the seed's point with the
+    /// parameters at `at`.
+    pub(crate) fn follow(
+        &self,
+        problem: &CurveProblem<'_, GaitInfo>,
+        at: (f64, f64),
+        options: &CurveOptions,
+    ) -> Result<Curve<GaitInfo>, MapFailure> {
+        continue_curve(problem, &self.x, at, options)
+    }
+
+    /// How the curve is computed, in words ([`CurveRecord::method`]).
+    fn method(&self) -> String {
+        let (border, offset) = (&self.condition, self.offset);
+        let aim = if offset == 0.0 {
+            String::new()
+        } else {
+            format!(
+                " (the family's side), steps at {:e}, polished",
+                offset * FOLLOW_OFFSET_FACTOR
+            )
+        };
+        format!("pseudo-arclength on P(x) = x, {border} = {offset:e}{aim}")
+    }
 }

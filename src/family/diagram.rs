@@ -12,12 +12,11 @@ use crate::continuation::corrector::solve_on_hyperplane;
 use crate::continuation::special::JUMP_TOL;
 use crate::continuation::{
     continue_family, switch_at_border, switch_at_period_doubling, ContinuationError,
-    ContinuationOptions, Family, FamilyEnd, FamilyMap, SpecialKind,
+    ContinuationOptions, Family, FamilyEnd, FamilyMap, SpecialKind, SpecialPoint,
 };
 use crate::family::natural::{EndCause, GaitPoint, NaturalContinuation};
 use crate::family::{GaitFamily, GaitInfo};
 use crate::gait::GaitOptions;
-use crate::params::Config;
 use crate::walk::interrupt::stop_requested;
 
 /// How a family ends at one side, with the physical cause found by walking just past it.
@@ -44,23 +43,33 @@ pub struct FollowedFamily<'a> {
 }
 
 /// The families born from family `k` (branch switching): the period-2 family of each of its located period
-/// doublings, the other piece's family at each border collision where it ends, and the family of each gait that a walk past one of its `ends` settles on (unless a family
-/// already followed passes through that gait). A family that cannot be started is a warning.
+/// doublings, the other piece's family at each border collision where it ends, and the family of each gait that
+/// a walk past one of its `ends` settles on (unless a family already followed passes through that gait). A
+/// family that cannot be started is a warning.
 fn switched_families<'a>(
-    param: &str,
     k: usize,
     families: &[FollowedFamily<'a>],
     base_map: GaitFamily<'a>,
     ends: &[EndRecord; 2],
     options: &ContinuationOptions,
 ) -> Vec<Result<FollowedFamily<'a>, String>> {
-    let parent = &families[k];
-    let mut born = Vec::new();
-    for (i, pd) in parent.family.special.iter().enumerate() {
-        if pd.kind != SpecialKind::PeriodDoubling || !pd.located {
-            continue;
-        }
-        born.push(
+    let mut born = period_doubling_families(k, &families[k], options);
+    born.extend(border_families(k, &families[k], options));
+    born.extend(end_families(k, families, base_map, ends, options));
+    born
+}
+
+/// The period-2 family of each located period doubling of `parent` (family `k`).
+fn period_doubling_families<'a>(
+    k: usize,
+    parent: &FollowedFamily<'a>,
+    options: &ContinuationOptions,
+) -> Vec<Result<FollowedFamily<'a>, String>> {
+    let param = parent.map.param();
+    let doublings = parent.family.special.iter().enumerate();
+    doublings
+        .filter(|(_, pd)| pd.kind == SpecialKind::PeriodDoubling && pd.located)
+        .map(|(i, pd)| {
             switch_at_period_doubling(&parent.map, pd, options)
                 .map(|family| FollowedFamily {
                     family,
@@ -75,21 +84,32 @@ fn switched_families<'a>(
                         param,
                         pd.param
                     )
-                }),
-        );
-    }
-    for (i, bc) in parent.family.special.iter().enumerate() {
-        // Where the map jumps across the border, no fixed point of the other piece is near: the walk past
-        // the end (below) looks for what takes over.
-        if bc.kind != SpecialKind::BorderCollision
-            || !bc.ends_family
-            || !bc.located
-            || bc.jump.is_nan()
-            || bc.jump > JUMP_TOL
-        {
-            continue;
-        }
-        born.push(
+                })
+        })
+        .collect()
+}
+
+/// The other piece's family at each located border collision that ends `parent` (family `k`) without a jump of
+/// the map across the border.
+fn border_families<'a>(
+    k: usize,
+    parent: &FollowedFamily<'a>,
+    options: &ContinuationOptions,
+) -> Vec<Result<FollowedFamily<'a>, String>> {
+    let param = parent.map.param();
+    // Where the map jumps across the border, no fixed point of the other piece is near: the walk past the end
+    // ([`end_families`]) looks for what takes over.
+    let continuous_ends = |bc: &&SpecialPoint<GaitInfo>| {
+        bc.kind == SpecialKind::BorderCollision
+            && bc.ends_family
+            && bc.located
+            && !bc.jump.is_nan()
+            && bc.jump <= JUMP_TOL
+    };
+    let collisions = parent.family.special.iter().enumerate();
+    collisions
+        .filter(|(_, bc)| continuous_ends(bc))
+        .map(|(i, bc)| {
             switch_at_border(&parent.map, bc, options)
                 .map(|family| FollowedFamily {
                     family,
@@ -107,9 +127,22 @@ fn switched_families<'a>(
                         param,
                         bc.param
                     )
-                }),
-        );
-    }
+                })
+        })
+        .collect()
+}
+
+/// The family of each gait that a walk past one of the `ends` of family `k` settles on, unless a family already
+/// followed passes through that gait or it lies outside the continuation's range.
+fn end_families<'a>(
+    k: usize,
+    families: &[FollowedFamily<'a>],
+    base_map: GaitFamily<'a>,
+    ends: &[EndRecord; 2],
+    options: &ContinuationOptions,
+) -> Vec<Result<FollowedFamily<'a>, String>> {
+    let param = base_map.param();
+    let mut born = Vec::new();
     for end in ends {
         let (
             Some(EndCause::OtherGait {
@@ -247,11 +280,9 @@ pub struct Diagram<'a> {
     pub interrupted: Option<String>,
 }
 
-/// What [`follow_families`] follows besides the start: the parameter, whether to switch to the families born
-/// at special points and ends, and the job's interrupt flag (the library's is read too).
+/// What [`follow_families`] follows besides the start: whether to switch to the families born at special
+/// points and ends, and the job's interrupt flag (the library's is read too).
 pub struct DiagramSettings<'s> {
-    /// The parameter followed (a key of the configuration).
-    pub param: &'s str,
     /// Follow the families born at period doublings, border collisions and ends (up to [`MAX_FAMILIES`]).
     pub switch: bool,
     /// The job's own interrupt flag.
@@ -270,7 +301,6 @@ pub const MAX_FAMILIES: usize = 8;
 /// The first family could not be started.
 pub fn follow_families<'a>(
     settings: &DiagramSettings,
-    config: &Config,
     base_map: GaitFamily<'a>,
     gait: &crate::gait::Gait,
     start: f64,
@@ -298,7 +328,7 @@ pub fn follow_families<'a>(
     let mut next = 0;
     while next < families.len() && !stop_requested(flag) {
         let ends = families[next].family.ends.clone().map(|end| {
-            let cause = end_cause(config, settings.param, &families[next], &end);
+            let cause = end_cause(&families[next], &end);
             EndRecord { end, cause }
         });
         if stop_requested(flag) {
@@ -306,7 +336,7 @@ pub fn follow_families<'a>(
         }
         families[next].ends = Some(ends.clone());
         let born = if settings.switch {
-            switched_families(settings.param, next, families, base_map, &ends, options)
+            switched_families(next, families, base_map, &ends, options)
         } else {
             Vec::new()
         };
@@ -359,12 +389,7 @@ pub fn drop_unlocated(families: &mut [FollowedFamily], warnings: &mut Vec<String
 }
 
 /// What the walk from the last gait does just past an end where the map failed (`NaturalContinuation::end_cause`).
-fn end_cause(
-    config: &Config,
-    param: &str,
-    followed: &FollowedFamily,
-    end: &FamilyEnd,
-) -> Option<EndCause> {
+fn end_cause(followed: &FollowedFamily, end: &FamilyEnd) -> Option<EndCause> {
     let (family, map) = (&followed.family, &followed.map);
     let FamilyEnd::Ended {
         param: at, beyond, ..
@@ -380,8 +405,8 @@ fn end_cause(
         .iter()
         .find(|p| p.param == *at)
         .or(family.points.last())?;
-    let continuation =
-        NaturalContinuation::new(config, param, &GaitOptions::default()).with_period(map.period());
+    let continuation = NaturalContinuation::new(map.parameter(), &GaitOptions::default())
+        .with_period(map.period());
     Some(continuation.end_cause(
         &GaitPoint {
             value: last.param,

@@ -7,19 +7,21 @@ pub mod curves;
 pub mod diagram;
 pub(crate) mod end_search;
 pub mod natural;
+pub mod parameter;
 
 use std::sync::atomic::AtomicBool;
 
 use nalgebra::{DMatrix, DVector};
 
 use crate::continuation::{Evaluation, FamilyMap, MapFailure};
-use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
+use crate::dynamics::DIFFERENTIABLE_KEYS;
 use crate::gait::step_map::{expand, free_coordinates, reduce};
 use crate::gait::{
     DerivativeError, SignedOutcome, StepMap, DERIVATIVE_CHECK_TIGHTENING, MAX_PERIOD,
 };
-use crate::params::{Config, ImpactModel};
+use crate::params::ImpactModel;
 use crate::walk::{Branch, SectionState, StepReport};
+pub use parameter::{ParamPoint, Parameter};
 
 /// The names of the border functions of each step of a period-k gait (up to [`MAX_PERIOD`] steps).
 const BORDER_NAMES: [[&str; 3]; MAX_PERIOD] = [
@@ -72,8 +74,7 @@ pub const LEAST_PERIOD_TOL: f64 = 1e-6;
 /// The VRW's step map (or its `k`-th iterate) with one parameter free.
 #[derive(Debug, Clone, Copy)]
 pub struct GaitFamily<'a> {
-    config: &'a Config,
-    param: &'static str,
+    parameter: Parameter<'a>,
     period: usize,
     /// The section state whose coordinates that are not free (with rigid legs, or Leg 2 held at its
     /// compression stop) every point keeps.
@@ -87,33 +88,18 @@ pub struct GaitFamily<'a> {
 }
 
 impl<'a> GaitFamily<'a> {
-    /// The family of `config` in the numeric key `param` (exact `dP/dp` for the keys of
-    /// [`DIFFERENTIABLE_KEYS`], a central difference for the others), around `base`.
-    pub fn new(
-        config: &'a Config,
-        param: &str,
-        base: SectionState,
-    ) -> Result<GaitFamily<'a>, MapFailure> {
-        let Some(&param) = Config::numeric_keys().iter().find(|k| **k == param) else {
-            return Err(MapFailure {
-                kind: "unknown_parameter".to_string(),
-                message: format!(
-                    "unknown parameter {:?}: expected one of {}",
-                    crate::fmt::clip(param),
-                    Config::numeric_keys().join(", ")
-                ),
-            });
-        };
-        let rear_held = base.rear_held_under(&config.params);
-        Ok(GaitFamily {
-            config,
-            param,
+    /// The family in `parameter` (exact `dP/dp` for the keys of [`DIFFERENTIABLE_KEYS`], a central difference
+    /// for the others), around `base`.
+    pub fn new(parameter: Parameter<'a>, base: SectionState) -> GaitFamily<'a> {
+        let params = &parameter.config().params;
+        GaitFamily {
+            parameter,
             period: 1,
-            base: base.pinned_under(&config.params),
-            rear_held,
+            base: base.pinned_under(params),
+            rear_held: base.rear_held_under(params),
             fd_step: 1e-6,
             interrupt: None,
-        })
+        }
     }
 
     /// The same family, whose walks stop when `flag` is set.
@@ -126,7 +112,18 @@ impl<'a> GaitFamily<'a> {
 
     /// The parameter's key.
     pub fn param(&self) -> &'static str {
-        self.param
+        self.parameter.key()
+    }
+
+    /// The parameter: the configuration and the key free in it.
+    pub fn parameter(&self) -> Parameter<'a> {
+        self.parameter
+    }
+
+    /// The configuration and the model at the parameter value `p` ([`Parameter::at`]), the broken rule as an
+    /// `invalid_parameter` failure where `p` leaves the valid domain.
+    pub fn at(&self, p: f64) -> Result<ParamPoint, MapFailure> {
+        self.parameter.at(p).map_err(invalid_parameter)
     }
 
     /// `P(x; p, q)` with `DP` and `dP/dp`: this family in the configuration with the key `second` at `q` (a
@@ -172,38 +169,24 @@ impl<'a> GaitFamily<'a> {
         q: f64,
         f: impl FnOnce(&GaitFamily) -> Result<R, MapFailure>,
     ) -> Result<R, MapFailure> {
-        let config = self.config.with(second, q).map_err(|e| MapFailure {
-            kind: "invalid_parameter".to_string(),
-            message: e.to_string(),
-        })?;
+        let config = self
+            .parameter
+            .fixing(second, q)
+            .map_err(invalid_parameter)?;
         f(&GaitFamily {
-            config: &config,
+            parameter: self.parameter.of(&config),
             ..*self
         })
     }
 
     /// `P(x; p)` and its walk's record, without derivatives.
     fn walked(&self, x: &DVector<f64>, p: f64) -> Result<(DVector<f64>, GaitInfo), MapFailure> {
-        let (c, model) = self.configured(p)?;
+        let at = self.at(p)?;
         let signed = self
-            .step_map(&model, &c)
+            .step_map(&at)
             .eval_signature(&self.section_at(x, p))
             .map_err(walk_failure)?;
         Ok((self.reduce(&signed.outcome.next), GaitInfo::of(signed)))
-    }
-
-    /// The configuration with the parameter at `p`, and its model.
-    fn configured(&self, p: f64) -> Result<(Config, Model), MapFailure> {
-        let invalid = |message: String| MapFailure {
-            kind: "invalid_parameter".to_string(),
-            message,
-        };
-        let c = self
-            .config
-            .with(self.param, p)
-            .map_err(|e| invalid(e.to_string()))?;
-        let model = Model::new(&c.params).map_err(|e| invalid(e.to_string()))?;
-        Ok((c, model))
     }
 
     /// The indices of the free coordinates ([`crate::walk::SECTION_COORDINATES`]): `dtheta/dt` alone with rigid
@@ -211,7 +194,7 @@ impl<'a> GaitFamily<'a> {
     /// slips at `base` (Coulomb friction).
     fn free(&self) -> &'static [usize] {
         free_coordinates(
-            self.config.params.rigid_legs || self.rear_held,
+            self.parameter.config().params.rigid_legs || self.rear_held,
             self.base.slips(),
         )
     }
@@ -231,7 +214,7 @@ impl<'a> GaitFamily<'a> {
     /// moves with the parameter, and the held leg with it.
     pub fn section_at(&self, x: &DVector<f64>, p: f64) -> SectionState {
         let s = self.expand(x);
-        if self.rear_held && self.param == "min_length" {
+        if self.rear_held && self.param() == "min_length" {
             SectionState { l2: p, ..s }
         } else {
             s
@@ -240,18 +223,18 @@ impl<'a> GaitFamily<'a> {
 
     /// `P(x; p)` at the parameter `p` (walk failures named by kind).
     fn outcome(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
-        let (c, model) = self.configured(p)?;
-        let map = self.step_map(&model, &c);
+        let at = self.at(p)?;
+        let map = self.step_map(&at);
         let out = map.eval(&self.section_at(x, p)).map_err(walk_failure)?;
         Ok(self.reduce(&out.next))
     }
 
-    /// The step map of `model`.
-    fn step_map<'m>(&self, model: &'m Model, c: &Config) -> StepMap<'m>
+    /// The step map at `at`.
+    fn step_map<'m>(&self, at: &'m ParamPoint) -> StepMap<'m>
     where
         'a: 'm,
     {
-        StepMap::new(model, &c.solver)
+        at.step_map()
             .with_rear_held(self.rear_held)
             .with_slip(self.base.slips())
             .iterated(self.period)
@@ -262,11 +245,11 @@ impl<'a> GaitFamily<'a> {
     /// the largest difference between `jacobian` and `DP` at tolerances that many times tighter; `NaN` where
     /// it cannot be computed.
     pub fn jacobian_error(&self, x: &DVector<f64>, p: f64, jacobian: &DMatrix<f64>) -> f64 {
-        let Ok((c, model)) = self.configured(p) else {
+        let Ok(at) = self.at(p) else {
             return f64::NAN;
         };
         let tighter = self
-            .step_map(&model, &c)
+            .step_map(&at)
             .with_tolerances_scaled(1.0 / DERIVATIVE_CHECK_TIGHTENING);
         match tighter.eval_with_derivatives(&self.section_at(x, p), None) {
             Ok(d) if d.jacobian.shape() == jacobian.shape() => (&d.jacobian - jacobian).amax(),
@@ -278,6 +261,14 @@ impl<'a> GaitFamily<'a> {
     fn dparam_by_difference(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
         let step = self.fd_step * p.abs().max(1.0);
         Ok((self.outcome(x, p + step)? - self.outcome(x, p - step)?) / (2.0 * step))
+    }
+}
+
+/// A parameter value outside the valid domain as a map failure.
+fn invalid_parameter(e: crate::params::ConfigError) -> MapFailure {
+    MapFailure {
+        kind: "invalid_parameter".to_string(),
+        message: e.to_string(),
     }
 }
 
@@ -297,12 +288,12 @@ impl<'a> FamilyMap for GaitFamily<'a> {
     }
 
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<GaitInfo>, MapFailure> {
-        let (c, model) = self.configured(p)?;
-        let map = self.step_map(&model, &c);
+        let at = self.at(p)?;
+        let map = self.step_map(&at);
         let s = self.section_at(x, p);
         let key = DIFFERENTIABLE_KEYS
-            .contains(&self.param)
-            .then_some(self.param);
+            .contains(&self.param())
+            .then_some(self.param());
         match map.eval_with_derivatives(&s, key) {
             Ok(d) => {
                 let exact = d.dparam.is_some();
@@ -366,7 +357,7 @@ impl<'a> FamilyMap for GaitFamily<'a> {
     /// bounce and (B3)); named with the step's number after the first (`lambda_2_plus@2`); none for rigid
     /// legs, the traditional impact or a landing with the rear leg in the air.
     fn borders(&self, info: &GaitInfo) -> Vec<(&'static str, f64)> {
-        let p = &self.config.params;
+        let p = &self.parameter.config().params;
         if p.rigid_legs || p.impact != ImpactModel::Dlsi {
             return Vec::new();
         }

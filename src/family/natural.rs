@@ -32,15 +32,15 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 
 use super::end_search::{gauges, EndSearch, Gauges};
-use crate::dynamics::Model;
+use super::Parameter;
 use crate::gait::derivative::newton_jacobian;
 use crate::gait::limit_cycle::{
-    solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitOptions,
+    solve_fixed_point, solve_fixed_point_asking, FixedPoint, GaitError, GaitOptions,
 };
 pub(crate) use crate::gait::periodicity::SAME_GAIT_TOL;
 use crate::gait::periodicity::{least_period, MAX_PERIOD, RETURN_TOL};
 use crate::gait::step_map::StepMap;
-use crate::params::Config;
+use crate::params::ConfigError;
 use crate::walk::{SectionState, Walker, SECTION_COORDINATES};
 
 /// The way back of a continuation step ends early where the first step of Newton's method lands this close to
@@ -96,33 +96,38 @@ pub fn section_distance(a: &SectionState, b: &SectionState) -> f64 {
 /// `P^k` for a family of period-k gaits ([`NaturalContinuation::with_period`]).
 #[derive(Debug, Clone)]
 pub(crate) struct NaturalContinuation<'a> {
-    config: &'a Config,
-    param: &'a str,
+    parameter: Parameter<'a>,
     options: GaitOptions,
     /// Steps per period of the family followed (1: fixed points of `P`).
     period: usize,
 }
 
-/// The gait `from` of a family in `param` of `config` as a start at `value` (see `NaturalContinuation::start_from`):
-/// its section state, or, where `param` is `min_length` and Leg 2 is held at its compression stop there, the
-/// state held at the stop of `value`.
-pub(crate) fn carried_start(
-    config: &Config,
-    param: &str,
-    from: &GaitPoint,
-    value: f64,
-) -> SectionState {
-    if param != "min_length" {
+/// The gait `from` of a family in `parameter` as a start at `value` (see `NaturalContinuation::start_from`):
+/// its section state, or, where the parameter is `min_length` and Leg 2 is held at its compression stop there,
+/// the state held at the stop of `value`.
+pub(crate) fn carried_start(parameter: &Parameter, from: &GaitPoint, value: f64) -> SectionState {
+    if parameter.key() != "min_length" {
         return from.section;
     }
-    match config.with(param, from.value) {
-        Ok(c) if from.section.rear_held_under(&c.params) => SectionState {
+    match parameter.at(from.value) {
+        Ok(at) if from.section.rear_held_under(&at.config.params) => SectionState {
             l2: value,
             l2_dot: 0.0,
             ..from.section
         },
         _ => from.section,
     }
+}
+
+/// Why Newton's method found no gait of a family at a parameter value.
+#[derive(Debug, thiserror::Error)]
+pub(crate) enum PointError {
+    /// The value leaves the parameter's valid domain.
+    #[error(transparent)]
+    InvalidParameter(#[from] ConfigError),
+    /// The search failed.
+    #[error(transparent)]
+    Gait(#[from] GaitError),
 }
 
 /// A point of a family: the parameter value and the gait's section state there.
@@ -254,15 +259,10 @@ pub enum EndCause {
 }
 
 impl<'a> NaturalContinuation<'a> {
-    /// NaturalContinuation of `param` in `config`, with Newton settings from `options`.
-    pub(crate) fn new(
-        config: &'a Config,
-        param: &'a str,
-        options: &GaitOptions,
-    ) -> NaturalContinuation<'a> {
+    /// NaturalContinuation in `parameter`, with Newton settings from `options`.
+    pub(crate) fn new(parameter: Parameter<'a>, options: &GaitOptions) -> NaturalContinuation<'a> {
         NaturalContinuation {
-            config,
-            param,
+            parameter,
             options: GaitOptions {
                 transient_steps: 0,
                 refine_jacobian: false,
@@ -281,22 +281,12 @@ impl<'a> NaturalContinuation<'a> {
         }
     }
 
-    /// The configuration with the followed parameter at `value`, and its model.
-    fn configured_at(&self, value: f64) -> Result<(Config, Model), String> {
-        let c = self
-            .config
-            .with(self.param, value)
-            .map_err(|e| e.to_string())?;
-        let model = Model::new(&c.params).map_err(|e| e.to_string())?;
-        Ok((c, model))
-    }
-
     /// The gait `from` of the family as a start at `value`: its section state, except that where the followed
     /// parameter is `min_length` and Leg 2 is held at its compression stop there, it is held at the stop of
     /// `value` (`L2 = value`, `dL2/dt = 0`): the stop moves with the parameter and the held leg with it (the
     /// section state at the old stop would be below the new one, or off it).
     fn start_from(&self, from: &GaitPoint, value: f64) -> SectionState {
-        carried_start(self.config, self.param, from, value)
+        carried_start(&self.parameter, from, value)
     }
 
     /// The fixed point at `value` by Newton's method from `start` (no transient), the Newton matrix's guess
@@ -307,11 +297,16 @@ impl<'a> NaturalContinuation<'a> {
         start: &SectionState,
         guess: &mut dyn FnMut() -> Option<DMatrix<f64>>,
         undamped: bool,
-    ) -> Result<FixedPoint, String> {
-        let (c, model) = self.configured_at(value)?;
-        let map = StepMap::new(&model, &c.solver).iterated(self.period);
-        solve_fixed_point_asking(&map, start, &self.options, guess, undamped)
-            .map_err(|e| e.to_string())
+    ) -> Result<FixedPoint, PointError> {
+        let at = self.parameter.at(value)?;
+        let map = at.step_map().iterated(self.period);
+        Ok(solve_fixed_point_asking(
+            &map,
+            start,
+            &self.options,
+            guess,
+            undamped,
+        )?)
     }
 
     /// One verified continuation step from `from` to `value` by Newton's method, there and back (see the module
@@ -342,7 +337,7 @@ impl<'a> NaturalContinuation<'a> {
         // for a period-k family: its fixed points of `P^k` include the period-1 gait where the period-k orbit
         // collapses onto it (a bounce that vanishes at `lambda_2+ = 0`), and a predicted start carries the
         // family through that border, so that the change of period would go unreported.
-        let tangent = tangent.filter(|_| self.param != "min_length" && self.period == 1);
+        let tangent = tangent.filter(|_| self.parameter.key() != "min_length" && self.period == 1);
         let predicted = tangent.and_then(|t| {
             let start = t.predict(from, value)?;
             let back = Tangent { at: value, ..*t };
@@ -449,10 +444,8 @@ impl<'a> NaturalContinuation<'a> {
         start: &SectionState,
         guess: Option<&DMatrix<f64>>,
     ) -> Option<SectionState> {
-        let (c, model) = self.configured_at(value).ok()?;
-        let map = StepMap::new(&model, &c.solver)
-            .iterated(self.period)
-            .on_section_of(start);
+        let at = self.parameter.at(value).ok()?;
+        let map = at.step_map().iterated(self.period).on_section_of(start);
         let n = map.free_coordinates().len();
         let guess = guess.filter(|g| g.nrows() == n && g.ncols() == n)?;
         let x = map.reduce(start);
@@ -484,8 +477,8 @@ impl<'a> NaturalContinuation<'a> {
     /// period-k family) closer than [`SETTLE_TOL`] within [`SETTLE_STEPS`] steps; `None` if the walk fails or
     /// does not settle.
     fn settle(&self, value: f64, start: &SectionState) -> Option<SectionState> {
-        let (c, model) = self.configured_at(value).ok()?;
-        let mut walker = Walker::new(&model, &c.solver, start).ok()?;
+        let at = self.parameter.at(value).ok()?;
+        let mut walker = Walker::new(&at.model, &at.config.solver, start).ok()?;
         let mut previous = *start;
         for _ in 0..SETTLE_STEPS.div_ceil(self.period) {
             for _ in 0..self.period {
@@ -503,9 +496,10 @@ impl<'a> NaturalContinuation<'a> {
     /// `DP` (`D(P^k)` for a period-k family; exact, or a central difference where the map is not
     /// differentiable) of the gait `at`.
     fn jacobian(&self, at: &GaitPoint) -> Option<DMatrix<f64>> {
-        let (c, model) = self.configured_at(at.value).ok()?;
+        let point = self.parameter.at(at.value).ok()?;
         // On the section of `at` where its stance tip slips (Coulomb friction): the slip is a coordinate there.
-        let map = StepMap::new(&model, &c.solver)
+        let map = point
+            .step_map()
             .iterated(self.period)
             .with_slip(at.section.slips());
         newton_jacobian(&map, &at.section, self.options.fd_step).ok()
@@ -656,8 +650,8 @@ impl<'a> NaturalContinuation<'a> {
     /// The longest step of the gait `at` \[s\] (of the `k` steps of a period-k gait); `None` where the walk
     /// fails.
     pub(crate) fn longest_step(&self, at: &GaitPoint) -> Option<f64> {
-        let (c, model) = self.configured_at(at.value).ok()?;
-        let map = StepMap::new(&model, &c.solver).iterated(self.period);
+        let point = self.parameter.at(at.value).ok()?;
+        let map = point.step_map().iterated(self.period);
         let walked = map.eval_signature(&at.section).ok()?;
         walked.cycle.iter().map(|r| r.period).reduce(f64::max)
     }
@@ -681,24 +675,25 @@ impl<'a> NaturalContinuation<'a> {
     /// What happens at `beyond`, just past the end of the family whose last gait is `last`: walk from it (see
     /// [`EndCause`]).
     pub(crate) fn end_cause(&self, last: &GaitPoint, beyond: f64) -> EndCause {
-        let (c, model) = match self.configured_at(beyond) {
-            Ok(x) => x,
-            Err(message) => {
-                return EndCause::WalkFails {
-                    failure: "invalid_parameter".to_string(),
-                    message,
-                }
-            }
-        };
-        let mut walker = match Walker::new(&model, &c.solver, &self.start_from(last, beyond)) {
-            Ok(w) => w,
+        let at = match self.parameter.at(beyond) {
+            Ok(at) => at,
             Err(e) => {
                 return EndCause::WalkFails {
-                    failure: e.kind().to_string(),
+                    failure: "invalid_parameter".to_string(),
                     message: e.to_string(),
                 }
             }
         };
+        let mut walker =
+            match Walker::new(&at.model, &at.config.solver, &self.start_from(last, beyond)) {
+                Ok(w) => w,
+                Err(e) => {
+                    return EndCause::WalkFails {
+                        failure: e.kind().to_string(),
+                        message: e.to_string(),
+                    }
+                }
+            };
         // The touchdowns of the walk, for its period.
         let mut returns = Vec::with_capacity(END_WALK_STEPS);
         for step in 1..=END_WALK_STEPS {
@@ -722,7 +717,7 @@ impl<'a> NaturalContinuation<'a> {
         // The period the walk shows (up to MAX_PERIOD), else the family's own: a period-1 family may end where
         // a period-2 gait takes over, for instance.
         let k = least_period(&returns, MAX_PERIOD, RETURN_TOL).unwrap_or(self.period);
-        let single = StepMap::new(&model, &c.solver);
+        let single = at.step_map();
         match solve_fixed_point(&single.iterated(k), &walked, &self.options, None) {
             Ok(fp) if k != self.period || !on_orbit(&single, &fp.section, k, &last.section) => {
                 EndCause::OtherGait {
@@ -774,7 +769,9 @@ fn on_orbit(map: &StepMap, orbit: &SectionState, k: usize, s: &SectionState) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dynamics::Model;
     use crate::gait::limit_cycle::find_gait;
+    use crate::params::Config;
     use crate::reference::default_initial;
 
     /// The default family in `viscosity` (it ends where the wheel rolls back, near `c = 135.489237`) and a
@@ -796,7 +793,10 @@ mod tests {
     #[test]
     fn a_coarse_end_tolerance_brackets_the_same_end() {
         let config = Config::default();
-        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default());
+        let cont = NaturalContinuation::new(
+            Parameter::named(&config, "viscosity").unwrap(),
+            &GaitOptions::default(),
+        );
         let (from, guess) = family_at(&config, 131.0);
         let FollowOutcome::Ended { last, beyond } =
             cont.follow_to(from, 141.0, (guess.as_ref(), None), 1.0)
@@ -825,7 +825,10 @@ mod tests {
     #[test]
     fn steps_tell_a_failing_start_from_a_failing_newton() {
         let config = Config::default();
-        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default());
+        let cont = NaturalContinuation::new(
+            Parameter::named(&config, "viscosity").unwrap(),
+            &GaitOptions::default(),
+        );
         let (from, guess) = family_at(&config, 135.0);
         let beyond = cont.step_asking(&from, 137.0, guess.as_ref(), false);
         assert_eq!(beyond, Err(StepFailure::Start));
@@ -872,7 +875,10 @@ mod tests {
     #[test]
     fn the_way_back_ends_early_only_on_the_gait_it_came_from() {
         let config = Config::default();
-        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default());
+        let cont = NaturalContinuation::new(
+            Parameter::named(&config, "viscosity").unwrap(),
+            &GaitOptions::default(),
+        );
         let (from, guess) = family_at(&config, 50.0);
         let reached = cont
             .step(&from, 51.0, guess.as_ref())
@@ -914,7 +920,10 @@ mod tests {
         config.apply_override("friction=0.105").unwrap();
         let (from, guess) = family_at(&config, 50.0);
         assert!(from.section.slips() && guess.is_some());
-        let cont = NaturalContinuation::new(&config, "viscosity", &GaitOptions::for_sweeps());
+        let cont = NaturalContinuation::new(
+            Parameter::named(&config, "viscosity").unwrap(),
+            &GaitOptions::for_sweeps(),
+        );
         let j = cont.jacobian(&from).expect("DP at a slipping gait");
         assert_eq!((j.nrows(), j.ncols()), (4, 4));
         assert!(cont

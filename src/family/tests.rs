@@ -3,7 +3,7 @@
 
 use nalgebra::DVector;
 
-use super::{GaitFamily, GaitInfo};
+use super::{GaitFamily, GaitInfo, Parameter};
 use crate::continuation::curve::border_curve_seed;
 use crate::continuation::*;
 
@@ -55,14 +55,18 @@ fn direct_residual(
 #[test]
 fn default_family_ends_where_the_sweep_ends() {
     let (config, section) = vrw_gait(&[("viscosity", 130.0)]);
-    let family_map = GaitFamily::new(&config, "viscosity", section).unwrap();
+    let family_map = GaitFamily::new(Parameter::named(&config, "viscosity").unwrap(), section);
     let options = ContinuationOptions::for_range(120.0, 140.0);
     let family =
         continue_family(&family_map, &family_map.reduce(&section), 130.0, &options).unwrap();
     let FamilyEnd::Ended { param, beyond, .. } = family.ends[1].clone() else {
         panic!("{:?}", family.ends);
     };
-    let natural = NaturalContinuation::new(&config, "viscosity", &GaitOptions::default()).follow(
+    let natural = NaturalContinuation::new(
+        Parameter::named(&config, "viscosity").unwrap(),
+        &GaitOptions::default(),
+    )
+    .follow(
         GaitPoint {
             value: 130.0,
             section,
@@ -89,7 +93,7 @@ fn default_family_ends_where_the_sweep_ends() {
 #[test]
 fn slope_family_through_its_fold() {
     let (config, section) = vrw_gait(&[("slope", 0.3)]);
-    let family_map = GaitFamily::new(&config, "slope", section).unwrap();
+    let family_map = GaitFamily::new(Parameter::named(&config, "slope").unwrap(), section);
     let options = ContinuationOptions::for_range(0.29, 0.34);
     let family = continue_family(&family_map, &family_map.reduce(&section), 0.3, &options).unwrap();
     let folds = of_kind(&family, SpecialKind::Fold);
@@ -122,7 +126,7 @@ fn slope_family_through_its_fold() {
 #[test]
 fn dls_family_ends_at_a_border_collision() {
     let (config, section) = vrw_gait(&[("viscosity", 20.0), ("stiffness", 590.0)]);
-    let family_map = GaitFamily::new(&config, "stiffness", section).unwrap();
+    let family_map = GaitFamily::new(Parameter::named(&config, "stiffness").unwrap(), section);
     let options = ContinuationOptions::for_range(585.0, 600.0);
     let family =
         continue_family(&family_map, &family_map.reduce(&section), 590.0, &options).unwrap();
@@ -131,7 +135,11 @@ fn dls_family_ends_at_a_border_collision() {
     let bc = bc[0];
     assert_eq!(bc.border.as_deref(), Some("lambda_2_plus"));
     assert!(bc.located && bc.test_value.abs() < 1e-6);
-    let natural = NaturalContinuation::new(&config, "stiffness", &GaitOptions::default()).follow(
+    let natural = NaturalContinuation::new(
+        Parameter::named(&config, "stiffness").unwrap(),
+        &GaitOptions::default(),
+    )
+    .follow(
         GaitPoint {
             value: 590.0,
             section,
@@ -157,7 +165,7 @@ fn dls_family_ends_at_a_border_collision() {
 #[test]
 fn border_curve_agrees_with_the_one_parameter_end() {
     let (config, section) = vrw_gait(&[("viscosity", 20.0), ("stiffness", 590.0)]);
-    let family_map = GaitFamily::new(&config, "stiffness", section).unwrap();
+    let family_map = GaitFamily::new(Parameter::named(&config, "stiffness").unwrap(), section);
     let options = ContinuationOptions::for_range(585.0, 600.0);
     let family =
         continue_family(&family_map, &family_map.reduce(&section), 590.0, &options).unwrap();
@@ -187,7 +195,11 @@ fn border_curve_agrees_with_the_one_parameter_end() {
     let at4 = curve_at_p2(&problem, &curve, 4.0, &curve_options).expect("the curve crosses c = 4");
     // Natural continuation along the stiffness at c = 4, as a sweep does.
     let (config4, section4) = vrw_gait(&[("viscosity", 4.0), ("stiffness", 560.0)]);
-    let natural = NaturalContinuation::new(&config4, "stiffness", &GaitOptions::default()).follow(
+    let natural = NaturalContinuation::new(
+        Parameter::named(&config4, "stiffness").unwrap(),
+        &GaitOptions::default(),
+    )
+    .follow(
         GaitPoint {
             value: 560.0,
             section: section4,
@@ -213,7 +225,7 @@ fn border_curve_agrees_with_the_one_parameter_end() {
 fn fold_curve_agrees_with_the_fold_of_another_line() {
     let fold_at = |c: f64| {
         let (config, section) = vrw_gait(&[("slope", 0.3), ("viscosity", c)]);
-        let family_map = GaitFamily::new(&config, "slope", section).unwrap();
+        let family_map = GaitFamily::new(Parameter::named(&config, "slope").unwrap(), section);
         let options = ContinuationOptions::for_range(0.29, 0.34);
         let family =
             continue_family(&family_map, &family_map.reduce(&section), 0.3, &options).unwrap();
@@ -222,8 +234,10 @@ fn fold_curve_agrees_with_the_fold_of_another_line() {
     };
     let (config, fold) = fold_at(50.0);
     let (_, fold60) = fold_at(60.0);
-    let family_map =
-        GaitFamily::new(&config, "slope", crate::reference::default_initial(&config)).unwrap();
+    let family_map = GaitFamily::new(
+        Parameter::named(&config, "slope").unwrap(),
+        crate::reference::default_initial(&config),
+    );
     let eval = |x: &DVector<f64>, p: f64, c: f64| family_map.eval_with("viscosity", x, p, c);
     let test = |ev: &Evaluation<GaitInfo>| {
         special::test_function(SpecialKind::Fold).unwrap()(&ev.jacobian)

@@ -345,6 +345,32 @@ fn document(text: &str, origin: &str) -> Result<Table, ConfigError> {
         .collect())
 }
 
+/// A key of [`Config::numeric_keys`], checked once: the parameter of a sweep, a map's axis, a continuation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NumericKey(&'static str);
+
+impl NumericKey {
+    /// The key `key`, or the error that names it and the keys there are.
+    pub fn new(key: &str) -> Result<NumericKey, ConfigError> {
+        Config::numeric_keys()
+            .iter()
+            .find(|k| **k == key)
+            .map(|k| NumericKey(k))
+            .ok_or_else(|| unknown_numeric_key(key))
+    }
+
+    /// Its name, as in the configuration.
+    pub fn name(self) -> &'static str {
+        self.0
+    }
+}
+
+impl std::fmt::Display for NumericKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
 /// The error for a key that is not one of [`Config::numeric_keys`].
 fn unknown_numeric_key(key: &str) -> ConfigError {
     ConfigError::UnknownKey {

@@ -28,9 +28,10 @@ use serde::Serialize;
 
 use super::sweep::{gait_rows_part, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec};
 use super::thresholds::{find_thresholds, Threshold};
+use crate::family::Parameter;
 use crate::fmt::short;
 use crate::gait::limit_cycle::GaitOptions;
-use crate::params::{Config, ConfigError};
+use crate::params::{Config, ConfigError, NumericKey};
 use crate::walk::SectionState;
 
 /// The most values along one axis of a map.
@@ -163,11 +164,12 @@ pub fn map_gaits_part(
     check_part(&part, spec.y.points)?;
     let xs = spec.x.values();
     let ys = spec.y.values();
+    let key = NumericKey::new(&spec.x.param)?;
     let rows: Vec<GaitRow> = ys
         .iter()
         .map(|&y| GaitRow {
             config: spec.with_y(config, y),
-            param: spec.x.param.clone(),
+            key,
             values: xs.clone(),
         })
         .collect();
@@ -344,29 +346,29 @@ pub fn curve_columns(nx: usize, max_columns: usize) -> Vec<usize> {
 
 /// The 1-D thresholds of every row of `map` and of the columns [`curve_columns`] picks (at most `max_columns`),
 /// and the curves through them (see the module documentation).
+///
+/// # Errors
+/// A parameter of the map's spec is not a numeric key.
 pub fn map_curves(
     config: &Config,
     map: &GaitMap,
     options: &GaitOptions,
     max_columns: usize,
-) -> MapCurves {
+) -> Result<MapCurves, ConfigError> {
     let columns = curve_columns(map.xs.len(), max_columns);
     let spec = &map.spec;
-    let row_spec = SweepSpec {
-        points: map.xs.len(),
-        ..spec.x.clone()
-    };
-    let col_spec = SweepSpec {
-        points: map.ys.len(),
-        ..spec.y.clone()
-    };
+    let (x_key, y_key) = (
+        NumericKey::new(&spec.x.param)?,
+        NumericKey::new(&spec.y.param)?,
+    );
     let rows: Vec<Vec<LineThreshold>> = map
         .rows
         .par_iter()
         .enumerate()
         .map(|(j, points)| {
             let c = spec.with_y(config, map.ys[j]);
-            line_thresholds(Along::X, j, find_thresholds(&c, &row_spec, points, options))
+            let parameter = Parameter::new(&c, x_key);
+            line_thresholds(Along::X, j, find_thresholds(parameter, points, options))
         })
         .collect();
     let cols: Vec<Vec<LineThreshold>> = columns
@@ -386,17 +388,14 @@ pub fn map_curves(
                     ..row[i].clone()
                 })
                 .collect();
-            number_families(&c, &spec.y.param, &mut points, options);
-            line_thresholds(
-                Along::Y,
-                i,
-                find_thresholds(&c, &col_spec, &points, options),
-            )
+            let parameter = Parameter::new(&c, y_key);
+            number_families(parameter, &mut points, options);
+            line_thresholds(Along::Y, i, find_thresholds(parameter, &points, options))
         })
         .collect();
     let thresholds: Vec<LineThreshold> = rows.into_iter().chain(cols).flatten().collect();
     let curves = connect(&map.xs, &map.ys, &columns, &thresholds);
-    MapCurves { curves, thresholds }
+    Ok(MapCurves { curves, thresholds })
 }
 
 fn line_thresholds(along: Along, line: usize, thresholds: Vec<Threshold>) -> Vec<LineThreshold> {

@@ -15,14 +15,12 @@ use super::{
     ContinuedCurve, CurveMethod, GaitMap, MapCurves, SweepSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
 use crate::continuation::curve::{
-    border_curve_seed, continue_curve, curve_at, Curve, CurveEnd, CurveOptions, CurveProblem,
-    CurveTest, BORDER_OFFSET, FOLLOW_OFFSET_FACTOR,
+    curve_at, Curve, CurveEnd, CurveOptions, CurveProblem, FOLLOW_OFFSET_FACTOR,
 };
-use crate::continuation::special::{test_function, test_name};
-use crate::continuation::{
-    continue_family, ContinuationOptions, Evaluation, MapFailure, SpecialKind,
-};
-use crate::family::{GaitFamily, GaitInfo};
+use crate::continuation::{continue_family, ContinuationOptions, Family, SpecialKind};
+use crate::family::curves::CurveSeed;
+use crate::family::{GaitFamily, GaitInfo, Parameter};
+use crate::gait::Gait;
 use crate::params::Config;
 
 /// What a continued curve of a map solves for with the fixed point.
@@ -157,71 +155,189 @@ fn follow_from_crossing(
     k: usize,
     condition: Condition,
 ) -> Result<(ThresholdCurve, Vec<usize>, Vec<usize>), String> {
-    let seed = seeds[k];
+    let line = CrossingLine::of(map, seeds[k])?;
     let spec = &map.spec;
-    let (j, t) = (seed.line, &seed.threshold);
-    // The line's parameter (x on a row, y on a column), the other one and its value on the line.
-    let (line_spec, other_spec, values, fixed) = match seed.along {
-        Along::X => (&spec.x, &spec.y, &map.xs, map.ys[j]),
-        Along::Y => (&spec.y, &spec.x, &map.ys, map.xs[j]),
-    };
-    // The grid point of the crossing's bracket nearest it that has a period-1 gait: its fixed point starts
-    // the line's family.
-    let lo = t.grid_bracket[0].min(t.grid_bracket[1]);
-    let i = values
-        .iter()
-        .position(|&v| v == lo)
-        .ok_or("the crossing's bracket is not a grid cell")?;
-    let (gait, v0) = [i, i + 1]
-        .into_iter()
-        .filter_map(|i| {
-            let p = match seed.along {
-                Along::X => map.rows[j].get(i)?,
-                Along::Y => map.rows.get(i)?.get(j)?,
-            };
-            let g = p.gait.as_ref().filter(|g| g.period_k == 1)?;
-            Some((g, values[i]))
-        })
-        .min_by(|a, b| (a.1 - t.value).abs().total_cmp(&(b.1 - t.value).abs()))
-        .ok_or("no period-1 gait next to the crossing")?;
     let mut line_config = config.clone();
     line_config
-        .set_numeric(&other_spec.param, fixed)
+        .set_numeric(&line.other.param, line.fixed)
         .map_err(|e| e.to_string())?;
-    let line_family =
-        GaitFamily::new(&line_config, &line_spec.param, gait.section).map_err(|e| e.message)?;
-    // The line's family followed across the crossing's cell and one more on either side (pseudo-arclength,
-    // its special points located), and the curve started from it: for a border, from its point nearest the
-    // collision that lies clearly on one side (near the end of a family's domain, lambda_2+ often reaches zero
-    // just before the wheel rolls back, a Newton step from the grid gait straight to the border could leave
-    // the domain); for a fold, period doubling or Neimark-Sacker point, from the located point.
-    let cell = |s: &SweepSpec, n: usize| (s.to - s.from).abs() / (n.max(2) - 1) as f64;
-    let x_cell = cell(&spec.x, map.xs.len());
-    let y_cell = cell(&spec.y, map.ys.len());
-    let line_cell = cell(line_spec, values.len());
-    let (v_min, v_max) = (
-        line_spec.from.min(line_spec.to),
-        line_spec.from.max(line_spec.to),
-    );
-    let hi = t.grid_bracket[0].max(t.grid_bracket[1]);
-    let row_options =
-        ContinuationOptions::for_range((lo - line_cell).max(v_min), (hi + line_cell).min(v_max));
-    let row_family = continue_family(
-        &line_family,
-        &line_family.reduce(&gait.section),
-        v0,
-        &row_options,
-    )
-    .map_err(|e| format!("the line's family: {e}"))?;
+    let parameter = |key: &str| Parameter::named(&line_config, key).map_err(|e| e.to_string());
+    let line_family = GaitFamily::new(parameter(&line.spec.param)?, line.gait.section);
+    let row_family = line.family(&line_family)?;
+    let seed = curve_seed(condition, &line_family, &row_family, line.threshold.value)?;
     // The curve's map: the family in x, whose evaluations set y.
-    let family =
-        GaitFamily::new(&line_config, &spec.x.param, gait.section).map_err(|e| e.message)?;
-    let y_param = spec.y.param.as_str();
-    let eval = |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.eval_with(y_param, x, p, q);
-    let observe =
-        |x: &nalgebra::DVector<f64>, p: f64, q: f64| family.observe_with(y_param, x, p, q);
-    let nearest = |a: f64, b: f64| (a - t.value).abs().total_cmp(&(b - t.value).abs());
-    let (start, v_start, offset, condition, name): (_, _, _, CurveTest, String) = match condition {
+    let family = GaitFamily::new(parameter(&spec.x.param)?, line.gait.section);
+    let options = CurveOptions::for_ranges((spec.x.from, spec.x.to), (spec.y.from, spec.y.to));
+    let at = match line.along {
+        Along::X => (seed.p, line.fixed),
+        Along::Y => (line.fixed, seed.p),
+    };
+    let (curve, (hits, misses)) = seed.with_problem(family, &spec.y.param, |problem| {
+        let curve = seed.follow(problem, at, &options).map_err(|e| e.message)?;
+        let checked = check_crossings(problem, &curve, map, seeds, &options);
+        Ok::<_, String>((curve, checked))
+    })?;
+    let method = ContinuedCurve {
+        seed: RefinedOn {
+            along: line.along,
+            line: line.index,
+            threshold: line.threshold.name.clone(),
+        },
+        condition: seed.condition.clone(),
+        offset: seed.offset,
+        ends: [end_words(&curve.ends[0]), end_words(&curve.ends[1])],
+        max_residual: curve.points.iter().map(|p| p.residual).fold(0.0, f64::max),
+        max_test_value: curve
+            .points
+            .iter()
+            .map(|p| p.test_value.abs())
+            .fold(0.0, f64::max),
+        lines_checked: hits.len(),
+        near_misses: misses
+            .iter()
+            .map(|&(m, difference)| NearMiss {
+                along: seeds[m].along,
+                line: seeds[m].line,
+                value: seeds[m].threshold.value,
+                difference,
+            })
+            .collect(),
+        max_line_difference: hits
+            .iter()
+            .map(|h| h.1)
+            .reduce(f64::max)
+            .unwrap_or(f64::NAN),
+        description: line.description(spec, &seed),
+    };
+    let curve_out = ThresholdCurve {
+        name: line.threshold.name.clone(),
+        points: curve.points.iter().map(|p| [p.p1, p.p2]).collect(),
+        refined_on: Vec::new(),
+        closed: false,
+        method: CurveMethod::Continuation(method),
+    };
+    Ok((
+        curve_out,
+        hits.into_iter().map(|h| h.0).collect(),
+        misses.into_iter().map(|m| m.0).collect(),
+    ))
+}
+
+/// A crossing's line of the map and the gait its family starts from.
+struct CrossingLine<'m> {
+    /// Along `x` (a row) or `y` (a column).
+    along: Along,
+    /// The line's index.
+    index: usize,
+    /// The crossing.
+    threshold: &'m crate::study::Threshold,
+    /// The line's parameter (x on a row, y on a column).
+    spec: &'m SweepSpec,
+    /// The other parameter.
+    other: &'m SweepSpec,
+    /// The other parameter's value on the line.
+    fixed: f64,
+    /// The line's grid values.
+    values: &'m [f64],
+    /// The period-1 gait of the crossing's grid bracket nearest it.
+    gait: &'m Gait,
+    /// Its value of the line's parameter.
+    v0: f64,
+}
+
+impl<'m> CrossingLine<'m> {
+    /// The line of the crossing `seed` and the grid point of its bracket nearest it that has a period-1 gait.
+    fn of(map: &'m GaitMap, seed: &'m LineThreshold) -> Result<CrossingLine<'m>, String> {
+        let spec = &map.spec;
+        let (j, t) = (seed.line, &seed.threshold);
+        let (line_spec, other, values, fixed) = match seed.along {
+            Along::X => (&spec.x, &spec.y, &map.xs, map.ys[j]),
+            Along::Y => (&spec.y, &spec.x, &map.ys, map.xs[j]),
+        };
+        let lo = t.grid_bracket[0].min(t.grid_bracket[1]);
+        let i = values
+            .iter()
+            .position(|&v| v == lo)
+            .ok_or("the crossing's bracket is not a grid cell")?;
+        let (gait, v0) = [i, i + 1]
+            .into_iter()
+            .filter_map(|i| {
+                let p = match seed.along {
+                    Along::X => map.rows[j].get(i)?,
+                    Along::Y => map.rows.get(i)?.get(j)?,
+                };
+                let g = p.gait.as_ref().filter(|g| g.period_k == 1)?;
+                Some((g, values[i]))
+            })
+            .min_by(|a, b| (a.1 - t.value).abs().total_cmp(&(b.1 - t.value).abs()))
+            .ok_or("no period-1 gait next to the crossing")?;
+        Ok(CrossingLine {
+            along: seed.along,
+            index: j,
+            threshold: t,
+            spec: line_spec,
+            other,
+            fixed,
+            values,
+            gait,
+            v0,
+        })
+    }
+
+    /// The line's family (of `line_family`) followed across the crossing's cell and one more on either side
+    /// (pseudo-arclength, its special points located).
+    fn family(&self, line_family: &GaitFamily) -> Result<Family<GaitInfo>, String> {
+        let s = self.spec;
+        let line_cell = (s.to - s.from).abs() / (self.values.len().max(2) - 1) as f64;
+        let (v_min, v_max) = (s.from.min(s.to), s.from.max(s.to));
+        let bracket = self.threshold.grid_bracket;
+        let (lo, hi) = (bracket[0].min(bracket[1]), bracket[0].max(bracket[1]));
+        let options = ContinuationOptions::for_range(
+            (lo - line_cell).max(v_min),
+            (hi + line_cell).min(v_max),
+        );
+        let x0 = line_family.reduce(&self.gait.section);
+        continue_family(line_family, &x0, self.v0, &options)
+            .map_err(|e| format!("the line's family: {e}"))
+    }
+
+    /// How the curve from `seed` on this line is computed, in words ([`ContinuedCurve::description`]).
+    fn description(&self, spec: &super::MapSpec, seed: &CurveSeed) -> String {
+        let (name, offset) = (&seed.condition, seed.offset);
+        format!(
+            "pseudo-arclength continuation of P(x) = x and {name} = {offset:e} in ({}, {}), from the gait of {} \
+             {}'s family at {} = {}{}",
+            spec.x.param,
+            spec.y.param,
+            if self.along == Along::X { "row" } else { "column" },
+            self.index,
+            self.spec.param,
+            seed.p,
+            if offset == 0.0 {
+                String::new()
+            } else {
+                format!(
+                    "; steps aimed at {name} = {:e}, each point polished",
+                    offset * FOLLOW_OFFSET_FACTOR
+                )
+            }
+        )
+    }
+}
+
+/// Where the curve of `condition` starts on the line's family `row_family` (of `line_family`), nearest the
+/// crossing at `value`: for a border, from the family's point nearest the collision that lies clearly on one
+/// side (near the end of a family's domain, lambda_2+ often reaches zero just before the wheel rolls back, and a
+/// Newton step from the grid gait straight to the border could leave the domain); for a fold, period doubling
+/// or Neimark-Sacker point, from the located point.
+fn curve_seed(
+    condition: Condition,
+    line_family: &GaitFamily,
+    row_family: &Family<GaitInfo>,
+    value: f64,
+) -> Result<CurveSeed, String> {
+    let nearest = |a: f64, b: f64| (a - value).abs().total_cmp(&(b - value).abs());
+    match condition {
         Condition::Border(border) => {
             let collision = row_family
                 .special
@@ -243,16 +359,9 @@ fn follow_from_crossing(
                         .map(|p| p.arclength)
                 })
                 .ok_or("the row's family has no points")?;
-            let (seed_point, side) =
-                border_curve_seed(&line_family, &row_family, collision, border)
-                    .ok_or("no point of the row's family lies clearly on one side of the border")?;
-            (
-                seed_point.x.clone(),
-                seed_point.param,
-                BORDER_OFFSET.copysign(side),
-                CurveTest::Border(border),
-                border.to_string(),
-            )
+            CurveSeed::at_border(line_family, row_family, collision, border).ok_or_else(|| {
+                "no point of the row's family lies clearly on one side of the border".into()
+            })
         }
         Condition::Special(kinds) => {
             let sp = row_family
@@ -263,128 +372,65 @@ fn follow_from_crossing(
                 .ok_or_else(|| {
                     format!("the row's family has no located {kinds:?} point near the crossing")
                 })?;
-            let test = test_function(sp.kind).ok_or("not a special point with a test function")?;
-            (
-                sp.x.clone(),
-                sp.param,
-                0.0,
-                CurveTest::Jacobian(test),
-                test_name(sp.kind).to_string(),
-            )
+            CurveSeed::at_special(sp)
+                .ok_or_else(|| "not a special point with a test function".into())
         }
-    };
-    let test = |ev: &Evaluation<GaitInfo>| condition.of(&family, ev);
-    let problem = CurveProblem {
-        eval: &eval,
-        observe: (!condition.needs_derivatives()).then_some(&observe),
-        test: &test,
-        offset,
-    };
-    let options = CurveOptions::for_ranges((spec.x.from, spec.x.to), (spec.y.from, spec.y.to));
-    let at = match seed.along {
-        Along::X => (v_start, fixed),
-        Along::Y => (fixed, v_start),
-    };
-    let curve =
-        continue_curve(&problem, &start, at, &options).map_err(|e: MapFailure| e.message)?;
-    // The crossings it may pass through: every one within one grid cell of the curve's polyline on its line.
+    }
+}
+
+/// The crossings of `seeds` the continued `curve` of `problem` passes through: every one within one grid cell of
+/// the curve's polyline on its line, solved for on the curve and compared with its line's threshold. Those
+/// within [`LINE_CHECK_TOL`] are the curve's (hits), the others a different border nearby (misses); each with
+/// its difference.
+fn check_crossings(
+    problem: &CurveProblem<'_, GaitInfo>,
+    curve: &Curve<GaitInfo>,
+    map: &GaitMap,
+    seeds: &[&LineThreshold],
+    options: &CurveOptions,
+) -> (Checked, Checked) {
+    let cell = |s: &SweepSpec, n: usize| (s.to - s.from).abs() / (n.max(2) - 1) as f64;
+    let x_cell = cell(&map.spec.x, map.xs.len());
+    let y_cell = cell(&map.spec.y, map.ys.len());
     let candidates: Vec<usize> = (0..seeds.len())
         .filter(|&m| {
             let s = seeds[m];
             match s.along {
-                Along::X => crossings_at(&curve, 1, map.ys[s.line])
+                Along::X => crossings_at(curve, 1, map.ys[s.line])
                     .any(|x| (x - s.threshold.value).abs() <= x_cell),
-                Along::Y => crossings_at(&curve, 0, map.xs[s.line])
+                Along::Y => crossings_at(curve, 0, map.xs[s.line])
                     .any(|y| (y - s.threshold.value).abs() <= y_cell),
             }
         })
         .collect();
-    // Each solved for on the curve and compared with its line's threshold: those within LINE_CHECK_TOL are the
-    // curve's, the others a different border nearby.
     let differences: Vec<f64> = candidates
         .par_iter()
         .map(|&m| {
             let s = seeds[m];
             let v = s.threshold.value;
             let on_curve = match s.along {
-                Along::X => {
-                    curve_at(&problem, &curve, (1, map.ys[s.line]), v, &options).map(|p| p.p1)
-                }
-                Along::Y => {
-                    curve_at(&problem, &curve, (0, map.xs[s.line]), v, &options).map(|p| p.p2)
-                }
+                Along::X => curve_at(problem, curve, (1, map.ys[s.line]), v, options).map(|p| p.p1),
+                Along::Y => curve_at(problem, curve, (0, map.xs[s.line]), v, options).map(|p| p.p2),
             };
             on_curve.map_or(f64::NAN, |v| (v - s.threshold.value).abs())
         })
         .collect();
-    type Checked = Vec<(usize, f64)>;
-    let (hits, misses): (Checked, Checked) = candidates
+    candidates
         .into_iter()
         .zip(differences)
-        .partition(|(_, d)| *d <= LINE_CHECK_TOL);
-    let checked: Vec<f64> = hits.iter().map(|h| h.1).collect();
-    let end_words = |e: &CurveEnd| match e {
+        .partition(|(_, d)| *d <= LINE_CHECK_TOL)
+}
+
+/// Crossings (their indices in the seeds), each with the difference between the curve and its line's threshold.
+type Checked = Vec<(usize, f64)>;
+
+/// How a continued curve ends, in words ([`ContinuedCurve::ends`]).
+fn end_words(e: &CurveEnd) -> String {
+    match e {
         CurveEnd::LeftRange => "left_range".to_string(),
         CurveEnd::MaxPoints => "max_points".to_string(),
         CurveEnd::Ended { message } => format!("ended: {message}"),
-    };
-    let method = ContinuedCurve {
-        seed: RefinedOn {
-            along: seed.along,
-            line: j,
-            threshold: t.name.clone(),
-        },
-        condition: name.clone(),
-        offset: problem.offset,
-        ends: [end_words(&curve.ends[0]), end_words(&curve.ends[1])],
-        max_residual: curve.points.iter().map(|p| p.residual).fold(0.0, f64::max),
-        max_test_value: curve
-            .points
-            .iter()
-            .map(|p| p.test_value.abs())
-            .fold(0.0, f64::max),
-        lines_checked: checked.len(),
-        near_misses: misses
-            .iter()
-            .map(|&(m, difference)| NearMiss {
-                along: seeds[m].along,
-                line: seeds[m].line,
-                value: seeds[m].threshold.value,
-                difference,
-            })
-            .collect(),
-        max_line_difference: checked.iter().copied().reduce(f64::max).unwrap_or(f64::NAN),
-        description: format!(
-            "pseudo-arclength continuation of P(x) = x and {name} = {:e} in ({}, {}), from the gait of {} \
-             {j}'s family at {} = {}{}",
-            problem.offset,
-            spec.x.param,
-            spec.y.param,
-            if seed.along == Along::X { "row" } else { "column" },
-            line_spec.param,
-            v_start,
-            if problem.offset == 0.0 {
-                String::new()
-            } else {
-                format!(
-                    "; steps aimed at {name} = {:e}, each point polished",
-                    problem.offset * FOLLOW_OFFSET_FACTOR
-                )
-            }
-        ),
-    };
-    let curve_out = ThresholdCurve {
-        name: t.name.clone(),
-        points: curve.points.iter().map(|p| [p.p1, p.p2]).collect(),
-        refined_on: Vec::new(),
-        closed: false,
-        method: CurveMethod::Continuation(method),
-    };
-    Ok((
-        curve_out,
-        hits.into_iter().map(|h| h.0).collect(),
-        misses.into_iter().map(|m| m.0).collect(),
-    ))
+    }
 }
 
 /// Where the curve's polyline crosses the line where parameter `which` (0: `x`, 1: `y`) equals `value`: the

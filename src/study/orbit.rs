@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use super::grid::{coarse_pass, fill, run_rows, Cell, Evaluated, COARSE_STRIDE};
 use super::sweep::{RangeNames, SweepSpec};
-use crate::dynamics::Model;
+use crate::family::Parameter;
 use crate::gait::periodicity::{least_period, MAX_PERIOD};
 use crate::params::{Config, ConfigError};
 use crate::walk::{SectionState, StepReport, Walker};
@@ -149,8 +149,7 @@ pub struct OrbitColumn {
 /// Walk at `value` from `start`: `transient` steps, then `steps` recorded. Returns the column and the state
 /// the walk ended in (`None` if it failed).
 fn walk_column(
-    config: &Config,
-    param: &str,
+    parameter: Parameter,
     value: f64,
     start: &SectionState,
     transient: usize,
@@ -164,18 +163,15 @@ fn walk_column(
         period_k: None,
         continued_from: None,
     };
-    let configured = config
-        .with(param, value)
-        .and_then(|c| Model::new(&c.params).map(|model| (c, model)));
-    let (c, model) = match configured {
-        Ok(x) => x,
+    let at = match parameter.at(value) {
+        Ok(at) => at,
         Err(e) => {
             column.status = WalkStatus::InvalidParameter;
             column.message = Some(e.to_string());
             return (column, None);
         }
     };
-    let walked = Walker::new(&model, &c.solver, start).and_then(|mut walker| {
+    let walked = Walker::new(&at.model, &at.config.solver, start).and_then(|mut walker| {
         for _ in 0..transient {
             walker.step(None)?;
         }
@@ -217,7 +213,8 @@ pub fn orbit_diagram(
 ) -> Result<Vec<OrbitColumn>, ConfigError> {
     spec.validate(config)?;
     let values = spec.range.values();
-    let eval = column_eval(config, spec, initial, &values, progress);
+    let parameter = Parameter::named(config, &spec.range.param)?;
+    let eval = column_eval(parameter, spec, initial, &values, progress);
     let mut rows = run_rows(1, values.len(), eval);
     Ok(rows.pop().unwrap_or_default())
 }
@@ -250,7 +247,8 @@ pub fn orbit_part(
 ) -> Result<Vec<(OrbitColumn, Option<SectionState>)>, ConfigError> {
     spec.validate(config)?;
     let values = spec.range.values();
-    let eval = column_eval(config, spec, initial, &values, progress);
+    let parameter = Parameter::named(config, &spec.range.param)?;
+    let eval = column_eval(parameter, spec, initial, &values, progress);
     // The end state as the column's point too, so that a fill hands it back.
     let with_end = |cell, from: Option<(usize, &SectionState)>| {
         let e = eval(cell, from);
@@ -281,7 +279,7 @@ pub fn orbit_part(
 /// The walk at one value of the diagram, from where the value it continues ended (else from `initial` with the
 /// longer transient): the grid runner's evaluation.
 fn column_eval<'a>(
-    config: &'a Config,
+    parameter: Parameter<'a>,
     spec: &'a OrbitSpec,
     initial: &'a SectionState,
     values: &'a [f64],
@@ -295,14 +293,7 @@ fn column_eval<'a>(
             Some((j, s)) => (*s, spec.transient, Some(values[j])),
             None => (*initial, fresh, None),
         };
-        let (mut column, end) = walk_column(
-            config,
-            &spec.range.param,
-            value,
-            &start,
-            transient,
-            spec.steps,
-        );
+        let (mut column, end) = walk_column(parameter, value, &start, transient, spec.steps);
         column.continued_from = continued_from;
         progress(&column);
         Evaluated {

@@ -20,16 +20,17 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::grid::{run_rows_part, Evaluated};
-use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
+use crate::dynamics::DIFFERENTIABLE_KEYS;
 use crate::family::natural::{FollowOutcome, GaitPoint, NaturalContinuation, Tangent, PARAM_TOL};
+use crate::family::Parameter;
 use crate::fmt::short;
 use crate::gait::limit_cycle::{
     gait_at_converged, solve_fixed_point, Gait, GaitOptions, Stability,
 };
 use crate::gait::period_k::{find_gait_any_period, periodic_gait_at};
 use crate::gait::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
-use crate::gait::step_map::{free_coordinates, StepMap};
-use crate::params::{Config, ConfigError, SolverOptions};
+use crate::gait::step_map::free_coordinates;
+use crate::params::{Config, ConfigError, NumericKey};
 use crate::walk::{SectionState, SECTION_COORDINATES};
 
 /// The most points a sweep may have.
@@ -85,7 +86,7 @@ impl SweepSpec {
     /// (the rules on one key are intervals, so the whole range is then valid), before anything is computed.
     /// Errors name the command and its flags (`names`).
     pub fn validate_as(&self, config: &Config, names: &RangeNames) -> Result<(), ConfigError> {
-        config.get_numeric(&self.param)?;
+        let parameter = Parameter::named(config, &self.param)?;
         let invalid = |value: String, reason: &str| ConfigError::InvalidValue {
             key: format!("{} {}", names.command, self.param),
             value,
@@ -113,7 +114,7 @@ impl SweepSpec {
             ));
         }
         for (flag, value) in [(names.from, self.from), (names.to, self.to)] {
-            if let Err(e) = config.with(&self.param, value) {
+            if let Err(e) = parameter.at(value) {
                 return Err(invalid(
                     format!("{flag} {}", short(value)),
                     &format!("the range leaves the valid domain: {e}"),
@@ -223,18 +224,14 @@ pub(crate) struct Previous<'a> {
 /// continuation steps if given; if the family does not reach `value`, searched from `initial` with the full
 /// transient, for a period-k gait too if Newton's method fails on `P` ([`find_gait_any_period`]).
 pub(crate) fn gait_at_value(
-    config: &Config,
-    param: &str,
+    parameter: Parameter,
     value: f64,
     initial: &SectionState,
     previous: Option<Previous>,
     options: &GaitOptions,
 ) -> SweepPoint {
-    let configured = config
-        .with(param, value)
-        .and_then(|c| Model::new(&c.params).map(|model| (c, model)));
-    let (c, model) = match configured {
-        Ok(x) => x,
+    let at = match parameter.at(value) {
+        Ok(at) => at,
         Err(e) => {
             return SweepPoint {
                 value,
@@ -247,12 +244,11 @@ pub(crate) fn gait_at_value(
             }
         }
     };
-    let solver: &SolverOptions = &c.solver;
-    let map = StepMap::new(&model, solver);
-    let options = &with_swept_parameter(options, param);
+    let map = at.step_map();
+    let options = &with_swept_parameter(options, parameter.key());
     let mut attempts = Vec::new();
     let continued = previous.and_then(|p| {
-        match follow_gait(config, param, p.value, p.gait, value, options, p.end_tol) {
+        match follow_gait(parameter, p.value, p.gait, value, options, p.end_tol) {
             Ok(g) => Some((p.index, g)),
             Err(attempt) => {
                 attempts.extend(attempt);
@@ -290,12 +286,16 @@ pub(crate) fn gait_at_value(
 }
 
 /// The tangent `ds*/dp = (I - DP)^-1 dP/dp` of the family of `g`, the gait at `from`, where its `dP/dp` is for
-/// `param` (a sweep asks for it: [`with_swept_parameter`]): the predictor of the first continuation step.
-pub(crate) fn family_tangent(config: &Config, param: &str, from: f64, g: &Gait) -> Option<Tangent> {
-    let d = g.dp_dparam.as_ref().filter(|d| d.parameter == param)?;
+/// `parameter` (a sweep asks for it: [`with_swept_parameter`]): the predictor of the first continuation step.
+pub(crate) fn family_tangent(parameter: &Parameter, from: f64, g: &Gait) -> Option<Tangent> {
+    let d = g
+        .dp_dparam
+        .as_ref()
+        .filter(|d| d.parameter == parameter.key())?;
     let dp = g.jacobian_guess()?;
     let n = dp.nrows();
-    let free = free_coordinates(config.params.rigid_legs || g.rear_held, g.section.slips());
+    let rigid = parameter.config().params.rigid_legs;
+    let free = free_coordinates(rigid || g.rear_held, g.section.slips());
     if free.len() != n || d.values.len() != n {
         return None;
     }
@@ -332,8 +332,7 @@ fn with_swept_parameter(options: &GaitOptions, param: &str) -> GaitOptions {
 /// `value`, the attempt (for [`SweepPoint::attempts`]); `Err(None)` if it reaches it but the gait there cannot be
 /// completed.
 fn follow_gait(
-    config: &Config,
-    param: &str,
+    parameter: Parameter,
     from: f64,
     g: &Gait,
     value: f64,
@@ -345,8 +344,8 @@ fn follow_gait(
         value: from,
         section: g.section,
     };
-    let cont = NaturalContinuation::new(config, param, options).with_period(g.period_k);
-    let tangent = family_tangent(config, param, from, g);
+    let cont = NaturalContinuation::new(parameter, options).with_period(g.period_k);
+    let tangent = family_tangent(&parameter, from, g);
     let p = match cont.follow_to(start, value, (guess.as_ref(), tangent), end_tol) {
         FollowOutcome::Reached(p) => p,
         followed => {
@@ -357,9 +356,9 @@ fn follow_gait(
             }))
         }
     };
-    let c = config.with(param, value).map_err(|_| None)?;
-    let model = Model::new(&c.params).map_err(|_| None)?;
-    let map = StepMap::new(&model, &c.solver);
+    // The family reached `value`, which is in the parameter's domain.
+    let at = parameter.at(value).map_err(|_| None)?;
+    let map = at.step_map();
     let opts = GaitOptions {
         transient_steps: 0,
         ..*options
@@ -385,7 +384,7 @@ fn continuable(point: &SweepPoint) -> Option<&Gait> {
 /// Points without a gait just left of a gait (or of a stretch of gaits) may be misses of the search from the
 /// initial state: follow each such gait backwards, from right to left, and fill in the points its family
 /// reaches. Sequential and in a fixed order, so deterministic.
-fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &GaitOptions) {
+fn backfill(parameter: Parameter, points: &mut [SweepPoint], options: &GaitOptions) {
     for i in (1..points.len()).rev() {
         let (left, right) = points.split_at_mut(i);
         let (a, b) = (&mut left[i - 1], &right[0]);
@@ -395,7 +394,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
         if a.status == PointStatus::InvalidParameter {
             continue;
         }
-        match follow_gait(config, param, b.value, gb, a.value, options, PARAM_TOL) {
+        match follow_gait(parameter, b.value, gb, a.value, options, PARAM_TOL) {
             Ok(g) => {
                 a.status = PointStatus::Gait(g.stability);
                 a.message = None;
@@ -410,8 +409,7 @@ fn backfill(config: &Config, param: &str, points: &mut [SweepPoint], options: &G
 /// Number the gait families: a point continued from another shares its family; a point found from the initial
 /// state starts a new one, unless a verified continuation step connects it to its left neighbour's gait.
 pub(crate) fn number_families(
-    config: &Config,
-    param: &str,
+    parameter: Parameter,
     points: &mut [SweepPoint],
     options: &GaitOptions,
 ) {
@@ -447,7 +445,7 @@ pub(crate) fn number_families(
             value: a.value,
             section: ga.section,
         };
-        let connected = NaturalContinuation::new(config, param, options)
+        let connected = NaturalContinuation::new(parameter, options)
             .with_period(ga.period_k)
             .step(&start, b.value, ga.jacobian_guess().as_ref())
             .is_some_and(|p| p.section.distance(&gb.section) <= SAME_GAIT_TOL);
@@ -472,10 +470,10 @@ pub(crate) fn number_families(
 /// One row of gait points: a configuration and the values one of its parameters takes along the row.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct GaitRow {
-    /// Parameters and solver options (`param` is overridden point by point).
+    /// Parameters and solver options (`key` is overridden point by point).
     pub config: Config,
-    /// The numeric key that varies along the row ([`Config::numeric_keys`]).
-    pub param: String,
+    /// The numeric key that varies along the row.
+    pub key: NumericKey,
     /// Its values, in the order they are continued.
     pub values: Vec<f64>,
 }
@@ -534,7 +532,8 @@ pub(crate) fn gait_rows_part(
                     end_tol,
                 }
             });
-            let point = gait_at_value(&row.config, &row.param, value, initial, previous, options);
+            let parameter = Parameter::new(&row.config, row.key);
+            let point = gait_at_value(parameter, value, initial, previous, options);
             progress(&point);
             Evaluated {
                 carry: continuable(&point).cloned(),
@@ -553,8 +552,9 @@ pub(crate) fn gait_rows_part(
                 return points;
             }
             let computed = points.clone();
-            backfill(&row.config, &row.param, &mut points, options);
-            number_families(&row.config, &row.param, &mut points, options);
+            let parameter = Parameter::new(&row.config, row.key);
+            backfill(parameter, &mut points, options);
+            number_families(parameter, &mut points, options);
             if crate::walk::interrupted() {
                 return computed;
             }
@@ -594,7 +594,7 @@ pub fn check_values(
     command: &str,
     max_points: usize,
 ) -> Result<(), ConfigError> {
-    config.get_numeric(param)?;
+    let parameter = Parameter::named(config, param)?;
     let invalid = |value: String, reason: String| ConfigError::InvalidValue {
         key: format!("{command} {param}"),
         value,
@@ -619,7 +619,7 @@ pub fn check_values(
         values.iter().max_by(by_value),
     ];
     for &value in ends.into_iter().flatten() {
-        if let Err(e) = config.with(param, value) {
+        if let Err(e) = parameter.at(value) {
             let i = values.iter().position(|v| *v == value).unwrap_or(0);
             let rule = match &e {
                 ConfigError::InvalidValue { key, reason, .. } if key == param => reason.clone(),
@@ -652,7 +652,7 @@ pub fn sweep_values(
     options.validate()?;
     let row = GaitRow {
         config: config.clone(),
-        param: param.to_string(),
+        key: NumericKey::new(param)?,
         values: values.to_vec(),
     };
     Ok(gait_rows(&[row], initial, options, progress)

@@ -20,22 +20,22 @@
 //! The refinements are independent and run in parallel (rayon); each is deterministic, so the results do not
 //! depend on the number of threads.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use rayon::prelude::*;
 use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 
-use super::sweep::{family_tangent, SweepPoint, SweepSpec};
-use crate::dynamics::Model;
+use nalgebra::DMatrix;
+
+use super::sweep::{family_tangent, SweepPoint};
 pub(crate) use crate::family::natural::PARAM_TOL;
 use crate::family::natural::{
     carried_start, EndCause, FollowOutcome, GaitPoint, NaturalContinuation,
 };
+use crate::family::Parameter;
 use crate::gait::limit_cycle::{find_gait, solve_fixed_point, Gait, GaitOptions};
 use crate::gait::periodicity::SAME_GAIT_TOL;
-use crate::gait::step_map::StepMap;
-use crate::params::Config;
 use crate::walk::DlsIndicators;
 
 /// Brent iterations allowed.
@@ -201,8 +201,7 @@ enum Task<'a> {
 
 /// Locate every threshold in the sweep `points` of `spec` (see the module documentation).
 pub fn find_thresholds(
-    config: &Config,
-    spec: &SweepSpec,
+    parameter: Parameter,
     points: &[SweepPoint],
     options: &GaitOptions,
 ) -> Vec<Threshold> {
@@ -232,13 +231,13 @@ pub fn find_thresholds(
     let found: Vec<Threshold> = tasks
         .par_iter()
         .flat_map_iter(|task| match task {
-            Task::Root(q, a, b) => vec![refine_root(config, spec, *q, a, b, options)],
+            Task::Root(q, a, b) => vec![refine_root(parameter, *q, a, b, options)],
             Task::End(from, toward) => {
-                refine_end(config, spec, from, toward, options, gait_before(from.value))
+                refine_end(parameter, from, toward, options, gait_before(from.value))
             }
         })
         .collect();
-    every_family_change_named(spec, points, without_repeats(found))
+    every_family_change_named(parameter.key(), points, without_repeats(found))
 }
 
 /// `thresholds` without the repeats of one end found from both sides (the same name within [`PARAM_TOL`] in
@@ -262,7 +261,7 @@ fn without_repeats(thresholds: Vec<Threshold>) -> Vec<Threshold> {
 /// threshold lies: the family change was seen but neither family's end could be bracketed between them (the
 /// reason in `detail`, the grid interval as the bracket, no value).
 fn every_family_change_named(
-    spec: &SweepSpec,
+    param: &str,
     points: &[SweepPoint],
     mut thresholds: Vec<Threshold>,
 ) -> Vec<Threshold> {
@@ -289,7 +288,7 @@ fn every_family_change_named(
                 ga.period_k,
                 b.value,
                 gb.period_k,
-                p = spec.param
+                p = param
             ),
         );
         entry.name = "family_change".to_string();
@@ -304,8 +303,7 @@ fn every_family_change_named(
 /// gait of the family, it reaches zero within [`PARAM_TOL`] of the end. Each is reported as its own threshold at
 /// the end's value, with the indicator's value at the last gait as its residual.
 fn vanishing_at_end(
-    config: &Config,
-    spec: &SweepSpec,
+    parameter: Parameter,
     from: &SweepPoint,
     last: &GaitPoint,
     end: &Threshold,
@@ -313,13 +311,13 @@ fn vanishing_at_end(
     let Some(g) = from.gait.as_ref() else {
         return Vec::new();
     };
-    let Ok(c) = config.with(&spec.param, last.value) else {
+    // Within the family's range, the parameter is valid and the walk worked in the continuation: no reason to
+    // report is lost where either fails.
+    let Ok(at) = parameter.at(last.value) else {
         return Vec::new();
     };
-    let Ok(model) = Model::new(&c.params) else {
-        return Vec::new();
-    };
-    let map = StepMap::new(&model, &c.solver)
+    let map = at
+        .step_map()
         .iterated(g.period_k)
         .with_slip(last.section.slips());
     let Ok(out) = map.eval(&last.section) else {
@@ -345,7 +343,7 @@ fn vanishing_at_end(
                     end.name,
                     q.name().trim_end_matches(" = 0"),
                     last.value,
-                    p = spec.param,
+                    p = parameter.key(),
                 )),
                 second_route: None,
             })
@@ -357,137 +355,28 @@ fn vanishing_at_end(
 /// it (see the module documentation), followed by the DLS indicators that vanish there
 /// ([`vanishing_at_end`]). Nothing if the family reaches `toward` after all and is `toward`'s gait.
 fn refine_end(
-    config: &Config,
-    spec: &SweepSpec,
+    parameter: Parameter,
     from: &SweepPoint,
     toward: &SweepPoint,
     options: &GaitOptions,
     gait_before: bool,
 ) -> Vec<Threshold> {
     let g = from.gait.as_ref().expect("an end starts at a gait");
-    let cont = NaturalContinuation::new(config, &spec.param, options).with_period(g.period_k);
-    let start = GaitPoint {
-        value: from.value,
-        section: g.section,
-    };
-    let guess = g.jacobian_guess();
+    let cont = NaturalContinuation::new(parameter, options).with_period(g.period_k);
     let grid_bracket = sorted([from.value, toward.value]);
-    // The sweep may have followed this family from this gait toward this point already (and failed): take
-    // that result rather than follow it again (the same computation, see `SweepPoint::attempts`).
-    let followed = match toward.attempt_from(&start) {
-        Some(f) => f.clone(),
-        // With the sweep's predictor (the tangent of `from`'s gait), so as to follow it as the sweep did.
-        None => {
-            let tangent = family_tangent(config, &spec.param, from.value, g);
-            cont.follow(start, toward.value, (guess.as_ref(), tangent))
-        }
-    };
-    let (last, beyond) = match followed {
-        FollowOutcome::Ended { last, beyond } => (last, beyond),
-        FollowOutcome::GaveUp { last, .. } => {
-            return vec![unconfirmed(
-                grid_bracket,
-                format!(
-                    "the family of {p} = {} was followed only to {p} = {} toward {p} = {} (given up after {} \
-                     continuation steps or {} steps by walking)",
-                    from.value,
-                    last.value,
-                    toward.value,
-                    crate::family::natural::MAX_FOLLOW_STEPS,
-                    crate::family::natural::MAX_FOLLOW_WALKS,
-                    p = spec.param,
-                ),
-            )]
-        }
-        FollowOutcome::Reached(p) => {
-            let same = toward.gait.as_ref().is_some_and(|gt| {
-gt.section.distance(&p.section) <= SAME_GAIT_TOL
-            });
-            if same {
-                return Vec::new();
-            }
-            let what = if toward.gait.is_some() {
-                "the sweep found another gait there (two gaits coexist)"
-            } else {
-                "the sweep found no gait there"
-            };
-            return vec![unconfirmed(
-                grid_bracket,
-                format!(
-                    "the family of {} = {} reaches {} = {}, but {what}",
-                    spec.param, from.value, spec.param, toward.value
-                ),
-            )];
-        }
+    let (last, beyond) = match followed_to_end(parameter, &cont, from, toward) {
+        Ok(end) => end,
+        Err(reported) => return reported,
     };
     let upward = toward.value > from.value;
-    let cause = cont.end_cause(&last, beyond);
-    let (name, detail) = match &cause {
-        EndCause::WalkFails { failure, message } => (
-            if upward { "gait_lost" } else { "gait_found" },
-            format!(
-                "{}; walking from its last gait at {p} = {beyond}: {failure} ({message}){}",
-                // A walk from an unstable gait fails whether or not the family goes on: then the evidence is
-                // Newton's method's alone.
-                if cont.largest_multiplier(&last).is_some_and(|m| m > 1.0) {
-                    format!(
-                        "the gait family is followed to {p} = {}, where its gait is unstable, and Newton's \
-                         method finds none of its gaits at {p} = {beyond} (the walk from an unstable gait fails \
-                         either way: that no gait of the family exists there is not shown)",
-                        last.value,
-                        p = spec.param
-                    )
-                } else {
-                    format!(
-                        "the gait family exists at {p} = {} and not at {p} = {beyond}",
-                        last.value,
-                        p = spec.param
-                    )
-                },
-                if !upward && gait_before {
-                    "; the gait is found again"
-                } else {
-                    ""
-                },
-                p = spec.param,
-            ) + &cut_by_step_limit(config, spec, &cont, (&last, beyond), failure),
-        ),
-        EndCause::OtherGait {
-            steps,
-            lambda_i4,
-            period_k,
-            ..
-        } => (
-            "branch_switch",
-            format!(
-                "the gait family of lambda_I4 = {:.6} N s (period {}) ends at {p} = {} (not reached at \
-                 {beyond}); walking {steps} steps from its last gait there settles on another gait, of period \
-                 {period_k}, lambda_I4 = {lambda_i4:.6} N s",
-                g.lambda_i4,
-                g.period_k,
-                last.value,
-                p = spec.param,
-            ),
-        ),
-        EndCause::Fold { multiplier } => (
-            "fold",
-            format!(
-                "the gait family ends at {p} = {} (not reached at {beyond}) with a Floquet multiplier {multiplier:.4} \
-                 near +1: a fold (saddle-node)",
-                last.value,
-                p = spec.param,
-            ),
-        ),
-        EndCause::Unconfirmed { reason } => (
-            "unconfirmed",
-            format!(
-                "the gait family is not followed past {p} = {} (to {beyond}), but no physical cause was found: \
-                 {reason}",
-                last.value,
-                p = spec.param,
-            ),
-        ),
+    let ended = EndOf {
+        parameter,
+        cont: &cont,
+        gait: g,
+        last,
+        beyond,
     };
+    let (name, detail) = ended.named(upward, gait_before);
     let end = Threshold {
         name: name.to_string(),
         value: 0.5 * (last.value + beyond),
@@ -497,8 +386,154 @@ gt.section.distance(&p.section) <= SAME_GAIT_TOL
         detail: Some(detail),
         second_route: None,
     };
-    let vanishing = vanishing_at_end(config, spec, from, &last, &end);
+    let vanishing = vanishing_at_end(parameter, from, &last, &end);
     std::iter::once(end).chain(vanishing).collect()
+}
+
+/// The family of `from`'s gait followed toward `toward` (or the sweep's attempt that did so already): its last
+/// gait and the first value it does not reach; else what is reported instead of an end (nothing where it
+/// reaches `toward`'s gait, an `unconfirmed` entry where it is given up or reaches another gait there).
+fn followed_to_end(
+    parameter: Parameter,
+    cont: &NaturalContinuation,
+    from: &SweepPoint,
+    toward: &SweepPoint,
+) -> Result<(GaitPoint, f64), Vec<Threshold>> {
+    let g = from.gait.as_ref().expect("an end starts at a gait");
+    let p = parameter.key();
+    let start = GaitPoint {
+        value: from.value,
+        section: g.section,
+    };
+    let grid_bracket = sorted([from.value, toward.value]);
+    // The sweep may have followed this family from this gait toward this point already (and failed): take
+    // that result rather than follow it again (the same computation, see `SweepPoint::attempts`).
+    let followed = match toward.attempt_from(&start) {
+        Some(f) => f.clone(),
+        // With the sweep's predictor (the tangent of `from`'s gait), so as to follow it as the sweep did.
+        None => {
+            let guess = g.jacobian_guess();
+            let tangent = family_tangent(&parameter, from.value, g);
+            cont.follow(start, toward.value, (guess.as_ref(), tangent))
+        }
+    };
+    match followed {
+        FollowOutcome::Ended { last, beyond } => Ok((last, beyond)),
+        FollowOutcome::GaveUp { last, .. } => Err(vec![unconfirmed(
+            grid_bracket,
+            format!(
+                "the family of {p} = {} was followed only to {p} = {} toward {p} = {} (given up after {} \
+                 continuation steps or {} steps by walking)",
+                from.value,
+                last.value,
+                toward.value,
+                crate::family::natural::MAX_FOLLOW_STEPS,
+                crate::family::natural::MAX_FOLLOW_WALKS,
+            ),
+        )]),
+        FollowOutcome::Reached(reached) => {
+            let same = toward
+                .gait
+                .as_ref()
+                .is_some_and(|gt| gt.section.distance(&reached.section) <= SAME_GAIT_TOL);
+            if same {
+                return Err(Vec::new());
+            }
+            let what = if toward.gait.is_some() {
+                "the sweep found another gait there (two gaits coexist)"
+            } else {
+                "the sweep found no gait there"
+            };
+            Err(vec![unconfirmed(
+                grid_bracket,
+                format!(
+                    "the family of {p} = {} reaches {p} = {}, but {what}",
+                    from.value, toward.value
+                ),
+            )])
+        }
+    }
+}
+
+/// The end of a family: its last gait, the first value it does not reach, and how it was followed.
+struct EndOf<'a> {
+    parameter: Parameter<'a>,
+    cont: &'a NaturalContinuation<'a>,
+    /// The sweep's gait the family was followed from.
+    gait: &'a Gait,
+    last: GaitPoint,
+    beyond: f64,
+}
+
+impl EndOf<'_> {
+    /// The end's name and detail, by what happens just past it ([`NaturalContinuation::end_cause`]); `upward`:
+    /// the family was followed up the parameter; `gait_before`: the sweep has a gait below it.
+    fn named(&self, upward: bool, gait_before: bool) -> (&'static str, String) {
+        let (p, last, beyond, g) = (self.parameter.key(), &self.last, self.beyond, self.gait);
+        match self.cont.end_cause(last, beyond) {
+            EndCause::WalkFails { failure, message } => (
+                if upward { "gait_lost" } else { "gait_found" },
+                format!(
+                    "{}; walking from its last gait at {p} = {beyond}: {failure} ({message}){}",
+                    self.existence(),
+                    if !upward && gait_before {
+                        "; the gait is found again"
+                    } else {
+                        ""
+                    },
+                ) + &cut_by_step_limit(self.parameter, self.cont, (last, beyond), &failure),
+            ),
+            EndCause::OtherGait {
+                steps,
+                lambda_i4,
+                period_k,
+                ..
+            } => (
+                "branch_switch",
+                format!(
+                    "the gait family of lambda_I4 = {:.6} N s (period {}) ends at {p} = {} (not reached at \
+                     {beyond}); walking {steps} steps from its last gait there settles on another gait, of period \
+                     {period_k}, lambda_I4 = {lambda_i4:.6} N s",
+                    g.lambda_i4, g.period_k, last.value,
+                ),
+            ),
+            EndCause::Fold { multiplier } => (
+                "fold",
+                format!(
+                    "the gait family ends at {p} = {} (not reached at {beyond}) with a Floquet multiplier {multiplier:.4} \
+                     near +1: a fold (saddle-node)",
+                    last.value,
+                ),
+            ),
+            EndCause::Unconfirmed { reason } => (
+                "unconfirmed",
+                format!(
+                    "the gait family is not followed past {p} = {} (to {beyond}), but no physical cause was found: \
+                     {reason}",
+                    last.value,
+                ),
+            ),
+        }
+    }
+
+    /// Where the family exists and where not, in words, for an end where the walk past it fails. A walk from an
+    /// unstable gait fails whether or not the family goes on: then the evidence is Newton's method's alone.
+    fn existence(&self) -> String {
+        let (p, last, beyond) = (self.parameter.key(), &self.last, self.beyond);
+        if self.cont.largest_multiplier(last).is_some_and(|m| m > 1.0) {
+            format!(
+                "the gait family is followed to {p} = {}, where its gait is unstable, and Newton's \
+                 method finds none of its gaits at {p} = {beyond} (the walk from an unstable gait fails \
+                 either way: that no gait of the family exists there is not shown)",
+                last.value,
+            )
+        } else {
+            format!(
+                "the gait family exists at {p} = {} and not at {p} = {beyond}",
+                last.value,
+            )
+        }
+    }
 }
 
 /// Where the walk past a family's end stalls (no touchdown within `max_step_time`) and the family's last gait
@@ -506,8 +541,7 @@ gt.section.distance(&p.section) <= SAME_GAIT_TOL
 /// physics (the wheel creeps ever more slowly over the top of its step): that, in words, for the end's detail;
 /// an empty string otherwise.
 fn cut_by_step_limit(
-    config: &Config,
-    spec: &SweepSpec,
+    parameter: Parameter,
     cont: &NaturalContinuation,
     (last, beyond): (&GaitPoint, f64),
     failure: &str,
@@ -516,10 +550,10 @@ fn cut_by_step_limit(
     if failure != "stalled" {
         return String::new();
     }
-    let Ok(c) = config.with(&spec.param, beyond) else {
+    let Ok(at) = parameter.at(beyond) else {
         return String::new();
     };
-    let limit = c.solver.max_step_time;
+    let limit = at.config.solver.max_step_time;
     match cont.longest_step(last) {
         Some(step) if step >= STEP_LIMIT_SHARE * limit => format!(
             "; the last gait's step lasts {step:.6} s of the max_step_time = {limit} s a step may last: the \
@@ -555,8 +589,7 @@ fn sorted(mut pair: [f64; 2]) -> [f64; 2] {
 /// each `v` starts from the gait found at the value nearest to `v` so far (`a`'s at first), carried to `v`, so
 /// that as Brent's brackets shrink its starts come closer to the gait.
 fn refine_root(
-    config: &Config,
-    spec: &SweepSpec,
+    parameter: Parameter,
     q: Quantity,
     a: &SweepPoint,
     b: &SweepPoint,
@@ -566,20 +599,23 @@ fn refine_root(
         .gait
         .as_ref()
         .expect("root tasks have gaits on both sides");
-    let continued = GaitOptions {
-        transient_steps: 0,
-        refine_jacobian: false,
-        ..*options
+    let search = RootSearch {
+        parameter,
+        q,
+        start,
+        options: GaitOptions {
+            transient_steps: 0,
+            refine_jacobian: false,
+            ..*options
+        },
+        guess: start.jacobian_guess(),
+        found: RefCell::new(vec![GaitPoint {
+            value: a.value,
+            section: start.section,
+        }]),
+        last_gait: RefCell::new(None),
     };
-    let guess = start.jacobian_guess();
-    // The gaits found so far (the family's points in the bracket).
-    let found = std::cell::RefCell::new(vec![GaitPoint {
-        value: a.value,
-        section: start.section,
-    }]);
     let failure: Cell<Option<String>> = Cell::new(None);
-    // The gait of the last evaluation (stability only): at the root, its critical multiplier names the change.
-    let last_gait: std::cell::RefCell<Option<Gait>> = std::cell::RefCell::new(None);
     let (lo, hi) = (Cell::new(a.value), Cell::new(b.value));
     let f_a = q.of(start);
     let f = |v: f64| -> f64 {
@@ -589,33 +625,7 @@ fn refine_root(
             failure.set(failed);
             return f64::NAN;
         }
-        let value = (|| {
-            let c = config.with(&spec.param, v).map_err(|e| e.to_string())?;
-            let model = Model::new(&c.params).map_err(|e| e.to_string())?;
-            // A period-k family's gaits are fixed points of P^k; the indicators are those of its first step.
-            let map = StepMap::new(&model, &c.solver).iterated(start.period_k);
-            let from = *found
-                .borrow()
-                .iter()
-                .min_by(|x, y| (x.value - v).abs().total_cmp(&(y.value - v).abs()))
-                .expect("a's gait is found");
-            let s = carried_start(config, &spec.param, &from, v);
-            let (y, section) = if q == Quantity::Stability {
-                let g =
-                    find_gait(&map, &s, &continued, guess.as_ref()).map_err(|e| e.to_string())?;
-                let y = q.of(&g);
-                let section = g.section;
-                *last_gait.borrow_mut() = Some(g);
-                (y, section)
-            } else {
-                let fp = solve_fixed_point(&map, &s, &continued, guess.as_ref())
-                    .map_err(|e| e.to_string())?;
-                (q.of_indicators(&fp.outcome.report.indicators), fp.section)
-            };
-            found.borrow_mut().push(GaitPoint { value: v, section });
-            Ok::<f64, String>(y)
-        })();
-        match value {
+        match search.evaluate(v) {
             Ok(y) => {
                 // Track the bracket for the report.
                 if (y < 0.0) == (f_a < 0.0) {
@@ -648,28 +658,18 @@ fn refine_root(
     } else {
         f64::NAN
     };
-    let mut name = q.name().to_string();
-    if q == Quantity::Stability {
-        let (stable_side, words) = stability_change(a.value, b.value, f_a);
-        name = words.to_string();
-        let root_gait = last_gait.borrow();
-        let critical = root_gait
-            .as_ref()
-            .filter(|_| value.is_finite())
-            .and_then(|g| critical_multiplier(&g.floquet_multipliers));
-        if let Some([re, im]) =
-            critical.filter(|[re, im]| *re < 0.0 && im.abs() <= REAL_MULTIPLIER_TOL)
-        {
-            name = "period_doubling".to_string();
-            let note = format!(
-                "a multiplier crosses -1 ({re:.6}{im:+.1e}i at the root): a period doubling, stable {stable_side}"
-            );
-            detail = Some(detail.map_or(note.clone(), |d| format!("{note}; {d}")));
-        } else if value.is_finite() {
-            let note = format!("stable {stable_side}");
-            detail = Some(detail.map_or(note.clone(), |d| format!("{note}; {d}")));
-        }
-    }
+    let (name, detail) = if q == Quantity::Stability {
+        let root_gait = search.last_gait.borrow();
+        let at_root = root_gait.as_ref().filter(|_| value.is_finite());
+        stability_named(
+            stability_change(a.value, b.value, f_a),
+            at_root,
+            value,
+            detail,
+        )
+    } else {
+        (q.name().to_string(), detail)
+    };
     Threshold {
         name,
         value,
@@ -678,6 +678,87 @@ fn refine_root(
         residual,
         detail,
         second_route: None,
+    }
+}
+
+/// Brent's function of [`refine_root`]: the quantity `q` of the gait of `start`'s family at a parameter value.
+struct RootSearch<'a> {
+    parameter: Parameter<'a>,
+    q: Quantity,
+    /// The gait the family is followed from.
+    start: &'a Gait,
+    /// Newton's method's settings (no transient).
+    options: GaitOptions,
+    /// Its Newton matrix.
+    guess: Option<DMatrix<f64>>,
+    /// The gaits found so far (the family's points in the bracket).
+    found: RefCell<Vec<GaitPoint>>,
+    /// The gait of the last evaluation (stability only): at the root, its critical multiplier names the change.
+    last_gait: RefCell<Option<Gait>>,
+}
+
+impl RootSearch<'_> {
+    /// `q` of the family's gait at `v`, by Newton's method from the gait found nearest `v` so far, carried to
+    /// `v`; why not, in words.
+    fn evaluate(&self, v: f64) -> Result<f64, String> {
+        let at = self.parameter.at(v).map_err(|e| e.to_string())?;
+        // A period-k family's gaits are fixed points of P^k; the indicators are those of its first step.
+        let map = at.step_map().iterated(self.start.period_k);
+        let from = *self
+            .found
+            .borrow()
+            .iter()
+            .min_by(|x, y| (x.value - v).abs().total_cmp(&(y.value - v).abs()))
+            .expect("a's gait is found");
+        let s = carried_start(&self.parameter, &from, v);
+        let guess = self.guess.as_ref();
+        let (y, section) = if self.q == Quantity::Stability {
+            let g = find_gait(&map, &s, &self.options, guess).map_err(|e| e.to_string())?;
+            let y = self.q.of(&g);
+            let section = g.section;
+            *self.last_gait.borrow_mut() = Some(g);
+            (y, section)
+        } else {
+            let fp =
+                solve_fixed_point(&map, &s, &self.options, guess).map_err(|e| e.to_string())?;
+            (
+                self.q.of_indicators(&fp.outcome.report.indicators),
+                fp.section,
+            )
+        };
+        self.found
+            .borrow_mut()
+            .push(GaitPoint { value: v, section });
+        Ok(y)
+    }
+}
+
+/// A stability change's name and detail: `period_doubling` where the critical multiplier of the gait at the
+/// root is real and negative, else the name of [`stability_change`]; the stable side noted before `detail`.
+fn stability_named(
+    (stable_side, words): (&'static str, &'static str),
+    at_root: Option<&Gait>,
+    value: f64,
+    detail: Option<String>,
+) -> (String, Option<String>) {
+    let critical = at_root.and_then(|g| critical_multiplier(&g.floquet_multipliers));
+    let noted = |note: String| {
+        Some(
+            detail
+                .clone()
+                .map_or(note.clone(), |d| format!("{note}; {d}")),
+        )
+    };
+    if let Some([re, im]) = critical.filter(|[re, im]| *re < 0.0 && im.abs() <= REAL_MULTIPLIER_TOL)
+    {
+        let note = format!(
+            "a multiplier crosses -1 ({re:.6}{im:+.1e}i at the root): a period doubling, stable {stable_side}"
+        );
+        ("period_doubling".to_string(), noted(note))
+    } else if value.is_finite() {
+        (words.to_string(), noted(format!("stable {stable_side}")))
+    } else {
+        (words.to_string(), detail)
     }
 }
 
