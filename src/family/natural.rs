@@ -543,7 +543,7 @@ impl<'a> NaturalContinuation<'a> {
         let mut walking = false;
         let mut failed_before = false;
         // Newton's method failed this many steps in a row.
-        let mut newton_failures = 0;
+        let mut failures = 0;
         // Steps tried by walking.
         let mut walks = 0;
         let mut end = EndSearch::default();
@@ -565,36 +565,8 @@ impl<'a> NaturalContinuation<'a> {
                 None if h.abs() >= remaining.abs() => target,
                 None => current.value + h,
             };
-            let matrix = jac.as_ref().map(|(_, j)| j);
             let at_end = (next_value - current.value).abs() <= end_tol;
-            let next = match self.step_predicted(
-                &current,
-                next_value,
-                (matrix, tangent.as_ref()),
-                (false, at_end),
-            ) {
-                Ok(p) => Some(p),
-                // A step that fails in Newton's method with a matrix computed elsewhere is retried with DP at
-                // `current`, as a quick test: Newton's method must not have to damp a step taken with DP at
-                // its iterate (`undamped`). Of the 1 338 retries of
-                // a 100 x 100 map, 1 336 failed, after up to 8 damped iterations each with a new DP; the two
-                // that worked (and the default map's one) damp none. Not a step whose walk fails at the
-                // start, where no matrix would help (near an end where the wheel rolls back, most steps of
-                // the bisection).
-                Err(StepFailure::Newton)
-                    if jac.as_ref().is_none_or(|(v, _)| *v != current.value) =>
-                {
-                    self.jacobian(&current).and_then(|j| {
-                        let predicted = (Some(&j), tangent.as_ref());
-                        let next = self
-                            .step_predicted(&current, next_value, predicted, (true, at_end))
-                            .ok();
-                        jac = Some((current.value, j));
-                        next
-                    })
-                }
-                Err(_) => None,
-            };
+            let next = self.newton_step(&current, next_value, &mut jac, tangent.as_ref(), at_end);
             let mut next = next.map(|v| {
                 end.verified(v.point.value, v.gauges);
                 v.point
@@ -603,13 +575,8 @@ impl<'a> NaturalContinuation<'a> {
             // every WALK_AFTER_FAILURES-th one after that; once a walk works, through every halving of a walking
             // step that fails, until Newton's method works again), a step is also tried by walking, before an
             // end is declared.
-            if next.is_none() {
-                newton_failures += 1;
-            } else {
-                newton_failures = 0;
-            }
-            let walk_due = newton_failures >= WALK_AFTER_FAILURES
-                && newton_failures % WALK_AFTER_FAILURES == 0;
+            failures = if next.is_some() { 0 } else { failures + 1 };
+            let walk_due = failures >= WALK_AFTER_FAILURES && failures % WALK_AFTER_FAILURES == 0;
             if next.is_none() && (walking || at_end || walk_due) {
                 next = self.walk_step(&current, next_value);
                 if let Some(p) = &next {
@@ -644,6 +611,40 @@ impl<'a> NaturalContinuation<'a> {
                     failed_before = true;
                 }
             }
+        }
+    }
+
+    /// The verified step from `current` to `next_value` by Newton's method ([`NaturalContinuation::step_predicted`])
+    /// with the Newton matrix `jac` (and the parameter value where it was computed), updated where the step is
+    /// retried; `at_end`: the step is the finest [`NaturalContinuation::follow_to`] takes.
+    fn newton_step(
+        &self,
+        current: &GaitPoint,
+        next_value: f64,
+        jac: &mut Option<(f64, DMatrix<f64>)>,
+        tangent: Option<&Tangent>,
+        at_end: bool,
+    ) -> Option<Verified> {
+        let matrix = jac.as_ref().map(|(_, j)| j);
+        match self.step_predicted(current, next_value, (matrix, tangent), (false, at_end)) {
+            Ok(p) => Some(p),
+            // A step that fails in Newton's method with a matrix computed elsewhere is retried with DP at
+            // `current`, as a quick test: Newton's method must not have to damp a step taken with DP at its
+            // iterate (`undamped`). Of the 1 338 retries of a 100 x 100 map, 1 336 failed, after up to 8 damped
+            // iterations each with a new DP; the two that worked (and the default map's one) damp none. Not a
+            // step whose walk fails at the start, where no matrix would help (near an end where the wheel rolls
+            // back, most steps of the bisection).
+            Err(StepFailure::Newton) if jac.as_ref().is_none_or(|(v, _)| *v != current.value) => {
+                self.jacobian(current).and_then(|j| {
+                    let predicted = (Some(&j), tangent);
+                    let next = self
+                        .step_predicted(current, next_value, predicted, (true, at_end))
+                        .ok();
+                    *jac = Some((current.value, j));
+                    next
+                })
+            }
+            Err(_) => None,
         }
     }
 

@@ -344,35 +344,14 @@ fn refine_root(
             section: start.section,
         }]),
         last_gait: RefCell::new(None),
+        failure: Cell::new(None),
+        bracket: [Cell::new(a.value), Cell::new(b.value)],
+        f_a: q.of(start),
     };
-    let failure: Cell<Option<String>> = Cell::new(None);
-    let (lo, hi) = (Cell::new(a.value), Cell::new(b.value));
-    let f_a = q.of(start);
-    let f = |v: f64| -> f64 {
-        // After a failure the search is abandoned: keep the first reason, evaluate nothing more.
-        let failed = failure.take();
-        if failed.is_some() {
-            failure.set(failed);
-            return f64::NAN;
-        }
-        match search.evaluate(v) {
-            Ok(y) => {
-                // Track the bracket for the report.
-                if (y < 0.0) == (f_a < 0.0) {
-                    lo.set(v);
-                } else {
-                    hi.set(v);
-                }
-                y
-            }
-            Err(message) => {
-                failure.set(Some(message));
-                f64::NAN
-            }
-        }
-    };
+    let f = |v: f64| search.f(v);
     let result = find_root_brent(a.value, b.value, &f, &mut ParamTolerance);
-    let mut detail = failure
+    let mut detail = search
+        .failure
         .take()
         .map(|m| format!("gait search failed inside the bracket: {m}"));
     let value = match result {
@@ -391,19 +370,15 @@ fn refine_root(
     let (name, detail) = if q == Quantity::Stability {
         let root_gait = search.last_gait.borrow();
         let at_root = root_gait.as_ref().filter(|_| value.is_finite());
-        stability_named(
-            stability_change(a.value, b.value, f_a),
-            at_root,
-            value,
-            detail,
-        )
+        let change = stability_change(a.value, b.value, search.f_a);
+        stability_named(change, at_root, value, detail)
     } else {
         (q.name().to_string(), detail)
     };
     Threshold {
         name,
         value,
-        bracket: sorted([lo.get(), hi.get()]),
+        bracket: sorted(search.bracket.each_ref().map(Cell::get)),
         grid_bracket: [a.value, b.value],
         residual,
         detail,
@@ -425,9 +400,38 @@ struct RootSearch<'a> {
     found: RefCell<Vec<GaitPoint>>,
     /// The gait of the last evaluation (stability only): at the root, its critical multiplier names the change.
     last_gait: RefCell<Option<Gait>>,
+    /// Why an evaluation failed (the first reason: the search evaluates nothing after it).
+    failure: Cell<Option<String>>,
+    /// The bracket Brent's method has reached, for the report: the last values with the sign of `f_a` and
+    /// without it.
+    bracket: [Cell<f64>; 2],
+    /// The quantity at the start.
+    f_a: f64,
 }
 
 impl RootSearch<'_> {
+    /// Brent's function: [`RootSearch::evaluate`], `NaN` after a failure (its reason kept in `failure`).
+    fn f(&self, v: f64) -> f64 {
+        // After a failure the search is abandoned: keep the first reason, evaluate nothing more.
+        let failed = self.failure.take();
+        if failed.is_some() {
+            self.failure.set(failed);
+            return f64::NAN;
+        }
+        match self.evaluate(v) {
+            Ok(y) => {
+                // Track the bracket for the report.
+                let side = usize::from((y < 0.0) != (self.f_a < 0.0));
+                self.bracket[side].set(v);
+                y
+            }
+            Err(message) => {
+                self.failure.set(Some(message));
+                f64::NAN
+            }
+        }
+    }
+
     /// `q` of the family's gait at `v`, by Newton's method from the gait found nearest `v` so far, carried to
     /// `v`; why not, in words.
     fn evaluate(&self, v: f64) -> Result<f64, String> {
