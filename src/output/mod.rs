@@ -218,12 +218,23 @@ pub fn write_atomic<T, E: From<OutputError>>(
 /// The temporary files being written in this process ([`write_atomic`]), for [`remove_temporaries`].
 static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
+/// Set once [`remove_temporaries`] runs: the process is about to exit, and no new temporary file is started.
+static QUITTING: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// A temporary file registered in [`TEMPORARIES`] while it exists; unregistered when dropped.
 struct Temporary(PathBuf);
 
 impl Temporary {
+    /// Register `path` before it is written. Once the process quits ([`remove_temporaries`]), the writer waits
+    /// here for the exit instead: a file it would start could be left behind.
     fn register(path: &Path) -> Temporary {
         if let Ok(mut all) = TEMPORARIES.lock() {
+            if QUITTING.load(std::sync::atomic::Ordering::SeqCst) {
+                drop(all);
+                loop {
+                    std::thread::park();
+                }
+            }
             all.push(path.to_path_buf());
         }
         Temporary(path.to_path_buf())
@@ -240,15 +251,29 @@ impl Drop for Temporary {
     }
 }
 
+/// How long [`remove_temporaries`] waits for the writers of temporary files to give up.
+const QUIT_WAIT: std::time::Duration = std::time::Duration::from_secs(1);
+
 /// Remove every temporary file this process is writing (a second Ctrl-C, just before the process exits, so
-/// that no half-written file is left behind). Best effort: a file whose writer creates it after this call
-/// (within the instant before the process exits) stays.
+/// that no half-written file is left behind). No temporary file is started after it; a writer already under
+/// way may create its file after a removal (it was registered, then preempted before creating it), so the
+/// removal is repeated every millisecond until every writer has given up (its file removed, its rename then
+/// failing) or finished (the whole file in place), for at most [`QUIT_WAIT`].
 pub(crate) fn remove_temporaries() {
-    let all = TEMPORARIES
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    for path in all.iter() {
-        let _ = std::fs::remove_file(path);
+    QUITTING.store(true, std::sync::atomic::Ordering::SeqCst);
+    let deadline = std::time::Instant::now() + QUIT_WAIT;
+    loop {
+        let all = TEMPORARIES
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        for path in all.iter() {
+            let _ = std::fs::remove_file(path);
+        }
+        if all.is_empty() || std::time::Instant::now() >= deadline {
+            return;
+        }
+        drop(all);
+        std::thread::sleep(std::time::Duration::from_millis(1));
     }
 }
 
