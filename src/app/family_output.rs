@@ -3,7 +3,8 @@
 
 use super::family::{compute_continuation, ContinueJob, ContinueResult};
 use super::{axis_label, in_run, AppError};
-use crate::continuation::FamilyEnd;
+use crate::continuation::{Family, FamilyEnd};
+use crate::family::GaitInfo;
 use crate::gait::Stability;
 use crate::output::bifurcation_plot::{
     BifurcationFigure, DiagramFamily, DiagramSpecial, BIFURCATION_SIZE,
@@ -200,59 +201,87 @@ fn diagram(job: &ContinueJob, result: &ContinueResult) -> BifurcationFigure {
         .iter()
         .zip(&result.stability)
         .enumerate()
-        .map(|(k, (f, verdicts))| {
-            // One line per step of the period (the multipliers are the orbit's: one line).
-            let phases = if job.plot == "max_floquet" {
-                1
-            } else {
-                f.period
-            };
-            let ends = result.summary.families[k]
-                .ends
-                .iter()
-                .zip([f.points.first(), f.points.last()])
-                .filter_map(|(end, point)| match (&end.end, point) {
-                    (FamilyEnd::Ended { failure, .. }, Some(p)) => {
-                        let value = match job.plot.as_str() {
-                            "max_floquet" => p.max_multiplier(),
-                            q => quantity_of_report(&p.info.report, q),
-                        };
-                        Some((p.param, value, failure.clone()))
-                    }
-                    _ => None,
-                })
-                .collect();
-            DiagramFamily {
-                ends,
-                label: format!("family {} (period {})", k + 1, f.period),
-                phases: (0..phases)
-                    .map(|j| {
-                        f.points
-                            .iter()
-                            .zip(verdicts)
-                            .map(|(p, s)| {
-                                let stable = match s {
-                                    Stability::Stable => Some(true),
-                                    Stability::Unstable => Some(false),
-                                    Stability::Uncertain => None,
-                                };
-                                let value = match job.plot.as_str() {
-                                    "max_floquet" => p.max_multiplier(),
-                                    q => p
-                                        .info
-                                        .cycle
-                                        .get(j)
-                                        .map_or(f64::NAN, |r| quantity_of_report(r, q)),
-                                };
-                                (p.param, value, stable)
-                            })
-                            .collect()
-                    })
-                    .collect(),
+        .map(|(k, (f, verdicts))| diagram_family(job, result, k, f, verdicts))
+        .collect();
+    BifurcationFigure {
+        title: format!(
+            "Gait families in {} (period of the start: {}){}",
+            job.param,
+            result.families.first().map_or(1, |f| f.period),
+            super::settings_note(&job.config, &[&job.param])
+        ),
+        param_label: axis_label(&job.param),
+        y_label: quantity_label(&job.plot),
+        x: job.from..job.to,
+        families,
+        special: diagram_specials(job, result),
+        styles_in_legend: true,
+    }
+}
+
+/// The `k`-th family `f` of the diagram, with the stability `verdicts` of its points: a line per step of
+/// its period (one for the multipliers) and its ends where it failed.
+fn diagram_family(
+    job: &ContinueJob,
+    result: &ContinueResult,
+    k: usize,
+    f: &Family<GaitInfo>,
+    verdicts: &[Stability],
+) -> DiagramFamily {
+    // One line per step of the period (the multipliers are the orbit's: one line).
+    let phases = if job.plot == "max_floquet" {
+        1
+    } else {
+        f.period
+    };
+    let ends = result.summary.families[k]
+        .ends
+        .iter()
+        .zip([f.points.first(), f.points.last()])
+        .filter_map(|(end, point)| match (&end.end, point) {
+            (FamilyEnd::Ended { failure, .. }, Some(p)) => {
+                let value = match job.plot.as_str() {
+                    "max_floquet" => p.max_multiplier(),
+                    q => quantity_of_report(&p.info.report, q),
+                };
+                Some((p.param, value, failure.clone()))
             }
+            _ => None,
         })
         .collect();
-    let special = result
+    DiagramFamily {
+        ends,
+        label: format!("family {} (period {})", k + 1, f.period),
+        phases: (0..phases)
+            .map(|j| {
+                f.points
+                    .iter()
+                    .zip(verdicts)
+                    .map(|(p, s)| {
+                        let stable = match s {
+                            Stability::Stable => Some(true),
+                            Stability::Unstable => Some(false),
+                            Stability::Uncertain => None,
+                        };
+                        let value = match job.plot.as_str() {
+                            "max_floquet" => p.max_multiplier(),
+                            q => p
+                                .info
+                                .cycle
+                                .get(j)
+                                .map_or(f64::NAN, |r| quantity_of_report(r, q)),
+                        };
+                        (p.param, value, stable)
+                    })
+                    .collect()
+            })
+            .collect(),
+    }
+}
+
+/// The special points of every family, at the value the diagram draws.
+fn diagram_specials(job: &ContinueJob, result: &ContinueResult) -> Vec<DiagramSpecial> {
+    result
         .families
         .iter()
         .enumerate()
@@ -270,21 +299,7 @@ fn diagram(job: &ContinueJob, result: &ContinueResult) -> BifurcationFigure {
                 label: s.kind.label().to_string(),
             })
         })
-        .collect();
-    BifurcationFigure {
-        title: format!(
-            "Gait families in {} (period of the start: {}){}",
-            job.param,
-            result.families.first().map_or(1, |f| f.period),
-            super::settings_note(&job.config, &[&job.param])
-        ),
-        param_label: axis_label(&job.param),
-        y_label: quantity_label(&job.plot),
-        x: job.from..job.to,
-        families,
-        special,
-        styles_in_legend: true,
-    }
+        .collect()
 }
 
 /// The axis label of a quantity of [`super::DIAGRAM_QUANTITIES`], with its unit.

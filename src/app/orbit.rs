@@ -2,6 +2,7 @@
 //! transient), the period-1 branch beside it, `orbit.csv`, `branch.csv`, `orbit.json` and `orbit.png`.
 
 use std::collections::BTreeMap;
+use std::ops::Range;
 use std::path::PathBuf;
 
 use serde::Serialize;
@@ -272,40 +273,71 @@ fn orbit_into(
     Ok(summary)
 }
 
-/// The two panels of the orbit diagram: `dtheta/dt` on the section and `lambda_I4`.
+/// The orbit diagram's figure: its two panels (`dtheta/dt` on the section and the DLS indicator `job.plot`,
+/// `lambda_I4` by default) with the branch, the shaded failures and the title.
 fn orbit_figure(
     job: &OrbitJob,
     columns: &[OrbitColumn],
     branch: &[(f64, Option<Gait>)],
 ) -> OrbitFigure {
-    type Pick = fn(&StepReport) -> f64;
-    type OfGait = fn(&Gait) -> f64;
-    let indicator: (&str, Pick, OfGait) = match job.plot.as_str() {
-        "lambda_2_plus" => (
-            "λ₂⁺ [N]",
-            |r| r.indicators.lambda_2_plus,
-            |g| g.lambda_2_plus,
-        ),
-        "lambda_4_plus" => (
-            "λ₄⁺ [N]",
-            |r| r.indicators.lambda_4_plus,
-            |g| g.lambda_4_plus,
-        ),
-        _ => ("λI4 [N s]", |r| r.indicators.lambda_i4, |g| g.lambda_i4),
-    };
-    let panels: [(&str, Pick, OfGait); 2] = [
-        (
-            "dθ/dt before touchdown [rad/s]",
-            |r| r.section.theta_dot,
-            |g| g.section.theta_dot,
-        ),
-        indicator,
-    ];
-    let p = &job.config.params;
     let range = &job.spec.range;
-    // Each failed value shades half a spacing on either side; a label per failure kind.
+    OrbitFigure {
+        failed: failed_stretches(job, columns),
+        title: orbit_title(job),
+        param_label: axis_label(&range.param),
+        x: range.from.min(range.to)..range.from.max(range.to),
+        panels: panel_quantities(&job.plot)
+            .iter()
+            .map(|q| orbit_panel(q, columns, branch))
+            .collect(),
+    }
+}
+
+/// What one panel of the orbit diagram draws: its axis label and the quantity of a step and of a gait.
+struct PanelQuantity {
+    /// The y axis description with unit.
+    y_label: &'static str,
+    /// The quantity of a recorded step.
+    of_step: fn(&StepReport) -> f64,
+    /// The same quantity of a gait of the branch.
+    of_gait: fn(&Gait) -> f64,
+}
+
+/// The quantities of the two panels: `dtheta/dt` before touchdown, then the DLS indicator `plot`.
+fn panel_quantities(plot: &str) -> [PanelQuantity; 2] {
+    let indicator = match plot {
+        "lambda_2_plus" => PanelQuantity {
+            y_label: "λ₂⁺ [N]",
+            of_step: |r| r.indicators.lambda_2_plus,
+            of_gait: |g| g.lambda_2_plus,
+        },
+        "lambda_4_plus" => PanelQuantity {
+            y_label: "λ₄⁺ [N]",
+            of_step: |r| r.indicators.lambda_4_plus,
+            of_gait: |g| g.lambda_4_plus,
+        },
+        _ => PanelQuantity {
+            y_label: "λI4 [N s]",
+            of_step: |r| r.indicators.lambda_i4,
+            of_gait: |g| g.lambda_i4,
+        },
+    };
+    [
+        PanelQuantity {
+            y_label: "dθ/dt before touchdown [rad/s]",
+            of_step: |r| r.section.theta_dot,
+            of_gait: |g| g.section.theta_dot,
+        },
+        indicator,
+    ]
+}
+
+/// The stretches of the parameter where the walk fails: half a spacing on either side of each failed value,
+/// with a label per failure kind.
+fn failed_stretches(job: &OrbitJob, columns: &[OrbitColumn]) -> Vec<(Range<f64>, String)> {
+    let range = &job.spec.range;
     let half = 0.5 * (range.to - range.from).abs() / (range.points.max(2) - 1) as f64;
-    let failed = columns
+    columns
         .iter()
         .filter(|c| c.status.failed())
         .map(|c| {
@@ -318,49 +350,58 @@ fn orbit_figure(
             };
             ((c.value - half)..(c.value + half), label)
         })
-        .collect();
-    OrbitFigure {
-        failed,
-        title: format!(
-            "Orbit diagram: {} steps after a transient of {}, {}impact {}",
-            job.spec.steps,
-            job.spec.transient,
-            [
-                ("viscosity", format!("c = {} N s/m, ", short(p.viscosity))),
-                ("stiffness", format!("k = {} N/m, ", short(p.stiffness))),
-                ("slope", format!("slope φ = {} rad, ", p.slope)),
-            ]
-            .into_iter()
-            .filter(|(key, _)| *key != range.param)
-            .map(|(_, fixed)| fixed)
-            .collect::<String>(),
-            p.impact
-        ) + &super::settings_note(
-            &job.config,
-            &[&range.param, "viscosity", "stiffness", "slope", "impact"],
-        ),
-        param_label: axis_label(&range.param),
-        x: range.from.min(range.to)..range.from.max(range.to),
-        panels: panels
+        .collect()
+}
+
+/// The orbit diagram's title: the steps, the transient, the fixed parameters and the settings that differ
+/// from the defaults.
+fn orbit_title(job: &OrbitJob) -> String {
+    let p = &job.config.params;
+    let range = &job.spec.range;
+    format!(
+        "Orbit diagram: {} steps after a transient of {}, {}impact {}",
+        job.spec.steps,
+        job.spec.transient,
+        [
+            ("viscosity", format!("c = {} N s/m, ", short(p.viscosity))),
+            ("stiffness", format!("k = {} N/m, ", short(p.stiffness))),
+            ("slope", format!("slope φ = {} rad, ", p.slope)),
+        ]
+        .into_iter()
+        .filter(|(key, _)| *key != range.param)
+        .map(|(_, fixed)| fixed)
+        .collect::<String>(),
+        p.impact
+    ) + &super::settings_note(
+        &job.config,
+        &[&range.param, "viscosity", "stiffness", "slope", "impact"],
+    )
+}
+
+/// One panel of the orbit diagram: the quantity `q` of every recorded step, and of the branch's gaits with
+/// their stability.
+fn orbit_panel(
+    q: &PanelQuantity,
+    columns: &[OrbitColumn],
+    branch: &[(f64, Option<Gait>)],
+) -> OrbitPanel {
+    let (pick, of_gait) = (q.of_step, q.of_gait);
+    OrbitPanel {
+        y_label: q.y_label.to_string(),
+        points: columns
             .iter()
-            .map(|(label, pick, of_gait)| OrbitPanel {
-                y_label: label.to_string(),
-                points: columns
-                    .iter()
-                    .flat_map(|c| c.returns.iter().map(move |r| (c.value, pick(r))))
-                    .collect(),
-                branch: branch
-                    .iter()
-                    .map(|(v, g)| BranchPoint {
-                        param: *v,
-                        value: g.as_ref().map_or(f64::NAN, of_gait),
-                        stable: g.as_ref().and_then(|g| match g.stability {
-                            Stability::Stable => Some(true),
-                            Stability::Unstable => Some(false),
-                            Stability::Uncertain => None,
-                        }),
-                    })
-                    .collect(),
+            .flat_map(|c| c.returns.iter().map(move |r| (c.value, pick(r))))
+            .collect(),
+        branch: branch
+            .iter()
+            .map(|(v, g)| BranchPoint {
+                param: *v,
+                value: g.as_ref().map_or(f64::NAN, of_gait),
+                stable: g.as_ref().and_then(|g| match g.stability {
+                    Stability::Stable => Some(true),
+                    Stability::Unstable => Some(false),
+                    Stability::Uncertain => None,
+                }),
             })
             .collect(),
     }

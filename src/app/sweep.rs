@@ -143,34 +143,46 @@ fn sweep_into(
     }
     if job.second_route {
         // Everything of the first route is written: nothing is lost if this fails.
-        let clock = std::time::Instant::now();
-        let (second_config, route) = second_route_config(&job.config);
-        let second = compute_sweep(
-            &second_config,
-            &job.spec.param,
-            &job.spec.values(),
-            Some(initial),
-            &job.options,
-            progress,
-            &mut |_| Ok(()),
-        )
-        .map_err(|e| match e {
-            AppError::Interrupted { .. } => AppError::Interrupted {
-                during: format!("during the second route ({route})"),
-                kept: format!(
-                    "{} are complete; the thresholds are not confirmed by a second route",
-                    summary.files.join(", ")
-                ),
-            },
-            other => other,
-        })?;
-        for t in &mut summary.thresholds {
-            t.second_route = Some(SecondRoute::check(t, &second.thresholds, &route));
-        }
-        summary.second_route_seconds = clock.elapsed().as_secs_f64();
+        second_route(job, initial, progress, &mut summary)?;
         output::write_json(&thresholds_json, &summary)?;
     }
     Ok(summary)
+}
+
+/// Sweep again with the other integrator and record in each of `summary`'s thresholds whether the second
+/// route confirms it, and the seconds it took.
+fn second_route(
+    job: &SweepJob,
+    initial: SectionState,
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+    summary: &mut SweepSummary,
+) -> Result<(), AppError> {
+    let clock = std::time::Instant::now();
+    let (second_config, route) = second_route_config(&job.config);
+    let second = compute_sweep(
+        &second_config,
+        &job.spec.param,
+        &job.spec.values(),
+        Some(initial),
+        &job.options,
+        progress,
+        &mut |_| Ok(()),
+    )
+    .map_err(|e| match e {
+        AppError::Interrupted { .. } => AppError::Interrupted {
+            during: format!("during the second route ({route})"),
+            kept: format!(
+                "{} are complete; the thresholds are not confirmed by a second route",
+                summary.files.join(", ")
+            ),
+        },
+        other => other,
+    })?;
+    for t in &mut summary.thresholds {
+        t.second_route = Some(SecondRoute::check(t, &second.thresholds, &route));
+    }
+    summary.second_route_seconds = clock.elapsed().as_secs_f64();
+    Ok(())
 }
 
 /// A sweep and its thresholds, as [`compute_sweep`] returns them.
@@ -221,14 +233,57 @@ pub fn compute_sweep(
     })
 }
 
+/// Write Fig. 2 (`fig2.svg`, `fig2.png`) of the sweep's `points` and `thresholds` into the job's directory.
 fn write_fig2(
     job: &SweepJob,
     points: &[SweepPoint],
     thresholds: &[Threshold],
 ) -> Result<(), AppError> {
+    let indicator_points = indicator_points(points);
+    let marks: Vec<ThresholdMark> = thresholds
+        .iter()
+        .filter(|t| t.value.is_finite())
+        .map(|t| ThresholdMark {
+            label: format!(
+                "{}: {} = {:.2}",
+                threshold_symbol(t),
+                short_name(&job.spec.param),
+                t.value
+            ),
+            value: t.value,
+        })
+        .collect();
+    let no_gait = no_gait_spans(points, thresholds);
+    let title = fig2_title(job);
+    let label = axis_label(&job.spec.param);
+    let (lo, hi) = (
+        job.spec.from.min(job.spec.to),
+        job.spec.from.max(job.spec.to),
+    );
+    let spec = Fig2Spec {
+        points: &indicator_points,
+        thresholds: &marks,
+        param_label: &label,
+        title: &title,
+        x_range: Some(lo..hi),
+        no_gait: &no_gait,
+    };
+    write_fig2_files(
+        &spec,
+        &job.out_dir.join("fig2.svg"),
+        &job.out_dir.join("fig2.png"),
+    )
+    .map_err(|e| AppError::InvalidOption {
+        option: "figure",
+        reason: e.to_string(),
+    })
+}
+
+/// The sweep points as Fig. 2 draws them.
+fn indicator_points(points: &[SweepPoint]) -> Vec<IndicatorPoint> {
     // Points without a gait are NaN, so the curves break there instead of bridging the gap; a change of
     // family breaks them too.
-    let indicator_points: Vec<IndicatorPoint> = points
+    points
         .iter()
         .map(|p| match &p.gait {
             Some(g) => IndicatorPoint {
@@ -254,8 +309,12 @@ fn write_fig2(
                 max_floquet: f64::NAN,
             },
         })
-        .collect();
-    let symbol = |t: &Threshold| match t.name.as_str() {
+        .collect()
+}
+
+/// The words of a threshold on Fig. 2 (`λ₄⁺ = 0`, `gait lost`, ...).
+fn threshold_symbol(t: &Threshold) -> &'static str {
+    match t.name.as_str() {
         "lambda_4_plus = 0" => "λ₄⁺ = 0",
         "lambda_2_plus = 0" => "λ₂⁺ = 0",
         "lambda_I4 = 0" => "λI4 = 0",
@@ -274,22 +333,12 @@ fn write_fig2(
         "branch_switch" => "branch switch",
         "fold" => "fold",
         _ => "unconfirmed end",
-    };
-    let marks: Vec<ThresholdMark> = thresholds
-        .iter()
-        .filter(|t| t.value.is_finite())
-        .map(|t| ThresholdMark {
-            label: format!(
-                "{}: {} = {:.2}",
-                symbol(t),
-                short_name(&job.spec.param),
-                t.value
-            ),
-            value: t.value,
-        })
-        .collect();
-    let no_gait = no_gait_spans(points, thresholds);
-    let title = format!(
+    }
+}
+
+/// Fig. 2's title: the swept parameter, the fixed ones and the settings that differ from the defaults.
+fn fig2_title(job: &SweepJob) -> String {
+    format!(
         "Gaits along {}: {}{} (hollow: scuffing of Leg 2; grey: no gait)",
         short_name(&job.spec.param),
         fixed_parameters(&job.config, &job.spec.param),
@@ -304,29 +353,7 @@ fn write_fig2(
                 "rigid_legs"
             ]
         )
-    );
-    let label = axis_label(&job.spec.param);
-    let (lo, hi) = (
-        job.spec.from.min(job.spec.to),
-        job.spec.from.max(job.spec.to),
-    );
-    let spec = Fig2Spec {
-        points: &indicator_points,
-        thresholds: &marks,
-        param_label: &label,
-        title: &title,
-        x_range: Some(lo..hi),
-        no_gait: &no_gait,
-    };
-    write_fig2_files(
-        &spec,
-        &job.out_dir.join("fig2.svg"),
-        &job.out_dir.join("fig2.png"),
     )
-    .map_err(|e| AppError::InvalidOption {
-        option: "figure",
-        reason: e.to_string(),
-    })
 }
 
 /// The parameter intervals without a gait: each maximal run of sweep points without one, from the end of the

@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use vrw::app::{run_continuation, ContinueJob, DIAGRAM_QUANTITIES};
+use vrw::app::{
+    run_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
+};
 use vrw::continuation::{CurveEnd, CurvePoint, FamilyEnd};
 use vrw::family::GaitInfo;
 use vrw::walk::SectionState;
@@ -107,28 +109,7 @@ fn end_words(end: &FamilyEnd) -> String {
 
 /// Run `vrw continue` and print its summary.
 pub(super) fn run(args: ContinueArgs) -> Result<()> {
-    let flag = interrupt_flag();
-    let job = ContinueJob {
-        config: args.model.load()?,
-        param: args.param.clone(),
-        start: args.start,
-        from: args.from,
-        to: args.to,
-        initial: args.initial,
-        period: args.period,
-        max_points: args.max_points,
-        max_step: args.max_step,
-        switch: !args.no_switch,
-        plot: args.plot.clone(),
-        out_dir: args.out.clone(),
-        overwrite: args.overwrite,
-        interrupt: Some(flag),
-        two_param: args
-            .two_param
-            .clone()
-            .zip(args.two_range)
-            .map(|(name, (a, b))| (name, a, b)),
-    };
+    let job = continue_job(&args)?;
     super::check_out(&job.out_dir, "continue", job.overwrite)?;
     let result = run_continuation(&job)
         .map_err(flagged)
@@ -156,6 +137,41 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
             end_words(&f.ends[1].end)
         );
     }
+    print_special_points(s);
+    print_curves(&result);
+    print_warnings(&s.warnings, "special_points.json");
+    println!("wrote {}/{{{}}}", args.out.display(), s.files.join(", "));
+    Ok(())
+}
+
+/// The continuation the options describe (Ctrl-C armed, then the model loaded from its file and flags).
+fn continue_job(args: &ContinueArgs) -> Result<ContinueJob> {
+    let flag = interrupt_flag();
+    Ok(ContinueJob {
+        config: args.model.load()?,
+        param: args.param.clone(),
+        start: args.start,
+        from: args.from,
+        to: args.to,
+        initial: args.initial,
+        period: args.period,
+        max_points: args.max_points,
+        max_step: args.max_step,
+        switch: !args.no_switch,
+        plot: args.plot.clone(),
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+        interrupt: Some(flag),
+        two_param: args
+            .two_param
+            .clone()
+            .zip(args.two_range)
+            .map(|(name, (a, b))| (name, a, b)),
+    })
+}
+
+/// One line per special point: its kind, family, parameter, border or modulus, and whether it was located.
+fn print_special_points(s: &ContinueSummary) {
     for sp in &s.special_points {
         let located = if sp.located {
             ""
@@ -183,6 +199,11 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
             sp.param,
         );
     }
+}
+
+/// One line per two-parameter curve: its condition, family, points and where and why it ends.
+fn print_curves(result: &ContinueResult) {
+    let s = &result.summary;
     for (c, curve) in s.curves.iter().zip(&result.curves) {
         let at = |p: Option<&CurvePoint<GaitInfo>>| {
             p.map(|p| format!("({:.9}, {:.9})", p.p1, p.p2))
@@ -207,7 +228,4 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
             end(&c.ends[1]),
         );
     }
-    print_warnings(&s.warnings, "special_points.json");
-    println!("wrote {}/{{{}}}", args.out.display(), s.files.join(", "));
-    Ok(())
 }

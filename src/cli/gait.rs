@@ -7,7 +7,7 @@ use clap::Args;
 
 use vrw::app::{run_gait, GaitJob};
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
-use vrw::gait::{GaitOptions, JacobianCheck};
+use vrw::gait::{Gait, GaitOptions, JacobianCheck};
 use vrw::walk::SectionState;
 
 use super::{flagged, progress_bar, ModelArgs};
@@ -68,20 +68,7 @@ fn parse_parameter(key: &str) -> Result<&'static str, String> {
 
 /// Run `vrw gait` and print its summary.
 pub(super) fn run(args: GaitArgs) -> Result<()> {
-    let job = GaitJob {
-        config: args.model.load()?,
-        initial: args.initial,
-        options: GaitOptions {
-            transient_steps: args.transient,
-            tolerance: args.tolerance,
-            parameter: args.parameter,
-            ..GaitOptions::default()
-        },
-        out_dir: args.out.clone(),
-        overwrite: args.overwrite,
-        check_jacobian: args.check_jacobian,
-        interrupt: Some(super::interrupt_flag()),
-    };
+    let job = gait_job(&args)?;
     super::check_out(&job.out_dir, "gait", job.overwrite)?;
     let bar = progress_bar(
         None,
@@ -107,31 +94,66 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
             summary.message.as_deref().unwrap_or("unknown reason")
         );
     };
-    let s = &g.section;
     if g.period_k > 1 {
+        print_cycle(g);
+    }
+    print_gait(g);
+    print_multipliers(g);
+    let check = summary.jacobian_check.as_ref().map(print_check).transpose();
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
+    super::print_wrote(&args.out);
+    check.map(|_| ())
+}
+
+/// The gait search the options describe (the model loaded from its file and flags, Ctrl-C armed).
+fn gait_job(args: &GaitArgs) -> Result<GaitJob> {
+    Ok(GaitJob {
+        config: args.model.load()?,
+        initial: args.initial,
+        options: GaitOptions {
+            transient_steps: args.transient,
+            tolerance: args.tolerance,
+            parameter: args.parameter,
+            ..GaitOptions::default()
+        },
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+        check_jacobian: args.check_jacobian,
+        interrupt: Some(super::interrupt_flag()),
+    })
+}
+
+/// The steps of a period-k gait, one line each, before the first step's detail.
+fn print_cycle(g: &Gait) {
+    println!(
+        "period-{} gait (a fixed point of P^{}, not of P): its steps",
+        g.period_k, g.period_k
+    );
+    for r in &g.cycle {
+        let (c, i) = (&r.section, &r.indicators);
         println!(
-            "period-{} gait (a fixed point of P^{}, not of P): its steps",
-            g.period_k, g.period_k
-        );
-        for r in &g.cycle {
-            let (c, i) = (&r.section, &r.indicators);
-            println!(
-                "  step {}: {}; lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
-                 lambda_4+ = {:.6} N, branch {}, period {:.6} s",
-                r.step,
-                c.labelled(Some(9)),
-                i.lambda_i4,
-                i.lambda_2_plus,
-                i.lambda_4_plus,
-                r.branch,
-                r.period
-            );
-        }
-        println!(
-            "the first step in detail, and the multipliers of P^{}:",
-            g.period_k
+            "  step {}: {}; lambda_I4 = {:.6} N s, lambda_2+ = {:.6} N, \
+             lambda_4+ = {:.6} N, branch {}, period {:.6} s",
+            r.step,
+            c.labelled(Some(9)),
+            i.lambda_i4,
+            i.lambda_2_plus,
+            i.lambda_4_plus,
+            r.branch,
+            r.period
         );
     }
+    println!(
+        "the first step in detail, and the multipliers of P^{}:",
+        g.period_k
+    );
+}
+
+/// The gait's section state, indicators, step quantities, contact audit, sticks and slips and friction.
+fn print_gait(g: &Gait) {
+    let s = &g.section;
     println!(
         "gait at {}, theta = {:.6} rad; residual {:.1e} after {} Newton iterations",
         s.labelled(Some(9)),
@@ -167,6 +189,10 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
             f.cone_violation, f.cone_violation_impulse, f.slip_power
         );
     }
+}
+
+/// The Floquet multipliers with the stability verdict, a missing Jacobian and the parameter derivative.
+fn print_multipliers(g: &Gait) {
     let multipliers: Vec<String> = g
         .floquet_multipliers
         .iter()
@@ -202,12 +228,6 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
             d.error
         );
     }
-    let check = summary.jacobian_check.as_ref().map(print_check).transpose();
-    for warning in &summary.warnings {
-        eprintln!("warning: {warning}");
-    }
-    super::print_wrote(&args.out);
-    check.map(|_| ())
 }
 
 /// Print the Jacobian check of `--check-jacobian`; an error if the two routes disagree.

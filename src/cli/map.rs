@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 
-use vrw::app::{run_map, MapJob};
+use vrw::app::{run_map, MapJob, MapSummary};
 use vrw::gait::GaitOptions;
 use vrw::output::map_plot::MapMark;
 use vrw::study::{CurveMethod, MapSpec, SecondRoute, SweepSpec};
@@ -111,7 +111,44 @@ impl std::str::FromStr for MarkArg {
 
 /// Run `vrw map` and print its summary.
 pub(super) fn run(args: MapArgs) -> Result<()> {
-    let job = MapJob {
+    let job = map_job(&args)?;
+    let routes = if args.second_route { 2 } else { 1 };
+    let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
+    // Ctrl-C stops the grid between points; what is complete is written.
+    interrupt_flag();
+    let bar = progress_bar(
+        Some(total as u64),
+        "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",
+    );
+    let started = std::time::Instant::now();
+    super::check_out(&job.out_dir, "map", job.overwrite)?;
+    let summary = run_map(&job, &|_| bar.inc(1)).context("map")?;
+    bar.finish_and_clear();
+    print_totals(&args, &summary, started.elapsed().as_secs_f64());
+    print_curves(&summary);
+    if args.second_route {
+        print_second_route(&args, &summary);
+    }
+    print_warnings(&summary.warnings, "curves.json");
+    let swept = [job.spec.x.param.as_str(), job.spec.y.param.as_str()];
+    let signatures = if vrw::output::friction_columns(&job.config, &swept) {
+        ", signatures.svg, signatures.png"
+    } else {
+        ""
+    };
+    println!(
+        "wrote {}/{{map.csv, curves.json, map.svg, map.png{signatures}}}",
+        args.out.display()
+    );
+    if summary.gaits_found == 0 {
+        bail!("no gait found anywhere on the map (see map.csv for the reasons)");
+    }
+    Ok(())
+}
+
+/// The map job the options describe (the model loaded from its file and flags).
+fn map_job(args: &MapArgs) -> Result<MapJob> {
+    Ok(MapJob {
         config: args.model.load()?,
         spec: MapSpec {
             x: SweepSpec {
@@ -134,22 +171,14 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         curve_columns: usize::try_from(args.curve_columns).unwrap_or(usize::MAX),
         continue_curves: args.curve_method == "continuation",
         second_route: args.second_route,
-        marks: args.mark.into_iter().map(|m| m.0).collect(),
+        marks: args.mark.iter().map(|m| m.0.clone()).collect(),
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
-    };
-    let routes = if args.second_route { 2 } else { 1 };
-    let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
-    // Ctrl-C stops the grid between points; what is complete is written.
-    interrupt_flag();
-    let bar = progress_bar(
-        Some(total as u64),
-        "{bar:40} {pos}/{len} points {msg} [{elapsed_precise}, eta {eta}]",
-    );
-    let started = std::time::Instant::now();
-    super::check_out(&job.out_dir, "map", job.overwrite)?;
-    let summary = run_map(&job, &|_| bar.inc(1)).context("map")?;
-    bar.finish_and_clear();
+    })
+}
+
+/// The first summary line: the two axes, the gaits found and the time spent (`seconds` in all).
+fn print_totals(args: &MapArgs, summary: &MapSummary, seconds: f64) {
     println!(
         "vrw map: {} from {} to {} ({}) x {} from {} to {} ({}): gait found at {} of {} points; {:.2} s \
          (gaits {:.2} s, curves {:.2} s, of which continued {:.2} s)",
@@ -163,11 +192,16 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         args.ny,
         summary.gaits_found,
         summary.points,
-        started.elapsed().as_secs_f64(),
+        seconds,
         summary.seconds[0],
         summary.seconds[1],
         summary.continuation_seconds
     );
+}
+
+/// One line per curve name (its polylines, points and how they were traced), then the crossings that could
+/// not be refined.
+fn print_curves(summary: &MapSummary) {
     let unrefined = summary
         .thresholds
         .iter()
@@ -210,51 +244,38 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
             "  {unrefined} crossings could not be refined (listed in curves.json with the reason)"
         );
     }
-    if args.second_route {
-        println!(
-            "  second route: {:.2} s; {}",
-            summary.second_route_seconds,
-            confirmed_count(summary.thresholds.iter().map(|t| &t.threshold))
-        );
-        for t in &summary.thresholds {
-            // Thresholds neither route located are among the crossings that could not be refined.
-            let shown = |r: &&SecondRoute| {
-                !r.confirmed && (t.threshold.value.is_finite() || r.value.is_finite())
+}
+
+/// The second route's time and count, then every threshold it did not confirm.
+fn print_second_route(args: &MapArgs, summary: &MapSummary) {
+    println!(
+        "  second route: {:.2} s; {}",
+        summary.second_route_seconds,
+        confirmed_count(summary.thresholds.iter().map(|t| &t.threshold))
+    );
+    for t in &summary.thresholds {
+        // Thresholds neither route located are among the crossings that could not be refined.
+        let shown = |r: &&SecondRoute| {
+            !r.confirmed && (t.threshold.value.is_finite() || r.value.is_finite())
+        };
+        if let Some(r) = t.threshold.second_route.as_ref().filter(shown) {
+            let param = match t.along {
+                vrw::study::map::Along::X => &args.x,
+                vrw::study::map::Along::Y => &args.y,
             };
-            if let Some(r) = t.threshold.second_route.as_ref().filter(shown) {
-                let param = match t.along {
-                    vrw::study::map::Along::X => &args.x,
-                    vrw::study::map::Along::Y => &args.y,
-                };
-                println!(
-                    "    {} {} = {:.6} on {} {}: {}",
-                    t.threshold.name,
-                    param,
-                    t.threshold.value,
-                    if t.along == vrw::study::map::Along::X {
-                        "row"
-                    } else {
-                        "column"
-                    },
-                    t.line,
-                    second_route_words(r)
-                );
-            }
+            println!(
+                "    {} {} = {:.6} on {} {}: {}",
+                t.threshold.name,
+                param,
+                t.threshold.value,
+                if t.along == vrw::study::map::Along::X {
+                    "row"
+                } else {
+                    "column"
+                },
+                t.line,
+                second_route_words(r)
+            );
         }
     }
-    print_warnings(&summary.warnings, "curves.json");
-    let swept = [job.spec.x.param.as_str(), job.spec.y.param.as_str()];
-    let signatures = if vrw::output::friction_columns(&job.config, &swept) {
-        ", signatures.svg, signatures.png"
-    } else {
-        ""
-    };
-    println!(
-        "wrote {}/{{map.csv, curves.json, map.svg, map.png{signatures}}}",
-        args.out.display()
-    );
-    if summary.gaits_found == 0 {
-        bail!("no gait found anywhere on the map (see map.csv for the reasons)");
-    }
-    Ok(())
 }

@@ -8,7 +8,7 @@ use clap::Args;
 use vrw::app::{run_sweep, SweepJob};
 use vrw::gait::GaitOptions;
 use vrw::params::Config;
-use vrw::study::SweepSpec;
+use vrw::study::{SweepSpec, Threshold};
 use vrw::walk::SectionState;
 
 use super::{
@@ -63,20 +63,7 @@ fn param_help() -> String {
 
 /// Run `vrw sweep` and print its summary.
 pub(super) fn run(args: SweepArgs) -> Result<()> {
-    let job = SweepJob {
-        config: args.model.load()?,
-        spec: SweepSpec {
-            param: args.param.clone(),
-            from: args.from,
-            to: args.to,
-            points: args.points,
-        },
-        initial: args.initial,
-        options: GaitOptions::for_sweeps(),
-        second_route: args.second_route,
-        out_dir: args.out.clone(),
-        overwrite: args.overwrite,
-    };
+    let job = sweep_job(&args)?;
     let routes = if args.second_route { 2 } else { 1 };
     // Ctrl-C stops the grid between points; what is complete is written.
     interrupt_flag();
@@ -105,31 +92,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         summary.seconds[1]
     );
     for t in &summary.thresholds {
-        // A threshold whose search failed has no value: its bracket and the reason instead of NaN.
-        let at = if t.value.is_finite() {
-            format!("{} = {:.6}", args.param, t.value)
-        } else {
-            format!("{} not located", args.param)
-        };
-        let residual = if t.residual.is_finite() {
-            format!(", residual {:.1e}", t.residual)
-        } else {
-            String::new()
-        };
-        println!(
-            "  {:<18} {at}  (bracket [{:.7}, {:.7}]{residual}){}{}",
-            t.name,
-            t.bracket[0],
-            t.bracket[1],
-            t.detail
-                .as_deref()
-                .map(|d| format!(": {d}"))
-                .unwrap_or_default(),
-            t.second_route
-                .as_ref()
-                .map(|r| format!("\n    {}", second_route_words(r)))
-                .unwrap_or_default()
-        );
+        print_threshold(&args.param, t);
     }
     if args.second_route {
         println!(
@@ -148,4 +111,52 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         bail!("no gait found anywhere in the sweep (see sweep.csv for the reasons)");
     }
     Ok(())
+}
+
+/// The sweep the options describe (the model loaded from its file and flags).
+fn sweep_job(args: &SweepArgs) -> Result<SweepJob> {
+    Ok(SweepJob {
+        config: args.model.load()?,
+        spec: SweepSpec {
+            param: args.param.clone(),
+            from: args.from,
+            to: args.to,
+            points: args.points,
+        },
+        initial: args.initial,
+        options: GaitOptions::for_sweeps(),
+        second_route: args.second_route,
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+    })
+}
+
+/// One threshold along `param`: where (or that it was not located), its bracket and residual, its detail and
+/// the second route's verdict.
+fn print_threshold(param: &str, t: &Threshold) {
+    // A threshold whose search failed has no value: its bracket and the reason instead of NaN.
+    let at = if t.value.is_finite() {
+        format!("{} = {:.6}", param, t.value)
+    } else {
+        format!("{} not located", param)
+    };
+    let residual = if t.residual.is_finite() {
+        format!(", residual {:.1e}", t.residual)
+    } else {
+        String::new()
+    };
+    println!(
+        "  {:<18} {at}  (bracket [{:.7}, {:.7}]{residual}){}{}",
+        t.name,
+        t.bracket[0],
+        t.bracket[1],
+        t.detail
+            .as_deref()
+            .map(|d| format!(": {d}"))
+            .unwrap_or_default(),
+        t.second_route
+            .as_ref()
+            .map(|r| format!("\n    {}", second_route_words(r)))
+            .unwrap_or_default()
+    );
 }

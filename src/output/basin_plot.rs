@@ -89,6 +89,75 @@ fn span(e: &[f64]) -> Range<f64> {
     a.min(b)..a.max(b)
 }
 
+impl BasinFigure {
+    /// The gait's states inside the plot on `sub`, as white circles with a cross; `to_px` maps the slice to
+    /// `sub`'s pixels.
+    fn draw_gait<DB: DrawingBackend>(
+        &self,
+        sub: &DrawingArea<DB, Shift>,
+        clip: &Clip,
+        to_px: &impl Fn((f64, f64)) -> (i32, i32),
+    ) -> DrawResult<DB> {
+        for &g in &self.gait {
+            let p = to_px(g);
+            if !clip.contains(p) {
+                continue;
+            }
+            clip.draw_circle(sub, p, 14, WHITE.filled())?;
+            clip.draw_circle(sub, p, 14, BLACK.stroke_width(3))?;
+            if clip.contains((p.0 - 8, p.1 - 8)) && clip.contains((p.0 + 8, p.1 + 8)) {
+                sub.draw(&Cross::new(p, 8, BLACK.stroke_width(3)))?;
+            } else {
+                for arm in [[(-8, -8), (8, 8)], [(-8, 8), (8, -8)]] {
+                    let ends = arm.map(|(dx, dy)| (p.0 + dx, p.1 + dy));
+                    clip.draw_path(sub, &ends, BLACK.stroke_width(3))?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The legend at x `lx` of `area`: the outcomes present, in a fixed order, then the gait marker.
+    fn draw_outcome_legend<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        lx: i32,
+    ) -> DrawResult<DB> {
+        let mut kinds: Vec<&str> = Vec::new();
+        for o in self.outcomes.iter().flatten() {
+            if !kinds.contains(&o.as_str()) {
+                kinds.push(o);
+            }
+        }
+        let order = |k: &str| match k {
+            "gait" => 0,
+            "other" => 1,
+            "undecided" => 3,
+            "invalid_start" => 4,
+            _ => 2,
+        };
+        kinds.sort_by(|a, b| order(a).cmp(&order(b)).then(a.cmp(b)));
+        let swatches: Vec<(String, RGBColor)> = kinds
+            .iter()
+            .map(|k| (outcome_label(k), outcome_color(k)))
+            .collect();
+        draw_legend(area, &[], &swatches, (lx, 20))?;
+        let gy = 20 + 34 * swatches.len() as i32 + 40;
+        area.draw(&Circle::new((lx + 30, gy), 14, BLACK.stroke_width(3)))?;
+        area.draw(&Cross::new((lx + 30, gy), 8, BLACK.stroke_width(3)))?;
+        let label = match self.gait.len() {
+            0 | 1 => "the gait".to_string(),
+            k => format!("the gait ({k} states)"),
+        };
+        area.draw(&Text::new(
+            label,
+            (lx + 60, gy),
+            font(24.0).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+        Ok(())
+    }
+}
+
 impl Figure for BasinFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
         let area = titled(root, &self.title)?;
@@ -131,55 +200,8 @@ impl Figure for BasinFigure {
             px.start - base.0..px.end - base.0,
             py.start - base.1..py.end - base.1,
         );
-        for &g in &self.gait {
-            let p = to_px(g);
-            if !clip.contains(p) {
-                continue;
-            }
-            clip.draw_circle(&sub, p, 14, WHITE.filled())?;
-            clip.draw_circle(&sub, p, 14, BLACK.stroke_width(3))?;
-            if clip.contains((p.0 - 8, p.1 - 8)) && clip.contains((p.0 + 8, p.1 + 8)) {
-                sub.draw(&Cross::new(p, 8, BLACK.stroke_width(3)))?;
-            } else {
-                for arm in [[(-8, -8), (8, 8)], [(-8, 8), (8, -8)]] {
-                    let ends = arm.map(|(dx, dy)| (p.0 + dx, p.1 + dy));
-                    clip.draw_path(&sub, &ends, BLACK.stroke_width(3))?;
-                }
-            }
-        }
-        // Legend: the outcomes present, in a fixed order, then the gait marker.
-        let mut kinds: Vec<&str> = Vec::new();
-        for o in self.outcomes.iter().flatten() {
-            if !kinds.contains(&o.as_str()) {
-                kinds.push(o);
-            }
-        }
-        let order = |k: &str| match k {
-            "gait" => 0,
-            "other" => 1,
-            "undecided" => 3,
-            "invalid_start" => 4,
-            _ => 2,
-        };
-        kinds.sort_by(|a, b| order(a).cmp(&order(b)).then(a.cmp(b)));
-        let swatches: Vec<(String, RGBColor)> = kinds
-            .iter()
-            .map(|k| (outcome_label(k), outcome_color(k)))
-            .collect();
-        let lx = w - LEGEND_W - 24;
-        draw_legend(&area, &[], &swatches, (lx, 20))?;
-        let gy = 20 + 34 * swatches.len() as i32 + 40;
-        area.draw(&Circle::new((lx + 30, gy), 14, BLACK.stroke_width(3)))?;
-        area.draw(&Cross::new((lx + 30, gy), 8, BLACK.stroke_width(3)))?;
-        let label = match self.gait.len() {
-            0 | 1 => "the gait".to_string(),
-            k => format!("the gait ({k} states)"),
-        };
-        area.draw(&Text::new(
-            label,
-            (lx + 60, gy),
-            font(24.0).pos(Pos::new(HPos::Left, VPos::Center)),
-        ))?;
+        self.draw_gait(&sub, &clip, &to_px)?;
+        self.draw_outcome_legend(&area, w - LEGEND_W - 24)?;
         Ok(())
     }
 }

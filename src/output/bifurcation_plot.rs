@@ -143,41 +143,21 @@ fn phase_curves(color: RGBColor, label: &str, phase: &[(f64, f64, Option<bool>)]
     curves
 }
 
-impl Figure for BifurcationFigure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
-        let area = titled(root, &self.title)?;
-        let (w, h) = area.dim_in_pixel();
-        let (w, h) = (w as i32, h as i32);
-        let panel = area.clone().shrink((0, 0), (w - LEGEND_W, h));
-        let values = self
-            .families
-            .iter()
-            .flat_map(|f| f.phases.iter().flatten().map(|p| p.1))
-            .chain(self.special.iter().map(|s| s.value));
-        let y = finite_range(values).map_or(-1.0..1.0, |r| padded(r.start, r.end, 0.08));
-        let axes = Axes {
-            x: self.x.clone(),
-            y: y.clone(),
-            x_label: Some(self.param_label.as_str()),
-            y_label: &self.y_label,
-            x_integer: false,
-        };
-        let curves: Vec<Curve> = self
-            .families
-            .iter()
-            .enumerate()
-            .flat_map(|(k, f)| family_curves(k, f))
-            .collect();
-        let (px, py) = draw_axes_and_curves(&panel, &axes, &curves, &[], &[])?;
-        let base = panel.get_base_pixel();
-        let to_px = data_to_px(self.x.clone(), y.clone(), (px.clone(), py.clone()), base);
+impl BifurcationFigure {
+    /// The special points inside the parameter range on `panel`, as circles with their labels; `to_px` maps
+    /// data to the panel's pixels.
+    fn draw_specials<DB: DrawingBackend>(
+        &self,
+        panel: &DrawingArea<DB, Shift>,
+        to_px: &impl Fn((f64, f64)) -> (i32, i32),
+    ) -> DrawResult<DB> {
         for sp in &self.special {
             if !(sp.param.is_finite() && sp.value.is_finite() && self.x.contains(&sp.param)) {
                 continue;
             }
             let at = to_px((sp.param, sp.value));
             draw_marker(
-                &panel,
+                panel,
                 at,
                 Marker::Circle,
                 family_color(sp.family),
@@ -190,6 +170,17 @@ impl Figure for BifurcationFigure {
                 font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Bottom)),
             ))?;
         }
+        Ok(())
+    }
+
+    /// The families' ends inside the parameter range on `panel`, as crosses with the word of why they end;
+    /// `to_px` maps data to the panel's pixels and `right` is the plot's right edge in them.
+    fn draw_ends<DB: DrawingBackend>(
+        &self,
+        panel: &DrawingArea<DB, Shift>,
+        to_px: &impl Fn((f64, f64)) -> (i32, i32),
+        right: i32,
+    ) -> DrawResult<DB> {
         // The rectangles of the words written at the families' ends.
         let mut words: Vec<(i32, i32, i32, i32)> = Vec::new();
         for (k, family) in self.families.iter().enumerate() {
@@ -216,7 +207,7 @@ impl Figure for BifurcationFigure {
                 let style = font(LEGEND_FONT * 0.8);
                 let (tw, th) = panel.estimate_text_size(why, &style)?;
                 let (tw, th) = (tw as i32, th as i32);
-                let (x, h_pos, left) = if at.0 + r + 4 + tw > px.end - base.0 {
+                let (x, h_pos, left) = if at.0 + r + 4 + tw > right {
                     (at.0 - r - 4, HPos::Right, at.0 - r - 4 - tw)
                 } else {
                     (at.0 + r + 4, HPos::Left, at.0 + r + 4)
@@ -236,6 +227,11 @@ impl Figure for BifurcationFigure {
                 ))?;
             }
         }
+        Ok(())
+    }
+
+    /// The legend's rows: a row per family, then the line styles and special points where they are drawn.
+    fn legend(&self) -> Vec<Curve> {
         let mut legend: Vec<Curve> = self
             .families
             .iter()
@@ -273,10 +269,44 @@ impl Figure for BifurcationFigure {
             });
         }
         legend.truncate(self.families.len() + styles);
+        legend
+    }
+}
+
+impl Figure for BifurcationFigure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult<DB> {
+        let area = titled(root, &self.title)?;
+        let (w, h) = area.dim_in_pixel();
+        let (w, h) = (w as i32, h as i32);
+        let panel = area.clone().shrink((0, 0), (w - LEGEND_W, h));
+        let values = self
+            .families
+            .iter()
+            .flat_map(|f| f.phases.iter().flatten().map(|p| p.1))
+            .chain(self.special.iter().map(|s| s.value));
+        let y = finite_range(values).map_or(-1.0..1.0, |r| padded(r.start, r.end, 0.08));
+        let axes = Axes {
+            x: self.x.clone(),
+            y: y.clone(),
+            x_label: Some(self.param_label.as_str()),
+            y_label: &self.y_label,
+            x_integer: false,
+        };
+        let curves: Vec<Curve> = self
+            .families
+            .iter()
+            .enumerate()
+            .flat_map(|(k, f)| family_curves(k, f))
+            .collect();
+        let (px, py) = draw_axes_and_curves(&panel, &axes, &curves, &[], &[])?;
+        let base = panel.get_base_pixel();
+        let to_px = data_to_px(self.x.clone(), y.clone(), (px.clone(), py.clone()), base);
+        self.draw_specials(&panel, &to_px)?;
+        self.draw_ends(&panel, &to_px, px.end - base.0)?;
         let area_base = area.get_base_pixel();
         draw_legend(
             &area,
-            &legend,
+            &self.legend(),
             &[],
             (w - LEGEND_W + 16, py.start - area_base.1 + 4),
         )?;

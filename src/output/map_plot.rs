@@ -13,6 +13,7 @@
 use std::ops::Range;
 use std::path::Path;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -64,6 +65,15 @@ const LEGEND_W: i32 = 430;
 const BAR_W: i32 = 190;
 const Y_LABEL_AREA: i32 = 130;
 const X_LABEL_AREA: i32 = 90;
+/// Height of a legend row \[px\].
+const LEGEND_LINE: i32 = 36;
+/// Width of a legend sample (line or swatch) \[px\].
+const LEGEND_SAMPLE_W: i32 = 50;
+/// The proportions of the legend boxes.
+const LEGEND_LAYOUT: LegendLayout = LegendLayout::new(12, LEGEND_SAMPLE_W, 10, LEGEND_LINE, 6);
+
+/// The chart of a panel, in the map's parameters.
+type MapChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Grey of points without a gait.
 pub(crate) const COLOR_NO_GAIT: RGBColor = RGBColor(200, 200, 200);
@@ -188,6 +198,8 @@ impl MapFigure<'_> {
         (step(&self.map.xs), step(&self.map.ys))
     }
 
+    /// One heat-map panel: `heading` above, the cells of `layer`, the curves and marks over them, and the colour
+    /// bar of an indicator on the right.
     pub(crate) fn panel<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
@@ -228,8 +240,33 @@ impl MapFigure<'_> {
                 .disable_mesh();
             mesh.draw()?;
         }
-        let (hx, hy) = self.cell();
-        let range = match layer {
+        let range = self.layer_range(layer);
+        self.draw_cells(&mut chart, layer, &range)?;
+        let (px, py) = chart.plotting_area().get_pixel_range();
+        let plot = chart.plotting_area().strip_coord_spec();
+        let clip = Clip::of_area(&plot);
+        let rel = |p: [f64; 2]| {
+            let (a, b) = chart.backend_coord(&(p[0], p[1]));
+            (a - px.start, b - py.start)
+        };
+        self.draw_curves(&plot, &clip, &rel)?;
+        self.draw_marks(&plot, &clip, &rel)?;
+        plot.draw(&Rectangle::new(
+            [(0, 0), (px.end - px.start - 1, py.end - py.start - 1)],
+            BLACK.stroke_width(2),
+        ))?;
+        if let Layer::Indicator(desc, _) = layer {
+            let base = area.get_base_pixel();
+            let top = py.start - base.1;
+            let bottom = py.end - base.1;
+            self.colour_bar(area, (w as i32 - bar_w + 20, top, bottom), &range, desc)?;
+        }
+        Ok(())
+    }
+
+    /// The colour scale of `layer`: an indicator's finite range with zero on it, `0..1` for the others.
+    fn layer_range(&self, layer: &Layer) -> Range<f64> {
+        match layer {
             Layer::Indicator(_, f) => {
                 let values = self
                     .map
@@ -242,7 +279,18 @@ impl MapFigure<'_> {
                     .map_or(-1.0..1.0, |r| r.start.min(0.0)..r.end.max(0.0))
             }
             Layer::Branch | Layer::Signature(_) => 0.0..1.0,
-        };
+        }
+    }
+
+    /// One cell per map point in the colour of `layer` (on the scale `range`), with a dot on an unstable gait
+    /// of the branch and signature layers.
+    fn draw_cells<DB: DrawingBackend>(
+        &self,
+        chart: &mut MapChart<DB>,
+        layer: &Layer,
+        range: &Range<f64>,
+    ) -> DrawResult<DB> {
+        let (hx, hy) = self.cell();
         for (row, &yv) in self.map.rows.iter().zip(&self.map.ys) {
             for p in row {
                 let color = match (&p.gait, layer) {
@@ -250,7 +298,7 @@ impl MapFigure<'_> {
                     (Some(g), Layer::Indicator(_, f)) => {
                         let v = f(g);
                         if v.is_finite() {
-                            diverging(v, &range)
+                            diverging(v, range)
                         } else {
                             COLOR_NO_GAIT
                         }
@@ -275,13 +323,17 @@ impl MapFigure<'_> {
                 }
             }
         }
-        let (px, py) = chart.plotting_area().get_pixel_range();
-        let plot = chart.plotting_area().strip_coord_spec();
-        let clip = Clip::of_area(&plot);
-        let rel = |p: [f64; 2]| {
-            let (a, b) = chart.backend_coord(&(p[0], p[1]));
-            (a - px.start, b - py.start)
-        };
+        Ok(())
+    }
+
+    /// The threshold curves on `plot` with a white halo (a single point as a dot), clipped; `rel` maps a data
+    /// point to the plot's pixels.
+    fn draw_curves<DB: DrawingBackend>(
+        &self,
+        plot: &DrawingArea<DB, Shift>,
+        clip: &Clip,
+        rel: &impl Fn([f64; 2]) -> (i32, i32),
+    ) -> DrawResult<DB> {
         for curve in self.curves {
             let (color, is_dashed, _) = curve_style(&curve.name);
             let mut pts: Vec<(i32, i32)> = curve.points.iter().map(|&p| rel(p)).collect();
@@ -289,25 +341,36 @@ impl MapFigure<'_> {
                 pts.push(pts[0]);
             }
             if pts.len() == 1 {
-                clip.draw_circle(&plot, pts[0], 5, WHITE.filled())?;
-                clip.draw_circle(&plot, pts[0], 3, color.filled())?;
+                clip.draw_circle(plot, pts[0], 5, WHITE.filled())?;
+                clip.draw_circle(plot, pts[0], 3, color.filled())?;
                 continue;
             }
-            clip.draw_path(&plot, &pts, WHITE.stroke_width(7))?;
+            clip.draw_path(plot, &pts, WHITE.stroke_width(7))?;
             if is_dashed {
-                clip.draw_dashed(&plot, &pts, color.stroke_width(3), DASH_GAP)?;
+                clip.draw_dashed(plot, &pts, color.stroke_width(3), DASH_GAP)?;
             } else {
-                clip.draw_path(&plot, &pts, color.stroke_width(3))?;
+                clip.draw_path(plot, &pts, color.stroke_width(3))?;
             }
         }
+        Ok(())
+    }
+
+    /// The marked points inside the clip on `plot`, as white circles with their labels on a light box; `rel`
+    /// maps a data point to the plot's pixels.
+    fn draw_marks<DB: DrawingBackend>(
+        &self,
+        plot: &DrawingArea<DB, Shift>,
+        clip: &Clip,
+        rel: &impl Fn([f64; 2]) -> (i32, i32),
+    ) -> DrawResult<DB> {
         for m in self.marks {
             let c = rel([m.x, m.y]);
             if !clip.contains(c) {
                 continue;
             }
-            clip.draw_circle(&plot, c, 10, WHITE.filled())?;
-            clip.draw_circle(&plot, c, 10, COLOR_BLACK.stroke_width(3))?;
-            clip.draw_circle(&plot, c, 3, COLOR_BLACK.filled())?;
+            clip.draw_circle(plot, c, 10, WHITE.filled())?;
+            clip.draw_circle(plot, c, 10, COLOR_BLACK.stroke_width(3))?;
+            clip.draw_circle(plot, c, 3, COLOR_BLACK.filled())?;
             let style = font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Bottom));
             let at = (c.0 + 14, c.1 - 8);
             let (tw, th) = plot.estimate_text_size(&m.label, &font(LEGEND_FONT))?;
@@ -319,16 +382,6 @@ impl MapFigure<'_> {
                 WHITE.mix(0.8).filled(),
             ))?;
             plot.draw(&Text::new(m.label.clone(), at, style))?;
-        }
-        plot.draw(&Rectangle::new(
-            [(0, 0), (px.end - px.start - 1, py.end - py.start - 1)],
-            BLACK.stroke_width(2),
-        ))?;
-        if let Layer::Indicator(desc, _) = layer {
-            let base = area.get_base_pixel();
-            let top = py.start - base.1;
-            let bottom = py.end - base.1;
-            self.colour_bar(area, (w as i32 - bar_w + 20, top, bottom), &range, desc)?;
         }
         Ok(())
     }
@@ -386,16 +439,19 @@ impl MapFigure<'_> {
         area: &DrawingArea<DB, Shift>,
         (x0, y0): (i32, i32),
     ) -> DrawResult<DB> {
-        const LINE: i32 = 36;
-        const SAMPLE_W: i32 = 50;
-        let layout = LegendLayout::new(12, SAMPLE_W, 10, LINE, 6);
+        let y = self.curve_legend(area, (x0, y0))?;
+        self.existence_legend(area, (x0, y))
+    }
+
+    /// The legend of the curves drawn (none without curves) at `(x0, y0)`; returns the y below it.
+    fn curve_legend<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        (x0, y0): (i32, i32),
+    ) -> Result<i32, DrawingAreaErrorKind<DB::ErrorType>> {
         let mut names: Vec<&str> = self.curves.iter().map(|c| c.name.as_str()).collect();
         names.sort_unstable();
         names.dedup();
-        let text = |s: &str| {
-            area.estimate_text_size(s, &font(LEGEND_FONT))
-                .map(|(w, _)| w as i32)
-        };
         let mut y = y0;
         if !names.is_empty() {
             area.draw(&Text::new(
@@ -403,15 +459,15 @@ impl MapFigure<'_> {
                 (x0, y),
                 font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Top)),
             ))?;
-            y += LINE;
+            y += LEGEND_LINE;
             let mut text_w = 0;
             for n in &names {
-                text_w = text_w.max(text(curve_style(n).2)?);
+                text_w = text_w.max(legend_text_w(area, curve_style(n).2)?);
             }
-            let (sx, tx, mut cy) = layout.frame(area, (x0, y), names.len(), text_w)?;
+            let (sx, tx, mut cy) = LEGEND_LAYOUT.frame(area, (x0, y), names.len(), text_w)?;
             for n in &names {
                 let (color, is_dashed, label) = curve_style(n);
-                let line = [(sx, cy), (sx + SAMPLE_W, cy)];
+                let line = [(sx, cy), (sx + LEGEND_SAMPLE_W, cy)];
                 if is_dashed {
                     dashed(area, &line, color.stroke_width(3))?;
                 } else {
@@ -422,10 +478,20 @@ impl MapFigure<'_> {
                     (tx, cy),
                     font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
                 ))?;
-                cy += LINE;
+                cy += LEGEND_LINE;
             }
-            y += names.len() as i32 * LINE + 2 * 6 + LINE;
+            y += names.len() as i32 * LEGEND_LINE + 2 * 6 + LEGEND_LINE;
         }
+        Ok(y)
+    }
+
+    /// The legend of existence and branch at `(x0, y)`: a swatch per branch present, no gait, and the dot of
+    /// an unstable gait.
+    fn existence_legend<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        (x0, mut y): (i32, i32),
+    ) -> DrawResult<DB> {
         let present = |b: Branch| {
             self.map
                 .rows
@@ -444,28 +510,32 @@ impl MapFigure<'_> {
             (x0, y),
             font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Top)),
         ))?;
-        y += LINE;
-        let mut text_w = text("dot: unstable or uncertain")?;
+        y += LEGEND_LINE;
+        let mut text_w = legend_text_w(area, "dot: unstable or uncertain")?;
         for (s, _) in &swatches {
-            text_w = text_w.max(text(s)?);
+            text_w = text_w.max(legend_text_w(area, s)?);
         }
-        let (sx, tx, mut cy) = layout.frame(area, (x0, y), swatches.len() + 1, text_w)?;
+        let (sx, tx, mut cy) = LEGEND_LAYOUT.frame(area, (x0, y), swatches.len() + 1, text_w)?;
         for (label, color) in &swatches {
-            draw_box(area, [(sx, cy - 12), (sx + SAMPLE_W, cy + 12)], *color)?;
+            draw_box(
+                area,
+                [(sx, cy - 12), (sx + LEGEND_SAMPLE_W, cy + 12)],
+                *color,
+            )?;
             area.draw(&Text::new(
                 label.clone(),
                 (tx, cy),
                 font(LEGEND_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
             ))?;
-            cy += LINE;
+            cy += LEGEND_LINE;
         }
         draw_box(
             area,
-            [(sx, cy - 12), (sx + SAMPLE_W, cy + 12)],
+            [(sx, cy - 12), (sx + LEGEND_SAMPLE_W, cy + 12)],
             branch_color(Branch::Dls),
         )?;
         area.draw(&Circle::new(
-            (sx + SAMPLE_W / 2, cy),
+            (sx + LEGEND_SAMPLE_W / 2, cy),
             3,
             COLOR_BLACK.filled(),
         ))?;
@@ -476,6 +546,15 @@ impl MapFigure<'_> {
         ))?;
         Ok(())
     }
+}
+
+/// The width of `s` in the legend font \[px\].
+fn legend_text_w<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    s: &str,
+) -> Result<i32, DrawingAreaErrorKind<DB::ErrorType>> {
+    area.estimate_text_size(s, &font(LEGEND_FONT))
+        .map(|(w, _)| w as i32)
 }
 
 impl Figure for MapFigure<'_> {

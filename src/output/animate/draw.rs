@@ -128,33 +128,88 @@ fn draw_leg<DB: DrawingBackend>(
     psi: f64,
     leg: &LegState,
 ) -> DrawResult<DB> {
-    let e = (-psi.sin(), -psi.cos());
-    let n = (-psi.cos(), psi.sin());
-    let l0 = geometry.stopper_length;
-    let p = |d: f64, side: f64| view.px(along(hub, e, n, d, side * l0));
-    let w = |f: f64| ((f * view.scale / 100.0).round() as u32).max(1);
+    let axes = LegAxes {
+        view,
+        hub,
+        e: (-psi.sin(), -psi.cos()),
+        n: (-psi.cos(), psi.sin()),
+        l0: geometry.stopper_length,
+    };
+    let l0 = axes.l0;
     let tip_r = (0.045 * l0 * view.scale).round().max(3.0) as i32;
     let Some((color, tip, locked)) = leg.compliant else {
         root.draw(&PathElement::new(
-            vec![p(0.0, 0.0), p(leg.length, 0.0)],
-            SPOKE.stroke_width(w(3.0)),
+            vec![axes.p(0.0, 0.0), axes.p(leg.length, 0.0)],
+            SPOKE.stroke_width(axes.w(3.0)),
         ))?;
-        return draw_tip(root, p(leg.length, 0.0), tip_r - 1, TipState::Air);
+        return draw_tip(root, axes.p(leg.length, 0.0), tip_r - 1, TipState::Air);
     };
     let l = leg.length;
     let housing_end = HOUSING * l0;
     let rod_top = (l - ROD * l0).max(housing_end);
     // Housing and rod.
     root.draw(&PathElement::new(
-        vec![p(0.0, 0.0), p(housing_end, 0.0)],
-        color.stroke_width(w(7.0)),
+        vec![axes.p(0.0, 0.0), axes.p(housing_end, 0.0)],
+        color.stroke_width(axes.w(7.0)),
     ))?;
     root.draw(&PathElement::new(
-        vec![p(rod_top, 0.0), p(l, 0.0)],
-        color.stroke_width(w(4.0)),
+        vec![axes.p(rod_top, 0.0), axes.p(l, 0.0)],
+        color.stroke_width(axes.w(4.0)),
     ))?;
-    // Spring: a zigzag of COILS coils between the housing and the rod.
-    let mut zig = vec![p(housing_end, 0.0)];
+    draw_spring(root, &axes, housing_end, rod_top)?;
+    draw_dashpot(root, &axes, housing_end, rod_top)?;
+    // Stopper, drawn while it holds the leg at L0 (or the compression stop at min_length).
+    if locked {
+        root.draw(&PathElement::new(
+            vec![axes.p(rod_top, -0.05), axes.p(rod_top, 0.05)],
+            STOPPER.stroke_width(axes.w(5.0)),
+        ))?;
+    }
+    // Leg mass at `a` from the tip.
+    let mass_r = (0.028 * l0 * view.scale).round().max(2.0) as i32;
+    root.draw(&Circle::new(
+        axes.p(l - geometry.leg_mass_offset, 0.0),
+        mass_r,
+        color.filled(),
+    ))?;
+    draw_tip(root, axes.p(l, 0.0), tip_r, tip)
+}
+
+/// A leg's own axes in a frame: pixels of points along and across it, and stroke widths in the view's scale.
+struct LegAxes<'a> {
+    /// The frame's camera.
+    view: &'a View,
+    /// The hub, where the leg starts (slope frame) \[m\].
+    hub: (f64, f64),
+    /// Unit vector along the leg, from the hub to the tip.
+    e: (f64, f64),
+    /// Unit vector across the leg.
+    n: (f64, f64),
+    /// `L0` \[m\], the unit of the offsets across the leg.
+    l0: f64,
+}
+
+impl LegAxes<'_> {
+    /// The pixel at `d` \[m\] along the leg from the hub and `side` (a fraction of `L0`) across it.
+    fn p(&self, d: f64, side: f64) -> (i32, i32) {
+        self.view
+            .px(along(self.hub, self.e, self.n, d, side * self.l0))
+    }
+
+    /// A stroke width of `f` pixels at 100 pixels per metre, in the view's scale (at least 1).
+    fn w(&self, f: f64) -> u32 {
+        ((f * self.view.scale / 100.0).round() as u32).max(1)
+    }
+}
+
+/// The spring: a zigzag of [`COILS`] coils between the housing's end and the rod's top.
+fn draw_spring<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    axes: &LegAxes,
+    housing_end: f64,
+    rod_top: f64,
+) -> DrawResult<DB> {
+    let mut zig = vec![axes.p(housing_end, 0.0)];
     let segments = 2 * COILS;
     for k in 0..segments {
         let d = housing_end + (rod_top - housing_end) * (k as f64 + 0.5) / segments as f64;
@@ -163,17 +218,26 @@ fn draw_leg<DB: DrawingBackend>(
         } else {
             -COIL_HALF_WIDTH
         };
-        zig.push(p(d, side));
+        zig.push(axes.p(d, side));
     }
-    zig.push(p(rod_top, 0.0));
-    root.draw(&PathElement::new(zig, INK.stroke_width(w(1.6))))?;
-    // Dashpot beside the spring (the textbook symbol): a cup hanging from the housing, a piston on the rod;
-    // its links stretch with the leg.
+    zig.push(axes.p(rod_top, 0.0));
+    root.draw(&PathElement::new(zig, INK.stroke_width(axes.w(1.6))))
+}
+
+/// The dashpot beside the spring (the textbook symbol): a cup hanging from the housing, a piston on the rod;
+/// its links stretch with the leg.
+fn draw_dashpot<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    axes: &LegAxes,
+    housing_end: f64,
+    rod_top: f64,
+) -> DrawResult<DB> {
+    let p = |d: f64, side: f64| axes.p(d, side);
     let span = rod_top - housing_end;
     let mid = housing_end + 0.5 * span;
-    let cup = (DASHPOT_CUP * l0).min(0.3 * span);
+    let cup = (DASHPOT_CUP * axes.l0).min(0.3 * span);
     let (off, half) = (DASHPOT_OFFSET, DASHPOT_HALF_WIDTH);
-    let thin = INK.stroke_width(w(1.6));
+    let thin = INK.stroke_width(axes.w(1.6));
     root.draw(&PathElement::new(
         vec![p(housing_end, 0.0), p(housing_end, off), p(mid - cup, off)],
         thin,
@@ -189,27 +253,12 @@ fn draw_leg<DB: DrawingBackend>(
     ))?;
     root.draw(&PathElement::new(
         vec![p(mid, off - 0.7 * half), p(mid, off + 0.7 * half)],
-        INK.stroke_width(w(3.0)),
+        INK.stroke_width(axes.w(3.0)),
     ))?;
     root.draw(&PathElement::new(
         vec![p(mid, off), p(rod_top, off), p(rod_top, 0.0)],
         thin,
-    ))?;
-    // Stopper, drawn while it holds the leg at L0 (or the compression stop at min_length).
-    if locked {
-        root.draw(&PathElement::new(
-            vec![p(rod_top, -0.05), p(rod_top, 0.05)],
-            STOPPER.stroke_width(w(5.0)),
-        ))?;
-    }
-    // Leg mass at `a` from the tip.
-    let mass_r = (0.028 * l0 * view.scale).round().max(2.0) as i32;
-    root.draw(&Circle::new(
-        p(l - geometry.leg_mass_offset, 0.0),
-        mass_r,
-        color.filled(),
-    ))?;
-    draw_tip(root, p(l, 0.0), tip_r, tip)
+    ))
 }
 
 /// Draws the ground: a filled band under the slope line, hatching every [`HATCH_SPACING`] `L0` and a labelled tick

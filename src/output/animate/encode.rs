@@ -108,6 +108,12 @@ pub(super) fn write_gif(
     let mut flat: Vec<u8> = palette.iter().flatten().copied().collect();
     flat.extend([255, 0, 255]);
     let (w, h) = (width as usize, height as usize);
+    let format = FrameFormat {
+        w,
+        h,
+        transparent,
+        fps,
+    };
     let out = Counted {
         inner: out,
         bytes: 0,
@@ -127,42 +133,8 @@ pub(super) fn write_gif(
                 total: frames.len(),
             });
         }
-        let indexed: Vec<Vec<u8>> = chunk
-            .par_iter()
-            .map_init(
-                || vec![255u8; w * h * 3],
-                |rgb, frame| {
-                    {
-                        let root =
-                            BitMapBackend::with_buffer(rgb, (width, height)).into_drawing_area();
-                        draw(&root, frame)?;
-                    }
-                    Ok(rgb
-                        .chunks_exact(3)
-                        .map(|px| {
-                            lut[(usize::from(px[0] >> 3) << 10)
-                                | (usize::from(px[1] >> 3) << 5)
-                                | usize::from(px[2] >> 3)]
-                        })
-                        .collect())
-                },
-            )
-            .collect::<Result<_, PlotError>>()?;
-        let encoded: Vec<gif::Frame<'static>> = (0..indexed.len())
-            .into_par_iter()
-            .map(|i| {
-                let k = c * RENDER_CHUNK + i;
-                let before = if i == 0 {
-                    previous.as_deref()
-                } else {
-                    Some(indexed[i - 1].as_slice())
-                };
-                let delay = (centis(k + 1, fps) - centis(k, fps)) as u16;
-                let mut frame = changed_rect(before, &indexed[i], w, h, transparent, delay);
-                frame.make_lzw_pre_encoded();
-                frame
-            })
-            .collect();
+        let indexed = render_indexed(chunk, (width, height), &lut, &draw)?;
+        let encoded = encode_chunk(&indexed, previous.as_deref(), c * RENDER_CHUNK, &format);
         for frame in &encoded {
             encoder
                 .write_lzw_pre_encoded_frame(frame)
@@ -173,6 +145,80 @@ pub(super) fn write_gif(
     let mut out = encoder.into_inner().map_err(|e| write_err(e.to_string()))?;
     out.flush().map_err(|e| write_err(e.to_string()))?;
     Ok(out.bytes)
+}
+
+/// What every frame of a GIF shares: its size \[px\], the palette's transparent index and the frame rate.
+struct FrameFormat {
+    /// Width \[px\].
+    w: usize,
+    /// Height \[px\].
+    h: usize,
+    /// The palette index of unchanged pixels.
+    transparent: u8,
+    /// Frames per second.
+    fps: u32,
+}
+
+/// Draws the frames of `chunk` with `draw` at `width` x `height` pixels in parallel and maps each to palette
+/// indices through the lookup table `lut`.
+fn render_indexed(
+    chunk: &[FrameTime],
+    (width, height): (u32, u32),
+    lut: &[u8],
+    draw: &(impl Fn(&DrawingArea<BitMapBackend<'_>, Shift>, &FrameTime) -> Result<(), PlotError> + Sync),
+) -> Result<Vec<Vec<u8>>, PlotError> {
+    let (w, h) = (width as usize, height as usize);
+    chunk
+        .par_iter()
+        .map_init(
+            || vec![255u8; w * h * 3],
+            |rgb, frame| {
+                {
+                    let root = BitMapBackend::with_buffer(rgb, (width, height)).into_drawing_area();
+                    draw(&root, frame)?;
+                }
+                Ok(rgb
+                    .chunks_exact(3)
+                    .map(|px| {
+                        lut[(usize::from(px[0] >> 3) << 10)
+                            | (usize::from(px[1] >> 3) << 5)
+                            | usize::from(px[2] >> 3)]
+                    })
+                    .collect())
+            },
+        )
+        .collect::<Result<_, PlotError>>()
+}
+
+/// The GIF frames of the indexed frames `indexed`, the first of which is frame `first` of the animation
+/// (`previous`: the frame before it), each LZW-compressed, in parallel.
+fn encode_chunk(
+    indexed: &[Vec<u8>],
+    previous: Option<&[u8]>,
+    first: usize,
+    format: &FrameFormat,
+) -> Vec<gif::Frame<'static>> {
+    let FrameFormat {
+        w,
+        h,
+        transparent,
+        fps,
+    } = *format;
+    (0..indexed.len())
+        .into_par_iter()
+        .map(|i| {
+            let k = first + i;
+            let before = if i == 0 {
+                previous
+            } else {
+                Some(indexed[i - 1].as_slice())
+            };
+            let delay = (centis(k + 1, fps) - centis(k, fps)) as u16;
+            let mut frame = changed_rect(before, &indexed[i], w, h, transparent, delay);
+            frame.make_lzw_pre_encoded();
+            frame
+        })
+        .collect()
 }
 
 /// The GIF frame for `current`: the whole frame first, then only the rectangle that changed since `previous`,

@@ -116,7 +116,75 @@ fn y_range(series: &[Series], reference: f64) -> Range<f64> {
     start..r.end
 }
 
+/// The series of the panels (a)-(d) of the points `sorted` by parameter: `lambda_I4`; `lambda_2+` and
+/// `lambda_4+`; the period; the largest multiplier.
+fn panel_series(sorted: &[&IndicatorPoint]) -> [Vec<Series>; 4] {
+    let panel_a = vec![Series::new(
+        NAME_I4,
+        COLOR_I4,
+        Marker::Circle,
+        sorted,
+        |p| p.lambda_i4,
+    )];
+    let panel_b = vec![
+        Series::new(NAME_2, COLOR_2, Marker::Circle, sorted, |p| p.lambda_2_plus),
+        Series::new(NAME_4, COLOR_4, Marker::Triangle, sorted, |p| {
+            p.lambda_4_plus
+        }),
+    ];
+    let panel_c = vec![Series::new(
+        NAME_PERIOD,
+        COLOR_I4,
+        Marker::Circle,
+        sorted,
+        |p| p.period,
+    )];
+    let panel_d = vec![Series::new(
+        NAME_FLOQUET,
+        COLOR_BLUE,
+        Marker::Circle,
+        sorted,
+        |p| p.max_floquet,
+    )];
+    [panel_a, panel_b, panel_c, panel_d]
+}
+
+/// The x range shown: `given` if it is not empty, else the span of the samples `xs` and the `marks`, padded
+/// (and not below zero when they are not).
+fn x_range(given: Option<&Range<f64>>, xs: &[f64], marks: &[ThresholdMark]) -> Range<f64> {
+    match given {
+        Some(r) if r.end > r.start => r.clone(),
+        _ => {
+            let (lo, hi) = xs
+                .iter()
+                .copied()
+                .chain(marks.iter().map(|m| m.value))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                });
+            let mut x = padded(lo, hi, 0.03);
+            if lo >= 0.0 && x.start < 0.0 {
+                x.start = 0.0;
+            }
+            x
+        }
+    }
+}
+
+/// The marker size \[px\]: smaller the more samples the densest series of panels (a) and (b) has.
+fn marker_size(panel_a: &[Series], panel_b: &[Series]) -> i32 {
+    let n = [panel_a, panel_b]
+        .into_iter()
+        .flatten()
+        .map(|s| s.samples().count())
+        .max()
+        .unwrap_or(1)
+        .max(1) as i32;
+    (1100 / n / 2).clamp(4, 7)
+}
+
 impl Prepared {
+    /// The series, axis ranges and marker size of `spec`; an error if it has no points or no gait.
     pub(super) fn new(spec: &Fig2Spec) -> Result<Self, PlotError> {
         if spec.points.is_empty() {
             return Err(PlotError::Empty("the sweep has no points".into()));
@@ -124,35 +192,7 @@ impl Prepared {
         let mut sorted: Vec<&IndicatorPoint> =
             spec.points.iter().filter(|p| p.param.is_finite()).collect();
         sorted.sort_by(|a, b| a.param.total_cmp(&b.param));
-        let panel_a = vec![Series::new(
-            NAME_I4,
-            COLOR_I4,
-            Marker::Circle,
-            &sorted,
-            |p| p.lambda_i4,
-        )];
-        let panel_b = vec![
-            Series::new(NAME_2, COLOR_2, Marker::Circle, &sorted, |p| {
-                p.lambda_2_plus
-            }),
-            Series::new(NAME_4, COLOR_4, Marker::Triangle, &sorted, |p| {
-                p.lambda_4_plus
-            }),
-        ];
-        let panel_c = vec![Series::new(
-            NAME_PERIOD,
-            COLOR_I4,
-            Marker::Circle,
-            &sorted,
-            |p| p.period,
-        )];
-        let panel_d = vec![Series::new(
-            NAME_FLOQUET,
-            COLOR_BLUE,
-            Marker::Circle,
-            &sorted,
-            |p| p.max_floquet,
-        )];
+        let [panel_a, panel_b, panel_c, panel_d] = panel_series(&sorted);
         let xs: Vec<f64> = [&panel_a, &panel_b, &panel_c, &panel_d]
             .into_iter()
             .flatten()
@@ -170,31 +210,8 @@ impl Prepared {
             .filter(|m| m.value.is_finite())
             .cloned()
             .collect();
-        let x = match &spec.x_range {
-            Some(r) if r.end > r.start => r.clone(),
-            _ => {
-                let (lo, hi) = xs
-                    .iter()
-                    .copied()
-                    .chain(marks.iter().map(|m| m.value))
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                        (lo.min(v), hi.max(v))
-                    });
-                let mut x = padded(lo, hi, 0.03);
-                if lo >= 0.0 && x.start < 0.0 {
-                    x.start = 0.0;
-                }
-                x
-            }
-        };
-        let n = [&panel_a, &panel_b]
-            .into_iter()
-            .flatten()
-            .map(|s| s.samples().count())
-            .max()
-            .unwrap_or(1)
-            .max(1) as i32;
-        let marker = (1100 / n / 2).clamp(4, 7);
+        let x = x_range(spec.x_range.as_ref(), &xs, &marks);
+        let marker = marker_size(&panel_a, &panel_b);
         let (y_a, y_b, y_c, y_d) = (
             y_range(&panel_a, 0.0),
             y_range(&panel_b, 0.0),

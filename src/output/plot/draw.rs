@@ -145,16 +145,7 @@ fn draw_panel<DB: DrawingBackend>(
     let plot = PlotArea::new(&area, &axes, &FIG2_AXES)?;
     let (px, py) = (plot.px.clone(), plot.py.clone());
     // Intervals without a gait, under everything else.
-    let no_gait: Vec<Band> = data
-        .no_gait
-        .iter()
-        .map(|span| Band {
-            from: span.start,
-            to: span.end,
-            color: NO_GAIT_FILL,
-        })
-        .collect();
-    plot.draw_bands(&no_gait)?;
+    plot.draw_bands(&no_gait_bands(data))?;
     // Reference line.
     plot.clip.draw_path(
         &plot.area,
@@ -178,7 +169,47 @@ fn draw_panel<DB: DrawingBackend>(
             dashed_vline(root, at, py.start, py.end)?;
         }
     }
-    // Lines, then markers on top.
+    draw_series(&plot, series, data.marker)?;
+    plot.draw_outline()?;
+    // Axis label, rotated and centred on the plot's height.
+    let label_w = rich_width(root, panel.y_label, AXIS_FONT)?;
+    draw_rich(
+        root,
+        panel.y_label,
+        (MARGIN + 6, (py.start + py.end + label_w) / 2),
+        AXIS_FONT,
+        true,
+    )?;
+    // Panel tag, top left of the figure beside the plot.
+    root.draw(&Text::new(
+        panel.tag,
+        (MARGIN, py.start - 4),
+        font(AXIS_FONT),
+    ))?;
+    // Legend, to the right of the plot.
+    let rows = legend_rows(series);
+    draw_legend_rows(root, &rows, &LEGEND, NOTE_FONT, (px.end + 28, py.start + 6))?;
+    Ok((px, py))
+}
+
+/// The intervals of the parameter without a gait, as grey bands.
+fn no_gait_bands(data: &Prepared) -> Vec<Band> {
+    data.no_gait
+        .iter()
+        .map(|span| Band {
+            from: span.start,
+            to: span.end,
+            color: NO_GAIT_FILL,
+        })
+        .collect()
+}
+
+/// The series' lines (a period-k gait's dashed), then their markers of size `marker` on top.
+fn draw_series<DB: DrawingBackend>(
+    plot: &PlotArea<DB>,
+    series: &[Series],
+    marker: i32,
+) -> DrawResult<DB> {
     for s in series {
         for (run, &multi) in s.runs.iter().zip(&s.multi_step) {
             let pts: Vec<(i32, i32)> = run.iter().map(|&(a, b, _)| plot.rel((a, b))).collect();
@@ -203,27 +234,16 @@ fn draw_panel<DB: DrawingBackend>(
                 s.shape,
                 s.color,
                 scuff,
-                data.marker,
+                marker,
             )?;
         }
     }
-    plot.draw_outline()?;
-    // Axis label, rotated and centred on the plot's height.
-    let label_w = rich_width(root, panel.y_label, AXIS_FONT)?;
-    draw_rich(
-        root,
-        panel.y_label,
-        (MARGIN + 6, (py.start + py.end + label_w) / 2),
-        AXIS_FONT,
-        true,
-    )?;
-    // Panel tag, top left of the figure beside the plot.
-    root.draw(&Text::new(
-        panel.tag,
-        (MARGIN, py.start - 4),
-        font(AXIS_FONT),
-    ))?;
-    // Legend, to the right of the plot: a row per series, and one for the hollow markers of scuffing.
+    Ok(())
+}
+
+/// A panel's legend rows: one per series, one for the hollow markers of scuffing and one for the dashed
+/// lines of period-k gaits (each where it occurs).
+fn legend_rows(series: &[Series]) -> Vec<LegendRow<'_>> {
     let mut rows: Vec<LegendRow> = series
         .iter()
         .map(|s| LegendRow {
@@ -261,8 +281,7 @@ fn draw_panel<DB: DrawingBackend>(
             label: Label::Plain(MULTI_STEP_NOTE),
         });
     }
-    draw_legend_rows(root, &rows, &LEGEND, NOTE_FONT, (px.end + 28, py.start + 6))?;
-    Ok((px, py))
+    rows
 }
 
 /// Draws the whole of Fig. 2 on `root`.

@@ -40,8 +40,18 @@ fn coordinate(r: &FamilyRow, k: usize) -> Cell {
     Real(r.point.info.report.section.to_array()[k])
 }
 
-/// The columns of `branch.csv`.
-pub(crate) fn family_columns<'a>() -> [Column<FamilyRow<'a>>; 28] {
+/// The columns of `branch.csv`: which point, the gait there, its stability and its (first) step, in order.
+pub(crate) fn family_columns<'a>() -> Vec<Column<FamilyRow<'a>>> {
+    let mut columns = Vec::with_capacity(28);
+    columns.extend(point_columns());
+    columns.extend(gait_columns());
+    columns.extend(stability_columns());
+    columns.extend(step_columns());
+    columns
+}
+
+/// The columns of `branch.csv` that say which point it is: family, period, point, arclength, parameter.
+fn point_columns<'a>() -> [Column<FamilyRow<'a>>; 6] {
     [
     Column::new("family", "Number of the family (from 1).", |r| {
         Count(r.family)
@@ -69,6 +79,13 @@ pub(crate) fn family_columns<'a>() -> [Column<FamilyRow<'a>>; 28] {
     Column::param(0, "The parameter's value (its config key's unit).", |r| {
         Real(r.point.param)
     }),
+]
+}
+
+/// The columns of `branch.csv` of the gait at the point: section state, DLS indicators, impact branch and
+/// event sequence.
+fn gait_columns<'a>() -> [Column<FamilyRow<'a>>; 8] {
+    [
     Column::new(
         "L2",
         "Length of Leg 2 at the fixed point (section state) [m].",
@@ -103,6 +120,12 @@ pub(crate) fn family_columns<'a>() -> [Column<FamilyRow<'a>>; 28] {
         "Event sequence of the step(s): TD and the branch, then LIFT/LAND, SLIDE/STICK, UNLOCK/LOCK with the leg's number; steps of a period-k gait separated by /.",
         |r| Text(r.point.info.signature.clone()),
     ),
+]
+}
+
+/// The columns of `branch.csv` of the point's stability: Floquet multipliers, verdict, exactness and residual.
+fn stability_columns<'a>() -> [Column<FamilyRow<'a>>; 10] {
+    [
     Column::new("mu1_re", "Floquet multiplier of largest modulus, real part.", |r| {
         multiplier(r, 0, false)
     }),
@@ -139,23 +162,29 @@ pub(crate) fn family_columns<'a>() -> [Column<FamilyRow<'a>>; 28] {
         "max |P(s) - s| by direct evaluation (section coordinates).",
         |r| Real(r.point.residual),
     ),
-    Column::new("period", "Time of the (first) step [s].", |r| {
-        Real(r.point.info.report.period)
-    }),
-    Column::new("speed", "Mean speed of the (first) step [m/s].", |r| {
-        Real(r.point.info.report.speed)
-    }),
-    Column::new(
-        "dls_duration",
-        "Double-limb support of the (first) step [s].",
-        |r| Real(r.point.info.report.dls_duration),
-    ),
-    Column::new(
-        "scuffing",
-        "Leg 2 re-contacts or slides after its lift-off in the (first) step.",
-        |r| Flag(r.point.info.report.scuffing),
-    ),
 ]
+}
+
+/// The columns of `branch.csv` of the gait's (first) step: period, speed, double-limb support, scuffing.
+fn step_columns<'a>() -> [Column<FamilyRow<'a>>; 4] {
+    [
+        Column::new("period", "Time of the (first) step [s].", |r| {
+            Real(r.point.info.report.period)
+        }),
+        Column::new("speed", "Mean speed of the (first) step [m/s].", |r| {
+            Real(r.point.info.report.speed)
+        }),
+        Column::new(
+            "dls_duration",
+            "Double-limb support of the (first) step [s].",
+            |r| Real(r.point.info.report.dls_duration),
+        ),
+        Column::new(
+            "scuffing",
+            "Leg 2 re-contacts or slides after its lift-off in the (first) step.",
+            |r| Flag(r.point.info.report.scuffing),
+        ),
+    ]
 }
 
 /// The column of `branch.csv` with Coulomb friction ([`crate::output::friction_columns`]), last: the point's
