@@ -178,256 +178,366 @@ fn follow<M: FamilyMap>(
     start: FamilyPoint<M::Info>,
     options: &ContinuationOptions,
 ) -> Followed<M::Info> {
-    let sigma = options.param_scale;
-    let z_start = start.z(sigma);
-    let mut points: Vec<FamilyPoint<M::Info>> = Vec::new();
-    let mut special = Vec::new();
-    // `J` of the last point that has derivatives: the corrector's matrix.
-    let mut held = augmented(&start.jacobian, &start.dparam, sigma);
-    let mut current = start;
-    let mut h = options.initial_step;
-    // The tangent at the point before `current` and the arclength between them (for the predictor's
-    // curvature), and the corrector's last contraction rate (to evaluate with derivatives where it expects to
-    // converge).
-    let mut curvature: Option<(DVector<f64>, f64)> = None;
-    let mut rate_hint = f64::NAN;
-    // The last jump of the map a rejected step crossed (reported at the end if nothing else ends the family).
-    let mut pending_jump: Option<SpecialPoint<M::Info>> = None;
-    // The parameter of the last corrected point rejected for jumping or turning too far.
-    let mut rejected_at = f64::NAN;
-    let mut last_failure: Option<MapFailure> = None;
-    // The last failure of the map itself since the last accepted step, and the parameter it failed at.
-    let mut map_failure: Option<(MapFailure, f64)> = None;
-    let mut travelled = 0.0;
-    while points.len() < options.max_points {
-        // An interrupted evaluation says nothing of the family: stop at once, without bracketing an end.
-        if last_failure.as_ref().is_some_and(MapFailure::interrupted)
-            || map_failure.as_ref().is_some_and(|(f, _)| f.interrupted())
-        {
-            return Followed {
-                points,
-                special,
-                end: FamilyEnd::Interrupted {
-                    param: current.param,
-                },
-            };
+    let mut follower = Follower::new(map, start, options);
+    while follower.points.len() < options.max_points {
+        if let Some(end) = follower.step() {
+            return follower.finish(end);
         }
-        if h < options.min_step {
-            let end = match map_failure {
-                Some((failure, at)) => {
-                    let (nearer, beyond, failure) =
-                        bracket_end(map, &current, &held, (at, failure), options);
-                    if let Some(nearer) = nearer {
-                        if options.detect {
-                            special.extend(detect_between(map, &current, &nearer, options));
-                        }
-                        points.push(nearer.clone());
-                        current = nearer;
-                    }
-                    FamilyEnd::Ended {
-                        param: current.param,
-                        beyond,
-                        failure: failure.kind,
-                        message: failure.message,
-                    }
-                }
-                None => {
-                    // No failure of the map: the family may end at a border of the map's pieces.
-                    let border = options
-                        .detect
-                        .then(|| {
-                            let previous = points.len().checked_sub(2).map(|i| &points[i]);
-                            border_at_end(map, previous, &current, options)
-                        })
-                        .flatten();
-                    // Just past the border, where the walk looks for what takes over; past a jump of the map
-                    // found on the way, its far side.
-                    let beyond = match (&border, &pending_jump) {
-                        (Some(b), _) => {
-                            let step = options.param_tolerance.max(1e-7) * b.param.abs().max(1.0);
-                            b.param + step.copysign(b.param - current.param)
-                        }
-                        (None, Some(jump)) => jump.bracket[1],
-                        // Just past the last point in the direction of travel (the steps that jumped or turned
-                        // too far may have landed back inside the family): the walk from there says what
-                        // takes over. Without a direction, where the last rejected step landed.
-                        (None, None) => {
-                            let direction = current.tangent[current.tangent.len() - 1];
-                            let step =
-                                options.param_tolerance.max(1e-7) * current.param.abs().max(1.0);
-                            if direction != 0.0 {
-                                current.param + step.copysign(direction)
-                            } else {
-                                rejected_at
-                            }
-                        }
-                    };
-                    let border = border.or(pending_jump);
-                    // The border is the end's cause where one was found; else the corrector's last failure.
-                    let failure = match &border {
-                        Some(b) => MapFailure {
-                            kind: "border".to_string(),
-                            message: format!(
-                                "{} = 0 at {}: {}",
-                                b.border.as_deref().unwrap_or("a border"),
-                                b.param,
-                                b.note.as_deref().unwrap_or("the family ends there")
-                            ),
-                        },
-                        None => last_failure.unwrap_or_else(|| corrector_failure(0, f64::NAN)),
-                    };
-                    special.extend(border);
-                    FamilyEnd::Ended {
-                        param: current.param,
-                        beyond,
-                        failure: failure.kind,
-                        message: failure.message,
-                    }
-                }
-            };
-            return Followed {
-                points,
-                special,
-                end,
-            };
-        }
-        let z = current.z(sigma);
-        // The tangent predictor, with the curvature of the last step where there is one (the change of the
-        // tangent over it): quadratic extrapolation, which leaves the corrector a residual of order h^3.
-        let mut z_pred = &z + h * &current.tangent;
-        if let Some((t_before, s_before)) = &curvature {
-            z_pred += (0.5 * h * h / s_before) * (&current.tangent - t_before);
-        }
-        if current.has_derivatives() {
-            held = augmented(&current.jacobian, &current.dparam, sigma);
-        }
-        let m = bordered(&held, &current.tangent);
-        let next = correct_to_point(
+    }
+    follower.finish(FamilyEnd::MaxPoints)
+}
+
+/// The state of the pseudo-arclength follower in one direction (see the module documentation): the points
+/// accepted so far, the step and what the step control remembers of the steps rejected since the last accepted.
+struct Follower<'a, M: FamilyMap> {
+    map: &'a M,
+    options: &'a ContinuationOptions,
+    /// The parameter's scale ([`ContinuationOptions::param_scale`]).
+    sigma: f64,
+    /// The start's scaled unknowns (to find a closed family).
+    z_start: DVector<f64>,
+    /// The points accepted after the start, in order.
+    points: Vec<FamilyPoint<M::Info>>,
+    /// The special points found between them.
+    special: Vec<SpecialPoint<M::Info>>,
+    /// `J` of the last point that has derivatives: the corrector's matrix.
+    held: DMatrix<f64>,
+    /// The last accepted point (the start at first).
+    current: FamilyPoint<M::Info>,
+    /// The step length in the scaled unknowns.
+    h: f64,
+    /// The tangent at the point before `current` and the arclength between them (for the predictor's
+    /// curvature).
+    curvature: Option<(DVector<f64>, f64)>,
+    /// The corrector's last contraction rate (to evaluate with derivatives where it expects to converge).
+    rate_hint: f64,
+    /// The last jump of the map a rejected step crossed (reported at the end if nothing else ends the family).
+    pending_jump: Option<SpecialPoint<M::Info>>,
+    /// The parameter of the last corrected point rejected for jumping or turning too far.
+    rejected_at: f64,
+    /// The last failure of a step.
+    last_failure: Option<MapFailure>,
+    /// The last failure of the map itself since the last accepted step, and the parameter it failed at.
+    map_failure: Option<(MapFailure, f64)>,
+    /// The arclength travelled from the start.
+    travelled: f64,
+}
+
+impl<'a, M: FamilyMap> Follower<'a, M> {
+    /// A follower at `start`, with the initial step.
+    fn new(map: &'a M, start: FamilyPoint<M::Info>, options: &'a ContinuationOptions) -> Self {
+        let sigma = options.param_scale;
+        Follower {
             map,
-            &z_pred,
-            &current.tangent,
-            &m,
-            (&current.tangent, rate_hint),
             options,
-        );
-        let mut next = match next {
+            sigma,
+            z_start: start.z(sigma),
+            points: Vec::new(),
+            special: Vec::new(),
+            held: augmented(&start.jacobian, &start.dparam, sigma),
+            current: start,
+            h: options.initial_step,
+            curvature: None,
+            rate_hint: f64::NAN,
+            pending_jump: None,
+            rejected_at: f64::NAN,
+            last_failure: None,
+            map_failure: None,
+            travelled: 0.0,
+        }
+    }
+
+    /// What was followed, ending with `end`.
+    fn finish(self, end: FamilyEnd) -> Followed<M::Info> {
+        Followed {
+            points: self.points,
+            special: self.special,
+            end,
+        }
+    }
+
+    /// One predictor-corrector step from `current`: accepted, or rejected with a halved step; the end of the
+    /// family where this step finds one.
+    fn step(&mut self) -> Option<FamilyEnd> {
+        let options = self.options;
+        // An interrupted evaluation says nothing of the family: stop at once, without bracketing an end.
+        if self
+            .last_failure
+            .as_ref()
+            .is_some_and(MapFailure::interrupted)
+            || self
+                .map_failure
+                .as_ref()
+                .is_some_and(|(f, _)| f.interrupted())
+        {
+            return Some(FamilyEnd::Interrupted {
+                param: self.current.param,
+            });
+        }
+        if self.h < options.min_step {
+            return Some(match self.map_failure.take() {
+                Some((failure, at)) => self.end_where_map_failed(failure, at),
+                None => self.end_where_map_worked(),
+            });
+        }
+        let z = self.current.z(self.sigma);
+        let z_pred = self.predict(&z);
+        let mut next = match self.correct(&z_pred) {
             Ok(next) => next,
             Err(failure) => {
                 if failure.kind != "corrector" {
-                    map_failure = Some((failure.clone(), split(&z_pred, sigma).1));
+                    self.map_failure = Some((failure.clone(), split(&z_pred, self.sigma).1));
                 }
-                last_failure = Some(failure);
-                h *= 0.5;
-                continue;
+                self.last_failure = Some(failure);
+                self.h *= 0.5;
+                return None;
             }
         };
-        let z_next = next.z(sigma);
-        let jumped = (&z_next - &z_pred).norm() > 0.5 * h;
+        let z_next = next.z(self.sigma);
+        if self.reject_far(&next, &z_next, &z_pred) {
+            return None;
+        }
+        let step = (&z_next - &z).norm();
+        self.travelled += step;
+        next.arclength = self.current.arclength + step;
+        if let Some(end) = self.end_on_bound(&next) {
+            return Some(end);
+        }
+        if options.detect && self.reject_jump(&next, step) {
+            return None;
+        }
+        self.accept(next, step);
+        // Back at the start after going round: a closed family.
+        if self.travelled > 4.0 * self.h && (&z_next - &self.z_start).norm() < 0.5 * self.h {
+            return Some(FamilyEnd::Closed);
+        }
+        let iterations = self.current.iterations;
+        if iterations <= EASY_CORRECTOR {
+            self.h = (self.h * GROW).min(options.max_step);
+        } else if iterations > HARD_CORRECTOR {
+            self.h = (self.h * SHRINK).max(options.min_step);
+        }
+        self.last_failure = None;
+        self.map_failure = None;
+        None
+    }
+
+    /// The tangent predictor from `z` (the current point's unknowns), with the curvature of the last step where
+    /// there is one (the change of the tangent over it): quadratic extrapolation, which leaves the corrector a
+    /// residual of order h^3.
+    fn predict(&self, z: &DVector<f64>) -> DVector<f64> {
+        let h = self.h;
+        let mut z_pred = z + h * &self.current.tangent;
+        if let Some((t_before, s_before)) = &self.curvature {
+            z_pred += (0.5 * h * h / s_before) * (&self.current.tangent - t_before);
+        }
+        z_pred
+    }
+
+    /// The corrector from `z_pred` on the hyperplane of the current tangent, with the matrix of the current
+    /// point where it has derivatives (else the one held).
+    fn correct(&mut self, z_pred: &DVector<f64>) -> Result<FamilyPoint<M::Info>, MapFailure> {
+        let current = &self.current;
+        if current.has_derivatives() {
+            self.held = augmented(&current.jacobian, &current.dparam, self.sigma);
+        }
+        let m = bordered(&self.held, &current.tangent);
+        correct_to_point(
+            self.map,
+            z_pred,
+            &current.tangent,
+            &m,
+            (&current.tangent, self.rate_hint),
+            self.options,
+        )
+    }
+
+    /// Reject (halving the step) a corrected point `next` (unknowns `z_next`) that jumped too far from the
+    /// prediction `z_pred`, whose tangent turned too far, or that is another family's.
+    fn reject_far(
+        &mut self,
+        next: &FamilyPoint<M::Info>,
+        z_next: &DVector<f64>,
+        z_pred: &DVector<f64>,
+    ) -> bool {
+        let h = self.h;
+        let current = &self.current;
+        let jumped = (z_next - z_pred).norm() > 0.5 * h;
         // A turn over a step this short is a corner of the family (it crosses a border where DP jumps), not
         // a jump to another family.
         let turned = next.tangent.dot(&current.tangent) < MAX_TURN && h > CORNER_STEP;
         // A step to a point that cannot be this family's (the VRW: another least period).
-        let other = !map.same_family(&current.info, &next.info);
-        if (jumped || turned || other) && h > options.min_step {
-            last_failure = Some(MapFailure {
-                kind: "step".to_string(),
-                message: if other {
-                    format!(
-                        "steps near p = {} reach another family (its least period differs)",
-                        current.param
-                    )
-                } else {
-                    format!(
-                        "steps near p = {} turn or jump too far (the family turns sharply, or another is \
-                         near)",
-                        current.param
-                    )
-                },
-            });
-            rejected_at = next.param;
-            h *= 0.5;
-            continue;
+        let other = !self.map.same_family(&current.info, &next.info);
+        if !((jumped || turned || other) && h > self.options.min_step) {
+            return false;
         }
-        let step = (&z_next - &z).norm();
-        travelled += step;
-        next.arclength = current.arclength + step;
-        // The end of the range: the last point is placed on the bound.
+        self.last_failure = Some(MapFailure {
+            kind: "step".to_string(),
+            message: if other {
+                format!(
+                    "steps near p = {} reach another family (its least period differs)",
+                    current.param
+                )
+            } else {
+                format!(
+                    "steps near p = {} turn or jump too far (the family turns sharply, or another is \
+                     near)",
+                    current.param
+                )
+            },
+        });
+        self.rejected_at = next.param;
+        self.h *= 0.5;
+        true
+    }
+
+    /// The end of the range, where `next` lies beyond it: the last point is placed on the bound.
+    fn end_on_bound(&mut self, next: &FamilyPoint<M::Info>) -> Option<FamilyEnd> {
+        let options = self.options;
         let bound = if next.param > options.to {
             Some(options.to)
         } else if next.param < options.from {
             Some(options.from)
         } else {
             None
-        };
-        if let Some(bound) = bound {
-            if let Ok(on_bound) = point_on_bound(map, &current, &next, bound, options) {
-                if options.detect {
-                    special.extend(detect_between(map, &current, &on_bound, options));
-                }
-                points.push(on_bound);
-                return Followed {
-                    points,
-                    special,
-                    end: FamilyEnd::LeftRange { bound },
-                };
-            }
-        }
+        }?;
+        let on_bound = point_on_bound(self.map, &self.current, next, bound, options).ok()?;
         if options.detect {
-            let found = detect_between(map, &current, &next, options);
-            // A border between the two points with no fixed point at its middle: the step reached another
-            // family across a jump of the map. The family ends at the last point before the border.
-            if let Some(jump) = found.iter().find(|s| s.ends_family) {
-                // The step reached past a jump of the map (another family's fixed point): rejected, like a
-                // step that jumps, so that the steps shrink toward the family's own end; the jump is kept
-                // for the end.
-                last_failure = Some(MapFailure {
-                    kind: "border".to_string(),
-                    message: format!(
-                        "a jump of the step map between {} and {}: {}",
-                        current.param,
-                        next.param,
-                        jump.note
-                            .as_deref()
-                            .unwrap_or("no fixed point at its middle")
-                    ),
-                });
-                pending_jump = Some(jump.clone());
-                travelled -= step;
-                h *= 0.5;
-                continue;
-            }
-            special.extend(found);
+            let found = detect_between(self.map, &self.current, &on_bound, options);
+            self.special.extend(found);
         }
+        self.points.push(on_bound);
+        Some(FamilyEnd::LeftRange { bound })
+    }
+
+    /// The special points between the current point and `next`, `step` from it; where a border between them
+    /// has no fixed point at its middle, the step reached another family across a jump of the map: it is
+    /// rejected (halving the step) and the jump kept for the end.
+    fn reject_jump(&mut self, next: &FamilyPoint<M::Info>, step: f64) -> bool {
+        let found = detect_between(self.map, &self.current, next, self.options);
+        // A border between the two points with no fixed point at its middle: the step reached another
+        // family across a jump of the map. The family ends at the last point before the border.
+        if let Some(jump) = found.iter().find(|s| s.ends_family) {
+            // The step reached past a jump of the map (another family's fixed point): rejected, like a
+            // step that jumps, so that the steps shrink toward the family's own end; the jump is kept
+            // for the end.
+            self.last_failure = Some(MapFailure {
+                kind: "border".to_string(),
+                message: format!(
+                    "a jump of the step map between {} and {}: {}",
+                    self.current.param,
+                    next.param,
+                    jump.note
+                        .as_deref()
+                        .unwrap_or("no fixed point at its middle")
+                ),
+            });
+            self.pending_jump = Some(jump.clone());
+            self.travelled -= step;
+            self.h *= 0.5;
+            return true;
+        }
+        self.special.extend(found);
+        false
+    }
+
+    /// Accept `next`, `step` from the current point, as the new current point.
+    fn accept(&mut self, next: FamilyPoint<M::Info>, step: f64) {
         // A jump crossed before this accepted step is not where the family ends (steps toward an end fail
         // in a row after the last accepted one).
-        pending_jump = None;
-        rejected_at = f64::NAN;
-        let iterations = next.iterations;
-        rate_hint = next.corrector_rate;
-        curvature = (current.has_derivatives() && next.has_derivatives())
-            .then(|| (current.tangent.clone(), step));
-        points.push(next.clone());
-        current = next;
-        // Back at the start after going round: a closed family.
-        if travelled > 4.0 * h && (&z_next - &z_start).norm() < 0.5 * h {
-            return Followed {
-                points,
-                special,
-                end: FamilyEnd::Closed,
-            };
-        }
-        if iterations <= EASY_CORRECTOR {
-            h = (h * GROW).min(options.max_step);
-        } else if iterations > HARD_CORRECTOR {
-            h = (h * SHRINK).max(options.min_step);
-        }
-        last_failure = None;
-        map_failure = None;
+        self.pending_jump = None;
+        self.rejected_at = f64::NAN;
+        self.rate_hint = next.corrector_rate;
+        self.curvature = (self.current.has_derivatives() && next.has_derivatives())
+            .then(|| (self.current.tangent.clone(), step));
+        self.points.push(next.clone());
+        self.current = next;
     }
-    Followed {
-        points,
-        special,
-        end: FamilyEnd::MaxPoints,
+
+    /// The end where the step fell below the smallest after the map failed at the parameter `at`: bracketed
+    /// by bisection ([`bracket_end`]), its nearest point added.
+    fn end_where_map_failed(&mut self, failure: MapFailure, at: f64) -> FamilyEnd {
+        let options = self.options;
+        let (nearer, beyond, failure) =
+            bracket_end(self.map, &self.current, &self.held, (at, failure), options);
+        if let Some(nearer) = nearer {
+            if options.detect {
+                let found = detect_between(self.map, &self.current, &nearer, options);
+                self.special.extend(found);
+            }
+            self.points.push(nearer.clone());
+            self.current = nearer;
+        }
+        FamilyEnd::Ended {
+            param: self.current.param,
+            beyond,
+            failure: failure.kind,
+            message: failure.message,
+        }
+    }
+
+    /// The end where the step fell below the smallest without a failure of the map: the family may end at a
+    /// border of the map's pieces (a special point), or at a jump of the map found on the way.
+    fn end_where_map_worked(&mut self) -> FamilyEnd {
+        let options = self.options;
+        let border = options
+            .detect
+            .then(|| {
+                let previous = self.points.len().checked_sub(2).map(|i| &self.points[i]);
+                border_at_end(self.map, previous, &self.current, options)
+            })
+            .flatten();
+        let beyond = self.beyond_end(border.as_ref());
+        let border = border.or(self.pending_jump.take());
+        // The border is the end's cause where one was found; else the corrector's last failure.
+        let failure = match &border {
+            Some(b) => MapFailure {
+                kind: "border".to_string(),
+                message: format!(
+                    "{} = 0 at {}: {}",
+                    b.border.as_deref().unwrap_or("a border"),
+                    b.param,
+                    b.note.as_deref().unwrap_or("the family ends there")
+                ),
+            },
+            None => self
+                .last_failure
+                .take()
+                .unwrap_or_else(|| corrector_failure(0, f64::NAN)),
+        };
+        self.special.extend(border);
+        FamilyEnd::Ended {
+            param: self.current.param,
+            beyond,
+            failure: failure.kind,
+            message: failure.message,
+        }
+    }
+
+    /// Where the walk looks for what takes over past an end without a failure of the map: just past the
+    /// `border` found at the end; past a jump of the map found on the way, its far side.
+    fn beyond_end(&self, border: Option<&SpecialPoint<M::Info>>) -> f64 {
+        let options = self.options;
+        let current = &self.current;
+        match (border, &self.pending_jump) {
+            (Some(b), _) => {
+                let step = options.param_tolerance.max(1e-7) * b.param.abs().max(1.0);
+                b.param + step.copysign(b.param - current.param)
+            }
+            (None, Some(jump)) => jump.bracket[1],
+            // Just past the last point in the direction of travel (the steps that jumped or turned too far
+            // may have landed back inside the family): the walk from there says what takes over. Without a
+            // direction, where the last rejected step landed.
+            (None, None) => {
+                let direction = current.tangent[current.tangent.len() - 1];
+                let step = options.param_tolerance.max(1e-7) * current.param.abs().max(1.0);
+                if direction != 0.0 {
+                    current.param + step.copysign(direction)
+                } else {
+                    self.rejected_at
+                }
+            }
+        }
     }
 }
 

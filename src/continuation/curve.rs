@@ -480,27 +480,7 @@ fn follow<I: Clone + Send>(
                 s += (&un - &u).norm();
                 let p = point(problem, &un, &ev, o, s);
                 if !inside(p.p1, p.p2) {
-                    // The last point lies on the bound the step crossed first, where one can be solved for.
-                    let n = un.len() - 2;
-                    let crossed = |k: usize, v: f64, (lo, hi): (f64, f64)| {
-                        let bound = if v > hi { hi } else { lo };
-                        let fraction = (bound / o_sigma(o, k) - u[n + k]) / (un[n + k] - u[n + k]);
-                        (v < lo || v > hi).then_some((fraction, n + k, bound / o_sigma(o, k)))
-                    };
-                    let first = [crossed(0, p.p1, o.range1), crossed(1, p.p2, o.range2)]
-                        .into_iter()
-                        .flatten()
-                        .min_by(|a, b| a.0.total_cmp(&b.0));
-                    let on_bound = first.and_then(|(_, index, value)| {
-                        on_hyperplane(problem, (&u, &j, &t), index, value, o)
-                    });
-                    points.push(match on_bound {
-                        Some((ub, evb)) => {
-                            let sb = s - (&un - &u).norm() + (&ub - &u).norm();
-                            point(problem, &ub, &evb, o, sb)
-                        }
-                        None => p,
-                    });
+                    points.push(last_in_range(problem, (&u, &j, &t), &un, p, o));
                     return (points, CurveEnd::LeftRange);
                 }
                 points.push(p);
@@ -520,6 +500,36 @@ fn follow<I: Clone + Send>(
         }
     }
     (points, CurveEnd::MaxPoints)
+}
+
+/// The last point of a curve whose step from `(u, j, t)` to `un` (the point `p`) left the box of the ranges:
+/// on the bound the step crossed first, where one can be solved for ([`on_hyperplane`]); else `p` itself.
+fn last_in_range<I: Clone + Send>(
+    problem: &CurveProblem<'_, I>,
+    (u, j, t): (&DVector<f64>, &DMatrix<f64>, &DVector<f64>),
+    un: &DVector<f64>,
+    p: CurvePoint<I>,
+    o: &CurveOptions,
+) -> CurvePoint<I> {
+    let n = un.len() - 2;
+    let crossed = |k: usize, v: f64, (lo, hi): (f64, f64)| {
+        let bound = if v > hi { hi } else { lo };
+        let fraction = (bound / o_sigma(o, k) - u[n + k]) / (un[n + k] - u[n + k]);
+        (v < lo || v > hi).then_some((fraction, n + k, bound / o_sigma(o, k)))
+    };
+    let first = [crossed(0, p.p1, o.range1), crossed(1, p.p2, o.range2)]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| a.0.total_cmp(&b.0));
+    let on_bound =
+        first.and_then(|(_, index, value)| on_hyperplane(problem, (u, j, t), index, value, o));
+    match on_bound {
+        Some((ub, evb)) => {
+            let sb = p.arclength - (un - u).norm() + (&ub - u).norm();
+            point(problem, &ub, &evb, o, sb)
+        }
+        None => p,
+    }
 }
 
 /// The point of `curve` at the second parameter `p2`, if the curve crosses `p2`: a step from the curve point

@@ -192,33 +192,70 @@ pub(crate) fn detect_between<M: FamilyMap>(
     b: &FamilyPoint<M::Info>,
     options: &ContinuationOptions,
 ) -> Vec<SpecialPoint<M::Info>> {
+    let mut found = smooth_points_between(map, a, b, options);
+    let collisions = border_collisions_between(map, a, b, options);
+    let border_crossed = !collisions.is_empty();
+    found.extend(collisions);
+    if !border_crossed && map.piece(&a.info) != map.piece(&b.info) {
+        found.push(bisect_piece(map, a, b, options));
+    }
+    found.sort_by(|x, y| x.arclength.total_cmp(&y.arclength));
+    found
+}
+
+/// A test function of `DP` for one kind of smooth special point, and whether it changes sign between two
+/// family points.
+struct SmoothTest<I> {
+    /// The kind of special point at its zero.
+    kind: SpecialKind,
+    /// It changes sign between the two points (the fold: the tangent's `p` component does).
+    detected: bool,
+    /// The test function of an evaluation.
+    test: fn(&Evaluation<I>) -> f64,
+    /// The condition solved for, in words.
+    condition: &'static str,
+}
+
+/// The folds, period doublings and Neimark-Sacker points between `a` and `b`, each detected by a sign change
+/// of its test function (the table of the module documentation) and located by [`locate`].
+fn smooth_points_between<M: FamilyMap>(
+    map: &M,
+    a: &FamilyPoint<M::Info>,
+    b: &FamilyPoint<M::Info>,
+    options: &ContinuationOptions,
+) -> Vec<SpecialPoint<M::Info>> {
     let n = a.x.len();
     let mut found = Vec::new();
-    type Test<I> = fn(&Evaluation<I>) -> f64;
-    let smooth: [(SpecialKind, bool, Test<M::Info>, &str); 3] = [
-        (
-            SpecialKind::Fold,
-            crosses(a.tangent[n], b.tangent[n]),
-            |ev| fold_test(&ev.jacobian),
-            "det(DP - I) = 0",
-        ),
-        (
-            SpecialKind::PeriodDoubling,
-            crosses(flip_test(&a.jacobian), flip_test(&b.jacobian)),
-            |ev| flip_test(&ev.jacobian),
-            "det(DP + I) = 0",
-        ),
-        (
-            SpecialKind::NeimarkSacker,
-            crosses(
+    let smooth: [SmoothTest<M::Info>; 3] = [
+        SmoothTest {
+            kind: SpecialKind::Fold,
+            detected: crosses(a.tangent[n], b.tangent[n]),
+            test: |ev| fold_test(&ev.jacobian),
+            condition: "det(DP - I) = 0",
+        },
+        SmoothTest {
+            kind: SpecialKind::PeriodDoubling,
+            detected: crosses(flip_test(&a.jacobian), flip_test(&b.jacobian)),
+            test: |ev| flip_test(&ev.jacobian),
+            condition: "det(DP + I) = 0",
+        },
+        SmoothTest {
+            kind: SpecialKind::NeimarkSacker,
+            detected: crosses(
                 neimark_sacker_test(&a.jacobian),
                 neimark_sacker_test(&b.jacobian),
             ),
-            |ev| neimark_sacker_test(&ev.jacobian),
-            "prod (mu_i mu_j - 1) = 0",
-        ),
+            test: |ev| neimark_sacker_test(&ev.jacobian),
+            condition: "prod (mu_i mu_j - 1) = 0",
+        },
     ];
-    for (kind, detected, test, condition) in smooth {
+    for SmoothTest {
+        kind,
+        detected,
+        test,
+        condition,
+    } in smooth
+    {
         if !detected {
             continue;
         }
@@ -239,8 +276,19 @@ pub(crate) fn detect_between<M: FamilyMap>(
         }
         found.push(sp);
     }
+    found
+}
+
+/// The border collisions between `a` and `b`: each border function of the map that changes sign between them,
+/// its zero located by [`locate`], with the one-sided multipliers ([`sides`]).
+fn border_collisions_between<M: FamilyMap>(
+    map: &M,
+    a: &FamilyPoint<M::Info>,
+    b: &FamilyPoint<M::Info>,
+    options: &ContinuationOptions,
+) -> Vec<SpecialPoint<M::Info>> {
+    let mut found = Vec::new();
     let (ba, bb) = (map.borders(&a.info), map.borders(&b.info));
-    let mut border_crossed = false;
     for (name, ga) in &ba {
         let Some((_, gb)) = bb.iter().find(|(other, _)| other == name) else {
             continue;
@@ -248,7 +296,6 @@ pub(crate) fn detect_between<M: FamilyMap>(
         if !crosses(*ga, *gb) {
             continue;
         }
-        border_crossed = true;
         let name = *name;
         let test = |ev: &Evaluation<M::Info>| map.border(&ev.info, name);
         let mut sp = locate(map, a, b, (*ga, *gb), &test, options);
@@ -265,10 +312,6 @@ pub(crate) fn detect_between<M: FamilyMap>(
         );
         found.push(sp);
     }
-    if !border_crossed && map.piece(&a.info) != map.piece(&b.info) {
-        found.push(bisect_piece(map, a, b, options));
-    }
-    found.sort_by(|x, y| x.arclength.total_cmp(&y.arclength));
     found
 }
 
@@ -506,34 +549,43 @@ pub(crate) fn border_at_end<M: FamilyMap>(
             jump: f64::NAN,
         };
         sp.sides = sides(map, &last.tangent, &sp, options);
-        // The map at the border: continuous (a nonsmooth fold: no fixed point of the other piece nearby) or
-        // not (the other piece's image jumps away).
-        let jump = {
-            let d = last.tangent.normalize();
-            let at = |sign: f64| {
-                let (xs, ps) = split(&(&z + sign * SIDE_OFFSET * &d), sigma);
-                map.value(&xs, ps).ok()
-            };
-            match (at(-1.0), at(1.0)) {
-                (Some(a), Some(b)) => (a - b).amax(),
-                _ => f64::NAN,
-            }
-        };
+        let jump = jump_across(map, &z, &last.tangent, sigma);
         sp.jump = jump;
-        sp.note = Some(if jump > JUMP_TOL {
-            format!(
-                "the family ends here: the step map jumps by {jump:.3e} across the border, and no fixed point \
-                 continues the family on the other side"
-            )
-        } else {
-            format!(
-                "the family ends here: the step map is continuous across the border (jump {jump:.1e}) but no \
-                 fixed point continues the family on the other side"
-            )
-        });
+        sp.note = Some(end_note(jump));
         best = Some((distance, sp));
     }
     best.map(|(_, sp)| sp)
+}
+
+/// The map at the border point `z`: continuous (a nonsmooth fold: no fixed point of the other piece nearby) or
+/// not (the other piece's image jumps away); how far its images at [`SIDE_OFFSET`] on either side along
+/// `tangent` differ (`NaN` where either fails).
+fn jump_across<M: FamilyMap>(map: &M, z: &DVector<f64>, tangent: &DVector<f64>, sigma: f64) -> f64 {
+    let d = tangent.normalize();
+    let at = |sign: f64| {
+        let (xs, ps) = split(&(z + sign * SIDE_OFFSET * &d), sigma);
+        map.value(&xs, ps).ok()
+    };
+    match (at(-1.0), at(1.0)) {
+        (Some(a), Some(b)) => (a - b).amax(),
+        _ => f64::NAN,
+    }
+}
+
+/// The note of a family's end at a border across which the step map jumps by `jump` ([`JUMP_TOL`] and more: a
+/// discontinuity).
+fn end_note(jump: f64) -> String {
+    if jump > JUMP_TOL {
+        format!(
+            "the family ends here: the step map jumps by {jump:.3e} across the border, and no fixed point \
+             continues the family on the other side"
+        )
+    } else {
+        format!(
+            "the family ends here: the step map is continuous across the border (jump {jump:.1e}) but no \
+             fixed point continues the family on the other side"
+        )
+    }
 }
 
 /// The zero of the border function `name` ahead of the family's last point `last`, approached along the

@@ -4,11 +4,15 @@
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
-use super::derivative::{gait_jacobian, newton_jacobian, GaitJacobian, ParamDerivative};
+use super::derivative::{gait_jacobian, GaitJacobian, ParamDerivative};
 use super::step_map::{StepMap, StepOutcome};
 use crate::params::{Params, RearExit};
 use crate::walk::WalkError;
 use crate::walk::{Branch, ContactAudit, SectionState, StepReport};
+
+mod newton;
+
+use newton::{Newton, Trial};
 
 /// How a gait is searched for. Each setting has a valid range, checked by [`GaitOptions::validate`]
 /// (`gait/options.rs`).
@@ -481,6 +485,48 @@ pub(crate) fn solve_fixed_point_asking(
         message: e.to_string(),
     })?;
     friction_admits_gaits(map.model().params())?;
+    let NewtonStart {
+        section,
+        first_step,
+    } = newton_start(map, initial, options)?;
+    let map = &map.on_section_of(&section);
+    let n = map.free_coordinates().len();
+    let trial = match first_step {
+        // The same map (`s` is not held) at the same point.
+        Some(out) => {
+            let r = map.reduce(&out.next) - map.reduce(&section);
+            Trial {
+                section,
+                outcome: out,
+                r,
+            }
+        }
+        None => Trial::at(map, section, 1)?,
+    };
+    // A guess for the other coordinates (a neighbour held where this one is not) is no guess.
+    let newton_matrix: Option<DMatrix<f64>> = jacobian_guess()
+        .filter(|j| j.nrows() == n)
+        .map(|j| j - DMatrix::identity(n, n));
+    let mut newton = Newton::new(map, options, undamped, trial, newton_matrix);
+    while newton.residual() >= options.tolerance {
+        newton.iterate()?;
+    }
+    Ok(newton.fixed_point())
+}
+
+/// Where Newton's method starts: the section state and, where it was walked already, the step from it.
+struct NewtonStart {
+    section: SectionState,
+    first_step: Option<StepOutcome>,
+}
+
+/// The start of Newton's method from `initial`: the end of the transient, moved by one more step onto the
+/// held set or onto the slipping section where that step lands there (see [`solve_fixed_point_asking`]).
+fn newton_start(
+    map: &StepMap,
+    initial: &SectionState,
+    options: &GaitOptions,
+) -> Result<NewtonStart, GaitError> {
     // The transient is one continuous walk (touchdowns on the way may be off the section, see
     // `WalkError::OffSection`); only where it ends must be on the section.
     let mut s = *initial;
@@ -514,123 +560,9 @@ pub(crate) fn solve_fixed_point_asking(
             }
         }
     }
-    let map = &map.on_section_of(&s);
-    let n = map.free_coordinates().len();
-    let eval =
-        |s: &SectionState, iteration: usize| -> Result<(StepOutcome, DVector<f64>), GaitError> {
-            let out = map
-                .eval(s)
-                .map_err(|source| GaitError::Newton { iteration, source })?;
-            let r = map.reduce(&out.next) - map.reduce(s);
-            Ok((out, r))
-        };
-    let (mut outcome, mut r) = match first_step {
-        // The same map (`s` is not held) at the same point.
-        Some(out) => {
-            let r = map.reduce(&out.next) - map.reduce(&s);
-            (out, r)
-        }
-        None => eval(&s, 1)?,
-    };
-    // A guess for the other coordinates (a neighbour held where this one is not) is no guess.
-    let mut newton_matrix: Option<DMatrix<f64>> = jacobian_guess()
-        .filter(|j| j.nrows() == n)
-        .map(|j| j - DMatrix::identity(n, n));
-    let mut iterations = 0;
-    // Was the current Newton matrix computed at the current iterate (so recomputing it cannot help)?
-    let mut fresh = false;
-    // Consecutive iterations with a fresh DP that did not even halve the residual: Newton is not converging
-    // (e.g. the iterate hops across a discontinuity of the map), so stop early.
-    let mut poor = 0;
-    while norm(&r) >= options.tolerance {
-        iterations += 1;
-        if iterations > options.max_iterations {
-            return Err(GaitError::NoConvergence {
-                iterations: options.max_iterations,
-                residual: norm(&r),
-            });
-        }
-        let a = match &newton_matrix {
-            Some(a) => a.clone(),
-            None => {
-                let dp = newton_jacobian(map, &s, options.fd_step).map_err(|source| {
-                    GaitError::Newton {
-                        iteration: iterations,
-                        source,
-                    }
-                })?;
-                let a = dp - DMatrix::identity(n, n);
-                newton_matrix = Some(a.clone());
-                fresh = true;
-                a
-            }
-        };
-        let delta = a
-            .lu()
-            .solve(&(-&r))
-            .ok_or(GaitError::SingularJacobian { residual: norm(&r) })?;
-        // Damped step: halve until the residual decreases (the map may fail far from the gait).
-        let x = map.reduce(&s);
-        let mut lambda = 1.0;
-        let mut accepted = None;
-        for _ in 0..6 {
-            let trial = map.expand(&s, &(&x + lambda * &delta));
-            if let Ok((out, r_trial)) = eval(&trial, iterations) {
-                if norm(&r_trial) < norm(&r) {
-                    accepted = Some((trial, out, r_trial));
-                    break;
-                }
-            }
-            lambda /= 2.0;
-        }
-        let Some((trial, out, r_trial)) = accepted.filter(|_| !(undamped && lambda < 1.0)) else {
-            if !fresh {
-                // A stale matrix (the guess, or DP from an earlier iterate): recompute DP here and retry.
-                newton_matrix = None;
-                continue;
-            }
-            return Err(GaitError::NoConvergence {
-                iterations,
-                residual: norm(&r),
-            });
-        };
-        if fresh && norm(&r_trial) > 0.5 * norm(&r) {
-            poor += 1;
-            if poor >= MAX_POOR_ITERATIONS {
-                return Err(GaitError::NoConvergence {
-                    iterations,
-                    residual: norm(&r_trial),
-                });
-            }
-        } else {
-            poor = 0;
-        }
-        fresh = false;
-        if norm(&r_trial) > 0.1 * norm(&r) {
-            newton_matrix = None;
-        } else if let Some(a) = &mut newton_matrix {
-            // Broyden's ("good") rank-one update (Broyden 1965): the matrix then maps this step to the change
-            // of the residual it made, which turns the linear convergence of a stale matrix (the neighbour's DP
-            // in a continuation: 10-15x per iteration, seven or eight iterations to 1e-10) into superlinear
-            // convergence (three to five) at no extra evaluation. Three lines, so no crate.
-            let dx = map.reduce(&trial) - &x;
-            let dr = &r_trial - &r;
-            let denom = dx.dot(&dx);
-            if denom > 0.0 {
-                *a += (dr - &*a * &dx) * dx.transpose() / denom;
-            }
-        }
-        s = trial;
-        outcome = out;
-        r = r_trial;
-    }
-    Ok(FixedPoint {
-        // Held: `L2 = min_length`, `dL2/dt = 0` exactly (the walk's rounding left out, as the map does).
-        section: s.pinned(map.model()),
-        outcome,
-        residual: norm(&r),
-        iterations,
-        rear_held: map.rear_held(),
+    Ok(NewtonStart {
+        section: s,
+        first_step,
     })
 }
 

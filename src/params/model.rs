@@ -196,6 +196,37 @@ impl Params {
 
     /// Checks every rule into `rules` (see [`Params::check`]).
     pub(crate) fn collect(&self, rules: &mut Rules<'_>) {
+        self.single_key_rules(rules);
+        self.mass_ratio_rule(rules);
+        self.stopper_length_rules(rules);
+        if !self.rear_stopper {
+            self.without_rear_stopper_rules(rules);
+        }
+        rules.single(non_negative("min_length", self.min_length));
+        if self.min_length > 0.0 {
+            self.min_length_rules(rules);
+        }
+        rules.single(non_negative("touchdown_length", self.touchdown_length));
+        if self.touchdown_length > 0.0 {
+            self.touchdown_length_rules(rules);
+        }
+        self.friction_rules(rules);
+        // The time scale needs sound masses: not when the mass ratio is already refused.
+        let ratio = self.leg_mass / self.hub_mass;
+        if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)
+            && !["leg_mass", "hub_mass", "viscosity", "stiffness"]
+                .iter()
+                .any(|key| rules.failed(key))
+        {
+            let result = self.stiff_legs_rule(&|key| rules.given(key));
+            rules.between(["viscosity", "stiffness"], |_| result);
+        }
+    }
+
+    /// The rules of one key each: `legs` from 3 to [`MAX_LEGS`]; the masses, the stopper length, the stiffness
+    /// and gravity positive; the inertia, the mass offset and the viscosity non-negative; the spring's natural
+    /// length finite; `|slope| < pi/2`.
+    fn single_key_rules(&self, rules: &mut Rules<'_>) {
         if !(3..=MAX_LEGS).contains(&self.legs) {
             rules.single(Err(invalid(
                 "legs",
@@ -223,6 +254,10 @@ impl Params {
             }
         }));
         rules.single(positive("gravity", self.gravity));
+    }
+
+    /// The rule of the mass ratio: `leg_mass / hub_mass` within [`MASS_RATIO_LIMIT`] of 1.
+    fn mass_ratio_rule(&self, rules: &mut Rules<'_>) {
         rules.between(["leg_mass", "hub_mass"], |given| {
             let ratio = self.leg_mass / self.hub_mass;
             if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio) {
@@ -244,6 +279,11 @@ impl Params {
                 ),
             ))
         });
+    }
+
+    /// The rules against the stopper length: the leg mass below it, and the spring's natural length at least
+    /// as long unless a leaving leg is reset.
+    fn stopper_length_rules(&self, rules: &mut Rules<'_>) {
         let stopper = ("stopper_length", self.stopper_length);
         rules.between(["leg_mass_offset", "stopper_length"], |given| {
             ordered(
@@ -276,74 +316,68 @@ impl Params {
                 })
             });
         }
-        if !self.rear_stopper {
-            rules.between(["rear_stopper", "rear_exit"], |_| {
-                if self.rear_exit != RearExit::Reset {
-                    return Err(invalid(
-                        "rear_stopper",
-                        self.rear_stopper,
-                        format!(
-                            "a rear leg without a stopper is never relocked: it needs rear_exit = \"reset\", not \"{}\"",
-                            self.rear_exit
-                        ),
-                    ));
-                }
-                Ok(())
-            });
-            rules.between(["rear_stopper", "rigid_legs"], |_| {
-                if self.rigid_legs {
-                    return Err(invalid(
-                        "rear_stopper",
-                        self.rear_stopper,
-                        "rigid legs are held by their stoppers both ways: they need rear_stopper = true",
-                    ));
-                }
-                Ok(())
-            });
-        }
-        rules.single(non_negative("min_length", self.min_length));
-        if self.min_length > 0.0 {
-            rules.between(["min_length", "stopper_length"], |given| {
-                ordered(("min_length", self.min_length), Below, stopper, given)
-            });
-            rules.between(["min_length", "rigid_legs"], |_| {
-                if self.rigid_legs {
-                    return Err(invalid(
-                        "min_length",
-                        short(self.min_length),
-                        "rigid legs never shorten: a compression stop needs rigid_legs = false (or min_length = 0, \
-                         none)",
-                    ));
-                }
-                Ok(())
-            });
-            rules.between(["min_length", "rear_exit"], |_| {
-                if self.rear_exit == RearExit::Continue {
-                    return Err(invalid(
-                        "min_length",
-                        short(self.min_length),
-                        "the swinging leg of rear_exit = \"continue\" has no compression stop yet: use \
-                         rear_exit = \"relock\" or \"reset\" with min_length (or min_length = 0, none)",
-                    ));
-                }
-                Ok(())
-            });
-        }
-        rules.single(non_negative("touchdown_length", self.touchdown_length));
-        if self.touchdown_length > 0.0 {
-            self.touchdown_length_rules(rules);
-        }
-        self.friction_rules(rules);
-        // The time scale needs sound masses: not when the mass ratio is already refused.
-        let ratio = self.leg_mass / self.hub_mass;
-        if (1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio)
-            && !["leg_mass", "hub_mass", "viscosity", "stiffness"]
-                .iter()
-                .any(|key| rules.failed(key))
-        {
-            let result = self.stiff_legs_rule(&|key| rules.given(key));
-            rules.between(["viscosity", "stiffness"], |_| result);
-        }
+    }
+
+    /// The rules of a rear leg without a stopper: only with `rear_exit = "reset"`, and not with rigid legs.
+    fn without_rear_stopper_rules(&self, rules: &mut Rules<'_>) {
+        rules.between(["rear_stopper", "rear_exit"], |_| {
+            if self.rear_exit != RearExit::Reset {
+                return Err(invalid(
+                    "rear_stopper",
+                    self.rear_stopper,
+                    format!(
+                        "a rear leg without a stopper is never relocked: it needs rear_exit = \"reset\", not \"{}\"",
+                        self.rear_exit
+                    ),
+                ));
+            }
+            Ok(())
+        });
+        rules.between(["rear_stopper", "rigid_legs"], |_| {
+            if self.rigid_legs {
+                return Err(invalid(
+                    "rear_stopper",
+                    self.rear_stopper,
+                    "rigid legs are held by their stoppers both ways: they need rear_stopper = true",
+                ));
+            }
+            Ok(())
+        });
+    }
+
+    /// The rules of a compression stop that is set: below the stopper, with soft legs, and not with
+    /// `rear_exit = "continue"`.
+    fn min_length_rules(&self, rules: &mut Rules<'_>) {
+        rules.between(["min_length", "stopper_length"], |given| {
+            ordered(
+                ("min_length", self.min_length),
+                Below,
+                ("stopper_length", self.stopper_length),
+                given,
+            )
+        });
+        rules.between(["min_length", "rigid_legs"], |_| {
+            if self.rigid_legs {
+                return Err(invalid(
+                    "min_length",
+                    short(self.min_length),
+                    "rigid legs never shorten: a compression stop needs rigid_legs = false (or min_length = 0, \
+                     none)",
+                ));
+            }
+            Ok(())
+        });
+        rules.between(["min_length", "rear_exit"], |_| {
+            if self.rear_exit == RearExit::Continue {
+                return Err(invalid(
+                    "min_length",
+                    short(self.min_length),
+                    "the swinging leg of rear_exit = \"continue\" has no compression stop yet: use \
+                     rear_exit = \"relock\" or \"reset\" with min_length (or min_length = 0, none)",
+                ));
+            }
+            Ok(())
+        });
     }
 
     /// The rules of the friction coefficient: non-negative, infinity allowed (no slip, the default); a finite

@@ -203,32 +203,22 @@ pub(crate) fn touchdown_impact(
         contact2: true,
         ..sls
     };
-    let (dls_set, dls_sol) = if model.params().has_friction() {
-        let mut with_rear = candidates.clone();
-        with_rear.push(Candidate::closing(Unit::Contact(Leg::Two), model));
-        plastic_impact(model, q, qd, rear_off, &with_rear)?
-    } else {
-        plastic_impact(model, q, qd, rear_on, &candidates)?
-    };
-    let lambda_i4 = dls_sol.normal_impulse(Leg::Two);
-    // (B1) forces just after the DLS collision, Eqs. (6)-(7).
-    let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
-        let after = constrained_dynamics(model, q, &dls_sol.qd_plus, &dls_set)?;
-        (after.normal_force(Leg::One), after.normal_force(Leg::Two))
-    } else {
-        (f64::NAN, f64::NAN)
-    };
-    let indicators = DlsIndicators {
-        lambda_i4,
-        lambda_2_plus,
-        lambda_4_plus,
-    };
+    let DlsCollision {
+        set: dls_set,
+        sol: dls_sol,
+        indicators,
+    } = dls_collision(model, (q, qd), &candidates, (rear_off, rear_on))?;
 
-    if model.params().impact == ImpactModel::Traditional || lambda_i4 < 0.0 {
+    if model.params().impact == ImpactModel::Traditional || indicators.lambda_i4 < 0.0 {
         // (A3), or the traditional exchange: the rear leg leaves at once.
         let (set, sol) = plastic_impact(model, q, qd, rear_off, &candidates)?;
         return Ok(finish(set, sol, indicators, Branch::Sls, sls));
     }
+    let DlsIndicators {
+        lambda_2_plus,
+        lambda_4_plus,
+        ..
+    } = indicators;
     let (branch, preferred) = match (lambda_2_plus >= 0.0, lambda_4_plus >= 0.0) {
         (true, true) => (Branch::Dls, dls),
         (true, false) => (Branch::SlsB3, sls),
@@ -241,6 +231,49 @@ pub(crate) fn touchdown_impact(
         ),
     };
     Ok(finish(dls_set, dls_sol, indicators, branch, preferred))
+}
+
+/// The DLS collision of a touchdown and its indicators: the units that took an impulse, its solution and the
+/// three DLS indicators.
+struct DlsCollision {
+    set: ActiveSet,
+    sol: ImpulseSolution,
+    indicators: DlsIndicators,
+}
+
+/// (A1) the DLS collision of a touchdown at `(q, q')` (Eq. (5) with `J_DLS`, among `candidates`, Leg 2's
+/// contact forced on as in `rear_on`, or with Coulomb friction a closing unit besides those forced in
+/// `rear_off`), and (B1) the forces just after it, Eqs. (6)-(7), where `lambda_I4 >= 0`.
+fn dls_collision(
+    model: &Model,
+    (q, qd): (&Coords, &Coords),
+    candidates: &[Candidate],
+    (rear_off, rear_on): (ActiveSet, ActiveSet),
+) -> Result<DlsCollision, ContactError> {
+    let (set, sol) = if model.params().has_friction() {
+        let mut with_rear = candidates.to_vec();
+        with_rear.push(Candidate::closing(Unit::Contact(Leg::Two), model));
+        plastic_impact(model, q, qd, rear_off, &with_rear)?
+    } else {
+        plastic_impact(model, q, qd, rear_on, candidates)?
+    };
+    let lambda_i4 = sol.normal_impulse(Leg::Two);
+    // (B1) forces just after the DLS collision, Eqs. (6)-(7).
+    let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
+        let after = constrained_dynamics(model, q, &sol.qd_plus, &set)?;
+        (after.normal_force(Leg::One), after.normal_force(Leg::Two))
+    } else {
+        (f64::NAN, f64::NAN)
+    };
+    Ok(DlsCollision {
+        set,
+        sol,
+        indicators: DlsIndicators {
+            lambda_i4,
+            lambda_2_plus,
+            lambda_4_plus,
+        },
+    })
 }
 
 /// Does `leg` have its extension stopper? Leg 1 always; Leg 2 unless `rear_stopper = false`.

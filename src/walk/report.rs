@@ -167,80 +167,21 @@ impl StepReport {
     /// pulling force, pulling impulse, penetration, stopper overrun), naming the step, the value and the
     /// tolerance. A NaN value is a warning too. Empty when every law holds.
     pub fn audit_warnings(&self) -> Vec<String> {
-        let c = &self.contact;
-        let mut checks: Vec<(&str, f64, f64, &str, &str)> = vec![
-            (
-                "energy residual",
-                self.energy.residual.abs(),
-                ENERGY_RESIDUAL_WARNING,
-                "J",
-                "the energy audit does not close",
-            ),
-            (
-                "pulling force",
-                c.pull_force,
-                PULL_FORCE_WARNING,
-                "N",
-                "the ground or a stopper pulled",
-            ),
-            (
-                "pulling impulse",
-                c.pull_impulse,
-                PULL_IMPULSE_WARNING,
-                "N s",
-                "an impact pulled",
-            ),
-            (
-                "penetration",
-                c.penetration,
-                PENETRATION_WARNING,
-                "m",
-                "a tip went below the ground",
-            ),
-            (
-                "stopper overrun",
-                c.stopper_overrun,
-                STOPPER_OVERRUN_WARNING,
-                "m",
-                "a leg went past its stopper",
-            ),
-            (
-                "Zeno stopper lock impulse",
-                c.zeno_impulse,
-                ZENO_IMPULSE_WARNING,
-                "N s",
-                "docs/model.md section 5: lower stopper_gap",
-            ),
-        ];
-        if let Some(f) = &c.friction {
-            checks.extend([
-                (
-                    "friction cone violation",
-                    f.cone_violation,
-                    CONE_VIOLATION_WARNING,
-                    "N",
-                    "a sticking tip's force left the friction cone",
-                ),
-                (
-                    "impulse cone violation",
-                    f.cone_violation_impulse,
-                    PULL_IMPULSE_WARNING,
-                    "N s",
-                    "a sticking impulse left the friction cone",
-                ),
-                (
-                    "friction power",
-                    f.slip_power,
-                    SLIP_POWER_WARNING,
-                    "W",
-                    "friction did positive work on a slipping tip",
-                ),
-            ]);
+        let mut checks = self.contact_checks();
+        if let Some(f) = &self.contact.friction {
+            checks.extend(friction_checks(f));
         }
         checks
             .iter()
-            .filter(|(_, value, limit, _, _)| value.is_nan() || value > limit)
-            .map(|(name, value, limit, unit, meaning)| {
+            .filter(|check| check.value.is_nan() || check.value > check.limit)
+            .map(|check| {
+                let AuditCheck {
+                    name,
+                    value,
+                    limit,
+                    unit,
+                    meaning,
+                } = check;
                 let shown = if *name == "energy residual" {
                     self.energy.residual
                 } else {
@@ -255,4 +196,95 @@ impl StepReport {
             })
             .collect()
     }
+
+    /// The checks of the energy audit and of the contact audit without friction (see
+    /// [`StepReport::audit_warnings`]).
+    fn contact_checks(&self) -> Vec<AuditCheck> {
+        let c = &self.contact;
+        vec![
+            AuditCheck {
+                name: "energy residual",
+                value: self.energy.residual.abs(),
+                limit: ENERGY_RESIDUAL_WARNING,
+                unit: "J",
+                meaning: "the energy audit does not close",
+            },
+            AuditCheck {
+                name: "pulling force",
+                value: c.pull_force,
+                limit: PULL_FORCE_WARNING,
+                unit: "N",
+                meaning: "the ground or a stopper pulled",
+            },
+            AuditCheck {
+                name: "pulling impulse",
+                value: c.pull_impulse,
+                limit: PULL_IMPULSE_WARNING,
+                unit: "N s",
+                meaning: "an impact pulled",
+            },
+            AuditCheck {
+                name: "penetration",
+                value: c.penetration,
+                limit: PENETRATION_WARNING,
+                unit: "m",
+                meaning: "a tip went below the ground",
+            },
+            AuditCheck {
+                name: "stopper overrun",
+                value: c.stopper_overrun,
+                limit: STOPPER_OVERRUN_WARNING,
+                unit: "m",
+                meaning: "a leg went past its stopper",
+            },
+            AuditCheck {
+                name: "Zeno stopper lock impulse",
+                value: c.zeno_impulse,
+                limit: ZENO_IMPULSE_WARNING,
+                unit: "N s",
+                meaning: "docs/model.md section 5: lower stopper_gap",
+            },
+        ]
+    }
+}
+
+/// One value of a step's audits against its tolerance, as [`StepReport::audit_warnings`] words a warning.
+struct AuditCheck {
+    /// What is checked.
+    name: &'static str,
+    /// Its value (a warning where above `limit` or NaN).
+    value: f64,
+    /// The tolerance.
+    limit: f64,
+    /// The unit of both.
+    unit: &'static str,
+    /// What a value above the tolerance means.
+    meaning: &'static str,
+}
+
+/// The checks of the friction audit (with Coulomb friction; see [`StepReport::audit_warnings`]).
+fn friction_checks(f: &FrictionAudit) -> [AuditCheck; 3] {
+    [
+        AuditCheck {
+            name: "friction cone violation",
+            value: f.cone_violation,
+            limit: CONE_VIOLATION_WARNING,
+            unit: "N",
+            meaning: "a sticking tip's force left the friction cone",
+        },
+        AuditCheck {
+            name: "impulse cone violation",
+            value: f.cone_violation_impulse,
+            limit: PULL_IMPULSE_WARNING,
+            unit: "N s",
+            meaning: "a sticking impulse left the friction cone",
+        },
+        AuditCheck {
+            name: "friction power",
+            value: f.slip_power,
+            limit: SLIP_POWER_WARNING,
+            unit: "W",
+            meaning: "friction did positive work on a slipping tip",
+        },
+    ]
 }

@@ -5,8 +5,7 @@ use crate::contact::{constrained_dynamics, ActiveSet, Leg};
 use crate::dynamics::Model;
 use crate::integrate::DenseStep;
 
-use super::impact::SwingLock;
-use super::impact::{Branch, TouchdownImpact};
+use super::impact::{Branch, SwingLock, TouchdownImpact, Unit, UnitImpact};
 use super::phase::{unpack, NY};
 use super::report::{ContactAudit, FrictionAudit};
 use super::zeno::ZenoLock;
@@ -123,6 +122,20 @@ impl StepTally {
         if let Some(friction) = &mut self.audit.friction {
             friction.cone_violation_impulse = friction.cone_violation_impulse.max(excess);
         }
+    }
+
+    /// Account for the plastic impact `closed` that closed `unit` of `leg` at a landing or a stopper hit: its
+    /// pulls to the contact audit, its kinetic energy loss as a ground impact's or a stopper's, and Leg 2
+    /// landing or sliding through it as scuffing.
+    pub(super) fn see_closed_unit(&mut self, closed: &UnitImpact, unit: Unit, leg: Leg) {
+        self.audit.pull_impulse = self.audit.pull_impulse.max(closed.pull_impulse);
+        self.see_cone_impulse(closed.cone_impulse);
+        match unit {
+            Unit::Contact(_) => self.impact_loss += closed.loss,
+            Unit::Stop(..) => self.stopper_loss += closed.loss,
+        }
+        self.scuffing |=
+            (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
     }
 
     /// Account for a Zeno lock (docs/model.md section 5): its kinetic energy loss is a stopper loss, its impulse

@@ -627,42 +627,7 @@ impl<'a> Phases<'a> {
             }
             EventKind::Landing(leg)
             | EventKind::StopperHit(leg)
-            | EventKind::CompressionHit(leg) => {
-                let unit = match kind.stop_hit() {
-                    Some((_, stop)) => Unit::Stop(leg, stop),
-                    None => Unit::Contact(leg),
-                };
-                let closed = close_unit(model, &q, &qd, self.active, unit)
-                    .map_err(WalkError::contact_at(t, phase))?
-                    .ok_or(WalkError::InconsistentContacts { time: t, phase })?;
-                self.work.impacts += 1;
-                if let Some(tape) = self.tape.as_deref_mut() {
-                    tape.impact(closed.impulse_set);
-                }
-                let tally = &mut self.tally;
-                tally.audit.pull_impulse = tally.audit.pull_impulse.max(closed.pull_impulse);
-                tally.see_cone_impulse(closed.cone_impulse);
-                match unit {
-                    Unit::Contact(_) => tally.impact_loss += closed.loss,
-                    Unit::Stop(..) => tally.stopper_loss += closed.loss,
-                }
-                tally.scuffing |=
-                    (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
-                let (mut qd_plus, mut active) = (closed.qd_plus, closed.active);
-                let gaps = (self.opts.stopper_gap, self.opts.recontact_gap);
-                if let Some(lock) = lock_zeno_stoppers(model, &q, &qd_plus, active, gaps, t)? {
-                    self.work.impacts += 1;
-                    self.tally.see_zeno(&lock);
-                    if let Some(tape) = self.tape.as_deref_mut() {
-                        lock.impulse_sets.iter().for_each(|set| tape.impact(*set));
-                    }
-                    (qd_plus, active) = (lock.qd_plus, lock.active);
-                }
-                // Leg 1's tip may leave the ground at an impact (a stopper lock that lifts the wheel).
-                self.tally.bounce |= self.active.contact1 && !active.contact1;
-                self.active = active;
-                self.y = pack(&q, &qd_plus, self.y[2 * NQ]);
-            }
+            | EventKind::CompressionHit(leg) => self.close_at_event(leg, kind, phase)?,
         }
         self.tally.events += 1;
         if self.tally.events > self.opts.max_events_per_step {
@@ -674,6 +639,41 @@ impl<'a> Phases<'a> {
         }
         self.restart_phase();
         Ok(None)
+    }
+
+    /// A landing or a stopper hit of `leg` (the event `kind`, in `phase`) at the current point: the unit closes
+    /// by a plastic impact ([`close_unit`], docs/model.md section 5), then the Zeno rule may lock the legs and
+    /// tips the impact kicked off ([`lock_zeno_stoppers`]).
+    fn close_at_event(&mut self, leg: Leg, kind: EventKind, phase: Phase) -> Result<(), WalkError> {
+        let (model, t) = (self.model, self.t);
+        let (q, qd) = unpack(&self.y);
+        let unit = match kind.stop_hit() {
+            Some((_, stop)) => Unit::Stop(leg, stop),
+            None => Unit::Contact(leg),
+        };
+        let closed = close_unit(model, &q, &qd, self.active, unit)
+            .map_err(WalkError::contact_at(t, phase))?
+            .ok_or(WalkError::InconsistentContacts { time: t, phase })?;
+        self.work.impacts += 1;
+        if let Some(tape) = self.tape.as_deref_mut() {
+            tape.impact(closed.impulse_set);
+        }
+        self.tally.see_closed_unit(&closed, unit, leg);
+        let (mut qd_plus, mut active) = (closed.qd_plus, closed.active);
+        let gaps = (self.opts.stopper_gap, self.opts.recontact_gap);
+        if let Some(lock) = lock_zeno_stoppers(model, &q, &qd_plus, active, gaps, t)? {
+            self.work.impacts += 1;
+            self.tally.see_zeno(&lock);
+            if let Some(tape) = self.tape.as_deref_mut() {
+                lock.impulse_sets.iter().for_each(|set| tape.impact(*set));
+            }
+            (qd_plus, active) = (lock.qd_plus, lock.active);
+        }
+        // Leg 1's tip may leave the ground at an impact (a stopper lock that lifts the wheel).
+        self.tally.bounce |= self.active.contact1 && !active.contact1;
+        self.active = active;
+        self.y = pack(&q, &qd_plus, self.y[2 * NQ]);
+        Ok(())
     }
 
     /// Start the next phase at the event just handled: the integrator and the event functions restart with the

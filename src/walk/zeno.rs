@@ -28,7 +28,8 @@
 //! both tips on the ground.
 
 use crate::contact::{
-    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ContactError, Leg, Stop,
+    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ContactError, ImpulseSolution, Leg,
+    Stop,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
@@ -198,99 +199,152 @@ pub fn lock_zeno_stoppers(
 ) -> Result<Option<ZenoLock>, WalkError> {
     let phase = active.phase();
     let contact_error = WalkError::contact_at(time, phase);
-    let rigid = model.params().rigid_legs;
-    let mut locked = ActiveSet::default();
+    let mut locks = Locks::default();
     let (mut qd_now, mut active_now) = (*qd, active);
-    let mut pull_impulse: f64 = 0.0;
-    let mut zeno_impulse: f64 = 0.0;
-    let mut impulse_sets = Vec::new();
-    let mut cone_impulse: f64 = 0.0;
     loop {
-        let mut legs =
-            zeno_units(model, (q, &qd_now), &active_now, gaps, &locked).map_err(contact_error)?;
+        let legs = zeno_units(model, (q, &qd_now), &active_now, gaps, &locks.locked)
+            .map_err(contact_error)?;
         if legs == ActiveSet::default() {
             break;
         }
-        // One impact problem: a tip closes as a landing does, held (no slip) unless holding it would pull it down
-        // by more than a grazing correction, then sliding (where sliding is allowed); and a unit that the impact
-        // itself kicks off too slowly to clear its gap closes in the same impact (two tips that would take turns
-        // landing close together, the accumulation point of their sequence).
-        let (impulse_set, sol) = loop {
-            let (forced, candidates) = zeno_impact_units(model, (q, &qd_now), &legs, &active_now);
-            let (set, sol) =
-                plastic_impact(model, q, &qd_now, forced, &candidates).map_err(contact_error)?;
-            let pulled = Leg::BOTH.into_iter().find(|&leg| {
-                legs.contact(leg)
-                    && !legs.slide(leg)
-                    && sol.normal_impulse(leg) < -ZENO_IMPULSE_WARNING
-            });
-            if let (Some(leg), ContactInconsistency::Slide, false) = (
-                pulled,
-                model.params().inconsistent_contact,
-                model.params().has_friction(),
-            ) {
-                legs.set_sliding(leg);
-                continue;
-            }
-            // The units that took an impulse hold; the others are free after the impact.
-            let kicked = zeno_units(model, (q, &sol.qd_plus), &set, gaps, &union(&legs, &locked))
-                .map_err(contact_error)?;
-            if kicked == ActiveSet::default() {
-                break (set, sol);
-            }
-            legs = union(&legs, &kicked);
-        };
-        for leg in Leg::BOTH {
-            for stop in Stop::BOTH {
-                if legs.held(leg, stop) {
-                    locked.set_held(leg, stop, true);
-                }
-            }
-            if legs.contact(leg) {
-                Unit::Contact(leg).apply(&mut locked, Unit::Contact(leg).mode(&legs));
-            }
-        }
-        impulse_sets.push(impulse_set);
-        let mut others = impulse_set;
-        let mut present = active_now;
-        for leg in Leg::BOTH {
-            for stop in Stop::BOTH {
-                if legs.held(leg, stop) {
-                    others.set_held(leg, stop, false);
-                    present.set_held(leg, stop, true);
-                    zeno_impulse = zeno_impulse.max(-sol.stop_impulse(leg, stop));
-                }
-            }
-            if legs.contact(leg) {
-                others.set_contact(leg, false);
-                Unit::Contact(leg).apply(&mut present, Unit::Contact(leg).mode(&legs));
-                zeno_impulse = zeno_impulse.max(-sol.normal_impulse(leg));
-            }
-        }
-        pull_impulse = pull_impulse.max(largest_pull(&sol.impulses, &others, rigid));
-        let mu = model.params().friction;
-        cone_impulse = cone_impulse.max(cone_excess(&sol.impulses, &impulse_set, mu));
+        let impact = zeno_impact(model, (q, &qd_now), &active_now, legs, gaps, &locks.locked)
+            .map_err(contact_error)?;
+        let present = locks.record(model, &impact, active_now);
+        let (sol, impulse_set) = (&impact.sol, &impact.impulse_set);
         let (forced, candidates) =
-            post_impact_candidates(model, q, &sol.qd_plus, &impulse_set, &present, &impulse_set);
+            post_impact_candidates(model, q, &sol.qd_plus, impulse_set, &present, impulse_set);
         let (next, _) = consistent_active_set(model, q, &sol.qd_plus, forced, &candidates)
             .map_err(contact_error)?
             .ok_or(WalkError::InconsistentContacts { time, phase })?;
         qd_now = sol.qd_plus;
         active_now = next;
     }
-    if locked == ActiveSet::default() {
+    if locks.locked == ActiveSet::default() {
         return Ok(None);
     }
     Ok(Some(ZenoLock {
-        locked,
+        locked: locks.locked,
         qd_plus: qd_now,
         active: active_now,
         loss: model.kinetic_energy(q, qd) - model.kinetic_energy(q, &qd_now),
-        impulse: zeno_impulse,
-        pull_impulse,
-        impulse_sets,
-        cone_impulse,
+        impulse: locks.zeno_impulse,
+        pull_impulse: locks.pull_impulse,
+        impulse_sets: locks.impulse_sets,
+        cone_impulse: locks.cone_impulse,
     }))
+}
+
+/// One plastic impact of a Zeno lock: the units it closes, the units that took an impulse and its solution.
+struct ZenoImpact {
+    /// The units the Zeno rule closes in it (those picked at first and those the impact kicks off too slowly).
+    legs: ActiveSet,
+    /// The units that took an impulse.
+    impulse_set: ActiveSet,
+    /// The impact's solution.
+    sol: ImpulseSolution,
+}
+
+/// One impact problem at `(q, q')` under `active`, closing the units `legs` (none of `locked`): a tip closes as
+/// a landing does, held (no slip) unless holding it would pull it down by more than a grazing correction, then
+/// sliding (where sliding is allowed); and a unit that the impact itself kicks off too slowly to clear its gap
+/// closes in the same impact (two tips that would take turns landing close together, the accumulation point of
+/// their sequence).
+fn zeno_impact(
+    model: &Model,
+    (q, qd): (&Coords, &Coords),
+    active: &ActiveSet,
+    mut legs: ActiveSet,
+    gaps: (f64, f64),
+    locked: &ActiveSet,
+) -> Result<ZenoImpact, ContactError> {
+    loop {
+        let (forced, candidates) = zeno_impact_units(model, (q, qd), &legs, active);
+        let (set, sol) = plastic_impact(model, q, qd, forced, &candidates)?;
+        let pulled = Leg::BOTH.into_iter().find(|&leg| {
+            legs.contact(leg) && !legs.slide(leg) && sol.normal_impulse(leg) < -ZENO_IMPULSE_WARNING
+        });
+        if let (Some(leg), ContactInconsistency::Slide, false) = (
+            pulled,
+            model.params().inconsistent_contact,
+            model.params().has_friction(),
+        ) {
+            legs.set_sliding(leg);
+            continue;
+        }
+        // The units that took an impulse hold; the others are free after the impact.
+        let kicked = zeno_units(model, (q, &sol.qd_plus), &set, gaps, &union(&legs, locked))?;
+        if kicked == ActiveSet::default() {
+            return Ok(ZenoImpact {
+                legs,
+                impulse_set: set,
+                sol,
+            });
+        }
+        legs = union(&legs, &kicked);
+    }
+}
+
+/// What the locks of one Zeno sequence add up to (the fields of [`ZenoLock`] gathered impact by impact).
+#[derive(Default)]
+struct Locks {
+    /// The stoppers locked and the contacts closed so far.
+    locked: ActiveSet,
+    /// The largest pulling impulse of the other units that took an impulse \[N s\].
+    pull_impulse: f64,
+    /// The largest pulling impulse of a locked stopper or a closed tip \[N s\].
+    zeno_impulse: f64,
+    /// The units that took an impulse in each impact, in order.
+    impulse_sets: Vec<ActiveSet>,
+    /// The largest excess of a sticking contact's impulse over the friction cone \[N s\].
+    cone_impulse: f64,
+}
+
+impl Locks {
+    /// Add `impact` under `active` (the set before it); the units present after it (`active` with the units
+    /// it closed).
+    fn record(&mut self, model: &Model, impact: &ZenoImpact, active: ActiveSet) -> ActiveSet {
+        let ZenoImpact {
+            legs,
+            impulse_set,
+            sol,
+        } = impact;
+        for leg in Leg::BOTH {
+            for stop in Stop::BOTH {
+                if legs.held(leg, stop) {
+                    self.locked.set_held(leg, stop, true);
+                }
+            }
+            if legs.contact(leg) {
+                Unit::Contact(leg).apply(&mut self.locked, Unit::Contact(leg).mode(legs));
+            }
+        }
+        self.impulse_sets.push(*impulse_set);
+        let mut others = *impulse_set;
+        let mut present = active;
+        for leg in Leg::BOTH {
+            for stop in Stop::BOTH {
+                if legs.held(leg, stop) {
+                    others.set_held(leg, stop, false);
+                    present.set_held(leg, stop, true);
+                    self.zeno_impulse = self.zeno_impulse.max(-sol.stop_impulse(leg, stop));
+                }
+            }
+            if legs.contact(leg) {
+                others.set_contact(leg, false);
+                Unit::Contact(leg).apply(&mut present, Unit::Contact(leg).mode(legs));
+                self.zeno_impulse = self.zeno_impulse.max(-sol.normal_impulse(leg));
+            }
+        }
+        let rigid = model.params().rigid_legs;
+        self.pull_impulse = self
+            .pull_impulse
+            .max(largest_pull(&sol.impulses, &others, rigid));
+        let mu = model.params().friction;
+        self.cone_impulse = self
+            .cone_impulse
+            .max(cone_excess(&sol.impulses, impulse_set, mu));
+        present
+    }
 }
 
 #[cfg(test)]
