@@ -1,5 +1,5 @@
 //! The layout of `src/` (STYLE.md point 17): the modules form a one-way pipeline without import cycles, every
-//! file says what it holds in an opening `//!` comment, and files stay small.
+//! file says what it holds in an opening `//!` comment, and files and functions stay small.
 //!
 //! The import check reads every file under `src/`, strips comments, string literals and `#[cfg(test)]` items,
 //! and collects the paths each file uses: its `use` declarations and the `crate::`/`super::`/`self::` paths in
@@ -21,6 +21,10 @@ use std::path::{Path, PathBuf};
 /// Files over this many lines of code (outside `#[cfg(test)]`, not counting blank and comment-only lines)
 /// fail: a file that grows past it holds more than one concern and is split.
 const MAX_FILE_LINES: usize = 600;
+
+/// Production functions over this many lines of code (from `fn` to its closing brace, not counting blank and
+/// comment-only lines) fail: a function that grows past it does more than one step and is split.
+const MAX_FUNCTION_LINES: usize = 80;
 
 /// Whether a file over [`MAX_FILE_LINES`] fails the test or is only reported.
 const ENFORCE_FILE_SIZE: bool = true;
@@ -733,6 +737,15 @@ fn source_files() -> Vec<(String, String)> {
 /// Lines of code of `text` outside `#[cfg(test)]` items: not blank, not only a comment.
 fn code_lines(text: &str) -> usize {
     let (_, tests) = strip_tests(tokenize(text));
+    code_lines_in(text, 1..=usize::MAX, &tests)
+}
+
+/// Lines of code of `text` among the (1-based) lines `within`, outside the line ranges `tests`.
+fn code_lines_in(
+    text: &str,
+    within: std::ops::RangeInclusive<usize>,
+    tests: &[(usize, usize)],
+) -> usize {
     let mut in_block_comment = false;
     text.lines()
         .enumerate()
@@ -747,9 +760,53 @@ fn code_lines(text: &str) -> usize {
                 in_block_comment = !t.contains("*/");
                 return false;
             }
-            !t.is_empty() && !t.starts_with("//") && !tests.iter().any(|&(a, b)| a <= n && n <= b)
+            !t.is_empty()
+                && !t.starts_with("//")
+                && within.contains(&n)
+                && !tests.iter().any(|&(a, b)| a <= n && n <= b)
         })
         .count()
+}
+
+/// The functions of `text` outside `#[cfg(test)]` items with their lines of code (from the line of `fn` to
+/// that of its closing brace; a function nested in another counts in both): `(name, first line, lines)`.
+fn function_lengths(text: &str) -> Vec<(String, usize, usize)> {
+    let (tokens, tests) = strip_tests(tokenize(text));
+    let mut out = Vec::new();
+    for (i, t) in tokens.iter().enumerate() {
+        let (Tok::Ident(kw), Some(Tok::Ident(name))) = (&t.tok, tokens.get(i + 1).map(|t| &t.tok))
+        else {
+            continue;
+        };
+        if kw != "fn" {
+            continue;
+        }
+        // The body: the first `{` before a `;` (a declaration without a body has none), through its match.
+        let mut depth = 0usize;
+        let mut end = None;
+        for u in &tokens[i + 2..] {
+            match u.tok {
+                Tok::Punct(';') if depth == 0 => break,
+                Tok::Punct('{') => depth += 1,
+                Tok::Punct('}') => {
+                    depth -= 1;
+                    if depth == 0 {
+                        end = Some(u.line);
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        if let Some(last) = end {
+            out.push((
+                name.clone(),
+                t.line,
+                code_lines_in(text, t.line..=last, &tests),
+            ));
+        }
+    }
+    out
 }
 
 #[test]
@@ -837,6 +894,38 @@ fn source_files_are_small() {
         !ENFORCE_FILE_SIZE || big.is_empty(),
         "files over {MAX_FILE_LINES} lines of code outside #[cfg(test)]: {big:?}"
     );
+}
+
+#[test]
+fn production_functions_are_short() {
+    let files = source_files();
+    let test_only = test_only_files(&files);
+    let long: Vec<String> = files
+        .iter()
+        .filter(|(rel, _)| !test_only.contains(rel))
+        .flat_map(|(rel, text)| {
+            function_lengths(text)
+                .into_iter()
+                .filter(|&(_, _, n)| n > MAX_FUNCTION_LINES)
+                .map(move |(name, line, n)| format!("src/{rel}:{line}: {name}: {n} lines of code"))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "production functions over {MAX_FUNCTION_LINES} lines of code:\n  {}",
+        long.join("\n  ")
+    );
+}
+
+#[test]
+fn a_long_function_is_measured_without_blank_lines_comments_and_tests() {
+    let body = "    let x = 1;\n\n    // a comment\n".repeat(3);
+    let text = format!(
+        "//! A.\nfn f() {{\n{body}}}\ntrait T {{\n    fn g(&self);\n}}\n#[cfg(test)]\nfn h() {{\n{body}}}\n"
+    );
+    let lengths = function_lengths(&text);
+    // `f`: its first and last line and the three `let` lines; `g` has no body; `h` is a test item.
+    assert_eq!(lengths, vec![("f".to_string(), 2, 5)]);
 }
 
 // ---------------------------------------------------------------------------------------------------------
