@@ -22,7 +22,7 @@ fn main() {
                 message = format!("{message}: {cause}");
             }
         }
-        eprintln!("Error: {message}");
+        eprintln!("Error: {}", cli::flags_in(&message));
         std::process::exit(1);
     }
 }

@@ -10,7 +10,7 @@ use vrw::gait::{find_gait, GaitOptions, StepMap};
 use vrw::params::Config;
 use vrw::reference::default_initial;
 use vrw::reference::period_two_config;
-use vrw::study::basin::{basin, Axis, BasinSpec, Coordinate};
+use vrw::study::basin::{basin, Axis, BasinSpec, Coordinate, OutcomeKind};
 use vrw::study::orbit::{orbit_diagram, OrbitSpec};
 use vrw::study::SweepSpec;
 use vrw::walk::simulate;
@@ -55,10 +55,10 @@ fn basin_points_agree_with_direct_simulation() {
     let mut kinds = std::collections::BTreeSet::new();
     for p in grid.iter().flatten() {
         let o = &p.outcome;
-        kinds.insert(o.kind.clone());
+        kinds.insert(o.kind.to_string());
         assert_eq!(p.start.l2_dot, gait.section.l2_dot);
-        match o.kind.as_str() {
-            "gait" => {
+        match o.kind {
+            OutcomeKind::Gait => {
                 let run = simulate(&model, &config.solver, &p.start, o.steps + 1, None).unwrap();
                 let d: Vec<f64> = run
                     .steps
@@ -68,8 +68,8 @@ fn basin_points_agree_with_direct_simulation() {
                 assert!(d[o.steps] < TOLERANCE, "{p:?}: {d:?}");
                 assert!(d[..o.steps].iter().all(|&x| x >= TOLERANCE), "{p:?}: {d:?}");
             }
-            "other" | "undecided" | "invalid_start" => {}
-            kind => {
+            OutcomeKind::Other | OutcomeKind::Undecided | OutcomeKind::InvalidStart => {}
+            OutcomeKind::Failed(kind) => {
                 let run = simulate(&model, &config.solver, &p.start, o.steps, None).unwrap();
                 assert_eq!(run.failure.as_ref().map(|e| e.kind()), Some(kind), "{p:?}");
                 assert_eq!(run.steps.len(), o.steps - 1, "{p:?}");
@@ -165,15 +165,15 @@ fn basin_job_refuses_bad_options() {
     let mut job = basin_job(dir.path());
     job.coordinates = [Coordinate::L2, Coordinate::L2];
     let e = run_basin(&job, &|_| {}).unwrap_err().to_string();
-    assert!(e.contains("--x/--y") && e.contains("different"), "{e}");
+    assert!(e.contains("`x/y`") && e.contains("different"), "{e}");
     let mut job = basin_job(dir.path());
     job.points = [1, 3];
     let e = run_basin(&job, &|_| {}).unwrap_err().to_string();
-    assert!(e.contains("--nx"), "{e}");
+    assert!(e.contains("`nx`"), "{e}");
     let mut job = basin_job(dir.path());
     job.ranges[1] = Some((1.0, f64::NAN));
     let e = run_basin(&job, &|_| {}).unwrap_err().to_string();
-    assert!(e.contains("--y-range"), "{e}");
+    assert!(e.contains("`y_range`"), "{e}");
 }
 
 /// `vrw orbit` writes orbit.csv (one row per recorded step), branch.csv, orbit.json and orbit.png; bad step
@@ -210,7 +210,7 @@ fn orbit_job_writes_its_files() {
     }
     job.spec.steps = 0;
     let e = run_orbit(&job, &|_| {}).unwrap_err().to_string();
-    assert!(e.contains("--steps"), "{e}");
+    assert!(e.contains("`steps`"), "{e}");
 }
 
 /// The grid runner's promise holds for the orbit diagram and the basin: the same results on one thread as

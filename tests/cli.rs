@@ -1027,7 +1027,7 @@ fn continue_refuses_bad_options() {
         (&["--param", "legs"][..], "unknown parameter"),
         (&["--from", "10", "--to", "5"][..], "from < to"),
         (&["--max-points", "0"][..], "--max-points"),
-        (&["--max-step=-1"][..], "--max-step"),
+        (&["--max-step=-1"][..], "the longest continuation step"),
         (&["--period", "9"][..], "--period"),
         (
             &[

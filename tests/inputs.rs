@@ -198,14 +198,14 @@ fn map_y_from_0_names_y_from_and_map_nx_1_states_the_maps_limit() {
     let (output, _dir) = vrw(&["map", "--y-from", "0"]);
     let stderr = assert_refused(
         &output,
-        &["--y-from 0", "map y stiffness", "must be positive"],
+        &["`--y-from` 0", "map y stiffness", "must be positive"],
     );
     assert!(
         !stderr.contains("sweep") && !stderr.contains(" --from"),
         "{stderr}"
     );
     let (output, _dir) = vrw(&["map", "--nx", "1"]);
-    let stderr = assert_refused(&output, &["--nx 1", "map x takes between 2 and 2000"]);
+    let stderr = assert_refused(&output, &["`--nx` 1", "map x takes between 2 and 2000"]);
     assert!(!stderr.contains("100000"), "{stderr}");
 }
 

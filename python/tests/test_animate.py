@@ -98,8 +98,14 @@ def test_bad_options_are_the_cli_errors(cli, run, run_dir, keywords, flags):
         vrw.animate(run, **keywords)
     expected = cli_error(cli("animate", run_dir, *flags, check=False))
     assert expected.startswith("animate: ")
-    # The window is named by its file: the run directory's for the command line, the bare name here.
-    assert str(raised.value) == expected[len("animate: "):].replace(f"{run_dir}/", "")
+    # The window is named by its file: the run directory's for the command line, the bare name here; the
+    # settings by their flags there (`--fps`), by their fields here (`fps`).
+    expected = expected[len("animate: "):].replace(f"{run_dir}/", "")
+    for field in ["fps", "speed", "width", "height", "from", "to"]:
+        expected = expected.replace(f"`--{field}`", f"`{field}`")
+    expected = expected.replace("`--from/--to`", "`from/to`")
+    assert "--" not in str(raised.value)
+    assert str(raised.value) == expected
 
 
 def test_bad_counts_are_named(run):

@@ -88,14 +88,14 @@ impl BasinJob {
     fn validate(&self) -> Result<(), AppError> {
         if self.coordinates[0] == self.coordinates[1] {
             return Err(Self::invalid(
-                "--x/--y",
+                "x/y",
                 format!(
                     "the two axes must be different coordinates (both are {})",
                     self.coordinates[0].name()
                 ),
             ));
         }
-        for (option, n) in [("--nx", self.points[0]), ("--ny", self.points[1])] {
+        for (option, n) in [("nx", self.points[0]), ("ny", self.points[1])] {
             if !(2..=MAX_BASIN_POINTS).contains(&n) {
                 return Err(Self::invalid(
                     option,
@@ -103,7 +103,7 @@ impl BasinJob {
                 ));
             }
         }
-        for (option, range) in [("--x-range", self.ranges[0]), ("--y-range", self.ranges[1])] {
+        for (option, range) in [("x_range", self.ranges[0]), ("y_range", self.ranges[1])] {
             if let Some((a, b)) = range {
                 if !(a.is_finite() && b.is_finite() && a != b) {
                     return Err(Self::invalid(
@@ -119,13 +119,13 @@ impl BasinJob {
         }
         if !(1..=100_000).contains(&self.max_steps) {
             return Err(Self::invalid(
-                "--max-steps",
+                "max_steps",
                 format!("{} steps; use 1 to 100000", self.max_steps),
             ));
         }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
             return Err(Self::invalid(
-                "--tolerance",
+                "tolerance",
                 format!("{} is not a positive distance", short(self.tolerance)),
             ));
         }
@@ -197,7 +197,7 @@ pub fn compute_basin_part(
 fn outcome_counts(grid: &[Vec<BasinPoint>]) -> BTreeMap<String, usize> {
     let mut outcomes = BTreeMap::new();
     for p in grid.iter().flatten() {
-        *outcomes.entry(p.outcome.kind.clone()).or_insert(0) += 1;
+        *outcomes.entry(p.outcome.kind.to_string()).or_insert(0) += 1;
     }
     outcomes
 }
@@ -277,7 +277,7 @@ fn basin_into(
         ys: (0..spec.y.points).map(|i| spec.y.value(i)).collect(),
         outcomes: grid
             .iter()
-            .map(|row| row.iter().map(|p| p.outcome.kind.clone()).collect())
+            .map(|row| row.iter().map(|p| p.outcome.kind.to_string()).collect())
             .collect(),
         gait: gait
             .cycle

@@ -172,7 +172,10 @@ impl ContinueJob {
         if !(self.max_step.is_finite() && self.max_step > 0.0) {
             return Err(invalid(
                 "max_step",
-                format!("must be a positive number, got {}", self.max_step),
+                format!(
+                    "the longest continuation step must be a positive number, got {}",
+                    self.max_step
+                ),
             ));
         }
         if let Some(k) = self.period {

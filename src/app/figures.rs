@@ -73,7 +73,7 @@ pub fn checked_run(dir: &Path, partial: bool) -> Result<(RunData, RunDir), AppEr
     if let Some(why) = &unfinished {
         if !partial {
             return Err(refuse(format!(
-                "{why}; pass --partial to draw its complete rows anyway"
+                "{why}; pass `partial` to draw its complete rows anyway"
             )));
         }
     }

@@ -186,7 +186,7 @@ fn checked_initial(job: &MapJob) -> Result<SectionState, AppError> {
     for m in &job.marks {
         if !(m.x.is_finite() && m.y.is_finite()) {
             return Err(AppError::InvalidOption {
-                option: "--mark",
+                option: "mark",
                 reason: format!("{} is not a point of two finite numbers", m.label),
             });
         }

@@ -96,7 +96,7 @@ pub enum AppError {
         kept: String,
     },
     /// A bad job setting that is not a model parameter.
-    #[error("invalid {option}: {reason}")]
+    #[error("invalid `{option}`: {reason}")]
     InvalidOption {
         /// The setting: the job's field, which is the Python keyword (`sample_dt`); the command line shows
         /// its flag instead (`--sample-dt`).

@@ -8,8 +8,6 @@ use clap::Args;
 use vrw::app::{run_animate, run_still, AnimateJob};
 use vrw::output::animate::AnimateOptions;
 
-use super::flagged;
-
 #[derive(Debug, Args)]
 pub(super) struct AnimateArgs {
     /// Output directory of `vrw simulate` or `vrw gait` (walk.gif is written there).
@@ -60,12 +58,12 @@ pub(super) fn run(args: AnimateArgs) -> Result<()> {
         partial: args.partial,
     };
     if let Some(time) = args.still {
-        let path = run_still(&job, time).map_err(flagged).context("animate")?;
+        let path = run_still(&job, time).context("animate")?;
         println!("wrote {}", path.display());
         return Ok(());
     }
     let started = std::time::Instant::now();
-    let outcome = run_animate(&job).map_err(flagged).context("animate")?;
+    let outcome = run_animate(&job).context("animate")?;
     for w in &outcome.warnings {
         eprintln!("warning: {w}");
     }

@@ -12,7 +12,7 @@ use vrw::continuation::{CurveEnd, CurvePoint, FamilyEnd};
 use vrw::family::GaitInfo;
 use vrw::walk::SectionState;
 
-use super::{flagged, interrupt_flag, print_warnings, ModelArgs};
+use super::{interrupt_flag, print_warnings, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct ContinueArgs {
@@ -111,9 +111,7 @@ fn end_words(end: &FamilyEnd) -> String {
 pub(super) fn run(args: ContinueArgs) -> Result<()> {
     let job = continue_job(&args)?;
     super::check_out(&job.out_dir, "continue", job.overwrite)?;
-    let result = run_continuation(&job)
-        .map_err(flagged)
-        .context("continue")?;
+    let result = run_continuation(&job).context("continue")?;
     let s = &result.summary;
     println!(
         "vrw continue: {} from {} to {}, from the period-{} gait at {}: {} families, {} special points; {:.2} s",

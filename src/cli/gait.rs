@@ -10,7 +10,7 @@ use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::gait::{Gait, GaitOptions, JacobianCheck};
 use vrw::walk::SectionState;
 
-use super::{flagged, progress_bar, ModelArgs};
+use super::{progress_bar, ModelArgs};
 
 /// `GaitOptions::default().tolerance` as `--help` shows it (a test checks that they agree).
 const DEFAULT_TOLERANCE: &str = "1e-10";
@@ -28,8 +28,8 @@ pub(super) struct GaitArgs {
     )]
     initial: Option<SectionState>,
     /// Steps walked before Newton's method starts.
-    #[arg(long, default_value_t = GaitOptions::default().transient_steps)]
-    transient: usize,
+    #[arg(long = "transient", default_value_t = GaitOptions::default().transient_steps)]
+    transient_steps: usize,
     /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
     #[arg(long, default_value = DEFAULT_TOLERANCE)]
     tolerance: f64,
@@ -76,12 +76,12 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
     );
     bar.set_message(format!(
         "{} transient steps, then Newton's method",
-        args.transient
+        args.transient_steps
     ));
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
     let result = run_gait(&job);
     bar.finish_and_clear();
-    let summary = result.map_err(flagged).context("gait")?;
+    let summary = result.context("gait")?;
     let p = &job.config.params;
     println!(
         "vrw gait: c = {} N s/m, slope = {} rad, impact = {}",
@@ -113,7 +113,7 @@ fn gait_job(args: &GaitArgs) -> Result<GaitJob> {
         config: args.model.load()?,
         initial: args.initial,
         options: GaitOptions {
-            transient_steps: args.transient,
+            transient_steps: args.transient_steps,
             tolerance: args.tolerance,
             parameter: args.parameter,
             ..GaitOptions::default()

@@ -12,17 +12,17 @@ mod plot;
 mod simulate;
 mod sweep;
 
+use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use vrw::app::AppError;
-use vrw::params::{Config, ConfigError};
+use vrw::params::Config;
 use vrw::study::{SecondRoute, Threshold, SECOND_ROUTE_TOL};
 
 /// Passive dynamic walking of a viscoelastic-legged rimless wheel, with the DLS indicators.
@@ -82,47 +82,55 @@ impl ModelArgs {
     }
 }
 
-/// The flag of each job setting that the library names by its field (the Python keyword).
-const FLAGS: [(&str, &str); 12] = [
-    ("transient_steps", "--transient"),
-    ("tolerance", "--tolerance"),
-    ("steps", "--steps"),
-    ("sample_dt", "--sample-dt"),
-    ("speed", "--speed"),
-    ("max_points", "--max-points"),
-    ("max_step", "--max-step"),
-    ("start", "--start"),
-    ("plot", "--plot"),
-    ("period", "--period"),
-    ("from", "--from/--to"),
-    ("two_param", "--two-param"),
-];
+/// The flag of each setting that the library names by its field (which is the Python keyword): the long name
+/// of the command-line argument whose field has that name, read off clap's definitions of every command (a
+/// field has one flag in all of them: `flags_are_one_per_field`). Never a table kept by hand. A field that is
+/// also a configuration key (`max_step`: the integrator's largest step, and `vrw continue --max-step`) keeps
+/// its name: in a message it is more often the key, set with `--set`.
+fn flags() -> &'static BTreeMap<String, String> {
+    static FLAGS: OnceLock<BTreeMap<String, String>> = OnceLock::new();
+    FLAGS.get_or_init(|| {
+        let keys = configuration_keys();
+        let cli = <Cli as clap::CommandFactory>::command();
+        cli.get_subcommands()
+            .flat_map(|c| c.get_arguments())
+            .filter(|a| !keys.contains(a.get_id().as_str()))
+            .filter_map(|a| Some((a.get_id().to_string(), format!("--{}", a.get_long()?))))
+            .collect()
+    })
+}
 
-/// A job's error with its settings named by their flags: the rule is the library's, the name the command
-/// line's (`invalid value 1 for `--tolerance`` instead of `tolerance`).
-fn flagged(error: AppError) -> AppError {
-    let flag = |name: &str| FLAGS.iter().find(|(field, _)| *field == name).map(|f| f.1);
-    fn renamed(error: ConfigError, flag: &dyn Fn(&str) -> Option<&'static str>) -> ConfigError {
-        match error {
-            ConfigError::InvalidValue { key, value, reason } => ConfigError::InvalidValue {
-                key: flag(&key).map_or(key, str::to_string),
-                value,
-                reason,
-            },
-            ConfigError::Several { errors } => ConfigError::Several {
-                errors: errors.into_iter().map(|e| renamed(e, flag)).collect(),
-            },
-            other => other,
-        }
-    }
-    match error {
-        AppError::InvalidOption { option, reason } => AppError::InvalidOption {
-            option: flag(option).unwrap_or(option),
-            reason,
-        },
-        AppError::Config(e) => AppError::Config(renamed(e, &flag)),
-        other => other,
-    }
+/// The keys of the configuration (those of its TOML file).
+fn configuration_keys() -> std::collections::BTreeSet<String> {
+    toml::Table::try_from(Config::default())
+        .map(|table| table.keys().cloned().collect())
+        .unwrap_or_default()
+}
+
+/// `message` with the settings the library quotes by their fields (`` `sample_dt` ``, or a pair `` `from/to` ``)
+/// quoted by their flags instead (`` `--sample-dt` ``, `` `--from/--to` ``): the rule is the library's, the name
+/// the command line's. Anything else in backticks (a configuration key, a value) is left as it is.
+pub fn flags_in(message: &str) -> String {
+    let flags = flags();
+    let flagged = |quoted: &str| -> Option<String> {
+        let parts: Option<Vec<&String>> = quoted.split('/').map(|f| flags.get(f)).collect();
+        Some(
+            parts?
+                .iter()
+                .map(|f| f.as_str())
+                .collect::<Vec<_>>()
+                .join("/"),
+        )
+    };
+    message
+        .split('`')
+        .enumerate()
+        .map(|(i, part)| match flagged(part) {
+            Some(flag) if i % 2 == 1 => flag,
+            _ => part.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("`")
 }
 
 /// Run the parsed command.
@@ -274,6 +282,71 @@ fn print_warnings(warnings: &[String], file: &str) {
         eprintln!(
             "warning: {} audit warnings in all, listed in {file}",
             warnings.len()
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A field has one flag in every command that takes it, so that a message names it the same way whatever
+    /// the command (`flags` reads all commands' definitions at once).
+    #[test]
+    fn flags_are_one_per_field() {
+        let cli = <Cli as clap::CommandFactory>::command();
+        let mut seen: BTreeMap<String, (String, String)> = BTreeMap::new();
+        for command in cli.get_subcommands() {
+            for arg in command.get_arguments() {
+                let Some(long) = arg.get_long() else { continue };
+                let (id, here) = (arg.get_id().to_string(), command.get_name().to_string());
+                if let Some((first, there)) = seen.get(&id) {
+                    assert_eq!(
+                        first, long,
+                        "`{id}` is --{first} in {there} and --{long} in {here}"
+                    );
+                } else {
+                    seen.insert(id, (long.to_string(), here));
+                }
+            }
+        }
+        assert_eq!(
+            flags().get("transient_steps").map(String::as_str),
+            Some("--transient")
+        );
+        assert_eq!(
+            flags().get("sample_dt").map(String::as_str),
+            Some("--sample-dt")
+        );
+    }
+
+    /// A configuration key quoted in a message (`viscosity`, `max_step`) is never turned into a flag, even where
+    /// an option has the same field (`vrw continue --max-step`).
+    #[test]
+    fn configuration_keys_stay_keys() {
+        let keys = configuration_keys();
+        assert!(
+            keys.contains("viscosity") && keys.contains("max_step"),
+            "{keys:?}"
+        );
+        assert!(keys.iter().all(|k| !flags().contains_key(k)));
+        assert_eq!(
+            flags_in("`max_step`, `max_points`"),
+            "`max_step`, `--max-points`"
+        );
+    }
+
+    /// The library's messages quote fields; the command line's quote flags, pairs included, and leave
+    /// anything else in backticks alone.
+    #[test]
+    fn messages_name_flags() {
+        assert_eq!(
+            flags_in("invalid `fps`: 60; raise `speed` or narrow the window with `from`/`to` or `from/to`"),
+            "invalid `--fps`: 60; raise `--speed` or narrow the window with `--from`/`--to` or `--from/--to`"
+        );
+        assert_eq!(
+            flags_in("invalid value 1 for `viscosity` (`vrw gait`, `x_from/nowhere`)"),
+            "invalid value 1 for `viscosity` (`vrw gait`, `x_from/nowhere`)"
         );
     }
 }

@@ -8,7 +8,7 @@ use clap::Args;
 use vrw::app::{run_simulate, SimulateEvent, SimulateJob, DEFAULT_SAMPLE_DT};
 use vrw::walk::SectionState;
 
-use super::{flagged, interrupt_flag, progress_bar, ModelArgs};
+use super::{interrupt_flag, progress_bar, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct SimulateArgs {
@@ -66,7 +66,6 @@ pub(super) fn run(args: SimulateArgs) -> Result<()> {
         }
         SimulateEvent::Warning(warning) => bar.suspend(|| eprintln!("warning: {warning}")),
     })
-    .map_err(flagged)
     .context("simulate")?;
     bar.finish_and_clear();
     println!(

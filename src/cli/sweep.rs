@@ -12,8 +12,7 @@ use vrw::study::{SweepSpec, Threshold};
 use vrw::walk::SectionState;
 
 use super::{
-    confirmed_count, flagged, interrupt_flag, print_warnings, progress_bar, second_route_words,
-    ModelArgs,
+    confirmed_count, interrupt_flag, print_warnings, progress_bar, second_route_words, ModelArgs,
 };
 
 #[derive(Debug, Args)]
@@ -77,7 +76,6 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
         bar.set_message(format!("{} = {:.4}: {}", args.param, p.value, p.status));
         bar.inc(1);
     })
-    .map_err(flagged)
     .context("sweep")?;
     bar.finish_and_clear();
     println!(

@@ -72,7 +72,7 @@ pub enum OutputError {
         source: csv::Error,
     },
     /// The output directory names an existing file.
-    #[error("output directory {path} is an existing file, not a directory: choose another --out")]
+    #[error("output directory {path} is an existing file, not a directory: choose another `out`")]
     NotADirectory {
         /// The path.
         path: PathBuf,
@@ -88,7 +88,7 @@ pub enum OutputError {
     /// The output directory holds files and no readable manifest: vrw did not write them (or cannot tell), and
     /// removes nothing it did not write.
     #[error(
-        "output directory {dir} holds files vrw did not write ({why}): {files}; choose another --out (vrw \
+        "output directory {dir} holds files vrw did not write ({why}): {files}; choose another `out` (vrw \
          never removes a file it did not write)"
     )]
     NotVrwDir {
@@ -101,8 +101,8 @@ pub enum OutputError {
     },
     /// The output directory holds a run of another command.
     #[error(
-        "output directory {dir} holds a run of `vrw {command}` ({files}): give --overwrite to replace it, or \
-         choose another --out"
+        "output directory {dir} holds a run of `vrw {command}` ({files}): give `overwrite` to replace it, or \
+         choose another `out`"
     )]
     OtherRun {
         /// The directory.

@@ -120,11 +120,40 @@ pub struct BasinSpec {
     pub tolerance: f64,
 }
 
+/// Where the walk from one start went. A value until it is written: its text (`gait`, `other`, `undecided`,
+/// `invalid_start` or the walk's failure kind) is the `outcome` of `basin.csv` and the figure's legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutcomeKind {
+    /// It reached the gait.
+    Gait,
+    /// It settled on another attractor (its period in [`Outcome::period_k`]).
+    Other,
+    /// Neither within the steps walked.
+    Undecided,
+    /// The start is not a valid section state.
+    InvalidStart,
+    /// The walk failed: its kind ([`crate::walk::WalkError::kind`]: `rolled_back`, `fell`, ...).
+    Failed(&'static str),
+}
+
+impl std::fmt::Display for OutcomeKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            OutcomeKind::Gait => "gait",
+            OutcomeKind::Other => "other",
+            OutcomeKind::Undecided => "undecided",
+            OutcomeKind::InvalidStart => "invalid_start",
+            OutcomeKind::Failed(kind) => kind,
+        })
+    }
+}
+
 /// What the walk from one start did.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Outcome {
-    /// `gait`, `other`, `undecided`, `invalid_start` or the walk's failure kind.
-    pub kind: String,
+    /// Where it went.
+    #[serde(serialize_with = "crate::fmt::as_text")]
+    pub kind: OutcomeKind,
     /// Steps walked until the outcome was known.
     pub steps: usize,
     /// For `other`, the period of the attractor reached.
@@ -135,13 +164,13 @@ pub struct Outcome {
 
 impl Outcome {
     fn new(
-        kind: &str,
+        kind: OutcomeKind,
         steps: usize,
         period_k: Option<usize>,
         end: Option<SectionState>,
     ) -> Outcome {
         Outcome {
-            kind: kind.to_string(),
+            kind,
             steps,
             period_k,
             end,
@@ -179,31 +208,43 @@ pub(crate) fn classify(
             .any(|g| g.distance(s) < tolerance)
     };
     if start.validate(model).is_err() {
-        return Outcome::new("invalid_start", 0, None, None);
+        return Outcome::new(OutcomeKind::InvalidStart, 0, None, None);
     }
     if near_gait(start) {
-        return Outcome::new("gait", 0, None, Some(*start));
+        return Outcome::new(OutcomeKind::Gait, 0, None, Some(*start));
     }
     let mut walker = match Walker::new(model, opts, start) {
         Ok(w) => w,
-        Err(e) => return Outcome::new(e.kind(), 0, None, None),
+        Err(e) => return Outcome::new(OutcomeKind::Failed(e.kind()), 0, None, None),
     };
     let mut returns: Vec<SectionState> = Vec::with_capacity(max_steps);
     for step in 1..=max_steps {
         // The touchdown's coordinates (a touchdown may be off the section inside another attractor's cycle).
         let s = match walker.step(None).map(|_| walker.touchdown_coordinates()) {
             Ok(s) => s,
-            Err(e) => return Outcome::new(e.kind(), step, None, returns.last().copied()),
+            Err(e) => {
+                return Outcome::new(
+                    OutcomeKind::Failed(e.kind()),
+                    step,
+                    None,
+                    returns.last().copied(),
+                )
+            }
         };
         returns.push(s);
         if near_gait(&s) {
-            return Outcome::new("gait", step, None, Some(s));
+            return Outcome::new(OutcomeKind::Gait, step, None, Some(s));
         }
         if let Some(k) = least_period(&returns, MAX_PERIOD, SETTLED_TOL) {
-            return Outcome::new("other", step, Some(k), Some(s));
+            return Outcome::new(OutcomeKind::Other, step, Some(k), Some(s));
         }
     }
-    Outcome::new("undecided", max_steps, None, returns.last().copied())
+    Outcome::new(
+        OutcomeKind::Undecided,
+        max_steps,
+        None,
+        returns.last().copied(),
+    )
 }
 
 /// The basin on the slice `spec` of `gait`: one [`BasinPoint`] per grid point, row by row (rows are `y`

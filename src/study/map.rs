@@ -37,21 +37,21 @@ use crate::walk::SectionState;
 /// The most values along one axis of a map.
 pub const MAX_MAP_AXIS_POINTS: usize = 2000;
 
-/// `vrw map`'s horizontal axis: `--x-from`, `--x-to`, `--nx` (at most [`MAX_MAP_AXIS_POINTS`]).
+/// `vrw map`'s horizontal axis: `x_from`, `x_to`, `nx` (at most [`MAX_MAP_AXIS_POINTS`]).
 pub const MAP_X_RANGE: RangeNames = RangeNames {
     command: "map x",
-    from: "--x-from",
-    to: "--x-to",
-    points: "--nx",
+    from: "x_from",
+    to: "x_to",
+    points: "nx",
     max_points: MAX_MAP_AXIS_POINTS,
 };
 
-/// `vrw map`'s vertical axis: `--y-from`, `--y-to`, `--ny` (at most [`MAX_MAP_AXIS_POINTS`]).
+/// `vrw map`'s vertical axis: `y_from`, `y_to`, `ny` (at most [`MAX_MAP_AXIS_POINTS`]).
 pub const MAP_Y_RANGE: RangeNames = RangeNames {
     command: "map y",
-    from: "--y-from",
-    to: "--y-to",
-    points: "--ny",
+    from: "y_from",
+    to: "y_to",
+    points: "ny",
     max_points: MAX_MAP_AXIS_POINTS,
 };
 
@@ -79,7 +79,7 @@ impl MapSpec {
         if self.x.param == self.y.param {
             return Err(invalid(
                 "map",
-                format!("--x {} --y {}", self.x.param, self.y.param),
+                format!("`x` {} `y` {}", self.x.param, self.y.param),
                 "the two axes must be different parameters".to_string(),
             ));
         }

@@ -40,9 +40,9 @@ pub const MAX_ORBIT_WALKED_STEPS: usize = 10_000_000;
 /// `vrw orbit`'s range: `--from`, `--to`, `--points` (at most [`MAX_ORBIT_VALUES`]).
 pub const ORBIT_RANGE: RangeNames = RangeNames {
     command: "orbit",
-    from: "--from",
-    to: "--to",
-    points: "--points",
+    from: "from",
+    to: "to",
+    points: "points",
     max_points: MAX_ORBIT_VALUES,
 };
 
@@ -68,9 +68,9 @@ impl OrbitSpec {
             .saturating_mul(self.transient.saturating_add(self.steps));
         if walked > MAX_ORBIT_WALKED_STEPS {
             return Err(ConfigError::InvalidValue {
-                key: "orbit --points".to_string(),
+                key: "points".to_string(),
                 value: format!(
-                    "{} (with --transient {} --steps {})",
+                    "{} (with `transient` {} `steps` {})",
                     self.range.points, self.transient, self.steps
                 ),
                 reason: format!(
@@ -81,14 +81,14 @@ impl OrbitSpec {
         }
         if !(1..=MAX_ORBIT_STEPS).contains(&self.steps) {
             return Err(ConfigError::InvalidValue {
-                key: "orbit --steps".to_string(),
+                key: "steps".to_string(),
                 value: self.steps.to_string(),
                 reason: format!("the recorded steps must be between 1 and {MAX_ORBIT_STEPS}"),
             });
         }
         if self.transient > MAX_ORBIT_STEPS {
             return Err(ConfigError::InvalidValue {
-                key: "orbit --transient".to_string(),
+                key: "transient".to_string(),
                 value: self.transient.to_string(),
                 reason: format!("the transient must be at most {MAX_ORBIT_STEPS} steps"),
             });

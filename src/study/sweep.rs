@@ -49,28 +49,28 @@ pub struct SweepSpec {
     pub points: usize,
 }
 
-/// How a command names a range of parameter values in its errors (its flags), and the most values it takes:
-/// each command states its own limit.
+/// How a command names a range of parameter values in its errors (the fields of its job, which the command
+/// line shows as their flags), and the most values it takes: each command states its own limit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RangeNames {
     /// The command and axis, e.g. `sweep` or `map y`.
     pub command: &'static str,
-    /// The first value's flag, e.g. `--from` or `--y-from`.
+    /// The first value's field, e.g. `from` or `y_from`.
     pub from: &'static str,
-    /// The last value's flag.
+    /// The last value's field.
     pub to: &'static str,
-    /// The number of values' flag, e.g. `--points` or `--ny`.
+    /// The number of values' field, e.g. `points` or `ny`.
     pub points: &'static str,
     /// The most values.
     pub max_points: usize,
 }
 
-/// `vrw sweep`'s range: `--from`, `--to`, `--points` (at most [`MAX_SWEEP_POINTS`]).
+/// `vrw sweep`'s range: `from`, `to`, `points` (at most [`MAX_SWEEP_POINTS`]).
 pub const SWEEP_RANGE: RangeNames = RangeNames {
     command: "sweep",
-    from: "--from",
-    to: "--to",
-    points: "--points",
+    from: "from",
+    to: "to",
+    points: "points",
     max_points: MAX_SWEEP_POINTS,
 };
 
@@ -95,7 +95,7 @@ impl SweepSpec {
         if !(self.from.is_finite() && self.to.is_finite()) || self.from == self.to {
             return Err(invalid(
                 format!(
-                    "{} {} {} {}",
+                    "`{}` {} `{}` {}",
                     names.from,
                     short(self.from),
                     names.to,
@@ -106,17 +106,17 @@ impl SweepSpec {
         }
         if !(2..=names.max_points).contains(&self.points) {
             return Err(invalid(
-                format!("{} {}", names.points, self.points),
+                format!("`{}` {}", names.points, self.points),
                 &format!(
                     "{} takes between 2 and {} values per axis",
                     names.command, names.max_points
                 ),
             ));
         }
-        for (flag, value) in [(names.from, self.from), (names.to, self.to)] {
+        for (field, value) in [(names.from, self.from), (names.to, self.to)] {
             if let Err(e) = parameter.at(value) {
                 return Err(invalid(
-                    format!("{flag} {}", short(value)),
+                    format!("`{field}` {}", short(value)),
                     &format!("the range leaves the valid domain: {e}"),
                 ));
             }

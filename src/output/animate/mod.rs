@@ -88,9 +88,9 @@ impl Default for AnimateOptions {
 #[derive(Debug, thiserror::Error)]
 pub enum AnimateError {
     /// An option is out of range.
-    #[error("invalid {option}: {reason}")]
+    #[error("invalid `{option}`: {reason}")]
     InvalidOption {
-        /// The option (`--fps`, ...).
+        /// The option, by its field (`fps`, ...; the command line shows its flag).
         option: &'static str,
         /// Why.
         reason: String,
@@ -133,12 +133,13 @@ pub enum AnimateError {
 }
 
 impl AnimateOptions {
-    /// Check every option; the error names the option (by its flag) and the value.
+    /// Check every option; the error names the option (by its field, which the command line shows as its flag)
+    /// and the value.
     pub fn validate(&self) -> Result<(), AnimateError> {
         let bad = |option, reason: String| Err(AnimateError::InvalidOption { option, reason });
         if !(1..=MAX_FPS).contains(&self.fps) {
             return bad(
-                "--fps",
+                "fps",
                 format!(
                     "{} frames per second is not between 1 and {MAX_FPS}",
                     self.fps
@@ -147,11 +148,11 @@ impl AnimateOptions {
         }
         if !(self.speed.is_finite() && self.speed > 0.0) {
             return bad(
-                "--speed",
+                "speed",
                 format!("{} is not a positive playback factor", self.speed),
             );
         }
-        for (option, v) in [("--from", self.from), ("--to", self.to)] {
+        for (option, v) in [("from", self.from), ("to", self.to)] {
             if let Some(v) = v.filter(|v| !v.is_finite()) {
                 return bad(option, format!("{v} is not a time"));
             }
@@ -159,12 +160,12 @@ impl AnimateOptions {
         if let (Some(from), Some(to)) = (self.from, self.to) {
             if from >= to {
                 return bad(
-                    "--from",
-                    format!("--from {from} s is not before --to {to} s"),
+                    "from/to",
+                    format!("`from` {from} s is not before `to` {to} s"),
                 );
             }
         }
-        for (option, v) in [("--width", self.width), ("--height", self.height)] {
+        for (option, v) in [("width", self.width), ("height", self.height)] {
             if !FRAME_SIDE.contains(&v) {
                 return bad(
                     option,
@@ -344,18 +345,18 @@ mod tests {
             assert!(e.contains(needle), "{e}");
         };
         let d = AnimateOptions::default;
-        bad(AnimateOptions { fps: 0, ..d() }, "--fps");
-        bad(AnimateOptions { fps: 60, ..d() }, "--fps");
-        bad(AnimateOptions { speed: 0.0, ..d() }, "--speed");
+        bad(AnimateOptions { fps: 0, ..d() }, "`fps`");
+        bad(AnimateOptions { fps: 60, ..d() }, "fps");
+        bad(AnimateOptions { speed: 0.0, ..d() }, "speed");
         bad(
             AnimateOptions {
                 from: Some(3.0),
                 to: Some(1.0),
                 ..d()
             },
-            "--to",
+            "`to`",
         );
-        bad(AnimateOptions { height: 5, ..d() }, "--height");
+        bad(AnimateOptions { height: 5, ..d() }, "`height`");
         assert!(d().validate().is_ok());
     }
 

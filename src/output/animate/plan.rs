@@ -40,10 +40,10 @@ pub(super) fn check_frame_count(run: &RunData, opts: &AnimateOptions) -> Result<
     let frames = ((to - from).max(0.0) * f64::from(opts.fps) / opts.speed).floor() + 1.0;
     if frames > MAX_ANIMATION_FRAMES as f64 {
         return Err(AnimateError::InvalidOption {
-            option: "--speed",
+            option: "speed",
             reason: format!(
                 "{} s of simulated time at speed {} and {} frames per second is {} frames, more than \
-                 {MAX_ANIMATION_FRAMES}: raise --speed, lower --fps or narrow the window with --from/--to",
+                 {MAX_ANIMATION_FRAMES}: raise `speed`, lower `fps` or narrow the window with `from`/`to`",
                 short(to - from),
                 short(opts.speed),
                 opts.fps,

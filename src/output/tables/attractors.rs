@@ -239,7 +239,7 @@ pub(crate) const BASIN: [Column<BasinPoint>; 11] = [
     Column::new(
         "outcome",
         "gait, other, undecided, invalid_start or the walk's failure kind.",
-        |p| Text(p.outcome.kind.clone()),
+        |p| Text(p.outcome.kind.to_string()),
     ),
     Column::new("steps", "Steps walked until the outcome was known.", |p| {
         Count(p.outcome.steps)

@@ -22,7 +22,7 @@ use crate::output::{
 };
 use crate::params::{Config, Params, RearExit};
 use crate::reference::default_initial;
-use crate::study::basin::{BasinPoint, Outcome};
+use crate::study::basin::{BasinPoint, Outcome, OutcomeKind};
 use crate::study::orbit::OrbitColumn;
 use crate::study::{GaitMap, MapSpec, PointStatus, SweepPoint, SweepSpec};
 use crate::walk::{simulate, Sample, SectionState, StepReport, Trajectory};
@@ -255,20 +255,20 @@ fn every_table_reads_back_by_name() {
     check_by_name(&path("branch.csv"), &BRANCH, &["viscosity"], &branch);
 
     let start = SectionState::from_array([0.7, 1.0, -0.2]);
-    let point = |ix, end: Option<SectionState>, kind: &str| BasinPoint {
+    let point = |ix, end: Option<SectionState>, kind: OutcomeKind| BasinPoint {
         ix,
         iy: 1,
         start,
         outcome: Outcome {
-            kind: kind.to_string(),
+            kind,
             steps: 7,
             period_k: end.map(|_| 2),
             end,
         },
     };
     let grid = vec![vec![
-        point(0, Some(f.gait.section), "other"),
-        point(1, None, "fell"),
+        point(0, Some(f.gait.section), OutcomeKind::Other),
+        point(1, None, OutcomeKind::Failed("fell")),
     ]];
     write_basin_csv(&path("basin.csv"), false, &grid).unwrap();
     check_by_name(&path("basin.csv"), &BASIN, &[], &grid[0]);
