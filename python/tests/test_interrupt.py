@@ -2,12 +2,18 @@
 discarded, and the next call runs normally."""
 
 import _thread
+import signal
 import threading
 import time
 
 import pytest
 
 import vrw
+
+# `_thread.interrupt_main` does nothing where Python does not handle SIGINT: a process started in the
+# background by a shell without job control (`.ci/run &`) inherits SIGINT ignored. Ctrl-C is what these tests
+# are about, so they install Python's own handler.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def test_ctrl_c_during_a_long_sweep_raises_keyboard_interrupt_within_a_second():
