@@ -113,20 +113,21 @@ pub fn swinging<T: Real>(q: &CoordsOf<T>) -> bool {
     q[L3] != T::zero()
 }
 
-/// Position, Jacobian and velocity-product acceleration of one point of the wheel.
+/// Position, Jacobian and velocity-product acceleration of one point of a mechanism with `N` coordinates (the
+/// wheel's by default).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PointKinematics<T: Real = f64> {
+pub struct PointKinematics<T: Real = f64, const N: usize = NQ> {
     /// Position in the slope frame \[m\].
     pub position: Vector2<T>,
     /// `J = dp/dq`.
-    pub jacobian: PointJacobian<T>,
+    pub jacobian: SMatrix<T, 2, N>,
     /// `dJ/dt q'`: the acceleration of the point when `q'' = 0` \[m/s^2\].
     pub velocity_product: Vector2<T>,
 }
 
-impl<T: Real> PointKinematics<T> {
+impl<T: Real, const N: usize> PointKinematics<T, N> {
     /// Velocity `J q'` of the point \[m/s\].
-    pub fn velocity(&self, qd: &CoordsOf<T>) -> Vector2<T> {
+    pub fn velocity(&self, qd: &SVector<T, N>) -> Vector2<T> {
         self.jacobian * qd
     }
 }
@@ -149,9 +150,9 @@ pub(crate) struct EquationsOfMotion<T: Real = f64> {
 }
 
 /// The physical constants the equations of motion use, as [`Real`]s: the [`Params`] values (as `f64` for the
-/// walk, or with one of them carrying a derivative, see [`Mechanics::seeded`]) and the gravity vector.
+/// walk, or with one of them carrying a derivative, see `Mechanics::seeded`) and the gravity vector.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Mechanics<T: Real = f64> {
+pub struct Mechanics<T: Real = f64> {
     /// `mH` \[kg\].
     pub hub_mass: T,
     /// `IH` \[kg m^2\].

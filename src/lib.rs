@@ -17,6 +17,7 @@
 //! | (beside the pipeline, importing none of the wheel) the continuation engine | [`continuation`] |
 //! | parameters and options | [`params`] |
 //! | equations of motion, Eq. (1) | [`dynamics`] |
+//! | the interface any planar walker gives the engine; its constrained solves; the compass gait | [`mechanism`] |
 //! | contacts, stoppers, KKT and impulse solves, Eqs. (2), (5) | [`contact`] |
 //! | the hybrid walk: phases, events, the DLS-indicator impact procedure | [`walk`], [`walk::impact`] |
 //! | exact derivatives of the step map: variational equations, saltation matrices | [`variational`] |
@@ -38,6 +39,9 @@
 //!   [`params::ConfigError`].
 //! - **Model**: [`dynamics::Model`], the equations of motion built from [`params::Params`]; the contact and
 //!   impulse solves [`contact::constrained_dynamics`] and [`contact::impulse`].
+//! - **Walkers**: the [`mechanism::Mechanism`] interface (the wheel's [`dynamics::Model`] is one, the
+//!   [`mechanism::compass::Compass`] gait another), and the force-level and impulse problems of any of them,
+//!   [`mechanism::constrained::accelerations`] and [`mechanism::constrained::impulse`].
 //! - **Integration**: the [`integrate::OdeSystem`] trait, the [`integrate::Dopri5`] solver with its
 //!   [`integrate::DenseStep`] and [`integrate::Tolerances`], and [`integrate::Method`].
 //! - **The walk**: [`walk::Walker`] (one step at a time), [`walk::simulate`] and [`walk::simulate_streaming`]
@@ -121,6 +125,7 @@ pub mod family;
 pub mod fmt;
 pub mod gait;
 pub mod integrate;
+pub mod mechanism;
 pub mod output;
 pub mod params;
 pub mod reference;

@@ -37,6 +37,7 @@ const PIPELINE: &[&str] = &[
     "continuation",
     "params",
     "dynamics",
+    "mechanism",
     "contact",
     "walk",
     "variational",
@@ -915,6 +916,62 @@ fn production_functions_are_short() {
         "production functions over {MAX_FUNCTION_LINES} lines of code:\n  {}",
         long.join("\n  ")
     );
+}
+
+/// The wheel's own names: its coordinate count and indices, its legs. The engine is to take any planar walker
+/// through `mechanism::Mechanism` (docs/model.md section 9), after which none of these is left in the layers
+/// above the wheel's model (`src/dynamics.rs`, `src/mechanism/wheel.rs`).
+const WHEEL_NAMES: &[&str] = &["NQ", "L1", "L2", "L3", "THETA", "LegIndex", "Leg"];
+
+/// The directories that are to take any walker, and the most uses of [`WHEEL_NAMES`] they hold today: the
+/// count may only fall (lower it as the walk, the contact solves and the derivatives move onto the interface).
+const WHEEL_NAMES_LEFT: &[(&str, usize)] = &[
+    ("mechanism/", 0),
+    ("contact/", 96),
+    ("walk/", 141),
+    ("variational/", 73),
+    ("gait/", 5),
+    ("family/", 0),
+    ("study/", 5),
+    ("output/", 7),
+    ("app/", 1),
+];
+
+/// Uses of [`WHEEL_NAMES`] in the production code of the files under `dir` (of `src/`), `mechanism/wheel.rs`
+/// (the wheel behind the interface) left out, and where they are.
+fn wheel_names_in(files: &[(String, String)], dir: &str) -> (usize, Vec<String>) {
+    let mut count = 0;
+    let mut places = Vec::new();
+    for (rel, text) in files.iter().filter(|(rel, _)| rel.starts_with(dir)) {
+        if rel == "mechanism/wheel.rs" {
+            continue;
+        }
+        let (tokens, _) = strip_tests(tokenize(text));
+        for t in &tokens {
+            if matches!(&t.tok, Tok::Ident(name) if WHEEL_NAMES.contains(&name.as_str())) {
+                count += 1;
+                places.push(format!("src/{rel}:{}", t.line));
+            }
+        }
+    }
+    (count, places)
+}
+
+#[test]
+fn the_engine_holds_no_more_of_the_wheel_than_before() {
+    let files = source_files();
+    let mut grown = Vec::new();
+    for &(dir, most) in WHEEL_NAMES_LEFT {
+        let (count, places) = wheel_names_in(&files, dir);
+        println!("src/{dir}: {count} uses of the wheel's names (at most {most})");
+        if count > most {
+            grown.push(format!(
+                "src/{dir}: {count} uses of {WHEEL_NAMES:?}, more than {most}: {}",
+                places.join(", ")
+            ));
+        }
+    }
+    assert!(grown.is_empty(), "{}", grown.join("\n"));
 }
 
 #[test]

@@ -1,0 +1,189 @@
+//! The compass-gait biped of Goswami, Thuilot and Espiau ("A study of the passive gait of a compass-like
+//! biped robot: symmetry and chaos", IJRR 17(12):1282-1301, 1998; docs/model.md section 13): two rigid legs of
+//! length `leg_length = a + b` hinged at the hip, a point mass `leg_mass` on each at `a = leg_mass_offset` from
+//! its foot, `hip_mass` at the hip, point feet.
+//!
+//! Coordinates `q = (x, z, theta1, theta2)`: the hip in the slope frame (`x` down the slope, `z` normal to it)
+//! and each leg's angle from the downward normal of the slope, positive toward `+x` (a leg ahead of the hip has
+//! a positive angle). The feet are the contact points 0 and 1; a stance foot is held by its contact's two rows,
+//! as the wheel's tips are (docs/model.md section 3), so that the force-level and impulse problems of the paper
+//! apply unchanged ([`super::constrained`]).
+
+use nalgebra::SVector;
+
+use super::assembly::{along_leg, point_mass_equations, point_mass_potential, up, PointMass};
+use super::{Equations, Mechanism, PointKinematics, Real};
+use crate::params::ConfigError;
+
+/// Index of the hip's `x` in `q`.
+pub const X: usize = 0;
+/// Index of the hip's `z` in `q`.
+pub const Z: usize = 1;
+/// Index of Leg 1's angle in `q`.
+pub const THETA1: usize = 2;
+/// Index of Leg 2's angle in `q`.
+pub const THETA2: usize = 3;
+
+/// The compass gait's parameters; the defaults are Goswami, Thuilot and Espiau's (their Table 1).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Compass {
+    /// Hip mass `mH` \[kg\]. Default 10.
+    pub hip_mass: f64,
+    /// Mass of each leg, a point at `leg_mass_offset` from its foot \[kg\]. Default 5.
+    pub leg_mass: f64,
+    /// Leg length `l = a + b` \[m\]. Default 1.
+    pub leg_length: f64,
+    /// Distance `a` of a leg's mass from its foot \[m\]. Default 0.5.
+    pub leg_mass_offset: f64,
+    /// Gravitational acceleration \[m/s^2\]. Default 9.81.
+    pub gravity: f64,
+    /// Slope `phi` of the ground \[rad\] (downhill toward `+x`). Default 3 degrees.
+    pub slope: f64,
+}
+
+impl Default for Compass {
+    fn default() -> Compass {
+        Compass {
+            hip_mass: 10.0,
+            leg_mass: 5.0,
+            leg_length: 1.0,
+            leg_mass_offset: 0.5,
+            gravity: 9.81,
+            slope: 3f64.to_radians(),
+        }
+    }
+}
+
+/// The compass gait's constants over a [`Real`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CompassConstants<T: Real> {
+    /// `mH` \[kg\].
+    pub hip_mass: T,
+    /// `m` \[kg\].
+    pub leg_mass: T,
+    /// `l` \[m\].
+    pub leg_length: T,
+    /// `a` \[m\].
+    pub leg_mass_offset: T,
+    /// `g (-sin phi, cos phi)` \[m/s^2\].
+    pub up: nalgebra::Vector2<T>,
+}
+
+impl Compass {
+    /// Checks every rule: positive masses, length and gravity, the leg's mass on the leg
+    /// (`0 <= leg_mass_offset <= leg_length`), a slope between -90 and 90 degrees. Every broken rule is
+    /// reported.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        use crate::params::{finite, positive};
+        let mut errors: Vec<ConfigError> = [
+            positive("hip_mass", self.hip_mass),
+            positive("leg_mass", self.leg_mass),
+            positive("leg_length", self.leg_length),
+            positive("gravity", self.gravity),
+            finite("leg_mass_offset", self.leg_mass_offset),
+            finite("slope", self.slope),
+        ]
+        .into_iter()
+        .filter_map(Result::err)
+        .collect();
+        if self.leg_mass_offset.is_finite()
+            && !(0.0..=self.leg_length).contains(&self.leg_mass_offset)
+        {
+            errors.push(ConfigError::InvalidValue {
+                key: "leg_mass_offset".to_string(),
+                value: crate::fmt::short(self.leg_mass_offset),
+                reason: format!(
+                    "the leg's mass must lie on the leg: between 0 and leg_length = {}",
+                    crate::fmt::short(self.leg_length)
+                ),
+            });
+        }
+        if self.slope.abs() >= std::f64::consts::FRAC_PI_2 {
+            errors.push(ConfigError::InvalidValue {
+                key: "slope".to_string(),
+                value: crate::fmt::short(self.slope),
+                reason: "the slope must be between -pi/2 and pi/2 rad".to_string(),
+            });
+        }
+        ConfigError::all(errors)
+    }
+
+    /// The hip mass and the two leg masses.
+    fn masses<T: Real>(
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> [PointMass<T, 4>; 3] {
+        let from_hip = c.leg_length - c.leg_mass_offset;
+        [
+            PointMass {
+                mass: c.hip_mass,
+                point: along_leg(q, qd, [X, Z, THETA1], T::zero()),
+            },
+            PointMass {
+                mass: c.leg_mass,
+                point: along_leg(q, qd, [X, Z, THETA1], from_hip),
+            },
+            PointMass {
+                mass: c.leg_mass,
+                point: along_leg(q, qd, [X, Z, THETA2], from_hip),
+            },
+        ]
+    }
+}
+
+impl Mechanism<4> for Compass {
+    type Constants<T: Real> = CompassConstants<T>;
+
+    fn name(&self) -> &'static str {
+        "compass"
+    }
+
+    fn coordinates(&self) -> [&'static str; 4] {
+        ["x", "z", "theta1", "theta2"]
+    }
+
+    fn constants<T: Real>(&self, value: &dyn Fn(&'static str, f64) -> T) -> CompassConstants<T> {
+        CompassConstants {
+            hip_mass: value("hip_mass", self.hip_mass),
+            leg_mass: value("leg_mass", self.leg_mass),
+            leg_length: value("leg_length", self.leg_length),
+            leg_mass_offset: value("leg_mass_offset", self.leg_mass_offset),
+            up: up(value("gravity", self.gravity), value("slope", self.slope)),
+        }
+    }
+
+    fn equations<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Equations<T, 4> {
+        point_mass_equations(&Compass::masses(c, q, qd), c.up)
+    }
+
+    fn contact_points(&self) -> usize {
+        2
+    }
+
+    fn contact<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+        i: usize,
+    ) -> PointKinematics<T, 4> {
+        let leg = if i == 0 { THETA1 } else { THETA2 };
+        along_leg(q, qd, [X, Z, leg], c.leg_length)
+    }
+
+    fn potential_energy(&self, q: &SVector<f64, 4>) -> f64 {
+        let c = self.constants_f64();
+        point_mass_potential(&Compass::masses(&c, q, &SVector::zeros()), c.up)
+    }
+
+    fn damper_power(&self, _q: &SVector<f64, 4>, _qd: &SVector<f64, 4>) -> f64 {
+        0.0
+    }
+}

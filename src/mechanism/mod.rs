@@ -1,0 +1,97 @@
+//! The interface a planar walker gives the engine (docs/model.md section 13): named generalized coordinates, the
+//! equations of motion `M(q) q'' + h(q, q') = J^T lambda` of Eq. (1) over any [`Real`] (so that the exact
+//! derivatives differentiate the very equations a walk integrates), the ground-contact points with their
+//! Jacobians, and the energies the audit closes.
+//!
+//! The paper's procedure (Eqs. (1)-(9)) needs nothing else of a walker: the force-level problem of a phase and
+//! the impulse problem of a touchdown are solved for any [`Mechanism`] by [`constrained`]. The wheel
+//! ([`crate::dynamics::Model`]) is one mechanism (`wheel.rs`, where its own reduced solver is checked against the
+//! general one); the compass-gait biped of Goswami, Thuilot and Espiau ([`compass`]) is another, assembled from
+//! point masses by [`assembly`].
+//!
+//! This is the first layer of the walker-models work: the walk, the gait search and the studies still run the
+//! wheel through `walk/`; they move onto this interface next (docs/model.md section 13).
+
+pub mod assembly;
+pub mod compass;
+pub mod constrained;
+mod wheel;
+
+use nalgebra::{SMatrix, SVector};
+
+pub use crate::dynamics::{PointKinematics, Real};
+
+/// `M(q)` and `h(q, q')` at one state: Eq. (1) reads `M q'' + h = J^T lambda`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Equations<T: Real, const N: usize> {
+    /// The mass matrix (symmetric, positive definite for an assembled mechanism).
+    pub mass: SMatrix<T, N, N>,
+    /// The bias: Coriolis and centrifugal terms, gravity, springs and dampers.
+    pub bias: SVector<T, N>,
+}
+
+/// A planar walker with `N` generalized coordinates, as the engine sees it.
+///
+/// The constants of its equations (masses, lengths, stiffnesses, the slope and gravity) are a
+/// [`Mechanism::Constants`] over any [`Real`]: `f64` for a walk, or with one of them a dual number carrying
+/// `d/dp` for the exact `dP/dp` (docs/model.md section 10).
+pub trait Mechanism<const N: usize> {
+    /// The constants the equations use, over a [`Real`].
+    type Constants<T: Real>: Copy;
+
+    /// The walker's name, as a configuration names it (`model = "compass"`).
+    fn name(&self) -> &'static str;
+
+    /// The names of the generalized coordinates, in the order of `q` (the columns of the outputs).
+    fn coordinates(&self) -> [&'static str; N];
+
+    /// The constants, each made a `T` by `value(key, value)` (the key as in a configuration file).
+    fn constants<T: Real>(&self, value: &dyn Fn(&'static str, f64) -> T) -> Self::Constants<T>;
+
+    /// The constants as `f64`.
+    fn constants_f64(&self) -> Self::Constants<f64> {
+        self.constants(&|_, v| v)
+    }
+
+    /// `M(q)` and `h(q, q')` (Eq. (1)) with the constants `c`.
+    fn equations<T: Real>(
+        &self,
+        c: &Self::Constants<T>,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+    ) -> Equations<T, N>;
+
+    /// Number of ground-contact points (feet, or tips of legs).
+    fn contact_points(&self) -> usize;
+
+    /// Position, Jacobian and `dJ/dt q'` of contact point `i` (`0..contact_points()`), in the slope frame
+    /// (`x` down the slope, `z` normal to it: a contact's tangential row is `x`, its normal row `z`).
+    fn contact<T: Real>(
+        &self,
+        c: &Self::Constants<T>,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+        i: usize,
+    ) -> PointKinematics<T, N>;
+
+    /// Potential energy \[J\]: gravity and springs.
+    fn potential_energy(&self, q: &SVector<f64, N>) -> f64;
+
+    /// The power the dampers take out of the motion (at least 0) \[W\]: with the impacts' losses, what the energy
+    /// audit of a step adds to the change of `T + V`.
+    fn damper_power(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64;
+
+    /// Kinetic energy `1/2 q'^T M q'` \[J\].
+    fn kinetic_energy(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64 {
+        let e = self.equations(&self.constants_f64(), q, qd);
+        0.5 * qd.dot(&(e.mass * qd))
+    }
+
+    /// Total mechanical energy `T + V` \[J\].
+    fn energy(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64 {
+        self.kinetic_energy(q, qd) + self.potential_energy(q)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,224 @@
+//! Tests of the interface on the compass gait: the laws its equations and the general solves must obey.
+
+use nalgebra::{SVector, Vector2};
+
+use super::compass::{Compass, THETA1, THETA2, X, Z};
+use super::constrained::{accelerations, impulse, Row};
+use super::Mechanism;
+
+type Q = SVector<f64, 4>;
+
+/// The compass gait just before heel strike: Leg 1 the stance leg behind the hip (`theta1 = -a`), Leg 2's
+/// foot reaching the ground ahead (`theta2 = a`), velocities made consistent with Leg 1's foot held.
+fn before_heel_strike(compass: &Compass, a: f64) -> (Q, Q) {
+    let q = Q::from([0.0, a.cos(), -a, a]);
+    let guess = Q::from([0.9, 0.1, -1.1, 0.6]);
+    let held = impulse(compass, &q, &guess, &Row::contact(0)).unwrap();
+    (q, held.qd_plus)
+}
+
+/// `sum m (p - o) x v` over the walker's masses (`o` the point about which), or over Leg 1's mass alone.
+fn angular_momentum(compass: &Compass, q: &Q, qd: &Q, about: Vector2<f64>, leg1_only: bool) -> f64 {
+    let from_hip = compass.leg_length - compass.leg_mass_offset;
+    let hip = Vector2::new(q[X], q[Z]);
+    let hip_v = Vector2::new(qd[X], qd[Z]);
+    let leg = |k: usize| {
+        let (s, c) = q[k].sin_cos();
+        let p = hip + from_hip * Vector2::new(s, -c);
+        let v = hip_v + from_hip * qd[k] * Vector2::new(c, s);
+        (p, v)
+    };
+    let cross = |m: f64, (p, v): (Vector2<f64>, Vector2<f64>)| m * (p - about).perp(&v);
+    if leg1_only {
+        return cross(compass.leg_mass, leg(THETA1));
+    }
+    cross(compass.hip_mass, (hip, hip_v))
+        + cross(compass.leg_mass, leg(THETA1))
+        + cross(compass.leg_mass, leg(THETA2))
+}
+
+/// The mass matrix is symmetric positive definite, and the potential energy is that of the three masses.
+#[test]
+fn the_compass_mass_matrix_is_symmetric_positive_definite() {
+    let compass = Compass::default();
+    let q = Q::from([0.3, 0.9, -0.25, 0.4]);
+    let e = compass.equations(&compass.constants_f64(), &q, &Q::zeros());
+    assert_eq!(e.mass, e.mass.transpose());
+    assert!(e.mass.symmetric_eigenvalues().min() > 0.0);
+    // Total mass on the hip's translation.
+    let total = compass.hip_mass + 2.0 * compass.leg_mass;
+    assert!((e.mass[(X, X)] - total).abs() < 1e-12 && (e.mass[(Z, Z)] - total).abs() < 1e-12);
+    let g = compass.gravity;
+    let (sp, cp) = compass.slope.sin_cos();
+    let height = |p: Vector2<f64>| g * (-p.x * sp + p.y * cp);
+    let b = compass.leg_length - compass.leg_mass_offset;
+    let hip = Vector2::new(q[X], q[Z]);
+    let leg = |t: f64| hip + b * Vector2::new(t.sin(), -t.cos());
+    let expected = compass.hip_mass * height(hip)
+        + compass.leg_mass * (height(leg(q[THETA1])) + height(leg(q[THETA2])));
+    assert!((compass.potential_energy(&q) - expected).abs() < 1e-12);
+}
+
+/// In single support (Leg 1's foot held) the walker conserves `T + V` and its foot stays put: the bias `h`
+/// holds the right Coriolis and gravity terms (integrated by RK4 over 0.4 s).
+#[test]
+fn single_support_conserves_energy_and_holds_the_foot() {
+    let compass = Compass::default();
+    let (q0, qd0) = before_heel_strike(&compass, 0.15);
+    let rows = Row::contact(0);
+    let field = |q: &Q, qd: &Q| (*qd, accelerations(&compass, q, qd, &rows).unwrap().qdd);
+    let (mut q, mut qd) = (q0, qd0);
+    let dt = 1e-3;
+    for _ in 0..400 {
+        let k1 = field(&q, &qd);
+        let k2 = field(&(q + 0.5 * dt * k1.0), &(qd + 0.5 * dt * k1.1));
+        let k3 = field(&(q + 0.5 * dt * k2.0), &(qd + 0.5 * dt * k2.1));
+        let k4 = field(&(q + dt * k3.0), &(qd + dt * k3.1));
+        q += dt / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+        qd += dt / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+    }
+    let drift = compass.energy(&q, &qd) - compass.energy(&q0, &qd0);
+    assert!(drift.abs() < 1e-9, "energy drift {drift:e} J");
+    let c = compass.constants_f64();
+    let foot0 = compass.contact(&c, &q0, &qd0, 0).position;
+    let foot = compass.contact(&c, &q, &qd, 0);
+    assert!((foot.position - foot0).amax() < 1e-9 && foot.velocity(&qd).amax() < 1e-9);
+}
+
+/// Heel strike with the traditional impact (the new foot held, the rear one released): the general impulse
+/// solve conserves the walker's angular momentum about the new foot and Leg 1's about the hip, the two laws
+/// Goswami, Thuilot and Espiau's impact model is made of (their Eq. (4)), and the new foot stops.
+#[test]
+fn heel_strike_conserves_goswamis_angular_momenta() {
+    let compass = Compass::default();
+    let (q, qd) = before_heel_strike(&compass, 0.2);
+    let c = compass.constants_f64();
+    let new_foot = compass.contact(&c, &q, &qd, 1).position;
+    assert!(new_foot.y.abs() < 1e-12, "Leg 2's foot is on the ground");
+    let after = impulse(&compass, &q, &qd, &Row::contact(1)).unwrap();
+    let hip = Vector2::new(q[X], q[Z]);
+    for (about, leg1_only) in [(new_foot, false), (hip, true)] {
+        let before = angular_momentum(&compass, &q, &qd, about, leg1_only);
+        let after = angular_momentum(&compass, &q, &after.qd_plus, about, leg1_only);
+        assert!((after - before).abs() < 1e-12, "{before} -> {after}");
+    }
+    assert!(
+        compass
+            .contact(&c, &q, &after.qd_plus, 1)
+            .velocity(&after.qd_plus)
+            .amax()
+            < 1e-12
+    );
+    // The rear foot leaves the ground (its normal velocity is upward), and the impact loses energy.
+    assert!(
+        compass
+            .contact(&c, &q, &after.qd_plus, 0)
+            .velocity(&after.qd_plus)
+            .y
+            > 0.0
+    );
+    assert!(compass.energy(&q, &after.qd_plus) < compass.energy(&q, &qd));
+}
+
+/// The DLS indicator `lambda_I4` of the compass gait (docs/model.md section 13): the rear foot's normal impulse
+/// of the impact with both feet held (the paper's (A1)). Rigid legs leave double support no freedom (four rows
+/// for four coordinates: the walker stops), so its sign decides the impact: negative, the ground would have to
+/// pull the rear foot down to stop the walker, which it cannot, and the rear foot leaves (the traditional
+/// impact); positive, the walker stops in double support.
+#[test]
+fn the_rear_foot_of_the_compass_gait_leaves_at_heel_strike() {
+    let compass = Compass::default();
+    let (q, qd) = before_heel_strike(&compass, 0.2);
+    let both = [Row::contact(0), Row::contact(1)].concat();
+    let held = impulse(&compass, &q, &qd, &both).unwrap();
+    assert!(
+        held.qd_plus.amax() < 1e-12,
+        "held by both feet, the walker stops: {:?}",
+        held.qd_plus
+    );
+    let lambda_i4 = held.impulses[1];
+    assert!(lambda_i4 < 0.0, "lambda_I4 = {lambda_i4}");
+}
+
+/// Bad parameters are refused, every broken rule named.
+#[test]
+fn bad_compass_parameters_name_every_key() {
+    let bad = Compass {
+        hip_mass: -1.0,
+        leg_mass_offset: 2.0,
+        slope: 2.0,
+        ..Compass::default()
+    };
+    let message = bad.validate().unwrap_err().to_string();
+    for key in ["hip_mass", "leg_mass_offset", "slope"] {
+        assert!(message.contains(key), "{message}");
+    }
+    assert!(Compass::default().validate().is_ok());
+}
+
+/// The compass gait's equations over dual numbers carry their exact derivatives (as the wheel's do for the
+/// step map's `DP` and `dP/dp`, docs/model.md section 10): `d(M, h)/d leg_mass` and `d(M, h)/d theta1` agree with
+/// central differences.
+#[test]
+fn the_compass_equations_differentiate_exactly() {
+    use crate::variational::Dual;
+    let compass = Compass::default();
+    let q = Q::from([0.1, 0.95, -0.2, 0.3]);
+    let qd = Q::from([0.8, -0.1, -1.2, 0.9]);
+    let flat = |e: super::Equations<f64, 4>| {
+        let mut v: Vec<f64> = e.mass.as_slice().to_vec();
+        v.extend_from_slice(e.bias.as_slice());
+        v
+    };
+    let seed = |on: bool, x: f64| Dual::<1>::new(x, SVector::from([f64::from(u8::from(on))]));
+    // By the mass of the legs: the constants seeded.
+    let c = compass.constants(&|key, v| seed(key == "leg_mass", v));
+    let lift = |x: &Q| x.map(|v| seed(false, v));
+    let dual = compass.equations(&c, &lift(&q), &lift(&qd));
+    let exact: Vec<f64> = dual
+        .mass
+        .iter()
+        .chain(dual.bias.iter())
+        .map(|d| d.eps[0])
+        .collect();
+    let h = 1e-6;
+    let at = |m: f64| {
+        let shifted = Compass {
+            leg_mass: m,
+            ..compass
+        };
+        flat(shifted.equations(&shifted.constants_f64(), &q, &qd))
+    };
+    let (plus, minus) = (at(compass.leg_mass + h), at(compass.leg_mass - h));
+    for (k, e) in exact.iter().enumerate() {
+        let fd = (plus[k] - minus[k]) / (2.0 * h);
+        assert!(
+            (e - fd).abs() < 1e-7 * (1.0 + fd.abs()),
+            "entry {k}: {e} vs {fd}"
+        );
+    }
+    // By the angle of Leg 1: the coordinate seeded.
+    let c = compass.constants(&|_, v| seed(false, v));
+    let mut qs = lift(&q);
+    qs[THETA1] = seed(true, q[THETA1]);
+    let dual = compass.equations(&c, &qs, &lift(&qd));
+    let exact: Vec<f64> = dual
+        .mass
+        .iter()
+        .chain(dual.bias.iter())
+        .map(|d| d.eps[0])
+        .collect();
+    let at = |t: f64| {
+        let mut shifted = q;
+        shifted[THETA1] = t;
+        flat(compass.equations(&compass.constants_f64(), &shifted, &qd))
+    };
+    let (plus, minus) = (at(q[THETA1] + h), at(q[THETA1] - h));
+    for (k, e) in exact.iter().enumerate() {
+        let fd = (plus[k] - minus[k]) / (2.0 * h);
+        assert!(
+            (e - fd).abs() < 1e-7 * (1.0 + fd.abs()),
+            "entry {k}: {e} vs {fd}"
+        );
+    }
+}
