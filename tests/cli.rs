@@ -1106,3 +1106,76 @@ fn continue_follows_a_border_curve_in_two_parameters() {
     );
     assert_error(&run, &["--two-param"]);
 }
+
+/// `vrw gait --model simplest` and `--model compass` find the classic walkers' gaits (docs/model.md section 13):
+/// gait.json names the section by the model's coordinates and holds the period and the multipliers; the
+/// parameters come from --set and a TOML file as the wheel's do.
+#[test]
+fn gait_of_the_classic_walkers() {
+    let run = command_in(
+        temp_dir_with(&[]),
+        "gait",
+        &["--model", "simplest", "--set", "slope=0.009"],
+    );
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let gait: Value = serde_json::from_str(&run.read("gait.json")).unwrap();
+    assert_eq!(gait["model"], "simplest");
+    let theta = gait["gait"]["section"]["theta"].as_f64().unwrap();
+    assert!((theta - 0.2003).abs() < 5e-5, "{gait}");
+    assert!(gait["gait"]["section"]["theta_dot"].as_f64().unwrap() < 0.0);
+    assert_eq!(gait["gait"]["stability"], "stable");
+    assert_eq!(
+        gait["gait"]["floquet_multipliers"]
+            .as_array()
+            .unwrap()
+            .len(),
+        2
+    );
+    let dir = temp_dir_with(&[("compass.toml", "leg_mass = 5\nslope = 0.0523598775598\n")]);
+    let run = command_in(
+        dir,
+        "gait",
+        &["--model", "compass", "--config", "compass.toml"],
+    );
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let gait: Value = serde_json::from_str(&run.read("gait.json")).unwrap();
+    let section = gait["gait"]["section"].as_object().unwrap();
+    let names: Vec<&str> = section.keys().map(String::as_str).collect();
+    assert_eq!(names.len(), 3, "{section:?}");
+    assert!(["theta1", "theta1_dot", "theta2_dot"]
+        .iter()
+        .all(|n| section.contains_key(*n)));
+    assert!(gait["gait"]["period"].as_f64().unwrap() > 0.0);
+    assert!(gait["gait"]["lambda_I4"].as_f64().unwrap() < 0.0);
+    assert!(run.stdout().contains("stable"), "{}", run.stdout());
+}
+
+/// A walker's bad input names the problem: an unknown model, a key it does not have, a bad value, a start of
+/// the wrong size, an option only the wheel has.
+#[test]
+fn bad_walker_input_names_the_problem() {
+    let cases: [(&[&str], &str); 5] = [
+        (&["--model", "biped"], "unknown model \"biped\""),
+        (
+            &["--model", "simplest", "--set", "viscosity=3"],
+            "unknown key `viscosity`",
+        ),
+        (
+            &["--model", "compass", "--set", "hip_mass=-1"],
+            "`hip_mass`",
+        ),
+        (
+            &["--model", "simplest", "--initial", "0.2"],
+            "the section of `simplest` has 2",
+        ),
+        (
+            &["--model", "compass", "--check-jacobian"],
+            "`--check-jacobian`",
+        ),
+    ];
+    for (args, needle) in cases {
+        let run = command_in(temp_dir_with(&[]), "gait", args);
+        assert_error(&run, &[needle]);
+        assert!(!run.out.join("gait.json").exists(), "{args:?}");
+    }
+}

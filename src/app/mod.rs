@@ -17,6 +17,7 @@ mod map;
 mod orbit;
 mod simulate;
 mod sweep;
+mod walkers;
 
 pub use crate::family::curves::CurveRecord;
 pub use crate::family::diagram::{EndRecord, KNOWN_GAIT_TOL, MAX_FAMILIES, SAME_END_TOL};
@@ -47,6 +48,7 @@ pub use simulate::{
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
+pub use walkers::{run_walker_gait, Walker, WalkerGait, WalkerGaitJob, WalkerGaitSummary, MODELS};
 
 use crate::dynamics::Model;
 use crate::output::manifest::{RunDir, RunStatus};

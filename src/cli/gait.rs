@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 
-use vrw::app::{run_gait, GaitJob};
+use vrw::app::{run_gait, run_walker_gait, GaitJob, Walker, WalkerGait, WalkerGaitJob};
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::gait::{Gait, GaitOptions, JacobianCheck};
 use vrw::walk::SectionState;
@@ -18,15 +18,21 @@ const DEFAULT_TOLERANCE: &str = "1e-10";
 #[derive(Debug, Args)]
 pub(super) struct GaitArgs {
     #[command(flatten)]
-    model: ModelArgs,
-    /// Where the search starts on the Poincare section, `L2,thetadot,L2dot` (with friction, `,slip` after them for
-    /// a slipping stance tip); default as for simulate.
+    params: ModelArgs,
+    /// The walker: `vrw`, the viscoelastic-legged rimless wheel (default); `simplest`, the simplest walking
+    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al. (docs/model.md section 13). For the
+    /// last two, --config and --set take their parameters and gait.json names the section by their coordinates.
+    #[arg(long, default_value = "vrw")]
+    model: String,
+    /// Where the search starts on the Poincare section: for the wheel `L2,thetadot,L2dot` (with friction,
+    /// `,slip` after them for a slipping stance tip), default as for simulate; for another model its section's
+    /// coordinates (`theta,theta_dot` for simplest, `theta1,theta1_dot,theta2_dot` for compass).
     #[arg(
         long,
         value_name = "L2,THETADOT,L2DOT[,SLIP]",
         allow_hyphen_values = true
     )]
-    initial: Option<SectionState>,
+    initial: Option<String>,
     /// Steps walked before Newton's method starts.
     #[arg(long = "transient", default_value_t = GaitOptions::default().transient_steps)]
     transient_steps: usize,
@@ -68,6 +74,10 @@ fn parse_parameter(key: &str) -> Result<&'static str, String> {
 
 /// Run `vrw gait` and print its summary.
 pub(super) fn run(args: GaitArgs) -> Result<()> {
+    let sets = &args.params.set;
+    if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
+        return run_walker(&args, walker);
+    }
     let job = gait_job(&args)?;
     super::check_out(&job.out_dir, "gait", job.overwrite)?;
     let bar = progress_bar(
@@ -109,9 +119,17 @@ pub(super) fn run(args: GaitArgs) -> Result<()> {
 
 /// The gait search the options describe (the model loaded from its file and flags, Ctrl-C armed).
 fn gait_job(args: &GaitArgs) -> Result<GaitJob> {
+    let initial = args
+        .initial
+        .as_deref()
+        .map(|text| {
+            text.parse::<SectionState>()
+                .with_context(|| format!("invalid value '{}' for `initial`", vrw::fmt::clip(text)))
+        })
+        .transpose()?;
     Ok(GaitJob {
-        config: args.model.load()?,
-        initial: args.initial,
+        config: args.params.load()?,
+        initial,
         options: GaitOptions {
             transient_steps: args.transient_steps,
             tolerance: args.tolerance,
@@ -264,6 +282,92 @@ fn print_check(check: &JacobianCheck) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json.
+fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
+    if args.parameter.is_some() || args.check_jacobian {
+        bail!(
+            "`parameter` and `check_jacobian` take the wheel's exact derivatives; the model `{}` has its DP by \
+             central differences so far (docs/model.md section 13)",
+            walker.name()
+        );
+    }
+    let initial = args
+        .initial
+        .as_deref()
+        .map(|text| {
+            text.split(',')
+                .map(|v| v.trim().parse::<f64>())
+                .collect::<Result<Vec<f64>, _>>()
+                .with_context(|| format!("invalid value '{}' for `initial`", vrw::fmt::clip(text)))
+        })
+        .transpose()?;
+    let job = WalkerGaitJob {
+        walker,
+        initial,
+        transient_steps: args.transient_steps,
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+    };
+    super::check_out(&job.out_dir, "gait", job.overwrite)?;
+    let summary = run_walker_gait(&job).context("gait")?;
+    let parameters = serde_json::to_value(summary.parameters)?;
+    let shown: Vec<String> = parameters
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect();
+    println!("vrw gait --model {}: {}", summary.model, shown.join(", "));
+    let Some(g) = &summary.gait else {
+        super::print_wrote(&args.out);
+        bail!(
+            "no gait found: {}",
+            summary.message.as_deref().unwrap_or("unknown reason")
+        );
+    };
+    print_walker_gait(g);
+    super::print_wrote(&args.out);
+    Ok(())
+}
+
+/// A walker's gait, as `vrw gait --model NAME` prints it.
+fn print_walker_gait(g: &WalkerGait) {
+    let section: Vec<String> = g
+        .section
+        .iter()
+        .map(|(n, v)| format!("{n} = {v:.9}"))
+        .collect();
+    println!(
+        "gait: {} (residual {:.1e}, {} Newton iterations)",
+        section.join(", "),
+        g.residual,
+        g.newton_iterations
+    );
+    println!(
+        "period {:.9}, lambda_I4 = {:.9} (the rear foot leaves), impact loss {:.6e}, energy audit {:.1e}, \
+         {} scuff(s) per step",
+        g.period, g.lambda_i4, g.impact_loss, g.energy_drift, g.scuffs
+    );
+    let multipliers: Vec<String> = g
+        .floquet_multipliers
+        .iter()
+        .map(|[re, im]| {
+            if *im == 0.0 {
+                format!("{re:.9}")
+            } else {
+                format!("{re:.9}{im:+.9}i")
+            }
+        })
+        .collect();
+    println!(
+        "Floquet multipliers ({}): {} (largest modulus {:.9}): {}",
+        g.derivative,
+        multipliers.join(", "),
+        g.largest_multiplier,
+        g.stability
+    );
 }
 
 #[cfg(test)]

@@ -9,9 +9,11 @@
 //! as the wheel's tips are (docs/model.md section 3), so that the force-level and impulse problems of the paper
 //! apply unchanged ([`super::constrained`]).
 
-use nalgebra::SVector;
+use nalgebra::{DVector, SVector};
 
 use super::assembly::{along_leg, point_mass_equations, point_mass_potential, up, PointMass};
+use super::constrained::{accelerations, impulse, ConstrainedError, Row};
+use super::rigid::{HeelStrike, RigidWalker};
 use super::{Equations, Mechanism, PointKinematics, Real};
 use crate::params::ConfigError;
 
@@ -109,6 +111,12 @@ impl Compass {
         ConfigError::all(errors)
     }
 
+    /// Where a gait search starts: the symmetric gait down 3 degrees with the paper's masses and lengths
+    /// (`theta1 = 0.2710` rad, `theta1' = -1.0924`, `theta2' = -0.3774` rad/s).
+    pub fn default_start(&self) -> DVector<f64> {
+        DVector::from_column_slice(&[0.2710, -1.0924, -0.3774])
+    }
+
     /// The hip mass and the two leg masses.
     fn masses<T: Real>(
         c: &CompassConstants<T>,
@@ -185,5 +193,83 @@ impl Mechanism<4> for Compass {
 
     fn damper_power(&self, _q: &SVector<f64, 4>, _qd: &SVector<f64, 4>) -> f64 {
         0.0
+    }
+}
+
+impl RigidWalker<4, 8> for Compass {
+    fn name(&self) -> &'static str {
+        "compass"
+    }
+
+    fn section_names(&self) -> Vec<&'static str> {
+        vec!["theta1", "theta1_dot", "theta2_dot"]
+    }
+
+    /// Eq. (1) with Leg 1's foot held ([`super::constrained::accelerations`]); its normal force.
+    fn single_support(
+        &self,
+        q: &SVector<f64, 4>,
+        qd: &SVector<f64, 4>,
+    ) -> Result<(SVector<f64, 4>, f64), ConstrainedError> {
+        let a = accelerations(self, q, qd, &Row::contact(0))?;
+        Ok((a.qdd, a.multipliers[1]))
+    }
+
+    fn swing_foot(&self, q: &SVector<f64, 4>) -> (f64, f64) {
+        let c = self.constants_f64();
+        let zero = SVector::zeros();
+        let (stance, swing) = (
+            self.contact(&c, q, &zero, 0).position,
+            self.contact(&c, q, &zero, 1).position,
+        );
+        (swing.y, swing.x - stance.x)
+    }
+
+    fn hip_height(&self, q: &SVector<f64, 4>) -> f64 {
+        q[Z]
+    }
+
+    /// The impact with both feet held gives `lambda_I4` (Leg 1's normal impulse); where it is negative, the
+    /// traditional impact with Leg 2's foot held, then Leg 2 is the stance leg (the angles exchanged, the hip
+    /// moved along the slope so that the new stance foot is at `x = 0`).
+    fn heel_strike(
+        &self,
+        q: &SVector<f64, 4>,
+        qd: &SVector<f64, 4>,
+    ) -> Result<HeelStrike<4>, ConstrainedError> {
+        let both = [Row::contact(0), Row::contact(1)].concat();
+        let lambda_i4 = impulse(self, q, qd, &both)?.impulses[1];
+        let traditional = impulse(self, q, qd, &Row::contact(1))?.qd_plus;
+        let loss = self.energy(q, qd) - self.energy(q, &traditional);
+        let new_foot = self.contact(&self.constants_f64(), q, qd, 1).position.x;
+        let swap = |v: &SVector<f64, 4>| SVector::from([v[X], v[Z], v[THETA2], v[THETA1]]);
+        let mut after = swap(q);
+        after[X] -= new_foot;
+        Ok(HeelStrike {
+            lambda_i4,
+            q: after,
+            qd: (lambda_i4 < 0.0).then(|| swap(&traditional)),
+            loss,
+        })
+    }
+
+    fn mechanical_energy(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> f64 {
+        self.energy(q, qd)
+    }
+
+    fn section_of(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> DVector<f64> {
+        DVector::from_column_slice(&[q[THETA1], qd[THETA1], qd[THETA2]])
+    }
+
+    /// `(theta1, theta1', theta2')` just after a heel strike: Leg 1's foot at the origin, Leg 2's on the ground
+    /// behind it (`theta2 = -theta1`), the hip moving about Leg 1's foot.
+    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, 4>, SVector<f64, 4>) {
+        let (theta, w, w2) = (s[0], s[1], s[2]);
+        let l = self.leg_length;
+        let (sn, cs) = theta.sin_cos();
+        (
+            SVector::from([-l * sn, l * cs, theta, -theta]),
+            SVector::from([-l * cs * w, -l * sn * w, w, w2]),
+        )
     }
 }

@@ -9,12 +9,17 @@
 //! general one); the compass-gait biped of Goswami, Thuilot and Espiau ([`compass`]) is another, assembled from
 //! point masses by [`assembly`].
 //!
-//! This is the first layer of the walker-models work: the walk, the gait search and the studies still run the
-//! wheel through `walk/`; they move onto this interface next (docs/model.md section 13).
+//! Walkers with rigid legs and point feet walk by [`rigid`] (single support between heel strikes) and have their
+//! gaits by [`rigid_gait`]: the compass gait and the simplest walking model of Garcia et al. ([`simplest`]),
+//! whose massless legs leave it only reduced equations. The wheel still walks through `walk/`; the two walks
+//! are to become one on this interface (docs/model.md section 13).
 
 pub mod assembly;
 pub mod compass;
 pub mod constrained;
+pub mod rigid;
+pub mod rigid_gait;
+pub mod simplest;
 mod wheel;
 
 use nalgebra::{SMatrix, SVector};

@@ -4,7 +4,12 @@ use nalgebra::{SVector, Vector2};
 
 use super::compass::{Compass, THETA1, THETA2, X, Z};
 use super::constrained::{accelerations, impulse, Row};
+use super::rigid::{RigidOptions, RigidWalker};
+use super::rigid_gait::{rigid_gait, RigidGait};
+use super::simplest::Simplest;
 use super::Mechanism;
+use crate::integrate::Tolerances;
+use nalgebra::DVector;
 
 type Q = SVector<f64, 4>;
 
@@ -221,4 +226,139 @@ fn the_compass_equations_differentiate_exactly() {
             "entry {k}: {e} vs {fd}"
         );
     }
+}
+
+/// The gait of `walker` from `start`, with the walk's default options.
+fn gait_of<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &[f64],
+) -> RigidGait<N> {
+    rigid_gait(
+        walker,
+        &DVector::from_column_slice(start),
+        &RigidOptions::default(),
+    )
+    .unwrap()
+}
+
+/// Garcia, Chatterjee, Ruina and Coleman's stable gait at `gamma = 0.009`: the paper's fixed point
+/// `(theta, theta') = (0.2003, -0.1998)` (their section 4), stable with a complex pair of multipliers. Second
+/// routes: over a step the hip's loss at heel strike is gravity's work `sin(gamma)` times the step length
+/// `2 sin(theta)` (the energy balance of a period), the step conserves `T + V`, and the fixed point is the same
+/// with the integrator's tolerance 100 times looser.
+#[test]
+fn the_simplest_walkers_gait_is_garcias() {
+    let walker = Simplest { slope: 0.009 };
+    let gait = gait_of(&walker, &[0.2, -0.2]);
+    let (theta, w) = (gait.section[0], gait.section[1]);
+    assert!(
+        (theta - 0.2003).abs() < 5e-5 && (w + 0.1998).abs() < 5e-5,
+        "{theta}, {w}"
+    );
+    assert!(
+        gait.largest_multiplier() < 1.0 && gait.multipliers[0][1].abs() > 0.1,
+        "{:?}",
+        gait.multipliers
+    );
+    let work = walker.slope.sin() * 2.0 * theta.sin();
+    assert!(
+        (gait.step.impact_loss - work).abs() < 1e-12 * work.max(1.0),
+        "{} vs {work}",
+        gait.step.impact_loss
+    );
+    assert!(
+        gait.step.energy_drift < 1e-10,
+        "{:e}",
+        gait.step.energy_drift
+    );
+    assert!(
+        gait.step.lambda_i4 < 0.0 && gait.step.scuffs == 1,
+        "{:?}",
+        gait.step
+    );
+    let loose = RigidOptions {
+        tolerances: Tolerances {
+            rtol: 1e-10,
+            atol: 1e-11,
+            ..RigidOptions::default().tolerances
+        },
+        ..RigidOptions::default()
+    };
+    let other = rigid_gait(&walker, &gait.section, &loose).unwrap();
+    assert!((other.section - &gait.section).amax() < 1e-9);
+}
+
+/// The largest multiplier's modulus less 1 of the walker's gait at `value`, continued from `start`.
+fn past_unit_circle<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &mut DVector<f64>,
+) -> f64 {
+    let gait = rigid_gait(walker, start, &RigidOptions::default()).unwrap();
+    *start = gait.section.clone();
+    assert!(
+        gait.multipliers[0][1] == 0.0 && gait.multipliers[0][0] < 0.0,
+        "{:?}",
+        gait.multipliers
+    );
+    gait.largest_multiplier() - 1.0
+}
+
+/// The simplest walker's gait loses its stability at the first period doubling of its cascade, near
+/// `gamma = 0.015` (the paper: stable for `0 < gamma < 0.015`): a real multiplier crosses -1, located by
+/// bisection to 1e-9 in `gamma`.
+#[test]
+fn the_simplest_walker_period_doubles_near_0_015() {
+    let (mut lo, mut hi) = (0.0150, 0.0155);
+    let mut start = gait_of(&Simplest { slope: lo }, &[0.2367, -0.2315]).section;
+    assert!(past_unit_circle(&Simplest { slope: lo }, &mut start) < 0.0);
+    assert!(past_unit_circle(&Simplest { slope: hi }, &mut start.clone()) > 0.0);
+    while hi - lo > 1e-9 {
+        let mid = 0.5 * (lo + hi);
+        if past_unit_circle(&Simplest { slope: mid }, &mut start) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    println!("simplest walker: period doubling at gamma = {lo:.9}");
+    assert!((0.0150..0.0152).contains(&lo), "{lo}");
+}
+
+/// The compass gait of Goswami, Thuilot and Espiau walks down 3 degrees with a stable symmetric gait, and its
+/// energy balance closes: the heel strike takes gravity's work over the step, `(mH + 2 m) g sin(phi)` times
+/// the step length `2 l sin(theta)`. Steeper, its first period doubling comes between 4.25 and 4.5 degrees.
+#[test]
+fn the_compass_gait_walks_down_three_degrees() {
+    let compass = Compass::default();
+    let gait = gait_of(&compass, &[0.27, -1.09, -0.38]);
+    assert!(gait.largest_multiplier() < 1.0, "{:?}", gait.multipliers);
+    let theta = gait.section[0];
+    let weight = (compass.hip_mass + 2.0 * compass.leg_mass) * compass.gravity;
+    let work = weight * compass.slope.sin() * 2.0 * compass.leg_length * theta.sin();
+    assert!(
+        (gait.step.impact_loss - work).abs() < 1e-9 * work,
+        "{} vs {work}",
+        gait.step.impact_loss
+    );
+    assert!(
+        gait.step.energy_drift < 1e-9,
+        "{:e}",
+        gait.step.energy_drift
+    );
+    assert!(
+        gait.step.lambda_i4 < 0.0 && gait.step.scuffs == 1,
+        "{:?}",
+        gait.step
+    );
+    let mut start = gait.section.clone();
+    let at = |deg: f64| Compass {
+        slope: deg.to_radians(),
+        ..compass
+    };
+    for deg in [3.5, 4.0, 4.25] {
+        let g = rigid_gait(&at(deg), &start, &RigidOptions::default()).unwrap();
+        start = g.section.clone();
+    }
+    assert!(past_unit_circle(&at(4.25), &mut start) < 0.0);
+    assert!(past_unit_circle(&at(4.5), &mut start) > 0.0);
 }

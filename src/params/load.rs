@@ -289,7 +289,7 @@ fn split_override(assignment: &str) -> Result<(&str, &str), ConfigError> {
 ///
 /// Only a regular file (or a link to one) is read, and at most [`MAX_CONFIG_BYTES`] of it: a device such as
 /// `/dev/zero` or a pipe would be read forever.
-fn file_table(path: &Path) -> Result<Table, ConfigError> {
+pub(crate) fn file_table(path: &Path) -> Result<Table, ConfigError> {
     use std::io::Read;
 
     let shown = path.display().to_string();
@@ -343,6 +343,65 @@ fn document(text: &str, origin: &str) -> Result<Table, ConfigError> {
             (key, Raw::Given(value.into_inner(), written))
         })
         .collect())
+}
+
+/// The parameters `T` of a walker other than the wheel (docs/model.md section 13), read as a configuration is:
+/// `T`'s defaults, then the flat TOML `file` if there is one, then each real-valued `key=value` of `overrides`.
+/// The keys are `T`'s fields (read off its serialization, never listed by hand); an unknown key, a value that
+/// is not a number or a malformed override is an error that names it.
+pub fn read_walker_parameters<T, S>(file: Option<&Path>, overrides: &[S]) -> Result<T, ConfigError>
+where
+    T: serde::Serialize + serde::de::DeserializeOwned + Default,
+    S: AsRef<str>,
+{
+    let defaults = toml::Table::try_from(T::default()).map_err(|e| ConfigError::Toml {
+        path: "<defaults>".to_string(),
+        message: e.to_string(),
+    })?;
+    let known = || defaults.keys().cloned().collect::<Vec<_>>().join(", ");
+    let mut table = defaults.clone();
+    if let Some(path) = file {
+        for (key, raw) in file_table(path)? {
+            if !defaults.contains_key(&key) {
+                return Err(ConfigError::UnknownKey {
+                    key,
+                    known: known(),
+                });
+            }
+            let value = match raw {
+                Raw::Stored(value) | Raw::Given(value, _) => value,
+                Raw::Text(text) => toml::Value::String(text),
+            };
+            table.insert(key, value);
+        }
+    }
+    for assignment in overrides {
+        let assignment = assignment.as_ref();
+        let Some((key, value)) = assignment.split_once('=') else {
+            return Err(ConfigError::MalformedOverride {
+                assignment: assignment.to_string(),
+            });
+        };
+        let key = key.trim();
+        if !defaults.contains_key(key) {
+            return Err(ConfigError::UnknownKey {
+                key: key.to_string(),
+                known: known(),
+            });
+        }
+        let number: f64 = value.trim().parse().map_err(|_| ConfigError::WrongType {
+            key: key.to_string(),
+            expected: "a number".to_string(),
+            found: value.to_string(),
+        })?;
+        table.insert(key.to_string(), toml::Value::Float(number));
+    }
+    table
+        .try_into()
+        .map_err(|e: toml::de::Error| ConfigError::Toml {
+            path: file.map_or_else(|| "--set".to_string(), |p| p.display().to_string()),
+            message: e.message().to_string(),
+        })
 }
 
 /// A key of [`Config::numeric_keys`], checked once: the parameter of a sweep, a map's axis, a continuation.

@@ -1,0 +1,262 @@
+//! `vrw gait --model NAME` for the walkers behind the mechanism interface other than the wheel (docs/model.md
+//! section 13): the simplest walking model and the compass gait. Their parameters are read as a
+//! configuration is (a flat TOML file, `--set key=value`), the gait is searched from the model's start after a
+//! transient walk, and `gait.json` holds it with its section named by the model's coordinates.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::DVector;
+use serde::Serialize;
+
+use super::{in_run, AppError, SearchEnded};
+use crate::mechanism::compass::Compass;
+use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
+use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP};
+use crate::mechanism::simplest::Simplest;
+use crate::output;
+use crate::params::read_walker_parameters;
+
+/// The models `--model` takes: the wheel (`vrw`, the default) and the walkers of this file.
+pub const MODELS: [&str; 3] = ["vrw", "simplest", "compass"];
+
+/// A walker other than the wheel, with its parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Walker {
+    /// The simplest walking model.
+    Simplest(Simplest),
+    /// The compass gait.
+    Compass(Compass),
+}
+
+impl Walker {
+    /// The walker `name` with its parameters from `file` and `overrides` (see
+    /// [`read_walker_parameters`]), validated; `None` for the wheel (`vrw`).
+    pub fn load<S: AsRef<str>>(
+        name: &str,
+        file: Option<&Path>,
+        overrides: &[S],
+    ) -> Result<Option<Walker>, AppError> {
+        let walker = match name {
+            "vrw" => return Ok(None),
+            "simplest" => {
+                let w: Simplest = read_walker_parameters(file, overrides)?;
+                w.validate()?;
+                Walker::Simplest(w)
+            }
+            "compass" => {
+                let w: Compass = read_walker_parameters(file, overrides)?;
+                w.validate()?;
+                Walker::Compass(w)
+            }
+            other => {
+                return Err(AppError::InvalidOption {
+                    option: "model",
+                    reason: format!(
+                        "unknown model {:?}: one of {}",
+                        crate::fmt::clip(other),
+                        MODELS.join(", ")
+                    ),
+                })
+            }
+        };
+        Ok(Some(walker))
+    }
+
+    /// The model's name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Walker::Simplest(w) => w.name(),
+            Walker::Compass(w) => w.name(),
+        }
+    }
+}
+
+/// What `vrw gait --model NAME` searches.
+#[derive(Debug, Clone)]
+pub struct WalkerGaitJob {
+    /// The walker.
+    pub walker: Walker,
+    /// Where the search starts on the section (the model's coordinates); default the model's start.
+    pub initial: Option<Vec<f64>>,
+    /// Steps walked before Newton's method starts.
+    pub transient_steps: usize,
+    /// Output directory for `gait.json`.
+    pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir`.
+    pub overwrite: bool,
+}
+
+/// `gait.json` of a walker: the gait, or why there is none.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WalkerGaitSummary {
+    /// vrw's version.
+    pub vrw_version: &'static str,
+    /// The model's name.
+    pub model: &'static str,
+    /// Its parameters.
+    pub parameters: Walker,
+    /// Where the search started (the transient walk from it), by the section's coordinates.
+    #[serde(serialize_with = "as_map")]
+    pub initial: Vec<(String, f64)>,
+    /// `found`, or the failure's kind.
+    #[serde(serialize_with = "crate::fmt::as_text")]
+    pub status: SearchEnded,
+    /// The failure, in words.
+    pub message: Option<String>,
+    /// The gait.
+    pub gait: Option<WalkerGait>,
+}
+
+/// A walker's gait as `gait.json` holds it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WalkerGait {
+    /// The fixed point on the section just after a heel strike, by the model's coordinates.
+    #[serde(serialize_with = "as_map")]
+    pub section: Vec<(String, f64)>,
+    /// `max |P(s) - s|` at it.
+    pub residual: f64,
+    /// Newton iterations.
+    pub newton_iterations: usize,
+    /// The step's duration (in the model's time unit: seconds for the compass gait, `sqrt(l/g)` for the
+    /// simplest walker).
+    pub period: f64,
+    /// The Floquet multipliers `[re, im]`, largest modulus first.
+    pub floquet_multipliers: Vec<[f64; 2]>,
+    /// The largest modulus.
+    pub largest_multiplier: f64,
+    /// `stable` below 1, else `unstable`.
+    pub stability: &'static str,
+    /// How `DP` was taken.
+    pub derivative: String,
+    /// The heel strike's DLS indicator: the rear foot's normal impulse with both feet held (negative: the rear
+    /// foot leaves, the traditional impact).
+    #[serde(rename = "lambda_I4")]
+    pub lambda_i4: f64,
+    /// The energy the heel strike takes.
+    pub impact_loss: f64,
+    /// The largest change of `T + V` over the step's integration (conserved in single support): its energy
+    /// audit.
+    pub energy_drift: f64,
+    /// Crossings of the ground by the swing foot ignored as scuffing.
+    pub scuffs: usize,
+}
+
+/// Search the gait of `job.walker` and write `gait.json` (also without a gait, with the reason), after the
+/// output directory is checked.
+pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
+    crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
+    let summary = match job.walker {
+        Walker::Simplest(w) => compute(&w, w.default_start(), job)?,
+        Walker::Compass(w) => compute(&w, w.default_start(), job)?,
+    };
+    in_run(&job.out_dir, job.overwrite, "gait", |run| {
+        output::write_json(&run.path("gait.json"), &summary)?;
+        run.add("gait.json");
+        Ok((summary, None))
+    })
+}
+
+/// The search of [`run_walker_gait`] for `walker`, from `job.initial` or `start`.
+fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: DVector<f64>,
+    job: &WalkerGaitJob,
+) -> Result<WalkerGaitSummary, AppError> {
+    let names = walker.section_names();
+    let start = match &job.initial {
+        Some(values) if values.len() != names.len() => {
+            return Err(AppError::InvalidOption {
+                option: "initial",
+                reason: format!(
+                    "{} values given; the section of `{}` has {}: {}",
+                    values.len(),
+                    walker.name(),
+                    names.len(),
+                    names.join(", ")
+                ),
+            })
+        }
+        Some(values) => DVector::from_column_slice(values),
+        None => start,
+    };
+    let named = |s: &DVector<f64>| {
+        names
+            .iter()
+            .map(|n| n.to_string())
+            .zip(s.iter().copied())
+            .collect()
+    };
+    let options = RigidOptions::default();
+    let result = transient(walker, &start, job.transient_steps, &options)
+        .map_err(|source| RigidGaitError::Step {
+            iteration: 0,
+            source,
+        })
+        .and_then(|s| rigid_gait(walker, &s, &options));
+    Ok(WalkerGaitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        model: walker.name(),
+        parameters: job.walker,
+        initial: named(&start),
+        status: match &result {
+            Ok(_) => SearchEnded::Found,
+            Err(e) => SearchEnded::Failed(failure_kind(e)),
+        },
+        message: result.as_ref().err().map(ToString::to_string),
+        gait: result.ok().map(|g| gait_record(&g, named(&g.section))),
+    })
+}
+
+/// The section state after `steps` steps of the walk from `start`.
+fn transient<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    steps: usize,
+    options: &RigidOptions,
+) -> Result<DVector<f64>, RigidError> {
+    let (mut q, mut qd) = walker.state_at_section(start);
+    for _ in 0..steps {
+        let step = rigid_step(walker, &q, &qd, options)?;
+        (q, qd) = (step.q, step.qd);
+    }
+    Ok(walker.section_of(&q, &qd))
+}
+
+/// The kind of a failed search.
+fn failure_kind(e: &RigidGaitError) -> &'static str {
+    match e {
+        RigidGaitError::Step { source, .. } => source.kind(),
+        RigidGaitError::Singular { .. } => "singular_jacobian",
+        RigidGaitError::NoConvergence { .. } => "no_convergence",
+    }
+}
+
+/// `gait.json`'s record of `g`.
+fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) -> WalkerGait {
+    let largest = g.largest_multiplier();
+    WalkerGait {
+        section,
+        residual: g.residual,
+        newton_iterations: g.iterations,
+        period: g.step.period,
+        floquet_multipliers: g.multipliers.clone(),
+        largest_multiplier: largest,
+        stability: if largest < 1.0 { "stable" } else { "unstable" },
+        derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
+        lambda_i4: g.step.lambda_i4,
+        impact_loss: g.step.impact_loss,
+        energy_drift: g.step.energy_drift,
+        scuffs: g.step.scuffs,
+    }
+}
+
+/// Named values as a JSON object, in their order.
+fn as_map<S: serde::Serializer>(pairs: &[(String, f64)], serializer: S) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut map = serializer.serialize_map(Some(pairs.len()))?;
+    for (name, value) in pairs {
+        map.serialize_entry(name, value)?;
+    }
+    map.end()
+}

@@ -1,0 +1,311 @@
+//! The walk of a walker with rigid legs and point feet (docs/model.md section 13): single support on the
+//! stance foot between heel strikes, the heel strike decided by the DLS indicator `lambda_I4` and followed by the
+//! legs' exchange of roles, and the step map on the section just after a heel strike.
+//!
+//! A step integrates the single-support dynamics (DOP853, [`crate::integrate`]) until the swing foot's height
+//! crosses zero from above while the foot is ahead of the stance foot (heel strike); the crossing near
+//! mid-swing, where the foot comes up through the ground, is not from above, and the start (the foot leaving
+//! the ground behind the stance foot) is not ahead: both are foot scuffing, ignored as the papers do and
+//! counted. The event is located on the dense output (`crate::integrate::locate_root`); the integration
+//! fails where the stance foot's normal force turns negative (the walker would leave the ground) or the hip
+//! falls below the ground.
+
+use nalgebra::{DVector, SVector};
+
+use super::constrained::ConstrainedError;
+use crate::integrate::{locate_root, Dop853, IntegrationError, OdeSystem, Tolerances};
+
+/// What a rigid-legged walker gives the walk (the assembled compass gait and the simplest walking model, whose
+/// massless legs leave it only reduced equations, implement it alike). `N` coordinates, `Y = 2 N` integrated
+/// states `(q, q')`.
+pub trait RigidWalker<const N: usize, const Y: usize> {
+    /// The walker's name.
+    fn name(&self) -> &'static str;
+
+    /// The names of the coordinates of the section ([`RigidWalker::section_of`]).
+    fn section_names(&self) -> Vec<&'static str>;
+
+    /// `q''` in single support, and the stance foot's normal force (in the walker's force unit).
+    fn single_support(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Result<(SVector<f64, N>, f64), ConstrainedError>;
+
+    /// The swing foot's height above the ground and its distance ahead of the stance foot along the slope.
+    fn swing_foot(&self, q: &SVector<f64, N>) -> (f64, f64);
+
+    /// The hip's height above the ground.
+    fn hip_height(&self, q: &SVector<f64, N>) -> f64;
+
+    /// The heel strike at `(q, q'-)`: the impact with both feet held (the paper's (A1)) and its `lambda_I4`, the
+    /// rear foot's normal impulse; where it is negative, the traditional impact (the new foot held, the rear
+    /// one released) and the legs' exchange of roles.
+    fn heel_strike(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Result<HeelStrike<N>, ConstrainedError>;
+
+    /// The mechanical energy `T + V`.
+    fn mechanical_energy(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64;
+
+    /// The free coordinates of a state just after a heel strike (the section; the others follow from the
+    /// stance foot on the ground and both feet on it).
+    fn section_of(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> DVector<f64>;
+
+    /// The state just after a heel strike with the free coordinates `s`.
+    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, N>, SVector<f64, N>);
+}
+
+/// A heel strike's outcome.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeelStrike<const N: usize> {
+    /// `lambda_I4`: the rear foot's normal impulse with both feet held (DLS indicator 1).
+    pub lambda_i4: f64,
+    /// Coordinates after the legs exchange roles (the new stance foot at `x = 0` where the walker has one).
+    pub q: SVector<f64, N>,
+    /// Velocities after the impact, in the new roles; `None` where `lambda_i4 >= 0`: the walker stops in
+    /// double support.
+    pub qd: Option<SVector<f64, N>>,
+    /// The energy the impact took (`T + V` before less after, at the same place).
+    pub loss: f64,
+}
+
+/// How a step of a rigid-legged walker is integrated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidOptions {
+    /// The integrator's tolerances.
+    pub tolerances: Tolerances,
+    /// The longest a step may last (in the walker's time unit).
+    pub max_step_time: f64,
+    /// Events are located to this time.
+    pub event_time_tol: f64,
+}
+
+impl Default for RigidOptions {
+    fn default() -> RigidOptions {
+        RigidOptions {
+            tolerances: Tolerances {
+                rtol: 1e-12,
+                atol: 1e-13,
+                h_max: 0.05,
+                h_min: 1e-14,
+            },
+            max_step_time: 20.0,
+            event_time_tol: 1e-14,
+        }
+    }
+}
+
+/// Why a step of a rigid-legged walker failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RigidError {
+    /// The integration failed.
+    #[error("integration failed: {0}")]
+    Integration(#[from] IntegrationError),
+    /// A constrained solve failed.
+    #[error("{0}")]
+    Constrained(#[from] ConstrainedError),
+    /// No heel strike within the longest step.
+    #[error("no heel strike within {time} time units")]
+    Stalled {
+        /// The time walked.
+        time: f64,
+    },
+    /// The stance foot's normal force turned negative: the walker would leave the ground.
+    #[error("the stance foot would leave the ground at t = {time} (normal force {force:e})")]
+    StanceLiftsOff {
+        /// When.
+        time: f64,
+        /// The normal force there.
+        force: f64,
+    },
+    /// The hip reached the ground.
+    #[error("the walker fell (hip on the ground) at t = {time}")]
+    Fell {
+        /// When.
+        time: f64,
+    },
+    /// `lambda_I4 >= 0` at heel strike: with rigid legs, double support holds the walker still.
+    #[error("the walker stops in double support (lambda_I4 = {lambda_i4:e} >= 0)")]
+    StopsInDoubleSupport {
+        /// The DLS indicator.
+        lambda_i4: f64,
+    },
+}
+
+impl RigidError {
+    /// Short machine-readable name.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            RigidError::Integration(_) => "integration_failed",
+            RigidError::Constrained(_) => "constrained_solve_failed",
+            RigidError::Stalled { .. } => "stalled",
+            RigidError::StanceLiftsOff { .. } => "stance_lifts_off",
+            RigidError::Fell { .. } => "fell",
+            RigidError::StopsInDoubleSupport { .. } => "stops_in_double_support",
+        }
+    }
+}
+
+/// One step from just after a heel strike to just after the next.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidStep<const N: usize> {
+    /// Coordinates just after the next heel strike (roles exchanged).
+    pub q: SVector<f64, N>,
+    /// Velocities just after it.
+    pub qd: SVector<f64, N>,
+    /// The step's duration.
+    pub period: f64,
+    /// The heel strike's DLS indicator.
+    pub lambda_i4: f64,
+    /// The energy the heel strike took (`T + V` before less after).
+    pub impact_loss: f64,
+    /// The largest `|T + V - (T + V)_0|` over the step's integrator steps (energy is conserved in single
+    /// support): the step's energy audit.
+    pub energy_drift: f64,
+    /// Crossings of the ground by the swing foot that were not heel strikes (scuffing).
+    pub scuffs: usize,
+}
+
+/// The single-support vector field of `walker` (with `N` coordinates), as the integrator sees it.
+struct SingleSupport<'w, W, const N: usize>(&'w W);
+
+impl<W: RigidWalker<N, Y>, const N: usize, const Y: usize> OdeSystem<Y>
+    for SingleSupport<'_, W, N>
+{
+    fn rhs(&self, _t: f64, y: &SVector<f64, Y>) -> SVector<f64, Y> {
+        let (q, qd) = unpack::<N, Y>(y);
+        match self.0.single_support(&q, &qd) {
+            Ok((qdd, _)) => pack(&qd, &qdd),
+            Err(_) => SVector::repeat(f64::NAN),
+        }
+    }
+}
+
+/// `(q, q')` as one state.
+fn pack<const N: usize, const Y: usize>(
+    q: &SVector<f64, N>,
+    qd: &SVector<f64, N>,
+) -> SVector<f64, Y> {
+    assert_eq!(Y, 2 * N, "a rigid walker integrates (q, q')");
+    let mut y = SVector::<f64, Y>::zeros();
+    y.rows_mut(0, N).copy_from(q);
+    y.rows_mut(N, N).copy_from(qd);
+    y
+}
+
+/// `(q, q')` of a state.
+fn unpack<const N: usize, const Y: usize>(
+    y: &SVector<f64, Y>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    (
+        SVector::from_iterator(y.rows(0, N).iter().copied()),
+        SVector::from_iterator(y.rows(N, N).iter().copied()),
+    )
+}
+
+/// The heel-strike event function: the swing foot's height where it is ahead of the stance foot, else a
+/// positive constant (no event behind the stance foot).
+fn strike_height<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    y: &SVector<f64, Y>,
+) -> f64 {
+    let (q, _) = unpack::<N, Y>(y);
+    let (height, ahead) = walker.swing_foot(&q);
+    if ahead > 0.0 {
+        height
+    } else {
+        1.0
+    }
+}
+
+/// One step of `walker` from `(q, q')` just after a heel strike (see the module documentation).
+pub fn rigid_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    q: &SVector<f64, N>,
+    qd: &SVector<f64, N>,
+    options: &RigidOptions,
+) -> Result<RigidStep<N>, RigidError> {
+    let system = SingleSupport::<W, N>(walker);
+    let y0 = pack::<N, Y>(q, qd);
+    let e0 = walker.mechanical_energy(q, qd);
+    let mut integrator = Dop853::new(&system, 0.0, y0, options.tolerances);
+    let (mut scuffs, mut energy_drift) = (0, 0.0f64);
+    let mut below = walker.swing_foot(q).0 < 0.0;
+    loop {
+        let step = integrator.step(&system, options.max_step_time)?;
+        let (t0, t1) = (step.t0(), step.t1());
+        let (g0, g1) = (
+            strike_height(walker, step.y0()),
+            strike_height(walker, step.y1()),
+        );
+        let (q1, qd1) = unpack::<N, Y>(step.y1());
+        energy_drift = energy_drift.max((walker.mechanical_energy(&q1, &qd1) - e0).abs());
+        if g0 > 0.0 && g1 <= 0.0 {
+            let t = locate_root(
+                &step,
+                |_, y| strike_height(walker, y),
+                t0,
+                g0,
+                t1,
+                g1,
+                options.event_time_tol,
+            );
+            let (q_minus, qd_minus) = unpack::<N, Y>(&step.eval(t));
+            return finish_step(walker, (&q_minus, &qd_minus), t, (scuffs, energy_drift));
+        }
+        // A crossing of the ground that is no heel strike: the swing foot comes up through it (scuffing).
+        let now_below = walker.swing_foot(&q1).0 < 0.0;
+        if below && !now_below {
+            scuffs += 1;
+        }
+        below = now_below;
+        check_support(walker, (&q1, &qd1), t1)?;
+        if t1 >= options.max_step_time {
+            return Err(RigidError::Stalled { time: t1 });
+        }
+    }
+}
+
+/// The walker still stands on its stance foot at `(q, q')` at time `t`: a pushing normal force and the hip
+/// above the ground.
+fn check_support<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    time: f64,
+) -> Result<(), RigidError> {
+    if walker.hip_height(q) <= 0.0 {
+        return Err(RigidError::Fell { time });
+    }
+    let (_, force) = walker.single_support(q, qd)?;
+    if force < 0.0 {
+        return Err(RigidError::StanceLiftsOff { time, force });
+    }
+    Ok(())
+}
+
+/// The step's end: the heel strike at `(q, q'-)` at time `t`.
+fn finish_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    t: f64,
+    (scuffs, energy_drift): (usize, f64),
+) -> Result<RigidStep<N>, RigidError> {
+    let strike = walker.heel_strike(q, qd)?;
+    let Some(qd_plus) = strike.qd else {
+        return Err(RigidError::StopsInDoubleSupport {
+            lambda_i4: strike.lambda_i4,
+        });
+    };
+    Ok(RigidStep {
+        q: strike.q,
+        qd: qd_plus,
+        period: t,
+        lambda_i4: strike.lambda_i4,
+        impact_loss: strike.loss,
+        energy_drift,
+        scuffs,
+    })
+}

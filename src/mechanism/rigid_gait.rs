@@ -1,0 +1,169 @@
+//! Gaits of a rigid-legged walker (docs/model.md section 13): fixed points of its step map `P` on the section
+//! ([`RigidWalker::section_of`]) by Newton's method, and their Floquet multipliers, the eigenvalues of `DP`.
+//!
+//! `DP` is taken by central differences here (relative step [`DIFFERENCE_STEP`], with the integrator at
+//! `rtol = 1e-12`), the route the papers of these walkers used; the exact derivatives of the wheel
+//! (docs/model.md section 10) come to these walkers when the walk moves onto the interface.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::rigid::{rigid_step, RigidError, RigidOptions, RigidStep, RigidWalker};
+
+/// Relative step of the central differences of `DP`.
+pub const DIFFERENCE_STEP: f64 = 1e-6;
+
+/// Newton's method stops when `max |P(s) - s|` is below this.
+pub const NEWTON_TOL: f64 = 1e-12;
+
+/// Most Newton iterations.
+const MAX_NEWTON_ITERATIONS: usize = 40;
+
+/// A gait of a rigid-legged walker.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidGait<const N: usize> {
+    /// The fixed point on the section.
+    pub section: DVector<f64>,
+    /// `max |P(s) - s|` there.
+    pub residual: f64,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// `DP` at the fixed point (central differences).
+    pub jacobian: DMatrix<f64>,
+    /// The Floquet multipliers `[re, im]`, largest modulus first.
+    pub multipliers: Vec<[f64; 2]>,
+    /// The step from the fixed point (its period, DLS indicator, impact loss, energy audit).
+    pub step: RigidStep<N>,
+}
+
+impl<const N: usize> RigidGait<N> {
+    /// The largest modulus of the multipliers: the gait is stable below 1.
+    pub fn largest_multiplier(&self) -> f64 {
+        self.multipliers
+            .first()
+            .map_or(f64::NAN, |[re, im]| re.hypot(*im))
+    }
+}
+
+/// Why no gait was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RigidGaitError {
+    /// A step of the walk failed.
+    #[error("step map failed in Newton iteration {iteration}: {source}")]
+    Step {
+        /// Iteration number (from 0: the start).
+        iteration: usize,
+        /// Why.
+        source: RigidError,
+    },
+    /// `DP - I` is singular.
+    #[error("DP - I is singular (a multiplier at 1), residual {residual:e}")]
+    Singular {
+        /// The residual there.
+        residual: f64,
+    },
+    /// Newton's method did not reach [`NEWTON_TOL`].
+    #[error("no convergence: residual {residual:e} after {iterations} Newton iterations")]
+    NoConvergence {
+        /// Iterations taken.
+        iterations: usize,
+        /// The last `max |P(s) - s|`.
+        residual: f64,
+    },
+}
+
+/// `P(s)` and the step that gives it.
+pub fn rigid_step_map<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    s: &DVector<f64>,
+    options: &RigidOptions,
+) -> Result<(DVector<f64>, RigidStep<N>), RigidError> {
+    let (q, qd) = walker.state_at_section(s);
+    let step = rigid_step(walker, &q, &qd, options)?;
+    Ok((walker.section_of(&step.q, &step.qd), step))
+}
+
+/// `DP` at `s` by central differences.
+pub fn rigid_jacobian<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    s: &DVector<f64>,
+    options: &RigidOptions,
+) -> Result<DMatrix<f64>, RigidError> {
+    let n = s.len();
+    let mut jacobian = DMatrix::zeros(n, n);
+    for k in 0..n {
+        let h = DIFFERENCE_STEP * s[k].abs().max(1.0);
+        let (mut plus, mut minus) = (s.clone(), s.clone());
+        plus[k] += h;
+        minus[k] -= h;
+        let (p, _) = rigid_step_map(walker, &plus, options)?;
+        let (m, _) = rigid_step_map(walker, &minus, options)?;
+        jacobian.set_column(k, &((p - m) / (2.0 * h)));
+    }
+    Ok(jacobian)
+}
+
+/// The gait near `start` (a section state) by Newton's method on `P(s) = s`, each step damped until the
+/// residual falls.
+pub fn rigid_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    options: &RigidOptions,
+) -> Result<RigidGait<N>, RigidGaitError> {
+    let map = |s: &DVector<f64>, iteration: usize| {
+        rigid_step_map(walker, s, options)
+            .map_err(|source| RigidGaitError::Step { iteration, source })
+    };
+    let mut s = start.clone();
+    let (mut image, mut step) = map(&s, 0)?;
+    for iteration in 1..=MAX_NEWTON_ITERATIONS {
+        let r = &image - &s;
+        let residual = r.amax();
+        if residual < NEWTON_TOL {
+            let jacobian = rigid_jacobian(walker, &s, options)
+                .map_err(|source| RigidGaitError::Step { iteration, source })?;
+            return Ok(RigidGait {
+                multipliers: multipliers(&jacobian),
+                section: s,
+                residual,
+                iterations: iteration - 1,
+                jacobian,
+                step,
+            });
+        }
+        let jacobian = rigid_jacobian(walker, &s, options)
+            .map_err(|source| RigidGaitError::Step { iteration, source })?;
+        let n = s.len();
+        let delta = (jacobian - DMatrix::identity(n, n))
+            .lu()
+            .solve(&(-r))
+            .ok_or(RigidGaitError::Singular { residual })?;
+        // Damped: the full step, or halves of it, until the residual falls (or the walk works at all).
+        let mut scale = 1.0;
+        loop {
+            let trial = &s + scale * &delta;
+            match map(&trial, iteration) {
+                Ok((next, next_step)) if (&next - &trial).amax() < residual || scale < 1e-3 => {
+                    (s, image, step) = (trial, next, next_step);
+                    break;
+                }
+                Err(e) if scale < 1e-3 => return Err(e),
+                _ => scale *= 0.5,
+            }
+        }
+    }
+    Err(RigidGaitError::NoConvergence {
+        iterations: MAX_NEWTON_ITERATIONS,
+        residual: (&image - &s).amax(),
+    })
+}
+
+/// The eigenvalues of `jacobian` as `[re, im]`, largest modulus first.
+fn multipliers(jacobian: &DMatrix<f64>) -> Vec<[f64; 2]> {
+    let mut m: Vec<[f64; 2]> = jacobian
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| [z.re, z.im])
+        .collect();
+    m.sort_by(|a, b| b[0].hypot(b[1]).total_cmp(&a[0].hypot(a[1])));
+    m
+}
