@@ -273,3 +273,37 @@ impl RigidWalker<4, 8> for Compass {
         )
     }
 }
+
+impl super::rigid_family::Parametrized for Compass {
+    fn parameter_keys(&self) -> Vec<&'static str> {
+        vec![
+            "hip_mass",
+            "leg_mass",
+            "leg_length",
+            "leg_mass_offset",
+            "gravity",
+            "slope",
+        ]
+    }
+
+    fn with_parameter(&self, key: &str, value: f64) -> Result<Compass, ConfigError> {
+        let mut walker = *self;
+        let field = match key {
+            "hip_mass" => &mut walker.hip_mass,
+            "leg_mass" => &mut walker.leg_mass,
+            "leg_length" => &mut walker.leg_length,
+            "leg_mass_offset" => &mut walker.leg_mass_offset,
+            "gravity" => &mut walker.gravity,
+            "slope" => &mut walker.slope,
+            _ => {
+                return Err(ConfigError::UnknownKey {
+                    key: key.to_string(),
+                    known: self.parameter_keys().join(", "),
+                })
+            }
+        };
+        *field = value;
+        walker.validate()?;
+        Ok(walker)
+    }
+}

@@ -18,6 +18,7 @@ pub mod assembly;
 pub mod compass;
 pub mod constrained;
 pub mod rigid;
+pub mod rigid_family;
 pub mod rigid_gait;
 pub mod simplest;
 mod wheel;

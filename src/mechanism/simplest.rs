@@ -145,3 +145,23 @@ impl RigidWalker<2, 4> for Simplest {
         )
     }
 }
+
+impl super::rigid_family::Parametrized for Simplest {
+    fn parameter_keys(&self) -> Vec<&'static str> {
+        vec!["slope"]
+    }
+
+    fn with_parameter(&self, key: &str, value: f64) -> Result<Simplest, ConfigError> {
+        let walker = match key {
+            "slope" => Simplest { slope: value },
+            _ => {
+                return Err(ConfigError::UnknownKey {
+                    key: key.to_string(),
+                    known: "slope".to_string(),
+                })
+            }
+        };
+        walker.validate()?;
+        Ok(walker)
+    }
+}

@@ -1,0 +1,187 @@
+//! A rigid-legged walker's step map with one parameter free, as a family for the continuation engine
+//! ([`crate::continuation`]): its gaits followed through folds, its period doublings and Neimark-Sacker points
+//! located by the engine's test functions, and its DLS indicator `lambda_I4` as the border where the heel
+//! strike would stop the walker in double support (docs/model.md section 13).
+//!
+//! `DP` and `dP/dp` are central differences ([`DIFFERENCE_STEP`]), marked as not exact.
+
+use std::marker::PhantomData;
+
+use nalgebra::{DMatrix, DVector};
+
+use super::rigid::{rigid_step, RigidOptions, RigidWalker};
+use super::rigid_gait::DIFFERENCE_STEP;
+use crate::continuation::{Evaluation, FamilyMap, MapFailure};
+use crate::params::ConfigError;
+
+/// A walker whose parameters can be set one at a time, by key.
+pub trait Parametrized: Sized {
+    /// The keys of its real-valued parameters.
+    fn parameter_keys(&self) -> Vec<&'static str>;
+
+    /// The same walker with the parameter `key` at `value`, validated.
+    fn with_parameter(&self, key: &str, value: f64) -> Result<Self, ConfigError>;
+}
+
+/// What the family records of a point: its step's duration and DLS indicator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidInfo {
+    /// The duration of the (first) step.
+    pub period: f64,
+    /// `lambda_I4` of the (first) heel strike.
+    pub lambda_i4: f64,
+}
+
+/// The step map `P` (or `P^k`) of `walker` in the parameter `key`.
+#[derive(Debug)]
+pub struct RigidFamily<'a, W, const N: usize, const Y: usize> {
+    walker: &'a W,
+    key: &'static str,
+    period: usize,
+    options: RigidOptions,
+    dims: PhantomData<[(); N]>,
+}
+
+impl<W, const N: usize, const Y: usize> Clone for RigidFamily<'_, W, N, Y> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<W, const N: usize, const Y: usize> Copy for RigidFamily<'_, W, N, Y> {}
+
+impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
+    RigidFamily<'a, W, N, Y>
+{
+    /// The family of `walker` in `key` (one of its [`Parametrized::parameter_keys`]).
+    pub fn new(walker: &'a W, key: &str) -> Result<RigidFamily<'a, W, N, Y>, ConfigError> {
+        let keys = walker.parameter_keys();
+        let key =
+            keys.iter()
+                .copied()
+                .find(|k| *k == key)
+                .ok_or_else(|| ConfigError::UnknownKey {
+                    key: key.to_string(),
+                    known: keys.join(", "),
+                })?;
+        Ok(RigidFamily {
+            walker,
+            key,
+            period: 1,
+            options: RigidOptions::default(),
+            dims: PhantomData,
+        })
+    }
+
+    /// The walker at the parameter value `p`.
+    fn at(&self, p: f64) -> Result<W, MapFailure> {
+        self.walker
+            .with_parameter(self.key, p)
+            .map_err(|e| MapFailure {
+                kind: "invalid_parameter".to_string(),
+                message: e.to_string(),
+            })
+    }
+
+    /// `P^k(x)` of `walker` and the first step's record.
+    fn walked(
+        &self,
+        walker: &W,
+        x: &DVector<f64>,
+    ) -> Result<(DVector<f64>, RigidInfo), MapFailure> {
+        let (mut q, mut qd) = walker.state_at_section(x);
+        let mut info = None;
+        for _ in 0..self.period {
+            let step = rigid_step(walker, &q, &qd, &self.options).map_err(|e| MapFailure {
+                kind: e.kind().to_string(),
+                message: e.to_string(),
+            })?;
+            info.get_or_insert(RigidInfo {
+                period: step.period,
+                lambda_i4: step.lambda_i4,
+            });
+            (q, qd) = (step.q, step.qd);
+        }
+        let info = info.unwrap_or(RigidInfo {
+            period: 0.0,
+            lambda_i4: f64::NAN,
+        });
+        Ok((walker.section_of(&q, &qd), info))
+    }
+}
+
+impl<W, const N: usize, const Y: usize> FamilyMap for RigidFamily<'_, W, N, Y>
+where
+    W: RigidWalker<N, Y> + Parametrized + Sync,
+{
+    type Info = RigidInfo;
+
+    fn dim(&self) -> usize {
+        self.walker.section_names().len()
+    }
+
+    fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<RigidInfo>, MapFailure> {
+        let walker = self.at(p)?;
+        let (value, info) = self.walked(&walker, x)?;
+        let iterated = IteratedMap {
+            family: self,
+            walker: &walker,
+        };
+        let n = x.len();
+        let mut jacobian = DMatrix::zeros(n, n);
+        for k in 0..n {
+            let h = DIFFERENCE_STEP * x[k].abs().max(1.0);
+            let (mut plus, mut minus) = (x.clone(), x.clone());
+            plus[k] += h;
+            minus[k] -= h;
+            jacobian.set_column(
+                k,
+                &((iterated.value(&plus)? - iterated.value(&minus)?) / (2.0 * h)),
+            );
+        }
+        let h = DIFFERENCE_STEP * p.abs().max(1.0);
+        let dparam = (self.value(x, p + h)? - self.value(x, p - h)?) / (2.0 * h);
+        Ok(Evaluation {
+            value,
+            jacobian,
+            dparam,
+            exact: false,
+            info,
+        })
+    }
+
+    fn value(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
+        let walker = self.at(p)?;
+        Ok(self.walked(&walker, x)?.0)
+    }
+
+    fn iterated(&self, k: usize) -> Self {
+        RigidFamily {
+            period: self.period * k.max(1),
+            ..*self
+        }
+    }
+
+    fn period(&self) -> usize {
+        self.period
+    }
+
+    /// `lambda_I4` of the first heel strike: where it turns positive, the walker stops in double support.
+    fn borders(&self, info: &RigidInfo) -> Vec<(&'static str, f64)> {
+        vec![("lambda_I4", info.lambda_i4)]
+    }
+}
+
+/// `P^k` of one walker (one parameter value), for the columns of `DP`.
+struct IteratedMap<'f, 'a, W, const N: usize, const Y: usize> {
+    family: &'f RigidFamily<'a, W, N, Y>,
+    walker: &'f W,
+}
+
+impl<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
+    IteratedMap<'_, '_, W, N, Y>
+{
+    fn value(&self, x: &DVector<f64>) -> Result<DVector<f64>, MapFailure> {
+        Ok(self.family.walked(self.walker, x)?.0)
+    }
+}
