@@ -1179,3 +1179,38 @@ fn bad_walker_input_names_the_problem() {
         assert!(!run.out.join("gait.json").exists(), "{args:?}");
     }
 }
+
+/// `vrw continue --model simplest --param slope` follows the simplest walker's gaits and locates their period
+/// doubling near `slope = 0.0151` (the paper's 0.015), written to special_points.json with branch.csv.
+#[test]
+fn continue_locates_the_simplest_walkers_period_doubling() {
+    let args = [
+        "--model", "simplest", "--param", "slope", "--from", "0.005", "--to", "0.017", "--start",
+        "0.009",
+    ];
+    let run = command_in(temp_dir_with(&[]), "continue", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    let summary: Value = serde_json::from_str(&run.read("special_points.json")).unwrap();
+    let special = summary["special_points"].as_array().unwrap();
+    assert_eq!(special.len(), 1, "{summary}");
+    assert_eq!(special[0]["kind"], "PD");
+    assert_eq!(special[0]["located"], true);
+    let value = special[0]["value"].as_f64().unwrap();
+    assert!((value - 0.0150884).abs() < 1e-6, "{value}");
+    let branch = run.read("branch.csv");
+    assert!(branch.starts_with("slope,theta,theta_dot,largest_multiplier,period,lambda_I4"));
+    assert!(data_rows(&branch) > 20);
+    let run = command_in(
+        temp_dir_with(&[]),
+        "continue",
+        &[
+            "--model",
+            "compass",
+            "--two-param",
+            "leg_mass",
+            "--two-range",
+            "4,6",
+        ],
+    );
+    assert_error(&run, &["`--two-param`"]);
+}

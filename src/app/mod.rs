@@ -48,7 +48,10 @@ pub use simulate::{
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
-pub use walkers::{run_walker_gait, Walker, WalkerGait, WalkerGaitJob, WalkerGaitSummary, MODELS};
+pub use walkers::{
+    run_walker_continuation, run_walker_gait, Walker, WalkerContinueJob, WalkerContinueSummary,
+    WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerSpecialPoint, MODELS,
+};
 
 use crate::dynamics::Model;
 use crate::output::manifest::{RunDir, RunStatus};

@@ -9,8 +9,10 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::{in_run, AppError, SearchEnded};
+use crate::continuation::{continue_family, ContinuationOptions, FamilyEnd, SpecialKind};
 use crate::mechanism::compass::Compass;
 use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
+use crate::mechanism::rigid_family::{Parametrized, RigidFamily};
 use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP};
 use crate::mechanism::simplest::Simplest;
 use crate::output;
@@ -66,8 +68,8 @@ impl Walker {
     /// The model's name.
     pub fn name(&self) -> &'static str {
         match self {
-            Walker::Simplest(w) => w.name(),
-            Walker::Compass(w) => w.name(),
+            Walker::Simplest(w) => RigidWalker::name(w),
+            Walker::Compass(w) => RigidWalker::name(w),
         }
     }
 }
@@ -259,4 +261,188 @@ fn as_map<S: serde::Serializer>(pairs: &[(String, f64)], serializer: S) -> Resul
         map.serialize_entry(name, value)?;
     }
     map.end()
+}
+
+/// What `vrw continue --model NAME` follows.
+#[derive(Debug, Clone)]
+pub struct WalkerContinueJob {
+    /// The walker.
+    pub walker: Walker,
+    /// The parameter followed.
+    pub param: String,
+    /// Where the first gait is searched (default the parameter's value in the walker).
+    pub start: Option<f64>,
+    /// The range followed.
+    pub range: (f64, f64),
+    /// Most points in each direction.
+    pub max_points: usize,
+    /// Largest continuation step (scaled unknowns).
+    pub max_step: f64,
+    /// Output directory for `branch.csv` and `special_points.json`.
+    pub out_dir: PathBuf,
+    /// Replace a run of another command in `out_dir`.
+    pub overwrite: bool,
+}
+
+/// `special_points.json` of a walker's family.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WalkerContinueSummary {
+    /// vrw's version.
+    pub vrw_version: &'static str,
+    /// The model's name.
+    pub model: &'static str,
+    /// Its parameters (the followed one at the start's value).
+    pub parameters: Walker,
+    /// The parameter followed.
+    pub param: String,
+    /// Where the family was started.
+    pub start: f64,
+    /// Points on the family (rows of `branch.csv`).
+    pub points: usize,
+    /// How the family ends at its first point and at its last.
+    pub ends: [FamilyEnd; 2],
+    /// Its special points.
+    pub special_points: Vec<WalkerSpecialPoint>,
+    /// How `DP` was taken.
+    pub derivative: String,
+}
+
+/// A special point of a walker's family.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WalkerSpecialPoint {
+    /// `LP`, `PD`, `NS` or `BC` (the DLS indicator `lambda_I4` crossing zero).
+    pub kind: SpecialKind,
+    /// The parameter's value.
+    pub value: f64,
+    /// Solved for (`true`), or only bracketed between two points of the family.
+    pub located: bool,
+    /// Why it is not located, or how it was.
+    pub note: Option<String>,
+    /// The multipliers there `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+    /// The fixed point, by the section's coordinates.
+    #[serde(serialize_with = "as_map")]
+    pub section: Vec<(String, f64)>,
+}
+
+/// Follow the family of `job.walker`'s gait in `job.param` by pseudo-arclength continuation and write
+/// `branch.csv` (a row per point) and `special_points.json`, after the output directory is checked.
+pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinueSummary, AppError> {
+    crate::output::manifest::check_out_dir(&job.out_dir, "continue", job.overwrite)?;
+    let (summary, rows) = match &job.walker {
+        Walker::Simplest(w) => follow(w, w.default_start(), job)?,
+        Walker::Compass(w) => follow(w, w.default_start(), job)?,
+    };
+    in_run(&job.out_dir, job.overwrite, "continue", |run| {
+        output::write_atomic(&run.path("branch.csv"), |path| {
+            let mut w = output::csv_writer(path)?;
+            for row in &rows {
+                output::write_record(&mut w, path, row)?;
+            }
+            w.flush().map_err(|source| crate::output::OutputError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+        })?;
+        run.add("branch.csv");
+        output::write_json(&run.path("special_points.json"), &summary)?;
+        run.add("special_points.json");
+        Ok((summary, None))
+    })
+}
+
+/// The family of [`run_walker_continuation`] for `walker`, and the rows of `branch.csv` (its header first).
+fn follow<W, const N: usize, const Y: usize>(
+    walker: &W,
+    section: DVector<f64>,
+    job: &WalkerContinueJob,
+) -> Result<(WalkerContinueSummary, Vec<Vec<String>>), AppError>
+where
+    W: RigidWalker<N, Y> + Parametrized + Sync,
+{
+    let invalid = |reason: String| AppError::InvalidOption {
+        option: "param",
+        reason,
+    };
+    let family: RigidFamily<W, N, Y> =
+        RigidFamily::new(walker, &job.param).map_err(|e| invalid(e.to_string()))?;
+    let start = job.start.unwrap_or(current_value(job)?);
+    let at_start = walker.with_parameter(&job.param, start)?;
+    let options = RigidOptions::default();
+    let gait = transient(&at_start, &section, TRANSIENT_STEPS, &options)
+        .map_err(|source| RigidGaitError::Step {
+            iteration: 0,
+            source,
+        })
+        .and_then(|s| rigid_gait(&at_start, &s, &options))
+        .map_err(|e| invalid(format!("no gait at {} = {start}: {e}", job.param)))?;
+    let mut continuation = ContinuationOptions::for_range(job.range.0, job.range.1);
+    continuation.max_points = job.max_points;
+    continuation.max_step = job.max_step;
+    continuation.initial_step = continuation.initial_step.min(job.max_step);
+    let followed = continue_family(&family, &gait.section, start, &continuation)
+        .map_err(|e| invalid(e.to_string()))?;
+    let names = walker.section_names();
+    let named = |x: &DVector<f64>| -> Vec<(String, f64)> {
+        names
+            .iter()
+            .map(|n| n.to_string())
+            .zip(x.iter().copied())
+            .collect()
+    };
+    let pairs = |m: &[nalgebra::Complex<f64>]| m.iter().map(|z| [z.re, z.im]).collect();
+    let mut rows = vec![[job.param.clone()]
+        .into_iter()
+        .chain(names.iter().map(|n| n.to_string()))
+        .chain(["largest_multiplier", "period", "lambda_I4"].map(String::from))
+        .collect::<Vec<_>>()];
+    rows.extend(followed.points.iter().map(|p| {
+        [p.param]
+            .into_iter()
+            .chain(p.x.iter().copied())
+            .chain([p.max_multiplier(), p.info.period, p.info.lambda_i4])
+            .map(|v| v.to_string())
+            .collect()
+    }));
+    let summary = WalkerContinueSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        model: walker.name(),
+        parameters: job.walker,
+        param: job.param.clone(),
+        start,
+        points: followed.points.len(),
+        ends: followed.ends.clone(),
+        special_points: followed
+            .special
+            .iter()
+            .map(|s| WalkerSpecialPoint {
+                kind: s.kind,
+                value: s.param,
+                located: s.located,
+                note: s.note.clone(),
+                multipliers: pairs(&s.multipliers),
+                section: named(&s.x),
+            })
+            .collect(),
+        derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
+    };
+    Ok((summary, rows))
+}
+
+/// The transient walk before a family's first gait is searched.
+const TRANSIENT_STEPS: usize = 20;
+
+/// The followed parameter's value in the job's walker.
+fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
+    let value = serde_json::to_value(job.walker)
+        .ok()
+        .and_then(|v| v.get(&job.param).and_then(serde_json::Value::as_f64));
+    value.ok_or_else(|| AppError::InvalidOption {
+        option: "param",
+        reason: format!(
+            "the model `{}` has no parameter {:?}",
+            job.walker.name(),
+            crate::fmt::clip(&job.param)
+        ),
+    })
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use vrw::app::{
@@ -13,11 +13,16 @@ use vrw::family::GaitInfo;
 use vrw::walk::SectionState;
 
 use super::{interrupt_flag, print_warnings, ModelArgs};
+use vrw::app::{run_walker_continuation, Walker, WalkerContinueJob};
 
 #[derive(Debug, Args)]
 pub(super) struct ContinueArgs {
     #[command(flatten)]
-    model: ModelArgs,
+    params: ModelArgs,
+    /// The walker: `vrw` (default), `simplest` or `compass` (docs/model.md section 13); for the last two the
+    /// family of the start's gait alone, branch.csv and special_points.json (no figure yet).
+    #[arg(long, default_value = "vrw")]
+    model: String,
     /// The parameter followed: one of the real-valued keys (as for sweep).
     #[arg(long, default_value = "viscosity")]
     param: String,
@@ -109,6 +114,10 @@ fn end_words(end: &FamilyEnd) -> String {
 
 /// Run `vrw continue` and print its summary.
 pub(super) fn run(args: ContinueArgs) -> Result<()> {
+    let sets = &args.params.set;
+    if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
+        return run_walker(&args, walker);
+    }
     let job = continue_job(&args)?;
     super::check_out(&job.out_dir, "continue", job.overwrite)?;
     let result = run_continuation(&job).context("continue")?;
@@ -142,11 +151,73 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
     Ok(())
 }
 
+/// `vrw continue --model NAME` for a walker other than the wheel: its start's family, branch.csv and
+/// special_points.json.
+fn run_walker(args: &ContinueArgs, walker: Walker) -> Result<()> {
+    if args.two_param.is_some() || args.initial.is_some() || args.period.is_some() {
+        bail!(
+            "`two_param`, `initial` and `period` take the wheel's continuation; the model `{}` follows its \
+             start's family only so far (docs/model.md section 13)",
+            walker.name()
+        );
+    }
+    let job = WalkerContinueJob {
+        walker,
+        param: args.param.clone(),
+        start: args.start,
+        range: (args.from, args.to),
+        max_points: args.max_points,
+        max_step: args.max_step,
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+    };
+    super::check_out(&job.out_dir, "continue", job.overwrite)?;
+    let s = run_walker_continuation(&job).context("continue")?;
+    println!(
+        "vrw continue --model {}: {} from {} to {}, from the gait at {}: {} points, {} special points \
+         ({}); {}; {}",
+        s.model,
+        s.param,
+        args.from,
+        args.to,
+        s.start,
+        s.points,
+        s.special_points.len(),
+        s.derivative,
+        end_words(&s.ends[0]),
+        end_words(&s.ends[1])
+    );
+    for sp in &s.special_points {
+        let moduli: Vec<String> = sp
+            .multipliers
+            .iter()
+            .map(|[re, im]| format!("{:.6}", re.hypot(*im)))
+            .collect();
+        let how = if sp.located {
+            "located".to_string()
+        } else {
+            format!(
+                "detected, not located: {}",
+                sp.note.as_deref().unwrap_or("no reason given")
+            )
+        };
+        println!(
+            "  {} at {} = {:.9} (multiplier moduli {}): {how}",
+            sp.kind,
+            s.param,
+            sp.value,
+            moduli.join(", ")
+        );
+    }
+    super::print_wrote(&args.out);
+    Ok(())
+}
+
 /// The continuation the options describe (Ctrl-C armed, then the model loaded from its file and flags).
 fn continue_job(args: &ContinueArgs) -> Result<ContinueJob> {
     let flag = interrupt_flag();
     Ok(ContinueJob {
-        config: args.model.load()?,
+        config: args.params.load()?,
         param: args.param.clone(),
         start: args.start,
         from: args.from,

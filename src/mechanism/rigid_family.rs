@@ -7,10 +7,10 @@
 
 use std::marker::PhantomData;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 use super::rigid::{rigid_step, RigidOptions, RigidWalker};
-use super::rigid_gait::DIFFERENCE_STEP;
+use super::rigid_gait::{central_jacobian, DIFFERENCE_STEP};
 use crate::continuation::{Evaluation, FamilyMap, MapFailure};
 use crate::params::ConfigError;
 
@@ -123,22 +123,7 @@ where
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<RigidInfo>, MapFailure> {
         let walker = self.at(p)?;
         let (value, info) = self.walked(&walker, x)?;
-        let iterated = IteratedMap {
-            family: self,
-            walker: &walker,
-        };
-        let n = x.len();
-        let mut jacobian = DMatrix::zeros(n, n);
-        for k in 0..n {
-            let h = DIFFERENCE_STEP * x[k].abs().max(1.0);
-            let (mut plus, mut minus) = (x.clone(), x.clone());
-            plus[k] += h;
-            minus[k] -= h;
-            jacobian.set_column(
-                k,
-                &((iterated.value(&plus)? - iterated.value(&minus)?) / (2.0 * h)),
-            );
-        }
+        let jacobian = central_jacobian(x, |x| Ok(self.walked(&walker, x)?.0))?;
         let h = DIFFERENCE_STEP * p.abs().max(1.0);
         let dparam = (self.value(x, p + h)? - self.value(x, p - h)?) / (2.0 * h);
         Ok(Evaluation {
@@ -169,19 +154,5 @@ where
     /// `lambda_I4` of the first heel strike: where it turns positive, the walker stops in double support.
     fn borders(&self, info: &RigidInfo) -> Vec<(&'static str, f64)> {
         vec![("lambda_I4", info.lambda_i4)]
-    }
-}
-
-/// `P^k` of one walker (one parameter value), for the columns of `DP`.
-struct IteratedMap<'f, 'a, W, const N: usize, const Y: usize> {
-    family: &'f RigidFamily<'a, W, N, Y>,
-    walker: &'f W,
-}
-
-impl<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
-    IteratedMap<'_, '_, W, N, Y>
-{
-    fn value(&self, x: &DVector<f64>) -> Result<DVector<f64>, MapFailure> {
-        Ok(self.family.walked(self.walker, x)?.0)
     }
 }

@@ -88,16 +88,23 @@ pub fn rigid_jacobian<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     s: &DVector<f64>,
     options: &RigidOptions,
 ) -> Result<DMatrix<f64>, RigidError> {
-    let n = s.len();
+    central_jacobian(s, |x| Ok(rigid_step_map(walker, x, options)?.0))
+}
+
+/// The Jacobian of `f` at `x` by central differences, each coordinate stepped by [`DIFFERENCE_STEP`] times its
+/// size (at least 1).
+pub fn central_jacobian<E>(
+    x: &DVector<f64>,
+    f: impl Fn(&DVector<f64>) -> Result<DVector<f64>, E>,
+) -> Result<DMatrix<f64>, E> {
+    let n = x.len();
     let mut jacobian = DMatrix::zeros(n, n);
     for k in 0..n {
-        let h = DIFFERENCE_STEP * s[k].abs().max(1.0);
-        let (mut plus, mut minus) = (s.clone(), s.clone());
+        let h = DIFFERENCE_STEP * x[k].abs().max(1.0);
+        let (mut plus, mut minus) = (x.clone(), x.clone());
         plus[k] += h;
         minus[k] -= h;
-        let (p, _) = rigid_step_map(walker, &plus, options)?;
-        let (m, _) = rigid_step_map(walker, &minus, options)?;
-        jacobian.set_column(k, &((p - m) / (2.0 * h)));
+        jacobian.set_column(k, &((f(&plus)? - f(&minus)?) / (2.0 * h)));
     }
     Ok(jacobian)
 }
