@@ -156,6 +156,40 @@ fn ctrl_c_in_gait_says_so_and_writes_nothing() {
     assert!(!out.join("manifest.json").exists());
 }
 
+/// The gait search of another walker (`--model`) answers Ctrl-C as the wheel's does: exit 1, a message that
+/// names no manifest, nothing written.
+#[test]
+fn ctrl_c_in_a_walkers_gait_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("W");
+    let args = [
+        "gait",
+        "--model",
+        "simplest",
+        "--transient",
+        "10000000",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let child = spawn(&args, tmp.path());
+    std::thread::sleep(Duration::from_millis(800));
+    sigint(&child);
+    let output = child.wait_with_output().unwrap();
+    assert_error(
+        &output,
+        &[
+            "interrupted (Ctrl-C) while searching the gait",
+            "nothing is written",
+        ],
+    );
+    assert!(
+        !stderr(&output).contains("manifest.json"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!out.join("manifest.json").exists());
+}
+
 /// A second Ctrl-C right after the first quits at once, but the manifest says `interrupted`, never
 /// `running`.
 #[test]

@@ -132,7 +132,7 @@ pub fn compute_gait(job: &GaitJob) -> Result<GaitSummary, AppError> {
     let map = StepMap::new(&model, &job.config.solver).with_interrupt(job.interrupt.as_deref());
     let result = find_gait_any_period(&map, &initial, &job.options, MAX_PERIOD);
     let flag = job.interrupt.as_deref();
-    let nothing = "nothing is written";
+    let nothing = super::NOTHING_WRITTEN;
     super::check_phase_interrupted(flag, "while searching the gait", nothing)?;
     let jacobian_check = match (&result, job.check_jacobian) {
         (Ok(gait), true) => Some(

@@ -93,7 +93,7 @@ pub enum AppError {
         reason: String,
     },
     /// The interrupt flag (Ctrl-C) stopped the job; what was complete is written (and named in `kept`).
-    #[error("interrupted (Ctrl-C) {during}; {kept} (manifest.json: interrupted)")]
+    #[error("interrupted (Ctrl-C) {during}; {kept}{}", recorded(kept))]
     Interrupted {
         /// Where the job was: `after 12 of 300 points`, `while locating the thresholds`.
         during: String,
@@ -109,6 +109,18 @@ pub enum AppError {
         /// Why.
         reason: String,
     },
+}
+
+/// What an interrupted job that writes nothing keeps ([`AppError::Interrupted`]'s `kept`).
+pub(crate) const NOTHING_WRITTEN: &str = "nothing is written";
+
+/// Where an interrupted job's record is: its manifest, unless it wrote nothing.
+fn recorded(kept: &str) -> &'static str {
+    if kept == NOTHING_WRITTEN {
+        ""
+    } else {
+        " (manifest.json: interrupted)"
+    }
 }
 
 /// The validated configuration's model and the start on the section (`initial`, or [`default_initial`]),

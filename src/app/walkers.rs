@@ -9,10 +9,12 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::{in_run, AppError, SearchEnded};
-use crate::continuation::{continue_family, ContinuationOptions, FamilyEnd, SpecialKind};
+use crate::continuation::{
+    continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
+};
 use crate::mechanism::compass::Compass;
 use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
-use crate::mechanism::rigid_family::{Parametrized, RigidFamily};
+use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
 use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP};
 use crate::mechanism::simplest::Simplest;
 use crate::output;
@@ -189,13 +191,14 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
             .zip(s.iter().copied())
             .collect()
     };
-    let options = RigidOptions::default();
+    let options = interruptible();
     let result = transient(walker, &start, job.transient_steps, &options)
         .map_err(|source| RigidGaitError::Step {
             iteration: 0,
             source,
         })
         .and_then(|s| rigid_gait(walker, &s, &options));
+    super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
@@ -219,6 +222,9 @@ fn transient<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
 ) -> Result<DVector<f64>, RigidError> {
     let (mut q, mut qd) = walker.state_at_section(start);
     for _ in 0..steps {
+        if options.stop.is_some_and(|stop| stop()) {
+            return Err(RigidError::Interrupted);
+        }
         let step = rigid_step(walker, &q, &qd, options)?;
         (q, qd) = (step.q, step.qd);
     }
@@ -364,11 +370,12 @@ where
         option: "param",
         reason,
     };
-    let family: RigidFamily<W, N, Y> =
-        RigidFamily::new(walker, &job.param).map_err(|e| invalid(e.to_string()))?;
+    let family: RigidFamily<W, N, Y> = RigidFamily::new(walker, &job.param)
+        .map_err(|e| invalid(e.to_string()))?
+        .with_options(interruptible());
     let start = job.start.unwrap_or(current_value(job)?);
     let at_start = walker.with_parameter(&job.param, start)?;
-    let options = RigidOptions::default();
+    let options = interruptible();
     let gait = transient(&at_start, &section, TRANSIENT_STEPS, &options)
         .map_err(|source| RigidGaitError::Step {
             iteration: 0,
@@ -380,30 +387,15 @@ where
     continuation.max_points = job.max_points;
     continuation.max_step = job.max_step;
     continuation.initial_step = continuation.initial_step.min(job.max_step);
+    super::check_phase_interrupted(
+        None,
+        "while searching the first gait",
+        super::NOTHING_WRITTEN,
+    )?;
     let followed = continue_family(&family, &gait.section, start, &continuation)
         .map_err(|e| invalid(e.to_string()))?;
+    super::check_phase_interrupted(None, "while following the family", super::NOTHING_WRITTEN)?;
     let names = walker.section_names();
-    let named = |x: &DVector<f64>| -> Vec<(String, f64)> {
-        names
-            .iter()
-            .map(|n| n.to_string())
-            .zip(x.iter().copied())
-            .collect()
-    };
-    let pairs = |m: &[nalgebra::Complex<f64>]| m.iter().map(|z| [z.re, z.im]).collect();
-    let mut rows = vec![[job.param.clone()]
-        .into_iter()
-        .chain(names.iter().map(|n| n.to_string()))
-        .chain(["largest_multiplier", "period", "lambda_I4"].map(String::from))
-        .collect::<Vec<_>>()];
-    rows.extend(followed.points.iter().map(|p| {
-        [p.param]
-            .into_iter()
-            .chain(p.x.iter().copied())
-            .chain([p.max_multiplier(), p.info.period, p.info.lambda_i4])
-            .map(|v| v.to_string())
-            .collect()
-    }));
     let summary = WalkerContinueSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
@@ -420,13 +412,39 @@ where
                 value: s.param,
                 located: s.located,
                 note: s.note.clone(),
-                multipliers: pairs(&s.multipliers),
-                section: named(&s.x),
+                multipliers: s.multipliers.iter().map(|z| [z.re, z.im]).collect(),
+                section: names
+                    .iter()
+                    .map(|n| n.to_string())
+                    .zip(s.x.iter().copied())
+                    .collect(),
             })
             .collect(),
         derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
     };
+    let rows = branch_rows(&job.param, &names, &followed.points);
     Ok((summary, rows))
+}
+
+/// The rows of a walker's `branch.csv`, its header first: the parameter, the section's coordinates, the largest
+/// multiplier, the step's period and `lambda_I4`.
+fn branch_rows(param: &str, names: &[&str], points: &[FamilyPoint<RigidInfo>]) -> Vec<Vec<String>> {
+    let header = [param.to_string()]
+        .into_iter()
+        .chain(names.iter().map(|n| n.to_string()))
+        .chain(["largest_multiplier", "period", "lambda_I4"].map(String::from))
+        .collect();
+    let row = |p: &FamilyPoint<RigidInfo>| {
+        [p.param]
+            .into_iter()
+            .chain(p.x.iter().copied())
+            .chain([p.max_multiplier(), p.info.period, p.info.lambda_i4])
+            .map(|v| v.to_string())
+            .collect()
+    };
+    std::iter::once(header)
+        .chain(points.iter().map(row))
+        .collect()
 }
 
 /// The transient walk before a family's first gait is searched.
@@ -445,4 +463,12 @@ fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
             crate::fmt::clip(&job.param)
         ),
     })
+}
+
+/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
+fn interruptible() -> RigidOptions {
+    RigidOptions {
+        stop: Some(crate::walk::interrupted),
+        ..RigidOptions::default()
+    }
 }

@@ -171,6 +171,7 @@ fn run_walker(args: &ContinueArgs, walker: Walker) -> Result<()> {
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
     };
+    super::interrupt_flag();
     super::check_out(&job.out_dir, "continue", job.overwrite)?;
     let s = run_walker_continuation(&job).context("continue")?;
     println!(

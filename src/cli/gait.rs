@@ -310,6 +310,7 @@ fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
     };
+    super::interrupt_flag();
     super::check_out(&job.out_dir, "gait", job.overwrite)?;
     let summary = run_walker_gait(&job).context("gait")?;
     let parameters = serde_json::to_value(summary.parameters)?;

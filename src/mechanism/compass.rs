@@ -15,7 +15,7 @@ use super::assembly::{along_leg, point_mass_equations, point_mass_potential, up,
 use super::constrained::{accelerations, impulse, ConstrainedError, Row};
 use super::rigid::{HeelStrike, RigidWalker};
 use super::{Equations, Mechanism, PointKinematics, Real};
-use crate::params::ConfigError;
+use crate::params::{ConfigError, MASS_RATIO_LIMIT};
 
 /// Index of the hip's `x` in `q`.
 pub const X: usize = 0;
@@ -73,8 +73,9 @@ pub struct CompassConstants<T: Real> {
 }
 
 impl Compass {
-    /// Checks every rule: positive masses, length and gravity, the leg's mass on the leg
-    /// (`0 <= leg_mass_offset <= leg_length`), a slope between -90 and 90 degrees. Every broken rule is
+    /// Checks every rule: positive masses, length and gravity, `leg_mass / hip_mass` within
+    /// [`MASS_RATIO_LIMIT`] of 1 (as the wheel's), the leg's mass on the leg below the hip
+    /// (`0 <= leg_mass_offset < leg_length`), a slope between -90 and 90 degrees. Every broken rule is
     /// reported.
     pub fn validate(&self) -> Result<(), ConfigError> {
         use crate::params::{finite, positive};
@@ -90,14 +91,30 @@ impl Compass {
         .filter_map(Result::err)
         .collect();
         if self.leg_mass_offset.is_finite()
-            && !(0.0..=self.leg_length).contains(&self.leg_mass_offset)
+            && !(0.0..self.leg_length).contains(&self.leg_mass_offset)
         {
             errors.push(ConfigError::InvalidValue {
                 key: "leg_mass_offset".to_string(),
                 value: crate::fmt::short(self.leg_mass_offset),
                 reason: format!(
-                    "the leg's mass must lie on the leg: between 0 and leg_length = {}",
+                    "the leg's mass must lie on the leg below the hip: from 0 to less than leg_length = {} (a \
+                     leg with its mass at the hip has no inertia and the mass matrix is singular; the simplest \
+                     walking model is that limit)",
                     crate::fmt::short(self.leg_length)
+                ),
+            });
+        }
+        let ratio = self.leg_mass / self.hip_mass;
+        if ratio.is_finite() && !(1.0 / MASS_RATIO_LIMIT..=MASS_RATIO_LIMIT).contains(&ratio) {
+            errors.push(ConfigError::InvalidValue {
+                key: "leg_mass".to_string(),
+                value: crate::fmt::short(self.leg_mass),
+                reason: format!(
+                    "leg_mass / hip_mass = {} is outside [{}, {}]: the mass matrix would be singular to \
+                     rounding",
+                    crate::fmt::short(ratio),
+                    crate::fmt::short(1.0 / MASS_RATIO_LIMIT),
+                    crate::fmt::short(MASS_RATIO_LIMIT)
                 ),
             });
         }

@@ -73,7 +73,7 @@ pub struct HeelStrike<const N: usize> {
 }
 
 /// How a step of a rigid-legged walker is integrated.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub struct RigidOptions {
     /// The integrator's tolerances.
     pub tolerances: Tolerances,
@@ -81,7 +81,18 @@ pub struct RigidOptions {
     pub max_step_time: f64,
     /// Events are located to this time.
     pub event_time_tol: f64,
+    /// Asked every [`STOP_CHECK_STEPS`] integrator steps whether to stop (the caller's interrupt: Ctrl-C);
+    /// `None`: never.
+    pub stop: Option<fn() -> bool>,
 }
+
+/// Integrator steps between two questions of [`RigidOptions::stop`].
+pub const STOP_CHECK_STEPS: usize = 1000;
+
+/// A swing foot that meets the ground less than this far ahead of the stance foot, relative to the hip's
+/// height, is passing it (the legs of equal length coincide there: foot scuffing near mid-swing), not striking
+/// the ground ahead: a heel strike is at least a step's length ahead.
+pub const MIN_STRIDE: f64 = 1e-6;
 
 impl Default for RigidOptions {
     fn default() -> RigidOptions {
@@ -94,6 +105,7 @@ impl Default for RigidOptions {
             },
             max_step_time: 20.0,
             event_time_tol: 1e-14,
+            stop: None,
         }
     }
 }
@@ -127,6 +139,9 @@ pub enum RigidError {
         /// When.
         time: f64,
     },
+    /// The caller asked the walk to stop ([`RigidOptions::stop`]).
+    #[error("interrupted")]
+    Interrupted,
     /// `lambda_I4 >= 0` at heel strike: with rigid legs, double support holds the walker still.
     #[error("the walker stops in double support (lambda_I4 = {lambda_i4:e} >= 0)")]
     StopsInDoubleSupport {
@@ -145,6 +160,7 @@ impl RigidError {
             RigidError::StanceLiftsOff { .. } => "stance_lifts_off",
             RigidError::Fell { .. } => "fell",
             RigidError::StopsInDoubleSupport { .. } => "stops_in_double_support",
+            RigidError::Interrupted => "interrupted",
         }
     }
 }
@@ -206,15 +222,15 @@ fn unpack<const N: usize, const Y: usize>(
     )
 }
 
-/// The heel-strike event function: the swing foot's height where it is ahead of the stance foot, else a
-/// positive constant (no event behind the stance foot).
+/// The heel-strike event function: the swing foot's height where it is ahead of the stance foot (by more than
+/// [`MIN_STRIDE`] of the hip's height), else a positive constant (no event behind the stance foot or beside it).
 fn strike_height<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
     y: &SVector<f64, Y>,
 ) -> f64 {
     let (q, _) = unpack::<N, Y>(y);
     let (height, ahead) = walker.swing_foot(&q);
-    if ahead > 0.0 {
+    if ahead > MIN_STRIDE * walker.hip_height(&q).abs() {
         height
     } else {
         1.0
@@ -234,7 +250,12 @@ pub fn rigid_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     let mut integrator = Dop853::new(&system, 0.0, y0, options.tolerances);
     let (mut scuffs, mut energy_drift) = (0, 0.0f64);
     let mut below = walker.swing_foot(q).0 < 0.0;
+    let mut taken = 0usize;
     loop {
+        taken += 1;
+        if taken.is_multiple_of(STOP_CHECK_STEPS) && options.stop.is_some_and(|stop| stop()) {
+            return Err(RigidError::Interrupted);
+        }
         let step = integrator.step(&system, options.max_step_time)?;
         let (t0, t1) = (step.t0(), step.t1());
         let (g0, g1) = (

@@ -73,6 +73,11 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
         })
     }
 
+    /// The same family walked with `options` (an interrupt, tolerances).
+    pub fn with_options(self, options: RigidOptions) -> RigidFamily<'a, W, N, Y> {
+        RigidFamily { options, ..self }
+    }
+
     /// The walker at the parameter value `p`.
     fn at(&self, p: f64) -> Result<W, MapFailure> {
         self.walker

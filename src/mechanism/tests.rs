@@ -159,6 +159,26 @@ fn bad_compass_parameters_name_every_key() {
         assert!(message.contains(key), "{message}");
     }
     assert!(Compass::default().validate().is_ok());
+    // A leg with its mass at the hip has no inertia, and a hip a billion times the legs makes M singular to
+    // rounding: both are refused before any walk.
+    let at_hip = Compass {
+        leg_mass_offset: 1.0,
+        ..Compass::default()
+    };
+    assert!(at_hip
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("below the hip"));
+    let heavy = Compass {
+        hip_mass: 1e9,
+        ..Compass::default()
+    };
+    assert!(heavy
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("leg_mass / hip_mass"));
 }
 
 /// The compass gait's equations over dual numbers carry their exact derivatives (as the wheel's do for the
