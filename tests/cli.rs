@@ -1154,8 +1154,12 @@ fn gait_of_the_classic_walkers() {
 /// the wrong size, an option only the wheel has.
 #[test]
 fn bad_walker_input_names_the_problem() {
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (&["--model", "biped"], "unknown model \"biped\""),
+        (
+            &["--model", "simplest", "--set", "slope=1e-400"],
+            "too small for a 64-bit float",
+        ),
         (
             &["--model", "simplest", "--set", "viscosity=3"],
             "unknown key `viscosity`",

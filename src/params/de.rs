@@ -361,7 +361,7 @@ impl<'de> de::Deserializer<'de> for Value<'_> {
 /// The real number `x` read from `text`, refused when the text names a finite non-zero number that an `f64`
 /// cannot hold (it would silently become infinite or 0). Non-finite spellings (`inf`, `nan`) pass here and
 /// are refused by validation, which names the key.
-fn literal(key: &str, text: &str, x: f64) -> Result<f64, ConfigError> {
+pub(crate) fn literal(key: &str, text: &str, x: f64) -> Result<f64, ConfigError> {
     let mantissa = text.split(['e', 'E']).next().unwrap_or(text);
     if x.is_infinite() && !text.to_ascii_lowercase().contains("inf") {
         Err(invalid(

@@ -369,6 +369,9 @@ where
                 });
             }
             let value = match raw {
+                Raw::Given(toml::Value::Float(x), Some(text)) => {
+                    toml::Value::Float(de::literal(&key, &text, x)?)
+                }
                 Raw::Stored(value) | Raw::Given(value, _) => value,
                 Raw::Text(text) => toml::Value::String(text),
             };
@@ -389,12 +392,16 @@ where
                 known: known(),
             });
         }
-        let number: f64 = value.trim().parse().map_err(|_| ConfigError::WrongType {
+        let text = value.trim();
+        let number: f64 = text.parse().map_err(|_| ConfigError::WrongType {
             key: key.to_string(),
             expected: "a number".to_string(),
             found: value.to_string(),
         })?;
-        table.insert(key.to_string(), toml::Value::Float(number));
+        table.insert(
+            key.to_string(),
+            toml::Value::Float(de::literal(key, text, number)?),
+        );
     }
     table
         .try_into()
