@@ -928,7 +928,7 @@ const WHEEL_NAMES: &[&str] = &["NQ", "L1", "L2", "L3", "THETA", "LegIndex", "Leg
 const WHEEL_NAMES_LEFT: &[(&str, usize)] = &[
     ("mechanism/", 0),
     ("contact/", 96),
-    ("walk/", 141),
+    ("walk/", 133),
     ("variational/", 73),
     ("gait/", 5),
     ("family/", 0),

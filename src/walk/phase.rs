@@ -11,8 +11,9 @@ use crate::contact::{
     constrained_dynamics, constrained_dynamics_solved, solve_into, ActiveSet, ConstrainedDynamics,
     ContactError, Solved,
 };
-use crate::dynamics::{swinging, Coords, Model, L1, L2, L3, NQ};
+use crate::dynamics::{swinging, Coords, Model, L3, NQ};
 use crate::integrate::OdeSystem;
+use crate::mechanism::Mechanism;
 
 /// Size of the integrated state `[q, q', E_damper]`.
 pub(crate) const NY: usize = 2 * NQ + 1;
@@ -72,7 +73,10 @@ impl<'a> PhaseSystem<'a> {
         y: &WalkVector,
     ) -> (WalkVector, Option<ConstrainedDynamics>) {
         let (q, qd) = unpack(y);
-        self.field(&qd, constrained_dynamics(self.model, &q, &qd, &self.active))
+        self.field(
+            (&q, &qd),
+            constrained_dynamics(self.model, &q, &qd, &self.active),
+        )
     }
 
     /// [`PhaseSystem::rhs_and_dynamics`] with what the solve computed on the way (the same numbers; the
@@ -83,21 +87,20 @@ impl<'a> PhaseSystem<'a> {
     ) -> (WalkVector, Option<ConstrainedDynamics>, Solved) {
         let (q, qd) = unpack(y);
         let (dynamics, solved) = constrained_dynamics_solved(self.model, &q, &qd, &self.active);
-        let (f, dynamics) = self.field(&qd, dynamics);
+        let (f, dynamics) = self.field((&q, &qd), dynamics);
         (f, dynamics, solved)
     }
 
-    /// The vector field from the constrained dynamics at a state with velocities `qd`.
+    /// The vector field from the constrained dynamics at `(q, q')`, with the dampers' power
+    /// ([`Mechanism::damper_power`]).
     pub(crate) fn field(
         &self,
-        qd: &Coords,
+        (q, qd): (&Coords, &Coords),
         dynamics: Result<ConstrainedDynamics, ContactError>,
     ) -> (WalkVector, Option<ConstrainedDynamics>) {
         match dynamics {
             Ok(d) => {
-                let c = self.model.params().viscosity;
-                let power = qd[L1] * qd[L1] + qd[L2] * qd[L2] + qd[L3] * qd[L3];
-                let f = pack(qd, &d.qdd, c * power);
+                let f = pack(qd, &d.qdd, self.model.damper_power(q, qd));
                 (f, Some(d))
             }
             // The integrator reports a non-finite derivative as an error with its time.
@@ -208,7 +211,7 @@ impl StageLog {
             },
         });
         let dynamics = solve_into(phase.model, (&q, &qd), &phase.active, &mut stage.solved);
-        (stage.f, stage.dynamics) = phase.field(&qd, dynamics);
+        (stage.f, stage.dynamics) = phase.field((&q, &qd), dynamics);
         stage.f
     }
 
