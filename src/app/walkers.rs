@@ -184,51 +184,54 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         Some(values) => DVector::from_column_slice(values),
         None => start,
     };
-    let named = |s: &DVector<f64>| {
-        names
-            .iter()
-            .map(|n| n.to_string())
-            .zip(s.iter().copied())
-            .collect()
-    };
-    let options = interruptible();
-    let result = transient(walker, &start, job.transient_steps, &options)
-        .map_err(|source| RigidGaitError::Step {
-            iteration: 0,
-            source,
-        })
-        .and_then(|s| rigid_gait(walker, &s, &options));
+    let result = search_gait(walker, &start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
         parameters: job.walker,
-        initial: named(&start),
+        initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
             Err(e) => SearchEnded::Failed(failure_kind(e)),
         },
         message: result.as_ref().err().map(ToString::to_string),
-        gait: result.ok().map(|g| gait_record(&g, named(&g.section))),
+        gait: result
+            .ok()
+            .map(|g| gait_record(&g, named(&names, &g.section))),
     })
 }
 
-/// The section state after `steps` steps of the walk from `start`.
-fn transient<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+/// The gait of `walker` searched from the section state `start`: `steps` steps walked, then Newton's method,
+/// each walk answering the interrupt flag ([`interruptible`]).
+fn search_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
     start: &DVector<f64>,
     steps: usize,
-    options: &RigidOptions,
-) -> Result<DVector<f64>, RigidError> {
+) -> Result<RigidGait<N>, RigidGaitError> {
+    let options = interruptible();
+    let transient = |source| RigidGaitError::Step {
+        iteration: 0,
+        source,
+    };
     let (mut q, mut qd) = walker.state_at_section(start);
     for _ in 0..steps {
         if options.stop.is_some_and(|stop| stop()) {
-            return Err(RigidError::Interrupted);
+            return Err(transient(RigidError::Interrupted));
         }
-        let step = rigid_step(walker, &q, &qd, options)?;
+        let step = rigid_step(walker, &q, &qd, &options).map_err(transient)?;
         (q, qd) = (step.q, step.qd);
     }
-    Ok(walker.section_of(&q, &qd))
+    rigid_gait(walker, &walker.section_of(&q, &qd), &options)
+}
+
+/// Values by the section's coordinate names.
+fn named(names: &[&str], x: &DVector<f64>) -> Vec<(String, f64)> {
+    names
+        .iter()
+        .map(|n| n.to_string())
+        .zip(x.iter().copied())
+        .collect()
 }
 
 /// The kind of a failed search.
@@ -375,13 +378,7 @@ where
         .with_options(interruptible());
     let start = job.start.unwrap_or(current_value(job)?);
     let at_start = walker.with_parameter(&job.param, start)?;
-    let options = interruptible();
-    let gait = transient(&at_start, &section, TRANSIENT_STEPS, &options)
-        .map_err(|source| RigidGaitError::Step {
-            iteration: 0,
-            source,
-        })
-        .and_then(|s| rigid_gait(&at_start, &s, &options))
+    let gait = search_gait(&at_start, &section, TRANSIENT_STEPS)
         .map_err(|e| invalid(format!("no gait at {} = {start}: {e}", job.param)))?;
     let mut continuation = ContinuationOptions::for_range(job.range.0, job.range.1);
     continuation.max_points = job.max_points;
@@ -413,11 +410,7 @@ where
                 located: s.located,
                 note: s.note.clone(),
                 multipliers: s.multipliers.iter().map(|z| [z.re, z.im]).collect(),
-                section: names
-                    .iter()
-                    .map(|n| n.to_string())
-                    .zip(s.x.iter().copied())
-                    .collect(),
+                section: named(&names, &s.x),
             })
             .collect(),
         derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
