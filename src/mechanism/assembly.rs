@@ -72,3 +72,35 @@ pub fn along_leg<T: Real, const N: usize>(
         velocity_product: Vector2::new(-(r * s * w * w), r * c * w * w),
     }
 }
+
+/// The point at distance `q[il] - offset` from `base` along the leg at angle `q[ia]` (as [`along_leg`]): a point
+/// of a telescopic leg of length `q[il]`, `offset` from its tip (its tip where `offset = 0`, the leg's sliding
+/// mass at the paper's `a` from the tip): position, Jacobian and `dJ/dt q'`.
+pub fn along_telescopic_leg<T: Real, const N: usize>(
+    q: &SVector<T, N>,
+    qd: &SVector<T, N>,
+    [ix, iz, ia, il]: [usize; 4],
+    offset: T,
+) -> PointKinematics<T, N> {
+    let r = q[il] - offset;
+    let (s, c) = q[ia].sin_cos();
+    let (w, rate) = (qd[ia], qd[il]);
+    let mut jacobian = SMatrix::<T, 2, N>::zeros();
+    jacobian[(0, ix)] = T::one();
+    jacobian[(1, iz)] = T::one();
+    jacobian[(0, ia)] = r * c;
+    jacobian[(1, ia)] = r * s;
+    jacobian[(0, il)] = s;
+    jacobian[(1, il)] = -c;
+    // d/dt of the angle's column times w, and of the length's column times its rate: 2 L' w (cos, sin) +
+    // r w^2 (-sin, cos).
+    let two = T::one() + T::one();
+    PointKinematics {
+        position: Vector2::new(q[ix] + r * s, q[iz] - r * c),
+        jacobian,
+        velocity_product: Vector2::new(
+            two * rate * w * c - r * s * w * w,
+            two * rate * w * s + r * c * w * w,
+        ),
+    }
+}

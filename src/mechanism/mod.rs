@@ -11,16 +11,22 @@
 //!
 //! Walkers with rigid legs and point feet walk by [`rigid`] (single support between heel strikes) and have their
 //! gaits by [`rigid_gait`]: the compass gait and the simplest walking model of Garcia et al. ([`simplest`]),
-//! whose massless legs leave it only reduced equations. The wheel still walks through `walk/`; the two walks
-//! are to become one on this interface (docs/model.md section 13).
+//! whose massless legs leave it only reduced equations. Walkers with compliant legs walk by [`legged`]: the
+//! paper's whole procedure (phases chosen by force-level complementarity, every impact an impulse-level
+//! complementarity problem, the DLS indicators at a heel strike, stoppers with their Zeno rule) for any
+//! mechanism whose two legs take turns, as the compass gait with the paper's telescopic legs
+//! ([`telescopic`]) does. The wheel still walks through `walk/`; the walks are to become one on this interface
+//! (docs/model.md section 13).
 
 pub mod assembly;
 pub mod compass;
 pub mod constrained;
+pub mod legged;
 pub mod rigid;
 pub mod rigid_family;
 pub mod rigid_gait;
 pub mod simplest;
+pub mod telescopic;
 mod wheel;
 
 use nalgebra::{SMatrix, SVector};

@@ -1,0 +1,133 @@
+//! Gaits of a legged walker (docs/model.md section 13): fixed points of its step map on the section
+//! ([`Legged::section_of`]) by Newton's method, and their Floquet multipliers, the eigenvalues of `DP`, by
+//! central differences ([`crate::mechanism::rigid_gait::central_jacobian`]).
+
+use nalgebra::{DMatrix, DVector};
+
+use super::walk::{legged_step, LeggedOptions, LeggedStep};
+use super::{Legged, LeggedError};
+use crate::mechanism::rigid_gait::central_jacobian;
+
+/// Newton's method stops when `max |P(s) - s|` is below this.
+pub const NEWTON_TOL: f64 = 1e-11;
+
+/// Most Newton iterations.
+const MAX_NEWTON_ITERATIONS: usize = 40;
+
+/// `P(s)` and the step that gives it.
+pub fn legged_step_map<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    s: &DVector<f64>,
+    options: &LeggedOptions,
+) -> Result<(DVector<f64>, LeggedStep<N>), LeggedError> {
+    let (q, qd) = walker.state_at_section(s).ok_or(LeggedError::OffSection)?;
+    let step = legged_step::<W, N, Y>(walker, (&q, &qd), options)?;
+    Ok((walker.section_of(&step.q, &step.qd), step))
+}
+
+/// A gait of a legged walker.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeggedGait<const N: usize> {
+    /// The fixed point on the section.
+    pub section: DVector<f64>,
+    /// `max |P(s) - s|` there.
+    pub residual: f64,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// `DP` at the fixed point (central differences).
+    pub jacobian: DMatrix<f64>,
+    /// The Floquet multipliers `[re, im]`, largest modulus first.
+    pub multipliers: Vec<[f64; 2]>,
+    /// The step from the fixed point.
+    pub step: LeggedStep<N>,
+}
+
+/// Why no gait was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LeggedGaitError {
+    /// A step of the walk failed.
+    #[error("step map failed in Newton iteration {iteration}: {source}")]
+    Step {
+        /// Iteration number (from 0: the start).
+        iteration: usize,
+        /// Why.
+        source: LeggedError,
+    },
+    /// `DP - I` is singular.
+    #[error("DP - I is singular (a multiplier at 1), residual {residual:e}")]
+    Singular {
+        /// The residual there.
+        residual: f64,
+    },
+    /// Newton's method did not converge.
+    #[error("no convergence: residual {residual:e} after {iterations} Newton iterations")]
+    NoConvergence {
+        /// Iterations taken.
+        iterations: usize,
+        /// The last residual.
+        residual: f64,
+    },
+}
+
+/// The gait near `start` by Newton's method on `P(s) = s`, each step damped until the residual falls.
+pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    options: &LeggedOptions,
+) -> Result<LeggedGait<N>, LeggedGaitError> {
+    let map = |s: &DVector<f64>, iteration: usize| {
+        legged_step_map::<W, N, Y>(walker, s, options)
+            .map_err(|source| LeggedGaitError::Step { iteration, source })
+    };
+    let jacobian_at =
+        |s: &DVector<f64>, iteration: usize| central_jacobian(s, |x| Ok(map(x, iteration)?.0));
+    let mut s = start.clone();
+    let (mut image, mut step) = map(&s, 0)?;
+    for iteration in 1..=MAX_NEWTON_ITERATIONS {
+        let r = &image - &s;
+        let residual = r.amax();
+        let jacobian = jacobian_at(&s, iteration)?;
+        if residual < NEWTON_TOL {
+            return Ok(LeggedGait {
+                multipliers: multipliers(&jacobian),
+                section: s,
+                residual,
+                iterations: iteration - 1,
+                jacobian,
+                step,
+            });
+        }
+        let n = s.len();
+        let delta = (jacobian - DMatrix::identity(n, n))
+            .lu()
+            .solve(&(-r))
+            .ok_or(LeggedGaitError::Singular { residual })?;
+        let mut scale = 1.0;
+        loop {
+            let trial = &s + scale * &delta;
+            match map(&trial, iteration) {
+                Ok((next, next_step)) if (&next - &trial).amax() < residual || scale < 1e-3 => {
+                    (s, image, step) = (trial, next, next_step);
+                    break;
+                }
+                Err(e) if scale < 1e-3 => return Err(e),
+                _ => scale *= 0.5,
+            }
+        }
+    }
+    Err(LeggedGaitError::NoConvergence {
+        iterations: MAX_NEWTON_ITERATIONS,
+        residual: (&image - &s).amax(),
+    })
+}
+
+/// The eigenvalues of `jacobian` as `[re, im]`, largest modulus first.
+fn multipliers(jacobian: &DMatrix<f64>) -> Vec<[f64; 2]> {
+    let mut m: Vec<[f64; 2]> = jacobian
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| [z.re, z.im])
+        .collect();
+    m.sort_by(|a, b| b[0].hypot(b[1]).total_cmp(&a[0].hypot(a[1])));
+    m
+}
