@@ -346,8 +346,13 @@ where
         s: &DVector<f64>,
         sampling: Option<Sampling<'_>>,
     ) -> Result<WalkerStep, RigidError> {
+        let options = interruptible();
+        // Asked at every step too: a step takes fewer integrator steps than the walk's own check waits for.
+        if options.stop.is_some_and(|stop| stop()) {
+            return Err(RigidError::Interrupted);
+        }
         let (q, qd) = self.walker.state_at_section(s);
-        let step = rigid_step(self.walker, &q, &qd, &interruptible())?;
+        let step = rigid_step(self.walker, &q, &qd, &options)?;
         if let Some(sampling) = sampling {
             self.sampled((&q, &qd), step.period, sampling)?;
         }
