@@ -2,6 +2,8 @@
 //! through the binary: `simulate`, `sweep`, `orbit`, `plot` and `animate` of their runs, Ctrl-C, and the jobs
 //! a walker cannot do yet refusing it by name.
 
+// The helpers every test binary shares; this one does not walk the wheel (`simulated`).
+#[allow(dead_code)]
 mod common;
 
 use std::fs;

@@ -260,7 +260,7 @@ fn walk(
     for k in 1..=job.steps {
         let mut samples: Vec<WalkerSample> = Vec::new();
         let mut sink = |sample| samples.push(sample);
-        let sampling = trajectory.is_some().then(|| Sampling {
+        let sampling = trajectory.is_some().then_some(Sampling {
             start: time,
             dt: job.sample_dt,
             sink: &mut sink,

@@ -218,8 +218,8 @@ fn run_walker(args: &SweepArgs, walker: Walker) -> Result<()> {
             t.kind,
             args.param,
             t.value,
-            t.bracket[0],
-            t.bracket[1],
+            vrw::fmt::short(t.bracket[0]),
+            vrw::fmt::short(t.bracket[1]),
             multipliers.join(", "),
             t.note
                 .as_deref()

@@ -205,9 +205,12 @@ pub fn read_walker_run(dir: &Path) -> Result<WalkerRun, ReadError> {
     })
 }
 
+/// A CSV file's header, complete numeric rows, and warnings about the rows left out.
+type NumericTable = (Vec<String>, Vec<Vec<f64>>, Vec<String>);
+
 /// The header and the complete numeric rows of the CSV file `path`; a last row with too few fields or a
 /// value that is no number (a killed run's) is left out with a warning.
-fn read_numbers(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>, Vec<String>), ReadError> {
+fn read_numbers(path: &Path) -> Result<NumericTable, ReadError> {
     let csv_error = |source| ReadError::Csv {
         path: path.to_path_buf(),
         source,
