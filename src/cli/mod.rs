@@ -149,8 +149,27 @@ fn wheel_initial(command: &str, text: Option<&str>) -> Option<SectionState> {
     let parser = clap::builder::StringValueParser::new().try_map(|s| s.parse::<SectionState>());
     match parser.parse_ref(sub, arg, std::ffi::OsStr::new(text)) {
         Ok(state) => Some(state),
-        Err(e) => e.exit(),
+        Err(e) => {
+            eprint!("{}", clipped_quotes(&e.render().to_string()));
+            std::process::exit(e.exit_code());
+        }
     }
+}
+
+/// `text` with every run of characters between single quotes [`vrw::fmt::clip`]ped (clap quotes the argument
+/// it could not read whole, however long).
+pub(crate) fn clipped_quotes(text: &str) -> String {
+    text.split('\'')
+        .enumerate()
+        .map(|(i, part)| {
+            if i % 2 == 1 {
+                vrw::fmt::clip(part)
+            } else {
+                part.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("'")
 }
 
 /// A walker's `--initial`: its section's coordinates, `a,b,...` (their number is checked by the job, which
