@@ -169,6 +169,24 @@ FIGURES: list[Figure] = [
         _in("out/continue-curve", *CONTINUE, "curves.csv"),
     ),
     Figure(
+        "orbit-simplest",
+        (
+            "orbit --model simplest --param slope --from 0.010 --to 0.019 --points 181 --transient 200 "
+            "--steps 64 --out out/orbit-simplest",
+        ),
+        "out/orbit-simplest/orbit.png",
+        _in("out/orbit-simplest", *ORBIT),
+    ),
+    Figure(
+        "orbit-compass",
+        (
+            "orbit --model compass --param slope --from 0.06 --to 0.092 --points 129 --transient 100 "
+            "--steps 32 --out out/orbit-compass",
+        ),
+        "out/orbit-compass/orbit.png",
+        _in("out/orbit-compass", *ORBIT),
+    ),
+    Figure(
         "map-no-preload-k5000",
         (
             "map --config readings/no-preload.toml --y-from 300 --y-to 5000 --nx 31 --ny 36 "

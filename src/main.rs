@@ -10,7 +10,7 @@ fn main() {
         // Help and version print as clap prints them; an error quotes at most 200 characters of each input.
         Err(e) if !e.use_stderr() => e.exit(),
         Err(e) => {
-            eprint!("{}", clipped_quotes(&e.render().to_string()));
+            eprint!("{}", cli::clipped_quotes(&e.render().to_string()));
             std::process::exit(e.exit_code());
         }
     };
@@ -25,20 +25,4 @@ fn main() {
         eprintln!("Error: {}", cli::flags_in(&message));
         std::process::exit(1);
     }
-}
-
-/// `text` with every run of characters between single quotes [`vrw::fmt::clip`]ped (clap quotes the argument
-/// it could not read whole, however long).
-fn clipped_quotes(text: &str) -> String {
-    text.split('\'')
-        .enumerate()
-        .map(|(i, part)| {
-            if i % 2 == 1 {
-                vrw::fmt::clip(part)
-            } else {
-                part.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("'")
 }

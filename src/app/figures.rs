@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use crate::output::animate::{write_animation, write_still, AnimateOptions, AnimationReport};
 use crate::output::manifest::{Manifest, RunDir, RunStatus};
 use crate::output::read::{read_run, RunData};
+use crate::output::walker_run::walker_model_of;
 use crate::output::{run_plot, steps_plot, write_atomic};
 
 use super::AppError;
@@ -101,6 +102,12 @@ pub struct AnimateOutcome {
 
 /// Run `vrw animate`: read the run and write `DIR/walk.gif`.
 pub fn run_animate(job: &AnimateJob) -> Result<AnimateOutcome, AppError> {
+    if let Some(model) = walker_model_of(&job.dir) {
+        let walker = (job.dir.as_path(), &job.options, job.partial);
+        let (report, _, warnings) = super::walker_figures::animate_walker(walker, &model, None)?;
+        let report = report.ok_or_else(|| unreachable_still(&job.dir))?;
+        return Ok(AnimateOutcome { report, warnings });
+    }
     job.options.validate()?;
     let (run, mut dir) = checked_run(&job.dir, job.partial)?;
     let path = job.dir.join("walk.gif");
@@ -118,6 +125,10 @@ pub fn run_animate(job: &AnimateJob) -> Result<AnimateOutcome, AppError> {
 
 /// Run `vrw animate --still TIME`: write the frame at simulated time `time` as `DIR/walk-frame.png`.
 pub fn run_still(job: &AnimateJob, time: f64) -> Result<PathBuf, AppError> {
+    if let Some(model) = walker_model_of(&job.dir) {
+        let walker = (job.dir.as_path(), &job.options, job.partial);
+        return Ok(super::walker_figures::animate_walker(walker, &model, Some(time))?.1);
+    }
     job.options.validate()?;
     let (run, mut dir) = checked_run(&job.dir, job.partial)?;
     let path = job.dir.join("walk-frame.png");
@@ -127,6 +138,15 @@ pub fn run_still(job: &AnimateJob, time: f64) -> Result<PathBuf, AppError> {
     dir.add("walk-frame.png");
     dir.write()?;
     Ok(path)
+}
+
+/// The error of an animation that wrote a still instead (never: [`super::walker_figures::animate_walker`]
+/// returns an outcome whenever it is asked for no still).
+fn unreachable_still(dir: &Path) -> AppError {
+    AppError::NotOneRun {
+        dir: dir.to_path_buf(),
+        reason: "no animation was written".to_string(),
+    }
 }
 
 /// The files `vrw plot` wrote.
@@ -141,6 +161,10 @@ pub struct PlotReport {
 /// Run `vrw plot`: read the run and write `DIR/run.{png,svg}` and `DIR/steps.{png,svg}`; `partial` draws a
 /// run that did not finish (see the module documentation).
 pub fn run_plot(dir: &Path, partial: bool) -> Result<PlotReport, AppError> {
+    if let Some(model) = walker_model_of(dir) {
+        let (files, warnings) = super::walker_figures::plot_walker(dir, &model, partial)?;
+        return Ok(PlotReport { files, warnings });
+    }
     let (run, mut run_dir) = checked_run(dir, partial)?;
     let mut files = run_plot::write_run_figure(&run)?;
     files.extend(steps_plot::write_steps_figure(&run)?);

@@ -17,6 +17,11 @@ mod map;
 mod orbit;
 mod simulate;
 mod sweep;
+mod walker_figures;
+mod walker_model;
+mod walker_orbit;
+mod walker_simulate;
+mod walker_sweep;
 mod walkers;
 
 pub use crate::family::curves::CurveRecord;
@@ -48,9 +53,23 @@ pub use simulate::{
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
+pub use walker_model::{
+    Body, FoundGait, RigidModel, Sampling, WalkerModel, WalkerSample, WalkerStep,
+};
+pub use walker_orbit::{
+    run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary, MAX_WALKER_PERIOD,
+};
+pub use walker_simulate::{
+    run_walker_simulate, WalkerSimulateJob, WalkerSimulateSummary, WalkerStepRecord,
+};
+pub use walker_sweep::{
+    run_walker_sweep, WalkerRange, WalkerSweepJob, WalkerSweepPoint, WalkerSweepSummary,
+    WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
+};
 pub use walkers::{
-    run_walker_continuation, run_walker_gait, Walker, WalkerContinueJob, WalkerContinueSummary,
-    WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerSpecialPoint, MODELS,
+    run_walker_continuation, run_walker_gait, wheel_only, Walker, WalkerContinueJob,
+    WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerSpecialPoint,
+    MODELS,
 };
 
 use crate::dynamics::Model;

@@ -8,17 +8,19 @@ use std::path::{Path, PathBuf};
 use nalgebra::DVector;
 use serde::Serialize;
 
+use super::walker_model::{interruptible, search_gait, RigidModel, WalkerModel};
 use super::{in_run, AppError, SearchEnded};
 use crate::continuation::{
     continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
 };
 use crate::mechanism::compass::Compass;
-use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
+use crate::mechanism::rigid::RigidWalker;
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
-use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP};
+use crate::mechanism::rigid_gait::{RigidGait, RigidGaitError, DIFFERENCE_STEP};
 use crate::mechanism::simplest::Simplest;
 use crate::output;
 use crate::params::read_walker_parameters;
+use crate::params::ConfigError;
 
 /// The models `--model` takes: the wheel (`vrw`, the default) and the walkers of this file.
 pub const MODELS: [&str; 3] = ["vrw", "simplest", "compass"];
@@ -74,6 +76,102 @@ impl Walker {
             Walker::Compass(w) => RigidWalker::name(w),
         }
     }
+
+    /// What the walker offers the jobs ([`WalkerModel`]): the one place a job meets the kind of walker.
+    pub fn model(&self) -> Box<dyn WalkerModel + '_> {
+        match self {
+            Walker::Simplest(w) => Box::new(RigidModel::<_, 2, 4>::new(w, Simplest::default_start)),
+            Walker::Compass(w) => Box::new(RigidModel::<_, 4, 8>::new(w, Compass::default_start)),
+        }
+    }
+
+    /// The keys of its real-valued parameters.
+    pub fn parameter_keys(&self) -> Vec<&'static str> {
+        match self {
+            Walker::Simplest(w) => w.parameter_keys(),
+            Walker::Compass(w) => w.parameter_keys(),
+        }
+    }
+
+    /// The same walker with the parameter `key` at `value`, validated.
+    pub fn with_parameter(&self, key: &str, value: f64) -> Result<Walker, ConfigError> {
+        Ok(match self {
+            Walker::Simplest(w) => Walker::Simplest(w.with_parameter(key, value)?),
+            Walker::Compass(w) => Walker::Compass(w.with_parameter(key, value)?),
+        })
+    }
+
+    /// The value of the parameter `key`, if the walker has it.
+    pub fn parameter(&self, key: &str) -> Option<f64> {
+        serde_json::to_value(self)
+            .ok()?
+            .get(key)
+            .and_then(serde_json::Value::as_f64)
+    }
+
+    /// The parameter `key`, checked to be one of the walker's (the error names the job's option `option`).
+    pub fn checked_parameter(&self, option: &'static str, key: &str) -> Result<f64, AppError> {
+        let known = self.parameter_keys();
+        match self.parameter(key).filter(|_| known.contains(&key)) {
+            Some(value) => Ok(value),
+            None => Err(AppError::InvalidOption {
+                option,
+                reason: format!(
+                    "the model `{}` has no parameter {:?}: one of {}",
+                    self.name(),
+                    crate::fmt::clip(key),
+                    known.join(", ")
+                ),
+            }),
+        }
+    }
+}
+
+/// The section state a job starts from: `initial` (checked against the model's section), or the model's
+/// default start.
+pub(super) fn start_of(
+    model: &dyn WalkerModel,
+    initial: Option<&[f64]>,
+) -> Result<DVector<f64>, AppError> {
+    let names = model.section_names();
+    match initial {
+        Some(values) if values.len() != names.len() => Err(AppError::InvalidOption {
+            option: "initial",
+            reason: format!(
+                "{} values given; the section of `{}` has {}: {}",
+                values.len(),
+                model.name(),
+                names.len(),
+                names.join(", ")
+            ),
+        }),
+        Some(values) if values.iter().any(|v| !v.is_finite()) => Err(AppError::InvalidOption {
+            option: "initial",
+            reason: format!("{values:?} holds a value that is not a finite number"),
+        }),
+        Some(values) => Ok(DVector::from_column_slice(values)),
+        None => Ok(model.default_start()),
+    }
+}
+
+/// `vrw JOB --model NAME` for a job that takes only the wheel so far: `Ok` for the wheel (`vrw`), else an error
+/// naming the model and the job (never the wheel's job run in its place).
+pub fn wheel_only(model: &str, job: &str) -> Result<(), AppError> {
+    if model == "vrw" {
+        return Ok(());
+    }
+    let walker = Walker::load(model, None, &[] as &[&str])?;
+    let name = walker
+        .as_ref()
+        .map_or(model.to_string(), |w| w.name().to_string());
+    Err(AppError::InvalidOption {
+        option: "model",
+        reason: format!(
+            "`vrw {job}` takes only the wheel (`vrw`) so far; the model `{name}` walks in `vrw simulate`, \
+             `vrw gait`, `vrw sweep`, `vrw orbit` and `vrw continue` (and `vrw plot` and `vrw animate` of \
+             its simulate run); docs/model.md section 13"
+        ),
+    })
 }
 
 /// What `vrw gait --model NAME` searches.
@@ -202,34 +300,11 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     })
 }
 
-/// The gait of `walker` searched from the section state `start`: `steps` steps walked, then Newton's method,
-/// each walk answering the interrupt flag ([`interruptible`]).
-fn search_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
-    walker: &W,
-    start: &DVector<f64>,
-    steps: usize,
-) -> Result<RigidGait<N>, RigidGaitError> {
-    let options = interruptible();
-    let transient = |source| RigidGaitError::Step {
-        iteration: 0,
-        source,
-    };
-    let (mut q, mut qd) = walker.state_at_section(start);
-    for _ in 0..steps {
-        if options.stop.is_some_and(|stop| stop()) {
-            return Err(transient(RigidError::Interrupted));
-        }
-        let step = rigid_step(walker, &q, &qd, &options).map_err(transient)?;
-        (q, qd) = (step.q, step.qd);
-    }
-    rigid_gait(walker, &walker.section_of(&q, &qd), &options)
-}
-
 /// Values by the section's coordinate names.
-fn named(names: &[&str], x: &DVector<f64>) -> Vec<(String, f64)> {
+pub(super) fn named<S: AsRef<str>>(names: &[S], x: &DVector<f64>) -> Vec<(String, f64)> {
     names
         .iter()
-        .map(|n| n.to_string())
+        .map(|n| n.as_ref().to_string())
         .zip(x.iter().copied())
         .collect()
 }
@@ -263,7 +338,10 @@ fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) ->
 }
 
 /// Named values as a JSON object, in their order.
-fn as_map<S: serde::Serializer>(pairs: &[(String, f64)], serializer: S) -> Result<S::Ok, S::Error> {
+pub(super) fn as_map<S: serde::Serializer>(
+    pairs: &[(String, f64)],
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
     use serde::ser::SerializeMap;
     let mut map = serializer.serialize_map(Some(pairs.len()))?;
     for (name, value) in pairs {
@@ -343,16 +421,7 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
     };
     in_run(&job.out_dir, job.overwrite, "continue", |run| {
-        output::write_atomic(&run.path("branch.csv"), |path| {
-            let mut w = output::csv_writer(path)?;
-            for row in &rows {
-                output::write_record(&mut w, path, row)?;
-            }
-            w.flush().map_err(|source| crate::output::OutputError::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-        })?;
+        write_rows(&run.path("branch.csv"), &rows)?;
         run.add("branch.csv");
         output::write_json(&run.path("special_points.json"), &summary)?;
         run.add("special_points.json");
@@ -440,6 +509,21 @@ fn branch_rows(param: &str, names: &[&str], points: &[FamilyPoint<RigidInfo>]) -
         .collect()
 }
 
+/// Write the table `rows` (its header first) as the CSV file `path`, atomically.
+pub(super) fn write_rows(path: &Path, rows: &[Vec<String>]) -> Result<(), AppError> {
+    output::write_atomic(path, |path| -> Result<(), AppError> {
+        let mut w = output::csv_writer(path)?;
+        for row in rows {
+            output::write_record(&mut w, path, row)?;
+        }
+        w.flush().map_err(|source| crate::output::OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(())
+    })
+}
+
 /// The transient walk before a family's first gait is searched.
 const TRANSIENT_STEPS: usize = 20;
 
@@ -456,12 +540,4 @@ fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
             crate::fmt::clip(&job.param)
         ),
     })
-}
-
-/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
-fn interruptible() -> RigidOptions {
-    RigidOptions {
-        stop: Some(crate::walk::interrupted),
-        ..RigidOptions::default()
-    }
 }

@@ -14,7 +14,11 @@ use super::{interrupt_flag, parse_range, progress_bar, ModelArgs};
 #[derive(Debug, Args)]
 pub(super) struct BasinArgs {
     #[command(flatten)]
-    model: ModelArgs,
+    params: ModelArgs,
+    /// The walker: only `vrw`, the wheel, so far; another model (`simplest`, `compass`) is refused, naming the
+    /// job (docs/model.md section 13).
+    #[arg(long, default_value = "vrw")]
+    model: String,
     /// Where the gait search starts, `L2,thetadot,L2dot` (with friction, `,slip` after them for a slipping stance
     /// tip); default as for simulate.
     #[arg(
@@ -59,8 +63,9 @@ pub(super) struct BasinArgs {
 
 /// Run `vrw basin` and print its summary.
 pub(super) fn run(args: BasinArgs) -> Result<()> {
+    vrw::app::wheel_only(&args.model, "basin")?;
     let job = BasinJob {
-        config: args.model.load()?,
+        config: args.params.load()?,
         initial: args.initial,
         coordinates: [args.x, args.y],
         ranges: [args.x_range, args.y_range],

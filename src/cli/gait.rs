@@ -293,16 +293,7 @@ fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
             walker.name()
         );
     }
-    let initial = args
-        .initial
-        .as_deref()
-        .map(|text| {
-            text.split(',')
-                .map(|v| v.trim().parse::<f64>())
-                .collect::<Result<Vec<f64>, _>>()
-                .with_context(|| format!("invalid value '{}' for `initial`", vrw::fmt::clip(text)))
-        })
-        .transpose()?;
+    let initial = super::walker_initial(args.initial.as_deref())?;
     let job = WalkerGaitJob {
         walker,
         initial,
@@ -313,14 +304,11 @@ fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
     super::interrupt_flag();
     super::check_out(&job.out_dir, "gait", job.overwrite)?;
     let summary = run_walker_gait(&job).context("gait")?;
-    let parameters = serde_json::to_value(summary.parameters)?;
-    let shown: Vec<String> = parameters
-        .as_object()
-        .into_iter()
-        .flatten()
-        .map(|(k, v)| format!("{k} = {v}"))
-        .collect();
-    println!("vrw gait --model {}: {}", summary.model, shown.join(", "));
+    println!(
+        "vrw gait --model {}: {}",
+        summary.model,
+        parameters_in_words(&summary.parameters)?
+    );
     let Some(g) = &summary.gait else {
         super::print_wrote(&args.out);
         bail!(
@@ -331,6 +319,18 @@ fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
     print_walker_gait(g);
     super::print_wrote(&args.out);
     Ok(())
+}
+
+/// A walker's parameters in words: `key = value, ...`.
+pub(super) fn parameters_in_words(walker: &Walker) -> Result<String> {
+    let parameters = serde_json::to_value(walker)?;
+    let shown: Vec<String> = parameters
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect();
+    Ok(shown.join(", "))
 }
 
 /// A walker's gait, as `vrw gait --model NAME` prints it.

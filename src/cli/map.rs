@@ -18,7 +18,11 @@ use super::{
 #[derive(Debug, Args)]
 pub(super) struct MapArgs {
     #[command(flatten)]
-    model: ModelArgs,
+    params: ModelArgs,
+    /// The walker: only `vrw`, the wheel, so far; another model (`simplest`, `compass`) is refused, naming the
+    /// job (docs/model.md section 13).
+    #[arg(long, default_value = "vrw")]
+    model: String,
     /// The parameter along the horizontal axis (rows), one of the keys `sweep --help` lists.
     #[arg(long, default_value = "viscosity")]
     x: String,
@@ -111,6 +115,7 @@ impl std::str::FromStr for MarkArg {
 
 /// Run `vrw map` and print its summary.
 pub(super) fn run(args: MapArgs) -> Result<()> {
+    vrw::app::wheel_only(&args.model, "map")?;
     let job = map_job(&args)?;
     let routes = if args.second_route { 2 } else { 1 };
     let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
@@ -149,7 +154,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
 /// The map job the options describe (the model loaded from its file and flags).
 fn map_job(args: &MapArgs) -> Result<MapJob> {
     Ok(MapJob {
-        config: args.model.load()?,
+        config: args.params.load()?,
         spec: MapSpec {
             x: SweepSpec {
                 param: args.x.clone(),

@@ -24,6 +24,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use vrw::params::Config;
 use vrw::study::{SecondRoute, Threshold, SECOND_ROUTE_TOL};
+use vrw::walk::SectionState;
 
 /// Passive dynamic walking of a viscoelastic-legged rimless wheel, with the DLS indicators.
 #[derive(Debug, Parser)]
@@ -131,6 +132,56 @@ pub fn flags_in(message: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join("`")
+}
+
+/// The wheel's `--initial` of `command` (`L2,thetadot,L2dot[,slip]`), read as clap reads a flag: a bad value
+/// is the usage error clap gives (exit status 2), word for word. (`--initial` is taken as text so that another
+/// model can read its own section coordinates from it.)
+fn wheel_initial(command: &str, text: Option<&str>) -> Option<SectionState> {
+    use clap::builder::TypedValueParser;
+    let text = text?;
+    let mut cli = <Cli as clap::CommandFactory>::command();
+    cli.build();
+    let sub = cli
+        .find_subcommand(command)
+        .expect("the command is one of the Cli's");
+    let arg = sub.get_arguments().find(|a| a.get_id() == "initial");
+    let parser = clap::builder::StringValueParser::new().try_map(|s| s.parse::<SectionState>());
+    match parser.parse_ref(sub, arg, std::ffi::OsStr::new(text)) {
+        Ok(state) => Some(state),
+        Err(e) => {
+            eprint!("{}", clipped_quotes(&e.render().to_string()));
+            std::process::exit(e.exit_code());
+        }
+    }
+}
+
+/// `text` with every run of characters between single quotes [`vrw::fmt::clip`]ped (clap quotes the argument
+/// it could not read whole, however long).
+pub(crate) fn clipped_quotes(text: &str) -> String {
+    text.split('\'')
+        .enumerate()
+        .map(|(i, part)| {
+            if i % 2 == 1 {
+                vrw::fmt::clip(part)
+            } else {
+                part.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("'")
+}
+
+/// A walker's `--initial`: its section's coordinates, `a,b,...` (their number is checked by the job, which
+/// knows the model).
+fn walker_initial(text: Option<&str>) -> Result<Option<Vec<f64>>> {
+    text.map(|text| {
+        text.split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<std::result::Result<Vec<f64>, _>>()
+            .with_context(|| format!("invalid value '{}' for `initial`", vrw::fmt::clip(text)))
+    })
+    .transpose()
 }
 
 /// Run the parsed command.

@@ -5,17 +5,20 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use vrw::app::{run_orbit, OrbitJob};
+use vrw::app::{run_orbit, run_walker_orbit, OrbitJob, Walker, WalkerOrbitJob, WalkerRange};
 use vrw::study::orbit::OrbitSpec;
 use vrw::study::SweepSpec;
-use vrw::walk::SectionState;
 
 use super::{interrupt_flag, progress_bar, ModelArgs};
 
 #[derive(Debug, Args)]
 pub(super) struct OrbitArgs {
     #[command(flatten)]
-    model: ModelArgs,
+    params: ModelArgs,
+    /// The walker: `vrw` (default), `simplest` or `compass` (docs/model.md section 13): for the last two the
+    /// diagram draws the section's first coordinate (the stance angle) and lambda_I4 along `--param`.
+    #[arg(long, default_value = "vrw")]
+    model: String,
     /// The parameter along the diagram: one of the real-valued keys (as for sweep).
     #[arg(long, default_value = "viscosity")]
     param: String,
@@ -35,13 +38,13 @@ pub(super) struct OrbitArgs {
     #[arg(long, default_value_t = 64)]
     steps: usize,
     /// Where the first walk starts, `L2,thetadot,L2dot` (with friction, `,slip` after them for a slipping stance
-    /// tip); default as for simulate.
+    /// tip); default as for simulate. For another model its section's coordinates.
     #[arg(
         long,
         value_name = "L2,THETADOT,L2DOT[,SLIP]",
         allow_hyphen_values = true
     )]
-    initial: Option<SectionState>,
+    initial: Option<String>,
     /// Do not compute and draw the period-1 branch.
     #[arg(long)]
     no_branch: bool,
@@ -59,8 +62,13 @@ pub(super) struct OrbitArgs {
 
 /// Run `vrw orbit` and print its summary.
 pub(super) fn run(args: OrbitArgs) -> Result<()> {
+    let sets = &args.params.set;
+    if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
+        return run_walker(&args, walker);
+    }
+    let initial = super::wheel_initial("orbit", args.initial.as_deref());
     let job = OrbitJob {
-        config: args.model.load()?,
+        config: args.params.load()?,
         spec: OrbitSpec {
             range: SweepSpec {
                 param: args.param.clone(),
@@ -71,7 +79,7 @@ pub(super) fn run(args: OrbitArgs) -> Result<()> {
             transient: args.transient,
             steps: args.steps,
         },
-        initial: args.initial,
+        initial,
         branch: !args.no_branch,
         plot: args.plot.clone(),
         out_dir: args.out.clone(),
@@ -120,5 +128,55 @@ pub(super) fn run(args: OrbitArgs) -> Result<()> {
         args.out.display(),
         summary.files.join(", ")
     );
+    Ok(())
+}
+
+/// `vrw orbit --model NAME` for a walker other than the wheel: its diagram, its summary, its files.
+fn run_walker(args: &OrbitArgs, walker: Walker) -> Result<()> {
+    if args.plot != "lambda_I4" {
+        anyhow::bail!(
+            "`plot` chooses one of the wheel's three DLS indicators; the model `{}` has lambda_I4 only",
+            walker.name()
+        );
+    }
+    let job = WalkerOrbitJob {
+        walker,
+        range: WalkerRange {
+            param: args.param.clone(),
+            from: args.from,
+            to: args.to,
+            points: args.points,
+        },
+        transient: args.transient,
+        steps: args.steps,
+        initial: super::walker_initial(args.initial.as_deref())?,
+        branch: !args.no_branch,
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+    };
+    interrupt_flag();
+    super::check_out(&job.out_dir, "orbit", job.overwrite)?;
+    let started = std::time::Instant::now();
+    let s = run_walker_orbit(&job).context("orbit")?;
+    let outcomes: Vec<String> = s.outcomes.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    println!(
+        "vrw orbit --model {}: {} from {} to {} ({} values, {} + {} steps each): {}; {:.2} s",
+        s.model,
+        args.param,
+        args.from,
+        args.to,
+        args.points,
+        args.transient,
+        args.steps,
+        outcomes.join(", "),
+        started.elapsed().as_secs_f64()
+    );
+    if !args.no_branch {
+        println!(
+            "period-1 branch: a gait at {} values, stable at {}",
+            s.branch_gaits[0], s.branch_gaits[1]
+        );
+    }
+    super::print_wrote(&args.out);
     Ok(())
 }

@@ -25,6 +25,8 @@ pub(crate) mod signature_plot;
 pub mod steps_plot;
 pub mod style;
 pub(crate) mod tables;
+pub mod walker_plot;
+pub mod walker_run;
 
 pub use tables::attractors::{
     basin_header, basin_row, branch_header, branch_rows, orbit_header, orbit_rows,

@@ -33,6 +33,7 @@ mod draw;
 mod encode;
 mod plan;
 mod pose;
+mod stick;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -44,6 +45,7 @@ use super::read::RunData;
 use super::style::{png_bytes, require_font, save_png, PlotError};
 use draw::Renderer;
 pub use plan::{plan_frames, FrameTime, SlowMotion, MAX_ANIMATION_FRAMES};
+pub use stick::{write_walker_animation, write_walker_still};
 
 /// Largest frame rate: GIF delays are whole hundredths of a second and viewers slow down delays below
 /// 0.02 s, so faster frame rates would not play at their speed.

@@ -1,0 +1,404 @@
+//! What a walker offers the jobs of `--model` (`simulate`, `sweep`, `orbit`, and `plot`/`animate` of their
+//! runs; docs/model.md section 13): [`WalkerModel`], an object-safe interface on section states, so that a job
+//! is written once for every walker. The built-in walkers (the simplest walker and the compass gait) give it
+//! through [`RigidModel`], their rigid-leg walk ([`crate::mechanism::rigid`]) with what a drawing and the
+//! energy split need ([`Body`]); another kind of walker slots in by implementing [`WalkerModel`] and being
+//! returned by [`super::Walker::model`].
+
+use nalgebra::{DVector, SVector};
+
+use crate::integrate::{Dop853, OdeSystem};
+use crate::mechanism::compass::{Compass, THETA1, THETA2, X, Z};
+use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidStep, RigidWalker};
+use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError};
+use crate::mechanism::simplest::{Simplest, INTER_LEG_ANGLE, STANCE_ANGLE};
+use crate::mechanism::Mechanism;
+use crate::output::walker_run::StickFigure;
+
+/// One step of a walker, from just after a heel strike to just after the next.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkerStep {
+    /// The section state just after the next heel strike.
+    pub section: DVector<f64>,
+    /// The step's duration (in the model's time unit).
+    pub period: f64,
+    /// How far the stance foot moves along the slope (the next stance foot's distance ahead of this one).
+    pub stride: f64,
+    /// The heel strike's DLS indicator `lambda_I4`.
+    pub lambda_i4: f64,
+    /// The energy the heel strike takes.
+    pub impact_loss: f64,
+    /// `T + V` at the step's start.
+    pub energy_start: f64,
+    /// The largest change of `T + V` over the step's single support (conserved there): its energy audit.
+    pub energy_drift: f64,
+    /// Crossings of the ground by the swing foot ignored as scuffing.
+    pub scuffs: usize,
+}
+
+/// A walker's state at one instant of a step, for `trajectory.csv` and the drawings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkerSample {
+    /// The walk's time.
+    pub time: f64,
+    /// The coordinates ([`WalkerModel::coordinates`]).
+    pub q: Vec<f64>,
+    /// Their rates.
+    pub qd: Vec<f64>,
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Potential energy (gravity, from the stance foot's height).
+    pub potential: f64,
+    /// The points of the drawing ([`StickFigure::points`]) in the slope frame, the stance foot at the origin.
+    pub points: Vec<[f64; 2]>,
+}
+
+/// A gait found from a start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FoundGait {
+    /// The fixed point on the section.
+    pub section: DVector<f64>,
+    /// `max |P(s) - s|` there.
+    pub residual: f64,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// The Floquet multipliers `[re, im]`, largest modulus first.
+    pub multipliers: Vec<[f64; 2]>,
+    /// The step from the fixed point.
+    pub step: WalkerStep,
+}
+
+impl FoundGait {
+    /// The largest modulus of the multipliers.
+    pub fn largest_multiplier(&self) -> f64 {
+        self.multipliers
+            .first()
+            .map_or(f64::NAN, |[re, im]| re.hypot(*im))
+    }
+}
+
+/// What a walker offers the jobs, on its Poincare section just after a heel strike. Every walk answers the
+/// library's interrupt flag (Ctrl-C) with [`RigidError::Interrupted`].
+pub trait WalkerModel {
+    /// The model's name.
+    fn name(&self) -> &str;
+    /// The names of the generalized coordinates (`trajectory.csv`'s columns).
+    fn coordinates(&self) -> Vec<String>;
+    /// The names of the section's coordinates.
+    fn section_names(&self) -> Vec<String>;
+    /// Where a walk or a gait search starts by default.
+    fn default_start(&self) -> DVector<f64>;
+    /// The slope \[rad\].
+    fn slope(&self) -> f64;
+    /// What a drawing of the walker shows.
+    fn figure(&self) -> StickFigure;
+    /// One step from the section state `s`; with `sampling`, its states at its start, at the multiples of the
+    /// sampling interval inside it and just before the heel strike are passed to the sink.
+    fn step(
+        &self,
+        s: &DVector<f64>,
+        sampling: Option<Sampling<'_>>,
+    ) -> Result<WalkerStep, RigidError>;
+    /// The gait near `start` (a section state), after `transient` steps.
+    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, RigidGaitError>;
+}
+
+/// What the jobs need of a rigid-legged walker besides its walk: the names of its coordinates, its kinetic
+/// energy, and the points of its drawing.
+pub trait Body<const N: usize> {
+    /// The names of `q`.
+    fn coordinate_names(&self) -> [&'static str; N];
+    /// Kinetic energy.
+    fn kinetic(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64;
+    /// The slope \[rad\].
+    fn slope_angle(&self) -> f64;
+    /// What the drawing shows.
+    fn stick_figure(&self) -> StickFigure;
+    /// The drawing's points at `q`, the stance foot at the origin of the slope frame.
+    fn points(&self, q: &SVector<f64, N>) -> Vec<[f64; 2]>;
+}
+
+/// A point at `length` along a leg of angle `angle` (from the slope's downward normal, positive down the slope)
+/// from `from`.
+fn along(from: [f64; 2], angle: f64, length: f64) -> [f64; 2] {
+    [
+        from[0] + length * angle.sin(),
+        from[1] - length * angle.cos(),
+    ]
+}
+
+impl Body<2> for Simplest {
+    fn coordinate_names(&self) -> [&'static str; 2] {
+        ["theta", "phi"]
+    }
+
+    /// The hip's `theta'^2 / 2` (the feet's masses tend to 0).
+    fn kinetic(&self, _q: &SVector<f64, 2>, qd: &SVector<f64, 2>) -> f64 {
+        0.5 * qd[STANCE_ANGLE] * qd[STANCE_ANGLE]
+    }
+
+    fn slope_angle(&self) -> f64 {
+        self.slope
+    }
+
+    fn stick_figure(&self) -> StickFigure {
+        StickFigure::legs_from_hip(&[])
+    }
+
+    /// The stance foot, the hip at `(-sin theta, cos theta)`, the swing foot along the swing leg's angle
+    /// `theta - phi`.
+    fn points(&self, q: &SVector<f64, 2>) -> Vec<[f64; 2]> {
+        let theta = q[STANCE_ANGLE];
+        let hip = [-theta.sin(), theta.cos()];
+        vec![[0.0, 0.0], hip, along(hip, theta - q[INTER_LEG_ANGLE], 1.0)]
+    }
+}
+
+impl Body<4> for Compass {
+    fn coordinate_names(&self) -> [&'static str; 4] {
+        self.coordinates()
+    }
+
+    fn kinetic(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> f64 {
+        self.kinetic_energy(q, qd)
+    }
+
+    fn slope_angle(&self) -> f64 {
+        self.slope
+    }
+
+    fn stick_figure(&self) -> StickFigure {
+        StickFigure::legs_from_hip(&["stance_leg_mass", "swing_leg_mass"])
+    }
+
+    /// The feet at `leg_length` from the hip, the legs' masses at `leg_mass_offset` from the feet.
+    fn points(&self, q: &SVector<f64, 4>) -> Vec<[f64; 2]> {
+        let hip = [q[X], q[Z]];
+        let (l, b) = (self.leg_length, self.leg_length - self.leg_mass_offset);
+        vec![
+            along(hip, q[THETA1], l),
+            hip,
+            along(hip, q[THETA2], l),
+            along(hip, q[THETA1], b),
+            along(hip, q[THETA2], b),
+        ]
+    }
+}
+
+/// A rigid-legged walker as a [`WalkerModel`].
+#[derive(Debug, Clone, Copy)]
+pub struct RigidModel<'w, W, const N: usize, const Y: usize> {
+    walker: &'w W,
+    start: fn(&W) -> DVector<f64>,
+}
+
+impl<'w, W, const N: usize, const Y: usize> RigidModel<'w, W, N, Y> {
+    /// `walker`, its searches and walks starting at `start(walker)` by default.
+    pub fn new(walker: &'w W, start: fn(&W) -> DVector<f64>) -> RigidModel<'w, W, N, Y> {
+        RigidModel { walker, start }
+    }
+}
+
+/// The single-support field of a rigid walker, as the walk integrates it (the jobs' sampling integrates it
+/// again, with the same integrator, tolerances and stop, so its steps are the walk's).
+struct Field<'w, W, const N: usize>(&'w W);
+
+impl<W: RigidWalker<N, Y>, const N: usize, const Y: usize> OdeSystem<Y> for Field<'_, W, N> {
+    fn rhs(&self, _t: f64, y: &SVector<f64, Y>) -> SVector<f64, Y> {
+        let (q, qd) = split::<N, Y>(y);
+        match self.0.single_support(&q, &qd) {
+            Ok((qdd, _)) => SVector::from_iterator(qd.iter().chain(qdd.iter()).copied()),
+            Err(_) => SVector::repeat(f64::NAN),
+        }
+    }
+}
+
+/// `(q, q')` of an integrated state.
+fn split<const N: usize, const Y: usize>(
+    y: &SVector<f64, Y>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    (
+        SVector::from_iterator(y.rows(0, N).iter().copied()),
+        SVector::from_iterator(y.rows(N, N).iter().copied()),
+    )
+}
+
+impl<W, const N: usize, const Y: usize> RigidModel<'_, W, N, Y>
+where
+    W: RigidWalker<N, Y> + Body<N>,
+{
+    /// The record of `step`, started at `(q, q')`.
+    fn record(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>, step: &RigidStep<N>) -> WalkerStep {
+        WalkerStep {
+            section: self.walker.section_of(&step.q, &step.qd),
+            period: step.period,
+            // Just after the strike the old stance foot is the swing foot, behind the new one.
+            stride: -self.walker.swing_foot(&step.q).1,
+            lambda_i4: step.lambda_i4,
+            impact_loss: step.impact_loss,
+            energy_start: self.walker.mechanical_energy(q, qd),
+            energy_drift: step.energy_drift,
+            scuffs: step.scuffs,
+        }
+    }
+
+    /// The sample of the state `y` at time `time` of a step.
+    fn sample(&self, time: f64, y: &SVector<f64, Y>) -> WalkerSample {
+        let (q, qd) = split::<N, Y>(y);
+        let kinetic = self.walker.kinetic(&q, &qd);
+        WalkerSample {
+            time,
+            q: q.iter().copied().collect(),
+            qd: qd.iter().copied().collect(),
+            kinetic,
+            potential: self.walker.mechanical_energy(&q, &qd) - kinetic,
+            points: self.walker.points(&q),
+        }
+    }
+
+    /// The states of the step from `(q, q')` lasting `period`, started at the walk's time `sampling.start`:
+    /// at its start, at the multiples of `sampling.dt` inside it, and just before the heel strike, integrated
+    /// as [`rigid_step`] integrates it (the same integrator, tolerances and stop, so the same steps).
+    fn sampled(
+        &self,
+        (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+        period: f64,
+        sampling: Sampling<'_>,
+    ) -> Result<(), RigidError> {
+        let options = interruptible();
+        let field = Field::<W, N>(self.walker);
+        let y0 = SVector::from_iterator(q.iter().chain(qd.iter()).copied());
+        let mut integrator = Dop853::new(&field, 0.0, y0, options.tolerances);
+        let Sampling { start, dt, sink } = sampling;
+        sink(self.sample(start, &y0));
+        // The walk's grid times k dt inside the step.
+        let mut k = (start / dt).floor() as u64 + 1;
+        loop {
+            if options.stop.is_some_and(|stop| stop()) {
+                return Err(RigidError::Interrupted);
+            }
+            let step = integrator.step(&field, options.max_step_time)?;
+            let end = step.t1().min(period);
+            while (k as f64) * dt - start < end {
+                let t = (k as f64) * dt - start;
+                if t > 0.0 {
+                    sink(self.sample(start + t, &step.eval(t)));
+                }
+                k += 1;
+            }
+            if step.t1() >= period {
+                sink(self.sample(start + period, &step.eval(period)));
+                return Ok(());
+            }
+        }
+    }
+}
+
+/// Where a step's samples go ([`WalkerModel::step`]): the walk's time at the step's start, the sampling
+/// interval, and what takes each sample.
+pub struct Sampling<'a> {
+    /// The walk's time at the step's start.
+    pub start: f64,
+    /// The sampling interval.
+    pub dt: f64,
+    /// What takes each sample (its `time` is the walk's).
+    pub sink: &'a mut dyn FnMut(WalkerSample),
+}
+
+impl<W, const N: usize, const Y: usize> WalkerModel for RigidModel<'_, W, N, Y>
+where
+    W: RigidWalker<N, Y> + Body<N>,
+{
+    fn name(&self) -> &str {
+        self.walker.name()
+    }
+
+    fn coordinates(&self) -> Vec<String> {
+        self.walker
+            .coordinate_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect()
+    }
+
+    fn section_names(&self) -> Vec<String> {
+        self.walker
+            .section_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect()
+    }
+
+    fn default_start(&self) -> DVector<f64> {
+        (self.start)(self.walker)
+    }
+
+    fn slope(&self) -> f64 {
+        self.walker.slope_angle()
+    }
+
+    fn figure(&self) -> StickFigure {
+        self.walker.stick_figure()
+    }
+
+    fn step(
+        &self,
+        s: &DVector<f64>,
+        sampling: Option<Sampling<'_>>,
+    ) -> Result<WalkerStep, RigidError> {
+        let options = interruptible();
+        // Asked at every step too: a step takes fewer integrator steps than the walk's own check waits for.
+        if options.stop.is_some_and(|stop| stop()) {
+            return Err(RigidError::Interrupted);
+        }
+        let (q, qd) = self.walker.state_at_section(s);
+        let step = rigid_step(self.walker, &q, &qd, &options)?;
+        if let Some(sampling) = sampling {
+            self.sampled((&q, &qd), step.period, sampling)?;
+        }
+        Ok(self.record(&q, &qd, &step))
+    }
+
+    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, RigidGaitError> {
+        let g: RigidGait<N> = search_gait(self.walker, start, transient)?;
+        let (q, qd) = self.walker.state_at_section(&g.section);
+        Ok(FoundGait {
+            step: self.record(&q, &qd, &g.step),
+            section: g.section,
+            residual: g.residual,
+            iterations: g.iterations,
+            multipliers: g.multipliers,
+        })
+    }
+}
+
+/// The gait of `walker` searched from the section state `start`: `steps` steps walked, then Newton's method,
+/// each walk answering the interrupt flag ([`interruptible`]).
+pub(crate) fn search_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    steps: usize,
+) -> Result<RigidGait<N>, RigidGaitError> {
+    let options = interruptible();
+    let transient = |source| RigidGaitError::Step {
+        iteration: 0,
+        source,
+    };
+    let (mut q, mut qd) = walker.state_at_section(start);
+    for _ in 0..steps {
+        if options.stop.is_some_and(|stop| stop()) {
+            return Err(transient(RigidError::Interrupted));
+        }
+        let step = rigid_step(walker, &q, &qd, &options).map_err(transient)?;
+        (q, qd) = (step.q, step.qd);
+    }
+    rigid_gait(walker, &walker.section_of(&q, &qd), &options)
+}
+
+/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
+pub(crate) fn interruptible() -> RigidOptions {
+    RigidOptions {
+        stop: Some(crate::walk::interrupted),
+        ..RigidOptions::default()
+    }
+}

@@ -1,0 +1,365 @@
+//! The jobs of the walkers other than the wheel (`--model simplest|compass`; docs/model.md section 13), run
+//! through the binary: `simulate`, `sweep`, `orbit`, `plot` and `animate` of their runs, Ctrl-C, and the jobs
+//! a walker cannot do yet refusing it by name.
+
+// The helpers every test binary shares; this one does not walk the wheel (`simulated`).
+#[allow(dead_code)]
+mod common;
+
+use std::fs;
+use std::path::Path;
+use std::process::Command;
+
+use common::{assert_error, ok, vrw};
+use serde_json::Value;
+
+/// The JSON file `path`.
+fn json(path: &Path) -> Value {
+    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The header and the rows of the CSV file `path`.
+fn table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = fs::read_to_string(path).unwrap();
+    let mut lines = text
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect::<Vec<_>>());
+    (lines.next().unwrap(), lines.collect())
+}
+
+/// `vrw simulate --model M` writes the walk named by the model's coordinates, and `vrw plot` and
+/// `vrw animate` draw it.
+#[test]
+fn simulate_plot_and_animate_each_walker() {
+    let cases: [(&str, &[&str], &[&str]); 2] = [
+        ("simplest", &["theta", "theta_dot"], &["theta", "phi"]),
+        (
+            "compass",
+            &["theta1", "theta1_dot", "theta2_dot"],
+            &["x", "z", "theta1", "theta2"],
+        ),
+    ];
+    for (model, section, coordinates) in cases {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("sim");
+        let o = out.to_str().unwrap();
+        let printed = ok(&vrw(
+            &["simulate", "--model", model, "--steps", "4", "--out", o],
+            tmp.path(),
+        ));
+        assert!(printed.contains(&format!("--model {model}")), "{printed}");
+        let (header, rows) = table(&out.join("steps.csv"));
+        assert_eq!(&header[2..2 + section.len()], section, "{header:?}");
+        assert!(
+            header.contains(&"lambda_I4".to_string())
+                && header.contains(&"energy_drift".to_string())
+        );
+        assert_eq!(rows.len(), 4);
+        let lambda = header.iter().position(|h| h == "lambda_I4").unwrap();
+        assert!(rows.iter().all(|r| r[lambda].parse::<f64>().unwrap() < 0.0));
+        let (trajectory, samples) = table(&out.join("trajectory.csv"));
+        assert_eq!(
+            &trajectory[3..3 + coordinates.len()],
+            coordinates,
+            "{trajectory:?}"
+        );
+        assert!(trajectory.contains(&"hip_x".to_string()) && samples.len() > 100);
+        let summary = json(&out.join("summary.json"));
+        assert_eq!(summary["model"], model);
+        assert_eq!(summary["status"], "completed");
+        assert_eq!(summary["steps_completed"], 4);
+        assert!(
+            summary["max_energy_drift"].as_f64().unwrap() < 1e-9,
+            "{summary}"
+        );
+        let manifest = json(&out.join("manifest.json"));
+        assert_eq!(manifest["command"], "simulate");
+        ok(&vrw(&["plot", o], tmp.path()));
+        ok(&vrw(&["animate", o, "--still", "1.0"], tmp.path()));
+        ok(&vrw(
+            &["animate", o, "--speed", "4", "--fps", "10"],
+            tmp.path(),
+        ));
+        let listed = json(&out.join("manifest.json"))["files"].to_string();
+        for f in ["run.png", "run.svg", "walk-frame.png", "walk.gif"] {
+            assert!(out.join(f).is_file() && listed.contains(f), "{f}: {listed}");
+        }
+    }
+}
+
+/// `vrw sweep --model M --param slope` continues the gait along the slope and bisects where it loses
+/// stability: the period doublings that `vrw continue` locates (0.015088438 and 0.076635632 rad).
+#[test]
+fn sweep_bisects_each_walkers_period_doubling() {
+    let cases = [
+        ("simplest", "0.013", "0.016", 0.015088438),
+        ("compass", "0.07", "0.08", 0.076635632),
+    ];
+    for (model, from, to, doubling) in cases {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("sweep");
+        let args = [
+            "sweep",
+            "--model",
+            model,
+            "--param",
+            "slope",
+            "--from",
+            from,
+            "--to",
+            to,
+            "--points",
+            "6",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        ok(&vrw(&args, tmp.path()));
+        let (header, rows) = table(&out.join("sweep.csv"));
+        assert_eq!(header[0], "slope");
+        assert!(header.contains(&"max_floquet".to_string()));
+        assert_eq!(rows.len(), 6);
+        assert_eq!(rows[0][1], "stable");
+        assert_eq!(rows[5][1], "unstable");
+        let thresholds = json(&out.join("thresholds.json"));
+        assert_eq!(thresholds["model"], model);
+        let found = &thresholds["thresholds"][0];
+        assert_eq!(found["kind"], "period_doubling", "{thresholds}");
+        let value = found["value"].as_f64().unwrap();
+        assert!((value - doubling).abs() < 2e-9, "{model}: {value}");
+    }
+}
+
+/// `vrw orbit --model simplest --param slope`: period 1 below the period doubling, and above it (slope
+/// 0.016) the walk alternates between two distinct stance angles, read from orbit.csv.
+#[test]
+fn orbit_of_the_simplest_walker_doubles_its_period() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("orbit");
+    let args = [
+        "orbit",
+        "--model",
+        "simplest",
+        "--param",
+        "slope",
+        "--from",
+        "0.010",
+        "--to",
+        "0.016",
+        "--points",
+        "4",
+        "--transient",
+        "300",
+        "--steps",
+        "8",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    ok(&vrw(&args, tmp.path()));
+    let (header, rows) = table(&out.join("orbit.csv"));
+    assert_eq!(
+        header[..5],
+        ["slope", "status", "period_k", "step", "theta"].map(String::from)
+    );
+    let thetas = |slope: &str| -> Vec<f64> {
+        rows.iter()
+            .filter(|r| r[0] == slope)
+            .map(|r| r[4].parse().unwrap())
+            .collect()
+    };
+    let (below, above) = (thetas("0.014"), thetas("0.016"));
+    assert_eq!((below.len(), above.len()), (8, 8));
+    assert!(
+        below.windows(2).all(|w| (w[0] - w[1]).abs() < 1e-6),
+        "{below:?}"
+    );
+    assert!((above[0] - above[1]).abs() > 1e-3, "{above:?}");
+    assert!(
+        above.windows(3).all(|w| (w[0] - w[2]).abs() < 1e-6),
+        "{above:?}"
+    );
+    assert!(rows.iter().filter(|r| r[0] == "0.016").all(|r| r[2] == "2"));
+    // The paper's long-period gait (a step of about 3.9 time units), followed from slope 0.010.
+    assert!(
+        rows.iter().all(|r| r[7].parse::<f64>().unwrap() > 3.5),
+        "{rows:?}"
+    );
+    let summary = json(&out.join("orbit.json"));
+    assert_eq!(summary["outcomes"]["period_2"], 1, "{summary}");
+    assert!(out.join("orbit.png").is_file() && out.join("branch.csv").is_file());
+    let (_, branch) = table(&out.join("branch.csv"));
+    assert_eq!(branch.last().unwrap().last().unwrap(), "unstable");
+}
+
+/// The compass gait's orbit diagram: one stance angle at 0.07 rad, two at 0.08 (past the period doubling), the section named by its coordinates.
+#[test]
+fn orbit_of_the_compass_gait() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("orbit");
+    let args = [
+        "orbit",
+        "--model",
+        "compass",
+        "--param",
+        "slope",
+        "--from",
+        "0.07",
+        "--to",
+        "0.08",
+        "--points",
+        "3",
+        "--transient",
+        "150",
+        "--steps",
+        "4",
+        "--no-branch",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    ok(&vrw(&args, tmp.path()));
+    let (header, rows) = table(&out.join("orbit.csv"));
+    assert_eq!(
+        header[4..7],
+        ["theta1", "theta1_dot", "theta2_dot"].map(String::from)
+    );
+    assert_eq!(rows[0][2], "1");
+    assert_eq!(rows[8][2], "2", "{rows:?}");
+    assert!(!out.join("branch.csv").exists());
+}
+
+/// Ctrl-C stops a walker's long walk: exit status 1, the complete steps in steps.csv, `interrupted` in
+/// summary.json and the manifest (never a finished result).
+#[cfg(unix)]
+#[test]
+fn interrupted_walker_walk_keeps_its_complete_steps() {
+    use std::time::{Duration, Instant};
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("sim");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vrw"))
+        .args([
+            "simulate",
+            "--model",
+            "simplest",
+            "--steps",
+            "10000000",
+            "--no-trajectory",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let rows = |p: &Path| fs::read_to_string(p).map_or(0, |s| s.lines().count().saturating_sub(1));
+    let started = Instant::now();
+    while rows(&out.join("steps.csv")) < 3 {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "no steps streamed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "vrw did not stop"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut stderr).unwrap();
+    assert_eq!(status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["status"], "interrupted");
+    assert_eq!(json(&out.join("manifest.json"))["status"], "interrupted");
+    let completed = summary["steps_completed"].as_u64().unwrap() as usize;
+    assert!(completed >= 3);
+    assert_eq!(rows(&out.join("steps.csv")), completed);
+}
+
+/// A job a walker cannot do yet refuses it, naming the job and the model; so do options only the wheel has,
+/// a parameter the model lacks, and `plot` of a walker's gait run (which holds no walk).
+#[test]
+fn jobs_a_walker_cannot_do_say_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &[&str]); 6] = [
+        (
+            &["map", "--model", "compass", "--out", "m"],
+            &["`vrw map`", "`compass`"],
+        ),
+        (
+            &["basin", "--model", "simplest", "--out", "b"],
+            &["`vrw basin`", "`simplest`"],
+        ),
+        (
+            &[
+                "sweep",
+                "--model",
+                "simplest",
+                "--param",
+                "viscosity",
+                "--out",
+                "s",
+            ],
+            &["viscosity", "slope"],
+        ),
+        (
+            &[
+                "sweep",
+                "--model",
+                "compass",
+                "--param",
+                "slope",
+                "--second-route",
+                "--out",
+                "s",
+            ],
+            &["`--second-route`"],
+        ),
+        (
+            &[
+                "orbit", "--model", "simplest", "--param", "slope", "--from", "0.01", "--to",
+                "0.01",
+            ],
+            &["`--from/--to`"],
+        ),
+        (
+            &[
+                "simulate",
+                "--model",
+                "compass",
+                "--initial",
+                "0.2,1",
+                "--out",
+                "c",
+            ],
+            &["`compass` has 3"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let run = vrw(args, tmp.path());
+        assert_error(&run, needles);
+    }
+    for dir in ["m", "b", "s", "c"] {
+        assert!(
+            !tmp.path().join(dir).join("manifest.json").exists(),
+            "{dir}"
+        );
+    }
+    ok(&vrw(
+        &["gait", "--model", "simplest", "--out", "g"],
+        tmp.path(),
+    ));
+    assert_error(
+        &vrw(&["plot", "g"], tmp.path()),
+        &["`vrw gait`", "`simplest`", "simulate"],
+    );
+}
