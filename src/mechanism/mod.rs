@@ -17,10 +17,12 @@
 pub mod assembly;
 pub mod compass;
 pub mod constrained;
+pub mod described;
 pub mod rigid;
 pub mod rigid_family;
 pub mod rigid_gait;
 pub mod simplest;
+pub mod turns;
 mod wheel;
 
 use nalgebra::{SMatrix, SVector};
