@@ -1,5 +1,6 @@
 //! `vrw gait --model NAME` for the walkers behind the mechanism interface other than the wheel (docs/model.md
-//! section 13): the simplest walking model and the compass gait. Their parameters are read as a
+//! section 13): the simplest walking model, the compass gait, and the bipeds described in a TOML file
+//! (`--model path/to/walker.toml`, [`crate::mechanism::described`]). Their parameters are read as a
 //! configuration is (a flat TOML file, `--set key=value`), the gait is searched from the model's start after a
 //! transient walk, and `gait.json` holds it with its section named by the model's coordinates.
 
@@ -13,6 +14,7 @@ use crate::continuation::{
     continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
 };
 use crate::mechanism::compass::Compass;
+use crate::mechanism::described::{self, AnyDescribed};
 use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
 use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP};
@@ -20,17 +22,20 @@ use crate::mechanism::simplest::Simplest;
 use crate::output;
 use crate::params::read_walker_parameters;
 
-/// The models `--model` takes: the wheel (`vrw`, the default) and the walkers of this file.
+/// The models `--model` takes by name: the wheel (`vrw`, the default) and the walkers of this file; any other
+/// name that ends in `.toml` or names a file is a description ([`crate::mechanism::described`]).
 pub const MODELS: [&str; 3] = ["vrw", "simplest", "compass"];
 
 /// A walker other than the wheel, with its parameters.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Walker {
     /// The simplest walking model.
     Simplest(Simplest),
     /// The compass gait.
     Compass(Compass),
+    /// A walker described in a file.
+    Described(AnyDescribed),
 }
 
 impl Walker {
@@ -53,11 +58,19 @@ impl Walker {
                 w.validate()?;
                 Walker::Compass(w)
             }
+            other if other.ends_with(".toml") || Path::new(other).is_file() => {
+                let model = |reason: String| AppError::InvalidOption {
+                    option: "model",
+                    reason,
+                };
+                let w = described::load(Path::new(other)).map_err(|e| model(e.to_string()))?;
+                Walker::Described(w.with_parameters(file, overrides)?)
+            }
             other => {
                 return Err(AppError::InvalidOption {
                     option: "model",
                     reason: format!(
-                        "unknown model {:?}: one of {}",
+                        "unknown model {:?}: one of {}, or a description file (`.toml`)",
                         crate::fmt::clip(other),
                         MODELS.join(", ")
                     ),
@@ -72,6 +85,7 @@ impl Walker {
         match self {
             Walker::Simplest(w) => RigidWalker::name(w),
             Walker::Compass(w) => RigidWalker::name(w),
+            Walker::Described(w) => w.description().name,
         }
     }
 }
@@ -150,9 +164,13 @@ pub struct WalkerGait {
 /// output directory is checked.
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
-    let summary = match job.walker {
-        Walker::Simplest(w) => compute(&w, w.default_start(), job)?,
-        Walker::Compass(w) => compute(&w, w.default_start(), job)?,
+    let summary = match &job.walker {
+        Walker::Simplest(w) => compute(w, w.default_start(), job)?,
+        Walker::Compass(w) => compute(w, w.default_start(), job)?,
+        Walker::Described(w) => {
+            let start = rigid_start(w)?;
+            crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
+        }
     };
     in_run(&job.out_dir, job.overwrite, "gait", |run| {
         output::write_json(&run.path("gait.json"), &summary)?;
@@ -189,7 +207,7 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
-        parameters: job.walker,
+        parameters: job.walker.clone(),
         initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
@@ -341,6 +359,10 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
     let (summary, rows) = match &job.walker {
         Walker::Simplest(w) => follow(w, w.default_start(), job)?,
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
+        Walker::Described(w) => {
+            let start = rigid_start(w)?;
+            crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
+        }
     };
     in_run(&job.out_dir, job.overwrite, "continue", |run| {
         output::write_atomic(&run.path("branch.csv"), |path| {
@@ -396,7 +418,7 @@ where
     let summary = WalkerContinueSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
-        parameters: job.walker,
+        parameters: job.walker.clone(),
         param: job.param.clone(),
         start,
         points: followed.points.len(),
@@ -445,7 +467,7 @@ const TRANSIENT_STEPS: usize = 20;
 
 /// The followed parameter's value in the job's walker.
 fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
-    let value = serde_json::to_value(job.walker)
+    let value = serde_json::to_value(&job.walker)
         .ok()
         .and_then(|v| v.get(&job.param).and_then(serde_json::Value::as_f64));
     value.ok_or_else(|| AppError::InvalidOption {
@@ -464,4 +486,27 @@ fn interruptible() -> RigidOptions {
         stop: Some(crate::walk::interrupted),
         ..RigidOptions::default()
     }
+}
+
+/// Where a described walker's gait search starts (its `[gait]` table's `start`), or why it cannot walk: no
+/// `[gait]` table, or joints that need the compliant walk ([`described::NotWalkable`]).
+fn rigid_start(w: &AnyDescribed) -> Result<DVector<f64>, AppError> {
+    let gait = described::walkable(w.description()).map_err(|e| AppError::InvalidOption {
+        option: "model",
+        reason: e.to_string(),
+    })?;
+    Ok(DVector::from_column_slice(&gait.start))
+}
+
+/// The error for a described walker with fewer than 3 coordinates, which its `[gait]` check already refuses
+/// (the contact conditions fix three positions on the section).
+fn unreachable_walk<T>(w: &AnyDescribed) -> Result<T, AppError> {
+    Err(AppError::InvalidOption {
+        option: "model",
+        reason: format!(
+            "`{}` has {} coordinates: a biped with rigid legs needs at least 3",
+            w.description().name,
+            w.description().coordinates.len()
+        ),
+    })
 }

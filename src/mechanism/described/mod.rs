@@ -84,8 +84,7 @@ impl<const N: usize> Described<N> {
         names.zip(self.values.iter().copied()).collect()
     }
 
-    /// The same walker with parameter `key` at `value`, checked: its domain, and every rule of the description
-    /// at the new point (no negative mass, unit directions, ...).
+    /// The same walker with parameter `key` at `value`, checked ([`Described::with_values`]).
     pub fn with_value(&self, key: &str, value: f64) -> Result<Described<N>, ConfigError> {
         let d = &self.description;
         let Some(i) = d.parameters.iter().position(|p| p.name == key) else {
@@ -99,19 +98,45 @@ impl<const N: usize> Described<N> {
                     .join(", "),
             });
         };
-        let invalid = |reason: String| ConfigError::InvalidValue {
-            key: key.to_string(),
-            value: crate::fmt::short(value),
-            reason,
-        };
-        if let Some(rule) = values::outside_domain(&d.parameters[i], value) {
-            return Err(invalid(format!("it must be {rule}")));
-        }
         let mut values = self.values.clone();
         values[i] = value;
-        if let Some((line, problem)) = values::problems(d, &values).into_iter().next() {
-            return Err(invalid(format!("{} line {line}: {problem}", d.file)));
+        self.with_values(values)
+    }
+
+    /// The same walker with the parameters at `values` (in their order), checked: each in its domain, and
+    /// every rule of the description at the new point (no negative mass, unit directions, ...), each broken
+    /// rule named with its parameter and the line of the file it is about.
+    pub fn with_values(&self, values: Vec<f64>) -> Result<Described<N>, ConfigError> {
+        let d = &self.description;
+        let changed: Vec<usize> = (0..values.len())
+            .filter(|i| values[*i] != self.values[*i])
+            .collect();
+        let invalid = |i: usize, reason: String| ConfigError::InvalidValue {
+            key: d.parameters[i].name.to_string(),
+            value: crate::fmt::short(values[i]),
+            reason,
+        };
+        let mut errors = Vec::new();
+        for (i, p) in d.parameters.iter().enumerate() {
+            if let Some(rule) = values::outside_domain(p, values[i]) {
+                errors.push(invalid(i, format!("it must be {rule}")));
+            }
         }
+        // The description's rules at the new point, once every parameter is in its domain.
+        let problems = if errors.is_empty() {
+            values::problems(d, &values)
+        } else {
+            Vec::new()
+        };
+        for (line, problem) in problems {
+            // The rule is about the changed parameters together; it is reported with the first of them.
+            let i = changed.first().copied().unwrap_or(0);
+            errors.push(invalid(
+                i,
+                format!("then {} line {line}: {problem}", d.file),
+            ));
+        }
+        ConfigError::all(errors)?;
         Ok(Described {
             description: Arc::clone(d),
             values,
@@ -252,6 +277,27 @@ impl AnyDescribed {
     /// The parameters' keys and values.
     pub fn parameters(&self) -> Vec<(&'static str, f64)> {
         with_described!(self, w => w.parameters())
+    }
+
+    /// The same walker with its parameters read as a walker's are: from the flat TOML `file` of `key = value`
+    /// lines, then the `--set key=value` `overrides` ([`crate::params::read_named_parameters`]), checked
+    /// ([`Described::with_values`]).
+    pub fn with_parameters<S: AsRef<str>>(
+        &self,
+        file: Option<&Path>,
+        overrides: &[S],
+    ) -> Result<AnyDescribed, ConfigError> {
+        let values = crate::params::read_named_parameters(&self.parameters(), file, overrides)?;
+        Ok(match self {
+            AnyDescribed::N1(w) => AnyDescribed::N1(w.with_values(values)?),
+            AnyDescribed::N2(w) => AnyDescribed::N2(w.with_values(values)?),
+            AnyDescribed::N3(w) => AnyDescribed::N3(w.with_values(values)?),
+            AnyDescribed::N4(w) => AnyDescribed::N4(w.with_values(values)?),
+            AnyDescribed::N5(w) => AnyDescribed::N5(w.with_values(values)?),
+            AnyDescribed::N6(w) => AnyDescribed::N6(w.with_values(values)?),
+            AnyDescribed::N7(w) => AnyDescribed::N7(w.with_values(values)?),
+            AnyDescribed::N8(w) => AnyDescribed::N8(w.with_values(values)?),
+        })
     }
 
     /// The same walker with parameter `key` at `value`, checked ([`Described::with_value`]).
