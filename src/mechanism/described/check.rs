@@ -3,112 +3,17 @@
 //! line it is about. The gait's table is checked in `check_gait.rs`, the values at the parameters' defaults in
 //! `values.rs`.
 
-use std::collections::HashMap;
-
 use toml::Spanned;
 
-use super::error::{line_of, DescriptionError, Problem};
+use super::checker::{Checker, GROUND};
+use super::error::{DescriptionError, Problem};
 use super::expr::Expr;
-use super::format::{self, AngleFrom, Field, JointKind, Value};
+use super::format::{self, AngleFrom, Field, JointKind};
 use super::intern;
 use super::model::{
-    Body, Contact, Description, Free, Joint, Motion, Parameter, State, Vector, MAX_COORDINATES,
+    Body, Contact, Description, Free, Joint, Motion, Parameter, State, MAX_COORDINATES,
     MAX_PARAMETERS,
 };
-
-/// The name of the tree's root.
-pub const GROUND: &str = "ground";
-
-/// The text being checked, for the lines of its errors.
-pub struct Checker<'a> {
-    /// The file, as given.
-    pub file: &'a str,
-    /// Its text.
-    pub text: &'a str,
-}
-
-impl Checker<'_> {
-    /// The error `problem` at byte `offset`.
-    pub fn at(&self, offset: usize, problem: Problem) -> DescriptionError {
-        DescriptionError::At {
-            file: self.file.to_string(),
-            line: line_of(self.text, offset),
-            problem,
-        }
-    }
-
-    /// The line of byte `offset`.
-    pub fn line(&self, offset: usize) -> usize {
-        line_of(self.text, offset)
-    }
-
-    /// The field `f` as an expression over `names`.
-    pub fn expr(&self, f: &Field, names: &[&str]) -> Result<Expr, DescriptionError> {
-        match f.get_ref() {
-            Value::Number(x) => Ok(Expr::Number(*x)),
-            Value::Expr(text) => {
-                Expr::parse(text, names).map_err(|e| self.at(f.span().start, e.into()))
-            }
-        }
-    }
-
-    /// An optional vector, default the origin.
-    pub fn vector(
-        &self,
-        v: &Option<format::Vector>,
-        names: &[&str],
-    ) -> Result<Vector, DescriptionError> {
-        match v {
-            None => Ok([Expr::Number(0.0), Expr::Number(0.0)]),
-            Some([x, z]) => Ok([self.expr(x, names)?, self.expr(z, names)?]),
-        }
-    }
-
-    /// The index of `name` among `known` (things of kind `what`), or an error at its place.
-    pub fn find(
-        &self,
-        name: &Spanned<String>,
-        known: &[&str],
-        what: &'static str,
-    ) -> Result<usize, DescriptionError> {
-        known
-            .iter()
-            .position(|k| k == name.get_ref())
-            .ok_or_else(|| {
-                self.at(
-                    name.span().start,
-                    Problem::Unknown {
-                        what,
-                        name: name.get_ref().clone(),
-                        known: known.join(", "),
-                    },
-                )
-            })
-    }
-
-    /// Refuse a second use of a name among `names` (with their lines).
-    fn unique<'n>(
-        &self,
-        what: &'static str,
-        names: impl Iterator<Item = &'n Spanned<String>>,
-    ) -> Result<(), DescriptionError> {
-        let mut seen: HashMap<&str, usize> = HashMap::new();
-        for n in names {
-            let line = self.line(n.span().start);
-            if let Some(first) = seen.insert(n.get_ref(), line) {
-                return Err(self.at(
-                    n.span().start,
-                    Problem::Duplicate {
-                        what,
-                        name: n.get_ref().clone(),
-                        first,
-                    },
-                ));
-            }
-        }
-        Ok(())
-    }
-}
 
 /// The description in `text`, read from `file` (see the module documentation).
 pub fn description(file: &str, text: &str) -> Result<Description, DescriptionError> {
@@ -317,64 +222,13 @@ fn joint(
     next: usize,
 ) -> Result<Joint, DescriptionError> {
     let j = spanned.get_ref();
-    let misplaced = |offset: usize, field: &'static str, reason: &str| {
-        cx.at(
-            offset,
-            Problem::Field {
-                field,
-                reason: reason.to_string(),
-            },
-        )
-    };
-    let motion = match *j.kind.get_ref() {
-        JointKind::Revolute => {
-            if let Some(d) = &j.direction {
-                return Err(misplaced(
-                    d.span().start,
-                    "direction",
-                    "only a prismatic joint has a direction",
-                ));
-            }
-            let absolute = j.angle.as_ref().map(|a| *a.get_ref()) == Some(AngleFrom::Absolute);
-            let clockwise = j.clockwise.as_ref().is_some_and(|c| *c.get_ref());
-            Motion::Revolute {
-                absolute,
-                sign: if clockwise { -1.0 } else { 1.0 },
-            }
-        }
-        JointKind::Prismatic => {
-            if let Some(a) = &j.angle {
-                return Err(misplaced(
-                    a.span().start,
-                    "angle",
-                    "only a revolute joint has an angle",
-                ));
-            }
-            if let Some(c) = &j.clockwise {
-                return Err(misplaced(
-                    c.span().start,
-                    "clockwise",
-                    "only a revolute joint turns",
-                ));
-            }
-            let Some(direction) = &j.direction else {
-                return Err(misplaced(
-                    spanned.span().start,
-                    "direction",
-                    "a prismatic joint needs its direction [x, z] in the parent's frame",
-                ));
-            };
-            Motion::Prismatic {
-                direction: cx.vector(&Some(direction.get_ref().clone()), names)?,
-            }
-        }
-    };
     let parent = match j.parent.get_ref().as_str() {
         GROUND => None,
         _ => Some(cx.find(&j.parent, bodies, "body")?),
     };
     if j.child.get_ref() == GROUND {
         return Err(misplaced(
+            cx,
             j.child.span().start,
             "child",
             "the ground cannot be a child",
@@ -382,7 +236,7 @@ fn joint(
     }
     Ok(Joint {
         name: j.name.get_ref().clone(),
-        motion,
+        motion: motion(cx, spanned, names)?,
         parent,
         child: cx.find(&j.child, bodies, "body")?,
         at: cx.vector(&j.at, names)?,
@@ -396,6 +250,74 @@ fn joint(
         ]
         .map(|s| cx.line(s.unwrap_or(spanned.span()).start)),
     })
+}
+
+/// The error of a field that does not belong where it is (or is missing), at byte `offset`.
+fn misplaced(cx: &Checker, offset: usize, field: &'static str, reason: &str) -> DescriptionError {
+    cx.at(
+        offset,
+        Problem::Field {
+            field,
+            reason: reason.to_string(),
+        },
+    )
+}
+
+/// How a joint moves its child: a revolute joint's angle (relative or absolute, its sense), a prismatic joint's
+/// direction; each refusing the other's fields.
+fn motion(
+    cx: &Checker,
+    spanned: &Spanned<format::Joint>,
+    names: &[&str],
+) -> Result<Motion, DescriptionError> {
+    let j = spanned.get_ref();
+    match *j.kind.get_ref() {
+        JointKind::Revolute => {
+            if let Some(d) = &j.direction {
+                return Err(misplaced(
+                    cx,
+                    d.span().start,
+                    "direction",
+                    "only a prismatic joint has a direction",
+                ));
+            }
+            let absolute = j.angle.as_ref().map(|a| *a.get_ref()) == Some(AngleFrom::Absolute);
+            let clockwise = j.clockwise.as_ref().is_some_and(|c| *c.get_ref());
+            Ok(Motion::Revolute {
+                absolute,
+                sign: if clockwise { -1.0 } else { 1.0 },
+            })
+        }
+        JointKind::Prismatic => {
+            if let Some(a) = &j.angle {
+                return Err(misplaced(
+                    cx,
+                    a.span().start,
+                    "angle",
+                    "only a revolute joint has an angle",
+                ));
+            }
+            if let Some(c) = &j.clockwise {
+                return Err(misplaced(
+                    cx,
+                    c.span().start,
+                    "clockwise",
+                    "only a revolute joint turns",
+                ));
+            }
+            let Some(direction) = &j.direction else {
+                return Err(misplaced(
+                    cx,
+                    spanned.span().start,
+                    "direction",
+                    "a prismatic joint needs its direction [x, z] in the parent's frame",
+                ));
+            };
+            Ok(Motion::Prismatic {
+                direction: cx.vector(&Some(direction.get_ref().clone()), names)?,
+            })
+        }
+    }
 }
 
 /// A joint's value: free (coordinate `next`, with its spring, damper and stoppers) or fixed (with none).

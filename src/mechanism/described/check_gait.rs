@@ -3,7 +3,7 @@
 
 use toml::Spanned;
 
-use super::check::Checker;
+use super::checker::Checker;
 use super::error::{DescriptionError, Problem};
 use super::format;
 use super::intern;

@@ -2,7 +2,8 @@
 //! masses and rigid bodies) in a tree of revolute and prismatic joints rooted at the ground, free or fixed joints
 //! with springs, dampers and stoppers, contact points, and for a biped with rigid legs how its legs take turns.
 //!
-//! The file is read by serde (`format.rs`) and checked (`check.rs`, `tree.rs`, `check_gait.rs`, `values.rs`)
+//! The file is read by serde (`format.rs`) and checked (`check.rs`, `checker.rs`, `tree.rs`, `check_gait.rs`,
+//! `values.rs`)
 //! into a [`Description`] whose numeric fields are expressions over the parameters (`expr.rs`), evaluated over
 //! any [`Real`] by the kinematics (`kinematics.rs`), so that a described walker is a [`Mechanism`] like the
 //! built-in ones, with exact derivatives through dual numbers. Its number of coordinates `N` is known only once
@@ -12,6 +13,7 @@
 
 mod check;
 mod check_gait;
+mod checker;
 mod error;
 pub mod expr;
 mod format;

@@ -3,7 +3,7 @@
 //! at the defaults when the file is read (naming the line) and at every point a `--set` or a continuation asks
 //! for (naming the parameter).
 
-use super::check::Checker;
+use super::checker::Checker;
 use super::error::{DescriptionError, Problem};
 use super::expr::Expr;
 use super::model::{
@@ -92,7 +92,9 @@ fn joint_problems(
     if let Motion::Prismatic { direction } = &j.motion {
         let (x, z) = (of(&direction[0]), of(&direction[1]));
         let norm = x.hypot(z);
-        if !((norm - 1.0).abs() <= UNIT_TOL) {
+        // NaN is no unit length either.
+        let unit = (norm - 1.0).abs() <= UNIT_TOL;
+        if !unit {
             return at(
                 DIRECTION_LINE,
                 Problem::OutOfRange {
@@ -118,7 +120,8 @@ fn joint_problems(
     if let State::Free(f) = &j.state {
         if let [Some(lo), Some(hi)] = &f.stoppers {
             let (lo, hi) = (of(lo), of(hi));
-            if !(lo < hi) {
+            let ordered = lo < hi;
+            if !ordered {
                 return at(
                     STOPPERS_LINE,
                     Problem::OutOfRange {

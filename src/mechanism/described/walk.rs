@@ -201,10 +201,13 @@ impl<const N: usize> Described<N> {
             }
         }
         let (r, _, behind) = conditions(q);
-        if !(r.amax() <= SECTION_RESIDUAL_TOL * q.amax().max(1.0)) {
+        // A NaN residual is no solution either.
+        let met = r.amax() <= SECTION_RESIDUAL_TOL * q.amax().max(1.0);
+        if !met {
             return Err(SectionError::NoSolution { residual: r.amax() });
         }
-        if !(behind < 0.0) {
+        let is_behind = behind < 0.0;
+        if !is_behind {
             return Err(SectionError::NotBehind { ahead: behind });
         }
         Ok(())
