@@ -1,6 +1,6 @@
 //! A walker's description once checked (docs/model.md section 13): names resolved to indices, expressions
-//! parsed, the joints ordered from the ground outward. [`super::check`] makes it from the file; the kinematics
-//! ([`super::kinematics`]) and the walk read it.
+//! parsed, the joints ordered from the ground outward. `check.rs` makes it from the file; the kinematics
+//! (`kinematics.rs`) and the walk read it.
 
 use super::expr::Expr;
 
