@@ -168,7 +168,7 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
         Walker::Simplest(w) => compute(w, w.default_start(), job)?,
         Walker::Compass(w) => compute(w, w.default_start(), job)?,
         Walker::Described(w) => {
-            let start = rigid_start(w)?;
+            let start = rigid_start(w, job.initial.as_deref())?;
             crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
         }
     };
@@ -360,7 +360,7 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
         Walker::Simplest(w) => follow(w, w.default_start(), job)?,
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
         Walker::Described(w) => {
-            let start = rigid_start(w)?;
+            let start = rigid_start(w, None)?;
             crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
         }
     };
@@ -489,13 +489,29 @@ fn interruptible() -> RigidOptions {
 }
 
 /// Where a described walker's gait search starts (its `[gait]` table's `start`), or why it cannot walk: no
-/// `[gait]` table, or joints that need the compliant walk ([`described::NotWalkable`]).
-fn rigid_start(w: &AnyDescribed) -> Result<DVector<f64>, AppError> {
-    let gait = described::walkable(w.description()).map_err(|e| AppError::InvalidOption {
-        option: "model",
-        reason: e.to_string(),
+/// `[gait]` table, or joints that need the compliant walk ([`described::NotWalkable`]); and whether that start
+/// (or `initial`, where given with the section's length) completes to a state after a heel strike.
+fn rigid_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<f64>, AppError> {
+    let invalid = |option: &'static str, reason: String| AppError::InvalidOption { option, reason };
+    let gait = described::walkable(w.description()).map_err(|e| invalid("model", e.to_string()))?;
+    let start = DVector::from_column_slice(&gait.start);
+    let (option, checked) = match initial {
+        Some(values) if values.len() == gait.start.len() => {
+            ("initial", DVector::from_column_slice(values))
+        }
+        _ => ("model", start.clone()),
+    };
+    w.check_section(&checked).map_err(|e| {
+        let named: Vec<String> = named(&gait.section_names, &checked)
+            .iter()
+            .map(|(n, v)| format!("{n} = {v}"))
+            .collect();
+        invalid(
+            option,
+            format!("at the section's {}: {e}", named.join(", ")),
+        )
     })?;
-    Ok(DVector::from_column_slice(&gait.start))
+    Ok(start)
 }
 
 /// The error for a described walker with fewer than 3 coordinates, which its `[gait]` check already refuses

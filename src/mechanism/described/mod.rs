@@ -24,6 +24,8 @@ mod values;
 mod walk;
 
 #[cfg(test)]
+mod refusal_tests;
+#[cfg(test)]
 mod tests;
 
 use std::collections::HashSet;

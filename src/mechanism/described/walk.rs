@@ -86,6 +86,15 @@ impl AnyDescribed {
     pub fn walkable(&self) -> Result<(), NotWalkable> {
         walkable(self.description()).map(|_| ())
     }
+
+    /// Whether the section values `s` complete to a state just after a heel strike
+    /// ([`Described::section_state`]); a walker that cannot walk has no section.
+    pub fn check_section(&self, s: &DVector<f64>) -> Result<(), SectionError> {
+        if self.walkable().is_err() {
+            return Err(SectionError::Singular);
+        }
+        crate::with_described!(self, w => w.section_state(s).map(|_| ()))
+    }
 }
 
 impl<const N: usize> Described<N> {
