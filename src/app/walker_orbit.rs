@@ -129,7 +129,14 @@ fn walk_column(
             return (column, None);
         }
     };
-    let model = walker.model();
+    let model = match walker.model() {
+        Ok(model) => model,
+        Err(e) => {
+            column.status = "invalid_model";
+            column.message = Some(e.to_string());
+            return (column, None);
+        }
+    };
     let transient = match from {
         Some(_) => job.transient,
         None => FRESH_TRANSIENT_FACTOR * job.transient,
@@ -187,7 +194,7 @@ pub struct WalkerOrbitSummary {
 /// checked.
 pub fn run_walker_orbit(job: &WalkerOrbitJob) -> Result<WalkerOrbitSummary, AppError> {
     let values = job.values()?;
-    let model = job.walker.model();
+    let model = job.walker.model()?;
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     let names = model.section_names();
     output::manifest::check_out_dir(&job.out_dir, "orbit", job.overwrite)?;
@@ -264,7 +271,7 @@ fn summary(
     WalkerOrbitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: model.to_string(),
-        parameters: job.walker,
+        parameters: job.walker.clone(),
         range: job.range.clone(),
         transient: job.transient,
         steps: job.steps,
@@ -367,7 +374,7 @@ fn orbit_figure(
             })
             .collect(),
     };
-    let others: Vec<String> = serde_json::to_value(job.walker)
+    let others: Vec<String> = serde_json::to_value(&job.walker)
         .ok()
         .and_then(|v| v.as_object().cloned())
         .into_iter()

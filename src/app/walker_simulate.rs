@@ -180,7 +180,7 @@ pub struct WalkerSimulateSummary {
 /// interrupted walk (Ctrl-C) keeps its complete steps, and the manifest says `interrupted`.
 pub fn run_walker_simulate(job: &WalkerSimulateJob) -> Result<WalkerSimulateSummary, AppError> {
     job.validate()?;
-    let model = job.walker.model();
+    let model = job.walker.model()?;
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     output::manifest::check_out_dir(&job.out_dir, "simulate", job.overwrite)?;
     in_run(&job.out_dir, job.overwrite, "simulate", |run| {
@@ -227,7 +227,7 @@ impl WalkerSimulateSummary {
         WalkerSimulateSummary {
             vrw_version: env!("CARGO_PKG_VERSION"),
             model: model.name().to_string(),
-            parameters: job.walker,
+            parameters: job.walker.clone(),
             slope: model.slope(),
             coordinates: model.coordinates(),
             figure: model.figure(),

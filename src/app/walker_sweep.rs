@@ -124,7 +124,16 @@ pub(super) fn gait_at(
             }
         }
     };
-    let model = at.model();
+    let model = match at.model() {
+        Ok(model) => model,
+        Err(e) => {
+            return WalkerSweepPoint {
+                value,
+                gait: Err(e.to_string()),
+                failure: Some("invalid_model"),
+            }
+        }
+    };
     let gait = match from.map(|s| model.gait(s, 0)) {
         Some(Ok(g)) => Ok(g),
         _ => model.gait(start, FRESH_TRANSIENT),
@@ -207,7 +216,7 @@ pub struct WalkerSweepSummary {
 /// directory are checked.
 pub fn run_walker_sweep(job: &WalkerSweepJob) -> Result<WalkerSweepSummary, AppError> {
     let values = job.range.values(&job.walker, MAX_WALKER_SWEEP_POINTS)?;
-    let model = job.walker.model();
+    let model = job.walker.model()?;
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     let names = model.section_names();
     output::manifest::check_out_dir(&job.out_dir, "sweep", job.overwrite)?;
@@ -226,7 +235,7 @@ pub fn run_walker_sweep(job: &WalkerSweepJob) -> Result<WalkerSweepSummary, AppE
         let summary = WalkerSweepSummary {
             vrw_version: env!("CARGO_PKG_VERSION"),
             model: model.name().to_string(),
-            parameters: job.walker,
+            parameters: job.walker.clone(),
             range: job.range.clone(),
             gaits_found: points.iter().filter(|p| p.gait.is_ok()).count(),
             stable: points.iter().filter(|p| p.status() == "stable").count(),

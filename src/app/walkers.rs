@@ -1,5 +1,6 @@
 //! `vrw gait --model NAME` for the walkers behind the mechanism interface other than the wheel (docs/model.md
-//! section 13): the simplest walking model and the compass gait. Their parameters are read as a
+//! section 13): the simplest walking model, the compass gait, and the bipeds described in a TOML file
+//! (`--model path/to/walker.toml`, [`crate::mechanism::described`]). Their parameters are read as a
 //! configuration is (a flat TOML file, `--set key=value`), the gait is searched from the model's start after a
 //! transient walk, and `gait.json` holds it with its section named by the model's coordinates.
 
@@ -14,6 +15,7 @@ use crate::continuation::{
     continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
 };
 use crate::mechanism::compass::Compass;
+use crate::mechanism::described::{self, AnyDescribed};
 use crate::mechanism::rigid::RigidWalker;
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
 use crate::mechanism::rigid_gait::{RigidGait, RigidGaitError, DIFFERENCE_STEP};
@@ -22,17 +24,20 @@ use crate::output;
 use crate::params::read_walker_parameters;
 use crate::params::ConfigError;
 
-/// The models `--model` takes: the wheel (`vrw`, the default) and the walkers of this file.
+/// The models `--model` takes by name: the wheel (`vrw`, the default) and the walkers of this file; any other
+/// name that ends in `.toml` or names a file is a description ([`crate::mechanism::described`]).
 pub const MODELS: [&str; 3] = ["vrw", "simplest", "compass"];
 
 /// A walker other than the wheel, with its parameters.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Walker {
     /// The simplest walking model.
     Simplest(Simplest),
     /// The compass gait.
     Compass(Compass),
+    /// A walker described in a file.
+    Described(AnyDescribed),
 }
 
 impl Walker {
@@ -55,11 +60,19 @@ impl Walker {
                 w.validate()?;
                 Walker::Compass(w)
             }
+            other if other.ends_with(".toml") || Path::new(other).is_file() => {
+                let model = |reason: String| AppError::InvalidOption {
+                    option: "model",
+                    reason,
+                };
+                let w = described::load(Path::new(other)).map_err(|e| model(e.to_string()))?;
+                Walker::Described(w.with_parameters(file, overrides)?)
+            }
             other => {
                 return Err(AppError::InvalidOption {
                     option: "model",
                     reason: format!(
-                        "unknown model {:?}: one of {}",
+                        "unknown model {:?}: one of {}, or a description file (`.toml`)",
                         crate::fmt::clip(other),
                         MODELS.join(", ")
                     ),
@@ -74,15 +87,28 @@ impl Walker {
         match self {
             Walker::Simplest(w) => RigidWalker::name(w),
             Walker::Compass(w) => RigidWalker::name(w),
+            Walker::Described(w) => w.description().name,
         }
     }
 
     /// What the walker offers the jobs ([`WalkerModel`]): the one place a job meets the kind of walker.
-    pub fn model(&self) -> Box<dyn WalkerModel + '_> {
-        match self {
+    ///
+    /// A described walker walks in `vrw gait` and `vrw continue` only so far: the other jobs refuse it.
+    pub fn model(&self) -> Result<Box<dyn WalkerModel + '_>, AppError> {
+        Ok(match self {
             Walker::Simplest(w) => Box::new(RigidModel::<_, 2, 4>::new(w, Simplest::default_start)),
             Walker::Compass(w) => Box::new(RigidModel::<_, 4, 8>::new(w, Compass::default_start)),
-        }
+            Walker::Described(w) => {
+                return Err(AppError::InvalidOption {
+                    option: "model",
+                    reason: format!(
+                        "the described walker `{}` walks in `vrw gait` and `vrw continue` so far (docs/model.md \
+                         section 13)",
+                        w.description().name
+                    ),
+                })
+            }
+        })
     }
 
     /// The keys of its real-valued parameters.
@@ -90,6 +116,7 @@ impl Walker {
         match self {
             Walker::Simplest(w) => w.parameter_keys(),
             Walker::Compass(w) => w.parameter_keys(),
+            Walker::Described(w) => w.parameters().into_iter().map(|(k, _)| k).collect(),
         }
     }
 
@@ -98,11 +125,15 @@ impl Walker {
         Ok(match self {
             Walker::Simplest(w) => Walker::Simplest(w.with_parameter(key, value)?),
             Walker::Compass(w) => Walker::Compass(w.with_parameter(key, value)?),
+            Walker::Described(w) => Walker::Described(w.with_value(key, value)?),
         })
     }
 
     /// The value of the parameter `key`, if the walker has it.
     pub fn parameter(&self, key: &str) -> Option<f64> {
+        if let Walker::Described(w) = self {
+            return w.parameters().into_iter().find(|(k, _)| *k == key).map(|(_, v)| v);
+        }
         serde_json::to_value(self)
             .ok()?
             .get(key)
@@ -248,9 +279,13 @@ pub struct WalkerGait {
 /// output directory is checked.
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
-    let summary = match job.walker {
-        Walker::Simplest(w) => compute(&w, w.default_start(), job)?,
-        Walker::Compass(w) => compute(&w, w.default_start(), job)?,
+    let summary = match &job.walker {
+        Walker::Simplest(w) => compute(w, w.default_start(), job)?,
+        Walker::Compass(w) => compute(w, w.default_start(), job)?,
+        Walker::Described(w) => {
+            let start = rigid_start(w, job.initial.as_deref())?;
+            crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
+        }
     };
     in_run(&job.out_dir, job.overwrite, "gait", |run| {
         output::write_json(&run.path("gait.json"), &summary)?;
@@ -287,7 +322,7 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
-        parameters: job.walker,
+        parameters: job.walker.clone(),
         initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
@@ -419,6 +454,10 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
     let (summary, rows) = match &job.walker {
         Walker::Simplest(w) => follow(w, w.default_start(), job)?,
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
+        Walker::Described(w) => {
+            let start = rigid_start(w, None)?;
+            crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
+        }
     };
     in_run(&job.out_dir, job.overwrite, "continue", |run| {
         write_rows(&run.path("branch.csv"), &rows)?;
@@ -465,7 +504,7 @@ where
     let summary = WalkerContinueSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
-        parameters: job.walker,
+        parameters: job.walker.clone(),
         param: job.param.clone(),
         start,
         points: followed.points.len(),
@@ -529,7 +568,7 @@ const TRANSIENT_STEPS: usize = 20;
 
 /// The followed parameter's value in the job's walker.
 fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
-    let value = serde_json::to_value(job.walker)
+    let value = serde_json::to_value(&job.walker)
         .ok()
         .and_then(|v| v.get(&job.param).and_then(serde_json::Value::as_f64));
     value.ok_or_else(|| AppError::InvalidOption {
@@ -538,6 +577,45 @@ fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
             "the model `{}` has no parameter {:?}",
             job.walker.name(),
             crate::fmt::clip(&job.param)
+        ),
+    })
+}
+
+/// Where a described walker's gait search starts (its `[gait]` table's `start`), or why it cannot walk: no
+/// `[gait]` table, or joints that need the compliant walk ([`described::NotWalkable`]); and whether that start
+/// (or `initial`, where given with the section's length) completes to a state after a heel strike.
+fn rigid_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<f64>, AppError> {
+    let invalid = |option: &'static str, reason: String| AppError::InvalidOption { option, reason };
+    let gait = described::walkable(w.description()).map_err(|e| invalid("model", e.to_string()))?;
+    let start = DVector::from_column_slice(&gait.start);
+    let (option, checked) = match initial {
+        Some(values) if values.len() == gait.start.len() => {
+            ("initial", DVector::from_column_slice(values))
+        }
+        _ => ("model", start.clone()),
+    };
+    w.check_section(&checked).map_err(|e| {
+        let named: Vec<String> = named(&gait.section_names, &checked)
+            .iter()
+            .map(|(n, v)| format!("{n} = {v}"))
+            .collect();
+        invalid(
+            option,
+            format!("at the section's {}: {e}", named.join(", ")),
+        )
+    })?;
+    Ok(start)
+}
+
+/// The error for a described walker with fewer than 3 coordinates, which its `[gait]` check already refuses
+/// (the contact conditions fix three positions on the section).
+fn unreachable_walk<T>(w: &AnyDescribed) -> Result<T, AppError> {
+    Err(AppError::InvalidOption {
+        option: "model",
+        reason: format!(
+            "`{}` has {} coordinates: a biped with rigid legs needs at least 3",
+            w.description().name,
+            w.description().coordinates.len()
         ),
     })
 }

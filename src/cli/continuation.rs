@@ -19,8 +19,9 @@ use vrw::app::{run_walker_continuation, Walker, WalkerContinueJob};
 pub(super) struct ContinueArgs {
     #[command(flatten)]
     params: ModelArgs,
-    /// The walker: `vrw` (default), `simplest` or `compass` (docs/model.md section 13); for the last two the
-    /// family of the start's gait alone, branch.csv and special_points.json (no figure yet).
+    /// The walker: `vrw` (default), `simplest`, `compass` or a walker described in a TOML file
+    /// (`models/compass.toml`; docs/model.md section 13); for all but the wheel the family of the start's gait
+    /// alone, branch.csv and special_points.json (no figure yet).
     #[arg(long, default_value = "vrw")]
     model: String,
     /// The parameter followed: one of the real-valued keys (as for sweep).

@@ -20,8 +20,9 @@ pub(super) struct GaitArgs {
     #[command(flatten)]
     params: ModelArgs,
     /// The walker: `vrw`, the viscoelastic-legged rimless wheel (default); `simplest`, the simplest walking
-    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al. (docs/model.md section 13). For the
-    /// last two, --config and --set take their parameters and gait.json names the section by their coordinates.
+    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al.; or a walker described in a TOML
+    /// file (`models/compass.toml`; docs/model.md section 13). For all but the wheel, --config and --set take
+    /// their parameters and gait.json names the section by their coordinates.
     #[arg(long, default_value = "vrw")]
     model: String,
     /// Where the search starts on the Poincare section: for the wheel `L2,thetadot,L2dot` (with friction,

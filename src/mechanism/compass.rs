@@ -12,8 +12,9 @@
 use nalgebra::{DVector, SVector};
 
 use super::assembly::{along_leg, point_mass_equations, point_mass_potential, up, PointMass};
-use super::constrained::{accelerations, impulse, ConstrainedError, Row};
+use super::constrained::ConstrainedError;
 use super::rigid::{HeelStrike, RigidWalker};
+use super::turns::{self, Turns};
 use super::{Equations, Mechanism, PointKinematics, Real};
 use crate::params::{ConfigError, MASS_RATIO_LIMIT};
 
@@ -25,6 +26,15 @@ pub const Z: usize = 1;
 pub const THETA1: usize = 2;
 /// Index of Leg 2's angle in `q`.
 pub const THETA2: usize = 3;
+
+/// How the compass gait takes turns: Leg 1's foot (contact 0) stands, Leg 2's (contact 1) lands, the legs'
+/// angles are exchanged and the hip slides along the slope (`x`) to put the new stance foot at the origin.
+pub const TURNS: Turns<4> = Turns {
+    stance: 0,
+    lands: 1,
+    relabel: [X, Z, THETA2, THETA1],
+    shift: Some((X, 1.0)),
+};
 
 /// The compass gait's parameters; the defaults are Goswami, Thuilot and Espiau's (their Table 1).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -222,24 +232,17 @@ impl RigidWalker<4, 8> for Compass {
         vec!["theta1", "theta1_dot", "theta2_dot"]
     }
 
-    /// Eq. (1) with Leg 1's foot held ([`super::constrained::accelerations`]); its normal force.
+    /// Eq. (1) with Leg 1's foot held ([`super::turns::single_support`]); its normal force.
     fn single_support(
         &self,
         q: &SVector<f64, 4>,
         qd: &SVector<f64, 4>,
     ) -> Result<(SVector<f64, 4>, f64), ConstrainedError> {
-        let a = accelerations(self, q, qd, &Row::contact(0))?;
-        Ok((a.qdd, a.multipliers[1]))
+        turns::single_support(self, &TURNS, q, qd)
     }
 
     fn swing_foot(&self, q: &SVector<f64, 4>) -> (f64, f64) {
-        let c = self.constants_f64();
-        let zero = SVector::zeros();
-        let (stance, swing) = (
-            self.contact(&c, q, &zero, 0).position,
-            self.contact(&c, q, &zero, 1).position,
-        );
-        (swing.y, swing.x - stance.x)
+        turns::swing_foot(self, &TURNS, q)
     }
 
     fn hip_height(&self, q: &SVector<f64, 4>) -> f64 {
@@ -248,26 +251,13 @@ impl RigidWalker<4, 8> for Compass {
 
     /// The impact with both feet held gives `lambda_I4` (Leg 1's normal impulse); where it is negative, the
     /// traditional impact with Leg 2's foot held, then Leg 2 is the stance leg (the angles exchanged, the hip
-    /// moved along the slope so that the new stance foot is at `x = 0`).
+    /// moved along the slope so that the new stance foot is at `x = 0`): [`super::turns::heel_strike`].
     fn heel_strike(
         &self,
         q: &SVector<f64, 4>,
         qd: &SVector<f64, 4>,
     ) -> Result<HeelStrike<4>, ConstrainedError> {
-        let both = [Row::contact(0), Row::contact(1)].concat();
-        let lambda_i4 = impulse(self, q, qd, &both)?.impulses[1];
-        let traditional = impulse(self, q, qd, &Row::contact(1))?.qd_plus;
-        let loss = self.energy(q, qd) - self.energy(q, &traditional);
-        let new_foot = self.contact(&self.constants_f64(), q, qd, 1).position.x;
-        let swap = |v: &SVector<f64, 4>| SVector::from([v[X], v[Z], v[THETA2], v[THETA1]]);
-        let mut after = swap(q);
-        after[X] -= new_foot;
-        Ok(HeelStrike {
-            lambda_i4,
-            q: after,
-            qd: (lambda_i4 < 0.0).then(|| swap(&traditional)),
-            loss,
-        })
+        turns::heel_strike(self, &TURNS, q, qd)
     }
 
     fn mechanical_energy(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> f64 {

@@ -21,12 +21,14 @@
 pub mod assembly;
 pub mod compass;
 pub mod constrained;
+pub mod described;
 pub mod legged;
 pub mod rigid;
 pub mod rigid_family;
 pub mod rigid_gait;
 pub mod simplest;
 pub mod telescopic;
+pub mod turns;
 mod wheel;
 
 use nalgebra::{SMatrix, SVector};

@@ -358,6 +358,48 @@ where
         path: "<defaults>".to_string(),
         message: e.to_string(),
     })?;
+    parameter_table(defaults, file, overrides)?
+        .try_into()
+        .map_err(|e: toml::de::Error| ConfigError::Toml {
+            path: file.map_or_else(|| "--set".to_string(), |p| p.display().to_string()),
+            message: e.message().to_string(),
+        })
+}
+
+/// The real-valued parameters named in `defaults` (a described walker's, docs/model.md section 13), read as
+/// [`read_walker_parameters`] reads a walker's: the defaults, then the flat TOML `file`, then `overrides`; their
+/// values in the order of `defaults`.
+pub fn read_named_parameters<S: AsRef<str>>(
+    defaults: &[(&str, f64)],
+    file: Option<&Path>,
+    overrides: &[S],
+) -> Result<Vec<f64>, ConfigError> {
+    let table: toml::Table = defaults
+        .iter()
+        .map(|(k, v)| (k.to_string(), toml::Value::Float(*v)))
+        .collect();
+    let read = parameter_table(table, file, overrides)?;
+    defaults
+        .iter()
+        .map(|(key, _)| match read.get(*key) {
+            Some(toml::Value::Float(x)) => Ok(*x),
+            Some(toml::Value::Integer(i)) => Ok(*i as f64),
+            other => Err(ConfigError::WrongType {
+                key: key.to_string(),
+                expected: "a number".to_string(),
+                found: other.map_or_else(String::new, ToString::to_string),
+            }),
+        })
+        .collect()
+}
+
+/// `defaults` with the keys of the flat TOML `file` and then of `overrides` (`key=value`, a number) replaced:
+/// an unknown key, a value that is not a number or a malformed override is an error that names it.
+fn parameter_table<S: AsRef<str>>(
+    defaults: toml::Table,
+    file: Option<&Path>,
+    overrides: &[S],
+) -> Result<toml::Table, ConfigError> {
     let known = || defaults.keys().cloned().collect::<Vec<_>>().join(", ");
     let mut table = defaults.clone();
     if let Some(path) = file {
@@ -403,12 +445,7 @@ where
             toml::Value::Float(de::literal(key, text, number)?),
         );
     }
-    table
-        .try_into()
-        .map_err(|e: toml::de::Error| ConfigError::Toml {
-            path: file.map_or_else(|| "--set".to_string(), |p| p.display().to_string()),
-            message: e.message().to_string(),
-        })
+    Ok(table)
 }
 
 /// A key of [`Config::numeric_keys`], checked once: the parameter of a sweep, a map's axis, a continuation.

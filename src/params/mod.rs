@@ -33,7 +33,7 @@ pub(crate) mod load;
 pub(crate) mod model;
 pub(crate) mod solver;
 
-pub use load::{read_walker_parameters, NumericKey};
+pub use load::{read_named_parameters, read_walker_parameters, NumericKey};
 pub use model::{
     LegTimeScale, Params, MASS_RATIO_LIMIT, MAX_LEGS, MIN_LEG_TIME_SCALE, SLOW_LEG_TIME_SCALE,
 };

@@ -1,0 +1,325 @@
+//! A described biped with rigid legs walks as the built-in compass gait does (docs/model.md section 13): single
+//! support, heel strike and the legs' exchange by [`super::super::turns`] with the stance and landing contacts
+//! and the relabeling of its `[gait]` table, and a section of its own.
+//!
+//! The section holds the coordinates and velocities the table names; the others follow from the contact
+//! conditions just after a heel strike: the stance contact at the origin and held (`x = z = 0`, `J q' = 0`),
+//! the landing contact on the ground behind it (`z = 0`). The positions are solved by Newton's method on the
+//! contacts' positions from the table's guesses, the velocities by the linear solve of the stance contact's rows.
+//! A description that cannot walk this way (no `[gait]` table, or joints with springs, dampers or stoppers,
+//! which need the compliant walk) says what it lacks ([`NotWalkable`]).
+
+use nalgebra::{DVector, Matrix2, Matrix3, SVector, Vector2, Vector3};
+
+use super::super::constrained::ConstrainedError;
+use super::super::rigid::{HeelStrike, RigidWalker};
+use super::super::turns::{self, Turns};
+use super::super::Mechanism;
+use super::model::{Description, Gait, Motion, State};
+use super::{AnyDescribed, Described};
+
+/// Newton's method on the section's contact conditions stops when its step is below this (relative to the
+/// coordinates' size, at least 1).
+pub const SECTION_STEP_TOL: f64 = 1e-15;
+
+/// The contact conditions on the section must hold to this (relative to the coordinates' size, at least 1).
+pub const SECTION_RESIDUAL_TOL: f64 = 1e-12;
+
+/// Most Newton iterations on the section's contact conditions.
+const SECTION_ITERATIONS: usize = 50;
+
+/// Why a description cannot walk (yet).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotWalkable {
+    /// Joints with springs, dampers or stoppers: the compliant walk.
+    #[error(
+        "`{name}` ({file}) cannot walk yet: its joints {joints} have springs, dampers or stoppers, which need \
+         the compliant walk (double support, stoppers: docs/model.md sections 3-5) that only the built-in \
+         wheel has so far; described walkers walk with rigid legs and point feet{gait}"
+    )]
+    Compliant {
+        /// The walker's name.
+        name: String,
+        /// Its file.
+        file: String,
+        /// The compliant joints.
+        joints: String,
+        /// Whether a `[gait]` table is missing too, in words.
+        gait: String,
+    },
+    /// No `[gait]` table.
+    #[error(
+        "`{name}` ({file}) cannot walk: it has no [gait] table (which contact stands, which lands, the \
+         relabeling of its coordinates, its section)"
+    )]
+    NoGait {
+        /// The walker's name.
+        name: String,
+        /// Its file.
+        file: String,
+    },
+}
+
+/// Whether `d` can walk as a rigid biped, or what it lacks.
+pub fn walkable(d: &Description) -> Result<&Gait, NotWalkable> {
+    let compliant = d.compliant_joints();
+    if !compliant.is_empty() {
+        return Err(NotWalkable::Compliant {
+            name: d.name.to_string(),
+            file: d.file.clone(),
+            joints: compliant.join(", "),
+            gait: if d.gait.is_none() {
+                "; it also has no [gait] table (how its legs take turns)".to_string()
+            } else {
+                String::new()
+            },
+        });
+    }
+    d.gait.as_ref().ok_or_else(|| NotWalkable::NoGait {
+        name: d.name.to_string(),
+        file: d.file.clone(),
+    })
+}
+
+impl AnyDescribed {
+    /// Whether it can walk as a rigid biped, or what it lacks.
+    pub fn walkable(&self) -> Result<(), NotWalkable> {
+        walkable(self.description()).map(|_| ())
+    }
+
+    /// Whether the section values `s` complete to a state just after a heel strike
+    /// ([`Described::section_state`]); a walker that cannot walk has no section.
+    pub fn check_section(&self, s: &DVector<f64>) -> Result<(), SectionError> {
+        if self.walkable().is_err() {
+            return Err(SectionError::Singular);
+        }
+        crate::with_described!(self, w => w.section_state(s).map(|_| ()))
+    }
+}
+
+impl<const N: usize> Described<N> {
+    /// Its `[gait]` table; a walker is checked [`walkable`] before it walks, and one without a table walks as
+    /// one whose stance contact is its first (it cannot be asked to: the jobs check first).
+    fn gait(&self) -> &Gait {
+        self.description
+            .gait
+            .as_ref()
+            .expect("a described walker walks only once checked walkable")
+    }
+
+    /// How it takes turns, at its parameter values.
+    pub fn turns(&self) -> Turns<N> {
+        let g = self.gait();
+        let shift = g.shift.map(|k| (k, self.slide_per_unit(k)));
+        Turns {
+            stance: g.stance,
+            lands: g.lands,
+            relabel: std::array::from_fn(|i| g.relabel[i]),
+            shift,
+        }
+    }
+
+    /// The `x` a unit of the sliding coordinate `k` moves the walker (its direction's `x`).
+    fn slide_per_unit(&self, k: usize) -> f64 {
+        let c = self.constants_f64();
+        self.description
+            .joints
+            .iter()
+            .find_map(|j| match (&j.motion, &j.state) {
+                (Motion::Prismatic { direction }, State::Free(f)) if f.coordinate == k => {
+                    Some(c.of(&direction[0]))
+                }
+                _ => None,
+            })
+            .unwrap_or(1.0)
+    }
+
+    /// The state just after a heel strike with the section values `s` (see the module documentation), or why
+    /// the contact conditions have no solution from the guesses.
+    pub fn section_state(
+        &self,
+        s: &DVector<f64>,
+    ) -> Result<(SVector<f64, N>, SVector<f64, N>), SectionError> {
+        let g = self.gait();
+        let (mut q, mut qd) = (SVector::<f64, N>::zeros(), SVector::<f64, N>::zeros());
+        let mut names = self.values.clone();
+        for (&(k, velocity), &v) in g.section.iter().zip(s.iter()) {
+            if velocity {
+                qd[k] = v;
+            } else {
+                q[k] = v;
+                names.push(v);
+            }
+        }
+        for (k, e) in &g.guess {
+            q[*k] = e.eval(&names);
+        }
+        let unknown: Vec<usize> = (0..N)
+            .filter(|k| !g.section.contains(&(*k, false)))
+            .collect();
+        self.solve_positions(g, &mut q, &unknown)?;
+        let unknown: Vec<usize> = (0..N)
+            .filter(|k| !g.section.contains(&(*k, true)))
+            .collect();
+        let c = self.constants_f64();
+        let stance = self.contact(&c, &q, &qd, g.stance).jacobian;
+        let a = Matrix2::from_fn(|r, i| stance[(r, unknown[i])]);
+        let rhs: Vector2<f64> = -(stance * qd);
+        let v = a.lu().solve(&rhs).ok_or(SectionError::Singular)?;
+        for (i, k) in unknown.iter().enumerate() {
+            qd[*k] = v[i];
+        }
+        Ok((q, qd))
+    }
+
+    /// Newton's method for the coordinates `unknown` of `q`: the stance contact at the origin, the landing
+    /// contact on the ground, behind it.
+    fn solve_positions(
+        &self,
+        g: &Gait,
+        q: &mut SVector<f64, N>,
+        unknown: &[usize],
+    ) -> Result<(), SectionError> {
+        let c = self.constants_f64();
+        let zero = SVector::zeros();
+        let conditions = |q: &SVector<f64, N>| {
+            let (stance, lands) = (
+                self.contact(&c, q, &zero, g.stance),
+                self.contact(&c, q, &zero, g.lands),
+            );
+            let r = Vector3::new(stance.position.x, stance.position.y, lands.position.y);
+            let rows = [
+                stance.jacobian.row(0),
+                stance.jacobian.row(1),
+                lands.jacobian.row(1),
+            ];
+            let j = Matrix3::from_fn(|r, i| rows[r][unknown[i]]);
+            (r, j, lands.position.x - stance.position.x)
+        };
+        for _ in 0..SECTION_ITERATIONS {
+            let (r, j, _) = conditions(q);
+            if r.amax() == 0.0 {
+                break;
+            }
+            let step = j.lu().solve(&-r).ok_or(SectionError::Singular)?;
+            for (i, k) in unknown.iter().enumerate() {
+                q[*k] += step[i];
+            }
+            if step.amax() <= SECTION_STEP_TOL * q.amax().max(1.0) {
+                break;
+            }
+        }
+        let (r, _, behind) = conditions(q);
+        // A NaN residual is no solution either.
+        let met = r.amax() <= SECTION_RESIDUAL_TOL * q.amax().max(1.0);
+        if !met {
+            return Err(SectionError::NoSolution { residual: r.amax() });
+        }
+        let is_behind = behind < 0.0;
+        if !is_behind {
+            return Err(SectionError::NotBehind { ahead: behind });
+        }
+        Ok(())
+    }
+}
+
+/// Why a section's state has no solution.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum SectionError {
+    /// The contact conditions' Jacobian is singular.
+    #[error("the contact conditions on the section are singular")]
+    Singular,
+    /// Newton's method did not meet the conditions.
+    #[error("the contact conditions on the section are not met (residual {residual:e})")]
+    NoSolution {
+        /// `max |residual|`.
+        residual: f64,
+    },
+    /// The solution found puts the landing contact ahead of the stance contact.
+    #[error("the landing contact is {ahead:e} ahead of the stance contact, not behind it (change the guesses)")]
+    NotBehind {
+        /// Its distance ahead.
+        ahead: f64,
+    },
+}
+
+/// The rigid walk of a described biped with `N` coordinates and `Y = 2 N` states.
+macro_rules! rigid_walker {
+    ($($n:literal => $y:literal),*) => {$(
+        impl RigidWalker<$n, $y> for Described<$n> {
+            fn name(&self) -> &'static str {
+                self.description.name
+            }
+
+            fn section_names(&self) -> Vec<&'static str> {
+                self.gait().section_names.clone()
+            }
+
+            fn single_support(
+                &self,
+                q: &SVector<f64, $n>,
+                qd: &SVector<f64, $n>,
+            ) -> Result<(SVector<f64, $n>, f64), ConstrainedError> {
+                turns::single_support(self, &self.turns(), q, qd)
+            }
+
+            fn swing_foot(&self, q: &SVector<f64, $n>) -> (f64, f64) {
+                turns::swing_foot(self, &self.turns(), q)
+            }
+
+            fn hip_height(&self, q: &SVector<f64, $n>) -> f64 {
+                let c = self.constants_f64();
+                let frames = super::kinematics::frames(&self.description, &c, q, &SVector::zeros());
+                frames[self.gait().hip].origin.position.y
+            }
+
+            fn heel_strike(
+                &self,
+                q: &SVector<f64, $n>,
+                qd: &SVector<f64, $n>,
+            ) -> Result<HeelStrike<$n>, ConstrainedError> {
+                turns::heel_strike(self, &self.turns(), q, qd)
+            }
+
+            fn mechanical_energy(&self, q: &SVector<f64, $n>, qd: &SVector<f64, $n>) -> f64 {
+                self.energy(q, qd)
+            }
+
+            fn section_of(&self, q: &SVector<f64, $n>, qd: &SVector<f64, $n>) -> DVector<f64> {
+                let g = self.gait();
+                DVector::from_iterator(
+                    g.section.len(),
+                    g.section.iter().map(|&(k, velocity)| if velocity { qd[k] } else { q[k] }),
+                )
+            }
+
+            /// [`Described::section_state`]; where it has no solution, a state of NaN, on which the walk's
+            /// first step fails (the interface's `state_at_section` has no error).
+            fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, $n>, SVector<f64, $n>) {
+                self.section_state(s).unwrap_or_else(|_| {
+                    (SVector::repeat(f64::NAN), SVector::repeat(f64::NAN))
+                })
+            }
+        }
+    )*};
+}
+
+rigid_walker!(3 => 6, 4 => 8, 5 => 10, 6 => 12, 7 => 14, 8 => 16);
+
+/// Calls `$body` with `$w` bound to the [`Described`] inside an [`AnyDescribed`] that can walk as a rigid biped
+/// (`3..=MAX_COORDINATES` coordinates: the contact conditions fix three positions), else `$other`.
+#[macro_export]
+macro_rules! with_rigid_described {
+    ($any:expr, $w:ident => $body:expr, _ => $other:expr) => {{
+        use $crate::mechanism::described::AnyDescribed as A;
+        match $any {
+            A::N3($w) => $body,
+            A::N4($w) => $body,
+            A::N5($w) => $body,
+            A::N6($w) => $body,
+            A::N7($w) => $body,
+            A::N8($w) => $body,
+            A::N1(_) | A::N2(_) => $other,
+        }
+    }};
+}

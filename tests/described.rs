@@ -1,0 +1,158 @@
+//! `vrw gait` and `vrw continue` with `--model path/to/walker.toml` (docs/model.md section 13): the shipped
+//! compass gait description walks the built-in's gait, the shipped wheel says what it lacks, and a bad
+//! description stops the program with the line of the problem.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A shipped description.
+fn model(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("models")
+        .join(name)
+}
+
+/// `vrw <args> --out <dir>/out` in a fresh temporary directory holding `files`.
+fn vrw(args: &[&str], files: &[(&str, &str)]) -> (Output, tempfile::TempDir) {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).expect("a test file");
+    }
+    let output = Command::new(env!("CARGO_BIN_EXE_vrw"))
+        .args(args)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .current_dir(dir.path())
+        .output()
+        .expect("the vrw binary runs");
+    (output, dir)
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// The described compass gait finds the built-in's gait at 3 degrees: the same printed lines but the model's
+/// name, and the same gait.json but the name.
+#[test]
+fn the_described_compass_walks_from_the_command_line() {
+    let path = model("compass.toml");
+    let set = ["--set", "slope=0.0523598775598"];
+    let (described, d1) = vrw(
+        &[&["gait", "--model", path.to_str().unwrap()][..], &set].concat(),
+        &[],
+    );
+    let (built_in, d2) = vrw(&[&["gait", "--model", "compass"][..], &set].concat(), &[]);
+    assert!(described.status.success(), "{}", text(&described.stderr));
+    assert!(built_in.status.success(), "{}", text(&built_in.stderr));
+    let out = text(&described.stdout);
+    assert!(out.starts_with("vrw gait --model compass-toml: "), "{out}");
+    assert!(
+        out.contains("theta1 = 0.271028680, theta1_dot = -1.092383590, theta2_dot = -0.377373949"),
+        "{out}"
+    );
+    let lines = |o: &str| {
+        o.lines()
+            .skip(1)
+            .filter(|l| !l.starts_with("wrote"))
+            .map(String::from)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(lines(&out), lines(&text(&built_in.stdout)));
+    let json =
+        |d: &tempfile::TempDir| std::fs::read_to_string(d.path().join("out/gait.json")).unwrap();
+    assert_eq!(
+        json(&d1).replace("\"compass-toml\"", "\"compass\""),
+        json(&d2)
+    );
+}
+
+/// `--config` and `--set` take the description's parameters; an unknown key or a value outside its domain is
+/// refused with its name.
+#[test]
+fn the_description_parameters_are_set_like_any_walkers() {
+    let path = model("compass.toml");
+    let p = path.to_str().unwrap();
+    let (ok, _d) = vrw(
+        &["gait", "--model", p, "--config", "c.toml"],
+        &[("c.toml", "slope = 0.06\nhip_mass = 8\n")],
+    );
+    assert!(ok.status.success(), "{}", text(&ok.stderr));
+    assert!(
+        text(&ok.stdout).contains("hip_mass = 8.0") && text(&ok.stdout).contains("slope = 0.06")
+    );
+    for (set, needle) in [
+        (
+            "hip_mass=-1",
+            "invalid value -1 for `hip_mass`: it must be above 0",
+        ),
+        ("legs=8", "unknown key `legs`"),
+        ("slope=2", "it must be at most 1.5"),
+    ] {
+        let (bad, _d) = vrw(&["gait", "--model", p, "--set", set], &[]);
+        assert_eq!(bad.status.code(), Some(1), "{set}");
+        assert!(
+            text(&bad.stderr).contains(needle),
+            "{set}: {}",
+            text(&bad.stderr)
+        );
+    }
+}
+
+/// A bad description file stops the program (exit code 1, no panic) with the file, the line and the problem;
+/// the wheel's description says what it lacks to walk.
+#[test]
+fn a_bad_description_names_its_line() {
+    let good = std::fs::read_to_string(model("compass.toml")).unwrap();
+    let bad = good.replacen("kind = \"revolute\"", "kind = \"hinge\"", 1);
+    let line = 1 + bad[..bad.find("\"hinge\"").unwrap()].matches('\n').count();
+    let (run, _d) = vrw(&["gait", "--model", "bad.toml"], &[("bad.toml", &bad)]);
+    let err = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains(&format!("bad.toml line {line}: unknown variant `hinge`")),
+        "{err}"
+    );
+    let wheel = model("wheel.toml");
+    let (run, _d) = vrw(&["gait", "--model", wheel.to_str().unwrap()], &[]);
+    let err = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("cannot walk yet")
+            && err.contains("L1, L2, L3")
+            && err.contains("compliant walk"),
+        "{err}"
+    );
+    let (run, _d) = vrw(
+        &["continue", "--model", "missing.toml", "--param", "slope"],
+        &[],
+    );
+    assert_eq!(run.status.code(), Some(1));
+    assert!(
+        text(&run.stderr).contains("missing.toml"),
+        "{}",
+        text(&run.stderr)
+    );
+}
+
+/// `vrw continue --model models/compass.toml --param slope` locates the built-in compass gait's period doubling.
+#[test]
+fn the_described_compass_continues_in_the_slope() {
+    let path = model("compass.toml");
+    let args = [
+        "continue",
+        "--model",
+        path.to_str().unwrap(),
+        "--param",
+        "slope",
+        "--from",
+        "0.04",
+        "--to",
+        "0.08",
+    ];
+    let (run, _d) = vrw(&args, &[]);
+    let out = text(&run.stdout);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert!(out.contains("PD at slope = 0.076635632"), "{out}");
+}
