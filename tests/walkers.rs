@@ -363,3 +363,51 @@ fn jobs_a_walker_cannot_do_say_so() {
         &["`vrw gait`", "`simplest`", "simulate"],
     );
 }
+
+/// `vrw gait --model telescopic`: the compass gait with the paper's telescopic legs walks with double support
+/// after its heel strike, its energy audit closed, and a bad parameter is refused by name.
+#[test]
+fn the_telescopic_biped_walks_with_double_support() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("tel");
+    let printed = ok(&vrw(
+        &[
+            "gait",
+            "--model",
+            "telescopic",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        tmp.path(),
+    ));
+    assert!(printed.contains("branch DLS"), "{printed}");
+    let gait = json(&out.join("gait.json"));
+    assert_eq!(gait["model"], "telescopic");
+    assert_eq!(gait["status"], "found");
+    let g = &gait["gait"];
+    assert_eq!(g["branch"], "DLS");
+    assert!(g["lambda_i4"].as_f64().unwrap() > 0.0);
+    assert!(g["dls_duration"].as_f64().unwrap() > 1e-3, "{g}");
+    assert!(g["energy_residual"].as_f64().unwrap().abs() < 1e-9, "{g}");
+    assert!(g["max_floquet"].as_f64().unwrap() < 1.0, "{g}");
+    let section: Vec<&str> = g["section"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(section.len(), 5, "{section:?}");
+    let refused = vrw(
+        &[
+            "gait",
+            "--model",
+            "telescopic",
+            "--set",
+            "foot_mass=-1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        tmp.path(),
+    );
+    assert_error(&refused, &["foot_mass"]);
+}

@@ -13,6 +13,7 @@ mod family_output;
 mod family_records;
 mod figures;
 mod gait;
+mod legged;
 mod map;
 mod orbit;
 mod simulate;
@@ -43,6 +44,7 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
+pub use legged::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary, TELESCOPIC};
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,

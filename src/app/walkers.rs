@@ -26,7 +26,7 @@ use crate::params::ConfigError;
 
 /// The models `--model` takes by name: the wheel (`vrw`, the default) and the walkers of this file; any other
 /// name that ends in `.toml` or names a file is a description ([`crate::mechanism::described`]).
-pub const MODELS: [&str; 3] = ["vrw", "simplest", "compass"];
+pub const MODELS: [&str; 4] = ["vrw", "simplest", "compass", "telescopic"];
 
 /// A walker other than the wheel, with its parameters.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -59,6 +59,14 @@ impl Walker {
                 let w: Compass = read_walker_parameters(file, overrides)?;
                 w.validate()?;
                 Walker::Compass(w)
+            }
+            super::legged::TELESCOPIC => {
+                return Err(AppError::InvalidOption {
+                    option: "model",
+                    reason: "the compass gait with telescopic legs (`telescopic`) walks in `vrw gait` only so \
+                             far (docs/model.md section 13)"
+                        .to_string(),
+                })
             }
             other if other.ends_with(".toml") || Path::new(other).is_file() => {
                 let model = |reason: String| AppError::InvalidOption {
@@ -132,7 +140,11 @@ impl Walker {
     /// The value of the parameter `key`, if the walker has it.
     pub fn parameter(&self, key: &str) -> Option<f64> {
         if let Walker::Described(w) = self {
-            return w.parameters().into_iter().find(|(k, _)| *k == key).map(|(_, v)| v);
+            return w
+                .parameters()
+                .into_iter()
+                .find(|(k, _)| *k == key)
+                .map(|(_, v)| v);
         }
         serde_json::to_value(self)
             .ok()?

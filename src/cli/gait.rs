@@ -12,6 +12,8 @@ use vrw::walk::SectionState;
 
 use super::{progress_bar, ModelArgs};
 
+mod legged;
+
 /// `GaitOptions::default().tolerance` as `--help` shows it (a test checks that they agree).
 const DEFAULT_TOLERANCE: &str = "1e-10";
 
@@ -76,6 +78,9 @@ fn parse_parameter(key: &str) -> Result<&'static str, String> {
 /// Run `vrw gait` and print its summary.
 pub(super) fn run(args: GaitArgs) -> Result<()> {
     let sets = &args.params.set;
+    if args.model == vrw::app::TELESCOPIC {
+        return legged::run(&args);
+    }
     if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
         return run_walker(&args, walker);
     }

@@ -1,0 +1,119 @@
+//! `vrw gait --model telescopic`: the compass gait with the paper's telescopic legs (docs/model.md section 13).
+
+use anyhow::{bail, Context, Result};
+
+use super::GaitArgs;
+use vrw::app::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, TELESCOPIC};
+use vrw::mechanism::telescopic::Telescopic;
+use vrw::params::read_walker_parameters;
+
+/// An energy audit beyond this is a warning \[J\].
+const AUDIT_WARNING: f64 = 1e-6;
+
+/// Run `vrw gait --model telescopic` and print its gait.
+pub(super) fn run(args: &GaitArgs) -> Result<()> {
+    if args.parameter.is_some() || args.check_jacobian {
+        bail!(
+            "`parameter` and `check_jacobian` take exact derivatives; the model `{TELESCOPIC}` has its DP by \
+             central differences so far (docs/model.md section 13)"
+        );
+    }
+    let walker: Telescopic =
+        read_walker_parameters(args.params.config.as_deref(), &args.params.set)?;
+    walker.validate()?;
+    let job = LeggedGaitJob {
+        walker,
+        initial: super::super::walker_initial(args.initial.as_deref())?,
+        transient_steps: args.transient_steps,
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+    };
+    super::super::interrupt_flag();
+    super::super::check_out(&job.out_dir, "gait", job.overwrite)?;
+    let summary = run_legged_gait(&job).context("gait")?;
+    let parameters: Vec<String> = serde_json::to_value(summary.parameters)?
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(k, v)| format!("{k} = {v}"))
+        .collect();
+    println!("vrw gait --model {TELESCOPIC}: {}", parameters.join(", "));
+    let Some(g) = &summary.gait else {
+        super::super::print_wrote(&args.out);
+        bail!(
+            "no gait found: {}",
+            summary.message.as_deref().unwrap_or("unknown reason")
+        );
+    };
+    print_gait(g);
+    super::super::print_wrote(&args.out);
+    Ok(())
+}
+
+/// The gait's lines.
+fn print_gait(g: &LeggedGaitRecord) {
+    let section: Vec<String> = g
+        .section
+        .iter()
+        .map(|(n, v)| format!("{n} = {v:.9}"))
+        .collect();
+    println!(
+        "gait: {} (residual {:.1e}, {} Newton iterations)",
+        section.join(", "),
+        g.residual,
+        g.iterations
+    );
+    let indicator = |x: Option<f64>| x.map_or("undefined".to_string(), |x| format!("{x:.6} N"));
+    println!(
+        "heel strike: lambda_I4 = {:.9} N s, lambda_2+ = {}, lambda_4+ = {}, branch {}",
+        g.lambda_i4,
+        indicator(g.lambda_2_plus),
+        indicator(g.lambda_4_plus),
+        serde_json::to_value(g.branch)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default()
+    );
+    println!(
+        "period {:.9} s, DLS {:.6} s, rear contact {:.6} s, {} events, {} scuff(s) per step",
+        g.period, g.dls_duration, g.rear_contact_duration, g.events, g.scuffs
+    );
+    println!(
+        "energy audit {:.1e} J (heel strike {:.6} J, stoppers {:.6} J, landings {:.6} J, dampers {:.6} J), \
+         penetration {:.1e} m",
+        g.energy_residual,
+        g.losses.heel_strike,
+        g.losses.stoppers,
+        g.losses.landings,
+        g.damper_work,
+        g.penetration
+    );
+    if g.energy_residual.abs() > AUDIT_WARNING {
+        eprintln!(
+            "warning: the step's energy audit is {:.1e} J, above {AUDIT_WARNING:.0e} J",
+            g.energy_residual
+        );
+    }
+    // DP by central differences of a map integrated to rtol 1e-11: the multipliers are good to about 1e-5.
+    let multipliers: Vec<String> = g
+        .floquet_multipliers
+        .iter()
+        .map(|[re, im]| {
+            if *im == 0.0 {
+                format!("{re:.6}")
+            } else {
+                format!("{re:.6}{im:+.6}i")
+            }
+        })
+        .collect();
+    println!(
+        "Floquet multipliers (central differences, to about 1e-5): {} (largest modulus {:.6}): {}",
+        multipliers.join(", "),
+        g.max_floquet,
+        if g.max_floquet < 1.0 {
+            "stable"
+        } else {
+            "unstable"
+        }
+    );
+}
