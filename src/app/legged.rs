@@ -10,8 +10,7 @@ use serde::Serialize;
 use super::walkers::{as_map, named};
 use super::{in_run, AppError, SearchEnded};
 use crate::mechanism::legged::gait::{legged_gait, legged_step_map, LeggedGait, LeggedGaitError};
-use crate::mechanism::legged::impact::Branch;
-use crate::mechanism::legged::walk::{LeggedOptions, Losses};
+use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
 use crate::mechanism::legged::{Legged, LeggedError};
 use crate::mechanism::telescopic::Telescopic;
 use crate::output;
@@ -52,30 +51,9 @@ pub struct LeggedGaitRecord {
     pub max_floquet: f64,
     /// How `DP` was taken.
     pub derivative: &'static str,
-    /// DLS indicator 1 \[N s\].
-    pub lambda_i4: f64,
-    /// DLS indicator 2, the fore tip's normal force after (A1) \[N\] (`null` where (A3) was taken).
-    pub lambda_2_plus: Option<f64>,
-    /// DLS indicator 3, the rear tip's \[N\].
-    pub lambda_4_plus: Option<f64>,
-    /// The branch of the DLS-indicator procedure.
-    pub branch: Branch,
-    /// Time with both tips stuck \[s\].
-    pub dls_duration: f64,
-    /// Time with the rear tip on the ground \[s\].
-    pub rear_contact_duration: f64,
-    /// The impacts' losses \[J\].
-    pub losses: Losses,
-    /// The dampers' work \[J\].
-    pub damper_work: f64,
-    /// The energy audit's residual \[J\].
-    pub energy_residual: f64,
-    /// The deepest an active tip went into the ground \[m\].
-    pub penetration: f64,
-    /// Swing-tip crossings of the ground ignored as scuffing.
-    pub scuffs: usize,
-    /// Events in the step.
-    pub events: usize,
+    /// The step's heel strike and audits.
+    #[serde(flatten)]
+    pub step: StepAccount,
 }
 
 /// `gait.json` of a legged walker: the gait, or why there is none.
@@ -121,18 +99,7 @@ fn record<W: Legged<6>>(walker: &W, gait: &LeggedGait<6>) -> LeggedGaitRecord {
             .map_or(f64::NAN, |[re, im]| re.hypot(*im)),
         floquet_multipliers: gait.multipliers.clone(),
         derivative: "central_differences",
-        lambda_i4: step.lambda_i4,
-        lambda_2_plus: step.lambda_plus.map(|[fore, _]| fore),
-        lambda_4_plus: step.lambda_plus.map(|[_, rear]| rear),
-        branch: step.branch,
-        dls_duration: step.dls_duration,
-        rear_contact_duration: step.rear_contact_duration,
-        losses: step.losses,
-        damper_work: step.damper_work,
-        energy_residual: step.energy_residual,
-        penetration: step.penetration,
-        scuffs: step.scuffs,
-        events: step.events,
+        step: step.account,
     }
 }
 

@@ -66,32 +66,32 @@ fn print_gait(g: &LeggedGaitRecord) {
     let indicator = |x: Option<f64>| x.map_or("undefined".to_string(), |x| format!("{x:.6} N"));
     println!(
         "heel strike: lambda_I4 = {:.9} N s, lambda_2+ = {}, lambda_4+ = {}, branch {}",
-        g.lambda_i4,
-        indicator(g.lambda_2_plus),
-        indicator(g.lambda_4_plus),
-        serde_json::to_value(g.branch)
+        g.step.lambda_i4,
+        indicator(g.step.lambda_2_plus),
+        indicator(g.step.lambda_4_plus),
+        serde_json::to_value(g.step.branch)
             .ok()
             .and_then(|v| v.as_str().map(str::to_string))
             .unwrap_or_default()
     );
     println!(
         "period {:.9} s, DLS {:.6} s, rear contact {:.6} s, {} events, {} scuff(s) per step",
-        g.period, g.dls_duration, g.rear_contact_duration, g.events, g.scuffs
+        g.period, g.step.dls_duration, g.step.rear_contact_duration, g.step.events, g.step.scuffs
     );
     println!(
         "energy audit {:.1e} J (heel strike {:.6} J, stoppers {:.6} J, landings {:.6} J, dampers {:.6} J), \
          penetration {:.1e} m",
-        g.energy_residual,
-        g.losses.heel_strike,
-        g.losses.stoppers,
-        g.losses.landings,
-        g.damper_work,
-        g.penetration
+        g.step.energy_residual,
+        g.step.losses.heel_strike,
+        g.step.losses.stoppers,
+        g.step.losses.landings,
+        g.step.damper_work,
+        g.step.penetration
     );
-    if g.energy_residual.abs() > AUDIT_WARNING {
+    if g.step.energy_residual.abs() > AUDIT_WARNING {
         eprintln!(
             "warning: the step's energy audit is {:.1e} J, above {AUDIT_WARNING:.0e} J",
-            g.energy_residual
+            g.step.energy_residual
         );
     }
     // DP by central differences of a map integrated to rtol 1e-11: the multipliers are good to about 1e-5.

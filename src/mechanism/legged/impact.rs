@@ -158,10 +158,11 @@ pub fn impact<W: Legged<N>, const N: usize>(
 }
 
 /// Which branch of the DLS-indicator procedure a heel strike took (docs/model.md section 5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "SCREAMING_SNAKE_CASE")]
 pub enum Branch {
     /// (B2): double support follows.
+    #[default]
     Dls,
     /// (A3): `lambda_I4 < 0`, the rear tip leaves at once.
     Sls,

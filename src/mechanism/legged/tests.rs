@@ -120,30 +120,37 @@ fn the_telescopic_biped_walks_with_double_support() {
     let gait = gait_at(1e-11);
     let step = &gait.step;
     assert!(gait.residual < 1e-11, "residual {}", gait.residual);
-    assert_eq!(step.branch, Branch::Dls);
-    assert!(step.lambda_i4 > 0.0, "lambda_I4 {}", step.lambda_i4);
-    let [fore, rear] = step.lambda_plus.expect("(A4) taken");
+    assert_eq!(step.account.branch, Branch::Dls);
+    assert!(
+        step.account.lambda_i4 > 0.0,
+        "lambda_I4 {}",
+        step.account.lambda_i4
+    );
+    let (fore, rear) = (
+        step.account.lambda_2_plus.expect("(A4) taken"),
+        step.account.lambda_4_plus.expect("(A4) taken"),
+    );
     assert!(
         fore > 0.0 && rear > 0.0,
         "lambda_2+ {fore}, lambda_4+ {rear}"
     );
     assert!(
-        step.dls_duration > 1e-3,
+        step.account.dls_duration > 1e-3,
         "DLS lasts {} s",
-        step.dls_duration
+        step.account.dls_duration
     );
-    assert!(step.rear_contact_duration >= step.dls_duration);
+    assert!(step.account.rear_contact_duration >= step.account.dls_duration);
     // The energy audit closes: T + V at the start less at the end is what the impacts and the dampers took.
     assert!(
-        step.energy_residual.abs() < 1e-9,
+        step.account.energy_residual.abs() < 1e-9,
         "residual {:e} J",
-        step.energy_residual
+        step.account.energy_residual
     );
-    assert!(step.losses.heel_strike > 0.0 && step.damper_work > 0.0);
+    assert!(step.account.losses.heel_strike > 0.0 && step.account.damper_work > 0.0);
     assert!(
-        step.penetration < 1e-8,
+        step.account.penetration < 1e-8,
         "penetration {:e} m",
-        step.penetration
+        step.account.penetration
     );
     let largest = gait.multipliers[0][0].hypot(gait.multipliers[0][1]);
     assert!(largest < 1.0, "multipliers {:?}", gait.multipliers);

@@ -72,21 +72,15 @@ pub struct Losses {
     pub landings: f64,
 }
 
-/// One step from a heel strike (on the section) to the next.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LeggedStep<const N: usize> {
-    /// The state at the next heel strike, relabeled, before its impact (on the section).
-    pub q: SVector<f64, N>,
-    /// Its velocities.
-    pub qd: SVector<f64, N>,
-    /// The legs held at their stoppers there (the new fore leg first).
-    pub held: [bool; 2],
-    /// The step's duration \[s\].
-    pub period: f64,
+/// What a step's heel strike decided and what its audits found (`gait.json` writes it as it is).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct StepAccount {
     /// DLS indicator 1 of the step's heel strike \[N s\].
     pub lambda_i4: f64,
-    /// DLS indicators 2 and 3 (`None` where (A3) was taken) \[N\].
-    pub lambda_plus: Option<[f64; 2]>,
+    /// DLS indicator 2, the fore tip's normal force after (A1) \[N\] (`None` where (A3) was taken).
+    pub lambda_2_plus: Option<f64>,
+    /// DLS indicator 3, the rear tip's \[N\].
+    pub lambda_4_plus: Option<f64>,
     /// The heel strike's branch.
     pub branch: Branch,
     /// Time with both tips on the ground without slipping \[s\].
@@ -105,6 +99,21 @@ pub struct LeggedStep<const N: usize> {
     pub scuffs: usize,
     /// Events in the step.
     pub events: usize,
+}
+
+/// One step from a heel strike (on the section) to the next.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeggedStep<const N: usize> {
+    /// The state at the next heel strike, relabeled, before its impact (on the section).
+    pub q: SVector<f64, N>,
+    /// Its velocities.
+    pub qd: SVector<f64, N>,
+    /// The legs held at their stoppers there (the new fore leg first).
+    pub held: [bool; 2],
+    /// The step's duration \[s\].
+    pub period: f64,
+    /// Its heel strike and audits.
+    pub account: StepAccount,
 }
 
 /// The vector field of a phase: `(q', q'', damper power)` with the rows of `modes`.
@@ -328,18 +337,7 @@ fn unpack_pair<const N: usize, const Y: usize>(y: &SVector<f64, Y>) -> Pair<N> {
     Pair(q, qd)
 }
 
-/// What a step counts as it goes.
-#[derive(Debug, Clone, Copy, Default)]
-struct Accounts {
-    losses: Losses,
-    dls_duration: f64,
-    rear_contact_duration: f64,
-    penetration: f64,
-    scuffs: usize,
-    events: usize,
-}
-
-impl Accounts {
+impl StepAccount {
     /// Count `dt` of a phase with `modes`, ending at `(q, q')`.
     fn phase<W: Legged<N>, const N: usize>(
         &mut self,
@@ -379,7 +377,7 @@ fn swing_below<W: Legged<N>, const N: usize>(
 fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
     (modes, t, y): (&mut Modes, &mut f64, &mut SVector<f64, Y>),
-    acc: &mut Accounts,
+    acc: &mut StepAccount,
     options: &LeggedOptions,
 ) -> Result<bool, LeggedError> {
     let system = Phase {
@@ -437,7 +435,7 @@ fn handle_event<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
     event: Event,
     (modes, t, y): (&mut Modes, f64, &mut SVector<f64, Y>),
-    acc: &mut Accounts,
+    acc: &mut StepAccount,
     options: &LeggedOptions,
 ) -> Result<bool, LeggedError> {
     acc.events += 1;
@@ -482,7 +480,7 @@ fn settle_zeno<W: Legged<N>, const N: usize>(
     (q, mut qd): (&SVector<f64, N>, SVector<f64, N>),
     start: Modes,
     t: f64,
-    acc: &mut Accounts,
+    acc: &mut StepAccount,
 ) -> Result<(Modes, SVector<f64, N>), LeggedError> {
     let (mut modes, mut solved) = next_phase(walker, (q, &qd), &start, t)?;
     let strokes = walker.strokes();
@@ -521,12 +519,16 @@ pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
 ) -> Result<LeggedStep<N>, LeggedError> {
     let e0 = walker.energy(q, qd);
     let strike = heel_strike(walker, (q, qd), legs_held(walker, q), 0.0)?;
-    let mut acc = Accounts {
+    let mut acc = StepAccount {
+        lambda_i4: strike.lambda_i4,
+        lambda_2_plus: strike.lambda_plus.map(|[fore, _]| fore),
+        lambda_4_plus: strike.lambda_plus.map(|[_, rear]| rear),
+        branch: strike.branch,
         losses: Losses {
             heel_strike: strike.impact.loss,
             ..Losses::default()
         },
-        ..Accounts::default()
+        ..StepAccount::default()
     };
     let mut modes = strike.next.0;
     let mut y = pack::<N, Y>(q, &strike.impact.qd_plus, 0.0);
@@ -542,25 +544,15 @@ pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
     if walker.strokes()[1].is_some() && !modes.held[1] {
         return Err(LeggedError::SwingLegNotLocked { time: t });
     }
-    let damper_work = y[2 * N];
+    acc.damper_work = y[2 * N];
     let lost = acc.losses.heel_strike + acc.losses.stoppers + acc.losses.landings;
-    let energy_residual = e0 - walker.energy(&q1, &qd1) - lost - damper_work;
+    acc.energy_residual = e0 - walker.energy(&q1, &qd1) - lost - acc.damper_work;
     let (q_next, qd_next) = walker.relabel(&q1, &qd1);
     Ok(LeggedStep {
         q: q_next,
         qd: qd_next,
         held: [modes.held[1], modes.held[0]],
         period: t,
-        lambda_i4: strike.lambda_i4,
-        lambda_plus: strike.lambda_plus,
-        branch: strike.branch,
-        dls_duration: acc.dls_duration,
-        rear_contact_duration: acc.rear_contact_duration,
-        losses: acc.losses,
-        damper_work,
-        energy_residual,
-        penetration: acc.penetration,
-        scuffs: acc.scuffs,
-        events: acc.events,
+        account: acc,
     })
 }
