@@ -374,11 +374,8 @@ fn orbit_figure(
             })
             .collect(),
     };
-    let others: Vec<String> = serde_json::to_value(&job.walker)
-        .ok()
-        .and_then(|v| v.as_object().cloned())
+    let others: Vec<String> = non_default_parameters(&job.walker)
         .into_iter()
-        .flatten()
         .filter(|(k, _)| *k != r.param)
         .map(|(k, v)| format!("{k} = {v}"))
         .collect();
@@ -410,4 +407,40 @@ fn orbit_figure(
             })
             .collect(),
     }
+}
+
+/// The parameters of `walker` that differ from its model's defaults (a figure's title names them).
+fn non_default_parameters(walker: &Walker) -> Vec<(String, f64)> {
+    let defaults: Vec<(String, f64)> = match walker {
+        Walker::Simplest(_) => serde_pairs(&Walker::Simplest(Default::default())),
+        Walker::Compass(_) => serde_pairs(&Walker::Compass(Default::default())),
+        Walker::Described(w) => w
+            .description()
+            .parameters
+            .iter()
+            .map(|p| (p.name.to_string(), p.default))
+            .collect(),
+    };
+    let now = match walker {
+        Walker::Described(w) => w
+            .parameters()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect(),
+        _ => serde_pairs(walker),
+    };
+    now.into_iter()
+        .filter(|(k, v)| !defaults.iter().any(|(dk, dv)| dk == k && dv == v))
+        .collect()
+}
+
+/// A built-in walker's parameters as `(key, value)` pairs, from its serialization.
+fn serde_pairs(walker: &Walker) -> Vec<(String, f64)> {
+    serde_json::to_value(walker)
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .into_iter()
+        .flatten()
+        .filter_map(|(k, v)| v.as_f64().map(|v| (k, v)))
+        .collect()
 }
