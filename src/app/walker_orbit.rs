@@ -35,7 +35,7 @@ pub struct WalkerOrbitJob {
     pub walker: Walker,
     /// The parameter and its values.
     pub range: WalkerRange,
-    /// Steps walked at each value before recording ([`FRESH_TRANSIENT_FACTOR`] times as many where a walk
+    /// Steps walked at each value before recording (`FRESH_TRANSIENT_FACTOR` times as many where a walk
     /// starts afresh).
     pub transient: usize,
     /// Steps recorded at each value.

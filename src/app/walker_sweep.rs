@@ -178,7 +178,7 @@ pub struct WalkerThreshold {
     /// `period_doubling` (a real multiplier crossing -1), `fold` (crossing +1) or `neimark_sacker` (a complex
     /// pair crossing the unit circle).
     pub kind: &'static str,
-    /// The parameter's value (bisected to [`THRESHOLD_TOL`]); `NaN` if a search in the bracket failed.
+    /// The parameter's value (bisected to `THRESHOLD_TOL`); `NaN` if a search in the bracket failed.
     pub value: f64,
     /// The bracket it was bisected from (two values of the sweep).
     pub bracket: [f64; 2],

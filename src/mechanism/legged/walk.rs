@@ -5,7 +5,7 @@
 //! A phase integrates `(q, q', W)` (`W` the dampers' work, a quadrature for the energy audit) with DOP853. After
 //! every accepted step the event functions are evaluated at the ends of [`EVENT_SAMPLES`] equal parts of it on
 //! the dense output; the earliest function that goes from `> 0` to `<= 0` over a part is located by Brent's
-//! method ([`crate::integrate::locate_root`]) and handled: a lift-off (a tip's normal force
+//! method (`crate::integrate::locate_root`) and handled: a lift-off (a tip's normal force
 //! [`FORCE_EVENT_MARGIN`] below zero) or a stopper's unlock (its holding force the same) chooses the next phase
 //! ([`super::forces::choose`]); a leg reaching its stopper or a bounced fore tip landing is an impact
 //! ([`super::impact::impact`]); the swing tip reaching the ground ahead of the fore tip ends the step. A stopper
