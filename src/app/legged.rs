@@ -7,16 +7,13 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walkers::{as_map, named};
+use super::walkers::{as_map, named, TELESCOPIC};
 use super::{in_run, AppError, SearchEnded};
 use crate::mechanism::legged::gait::{legged_gait, legged_step_map, LeggedGait, LeggedGaitError};
 use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
 use crate::mechanism::legged::{Legged, LeggedError};
 use crate::mechanism::telescopic::Telescopic;
 use crate::output;
-
-/// The model name of the compass gait with telescopic legs.
-pub const TELESCOPIC: &str = "telescopic";
 
 /// What `vrw gait --model telescopic` searches.
 #[derive(Debug, Clone)]

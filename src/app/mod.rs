@@ -44,7 +44,7 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
-pub use legged::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary, TELESCOPIC};
+pub use legged::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary};
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
@@ -71,7 +71,7 @@ pub use walker_sweep::{
 pub use walkers::{
     run_walker_continuation, run_walker_gait, wheel_only, Walker, WalkerContinueJob,
     WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerSpecialPoint,
-    MODELS,
+    MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

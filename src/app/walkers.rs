@@ -26,7 +26,11 @@ use crate::params::ConfigError;
 
 /// The models `--model` takes by name: the wheel (`vrw`, the default) and the walkers of this file; any other
 /// name that ends in `.toml` or names a file is a description ([`crate::mechanism::described`]).
-pub const MODELS: [&str; 4] = ["vrw", "simplest", "compass", "telescopic"];
+pub const MODELS: [&str; 4] = ["vrw", "simplest", "compass", TELESCOPIC];
+
+/// The model name of the compass gait with telescopic legs ([`crate::mechanism::telescopic`]), which walks by
+/// the legged walk (`super::legged`).
+pub const TELESCOPIC: &str = "telescopic";
 
 /// A walker other than the wheel, with its parameters.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -60,7 +64,7 @@ impl Walker {
                 w.validate()?;
                 Walker::Compass(w)
             }
-            super::legged::TELESCOPIC => {
+            TELESCOPIC => {
                 return Err(AppError::InvalidOption {
                     option: "model",
                     reason: "the compass gait with telescopic legs (`telescopic`) walks in `vrw gait` only so \
