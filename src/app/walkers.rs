@@ -15,7 +15,9 @@ use crate::continuation::{
 use crate::mechanism::compass::Compass;
 use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
-use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP};
+use crate::mechanism::rigid_gait::{
+    rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP, EXACT_ROUTE,
+};
 use crate::mechanism::simplest::Simplest;
 use crate::output;
 use crate::params::read_walker_parameters;
@@ -240,6 +242,7 @@ fn failure_kind(e: &RigidGaitError) -> &'static str {
         RigidGaitError::Step { source, .. } => source.kind(),
         RigidGaitError::Singular { .. } => "singular_jacobian",
         RigidGaitError::NoConvergence { .. } => "no_convergence",
+        RigidGaitError::NotDifferentiable { .. } => "not_differentiable",
     }
 }
 
@@ -254,7 +257,7 @@ fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) ->
         floquet_multipliers: g.multipliers.clone(),
         largest_multiplier: largest,
         stability: if largest < 1.0 { "stable" } else { "unstable" },
-        derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
+        derivative: g.derivative.to_string(),
         lambda_i4: g.step.lambda_i4,
         impact_loss: g.step.impact_loss,
         energy_drift: g.step.energy_drift,
@@ -413,7 +416,7 @@ where
                 section: named(&names, &s.x),
             })
             .collect(),
-        derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
+        derivative: family_route(&followed.points),
     };
     let rows = branch_rows(&job.param, &names, &followed.points);
     Ok((summary, rows))
@@ -458,10 +461,29 @@ fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
     })
 }
 
-/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
+/// How a family's `DP` and `dP/dp` were taken: exactly, or by central differences at the points where the
+/// step map has no derivative (counted).
+fn family_route<I>(points: &[FamilyPoint<I>]) -> String {
+    let by_differences = points
+        .iter()
+        .filter(|p| p.has_derivatives() && !p.exact)
+        .count();
+    if by_differences == 0 {
+        EXACT_ROUTE.to_string()
+    } else {
+        format!(
+            "{EXACT_ROUTE}; central differences, relative step {DIFFERENCE_STEP:e}, at {by_differences} \
+             point(s) where the step map is not differentiable"
+        )
+    }
+}
+
+/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop, and `DP` by central
+/// differences where the step map has no exact derivative (the outputs say where: `derivative`).
 fn interruptible() -> RigidOptions {
     RigidOptions {
         stop: Some(crate::walk::interrupted),
+        difference_fallback: true,
         ..RigidOptions::default()
     }
 }

@@ -12,8 +12,9 @@
 use nalgebra::{DVector, SVector};
 
 use super::assembly::{along_leg, point_mass_equations, point_mass_potential, up, PointMass};
-use super::constrained::{accelerations, impulse, ConstrainedError, Row};
-use super::rigid::{HeelStrike, RigidWalker};
+use super::constrained::{accelerations_with, impulse_with, ConstrainedError, Row};
+use super::rigid::{HeelStrike, RigidOptions, RigidWalker, Transition};
+use super::rigid_derivative::{step_map_derivative, DerivativeError, StepMapDerivative};
 use super::{Equations, Mechanism, PointKinematics, Real};
 use crate::params::{ConfigError, MASS_RATIO_LIMIT};
 
@@ -214,6 +215,8 @@ impl Mechanism<4> for Compass {
 }
 
 impl RigidWalker<4, 8> for Compass {
+    type Constants<T: Real> = CompassConstants<T>;
+
     fn name(&self) -> &'static str {
         "compass"
     }
@@ -222,22 +225,29 @@ impl RigidWalker<4, 8> for Compass {
         vec!["theta1", "theta1_dot", "theta2_dot"]
     }
 
-    /// Eq. (1) with Leg 1's foot held ([`super::constrained::accelerations`]); its normal force.
-    fn single_support(
+    fn rigid_constants<T: Real>(
         &self,
-        q: &SVector<f64, 4>,
-        qd: &SVector<f64, 4>,
-    ) -> Result<(SVector<f64, 4>, f64), ConstrainedError> {
-        let a = accelerations(self, q, qd, &Row::contact(0))?;
+        value: &dyn Fn(&'static str, f64) -> T,
+    ) -> CompassConstants<T> {
+        Mechanism::constants(self, value)
+    }
+
+    /// Eq. (1) with Leg 1's foot held ([`super::constrained::accelerations_with`]); its normal force.
+    fn single_support_with<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Result<(SVector<T, 4>, T), ConstrainedError> {
+        let a = accelerations_with(self, c, (q, qd), &Row::contact(0))?;
         Ok((a.qdd, a.multipliers[1]))
     }
 
-    fn swing_foot(&self, q: &SVector<f64, 4>) -> (f64, f64) {
-        let c = self.constants_f64();
+    fn swing_foot_with<T: Real>(&self, c: &CompassConstants<T>, q: &SVector<T, 4>) -> (T, T) {
         let zero = SVector::zeros();
         let (stance, swing) = (
-            self.contact(&c, q, &zero, 0).position,
-            self.contact(&c, q, &zero, 1).position,
+            self.contact(c, q, &zero, 0).position,
+            self.contact(c, q, &zero, 1).position,
         );
         (swing.y, swing.x - stance.x)
     }
@@ -246,26 +256,41 @@ impl RigidWalker<4, 8> for Compass {
         q[Z]
     }
 
-    /// The impact with both feet held gives `lambda_I4` (Leg 1's normal impulse); where it is negative, the
-    /// traditional impact with Leg 2's foot held, then Leg 2 is the stance leg (the angles exchanged, the hip
-    /// moved along the slope so that the new stance foot is at `x = 0`).
+    /// The impact with both feet held gives `lambda_I4` (Leg 1's normal impulse); the traditional impact with
+    /// Leg 2's foot held, then Leg 2 is the stance leg (the angles exchanged, the hip moved along the slope so
+    /// that the new stance foot is at `x = 0`).
+    fn transition_with<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Result<Transition<4, T>, ConstrainedError> {
+        let both = [Row::contact(0), Row::contact(1)].concat();
+        let lambda_i4 = impulse_with(self, c, (q, qd), &both)?.impulses[1];
+        let traditional = impulse_with(self, c, (q, qd), &Row::contact(1))?.qd_plus;
+        let new_foot = self.contact(c, q, qd, 1).position.x;
+        let mut after = exchange(q);
+        after[X] -= new_foot;
+        Ok(Transition {
+            lambda_i4,
+            q: after,
+            qd: exchange(&traditional),
+        })
+    }
+
+    /// [`RigidWalker::transition_with`]; where `lambda_I4 < 0` the rear foot leaves (the traditional impact).
     fn heel_strike(
         &self,
         q: &SVector<f64, 4>,
         qd: &SVector<f64, 4>,
     ) -> Result<HeelStrike<4>, ConstrainedError> {
-        let both = [Row::contact(0), Row::contact(1)].concat();
-        let lambda_i4 = impulse(self, q, qd, &both)?.impulses[1];
-        let traditional = impulse(self, q, qd, &Row::contact(1))?.qd_plus;
-        let loss = self.energy(q, qd) - self.energy(q, &traditional);
-        let new_foot = self.contact(&self.constants_f64(), q, qd, 1).position.x;
-        let swap = |v: &SVector<f64, 4>| SVector::from([v[X], v[Z], v[THETA2], v[THETA1]]);
-        let mut after = swap(q);
-        after[X] -= new_foot;
+        let t = self.transition_with(&self.constants_f64(), q, qd)?;
+        // The velocities after the impact in the old roles, where the energy before is measured.
+        let loss = self.energy(q, qd) - self.energy(q, &exchange(&t.qd));
         Ok(HeelStrike {
-            lambda_i4,
-            q: after,
-            qd: (lambda_i4 < 0.0).then(|| swap(&traditional)),
+            lambda_i4: t.lambda_i4,
+            q: t.q,
+            qd: (t.lambda_i4 < 0.0).then_some(t.qd),
             loss,
         })
     }
@@ -274,21 +299,45 @@ impl RigidWalker<4, 8> for Compass {
         self.energy(q, qd)
     }
 
-    fn section_of(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> DVector<f64> {
-        DVector::from_column_slice(&[q[THETA1], qd[THETA1], qd[THETA2]])
+    fn section_with<T: Real>(
+        &self,
+        _: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Vec<T> {
+        vec![q[THETA1], qd[THETA1], qd[THETA2]]
     }
 
     /// `(theta1, theta1', theta2')` just after a heel strike: Leg 1's foot at the origin, Leg 2's on the ground
     /// behind it (`theta2 = -theta1`), the hip moving about Leg 1's foot.
-    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, 4>, SVector<f64, 4>) {
+    fn state_at_section_with<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        s: &[T],
+    ) -> (SVector<T, 4>, SVector<T, 4>) {
         let (theta, w, w2) = (s[0], s[1], s[2]);
-        let l = self.leg_length;
+        let l = c.leg_length;
         let (sn, cs) = theta.sin_cos();
         (
-            SVector::from([-l * sn, l * cs, theta, -theta]),
-            SVector::from([-l * cs * w, -l * sn * w, w, w2]),
+            SVector::from([-(l * sn), l * cs, theta, -theta]),
+            SVector::from([-(l * cs * w), -(l * sn * w), w, w2]),
         )
     }
+
+    fn step_map_derivative(
+        &self,
+        x: &DVector<f64>,
+        param: Option<&str>,
+        period: usize,
+        options: &RigidOptions,
+    ) -> Result<StepMapDerivative<4>, DerivativeError> {
+        step_map_derivative::<Compass, 4, 8, 4, 5, 40>(self, x, param, period, options)
+    }
+}
+
+/// The legs' exchange of roles: Leg 1's angle and Leg 2's swapped, the hip's coordinates kept.
+fn exchange<T: Real>(v: &SVector<T, 4>) -> SVector<T, 4> {
+    SVector::from([v[X], v[Z], v[THETA2], v[THETA1]])
 }
 
 impl super::rigid_family::Parametrized for Compass {

@@ -18,8 +18,11 @@ pub mod assembly;
 pub mod compass;
 pub mod constrained;
 pub mod rigid;
+pub mod rigid_check;
+pub mod rigid_derivative;
 pub mod rigid_family;
 pub mod rigid_gait;
+pub mod sensitivity;
 pub mod simplest;
 mod wheel;
 
@@ -99,5 +102,7 @@ pub trait Mechanism<const N: usize> {
     }
 }
 
+#[cfg(test)]
+mod derivative_tests;
 #[cfg(test)]
 mod tests;
