@@ -50,7 +50,8 @@ pub use simulate::{
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 pub use walkers::{
     run_walker_continuation, run_walker_gait, Walker, WalkerContinueJob, WalkerContinueSummary,
-    WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerSpecialPoint, MODELS,
+    WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative, WalkerSpecialPoint,
+    MODELS,
 };
 
 use crate::dynamics::Model;

@@ -14,9 +14,11 @@ use crate::continuation::{
 };
 use crate::mechanism::compass::Compass;
 use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
+use crate::mechanism::rigid_check::{check_rigid_derivatives, RigidDerivativeCheck};
+use crate::mechanism::rigid_derivative::{parameter_value, DerivativeError};
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
 use crate::mechanism::rigid_gait::{
-    rigid_gait, RigidGait, RigidGaitError, DIFFERENCE_STEP, EXACT_ROUTE,
+    rigid_gait, rigid_step_map, RigidGait, RigidGaitError, DIFFERENCE_STEP, EXACT_ROUTE,
 };
 use crate::mechanism::simplest::Simplest;
 use crate::output;
@@ -76,6 +78,43 @@ impl Walker {
             Walker::Compass(w) => RigidWalker::name(w),
         }
     }
+
+    /// The keys of its parameters (those `continue --param` follows and `gait --parameter` differentiates in).
+    pub fn parameter_keys(&self) -> Vec<&'static str> {
+        match self {
+            Walker::Simplest(w) => w.parameter_keys(),
+            Walker::Compass(w) => w.parameter_keys(),
+        }
+    }
+
+    /// Every built-in walker's parameter keys, each once (what `gait --parameter` may name besides the
+    /// wheel's keys).
+    pub fn all_parameter_keys() -> Vec<&'static str> {
+        let mut keys = Simplest::default().parameter_keys();
+        for key in Compass::default().parameter_keys() {
+            if !keys.contains(&key) {
+                keys.push(key);
+            }
+        }
+        keys
+    }
+
+    /// `key` is one of its parameters, or an error for `option` naming them.
+    fn check_parameter(&self, key: &str, option: &'static str) -> Result<(), AppError> {
+        let keys = self.parameter_keys();
+        if keys.contains(&key) {
+            return Ok(());
+        }
+        Err(AppError::InvalidOption {
+            option,
+            reason: format!(
+                "`{}` is not a parameter of the model `{}`: one of {}",
+                crate::fmt::clip(key),
+                self.name(),
+                keys.join(", ")
+            ),
+        })
+    }
 }
 
 /// What `vrw gait --model NAME` searches.
@@ -87,6 +126,10 @@ pub struct WalkerGaitJob {
     pub initial: Option<Vec<f64>>,
     /// Steps walked before Newton's method starts.
     pub transient_steps: usize,
+    /// Also `dP/dp` at the gait for this parameter (one of the walker's keys).
+    pub parameter: Option<String>,
+    /// Check the exact `DP` (and `dP/dp`) at the gait against Richardson-extrapolated central differences.
+    pub check_jacobian: bool,
     /// Output directory for `gait.json`.
     pub out_dir: PathBuf,
     /// Replace a run of another command in `out_dir`.
@@ -112,6 +155,9 @@ pub struct WalkerGaitSummary {
     pub message: Option<String>,
     /// The gait.
     pub gait: Option<WalkerGait>,
+    /// The exact derivatives against central differences, if asked for ([`WalkerGaitJob::check_jacobian`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian_check: Option<RigidDerivativeCheck>,
 }
 
 /// A walker's gait as `gait.json` holds it.
@@ -146,12 +192,30 @@ pub struct WalkerGait {
     pub energy_drift: f64,
     /// Crossings of the ground by the swing foot ignored as scuffing.
     pub scuffs: usize,
+    /// `dP/dp` at the gait for the parameter asked for ([`WalkerGaitJob::parameter`]).
+    #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
+    pub dp_dparam: Option<WalkerParamDerivative>,
+}
+
+/// `dP/dp` of a walker's step map at its gait, by the section's coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WalkerParamDerivative {
+    /// The parameter.
+    pub parameter: String,
+    /// `dP/dp`, one value per section coordinate.
+    #[serde(serialize_with = "as_map")]
+    pub values: Vec<(String, f64)>,
+    /// How it was taken.
+    pub derivative: String,
 }
 
 /// Search the gait of `job.walker` and write `gait.json` (also without a gait, with the reason), after the
 /// output directory is checked.
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
+    if let Some(key) = &job.parameter {
+        job.walker.check_parameter(key, "parameter")?;
+    }
     let summary = match job.walker {
         Walker::Simplest(w) => compute(&w, w.default_start(), job)?,
         Walker::Compass(w) => compute(&w, w.default_start(), job)?,
@@ -164,7 +228,7 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
 }
 
 /// The search of [`run_walker_gait`] for `walker`, from `job.initial` or `start`.
-fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
     walker: &W,
     start: DVector<f64>,
     job: &WalkerGaitJob,
@@ -188,6 +252,22 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     };
     let result = search_gait(walker, &start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
+    let jacobian_check = match (&result, job.check_jacobian) {
+        (Ok(g), true) => Some(
+            check_rigid_derivatives(
+                walker,
+                &g.section,
+                job.parameter.as_deref(),
+                &interruptible(),
+            )
+            .unwrap_or_else(|e| RigidDerivativeCheck::failed(e.to_string())),
+        ),
+        _ => None,
+    };
+    let dp_dparam = match (&result, &job.parameter) {
+        (Ok(g), Some(key)) => Some(param_derivative(walker, g, key)?),
+        _ => None,
+    };
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
@@ -198,9 +278,51 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
             Err(e) => SearchEnded::Failed(failure_kind(e)),
         },
         message: result.as_ref().err().map(ToString::to_string),
-        gait: result
-            .ok()
-            .map(|g| gait_record(&g, named(&names, &g.section))),
+        gait: result.ok().map(|g| WalkerGait {
+            dp_dparam,
+            ..gait_record(&g, named(&names, &g.section))
+        }),
+        jacobian_check,
+    })
+}
+
+/// `dP/dp` of `walker`'s step map at its gait `g` in the parameter `key`: exact, or central differences where
+/// the map is not differentiable there (said in `derivative`).
+fn param_derivative<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
+    walker: &W,
+    g: &RigidGait<N>,
+    key: &str,
+) -> Result<WalkerParamDerivative, AppError> {
+    let options = interruptible();
+    let names = walker.section_names();
+    let failed = |reason: String| AppError::InvalidOption {
+        option: "parameter",
+        reason,
+    };
+    let (values, derivative) = match walker.step_map_derivative(&g.section, Some(key), 1, &options)
+    {
+        Ok(d) => (d.dparam.unwrap_or_default(), EXACT_ROUTE.to_string()),
+        Err(DerivativeError::NotDifferentiable(reason)) => {
+            let value = parameter_value(walker, key).unwrap_or(f64::NAN);
+            let h = DIFFERENCE_STEP * value.abs().max(1.0);
+            let at = |p: f64| -> Result<DVector<f64>, AppError> {
+                let moved = walker.with_parameter(key, p)?;
+                Ok(rigid_step_map(&moved, &g.section, &options)
+                    .map_err(|e| failed(e.to_string()))?
+                    .0)
+            };
+            let values = (at(value + h)? - at(value - h)?) / (2.0 * h);
+            let route = format!(
+                "central differences, relative step {DIFFERENCE_STEP:e} (no exact derivative: {reason})"
+            );
+            (values, route)
+        }
+        Err(e) => return Err(failed(e.to_string())),
+    };
+    Ok(WalkerParamDerivative {
+        parameter: key.to_string(),
+        values: named(&names, &values),
+        derivative,
     })
 }
 
@@ -262,6 +384,7 @@ fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) ->
         impact_loss: g.step.impact_loss,
         energy_drift: g.step.energy_drift,
         scuffs: g.step.scuffs,
+        dp_dparam: None,
     }
 }
 

@@ -10,11 +10,10 @@
 //! fails where the stance foot's normal force turns negative (the walker would leave the ground) or the hip
 //! falls below the ground.
 
-use nalgebra::{DVector, SVector};
+use nalgebra::{DMatrix, DVector, SVector};
 
 use super::constrained::ConstrainedError;
-use super::rigid_derivative::{DerivativeError, StepMapDerivative};
-use super::sensitivity::Tape;
+use super::sensitivity::{NotDifferentiable, Tape};
 use super::Real;
 use crate::integrate::{locate_root, Dop853, IntegrationError, Method, OdeSystem, Tolerances};
 
@@ -468,4 +467,34 @@ fn finish_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         energy_drift,
         scuffs,
     })
+}
+
+/// `P^k(x)` with its exact derivatives ([`RigidWalker::step_map_derivative`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepMapDerivative<const N: usize> {
+    /// `P^k(x)`.
+    pub value: DVector<f64>,
+    /// `DP^k` at `x`.
+    pub jacobian: DMatrix<f64>,
+    /// `dP^k/dp` in the parameter asked for.
+    pub dparam: Option<DVector<f64>>,
+    /// The first step (its duration, DLS indicator, audit).
+    pub step: RigidStep<N>,
+}
+
+/// Why a step map has no exact derivative here.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DerivativeError {
+    /// The walk failed.
+    #[error(transparent)]
+    Walk(#[from] RigidError),
+    /// The walk went, but the map has no derivative there (or the replay could not give it).
+    #[error(transparent)]
+    NotDifferentiable(#[from] NotDifferentiable),
+    /// The parameter asked for is not one of the walker's constants.
+    #[error("`{key}` is not a parameter of this walker")]
+    UnknownParameter {
+        /// The key asked for.
+        key: String,
+    },
 }

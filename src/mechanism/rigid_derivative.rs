@@ -17,9 +17,10 @@ use nalgebra::{DMatrix, DVector, SVector};
 
 use super::constrained::ConstrainedError;
 use super::rigid::{
-    pack, rigid_step_taped, HeelStrikeEvent, RigidError, RigidOptions, RigidStep, RigidTape,
-    RigidWalker, SingleSupportPhase,
+    pack, rigid_step_taped, HeelStrikeEvent, RigidOptions, RigidTape, RigidWalker,
+    SingleSupportPhase,
 };
+pub use super::rigid::{DerivativeError, StepMapDerivative};
 use super::sensitivity::{
     replay, seeded, sensitivity_of, state_duals, Hybrid, NotDifferentiable, Sensitivity, BORDER_TOL,
 };
@@ -69,23 +70,6 @@ impl<W: RigidWalker<N, Y>, const N: usize, const Y: usize> Hybrid<N> for Rigid<'
     }
 }
 
-/// Why a step map has no exact derivative here.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum DerivativeError {
-    /// The walk failed.
-    #[error(transparent)]
-    Walk(#[from] RigidError),
-    /// The walk went, but the map has no derivative there (or the replay could not give it).
-    #[error(transparent)]
-    NotDifferentiable(#[from] NotDifferentiable),
-    /// The parameter asked for is not one of the walker's constants.
-    #[error("`{key}` is not a parameter of this walker")]
-    UnknownParameter {
-        /// The key asked for.
-        key: String,
-    },
-}
-
 /// The value of `walker`'s constant `key` (as its constants read it), `None` for no such key.
 pub fn parameter_value<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
@@ -99,19 +83,6 @@ pub fn parameter_value<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         v
     });
     found.get()
-}
-
-/// `P^k(x)` with its exact derivatives.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StepMapDerivative<const N: usize> {
-    /// `P^k(x)`.
-    pub value: DVector<f64>,
-    /// `DP^k` at `x`.
-    pub jacobian: DMatrix<f64>,
-    /// `dP^k/dp` in the parameter asked for.
-    pub dparam: Option<DVector<f64>>,
-    /// The first step (its duration, DLS indicator, audit).
-    pub step: RigidStep<N>,
 }
 
 /// `P^period(x)` of `walker` with its exact `DP` and, if `param` names one of the walker's constants, `dP/dp`
