@@ -11,8 +11,11 @@
 //!
 //! Walkers with rigid legs and point feet walk by [`rigid`] (single support between heel strikes) and have their
 //! gaits by [`rigid_gait`]: the compass gait and the simplest walking model of Garcia et al. ([`simplest`]),
-//! whose massless legs leave it only reduced equations. The wheel still walks through `walk/`; the two walks
-//! are to become one on this interface (docs/model.md section 13).
+//! whose massless legs leave it only reduced equations. Their step maps have exact derivatives
+//! ([`rigid_derivative`], checked against differences by [`rigid_check`]) from a replay of the walk's own steps
+//! that knows only phases, guards and resets ([`sensitivity`]), and their families are followed by
+//! [`rigid_family`]. The wheel still walks through `walk/`; the two walks are to become one on this interface
+//! (docs/model.md section 13).
 
 pub mod assembly;
 pub mod compass;
