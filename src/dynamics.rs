@@ -31,12 +31,13 @@ mod force;
 pub(crate) use dual::Dual;
 
 /// A real scalar the kinematics and the equations of motion are written for: `f64` for the walk, and the dual
-/// numbers ([`Dual`], of the wheel's [`crate::variational`] and the rigid walkers' derivatives) that carry
-/// derivatives through the very same code (forward-mode automatic differentiation, docs/model.md section 10). STYLE.md asks for concrete `f64`; this is the one exception, so
-/// that the exact derivatives differentiate the equations the walk integrates rather than a copy of them.
+/// numbers (`Dual`, of the wheel's [`crate::variational`] and the rigid walkers' derivatives) that carry
+/// derivatives through the very same code (forward-mode automatic differentiation, docs/model.md section 10).
+/// STYLE.md asks for concrete `f64`; this is the one exception, so that the exact derivatives differentiate the
+/// equations the walk integrates rather than a copy of them.
 ///
 /// The trait asks only for what the kinematics use (field arithmetic, the sine, cosine and arctangent, and the
-/// value for a solver's pivot), so that a plain dual number ([`Dual`]) can implement it.
+/// value for a solver's pivot), so that a plain dual number (`Dual`) can implement it.
 pub trait Real:
     nalgebra::Scalar
     + Copy
