@@ -151,6 +151,7 @@ pub(super) fn search_kind(e: &RigidGaitError) -> &'static str {
         RigidGaitError::Step { source, .. } => source.kind(),
         RigidGaitError::Singular { .. } => "singular_jacobian",
         RigidGaitError::NoConvergence { .. } => "no_convergence",
+        RigidGaitError::NotDifferentiable { .. } => "not_differentiable",
     }
 }
 
