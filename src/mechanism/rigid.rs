@@ -316,18 +316,17 @@ pub(crate) fn unpack<const N: usize, const Y: usize>(
 }
 
 /// The heel-strike event function: the swing foot's height where it is ahead of the stance foot (by more than
-/// [`MIN_STRIDE`] of the hip's height), else a positive constant (no event behind the stance foot or beside it).
+/// [`MIN_STRIDE`] of the hip's height), `None` where it is not (behind the stance foot or beside it). A heel
+/// strike is a crossing of zero from above between two samples that are both ahead: a foot that comes ahead
+/// while under the ground (passing the stance foot from above, the legs' coincidence) is scuffing, not
+/// striking (as `super::legged`'s `Event::Strike` does).
 fn strike_height<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
     y: &SVector<f64, Y>,
-) -> f64 {
+) -> Option<f64> {
     let (q, _) = unpack::<N, Y>(y);
     let (height, ahead) = walker.swing_foot(&q);
-    if ahead > MIN_STRIDE * walker.hip_height(&q).abs() {
-        height
-    } else {
-        1.0
-    }
+    (ahead > MIN_STRIDE * walker.hip_height(&q).abs()).then_some(height)
 }
 
 /// One step of `walker` from `(q, q')` just after a heel strike (see the module documentation).
@@ -398,10 +397,15 @@ fn walk_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         );
         let (q1, qd1) = unpack::<N, Y>(step.y1());
         energy_drift = energy_drift.max((walker.mechanical_energy(&q1, &qd1) - e0).abs());
-        if g0 > 0.0 && g1 <= 0.0 {
+        // A heel strike: the height crossing zero from above, the foot ahead at both ends of the step.
+        let strike = match (g0, g1) {
+            (Some(g0), Some(g1)) if g0 > 0.0 && g1 <= 0.0 => Some((g0, g1)),
+            _ => None,
+        };
+        if let Some((g0, g1)) = strike {
             let t = locate_root(
                 &step,
-                |_, y| strike_height(walker, y),
+                |_, y| walker.swing_foot(&unpack::<N, Y>(y).0).0,
                 t0,
                 g0,
                 t1,

@@ -479,3 +479,28 @@ fn continuation_locates_the_compass_gaits_period_doubling() {
     assert!((value - bisected).abs() < 1e-9, "{value} vs {bisected}");
     assert!((value - 0.076635632).abs() < 1e-9, "{value}");
 }
+
+/// Regression: the swing foot passing the stance foot from above while under the ground (the legs' coincidence
+/// near mid-swing) is scuffing, not a heel strike. The event function once switched there from a positive
+/// placeholder to the foot's (negative) height, and the simplest walker had a spurious period-1 "gait" at slope
+/// 0.014 (a step of 1.6905 time units from `(0.186197702, -0.260652416)`); from that state the walk now goes on
+/// past the coincidence (and the stance foot lifts off), and the paper's long step (3.9 time units) is kept.
+#[test]
+fn a_swing_foot_passing_the_stance_foot_under_the_ground_is_no_heel_strike() {
+    let walker = Simplest { slope: 0.014 };
+    let options = RigidOptions::default();
+    let spurious = DVector::from_column_slice(&[0.186197702, -0.260652416]);
+    let (q, qd) = walker.state_at_section(&spurious);
+    let step = super::rigid::rigid_step(&walker, &q, &qd, &options);
+    assert!(
+        !matches!(&step, Ok(s) if s.period < 3.0),
+        "a heel strike at the legs' coincidence: {step:?}"
+    );
+    let gait = gait_of(&walker, &[0.2314, -0.2271]);
+    assert!(
+        (gait.step.period - 3.907370566).abs() < 1e-8,
+        "{}",
+        gait.step.period
+    );
+    assert_eq!(gait.step.scuffs, 1);
+}
