@@ -404,3 +404,13 @@ pub(crate) fn interruptible() -> RigidOptions {
         ..RigidOptions::default()
     }
 }
+
+/// The kind of a failed search.
+pub(super) fn search_kind(e: &RigidGaitError) -> &'static str {
+    match e {
+        RigidGaitError::Step { source, .. } => source.kind(),
+        RigidGaitError::Singular { .. } => "singular_jacobian",
+        RigidGaitError::NoConvergence { .. } => "no_convergence",
+        RigidGaitError::NotDifferentiable { .. } => "not_differentiable",
+    }
+}

@@ -390,7 +390,7 @@ fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
         initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
-            Err(e) => SearchEnded::Failed(super::walker_sweep::search_kind(e)),
+            Err(e) => SearchEnded::Failed(super::walker_model::search_kind(e)),
         },
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok().map(|g| WalkerGait {
