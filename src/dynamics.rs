@@ -25,15 +25,19 @@ use num_traits::{One, Zero};
 
 use crate::params::{ConfigError, Params};
 
+mod dual;
 mod force;
 
+pub(crate) use dual::Dual;
+
 /// A real scalar the kinematics and the equations of motion are written for: `f64` for the walk, and the dual
-/// numbers of [`crate::variational`] that carry derivatives through the very same code (forward-mode automatic
-/// differentiation, docs/model.md section 10). STYLE.md asks for concrete `f64`; this is the one exception, so
-/// that the exact derivatives differentiate the equations the walk integrates rather than a copy of them.
+/// numbers (`Dual`, of the wheel's [`crate::variational`] and the rigid walkers' derivatives) that carry
+/// derivatives through the very same code (forward-mode automatic differentiation, docs/model.md section 10).
+/// STYLE.md asks for concrete `f64`; this is the one exception, so that the exact derivatives differentiate the
+/// equations the walk integrates rather than a copy of them.
 ///
-/// The trait asks only for what the kinematics use (field arithmetic, the sine, cosine and arctangent), so that
-/// a plain dual number (`crate::variational`'s) can implement it.
+/// The trait asks only for what the kinematics use (field arithmetic, the sine, cosine and arctangent, and the
+/// value for a solver's pivot), so that a plain dual number (`Dual`) can implement it.
 pub trait Real:
     nalgebra::Scalar
     + Copy
@@ -55,6 +59,9 @@ pub trait Real:
     fn sin_cos(self) -> (Self, Self);
     /// `atan(self)`.
     fn atan(self) -> Self;
+    /// The value without its derivatives (itself for `f64`): for the decisions a computation makes (a pivot's
+    /// sign), never for its arithmetic.
+    fn value(self) -> f64;
 }
 
 impl Real for f64 {
@@ -72,6 +79,9 @@ impl Real for f64 {
     }
     fn atan(self) -> f64 {
         f64::atan(self)
+    }
+    fn value(self) -> f64 {
+        self
     }
 }
 

@@ -1151,7 +1151,7 @@ fn gait_of_the_classic_walkers() {
 }
 
 /// A walker's bad input names the problem: an unknown model, a key it does not have, a bad value, a start of
-/// the wrong size, an option only the wheel has.
+/// the wrong size, a derivative in a parameter it does not have.
 #[test]
 fn bad_walker_input_names_the_problem() {
     let cases: [(&[&str], &str); 6] = [
@@ -1173,8 +1173,8 @@ fn bad_walker_input_names_the_problem() {
             "the section of `simplest` has 2",
         ),
         (
-            &["--model", "compass", "--check-jacobian"],
-            "`--check-jacobian`",
+            &["--model", "simplest", "--parameter", "hip_mass"],
+            "`hip_mass` is not a parameter of the model `simplest`",
         ),
     ];
     for (args, needle) in cases {
@@ -1182,6 +1182,35 @@ fn bad_walker_input_names_the_problem() {
         assert_error(&run, &[needle]);
         assert!(!run.out.join("gait.json").exists(), "{args:?}");
     }
+}
+
+/// `vrw gait --model compass --check-jacobian --parameter slope` compares the exact `DP` and `dP/dp` with
+/// extrapolated central differences: they agree, gait.json holds the check and `dP_dparam`, and the multipliers
+/// are said to be the exact `DP`'s.
+#[test]
+fn a_walkers_exact_derivatives_are_checked() {
+    let args = [
+        "--model",
+        "compass",
+        "--check-jacobian",
+        "--parameter",
+        "slope",
+    ];
+    let run = command_in(temp_dir_with(&[]), "gait", &args);
+    assert_eq!(run.code(), Some(0), "{}", run.stderr());
+    assert!(run.stdout().contains("agree"), "{}", run.stdout());
+    let gait: Value = serde_json::from_str(&run.read("gait.json")).unwrap();
+    let check = &gait["jacobian_check"];
+    assert_eq!(check["agree"], true, "{check}");
+    assert!(check["difference"].as_f64().unwrap() < 1e-8, "{check}");
+    assert_eq!(check["exact"][0].as_array().unwrap().len(), 4, "{check}");
+    let d = &gait["gait"]["dP_dparam"];
+    assert_eq!(d["parameter"], "slope");
+    assert!(d["values"]["theta1"].as_f64().unwrap().is_finite(), "{d}");
+    assert!(gait["gait"]["derivative"]
+        .as_str()
+        .unwrap()
+        .starts_with("exact"));
 }
 
 /// `vrw continue --model simplest --param slope` follows the simplest walker's gaits and locates their period

@@ -411,3 +411,59 @@ fn the_telescopic_biped_walks_with_double_support() {
     );
     assert_error(&refused, &["foot_mass"]);
 }
+
+/// Regression (the spurious heel strike at the legs' coincidence): at slope 0.014 from the default start,
+/// `vrw gait --model simplest` once found a 1.69-time-unit "gait" and `vrw simulate` walked onto it; every
+/// step of either is now a real heel strike (the paper's steps last about 3 time units or more: this start's
+/// walk falls after 3 of them, the stance foot lifting off, and the search says so).
+#[test]
+fn the_simplest_walker_has_no_short_spurious_gait_at_slope_0_014() {
+    let tmp = tempfile::tempdir().unwrap();
+    let gait_out = tmp.path().join("gait");
+    let run = vrw(
+        &[
+            "gait",
+            "--model",
+            "simplest",
+            "--set",
+            "slope=0.014",
+            "--out",
+        ]
+        .into_iter()
+        .chain([gait_out.to_str().unwrap()])
+        .collect::<Vec<_>>(),
+        tmp.path(),
+    );
+    let gait = json(&gait_out.join("gait.json"));
+    let period = gait["gait"]["period"].as_f64();
+    assert!(period.is_none_or(|p| p > 3.0), "{gait}");
+    if period.is_none() {
+        assert_error(
+            &run,
+            &["no gait found", "stance foot would leave the ground"],
+        );
+    }
+    let sim = tmp.path().join("sim");
+    let o = sim.to_str().unwrap();
+    let _ = vrw(
+        &[
+            "simulate",
+            "--model",
+            "simplest",
+            "--set",
+            "slope=0.014",
+            "--steps",
+            "30",
+            "--out",
+            o,
+        ],
+        tmp.path(),
+    );
+    let (header, rows) = table(&sim.join("steps.csv"));
+    let column = header.iter().position(|h| h == "period").unwrap();
+    assert!(!rows.is_empty());
+    for row in &rows {
+        let p: f64 = row[column].parse().unwrap();
+        assert!(p > 3.0, "a step of {p} time units: {rows:?}");
+    }
+}

@@ -70,8 +70,8 @@ pub use walker_sweep::{
 };
 pub use walkers::{
     run_walker_continuation, run_walker_gait, wheel_only, Walker, WalkerContinueJob,
-    WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerSpecialPoint,
-    MODELS, TELESCOPIC,
+    WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative,
+    WalkerSpecialPoint, MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

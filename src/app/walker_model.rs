@@ -395,10 +395,22 @@ pub(crate) fn search_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     rigid_gait(walker, &walker.section_of(&q, &qd), &options)
 }
 
-/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
+/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop, and `DP` by central
+/// differences where the step map has no exact derivative (the outputs say where: `derivative`).
 pub(crate) fn interruptible() -> RigidOptions {
     RigidOptions {
         stop: Some(crate::walk::interrupted),
+        difference_fallback: true,
         ..RigidOptions::default()
+    }
+}
+
+/// The kind of a failed search.
+pub(super) fn search_kind(e: &RigidGaitError) -> &'static str {
+    match e {
+        RigidGaitError::Step { source, .. } => source.kind(),
+        RigidGaitError::Singular { .. } => "singular_jacobian",
+        RigidGaitError::NoConvergence { .. } => "no_convergence",
+        RigidGaitError::NotDifferentiable { .. } => "not_differentiable",
     }
 }

@@ -10,10 +10,9 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walker_model::FoundGait;
+use super::walker_model::{search_kind, FoundGait};
 use super::walkers::{as_map, named, Walker};
 use super::{check_interrupted, in_run, AppError};
-use crate::mechanism::rigid_gait::RigidGaitError;
 use crate::output;
 use crate::study::grid::{run_rows, Evaluated};
 
@@ -142,15 +141,6 @@ pub(super) fn gait_at(
         value,
         failure: gait.as_ref().err().map(search_kind),
         gait: gait.map_err(|e| e.to_string()),
-    }
-}
-
-/// The kind of a failed search.
-pub(super) fn search_kind(e: &RigidGaitError) -> &'static str {
-    match e {
-        RigidGaitError::Step { source, .. } => source.kind(),
-        RigidGaitError::Singular { .. } => "singular_jacobian",
-        RigidGaitError::NoConvergence { .. } => "no_convergence",
     }
 }
 

@@ -17,8 +17,10 @@ use crate::continuation::{
 use crate::mechanism::compass::Compass;
 use crate::mechanism::described::{self, AnyDescribed};
 use crate::mechanism::rigid::RigidWalker;
+use crate::mechanism::rigid_check::{check_rigid_derivatives, RigidDerivativeCheck};
+use crate::mechanism::rigid_derivative::{parameter_value, DerivativeError};
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
-use crate::mechanism::rigid_gait::{RigidGait, RigidGaitError, DIFFERENCE_STEP};
+use crate::mechanism::rigid_gait::{rigid_step_map, RigidGait, DIFFERENCE_STEP, EXACT_ROUTE};
 use crate::mechanism::simplest::Simplest;
 use crate::output;
 use crate::params::read_walker_parameters;
@@ -123,7 +125,7 @@ impl Walker {
         })
     }
 
-    /// The keys of its real-valued parameters.
+    /// The keys of its parameters (those `continue --param` follows and `gait --parameter` differentiates in).
     pub fn parameter_keys(&self) -> Vec<&'static str> {
         match self {
             Walker::Simplest(w) => w.parameter_keys(),
@@ -171,6 +173,23 @@ impl Walker {
                 ),
             }),
         }
+    }
+
+    /// `key` is one of its parameters, or an error for `option` naming them.
+    fn check_parameter(&self, key: &str, option: &'static str) -> Result<(), AppError> {
+        let keys = self.parameter_keys();
+        if keys.contains(&key) {
+            return Ok(());
+        }
+        Err(AppError::InvalidOption {
+            option,
+            reason: format!(
+                "`{}` is not a parameter of the model `{}`: one of {}",
+                crate::fmt::clip(key),
+                self.name(),
+                keys.join(", ")
+            ),
+        })
     }
 }
 
@@ -230,6 +249,10 @@ pub struct WalkerGaitJob {
     pub initial: Option<Vec<f64>>,
     /// Steps walked before Newton's method starts.
     pub transient_steps: usize,
+    /// Also `dP/dp` at the gait for this parameter (one of the walker's keys).
+    pub parameter: Option<String>,
+    /// Check the exact `DP` (and `dP/dp`) at the gait against Richardson-extrapolated central differences.
+    pub check_jacobian: bool,
     /// Output directory for `gait.json`.
     pub out_dir: PathBuf,
     /// Replace a run of another command in `out_dir`.
@@ -255,6 +278,9 @@ pub struct WalkerGaitSummary {
     pub message: Option<String>,
     /// The gait.
     pub gait: Option<WalkerGait>,
+    /// The exact derivatives against central differences, if asked for ([`WalkerGaitJob::check_jacobian`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian_check: Option<RigidDerivativeCheck>,
 }
 
 /// A walker's gait as `gait.json` holds it.
@@ -289,12 +315,30 @@ pub struct WalkerGait {
     pub energy_drift: f64,
     /// Crossings of the ground by the swing foot ignored as scuffing.
     pub scuffs: usize,
+    /// `dP/dp` at the gait for the parameter asked for ([`WalkerGaitJob::parameter`]).
+    #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
+    pub dp_dparam: Option<WalkerParamDerivative>,
+}
+
+/// `dP/dp` of a walker's step map at its gait, by the section's coordinates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WalkerParamDerivative {
+    /// The parameter.
+    pub parameter: String,
+    /// `dP/dp`, one value per section coordinate.
+    #[serde(serialize_with = "as_map")]
+    pub values: Vec<(String, f64)>,
+    /// How it was taken.
+    pub derivative: String,
 }
 
 /// Search the gait of `job.walker` and write `gait.json` (also without a gait, with the reason), after the
 /// output directory is checked.
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
+    if let Some(key) = &job.parameter {
+        job.walker.check_parameter(key, "parameter")?;
+    }
     let summary = match &job.walker {
         Walker::Simplest(w) => compute(w, w.default_start(), job)?,
         Walker::Compass(w) => compute(w, w.default_start(), job)?,
@@ -311,7 +355,7 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
 }
 
 /// The search of [`run_walker_gait`] for `walker`, from `job.initial` or `start`.
-fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
     walker: &W,
     start: DVector<f64>,
     job: &WalkerGaitJob,
@@ -335,6 +379,22 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     };
     let result = search_gait(walker, &start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
+    let jacobian_check = match (&result, job.check_jacobian) {
+        (Ok(g), true) => Some(
+            check_rigid_derivatives(
+                walker,
+                &g.section,
+                job.parameter.as_deref(),
+                &interruptible(),
+            )
+            .unwrap_or_else(|e| RigidDerivativeCheck::failed(e.to_string())),
+        ),
+        _ => None,
+    };
+    let dp_dparam = match (&result, &job.parameter) {
+        (Ok(g), Some(key)) => Some(param_derivative(walker, g, key)?),
+        _ => None,
+    };
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: walker.name(),
@@ -342,12 +402,54 @@ fn compute<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
-            Err(e) => SearchEnded::Failed(failure_kind(e)),
+            Err(e) => SearchEnded::Failed(super::walker_model::search_kind(e)),
         },
         message: result.as_ref().err().map(ToString::to_string),
-        gait: result
-            .ok()
-            .map(|g| gait_record(&g, named(&names, &g.section))),
+        gait: result.ok().map(|g| WalkerGait {
+            dp_dparam,
+            ..gait_record(&g, named(&names, &g.section))
+        }),
+        jacobian_check,
+    })
+}
+
+/// `dP/dp` of `walker`'s step map at its gait `g` in the parameter `key`: exact, or central differences where
+/// the map is not differentiable there (said in `derivative`).
+fn param_derivative<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
+    walker: &W,
+    g: &RigidGait<N>,
+    key: &str,
+) -> Result<WalkerParamDerivative, AppError> {
+    let options = interruptible();
+    let names = walker.section_names();
+    let failed = |reason: String| AppError::InvalidOption {
+        option: "parameter",
+        reason,
+    };
+    let (values, derivative) = match walker.step_map_derivative(&g.section, Some(key), 1, &options)
+    {
+        Ok(d) => (d.dparam.unwrap_or_default(), EXACT_ROUTE.to_string()),
+        Err(DerivativeError::NotDifferentiable(reason)) => {
+            let value = parameter_value(walker, key).unwrap_or(f64::NAN);
+            let h = DIFFERENCE_STEP * value.abs().max(1.0);
+            let at = |p: f64| -> Result<DVector<f64>, AppError> {
+                let moved = walker.with_parameter(key, p)?;
+                Ok(rigid_step_map(&moved, &g.section, &options)
+                    .map_err(|e| failed(e.to_string()))?
+                    .0)
+            };
+            let values = (at(value + h)? - at(value - h)?) / (2.0 * h);
+            let route = format!(
+                "central differences, relative step {DIFFERENCE_STEP:e} (no exact derivative: {reason})"
+            );
+            (values, route)
+        }
+        Err(e) => return Err(failed(e.to_string())),
+    };
+    Ok(WalkerParamDerivative {
+        parameter: key.to_string(),
+        values: named(&names, &values),
+        derivative,
     })
 }
 
@@ -358,15 +460,6 @@ pub(super) fn named<S: AsRef<str>>(names: &[S], x: &DVector<f64>) -> Vec<(String
         .map(|n| n.as_ref().to_string())
         .zip(x.iter().copied())
         .collect()
-}
-
-/// The kind of a failed search.
-fn failure_kind(e: &RigidGaitError) -> &'static str {
-    match e {
-        RigidGaitError::Step { source, .. } => source.kind(),
-        RigidGaitError::Singular { .. } => "singular_jacobian",
-        RigidGaitError::NoConvergence { .. } => "no_convergence",
-    }
 }
 
 /// `gait.json`'s record of `g`.
@@ -380,11 +473,12 @@ fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) ->
         floquet_multipliers: g.multipliers.clone(),
         largest_multiplier: largest,
         stability: if largest < 1.0 { "stable" } else { "unstable" },
-        derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
+        derivative: g.derivative.to_string(),
         lambda_i4: g.step.lambda_i4,
         impact_loss: g.step.impact_loss,
         energy_drift: g.step.energy_drift,
         scuffs: g.step.scuffs,
+        dp_dparam: None,
     }
 }
 
@@ -537,7 +631,7 @@ where
                 section: named(&names, &s.x),
             })
             .collect(),
-        derivative: format!("central differences, relative step {DIFFERENCE_STEP:e}"),
+        derivative: family_route(&followed.points),
     };
     let rows = branch_rows(&job.param, &names, &followed.points);
     Ok((summary, rows))
@@ -634,4 +728,21 @@ fn unreachable_walk<T>(w: &AnyDescribed) -> Result<T, AppError> {
             w.description().coordinates.len()
         ),
     })
+}
+
+/// How a family's `DP` and `dP/dp` were taken: exactly, or by central differences at the points where the
+/// step map has no derivative (counted).
+fn family_route<I>(points: &[FamilyPoint<I>]) -> String {
+    let by_differences = points
+        .iter()
+        .filter(|p| p.has_derivatives() && !p.exact)
+        .count();
+    if by_differences == 0 {
+        EXACT_ROUTE.to_string()
+    } else {
+        format!(
+            "{EXACT_ROUTE}; central differences, relative step {DIFFERENCE_STEP:e}, at {by_differences} \
+             point(s) where the step map is not differentiable"
+        )
+    }
 }

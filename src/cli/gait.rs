@@ -8,6 +8,7 @@ use clap::Args;
 use vrw::app::{run_gait, run_walker_gait, GaitJob, Walker, WalkerGait, WalkerGaitJob};
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::gait::{Gait, GaitOptions, JacobianCheck};
+use vrw::mechanism::rigid_check::RigidDerivativeCheck;
 use vrw::walk::SectionState;
 
 use super::{progress_bar, ModelArgs};
@@ -42,11 +43,13 @@ pub(super) struct GaitArgs {
     /// Newton tolerance on max |P(s) - s|; at least 1e-13, about what the step map can resolve.
     #[arg(long, default_value = DEFAULT_TOLERANCE)]
     tolerance: f64,
-    /// Also compute dP/dp of the gait for this parameter (gait.json's dP_dparam): one of hub_mass,
-    /// hub_inertia, leg_mass, leg_mass_offset, stopper_length, spring_natural_length, stiffness, viscosity,
-    /// slope, gravity.
-    #[arg(long, value_name = "KEY", value_parser = parse_parameter)]
-    parameter: Option<&'static str>,
+    /// Also compute dP/dp of the gait for this parameter (gait.json's dP_dparam): for the wheel one of
+    /// hub_mass, hub_inertia, leg_mass, leg_mass_offset, stopper_length, spring_natural_length, stiffness,
+    /// viscosity, slope, gravity (and friction); for another model one of its parameters (simplest: slope;
+    /// compass: hip_mass, leg_mass, leg_length, leg_mass_offset, gravity, slope; a described walker: those of
+    /// its file).
+    #[arg(long, value_name = "KEY")]
+    parameter: Option<String>,
     /// Check the exact Jacobian against central differences with Richardson extrapolation: print both and their
     /// difference, and fail if they disagree beyond the two error estimates.
     #[arg(long)]
@@ -60,19 +63,29 @@ pub(super) struct GaitArgs {
     overwrite: bool,
 }
 
-/// A parameter `dP/dp` can be taken for ([`DIFFERENTIABLE_KEYS`]).
-fn parse_parameter(key: &str) -> Result<&'static str, String> {
-    DIFFERENTIABLE_KEYS
-        .iter()
-        .find(|k| **k == key)
-        .copied()
-        .ok_or_else(|| {
-            format!(
-                "no derivative with respect to {:?}: the parameter must be one of {}",
+/// The wheel's refusal of a parameter it has no derivative in.
+fn no_derivative(key: &str) -> String {
+    format!(
+        "no derivative with respect to {:?}: the parameter must be one of {}",
+        vrw::fmt::clip(key),
+        DIFFERENTIABLE_KEYS.join(", ")
+    )
+}
+
+/// The parameter of `--parameter` for the wheel: one of its [`DIFFERENTIABLE_KEYS`] (another model's keys are
+/// checked by its job, which knows them: a described walker's come from its file).
+fn wheel_parameter(key: Option<&str>) -> Result<Option<&'static str>> {
+    match key {
+        None => Ok(None),
+        Some(key) => match DIFFERENTIABLE_KEYS.iter().find(|k| **k == key) {
+            Some(known) => Ok(Some(known)),
+            None => bail!(
+                "invalid value '{}' for '--parameter <KEY>': {}",
                 vrw::fmt::clip(key),
-                DIFFERENTIABLE_KEYS.join(", ")
-            )
-        })
+                no_derivative(key)
+            ),
+        },
+    }
 }
 
 /// Run `vrw gait` and print its summary.
@@ -139,7 +152,7 @@ fn gait_job(args: &GaitArgs) -> Result<GaitJob> {
         options: GaitOptions {
             transient_steps: args.transient_steps,
             tolerance: args.tolerance,
-            parameter: args.parameter,
+            parameter: wheel_parameter(args.parameter.as_deref())?,
             ..GaitOptions::default()
         },
         out_dir: args.out.clone(),
@@ -292,18 +305,13 @@ fn print_check(check: &JacobianCheck) -> Result<()> {
 
 /// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json.
 fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
-    if args.parameter.is_some() || args.check_jacobian {
-        bail!(
-            "`parameter` and `check_jacobian` take the wheel's exact derivatives; the model `{}` has its DP by \
-             central differences so far (docs/model.md section 13)",
-            walker.name()
-        );
-    }
     let initial = super::walker_initial(args.initial.as_deref())?;
     let job = WalkerGaitJob {
         walker,
         initial,
         transient_steps: args.transient_steps,
+        parameter: args.parameter.clone(),
+        check_jacobian: args.check_jacobian,
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
     };
@@ -323,6 +331,9 @@ fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
         );
     };
     print_walker_gait(g);
+    if let Some(check) = &summary.jacobian_check {
+        print_walker_check(check)?;
+    }
     super::print_wrote(&args.out);
     Ok(())
 }
@@ -337,6 +348,47 @@ pub(super) fn parameters_in_words(walker: &Walker) -> Result<String> {
         .map(|(k, v)| format!("{k} = {v}"))
         .collect();
     Ok(shown.join(", "))
+}
+
+/// Print a walker's check of `--check-jacobian`; an error if the two routes disagree.
+fn print_walker_check(check: &RigidDerivativeCheck) -> Result<()> {
+    if let Some(failure) = &check.failure {
+        bail!("Jacobian check failed: {failure}");
+    }
+    let columns = match &check.parameter {
+        Some(key) => format!("DP | dP/d{key}"),
+        None => "DP".to_string(),
+    };
+    print_rows(&format!("exact {columns}"), &check.exact);
+    print_rows(
+        &format!(
+            "finite-difference {columns} (Richardson, the best of relative steps 1e-3 to 1e-5)"
+        ),
+        &check.finite_difference,
+    );
+    println!(
+        "largest difference {:.1e}; error estimates: exact {:.1e}, finite difference {:.1e}: {}",
+        check.difference,
+        check.exact_error,
+        check.finite_difference_error,
+        if check.agree { "agree" } else { "DISAGREE" }
+    );
+    if !check.agree {
+        bail!(
+            "the exact derivatives and the finite differences disagree by {:.1e}, beyond their error estimates",
+            check.difference
+        );
+    }
+    Ok(())
+}
+
+/// A matrix, one row a line, under its name.
+fn print_rows(name: &str, m: &[Vec<f64>]) {
+    println!("{name}:");
+    for row in m {
+        let row: Vec<String> = row.iter().map(|v| format!("{v:+.12e}")).collect();
+        println!("  [{}]", row.join(", "));
+    }
 }
 
 /// A walker's gait, as `vrw gait --model NAME` prints it.
@@ -375,6 +427,19 @@ fn print_walker_gait(g: &WalkerGait) {
         g.largest_multiplier,
         g.stability
     );
+    if let Some(d) = &g.dp_dparam {
+        let values: Vec<String> = d
+            .values
+            .iter()
+            .map(|(n, v)| format!("{n} {v:.9e}"))
+            .collect();
+        println!(
+            "dP/d{} = [{}] ({})",
+            d.parameter,
+            values.join(", "),
+            d.derivative
+        );
+    }
 }
 
 #[cfg(test)]

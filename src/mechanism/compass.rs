@@ -13,7 +13,8 @@ use nalgebra::{DVector, SVector};
 
 use super::assembly::{along_leg, point_mass_equations, point_mass_potential, up, PointMass};
 use super::constrained::ConstrainedError;
-use super::rigid::{HeelStrike, RigidWalker};
+use super::rigid::{HeelStrike, RigidOptions, RigidWalker, Transition};
+use super::rigid_derivative::{step_map_derivative, DerivativeError, StepMapDerivative};
 use super::turns::{self, Turns};
 use super::{Equations, Mechanism, PointKinematics, Real};
 use crate::params::{ConfigError, MASS_RATIO_LIMIT};
@@ -224,6 +225,8 @@ impl Mechanism<4> for Compass {
 }
 
 impl RigidWalker<4, 8> for Compass {
+    type Constants<T: Real> = CompassConstants<T>;
+
     fn name(&self) -> &'static str {
         "compass"
     }
@@ -232,26 +235,45 @@ impl RigidWalker<4, 8> for Compass {
         vec!["theta1", "theta1_dot", "theta2_dot"]
     }
 
-    /// Eq. (1) with Leg 1's foot held ([`super::turns::single_support`]); its normal force.
-    fn single_support(
+    fn rigid_constants<T: Real>(
         &self,
-        q: &SVector<f64, 4>,
-        qd: &SVector<f64, 4>,
-    ) -> Result<(SVector<f64, 4>, f64), ConstrainedError> {
-        turns::single_support(self, &TURNS, q, qd)
+        value: &dyn Fn(&'static str, f64) -> T,
+    ) -> CompassConstants<T> {
+        Mechanism::constants(self, value)
     }
 
-    fn swing_foot(&self, q: &SVector<f64, 4>) -> (f64, f64) {
-        turns::swing_foot(self, &TURNS, q)
+    /// Eq. (1) with Leg 1's foot held ([`super::turns::single_support`]); its normal force.
+    fn single_support_with<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Result<(SVector<T, 4>, T), ConstrainedError> {
+        turns::single_support(self, &TURNS.lit(), c, (q, qd))
+    }
+
+    fn swing_foot_with<T: Real>(&self, c: &CompassConstants<T>, q: &SVector<T, 4>) -> (T, T) {
+        turns::swing_foot(self, &TURNS.lit(), c, q)
     }
 
     fn hip_height(&self, q: &SVector<f64, 4>) -> f64 {
         q[Z]
     }
 
-    /// The impact with both feet held gives `lambda_I4` (Leg 1's normal impulse); where it is negative, the
-    /// traditional impact with Leg 2's foot held, then Leg 2 is the stance leg (the angles exchanged, the hip
-    /// moved along the slope so that the new stance foot is at `x = 0`): [`super::turns::heel_strike`].
+    /// The impact with both feet held gives `lambda_I4` (Leg 1's normal impulse); the traditional impact with
+    /// Leg 2's foot held, then Leg 2 is the stance leg (the angles exchanged, the hip moved along the slope so
+    /// that the new stance foot is at `x = 0`): [`super::turns::transition`].
+    fn transition_with<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Result<Transition<4, T>, ConstrainedError> {
+        turns::transition(self, &TURNS.lit(), c, (q, qd))
+    }
+
+    /// [`RigidWalker::transition_with`]; where `lambda_I4 < 0` the rear foot leaves (the traditional impact):
+    /// [`super::turns::heel_strike`].
     fn heel_strike(
         &self,
         q: &SVector<f64, 4>,
@@ -264,20 +286,39 @@ impl RigidWalker<4, 8> for Compass {
         self.energy(q, qd)
     }
 
-    fn section_of(&self, q: &SVector<f64, 4>, qd: &SVector<f64, 4>) -> DVector<f64> {
-        DVector::from_column_slice(&[q[THETA1], qd[THETA1], qd[THETA2]])
+    fn section_with<T: Real>(
+        &self,
+        _: &CompassConstants<T>,
+        q: &SVector<T, 4>,
+        qd: &SVector<T, 4>,
+    ) -> Vec<T> {
+        vec![q[THETA1], qd[THETA1], qd[THETA2]]
     }
 
     /// `(theta1, theta1', theta2')` just after a heel strike: Leg 1's foot at the origin, Leg 2's on the ground
     /// behind it (`theta2 = -theta1`), the hip moving about Leg 1's foot.
-    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, 4>, SVector<f64, 4>) {
+    fn state_at_section_with<T: Real>(
+        &self,
+        c: &CompassConstants<T>,
+        s: &[T],
+    ) -> (SVector<T, 4>, SVector<T, 4>) {
         let (theta, w, w2) = (s[0], s[1], s[2]);
-        let l = self.leg_length;
+        let l = c.leg_length;
         let (sn, cs) = theta.sin_cos();
         (
-            SVector::from([-l * sn, l * cs, theta, -theta]),
-            SVector::from([-l * cs * w, -l * sn * w, w, w2]),
+            SVector::from([-(l * sn), l * cs, theta, -theta]),
+            SVector::from([-(l * cs * w), -(l * sn * w), w, w2]),
         )
+    }
+
+    fn step_map_derivative(
+        &self,
+        x: &DVector<f64>,
+        param: Option<&str>,
+        period: usize,
+        options: &RigidOptions,
+    ) -> Result<StepMapDerivative<4>, DerivativeError> {
+        step_map_derivative::<Compass, 4, 8, 4, 5, 40>(self, x, param, period, options)
     }
 }
 

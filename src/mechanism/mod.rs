@@ -11,11 +11,14 @@
 //!
 //! Walkers with rigid legs and point feet walk by [`rigid`] (single support between heel strikes) and have their
 //! gaits by [`rigid_gait`]: the compass gait and the simplest walking model of Garcia et al. ([`simplest`]),
-//! whose massless legs leave it only reduced equations. Walkers with compliant legs walk by [`legged`]: the
-//! paper's whole procedure (phases chosen by force-level complementarity, every impact an impulse-level
-//! complementarity problem, the DLS indicators at a heel strike, stoppers with their Zeno rule) for any
-//! mechanism whose two legs take turns, as the compass gait with the paper's telescopic legs
-//! ([`telescopic`]) does. The wheel still walks through `walk/`; the walks are to become one on this interface
+//! whose massless legs leave it only reduced equations. Their step maps have exact derivatives
+//! ([`rigid_derivative`], checked against differences by [`rigid_check`]) from a replay of the walk's own steps
+//! that knows only phases, guards and resets ([`sensitivity`]), and their families are followed by
+//! [`rigid_family`]. Walkers with compliant legs walk by [`legged`]: the paper's whole procedure (phases chosen
+//! by force-level complementarity, every impact an impulse-level complementarity problem, the DLS indicators at
+//! a heel strike, stoppers with their Zeno rule) for any mechanism whose two legs take turns, as the compass
+//! gait with the paper's telescopic legs ([`telescopic`]) does. The wheel still walks through `walk/`; the walks
+//! are to become one on this interface
 //! (docs/model.md section 13).
 
 pub mod assembly;
@@ -24,8 +27,11 @@ pub mod constrained;
 pub mod described;
 pub mod legged;
 pub mod rigid;
+pub mod rigid_check;
+pub mod rigid_derivative;
 pub mod rigid_family;
 pub mod rigid_gait;
+pub mod sensitivity;
 pub mod simplest;
 pub mod telescopic;
 pub mod turns;
@@ -107,5 +113,7 @@ pub trait Mechanism<const N: usize> {
     }
 }
 
+#[cfg(test)]
+mod derivative_tests;
 #[cfg(test)]
 mod tests;

@@ -10,37 +10,65 @@
 //! fails where the stance foot's normal force turns negative (the walker would leave the ground) or the hip
 //! falls below the ground.
 
-use nalgebra::{DVector, SVector};
+use nalgebra::{DMatrix, DVector, SVector};
 
 use super::constrained::ConstrainedError;
-use crate::integrate::{locate_root, Dop853, IntegrationError, OdeSystem, Tolerances};
+use super::sensitivity::{NotDifferentiable, Tape};
+use super::Real;
+use crate::integrate::{locate_root, Dop853, IntegrationError, Method, OdeSystem, Tolerances};
 
 /// What a rigid-legged walker gives the walk (the assembled compass gait and the simplest walking model, whose
 /// massless legs leave it only reduced equations, implement it alike). `N` coordinates, `Y = 2 N` integrated
 /// states `(q, q')`.
+///
+/// The dynamics, the guard, the heel strike and the section's maps are written over any [`Real`] with the
+/// walker's constants as [`RigidWalker::Constants`] (as [`super::Mechanism::constants`] makes them): the walk
+/// runs them on `f64`, and its exact derivatives (`super::rigid_derivative`) on dual numbers, one of the
+/// constants carrying `d/dp`.
 pub trait RigidWalker<const N: usize, const Y: usize> {
+    /// The constants of the walker's equations, over a [`Real`].
+    type Constants<T: Real>: Copy;
+
     /// The walker's name.
     fn name(&self) -> &'static str;
 
     /// The names of the coordinates of the section ([`RigidWalker::section_of`]).
     fn section_names(&self) -> Vec<&'static str>;
 
-    /// `q''` in single support, and the stance foot's normal force (in the walker's force unit).
-    fn single_support(
+    /// The constants, each made a `T` by `value(key, value)` (the key as in a configuration file).
+    fn rigid_constants<T: Real>(
         &self,
-        q: &SVector<f64, N>,
-        qd: &SVector<f64, N>,
-    ) -> Result<(SVector<f64, N>, f64), ConstrainedError>;
+        value: &dyn Fn(&'static str, f64) -> T,
+    ) -> Self::Constants<T>;
 
-    /// The swing foot's height above the ground and its distance ahead of the stance foot along the slope.
-    fn swing_foot(&self, q: &SVector<f64, N>) -> (f64, f64);
+    /// `q''` in single support, and the stance foot's normal force (in the walker's force unit), with the
+    /// constants `c`.
+    fn single_support_with<T: Real>(
+        &self,
+        c: &Self::Constants<T>,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+    ) -> Result<(SVector<T, N>, T), ConstrainedError>;
+
+    /// The swing foot's height above the ground (the heel strike's guard) and its distance ahead of the stance
+    /// foot along the slope, with the constants `c`.
+    fn swing_foot_with<T: Real>(&self, c: &Self::Constants<T>, q: &SVector<T, N>) -> (T, T);
 
     /// The hip's height above the ground.
     fn hip_height(&self, q: &SVector<f64, N>) -> f64;
 
-    /// The heel strike at `(q, q'-)`: the impact with both feet held (the paper's (A1)) and its `lambda_I4`, the
-    /// rear foot's normal impulse; where it is negative, the traditional impact (the new foot held, the rear
-    /// one released) and the legs' exchange of roles.
+    /// The heel strike at `(q, q'-)` with the constants `c`: `lambda_I4`, the rear foot's normal impulse with
+    /// both feet held (the paper's (A1)), and the traditional impact (the new foot held, the rear one released)
+    /// followed by the legs' exchange of roles, whatever the sign of `lambda_I4`.
+    fn transition_with<T: Real>(
+        &self,
+        c: &Self::Constants<T>,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+    ) -> Result<Transition<N, T>, ConstrainedError>;
+
+    /// The heel strike at `(q, q'-)` ([`RigidWalker::transition_with`] on `f64`), the walker stopping in double
+    /// support where `lambda_I4 >= 0`, and the energy it takes.
     fn heel_strike(
         &self,
         q: &SVector<f64, N>,
@@ -51,11 +79,72 @@ pub trait RigidWalker<const N: usize, const Y: usize> {
     fn mechanical_energy(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64;
 
     /// The free coordinates of a state just after a heel strike (the section; the others follow from the
-    /// stance foot on the ground and both feet on it).
-    fn section_of(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> DVector<f64>;
+    /// stance foot on the ground and both feet on it), with the constants `c`.
+    fn section_with<T: Real>(
+        &self,
+        c: &Self::Constants<T>,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+    ) -> Vec<T>;
 
-    /// The state just after a heel strike with the free coordinates `s`.
-    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, N>, SVector<f64, N>);
+    /// The state just after a heel strike with the free coordinates `s`, with the constants `c`.
+    fn state_at_section_with<T: Real>(
+        &self,
+        c: &Self::Constants<T>,
+        s: &[T],
+    ) -> (SVector<T, N>, SVector<T, N>);
+
+    /// `P^period(x)` with its exact `DP` (and `dP/dp` in the parameter `param`, one of the walker's keys):
+    /// [`super::rigid_derivative::step_map_derivative`] with the sizes of this walker's dual numbers (a const
+    /// generic cannot be computed from `N` on stable Rust, so each walker names them).
+    fn step_map_derivative(
+        &self,
+        x: &DVector<f64>,
+        param: Option<&str>,
+        period: usize,
+        options: &RigidOptions,
+    ) -> Result<StepMapDerivative<N>, DerivativeError>;
+
+    /// The constants as `f64`.
+    fn rigid_constants_f64(&self) -> Self::Constants<f64> {
+        self.rigid_constants(&|_, v| v)
+    }
+
+    /// `q''` in single support and the stance foot's normal force ([`RigidWalker::single_support_with`]).
+    fn single_support(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Result<(SVector<f64, N>, f64), ConstrainedError> {
+        self.single_support_with(&self.rigid_constants_f64(), q, qd)
+    }
+
+    /// The swing foot's height and its distance ahead ([`RigidWalker::swing_foot_with`]).
+    fn swing_foot(&self, q: &SVector<f64, N>) -> (f64, f64) {
+        self.swing_foot_with(&self.rigid_constants_f64(), q)
+    }
+
+    /// The section's coordinates of a state just after a heel strike ([`RigidWalker::section_with`]).
+    fn section_of(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> DVector<f64> {
+        DVector::from_vec(self.section_with(&self.rigid_constants_f64(), q, qd))
+    }
+
+    /// The state just after a heel strike with the section's coordinates `s`
+    /// ([`RigidWalker::state_at_section_with`]).
+    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, N>, SVector<f64, N>) {
+        self.state_at_section_with(&self.rigid_constants_f64(), s.as_slice())
+    }
+}
+
+/// The heel strike's transition over a [`Real`] ([`RigidWalker::transition_with`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transition<const N: usize, T: Real = f64> {
+    /// `lambda_I4`: the rear foot's normal impulse with both feet held (DLS indicator 1).
+    pub lambda_i4: T,
+    /// Coordinates after the legs exchange roles.
+    pub q: SVector<T, N>,
+    /// Velocities after the traditional impact, in the new roles.
+    pub qd: SVector<T, N>,
 }
 
 /// A heel strike's outcome.
@@ -84,6 +173,9 @@ pub struct RigidOptions {
     /// Asked every [`STOP_CHECK_STEPS`] integrator steps whether to stop (the caller's interrupt: Ctrl-C);
     /// `None`: never.
     pub stop: Option<fn() -> bool>,
+    /// Where the step map has no exact derivative (a grazing heel strike, `lambda_I4` at 0), take `DP` and
+    /// `dP/dp` by central differences and say so (`true`), or fail (`false`, the default).
+    pub difference_fallback: bool,
 }
 
 /// Integrator steps between two questions of [`RigidOptions::stop`].
@@ -106,6 +198,7 @@ impl Default for RigidOptions {
             max_step_time: 20.0,
             event_time_tol: 1e-14,
             stop: None,
+            difference_fallback: false,
         }
     }
 }
@@ -201,7 +294,7 @@ impl<W: RigidWalker<N, Y>, const N: usize, const Y: usize> OdeSystem<Y>
 }
 
 /// `(q, q')` as one state.
-fn pack<const N: usize, const Y: usize>(
+pub(crate) fn pack<const N: usize, const Y: usize>(
     q: &SVector<f64, N>,
     qd: &SVector<f64, N>,
 ) -> SVector<f64, Y> {
@@ -213,7 +306,7 @@ fn pack<const N: usize, const Y: usize>(
 }
 
 /// `(q, q')` of a state.
-fn unpack<const N: usize, const Y: usize>(
+pub(crate) fn unpack<const N: usize, const Y: usize>(
     y: &SVector<f64, Y>,
 ) -> (SVector<f64, N>, SVector<f64, N>) {
     (
@@ -223,18 +316,17 @@ fn unpack<const N: usize, const Y: usize>(
 }
 
 /// The heel-strike event function: the swing foot's height where it is ahead of the stance foot (by more than
-/// [`MIN_STRIDE`] of the hip's height), else a positive constant (no event behind the stance foot or beside it).
+/// [`MIN_STRIDE`] of the hip's height), `None` where it is not (behind the stance foot or beside it). A heel
+/// strike is a crossing of zero from above between two samples that are both ahead: a foot that comes ahead
+/// while under the ground (passing the stance foot from above, the legs' coincidence) is scuffing, not
+/// striking (as `super::legged`'s `Event::Strike` does).
 fn strike_height<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
     y: &SVector<f64, Y>,
-) -> f64 {
+) -> Option<f64> {
     let (q, _) = unpack::<N, Y>(y);
     let (height, ahead) = walker.swing_foot(&q);
-    if ahead > MIN_STRIDE * walker.hip_height(&q).abs() {
-        height
-    } else {
-        1.0
-    }
+    (ahead > MIN_STRIDE * walker.hip_height(&q).abs()).then_some(height)
 }
 
 /// One step of `walker` from `(q, q')` just after a heel strike (see the module documentation).
@@ -244,10 +336,48 @@ pub fn rigid_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     qd: &SVector<f64, N>,
     options: &RigidOptions,
 ) -> Result<RigidStep<N>, RigidError> {
+    walk_step(walker, (q, qd), options, None)
+}
+
+/// The single support of a rigid walker: its one phase (the stance foot held).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SingleSupportPhase;
+
+/// The heel strike: the event that ends a rigid walker's step (the swing foot's height reaching 0 ahead).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HeelStrikeEvent;
+
+/// The record of a rigid walker's step ([`rigid_step_taped`]): its accepted integrator steps and its heel
+/// strike.
+pub type RigidTape<const Y: usize> = Tape<SingleSupportPhase, HeelStrikeEvent, Y>;
+
+/// [`rigid_step`], recording on `tape` what its exact derivatives replay (`super::rigid_derivative`): the
+/// start, every accepted integrator step and the heel strike (its time and the state then, before the
+/// impact).
+pub fn rigid_step_taped<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    options: &RigidOptions,
+    tape: &mut RigidTape<Y>,
+) -> Result<RigidStep<N>, RigidError> {
+    walk_step(walker, (q, qd), options, Some(tape))
+}
+
+/// The step of [`rigid_step`], recorded on `tape` if given.
+fn walk_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    options: &RigidOptions,
+    mut tape: Option<&mut RigidTape<Y>>,
+) -> Result<RigidStep<N>, RigidError> {
     let system = SingleSupport::<W, N>(walker);
     let y0 = pack::<N, Y>(q, qd);
     let e0 = walker.mechanical_energy(q, qd);
     let mut integrator = Dop853::new(&system, 0.0, y0, options.tolerances);
+    if let Some(tape) = tape.as_deref_mut() {
+        *tape = Tape::new(Method::Dop853);
+        tape.begin(SingleSupportPhase, 0.0, y0);
+    }
     let (mut scuffs, mut energy_drift) = (0, 0.0f64);
     let mut below = walker.swing_foot(q).0 < 0.0;
     let mut taken = 0usize;
@@ -258,23 +388,35 @@ pub fn rigid_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         }
         let step = integrator.step(&system, options.max_step_time)?;
         let (t0, t1) = (step.t0(), step.t1());
+        if let Some(tape) = tape.as_deref_mut() {
+            tape.step(step.h(), t1);
+        }
         let (g0, g1) = (
             strike_height(walker, step.y0()),
             strike_height(walker, step.y1()),
         );
         let (q1, qd1) = unpack::<N, Y>(step.y1());
         energy_drift = energy_drift.max((walker.mechanical_energy(&q1, &qd1) - e0).abs());
-        if g0 > 0.0 && g1 <= 0.0 {
+        // A heel strike: the height crossing zero from above, the foot ahead at both ends of the step.
+        let strike = match (g0, g1) {
+            (Some(g0), Some(g1)) if g0 > 0.0 && g1 <= 0.0 => Some((g0, g1)),
+            _ => None,
+        };
+        if let Some((g0, g1)) = strike {
             let t = locate_root(
                 &step,
-                |_, y| strike_height(walker, y),
+                |_, y| walker.swing_foot(&unpack::<N, Y>(y).0).0,
                 t0,
                 g0,
                 t1,
                 g1,
                 options.event_time_tol,
             );
-            let (q_minus, qd_minus) = unpack::<N, Y>(&step.eval(t));
+            let y_minus = step.eval(t);
+            if let Some(tape) = tape.as_deref_mut() {
+                tape.end(t, HeelStrikeEvent, y_minus);
+            }
+            let (q_minus, qd_minus) = unpack::<N, Y>(&y_minus);
             return finish_step(walker, (&q_minus, &qd_minus), t, (scuffs, energy_drift));
         }
         // A crossing of the ground that is no heel strike: the swing foot comes up through it (scuffing).
@@ -329,4 +471,34 @@ fn finish_step<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         energy_drift,
         scuffs,
     })
+}
+
+/// `P^k(x)` with its exact derivatives ([`RigidWalker::step_map_derivative`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepMapDerivative<const N: usize> {
+    /// `P^k(x)`.
+    pub value: DVector<f64>,
+    /// `DP^k` at `x`.
+    pub jacobian: DMatrix<f64>,
+    /// `dP^k/dp` in the parameter asked for.
+    pub dparam: Option<DVector<f64>>,
+    /// The first step (its duration, DLS indicator, audit).
+    pub step: RigidStep<N>,
+}
+
+/// Why a step map has no exact derivative here.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DerivativeError {
+    /// The walk failed.
+    #[error(transparent)]
+    Walk(#[from] RigidError),
+    /// The walk went, but the map has no derivative there (or the replay could not give it).
+    #[error(transparent)]
+    NotDifferentiable(#[from] NotDifferentiable),
+    /// The parameter asked for is not one of the walker's constants.
+    #[error("`{key}` is not a parameter of this walker")]
+    UnknownParameter {
+        /// The key asked for.
+        key: String,
+    },
 }

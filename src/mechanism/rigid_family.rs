@@ -3,13 +3,17 @@
 //! located by the engine's test functions, and its DLS indicator `lambda_I4` as the border where the heel
 //! strike would stop the walker in double support (docs/model.md section 13).
 //!
-//! `DP` and `dP/dp` are central differences ([`DIFFERENCE_STEP`]), marked as not exact.
+//! `DP` and `dP/dp` are exact ([`super::rigid_derivative`]: the variational equations over the walk's steps, in
+//! the parameter through the constants as dual numbers). Where the map has no derivative (a grazing heel
+//! strike, `lambda_I4` at 0) a point fails (`not_differentiable`), or, where the options ask for it
+//! ([`RigidOptions::difference_fallback`]), takes central differences ([`DIFFERENCE_STEP`]) marked as not exact.
 
 use std::marker::PhantomData;
 
 use nalgebra::DVector;
 
-use super::rigid::{rigid_step, RigidOptions, RigidWalker};
+use super::rigid::{rigid_step, RigidError, RigidOptions, RigidWalker};
+use super::rigid_derivative::DerivativeError;
 use super::rigid_gait::{central_jacobian, DIFFERENCE_STEP};
 use crate::continuation::{Evaluation, FamilyMap, MapFailure};
 use crate::params::ConfigError;
@@ -88,6 +92,28 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
             })
     }
 
+    /// `P^k(x)` with `DP` and `dP/dp` by central differences ([`DIFFERENCE_STEP`]), not exact.
+    fn differences(
+        &self,
+        walker: &W,
+        x: &DVector<f64>,
+        p: f64,
+    ) -> Result<Evaluation<RigidInfo>, MapFailure> {
+        let (value, info) = self.walked(walker, x)?;
+        let jacobian = central_jacobian(x, |x| Ok(self.walked(walker, x)?.0))?;
+        let h = DIFFERENCE_STEP * p.abs().max(1.0);
+        let at =
+            |p: f64| -> Result<DVector<f64>, MapFailure> { Ok(self.walked(&self.at(p)?, x)?.0) };
+        let dparam = (at(p + h)? - at(p - h)?) / (2.0 * h);
+        Ok(Evaluation {
+            value,
+            jacobian,
+            dparam,
+            exact: false,
+            info,
+        })
+    }
+
     /// `P^k(x)` of `walker` and the first step's record.
     fn walked(
         &self,
@@ -97,10 +123,7 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
         let (mut q, mut qd) = walker.state_at_section(x);
         let mut info = None;
         for _ in 0..self.period {
-            let step = rigid_step(walker, &q, &qd, &self.options).map_err(|e| MapFailure {
-                kind: e.kind().to_string(),
-                message: e.to_string(),
-            })?;
+            let step = rigid_step(walker, &q, &qd, &self.options).map_err(failure)?;
             info.get_or_insert(RigidInfo {
                 period: step.period,
                 lambda_i4: step.lambda_i4,
@@ -112,6 +135,14 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
             lambda_i4: f64::NAN,
         });
         Ok((walker.section_of(&q, &qd), info))
+    }
+}
+
+/// A failed walk as the continuation engine reports it.
+fn failure(e: RigidError) -> MapFailure {
+    MapFailure {
+        kind: e.kind().to_string(),
+        message: e.to_string(),
     }
 }
 
@@ -127,17 +158,30 @@ where
 
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<RigidInfo>, MapFailure> {
         let walker = self.at(p)?;
-        let (value, info) = self.walked(&walker, x)?;
-        let jacobian = central_jacobian(x, |x| Ok(self.walked(&walker, x)?.0))?;
-        let h = DIFFERENCE_STEP * p.abs().max(1.0);
-        let dparam = (self.value(x, p + h)? - self.value(x, p - h)?) / (2.0 * h);
-        Ok(Evaluation {
-            value,
-            jacobian,
-            dparam,
-            exact: false,
-            info,
-        })
+        match walker.step_map_derivative(x, Some(self.key), self.period, &self.options) {
+            Ok(d) => Ok(Evaluation {
+                value: d.value,
+                jacobian: d.jacobian,
+                dparam: d.dparam.expect("the parameter was asked for"),
+                exact: true,
+                info: RigidInfo {
+                    period: d.step.period,
+                    lambda_i4: d.step.lambda_i4,
+                },
+            }),
+            Err(DerivativeError::Walk(e)) => Err(failure(e)),
+            Err(DerivativeError::NotDifferentiable(_)) if self.options.difference_fallback => {
+                self.differences(&walker, x, p)
+            }
+            Err(e) => Err(MapFailure {
+                kind: match e {
+                    DerivativeError::UnknownParameter { .. } => "unknown_parameter",
+                    _ => "not_differentiable",
+                }
+                .to_string(),
+                message: e.to_string(),
+            }),
+        }
     }
 
     fn value(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {

@@ -1,13 +1,18 @@
 //! Gaits of a rigid-legged walker (docs/model.md section 13): fixed points of its step map `P` on the section
 //! ([`RigidWalker::section_of`]) by Newton's method, and their Floquet multipliers, the eigenvalues of `DP`.
 //!
-//! `DP` is taken by central differences here (relative step [`DIFFERENCE_STEP`], with the integrator at
-//! `rtol = 1e-12`), the route the papers of these walkers used; the exact derivatives of the wheel
-//! (docs/model.md section 10) come to these walkers when the walk moves onto the interface.
+//! `DP` is exact ([`super::rigid_derivative`]: the variational equations over the walk's own integrator steps,
+//! the heel strike's saltation). Where the map has no derivative (a grazing heel strike, `lambda_I4` at 0)
+//! Newton's method takes central differences instead (relative step [`DIFFERENCE_STEP`]: a Newton matrix need
+//! not be exact), and the gait's multipliers do so only where the caller asks
+//! ([`RigidOptions::difference_fallback`]), saying so ([`JacobianRoute`]). The central differences also check
+//! the exact `DP` ([`super::rigid_check::check_rigid_derivatives`], `vrw gait --model NAME --check-jacobian`).
 
 use nalgebra::{DMatrix, DVector};
 
 use super::rigid::{rigid_step, RigidError, RigidOptions, RigidStep, RigidWalker};
+use super::rigid_derivative::DerivativeError;
+use super::sensitivity::NotDifferentiable;
 
 /// Relative step of the central differences of `DP`.
 pub const DIFFERENCE_STEP: f64 = 1e-6;
@@ -27,8 +32,10 @@ pub struct RigidGait<const N: usize> {
     pub residual: f64,
     /// Newton iterations taken.
     pub iterations: usize,
-    /// `DP` at the fixed point (central differences).
+    /// `DP` at the fixed point.
     pub jacobian: DMatrix<f64>,
+    /// How `DP` was taken.
+    pub derivative: JacobianRoute,
     /// The Floquet multipliers `[re, im]`, largest modulus first.
     pub multipliers: Vec<[f64; 2]>,
     /// The step from the fixed point (its period, DLS indicator, impact loss, energy audit).
@@ -44,6 +51,35 @@ impl<const N: usize> RigidGait<N> {
     }
 }
 
+/// How a gait's `DP` was taken.
+#[derive(Debug, Clone, PartialEq)]
+pub enum JacobianRoute {
+    /// Exactly (the variational equations and the heel strike's saltation).
+    Exact,
+    /// By central differences of relative step [`DIFFERENCE_STEP`], because the map is not differentiable at the
+    /// gait (the caller asked for this fallback, [`RigidOptions::difference_fallback`]).
+    CentralDifferences {
+        /// Why not exactly.
+        reason: NotDifferentiable,
+    },
+}
+
+impl std::fmt::Display for JacobianRoute {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            JacobianRoute::Exact => f.write_str(EXACT_ROUTE),
+            JacobianRoute::CentralDifferences { reason } => write!(
+                f,
+                "central differences, relative step {DIFFERENCE_STEP:e} (no exact derivative: {reason})"
+            ),
+        }
+    }
+}
+
+/// How an exact `DP` is taken, in words (`gait.json`'s `derivative`).
+pub const EXACT_ROUTE: &str =
+    "exact: variational equations over the walk's steps, saltation at the heel strike";
+
 /// Why no gait was found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RigidGaitError {
@@ -54,6 +90,12 @@ pub enum RigidGaitError {
         iteration: usize,
         /// Why.
         source: RigidError,
+    },
+    /// The map is not differentiable at the gait, and no fallback to differences was asked for.
+    #[error("no exact DP at the gait: {source}")]
+    NotDifferentiable {
+        /// Why.
+        source: NotDifferentiable,
     },
     /// `DP - I` is singular.
     #[error("DP - I is singular (a multiplier at 1), residual {residual:e}")]
@@ -82,13 +124,59 @@ pub fn rigid_step_map<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     Ok((walker.section_of(&step.q, &step.qd), step))
 }
 
-/// `DP` at `s` by central differences.
+/// The exact `DP` at `s` ([`RigidWalker::step_map_derivative`]).
 pub fn rigid_jacobian<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    s: &DVector<f64>,
+    options: &RigidOptions,
+) -> Result<DMatrix<f64>, DerivativeError> {
+    Ok(walker.step_map_derivative(s, None, 1, options)?.jacobian)
+}
+
+/// `DP` at `s` by central differences ([`central_jacobian`]).
+pub fn difference_jacobian<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
     s: &DVector<f64>,
     options: &RigidOptions,
 ) -> Result<DMatrix<f64>, RigidError> {
     central_jacobian(s, |x| Ok(rigid_step_map(walker, x, options)?.0))
+}
+
+/// Newton's matrix `DP` at `s`: exact, or central differences where the map has no derivative.
+fn newton_jacobian<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    s: &DVector<f64>,
+    options: &RigidOptions,
+) -> Result<DMatrix<f64>, RigidError> {
+    match rigid_jacobian(walker, s, options) {
+        Ok(jacobian) => Ok(jacobian),
+        Err(DerivativeError::Walk(e)) => Err(e),
+        // Not differentiable here (no parameter was asked for, so no other reason).
+        Err(_) => difference_jacobian(walker, s, options),
+    }
+}
+
+/// The gait's `DP` at `s` and how it was taken: exact, or (where the map has no derivative and `options` ask
+/// for it) central differences.
+fn gait_jacobian<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    s: &DVector<f64>,
+    options: &RigidOptions,
+    iteration: usize,
+) -> Result<(DMatrix<f64>, JacobianRoute), RigidGaitError> {
+    let step = |source| RigidGaitError::Step { iteration, source };
+    match rigid_jacobian(walker, s, options) {
+        Ok(jacobian) => Ok((jacobian, JacobianRoute::Exact)),
+        Err(DerivativeError::Walk(e)) => Err(step(e)),
+        Err(DerivativeError::NotDifferentiable(reason)) if options.difference_fallback => Ok((
+            difference_jacobian(walker, s, options).map_err(step)?,
+            JacobianRoute::CentralDifferences { reason },
+        )),
+        Err(DerivativeError::NotDifferentiable(source)) => {
+            Err(RigidGaitError::NotDifferentiable { source })
+        }
+        Err(DerivativeError::UnknownParameter { .. }) => unreachable!("no parameter asked for"),
+    }
 }
 
 /// The Jacobian of `f` at `x` by central differences, each coordinate stepped by [`DIFFERENCE_STEP`] times its
@@ -126,18 +214,18 @@ pub fn rigid_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
         let r = &image - &s;
         let residual = r.amax();
         if residual < NEWTON_TOL {
-            let jacobian = rigid_jacobian(walker, &s, options)
-                .map_err(|source| RigidGaitError::Step { iteration, source })?;
+            let (jacobian, derivative) = gait_jacobian(walker, &s, options, iteration)?;
             return Ok(RigidGait {
                 multipliers: multipliers(&jacobian),
                 section: s,
                 residual,
                 iterations: iteration - 1,
                 jacobian,
+                derivative,
                 step,
             });
         }
-        let jacobian = rigid_jacobian(walker, &s, options)
+        let jacobian = newton_jacobian(walker, &s, options)
             .map_err(|source| RigidGaitError::Step { iteration, source })?;
         let n = s.len();
         let delta = (jacobian - DMatrix::identity(n, n))
@@ -165,7 +253,7 @@ pub fn rigid_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
 }
 
 /// The eigenvalues of `jacobian` as `[re, im]`, largest modulus first.
-fn multipliers(jacobian: &DMatrix<f64>) -> Vec<[f64; 2]> {
+pub fn multipliers(jacobian: &DMatrix<f64>) -> Vec<[f64; 2]> {
     let mut m: Vec<[f64; 2]> = jacobian
         .complex_eigenvalues()
         .iter()

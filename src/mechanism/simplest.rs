@@ -28,7 +28,9 @@
 use nalgebra::{DVector, SVector};
 
 use super::constrained::ConstrainedError;
-use super::rigid::{HeelStrike, RigidWalker};
+use super::rigid::{HeelStrike, RigidOptions, RigidWalker, Transition};
+use super::rigid_derivative::{step_map_derivative, DerivativeError, StepMapDerivative};
+use super::Real;
 use crate::params::ConfigError;
 
 /// Index of `theta`, the stance leg's angle, in `q`.
@@ -72,7 +74,16 @@ impl Simplest {
     }
 }
 
+/// The simplest walker's one constant over a [`Real`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimplestConstants<T: Real> {
+    /// The slope `gamma` \[rad\].
+    pub slope: T,
+}
+
 impl RigidWalker<2, 4> for Simplest {
+    type Constants<T: Real> = SimplestConstants<T>;
+
     fn name(&self) -> &'static str {
         "simplest"
     }
@@ -81,22 +92,32 @@ impl RigidWalker<2, 4> for Simplest {
         vec!["theta", "theta_dot"]
     }
 
+    fn rigid_constants<T: Real>(
+        &self,
+        value: &dyn Fn(&'static str, f64) -> T,
+    ) -> SimplestConstants<T> {
+        SimplestConstants {
+            slope: value("slope", self.slope),
+        }
+    }
+
     /// The paper's Eqs. (2)-(3), and the stance leg's push along itself projected on the slope normal:
     /// `(cos(theta - gamma) - theta'^2) cos(theta)`.
-    fn single_support(
+    fn single_support_with<T: Real>(
         &self,
-        q: &SVector<f64, 2>,
-        qd: &SVector<f64, 2>,
-    ) -> Result<(SVector<f64, 2>, f64), ConstrainedError> {
+        c: &SimplestConstants<T>,
+        q: &SVector<T, 2>,
+        qd: &SVector<T, 2>,
+    ) -> Result<(SVector<T, 2>, T), ConstrainedError> {
         let (theta, phi, w) = (q[STANCE_ANGLE], q[INTER_LEG_ANGLE], qd[STANCE_ANGLE]);
-        let (s, c) = (theta - self.slope).sin_cos();
+        let (s, cs) = (theta - c.slope).sin_cos();
         let theta_dd = s;
-        let phi_dd = theta_dd + w * w * phi.sin() - c * phi.sin();
-        let push = (c - w * w) * theta.cos();
+        let phi_dd = theta_dd + w * w * phi.sin() - cs * phi.sin();
+        let push = (cs - w * w) * theta.cos();
         Ok((SVector::from([theta_dd, phi_dd]), push))
     }
 
-    fn swing_foot(&self, q: &SVector<f64, 2>) -> (f64, f64) {
+    fn swing_foot_with<T: Real>(&self, _: &SimplestConstants<T>, q: &SVector<T, 2>) -> (T, T) {
         let (theta, phi) = (q[STANCE_ANGLE], q[INTER_LEG_ANGLE]);
         let height = theta.cos() - (theta - phi).cos();
         let ahead = -theta.sin() + (theta - phi).sin();
@@ -107,21 +128,34 @@ impl RigidWalker<2, 4> for Simplest {
         q[STANCE_ANGLE].cos()
     }
 
+    /// The paper's Eq. (4) and the DLS indicator of the module documentation.
+    fn transition_with<T: Real>(
+        &self,
+        _: &SimplestConstants<T>,
+        q: &SVector<T, 2>,
+        qd: &SVector<T, 2>,
+    ) -> Result<Transition<2, T>, ConstrainedError> {
+        let (theta, w) = (q[STANCE_ANGLE], qd[STANCE_ANGLE]);
+        let two = T::lit(2.0);
+        let (s2, c2) = (two * theta).sin_cos();
+        Ok(Transition {
+            lambda_i4: -w * c2 / s2 * theta.cos(),
+            q: SVector::from([-theta, -(two * theta)]),
+            qd: SVector::from([c2 * w, c2 * (T::one() - c2) * w]),
+        })
+    }
+
     fn heel_strike(
         &self,
         q: &SVector<f64, 2>,
         qd: &SVector<f64, 2>,
     ) -> Result<HeelStrike<2>, ConstrainedError> {
-        let (theta, w) = (q[STANCE_ANGLE], qd[STANCE_ANGLE]);
-        let (s2, c2) = (2.0 * theta).sin_cos();
-        let lambda_i4 = -w * c2 / s2 * theta.cos();
-        let after = SVector::from([-theta, -2.0 * theta]);
-        let qd_plus = SVector::from([c2 * w, c2 * (1.0 - c2) * w]);
-        let loss = self.mechanical_energy(q, qd) - self.mechanical_energy(q, &qd_plus);
+        let t = self.transition_with(&self.rigid_constants_f64(), q, qd)?;
+        let loss = self.mechanical_energy(q, qd) - self.mechanical_energy(q, &t.qd);
         Ok(HeelStrike {
-            lambda_i4,
-            q: after,
-            qd: (lambda_i4 < 0.0).then_some(qd_plus),
+            lambda_i4: t.lambda_i4,
+            q: t.q,
+            qd: (t.lambda_i4 < 0.0).then_some(t.qd),
             loss,
         })
     }
@@ -132,17 +166,37 @@ impl RigidWalker<2, 4> for Simplest {
         0.5 * qd[STANCE_ANGLE] * qd[STANCE_ANGLE] + (q[STANCE_ANGLE] - self.slope).cos()
     }
 
-    fn section_of(&self, q: &SVector<f64, 2>, qd: &SVector<f64, 2>) -> DVector<f64> {
-        DVector::from_column_slice(&[q[STANCE_ANGLE], qd[STANCE_ANGLE]])
+    fn section_with<T: Real>(
+        &self,
+        _: &SimplestConstants<T>,
+        q: &SVector<T, 2>,
+        qd: &SVector<T, 2>,
+    ) -> Vec<T> {
+        vec![q[STANCE_ANGLE], qd[STANCE_ANGLE]]
     }
 
     /// `(theta, theta')` just after a heel strike: `phi = 2 theta`, `phi' = (1 - cos(2 theta)) theta'`.
-    fn state_at_section(&self, s: &DVector<f64>) -> (SVector<f64, 2>, SVector<f64, 2>) {
+    fn state_at_section_with<T: Real>(
+        &self,
+        _: &SimplestConstants<T>,
+        s: &[T],
+    ) -> (SVector<T, 2>, SVector<T, 2>) {
         let (theta, w) = (s[0], s[1]);
+        let two = T::lit(2.0);
         (
-            SVector::from([theta, 2.0 * theta]),
-            SVector::from([w, (1.0 - (2.0 * theta).cos()) * w]),
+            SVector::from([theta, two * theta]),
+            SVector::from([w, (T::one() - (two * theta).cos()) * w]),
         )
+    }
+
+    fn step_map_derivative(
+        &self,
+        x: &DVector<f64>,
+        param: Option<&str>,
+        period: usize,
+        options: &RigidOptions,
+    ) -> Result<StepMapDerivative<2>, DerivativeError> {
+        step_map_derivative::<Simplest, 2, 4, 3, 4, 16>(self, x, param, period, options)
     }
 }
 

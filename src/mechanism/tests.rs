@@ -369,8 +369,8 @@ fn the_compass_gait_walks_down_three_degrees() {
 }
 
 /// The continuation engine follows the simplest walker's gaits in the slope and locates their period doubling
-/// by its test function `det(DP + I)`: the same slope as the bisection on the largest multiplier (a second
-/// route, to 1e-7).
+/// by its test function `det(DP + I)` with the exact `DP`: the same slope as the bisection on the largest
+/// multiplier (a second route) to 1e-9.
 #[test]
 fn continuation_locates_the_simplest_walkers_period_doubling() {
     use super::rigid_family::RigidFamily;
@@ -386,16 +386,43 @@ fn continuation_locates_the_simplest_walkers_period_doubling() {
         .filter(|s| s.kind == SpecialKind::PeriodDoubling && s.located)
         .map(|s| s.param)
         .collect();
+    let at = |slope: f64| Simplest { slope };
+    let mut start = gait_of(&at(0.0150), &[0.2367, -0.2315]).section;
+    let bisected = bisect_doubling(&at, (0.0150, 0.0155), &mut start);
     println!(
-        "period doublings at {doublings:?}; ends {:?}",
+        "period doublings at {doublings:?}, by bisection at {bisected:.12}; ends {:?}",
         followed.ends
     );
     assert_eq!(doublings.len(), 1, "{doublings:?}");
     assert!(
-        (doublings[0] - 0.015088437).abs() < 1e-7,
+        (doublings[0] - bisected).abs() < 1e-9,
+        "{doublings:?} vs {bisected}"
+    );
+    assert!(
+        (doublings[0] - 0.015088438).abs() < 1e-9,
         "{}",
         doublings[0]
     );
+}
+
+/// Where the largest multiplier of `walker(value)`'s gait crosses the unit circle in `[lo, hi]`, by bisection
+/// to 1e-11 (each gait continued from the last, from `start`).
+fn bisect_doubling<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &impl Fn(f64) -> W,
+    (mut lo, mut hi): (f64, f64),
+    start: &mut DVector<f64>,
+) -> f64 {
+    assert!(past_unit_circle(&walker(lo), start) < 0.0);
+    assert!(past_unit_circle(&walker(hi), &mut start.clone()) > 0.0);
+    while hi - lo > 1e-11 {
+        let mid = 0.5 * (lo + hi);
+        if past_unit_circle(&walker(mid), start) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
 
 /// The compass gait's parameters for continuation are those of its configuration.
@@ -418,9 +445,9 @@ fn the_compass_parameters_are_its_configuration_keys() {
 }
 
 /// The compass gait's first period doubling in the slope, detected by the continuation engine (a sign change of
-/// `det(DP + I)`) and located by bisection on the largest multiplier: the two agree to 1e-7 rad. The engine's
-/// own location (Newton's method on the extended system) does not converge with `DP` by central differences
-/// here, and says so (`located: false`, with the reason).
+/// `det(DP + I)`) and located by its Newton's method on the extended system with the exact `DP` (with `DP` by
+/// central differences it did not converge here, and said so: `located: false`), equals the bisection on the
+/// largest multiplier to 1e-9 rad.
 #[test]
 fn continuation_locates_the_compass_gaits_period_doubling() {
     use super::rigid_family::RigidFamily;
@@ -430,31 +457,50 @@ fn continuation_locates_the_compass_gaits_period_doubling() {
     let family: RigidFamily<Compass, 4, 8> = RigidFamily::new(&compass, "slope").unwrap();
     let options = ContinuationOptions::for_range(0.04, 0.08);
     let followed = continue_family(&family, &gait.section, compass.slope, &options).unwrap();
-    let doublings: Vec<f64> = followed
+    let doublings: Vec<(f64, bool)> = followed
         .special
         .iter()
         .filter(|s| s.kind == SpecialKind::PeriodDoubling)
-        .map(|s| s.param)
+        .map(|s| (s.param, s.located))
         .collect();
     let at = |slope: f64| Compass { slope, ..compass };
-    let (mut lo, mut hi) = (4.25f64.to_radians(), 4.5f64.to_radians());
     let mut start = gait.section.clone();
     for deg in [3.5, 4.0, 4.25] {
         start = rigid_gait(&at(f64::to_radians(deg)), &start, &RigidOptions::default())
             .unwrap()
             .section;
     }
-    while hi - lo > 1e-10 {
-        let mid = 0.5 * (lo + hi);
-        if past_unit_circle(&at(mid), &mut start) < 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    println!("compass gait: period doubling at {doublings:?}, by bisection at {lo:.10} rad");
+    let range = (4.25f64.to_radians(), 4.5f64.to_radians());
+    let bisected = bisect_doubling(&at, range, &mut start);
+    println!("compass gait: period doubling at {doublings:?}, by bisection at {bisected:.12} rad");
+    assert_eq!(doublings.len(), 1, "{doublings:?}");
+    let (value, located) = doublings[0];
+    assert!(located, "{:?}", followed.special);
+    assert!((value - bisected).abs() < 1e-9, "{value} vs {bisected}");
+    assert!((value - 0.076635632).abs() < 1e-9, "{value}");
+}
+
+/// Regression: the swing foot passing the stance foot from above while under the ground (the legs' coincidence
+/// near mid-swing) is scuffing, not a heel strike. The event function once switched there from a positive
+/// placeholder to the foot's (negative) height, and the simplest walker had a spurious period-1 "gait" at slope
+/// 0.014 (a step of 1.6905 time units from `(0.186197702, -0.260652416)`); from that state the walk now goes on
+/// past the coincidence (and the stance foot lifts off), and the paper's long step (3.9 time units) is kept.
+#[test]
+fn a_swing_foot_passing_the_stance_foot_under_the_ground_is_no_heel_strike() {
+    let walker = Simplest { slope: 0.014 };
+    let options = RigidOptions::default();
+    let spurious = DVector::from_column_slice(&[0.186197702, -0.260652416]);
+    let (q, qd) = walker.state_at_section(&spurious);
+    let step = super::rigid::rigid_step(&walker, &q, &qd, &options);
     assert!(
-        !doublings.is_empty() && (doublings[0] - lo).abs() < 1e-7,
-        "{doublings:?} vs {lo}"
+        !matches!(&step, Ok(s) if s.period < 3.0),
+        "a heel strike at the legs' coincidence: {step:?}"
     );
+    let gait = gait_of(&walker, &[0.2314, -0.2271]);
+    assert!(
+        (gait.step.period - 3.907370566).abs() < 1e-8,
+        "{}",
+        gait.step.period
+    );
+    assert_eq!(gait.step.scuffs, 1);
 }

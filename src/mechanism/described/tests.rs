@@ -5,7 +5,7 @@ use nalgebra::{DVector, SVector};
 
 use super::super::compass::Compass;
 use super::super::rigid::{RigidOptions, RigidWalker};
-use super::super::rigid_gait::rigid_gait;
+use super::super::rigid_gait::{rigid_gait, JacobianRoute};
 use super::super::{Equations, Mechanism, PointKinematics};
 use super::{load, parse, AnyDescribed, Described};
 use crate::dynamics::Model;
@@ -144,6 +144,45 @@ fn the_described_compass_walks_the_built_in_gait() {
     assert!(section < 1e-10 && period < 1e-10 && multipliers < 1e-10);
     assert_eq!(described.section_names(), built_in.section_names());
     assert!((g1.step.lambda_i4 - g2.step.lambda_i4).abs() < 1e-10);
+}
+
+/// The described compass's step map has the built-in's exact derivatives: `DP` and `dP/dp` in the slope, a mass
+/// and the leg's length (which moves the section's state: the implicit differentiation of the contact
+/// conditions), on the gait and off it, to 1e-10; its gait's multipliers are exact, not differences.
+#[test]
+fn the_described_compass_has_the_built_in_exact_derivatives() {
+    let described = compass_toml().with_value("slope", 0.0523598775598).unwrap();
+    let built_in = Compass {
+        slope: 0.0523598775598,
+        ..Compass::default()
+    };
+    let options = RigidOptions::default();
+    let gait = rigid_gait(&described, &built_in.default_start(), &options).unwrap();
+    assert_eq!(gait.derivative, JacobianRoute::Exact);
+    let off = DVector::from_column_slice(&[0.25, -1.0, -0.4]);
+    for x in [&gait.section, &off] {
+        for key in ["slope", "hip_mass", "leg_length"] {
+            let a = built_in
+                .step_map_derivative(x, Some(key), 1, &options)
+                .unwrap();
+            let b = described
+                .step_map_derivative(x, Some(key), 1, &options)
+                .unwrap();
+            let jacobian = max_diff(a.jacobian.iter(), b.jacobian.iter());
+            let dparam = max_diff(
+                a.dparam.as_ref().unwrap().iter(),
+                b.dparam.as_ref().unwrap().iter(),
+            );
+            println!(
+                "{key} at {:?}: DP {jacobian:e}, dP/dp {dparam:e}",
+                x.as_slice()
+            );
+            assert!(
+                jacobian < 1e-10 && dparam < 1e-10,
+                "{key}: {jacobian:e}, {dparam:e}"
+            );
+        }
+    }
 }
 
 /// The section's positions are solved by Newton's method from the guesses, not taken from them: a poor guess

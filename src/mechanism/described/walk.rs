@@ -12,9 +12,11 @@
 use nalgebra::{DVector, Matrix2, Matrix3, SVector, Vector2, Vector3};
 
 use super::super::constrained::ConstrainedError;
-use super::super::rigid::{HeelStrike, RigidWalker};
+use super::super::rigid::{HeelStrike, RigidOptions, RigidWalker, Transition};
+use super::super::rigid_derivative::{step_map_derivative, DerivativeError, StepMapDerivative};
 use super::super::turns::{self, Turns};
-use super::super::Mechanism;
+use super::super::{Mechanism, Real};
+use super::kinematics::Values;
 use super::model::{Description, Gait, Motion, State};
 use super::{AnyDescribed, Described};
 
@@ -109,8 +111,13 @@ impl<const N: usize> Described<N> {
 
     /// How it takes turns, at its parameter values.
     pub fn turns(&self) -> Turns<N> {
+        self.turns_with(&self.constants_f64())
+    }
+
+    /// How it takes turns, with the constants `c` (the slide's rate may depend on the parameters).
+    pub fn turns_with<T: Real>(&self, c: &Values<T>) -> Turns<N, T> {
         let g = self.gait();
-        let shift = g.shift.map(|k| (k, self.slide_per_unit(k)));
+        let shift = g.shift.map(|k| (k, self.slide_per_unit(c, k)));
         Turns {
             stance: g.stance,
             lands: g.lands,
@@ -119,9 +126,9 @@ impl<const N: usize> Described<N> {
         }
     }
 
-    /// The `x` a unit of the sliding coordinate `k` moves the walker (its direction's `x`).
-    fn slide_per_unit(&self, k: usize) -> f64 {
-        let c = self.constants_f64();
+    /// The `x` a unit of the sliding coordinate `k` moves the walker (its direction's `x`), with the constants
+    /// `c`.
+    fn slide_per_unit<T: Real>(&self, c: &Values<T>, k: usize) -> T {
         self.description
             .joints
             .iter()
@@ -131,7 +138,7 @@ impl<const N: usize> Described<N> {
                 }
                 _ => None,
             })
-            .unwrap_or(1.0)
+            .unwrap_or(T::one())
     }
 
     /// The state just after a heel strike with the section values `s` (see the module documentation), or why
@@ -223,6 +230,81 @@ impl<const N: usize> Described<N> {
     }
 }
 
+impl<const N: usize> Described<N> {
+    /// [`Described::section_state`] over a [`Real`] with the constants `c`, differentiated implicitly: the
+    /// positions solved on `f64`, then one Newton correction on `T` from that solution, which moves the values
+    /// by the residual only and gives the derivative parts exactly (`dq_u = -J_u^-1 (J_s dq_s + dr/dp)`, the
+    /// implicit function theorem on the contact conditions `r`), and the velocities by the stance contact's rows
+    /// solved on `T` (Cramer's rule). A state of NaN where the conditions have no solution.
+    pub fn section_state_with<T: Real>(
+        &self,
+        c: &Values<T>,
+        s: &[T],
+    ) -> (SVector<T, N>, SVector<T, N>) {
+        let nan = || {
+            (
+                SVector::repeat(T::lit(f64::NAN)),
+                SVector::repeat(T::lit(f64::NAN)),
+            )
+        };
+        let values = DVector::from_iterator(s.len(), s.iter().map(|v| v.value()));
+        let Ok((q0, _)) = self.section_state(&values) else {
+            return nan();
+        };
+        let g = self.gait();
+        let (mut q, mut qd) = (q0.map(T::lit), SVector::<T, N>::zeros());
+        for (&(k, velocity), &v) in g.section.iter().zip(s) {
+            if velocity {
+                qd[k] = v;
+            } else {
+                q[k] = v;
+            }
+        }
+        let unknown: Vec<usize> = (0..N)
+            .filter(|k| !g.section.contains(&(*k, false)))
+            .collect();
+        let Some(inverse) = self.conditions_jacobian(g, &q0, &unknown).try_inverse() else {
+            return nan();
+        };
+        let zero = SVector::zeros();
+        let (stance, lands) = (
+            self.contact(c, &q, &zero, g.stance).position,
+            self.contact(c, &q, &zero, g.lands).position,
+        );
+        let r = [stance.x, stance.y, lands.y];
+        for (i, k) in unknown.iter().enumerate() {
+            q[*k] -= (0..3).fold(T::zero(), |sum, j| sum + T::lit(inverse[(i, j)]) * r[j]);
+        }
+        let unknown: Vec<usize> = (0..N)
+            .filter(|k| !g.section.contains(&(*k, true)))
+            .collect();
+        let j = self.contact(c, &q, &qd, g.stance).jacobian;
+        let rhs = -(j * qd);
+        let a = |r: usize, i: usize| j[(r, unknown[i])];
+        let det = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
+        qd[unknown[0]] = (rhs[0] * a(1, 1) - a(0, 1) * rhs[1]) / det;
+        qd[unknown[1]] = (a(0, 0) * rhs[1] - rhs[0] * a(1, 0)) / det;
+        (q, qd)
+    }
+
+    /// The contact conditions' Jacobian at `q` (on `f64`) in the coordinates `unknown`: the rows of the stance
+    /// contact's `x` and `z` and the landing contact's `z`.
+    fn conditions_jacobian(
+        &self,
+        g: &Gait,
+        q: &SVector<f64, N>,
+        unknown: &[usize],
+    ) -> Matrix3<f64> {
+        let (c, zero) = (self.constants_f64(), SVector::zeros());
+        let (stance, lands) = (
+            self.contact(&c, q, &zero, g.stance).jacobian,
+            self.contact(&c, q, &zero, g.lands).jacobian,
+        );
+        let rows = [stance.row(0), stance.row(1), lands.row(1)];
+        Matrix3::from_fn(|r, i| rows[r][unknown[i]])
+    }
+}
+
 /// Why a section's state has no solution.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum SectionError {
@@ -243,10 +325,14 @@ pub enum SectionError {
     },
 }
 
-/// The rigid walk of a described biped with `N` coordinates and `Y = 2 N` states.
+/// The rigid walk of a described biped with `N` coordinates and `Y = 2 N` states; its exact derivatives in
+/// `D = 2 N - 4` directions (the section's `N - 3` coordinates and `N - 2` velocities, and the parameter), `E =
+/// D + 1`, `A = Y + Y D` ([`RigidWalker::step_map_derivative`]).
 macro_rules! rigid_walker {
-    ($($n:literal => $y:literal),*) => {$(
+    ($($n:literal => $y:literal, $d:literal, $e:literal, $a:literal);*) => {$(
         impl RigidWalker<$n, $y> for Described<$n> {
+            type Constants<T: Real> = Values<T>;
+
             fn name(&self) -> &'static str {
                 self.description.name
             }
@@ -255,22 +341,36 @@ macro_rules! rigid_walker {
                 self.gait().section_names.clone()
             }
 
-            fn single_support(
-                &self,
-                q: &SVector<f64, $n>,
-                qd: &SVector<f64, $n>,
-            ) -> Result<(SVector<f64, $n>, f64), ConstrainedError> {
-                turns::single_support(self, &self.turns(), q, qd)
+            fn rigid_constants<T: Real>(&self, value: &dyn Fn(&'static str, f64) -> T) -> Values<T> {
+                Mechanism::constants(self, value)
             }
 
-            fn swing_foot(&self, q: &SVector<f64, $n>) -> (f64, f64) {
-                turns::swing_foot(self, &self.turns(), q)
+            fn single_support_with<T: Real>(
+                &self,
+                c: &Values<T>,
+                q: &SVector<T, $n>,
+                qd: &SVector<T, $n>,
+            ) -> Result<(SVector<T, $n>, T), ConstrainedError> {
+                turns::single_support(self, &self.turns_with(c), c, (q, qd))
+            }
+
+            fn swing_foot_with<T: Real>(&self, c: &Values<T>, q: &SVector<T, $n>) -> (T, T) {
+                turns::swing_foot(self, &self.turns_with(c), c, q)
             }
 
             fn hip_height(&self, q: &SVector<f64, $n>) -> f64 {
                 let c = self.constants_f64();
                 let frames = super::kinematics::frames(&self.description, &c, q, &SVector::zeros());
                 frames[self.gait().hip].origin.position.y
+            }
+
+            fn transition_with<T: Real>(
+                &self,
+                c: &Values<T>,
+                q: &SVector<T, $n>,
+                qd: &SVector<T, $n>,
+            ) -> Result<Transition<$n, T>, ConstrainedError> {
+                turns::transition(self, &self.turns_with(c), c, (q, qd))
             }
 
             fn heel_strike(
@@ -285,12 +385,33 @@ macro_rules! rigid_walker {
                 self.energy(q, qd)
             }
 
-            fn section_of(&self, q: &SVector<f64, $n>, qd: &SVector<f64, $n>) -> DVector<f64> {
+            fn section_with<T: Real>(
+                &self,
+                _: &Values<T>,
+                q: &SVector<T, $n>,
+                qd: &SVector<T, $n>,
+            ) -> Vec<T> {
                 let g = self.gait();
-                DVector::from_iterator(
-                    g.section.len(),
-                    g.section.iter().map(|&(k, velocity)| if velocity { qd[k] } else { q[k] }),
-                )
+                g.section.iter().map(|&(k, velocity)| if velocity { qd[k] } else { q[k] }).collect()
+            }
+
+            /// [`Described::section_state_with`]: the contact conditions differentiated implicitly.
+            fn state_at_section_with<T: Real>(
+                &self,
+                c: &Values<T>,
+                s: &[T],
+            ) -> (SVector<T, $n>, SVector<T, $n>) {
+                self.section_state_with(c, s)
+            }
+
+            fn step_map_derivative(
+                &self,
+                x: &DVector<f64>,
+                param: Option<&str>,
+                period: usize,
+                options: &RigidOptions,
+            ) -> Result<StepMapDerivative<$n>, DerivativeError> {
+                step_map_derivative::<Self, $n, $y, $d, $e, $a>(self, x, param, period, options)
             }
 
             /// [`Described::section_state`]; where it has no solution, a state of NaN, on which the walk's
@@ -304,7 +425,14 @@ macro_rules! rigid_walker {
     )*};
 }
 
-rigid_walker!(3 => 6, 4 => 8, 5 => 10, 6 => 12, 7 => 14, 8 => 16);
+rigid_walker!(
+    3 => 6, 2, 3, 18;
+    4 => 8, 4, 5, 40;
+    5 => 10, 6, 7, 70;
+    6 => 12, 8, 9, 108;
+    7 => 14, 10, 11, 154;
+    8 => 16, 12, 13, 208
+);
 
 /// Calls `$body` with `$w` bound to the [`Described`] inside an [`AnyDescribed`] that can walk as a rigid biped
 /// (`3..=MAX_COORDINATES` coordinates: the contact conditions fix three positions), else `$other`.
