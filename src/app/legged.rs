@@ -48,6 +48,8 @@ pub struct LeggedGaitRecord {
     pub max_floquet: f64,
     /// How `DP` was taken.
     pub derivative: &'static str,
+    /// Its error estimate (the multipliers' accuracy is about as good).
+    pub jacobian_error: f64,
     /// The step's heel strike and audits.
     #[serde(flatten)]
     pub step: StepAccount,
@@ -95,7 +97,8 @@ fn record<W: Legged<6>>(walker: &W, gait: &LeggedGait<6>) -> LeggedGaitRecord {
             .first()
             .map_or(f64::NAN, |[re, im]| re.hypot(*im)),
         floquet_multipliers: gait.multipliers.clone(),
-        derivative: "central_differences",
+        derivative: "richardson_differences",
+        jacobian_error: gait.jacobian_error,
         step: step.account,
     }
 }

@@ -122,16 +122,33 @@ where
         };
         Ok(walked.map_err(DerivativeError::from)?.0)
     };
-    let (mut chosen, mut error) = (DMatrix::zeros(n, columns), 0.0f64);
-    for k in 0..columns {
-        let size = if k < n {
-            s[k]
-        } else {
-            param.map_or(0.0, |(_, p)| p)
-        };
-        let central = |h: f64| -> Result<DVector<f64>, CheckError> {
-            Ok((at(k, h)? - at(k, -h)?) / (2.0 * h))
-        };
+    let sizes: Vec<f64> = (0..columns)
+        .map(|k| {
+            if k < n {
+                s[k]
+            } else {
+                param.map_or(0.0, |(_, p)| p)
+            }
+        })
+        .collect();
+    richardson_jacobian(n, &sizes, at)
+}
+
+/// The Jacobian of a map into `R^rows` whose columns are the directions `k` of `sizes` (each of the size
+/// `sizes[k]`), from `at(k, t)`, the map with direction `k` moved by `t`: Richardson-extrapolated central
+/// differences at each of [`CHECK_STEPS`] (relative to the size, at least 1), each column taken at the finer of
+/// the two successive steps that agree best; with its error estimate (the largest over the columns of twice
+/// its agreement with the steps on either side). Hand-written: the difference crates take one step.
+pub fn richardson_jacobian<E>(
+    rows: usize,
+    sizes: &[f64],
+    at: impl Fn(usize, f64) -> Result<DVector<f64>, E>,
+) -> Result<(DMatrix<f64>, f64), E> {
+    let columns = sizes.len();
+    let (mut chosen, mut error) = (DMatrix::zeros(rows, columns), 0.0f64);
+    for (k, size) in sizes.iter().enumerate() {
+        let central =
+            |h: f64| -> Result<DVector<f64>, E> { Ok((at(k, h)? - at(k, -h)?) / (2.0 * h)) };
         let mut extrapolated = Vec::with_capacity(CHECK_STEPS.len());
         for step in CHECK_STEPS {
             let h = step * size.abs().max(1.0);

@@ -94,7 +94,6 @@ fn print_gait(g: &LeggedGaitRecord) {
             g.step.energy_residual
         );
     }
-    // DP by central differences of a map integrated to rtol 1e-11: the multipliers are good to about 1e-5.
     let multipliers: Vec<String> = g
         .floquet_multipliers
         .iter()
@@ -107,7 +106,8 @@ fn print_gait(g: &LeggedGaitRecord) {
         })
         .collect();
     println!(
-        "Floquet multipliers (central differences, to about 1e-5): {} (largest modulus {:.6}): {}",
+        "Floquet multipliers (Richardson-extrapolated differences, DP to {:.0e}): {} (largest modulus {:.6}): {}",
+        g.jacobian_error,
         multipliers.join(", "),
         g.max_floquet,
         if g.max_floquet < 1.0 {

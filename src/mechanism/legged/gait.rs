@@ -1,11 +1,14 @@
 //! Gaits of a legged walker (docs/model.md section 13): fixed points of its step map on the section
-//! ([`Legged::section_of`]) by Newton's method, and their Floquet multipliers, the eigenvalues of `DP`, by
-//! central differences ([`crate::mechanism::rigid_gait::central_jacobian`]).
+//! ([`Legged::section_of`]) by Newton's method (its `DP` by central differences,
+//! [`crate::mechanism::rigid_gait::central_jacobian`]), and their Floquet multipliers, the eigenvalues of `DP`
+//! at the fixed point by Richardson-extrapolated central differences with their error estimate
+//! ([`crate::mechanism::rigid_check::richardson_jacobian`]): the exact derivatives of the replay are to come.
 
 use nalgebra::{DMatrix, DVector};
 
 use super::walk::{legged_step, LeggedOptions, LeggedStep};
 use super::{Legged, LeggedError};
+use crate::mechanism::rigid_check::richardson_jacobian;
 use crate::mechanism::rigid_gait::central_jacobian;
 
 /// Newton's method stops when `max |P(s) - s|` is below this.
@@ -34,8 +37,10 @@ pub struct LeggedGait<const N: usize> {
     pub residual: f64,
     /// Newton iterations taken.
     pub iterations: usize,
-    /// `DP` at the fixed point (central differences).
+    /// `DP` at the fixed point (Richardson-extrapolated central differences).
     pub jacobian: DMatrix<f64>,
+    /// Its error estimate (the largest over its columns, [`richardson_jacobian`]).
+    pub jacobian_error: f64,
     /// The Floquet multipliers `[re, im]`, largest modulus first.
     pub multipliers: Vec<[f64; 2]>,
     /// The step from the fixed point.
@@ -86,17 +91,24 @@ pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
     for iteration in 1..=MAX_NEWTON_ITERATIONS {
         let r = &image - &s;
         let residual = r.amax();
-        let jacobian = jacobian_at(&s, iteration)?;
         if residual < NEWTON_TOL {
+            let sizes: Vec<f64> = s.iter().copied().collect();
+            let (jacobian, jacobian_error) = richardson_jacobian(s.len(), &sizes, |k, t| {
+                let mut x = s.clone();
+                x[k] += t;
+                Ok(map(&x, iteration)?.0)
+            })?;
             return Ok(LeggedGait {
                 multipliers: multipliers(&jacobian),
                 section: s,
                 residual,
                 iterations: iteration - 1,
                 jacobian,
+                jacobian_error,
                 step,
             });
         }
+        let jacobian = jacobian_at(&s, iteration)?;
         let n = s.len();
         let delta = (jacobian - DMatrix::identity(n, n))
             .lu()

@@ -163,13 +163,14 @@ fn the_telescopic_gait_does_not_depend_on_the_tolerance() {
     let (a, b) = (gait_at(1e-11), gait_at(1e-12));
     assert!((a.step.period - b.step.period).abs() < 1e-9);
     assert!((&a.section - &b.section).amax() < 1e-8);
-    // DP by central differences (step 1e-6) of a map with events (the double support, the stoppers): the
-    // multipliers are good to some 1e-5 and do not converge with the tolerance (at rtol 1e-11, 1e-12 and 1e-13
-    // they differ by up to 5.3e-5, and by 3e-6 before the constrained solves' rounding changed with their
-    // hand-written L D L^T); the exact derivatives of the replay are to come.
+    // DP by Richardson-extrapolated central differences at the fixed point (plain central differences of step
+    // 1e-6 were noise-bound: at rtol 1e-11, 1e-12 and 1e-13 their multipliers differed by up to 5.3e-5); their
+    // error estimate bounds how far the multipliers can move with the tolerance. The exact derivatives of the
+    // replay are to come.
+    assert!(a.jacobian_error < 1e-6 && b.jacobian_error < 1e-6);
     for (x, y) in a.multipliers.iter().zip(&b.multipliers).take(3) {
         assert!(
-            (x[0] - y[0]).abs() + (x[1] - y[1]).abs() < 1e-4,
+            (x[0] - y[0]).abs() + (x[1] - y[1]).abs() < 4e-6,
             "{:?} against {:?}",
             a.multipliers,
             b.multipliers
