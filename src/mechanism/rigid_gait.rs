@@ -197,42 +197,53 @@ pub fn central_jacobian<E>(
     Ok(jacobian)
 }
 
-/// The gait near `start` (a section state) by Newton's method on `P(s) = s`, each step damped until the
-/// residual falls.
-pub fn rigid_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
-    walker: &W,
+/// What a fixed-point search needs to say why it failed, besides the map's own failures.
+pub trait FixedPointError {
+    /// `DP - I` is singular at a point of residual `residual`.
+    fn singular(residual: f64) -> Self;
+    /// No convergence after `iterations` iterations, the last residual `residual`.
+    fn no_convergence(iterations: usize, residual: f64) -> Self;
+}
+
+impl FixedPointError for RigidGaitError {
+    fn singular(residual: f64) -> Self {
+        RigidGaitError::Singular { residual }
+    }
+    fn no_convergence(iterations: usize, residual: f64) -> Self {
+        RigidGaitError::NoConvergence {
+            iterations,
+            residual,
+        }
+    }
+}
+
+/// A fixed point of `map` found by [`damped_newton`]: the point, `max |P(s) - s|` there, the Newton iterations
+/// taken, and what the map gave with its image there.
+pub type FixedPoint<S> = (DVector<f64>, f64, usize, S);
+
+/// The fixed point of `map` (a section state to its image and what the step gave, in Newton iteration `i`)
+/// near `start` by Newton's method on `P(s) = s` to `max |P(s) - s| < tol`, with `DP` from `jacobian`, each
+/// step damped until the residual falls: the full step, or halves of it, down to 1e-3 of it. The one Newton
+/// loop of the rigid and the legged walkers.
+pub fn damped_newton<S, E: FixedPointError>(
     start: &DVector<f64>,
-    options: &RigidOptions,
-) -> Result<RigidGait<N>, RigidGaitError> {
-    let map = |s: &DVector<f64>, iteration: usize| {
-        rigid_step_map(walker, s, options)
-            .map_err(|source| RigidGaitError::Step { iteration, source })
-    };
+    tol: f64,
+    map: impl Fn(&DVector<f64>, usize) -> Result<(DVector<f64>, S), E>,
+    jacobian: impl Fn(&DVector<f64>, usize) -> Result<DMatrix<f64>, E>,
+) -> Result<FixedPoint<S>, E> {
     let mut s = start.clone();
     let (mut image, mut step) = map(&s, 0)?;
     for iteration in 1..=MAX_NEWTON_ITERATIONS {
         let r = &image - &s;
         let residual = r.amax();
-        if residual < NEWTON_TOL {
-            let (jacobian, derivative) = gait_jacobian(walker, &s, options, iteration)?;
-            return Ok(RigidGait {
-                multipliers: multipliers(&jacobian),
-                section: s,
-                residual,
-                iterations: iteration - 1,
-                jacobian,
-                derivative,
-                step,
-            });
+        if residual < tol {
+            return Ok((s, residual, iteration - 1, step));
         }
-        let jacobian = newton_jacobian(walker, &s, options)
-            .map_err(|source| RigidGaitError::Step { iteration, source })?;
         let n = s.len();
-        let delta = (jacobian - DMatrix::identity(n, n))
+        let delta = (jacobian(&s, iteration)? - DMatrix::identity(n, n))
             .lu()
             .solve(&(-r))
-            .ok_or(RigidGaitError::Singular { residual })?;
-        // Damped: the full step, or halves of it, until the residual falls (or the walk works at all).
+            .ok_or_else(|| E::singular(residual))?;
         let mut scale = 1.0;
         loop {
             let trial = &s + scale * &delta;
@@ -246,9 +257,39 @@ pub fn rigid_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
             }
         }
     }
-    Err(RigidGaitError::NoConvergence {
-        iterations: MAX_NEWTON_ITERATIONS,
-        residual: (&image - &s).amax(),
+    Err(E::no_convergence(
+        MAX_NEWTON_ITERATIONS,
+        (&image - &s).amax(),
+    ))
+}
+
+/// The gait near `start` (a section state) by Newton's method on `P(s) = s` ([`damped_newton`]).
+pub fn rigid_gait<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    options: &RigidOptions,
+) -> Result<RigidGait<N>, RigidGaitError> {
+    let (section, residual, iterations, step) = damped_newton(
+        start,
+        NEWTON_TOL,
+        |s, iteration| {
+            rigid_step_map(walker, s, options)
+                .map_err(|source| RigidGaitError::Step { iteration, source })
+        },
+        |s, iteration| {
+            newton_jacobian(walker, s, options)
+                .map_err(|source| RigidGaitError::Step { iteration, source })
+        },
+    )?;
+    let (jacobian, derivative) = gait_jacobian(walker, &section, options, iterations + 1)?;
+    Ok(RigidGait {
+        multipliers: multipliers(&jacobian),
+        section,
+        residual,
+        iterations,
+        jacobian,
+        derivative,
+        step,
     })
 }
 

@@ -9,13 +9,10 @@ use nalgebra::{DMatrix, DVector};
 use super::walk::{legged_step, LeggedOptions, LeggedStep};
 use super::{Legged, LeggedError};
 use crate::mechanism::rigid_check::richardson_jacobian;
-use crate::mechanism::rigid_gait::central_jacobian;
+use crate::mechanism::rigid_gait::{central_jacobian, damped_newton, multipliers, FixedPointError};
 
 /// Newton's method stops when `max |P(s) - s|` is below this.
 pub const NEWTON_TOL: f64 = 1e-11;
-
-/// Most Newton iterations.
-const MAX_NEWTON_ITERATIONS: usize = 40;
 
 /// `P(s)` and the step that gives it.
 pub fn legged_step_map<W: Legged<N>, const N: usize, const Y: usize>(
@@ -74,7 +71,20 @@ pub enum LeggedGaitError {
     },
 }
 
-/// The gait near `start` by Newton's method on `P(s) = s`, each step damped until the residual falls.
+impl FixedPointError for LeggedGaitError {
+    fn singular(residual: f64) -> Self {
+        LeggedGaitError::Singular { residual }
+    }
+    fn no_convergence(iterations: usize, residual: f64) -> Self {
+        LeggedGaitError::NoConvergence {
+            iterations,
+            residual,
+        }
+    }
+}
+
+/// The gait near `start` by Newton's method on `P(s) = s` ([`damped_newton`]), its multipliers from `DP` at
+/// the fixed point by Richardson-extrapolated differences.
 pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
     start: &DVector<f64>,
@@ -84,62 +94,22 @@ pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
         legged_step_map::<W, N, Y>(walker, s, options)
             .map_err(|source| LeggedGaitError::Step { iteration, source })
     };
-    let jacobian_at =
-        |s: &DVector<f64>, iteration: usize| central_jacobian(s, |x| Ok(map(x, iteration)?.0));
-    let mut s = start.clone();
-    let (mut image, mut step) = map(&s, 0)?;
-    for iteration in 1..=MAX_NEWTON_ITERATIONS {
-        let r = &image - &s;
-        let residual = r.amax();
-        if residual < NEWTON_TOL {
-            let sizes: Vec<f64> = s.iter().copied().collect();
-            let (jacobian, jacobian_error) = richardson_jacobian(s.len(), &sizes, |k, t| {
-                let mut x = s.clone();
-                x[k] += t;
-                Ok(map(&x, iteration)?.0)
-            })?;
-            return Ok(LeggedGait {
-                multipliers: multipliers(&jacobian),
-                section: s,
-                residual,
-                iterations: iteration - 1,
-                jacobian,
-                jacobian_error,
-                step,
-            });
-        }
-        let jacobian = jacobian_at(&s, iteration)?;
-        let n = s.len();
-        let delta = (jacobian - DMatrix::identity(n, n))
-            .lu()
-            .solve(&(-r))
-            .ok_or(LeggedGaitError::Singular { residual })?;
-        let mut scale = 1.0;
-        loop {
-            let trial = &s + scale * &delta;
-            match map(&trial, iteration) {
-                Ok((next, next_step)) if (&next - &trial).amax() < residual || scale < 1e-3 => {
-                    (s, image, step) = (trial, next, next_step);
-                    break;
-                }
-                Err(e) if scale < 1e-3 => return Err(e),
-                _ => scale *= 0.5,
-            }
-        }
-    }
-    Err(LeggedGaitError::NoConvergence {
-        iterations: MAX_NEWTON_ITERATIONS,
-        residual: (&image - &s).amax(),
+    let (section, residual, iterations, step) = damped_newton(start, NEWTON_TOL, map, |s, i| {
+        central_jacobian(s, |x| Ok(map(x, i)?.0))
+    })?;
+    let sizes: Vec<f64> = section.iter().copied().collect();
+    let (jacobian, jacobian_error) = richardson_jacobian(section.len(), &sizes, |k, t| {
+        let mut x = section.clone();
+        x[k] += t;
+        Ok(map(&x, iterations + 1)?.0)
+    })?;
+    Ok(LeggedGait {
+        multipliers: multipliers(&jacobian),
+        section,
+        residual,
+        iterations,
+        jacobian,
+        jacobian_error,
+        step,
     })
-}
-
-/// The eigenvalues of `jacobian` as `[re, im]`, largest modulus first.
-fn multipliers(jacobian: &DMatrix<f64>) -> Vec<[f64; 2]> {
-    let mut m: Vec<[f64; 2]> = jacobian
-        .complex_eigenvalues()
-        .iter()
-        .map(|z| [z.re, z.im])
-        .collect();
-    m.sort_by(|a, b| b[0].hypot(b[1]).total_cmp(&a[0].hypot(a[1])));
-    m
 }
