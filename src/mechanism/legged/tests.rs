@@ -214,3 +214,17 @@ fn bad_telescopic_parameters_name_every_key() {
         .with_parameter("stifness", 1.0)
         .is_err());
 }
+
+#[test]
+fn a_step_answers_the_stop_at_its_first_phase() {
+    let w = Telescopic::default();
+    let options = LeggedOptions {
+        stop: Some(|| true),
+        ..LeggedOptions::default()
+    };
+    let outcome = super::gait::legged_step_map::<_, 6, 13>(&w, &w.default_start(), &options);
+    assert!(
+        matches!(outcome, Err(super::LeggedError::Interrupted)),
+        "{outcome:?}"
+    );
+}

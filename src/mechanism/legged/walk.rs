@@ -392,12 +392,14 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
         start.as_refs(),
         swing_below(walker, modes, &start.0),
     );
+    // The stop is asked at every phase's start (a phase is often shorter than STOP_CHECK_STEPS steps) and every
+    // STOP_CHECK_STEPS steps within one.
     let mut taken = 0usize;
     loop {
-        taken += 1;
         if taken.is_multiple_of(STOP_CHECK_STEPS) && options.stop.is_some_and(|stop| stop()) {
             return Err(LeggedError::Interrupted);
         }
+        taken += 1;
         let step = integrator.step(&system, options.max_step_time)?;
         let (t0, t1) = (step.t0(), step.t1());
         if let Some((event, te)) = earliest_event(walker, modes, &watch, &step, options) {
