@@ -209,7 +209,7 @@ pub enum LeggedError {
         time: f64,
     },
     /// The section state has no walker state.
-    #[error("the section state has no walker state (the rear leg cannot reach the ground)")]
+    #[error("the section state has no walker state (the hip at or below the ground, or the rear leg too short to reach it)")]
     OffSection,
     /// The caller asked the walk to stop.
     #[error("interrupted")]
