@@ -230,17 +230,7 @@ fn print_gait(g: &Gait) {
 
 /// The Floquet multipliers with the stability verdict, a missing Jacobian and the parameter derivative.
 fn print_multipliers(g: &Gait) {
-    let multipliers: Vec<String> = g
-        .floquet_multipliers
-        .iter()
-        .map(|[re, im]| {
-            if *im == 0.0 {
-                format!("{re:.6}")
-            } else {
-                format!("{re:.6}{im:+.6}i")
-            }
-        })
-        .collect();
+    let multipliers = multiplier_texts(&g.floquet_multipliers, 6);
     println!(
         "Floquet multipliers [{}] (exact Jacobian, error ~{:.0e}): {}",
         multipliers.join(", "),
@@ -287,20 +277,12 @@ fn print_check(check: &JacobianCheck) -> Result<()> {
         ),
         &check.finite_difference,
     );
-    println!(
-        "largest difference {:.1e}; error estimates: exact {:.1e}, finite difference {:.1e}: {}",
+    print_agreement(
+        "the exact Jacobian",
         check.difference,
-        check.exact_error,
-        check.finite_difference_error,
-        if check.agree { "agree" } else { "DISAGREE" }
-    );
-    if !check.agree {
-        bail!(
-            "the exact Jacobian and the finite differences disagree by {:.1e}, beyond their error estimates",
-            check.difference
-        );
-    }
-    Ok(())
+        (check.exact_error, check.finite_difference_error),
+        check.agree,
+    )
 }
 
 /// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json.
@@ -366,20 +348,47 @@ fn print_walker_check(check: &RigidDerivativeCheck) -> Result<()> {
         ),
         &check.finite_difference,
     );
-    println!(
-        "largest difference {:.1e}; error estimates: exact {:.1e}, finite difference {:.1e}: {}",
+    print_agreement(
+        "the exact derivatives",
         check.difference,
-        check.exact_error,
-        check.finite_difference_error,
-        if check.agree { "agree" } else { "DISAGREE" }
+        (check.exact_error, check.finite_difference_error),
+        check.agree,
+    )
+}
+
+/// The verdict of a derivative check: the largest difference of `exact` (the exact derivatives, named so) and
+/// the finite differences, their error estimates, and an error where they disagree.
+fn print_agreement(
+    exact: &str,
+    difference: f64,
+    (exact_error, finite_difference_error): (f64, f64),
+    agree: bool,
+) -> Result<()> {
+    println!(
+        "largest difference {difference:.1e}; error estimates: exact {exact_error:.1e}, finite difference \
+         {finite_difference_error:.1e}: {}",
+        if agree { "agree" } else { "DISAGREE" }
     );
-    if !check.agree {
+    if !agree {
         bail!(
-            "the exact derivatives and the finite differences disagree by {:.1e}, beyond their error estimates",
-            check.difference
+            "{exact} and the finite differences disagree by {difference:.1e}, beyond their error estimates"
         );
     }
     Ok(())
+}
+
+/// Floquet multipliers as text, `digits` decimals: `re`, or `re+imi` for a complex one.
+fn multiplier_texts(multipliers: &[[f64; 2]], digits: usize) -> Vec<String> {
+    multipliers
+        .iter()
+        .map(|[re, im]| {
+            if *im == 0.0 {
+                format!("{re:.digits$}")
+            } else {
+                format!("{re:.digits$}{im:+.digits$}i")
+            }
+        })
+        .collect()
 }
 
 /// A matrix, one row a line, under its name.
@@ -409,17 +418,7 @@ fn print_walker_gait(g: &WalkerGait) {
          {} scuff(s) per step",
         g.period, g.lambda_i4, g.impact_loss, g.energy_drift, g.scuffs
     );
-    let multipliers: Vec<String> = g
-        .floquet_multipliers
-        .iter()
-        .map(|[re, im]| {
-            if *im == 0.0 {
-                format!("{re:.9}")
-            } else {
-                format!("{re:.9}{im:+.9}i")
-            }
-        })
-        .collect();
+    let multipliers = multiplier_texts(&g.floquet_multipliers, 9);
     println!(
         "Floquet multipliers ({}): {} (largest modulus {:.9}): {}",
         g.derivative,

@@ -94,17 +94,7 @@ fn print_gait(g: &LeggedGaitRecord) {
             g.step.energy_residual
         );
     }
-    let multipliers: Vec<String> = g
-        .floquet_multipliers
-        .iter()
-        .map(|[re, im]| {
-            if *im == 0.0 {
-                format!("{re:.6}")
-            } else {
-                format!("{re:.6}{im:+.6}i")
-            }
-        })
-        .collect();
+    let multipliers = super::multiplier_texts(&g.floquet_multipliers, 6);
     println!(
         "Floquet multipliers (Richardson-extrapolated differences, DP to {:.0e}): {} (largest modulus {:.6}): {}",
         g.jacobian_error,
