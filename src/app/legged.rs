@@ -9,7 +9,9 @@ use serde::Serialize;
 
 use super::walkers::{as_map, named, TELESCOPIC};
 use super::{in_run, AppError, SearchEnded};
-use crate::mechanism::legged::gait::{legged_gait, legged_step_map, LeggedGait, LeggedGaitError};
+use crate::mechanism::legged::gait::{
+    legged_gait_exact, legged_step_map, LeggedGait, LeggedGaitError,
+};
 use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
 use crate::mechanism::legged::{Legged, LeggedError};
 use crate::mechanism::telescopic::Telescopic;
@@ -48,7 +50,8 @@ pub struct LeggedGaitRecord {
     pub max_floquet: f64,
     /// How `DP` was taken.
     pub derivative: &'static str,
-    /// Its error estimate (the multipliers' accuracy is about as good).
+    /// Its error estimate (the multipliers' accuracy is about as good): for exact derivatives, their largest
+    /// difference from Richardson-extrapolated differences.
     pub jacobian_error: f64,
     /// The step's heel strike and audits.
     #[serde(flatten)]
@@ -97,7 +100,7 @@ fn record<W: Legged<6>>(walker: &W, gait: &LeggedGait<6>) -> LeggedGaitRecord {
             .first()
             .map_or(f64::NAN, |[re, im]| re.hypot(*im)),
         floquet_multipliers: gait.multipliers.clone(),
-        derivative: "richardson_differences",
+        derivative: gait.derivative,
         jacobian_error: gait.jacobian_error,
         step: step.account,
     }
@@ -119,7 +122,7 @@ fn search(
             })?
             .0;
     }
-    legged_gait::<_, 6, 13>(walker, &s, &options)
+    legged_gait_exact::<_, 6, 13>(walker, &s, &options)
 }
 
 /// The failure's short name.

@@ -20,6 +20,10 @@ use nalgebra::{DVector, SVector};
 use super::assembly::{
     along_leg, along_telescopic_leg, point_mass_equations, point_mass_potential, up, PointMass,
 };
+use super::legged::derivative::{
+    replayed_step_map, LeggedDerivative, LeggedDerivativeError, LeggedDerivatives,
+};
+use super::legged::walk::LeggedOptions;
 use super::legged::{Legged, Stroke};
 use super::{Equations, Mechanism, PointKinematics, Real};
 use crate::params::{ConfigError, MASS_RATIO_LIMIT};
@@ -92,6 +96,8 @@ pub struct TelescopicConstants<T: Real> {
     pub hip_mass: T,
     /// `m` \[kg\].
     pub leg_mass: T,
+    /// The stoppers' length `L0` \[m\].
+    pub stopper_length: T,
     /// The sleeve mass's distance from the hip, `L0 - a` \[m\].
     pub sleeve_radius: T,
     /// The foot's mass \[kg\].
@@ -265,6 +271,7 @@ impl Mechanism<6> for Telescopic {
         TelescopicConstants {
             hip_mass: value("hip_mass", self.hip_mass),
             leg_mass: value("leg_mass", self.leg_mass),
+            stopper_length: value("stopper_length", self.stopper_length),
             sleeve_radius: value("stopper_length", self.stopper_length)
                 - value("leg_mass_offset", self.leg_mass_offset),
             foot_mass: value("foot_mass", self.foot_mass),
@@ -349,12 +356,7 @@ impl Legged<6> for Telescopic {
         q: &SVector<f64, 6>,
         qd: &SVector<f64, 6>,
     ) -> (SVector<f64, 6>, SVector<f64, 6>) {
-        let swap = |v: &SVector<f64, 6>| {
-            SVector::from([v[X], v[Z], v[THETA2], v[THETA1], v[LENGTH2], v[LENGTH1]])
-        };
-        let mut after = swap(q);
-        after[X] -= q[X] + q[LENGTH2] * q[THETA2].sin();
-        (after, swap(qd))
+        self.relabel_with(q, qd)
     }
 
     fn section_names(&self) -> Vec<&'static str> {
@@ -362,20 +364,55 @@ impl Legged<6> for Telescopic {
     }
 
     fn section_of(&self, q: &SVector<f64, 6>, qd: &SVector<f64, 6>) -> DVector<f64> {
-        DVector::from_column_slice(&[q[THETA1], q[LENGTH2], qd[THETA1], qd[THETA2], qd[LENGTH2]])
+        DVector::from_vec(self.section_with(q, qd))
     }
 
-    /// `(theta1, L2, theta1', theta2', L2')` at a heel strike, before its impact: Leg 1 at its stopper with its
-    /// tip at the origin, Leg 2's tip on the ground behind at rest (`theta2 < 0` from `L2 cos theta2 = L0 cos
-    /// theta1`), Leg 1 not extending.
     fn state_at_section(&self, s: &DVector<f64>) -> Option<(SVector<f64, 6>, SVector<f64, 6>)> {
+        self.state_at_section_with(&self.constants_f64(), s.as_slice())
+    }
+}
+
+impl LeggedDerivatives<6> for Telescopic {
+    fn stopper_with<T: Real>(&self, c: &TelescopicConstants<T>, _leg: usize) -> T {
+        c.stopper_length
+    }
+
+    /// Leg 2 becomes the fore leg at the origin: the hip moves back by its tip's `x`.
+    fn relabel_with<T: Real>(
+        &self,
+        q: &SVector<T, 6>,
+        qd: &SVector<T, 6>,
+    ) -> (SVector<T, 6>, SVector<T, 6>) {
+        let swap = |v: &SVector<T, 6>| {
+            SVector::from([v[X], v[Z], v[THETA2], v[THETA1], v[LENGTH2], v[LENGTH1]])
+        };
+        let mut after = swap(q);
+        after[X] -= q[X] + q[LENGTH2] * q[THETA2].sin();
+        (after, swap(qd))
+    }
+
+    fn section_with<T: Real>(&self, q: &SVector<T, 6>, qd: &SVector<T, 6>) -> Vec<T> {
+        vec![q[THETA1], q[LENGTH2], qd[THETA1], qd[THETA2], qd[LENGTH2]]
+    }
+
+    /// The fore leg at its stopper with its tip at the origin; Leg 2's angle from `cos theta2 = h / L2` (`h` the
+    /// hip's height), taken on `f64` and carried to a [`Real`] by one Newton step of that equation from its
+    /// root (which leaves the value as it is and gives the derivative the implicit function theorem gives).
+    fn state_at_section_with<T: Real>(
+        &self,
+        c: &TelescopicConstants<T>,
+        s: &[T],
+    ) -> Option<(SVector<T, 6>, SVector<T, 6>)> {
         let (theta1, l2, w1, w2, l2d) = (s[0], s[1], s[2], s[3], s[4]);
-        let l0 = self.stopper_length;
+        let l0 = c.stopper_length;
         let height = l0 * theta1.cos();
-        if !(l2 > 0.0 && height > 0.0 && height <= l2) {
+        if !(l2.value() > 0.0 && height.value() > 0.0 && height.value() <= l2.value()) {
             return None;
         }
-        let theta2 = -(height / l2).acos();
+        let root = -(height.value() / l2.value()).acos();
+        let (sin_root, cos_root) = root.sin_cos();
+        let miss = T::lit(cos_root) - height / l2;
+        let theta2 = T::lit(root) + (miss - T::lit(miss.value())) / T::lit(sin_root);
         let (s2, c2) = theta2.sin_cos();
         let q = SVector::from([-l0 * theta1.sin(), height, theta1, theta2, l0, l2]);
         // The hip moves about Leg 2's tip at rest: hip = tip - L2 (sin theta2, -cos theta2).
@@ -384,9 +421,18 @@ impl Legged<6> for Telescopic {
             l2d * c2 - l2 * s2 * w2,
             w1,
             w2,
-            0.0,
+            T::zero(),
             l2d,
         ]);
         Some((q, qd))
+    }
+
+    fn exact_step_map(
+        &self,
+        x: &DVector<f64>,
+        param: Option<&str>,
+        options: &LeggedOptions,
+    ) -> Result<LeggedDerivative<6>, LeggedDerivativeError> {
+        replayed_step_map::<_, 6, 13, 12, 6, 7, 84>(self, x, param, options)
     }
 }

@@ -14,8 +14,8 @@ const AUDIT_WARNING: f64 = 1e-6;
 pub(super) fn run(args: &GaitArgs) -> Result<()> {
     if args.parameter.is_some() || args.check_jacobian {
         bail!(
-            "`parameter` and `check_jacobian` take exact derivatives; the model `{TELESCOPIC}` has its DP by \
-             central differences so far (docs/model.md section 13)"
+            "`parameter` and `check_jacobian` are not offered for the model `{TELESCOPIC}` yet: its gait's exact DP \
+             is checked against differences at every gait (gait.json's `jacobian_error`; docs/model.md section 13)"
         );
     }
     let walker: Telescopic =
@@ -95,9 +95,19 @@ fn print_gait(g: &LeggedGaitRecord) {
         );
     }
     let multipliers = super::multiplier_texts(&g.floquet_multipliers, 6);
+    let route = if g.derivative == vrw::mechanism::legged::gait::EXACT_ROUTE {
+        format!(
+            "exact DP, Richardson-extrapolated differences agree to {:.0e}",
+            g.jacobian_error
+        )
+    } else {
+        format!(
+            "Richardson-extrapolated differences, DP to {:.0e}",
+            g.jacobian_error
+        )
+    };
     println!(
-        "Floquet multipliers (Richardson-extrapolated differences, DP to {:.0e}): {} (largest modulus {:.6}): {}",
-        g.jacobian_error,
+        "Floquet multipliers ({route}): {} (largest modulus {:.6}): {}",
         multipliers.join(", "),
         g.max_floquet,
         if g.max_floquet < 1.0 {

@@ -1,15 +1,25 @@
 //! Gaits of a legged walker (docs/model.md section 13): fixed points of its step map on the section
-//! ([`Legged::section_of`]) by Newton's method (its `DP` by central differences,
-//! [`crate::mechanism::rigid_gait::central_jacobian`]), and their Floquet multipliers, the eigenvalues of `DP`
-//! at the fixed point by Richardson-extrapolated central differences with their error estimate
-//! ([`crate::mechanism::rigid_check::richardson_jacobian`]): the exact derivatives of the replay are to come.
+//! ([`Legged::section_of`]) by Newton's method, and their Floquet multipliers, the eigenvalues of `DP` at the
+//! fixed point. A walker with exact derivatives ([`LeggedDerivatives`], the replay of `super::derivative`) has
+//! them in Newton's method and for its multipliers, Richardson-extrapolated central differences
+//! ([`crate::mechanism::rigid_check::richardson_jacobian`]) their second route ([`legged_gait_exact`]); another
+//! has its `DP` by central differences in Newton's method
+//! ([`crate::mechanism::rigid_gait::central_jacobian`]) and by Richardson's at the fixed point with their error
+//! estimate ([`legged_gait`]).
 
 use nalgebra::{DMatrix, DVector};
 
+use super::derivative::LeggedDerivatives;
 use super::walk::{legged_step, LeggedOptions, LeggedStep};
 use super::{Legged, LeggedError};
 use crate::mechanism::rigid_check::richardson_jacobian;
 use crate::mechanism::rigid_gait::{central_jacobian, damped_newton, multipliers, FixedPointError};
+
+/// [`LeggedGait::derivative`] of exact derivatives (the replay of the walk's step).
+pub const EXACT_ROUTE: &str = "exact_replay";
+
+/// [`LeggedGait::derivative`] of Richardson-extrapolated central differences.
+pub const DIFFERENCES_ROUTE: &str = "richardson_differences";
 
 /// Newton's method stops when `max |P(s) - s|` is below this.
 pub const NEWTON_TOL: f64 = 1e-11;
@@ -34,9 +44,13 @@ pub struct LeggedGait<const N: usize> {
     pub residual: f64,
     /// Newton iterations taken.
     pub iterations: usize,
-    /// `DP` at the fixed point (Richardson-extrapolated central differences).
+    /// `DP` at the fixed point.
     pub jacobian: DMatrix<f64>,
-    /// Its error estimate (the largest over its columns, [`richardson_jacobian`]).
+    /// How it was taken: [`EXACT_ROUTE`] or [`DIFFERENCES_ROUTE`].
+    pub derivative: &'static str,
+    /// Its error estimate: with exact derivatives, the largest difference from Richardson-extrapolated
+    /// central differences (their second route); with differences, their own estimate (the largest over the
+    /// columns, [`richardson_jacobian`]).
     pub jacobian_error: f64,
     /// The Floquet multipliers `[re, im]`, largest modulus first.
     pub multipliers: Vec<[f64; 2]>,
@@ -83,8 +97,25 @@ impl FixedPointError for LeggedGaitError {
     }
 }
 
-/// The gait near `start` by Newton's method on `P(s) = s` ([`damped_newton`]), its multipliers from `DP` at
-/// the fixed point by Richardson-extrapolated differences.
+/// `DP` at `section` by Richardson-extrapolated central differences, with their error estimate.
+fn differences<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    section: &DVector<f64>,
+    iteration: usize,
+    options: &LeggedOptions,
+) -> Result<(DMatrix<f64>, f64), LeggedGaitError> {
+    let sizes: Vec<f64> = section.iter().copied().collect();
+    richardson_jacobian(section.len(), &sizes, |k, t| {
+        let mut x = section.clone();
+        x[k] += t;
+        legged_step_map::<W, N, Y>(walker, &x, options)
+            .map(|(image, _)| image)
+            .map_err(|source| LeggedGaitError::Step { iteration, source })
+    })
+}
+
+/// The gait near `start` by Newton's method on `P(s) = s` ([`damped_newton`], `DP` by central differences),
+/// its multipliers from `DP` at the fixed point by Richardson-extrapolated differences.
 pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
     start: &DVector<f64>,
@@ -97,18 +128,56 @@ pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
     let (section, residual, iterations, step) = damped_newton(start, NEWTON_TOL, map, |s, i| {
         central_jacobian(s, |x| Ok(map(x, i)?.0))
     })?;
-    let sizes: Vec<f64> = section.iter().copied().collect();
-    let (jacobian, jacobian_error) = richardson_jacobian(section.len(), &sizes, |k, t| {
-        let mut x = section.clone();
-        x[k] += t;
-        Ok(map(&x, iterations + 1)?.0)
-    })?;
+    let (jacobian, jacobian_error) =
+        differences::<W, N, Y>(walker, &section, iterations + 1, options)?;
     Ok(LeggedGait {
         multipliers: multipliers(&jacobian),
         section,
         residual,
         iterations,
         jacobian,
+        derivative: DIFFERENCES_ROUTE,
+        jacobian_error,
+        step,
+    })
+}
+
+/// The gait near `start` of a walker with exact derivatives: Newton's method with the exact `DP` (central
+/// differences at an iterate where the map has none), its multipliers from the exact `DP` at the fixed point,
+/// checked against Richardson-extrapolated differences (their largest difference is the error stated). Where
+/// the map has no derivative at the fixed point (a DLS indicator at zero, a grazing event), Richardson's
+/// differences give `DP`, said in [`LeggedGait::derivative`].
+pub fn legged_gait_exact<W: LeggedDerivatives<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    options: &LeggedOptions,
+) -> Result<LeggedGait<N>, LeggedGaitError> {
+    let map = |s: &DVector<f64>, iteration: usize| {
+        legged_step_map::<W, N, Y>(walker, s, options)
+            .map_err(|source| LeggedGaitError::Step { iteration, source })
+    };
+    let (section, residual, iterations, step) = damped_newton(start, NEWTON_TOL, map, |s, i| {
+        match walker.exact_step_map(s, None, options) {
+            Ok(d) => Ok(d.jacobian),
+            Err(_) => central_jacobian(s, |x| Ok(map(x, i)?.0)),
+        }
+    })?;
+    let (second, spread) = differences::<W, N, Y>(walker, &section, iterations + 1, options)?;
+    let (jacobian, derivative, jacobian_error) =
+        match walker.exact_step_map(&section, None, options) {
+            Ok(d) => {
+                let error = (&d.jacobian - &second).amax();
+                (d.jacobian, EXACT_ROUTE, error)
+            }
+            Err(_) => (second, DIFFERENCES_ROUTE, spread),
+        };
+    Ok(LeggedGait {
+        multipliers: multipliers(&jacobian),
+        section,
+        residual,
+        iterations,
+        jacobian,
+        derivative,
         jacobian_error,
         step,
     })

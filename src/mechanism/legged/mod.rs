@@ -4,7 +4,8 @@
 //! force-level complementarity rule of docs/model.md section 3 ([`forces`]); every impact is the impulse-level
 //! complementarity problem of section 5, and a heel strike follows the DLS-indicator procedure (A1)-(A4),
 //! (B1)-(B3) ([`impact`]). Events (a heel strike, a lift-off, a stopper's hit and unlock, a bounced tip's
-//! landing, a fall) are located on the integrator's dense output ([`walk`]).
+//! landing, a fall) are located on the integrator's dense output ([`walk`]), which records the step for its
+//! exact derivatives ([`derivative`]).
 //!
 //! Conventions: contact point 0 is the fore (stance) leg's tip and contact point 1 the rear leg's; the rear
 //! leg, once its tip has left the ground, is the swing leg, and its tip reaching the ground ahead of the fore
@@ -15,6 +16,7 @@
 //!
 //! The wheel walks by `crate::walk` still; this walk is to become the one walk (docs/model.md section 13).
 
+pub mod derivative;
 pub mod forces;
 pub mod gait;
 pub mod impact;

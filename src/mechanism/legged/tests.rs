@@ -2,7 +2,7 @@
 
 use nalgebra::{SVector, Vector2};
 
-use super::gait::{legged_gait, LeggedGait};
+use super::gait::{legged_gait, legged_gait_exact, LeggedGait, DIFFERENCES_ROUTE, EXACT_ROUTE};
 use super::impact::Branch;
 use super::walk::LeggedOptions;
 use super::Legged;
@@ -112,7 +112,7 @@ fn gait_at(rtol: f64) -> LeggedGait<6> {
     let mut options = LeggedOptions::default();
     options.tolerances.rtol = rtol;
     options.tolerances.atol = rtol / 10.0;
-    legged_gait::<_, 6, 13>(&w, &w.default_start(), &options).expect("the default gait")
+    legged_gait_exact::<_, 6, 13>(&w, &w.default_start(), &options).expect("the default gait")
 }
 
 #[test]
@@ -163,14 +163,19 @@ fn the_telescopic_gait_does_not_depend_on_the_tolerance() {
     let (a, b) = (gait_at(1e-11), gait_at(1e-12));
     assert!((a.step.period - b.step.period).abs() < 1e-9);
     assert!((&a.section - &b.section).amax() < 1e-8);
-    // DP by Richardson-extrapolated central differences at the fixed point (plain central differences of step
-    // 1e-6 were noise-bound: at rtol 1e-11, 1e-12 and 1e-13 their multipliers differed by up to 5.3e-5); their
-    // error estimate bounds how far the multipliers can move with the tolerance. The exact derivatives of the
-    // replay are to come.
+    // The exact DP of the replay at the fixed point, checked against Richardson-extrapolated central differences
+    // (plain central differences of step 1e-6 were noise-bound: at rtol 1e-11, 1e-12 and 1e-13 their
+    // multipliers differed by up to 5.3e-5).
+    assert_eq!((a.derivative, b.derivative), (EXACT_ROUTE, EXACT_ROUTE));
+    println!(
+        "exact DP against differences: {:e}, {:e}",
+        a.jacobian_error, b.jacobian_error
+    );
     assert!(a.jacobian_error < 1e-6 && b.jacobian_error < 1e-6);
     for (x, y) in a.multipliers.iter().zip(&b.multipliers).take(3) {
+        println!("multiplier {x:?} against {y:?}");
         assert!(
-            (x[0] - y[0]).abs() + (x[1] - y[1]).abs() < 4e-6,
+            (x[0] - y[0]).abs() + (x[1] - y[1]).abs() < 1e-9,
             "{:?} against {:?}",
             a.multipliers,
             b.multipliers
@@ -227,4 +232,56 @@ fn a_step_answers_the_stop_at_its_first_phase() {
         matches!(outcome, Err(super::LeggedError::Interrupted)),
         "{outcome:?}"
     );
+}
+
+#[test]
+fn the_exact_derivatives_agree_with_differences() {
+    use super::derivative::LeggedDerivatives;
+    use crate::mechanism::rigid_check::richardson_jacobian;
+    let w = Telescopic::default();
+    let options = LeggedOptions::default();
+    let gait = gait_at(1e-11);
+    let key = "viscosity";
+    let exact = w
+        .exact_step_map(&gait.section, Some(key), &options)
+        .expect("the gait's step map is differentiable");
+    // The value is the walk's, bit for bit.
+    let (value, _) = super::gait::legged_step_map::<_, 6, 13>(&w, &gait.section, &options).unwrap();
+    assert_eq!(exact.value, value);
+    // DP against Richardson-extrapolated differences (gait.jacobian), within their error estimate.
+    let dp = (&exact.jacobian - &gait.jacobian).amax();
+    println!(
+        "DP: exact against differences {dp:e} (their error {:e})",
+        gait.jacobian_error
+    );
+    assert!(dp < 1e-6, "DP differs by {dp:e}");
+    // dP/dc against differences in the parameter.
+    let c = w.viscosity;
+    let (dpdc, error) = richardson_jacobian(5, &[c], |_, t| {
+        let moved = w.with_parameter(key, c + t).unwrap();
+        Ok::<_, super::LeggedError>(
+            super::gait::legged_step_map::<_, 6, 13>(&moved, &gait.section, &options)?.0,
+        )
+    })
+    .unwrap();
+    let exact_dpdc = exact.dparam.expect("dP/dc asked for");
+    let diff = (&exact_dpdc - dpdc.column(0)).amax();
+    println!("dP/dc: exact {exact_dpdc:?}, against differences {diff:e} (their error {error:e})");
+    assert!(
+        diff < 1e-6 * exact_dpdc.amax().max(1.0),
+        "dP/dc differs by {diff:e}"
+    );
+}
+
+#[test]
+fn a_walker_without_exact_derivatives_takes_differences() {
+    // The same walker through the differences' route: the same gait, its multipliers within their estimate.
+    let w = Telescopic::default();
+    let options = LeggedOptions::default();
+    let by_differences = legged_gait::<_, 6, 13>(&w, &w.default_start(), &options).unwrap();
+    let exact = gait_at(1e-11);
+    assert_eq!(by_differences.derivative, DIFFERENCES_ROUTE);
+    assert!((&by_differences.section - &exact.section).amax() < 1e-9);
+    let error = by_differences.jacobian_error.max(1e-9);
+    assert!((&by_differences.jacobian - &exact.jacobian).amax() < 2.0 * error);
 }

@@ -17,8 +17,9 @@ use nalgebra::SVector;
 use super::forces::{solve, Solved};
 use super::impact::{heel_strike, impact, next_phase, Branch, Closing};
 use super::{Legged, LeggedError, Modes, Tip};
-use crate::integrate::{locate_root, DenseStep, Dop853, OdeSystem, Tolerances};
+use crate::integrate::{locate_root, DenseStep, Dop853, Method, OdeSystem, Tolerances};
 use crate::mechanism::rigid::{MIN_STRIDE, STOP_CHECK_STEPS};
+use crate::mechanism::sensitivity::Tape;
 
 /// Equal parts of an accepted step at whose ends the event functions are evaluated.
 pub const EVENT_SAMPLES: usize = 4;
@@ -181,7 +182,7 @@ impl Guard {
 
 /// The events a phase watches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Event {
+pub enum Event {
     /// Tip `i`'s normal force vanishes.
     LiftOff(usize),
     /// Leg `i`'s stopper lets go.
@@ -233,6 +234,50 @@ fn event_values<W: Legged<N>, const N: usize>(
     out.push((Event::Fall, Some(walker.hip_height(q))));
     out.push((Event::RollBack, Some(walker.progress(q, qd))));
     out
+}
+
+/// The most impulses one event applies: its impact, then a Zeno lock of each leg ([`settle_zeno`]).
+pub const MOST_IMPULSES: usize = 3;
+
+/// An event as the step's exact derivatives replay it (`super::derivative`): which event, and the impulses its
+/// reset applied in order (the units that took each: the impact's, then the Zeno locks'), the legs exchanged
+/// after the heel strike that ends the step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Crossing {
+    /// The event.
+    pub event: Event,
+    /// The impulses, in order.
+    pub impulses: [Option<Modes>; MOST_IMPULSES],
+}
+
+/// The record of a legged walker's step: the heel strike's impulse at its start (the units that took it), and
+/// its phases with their accepted integrator steps and the events that ended them, on the walk's state
+/// `(q, q', W)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeggedTape<const Y: usize> {
+    /// The units that took the heel strike's impulse at the step's start.
+    pub strike: Modes,
+    /// The phases.
+    pub phases: Tape<Modes, Crossing, Y>,
+}
+
+impl<const Y: usize> LeggedTape<Y> {
+    /// An empty record.
+    pub fn new() -> LeggedTape<Y> {
+        LeggedTape {
+            strike: Modes {
+                tips: [Tip::Free; 2],
+                held: [false; 2],
+            },
+            phases: Tape::new(Method::Dop853),
+        }
+    }
+}
+
+impl<const Y: usize> Default for LeggedTape<Y> {
+    fn default() -> LeggedTape<Y> {
+        LeggedTape::new()
+    }
 }
 
 /// What a phase keeps between accepted steps.
@@ -377,13 +422,14 @@ fn swing_below<W: Legged<N>, const N: usize>(
 fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
     (modes, t, y): (&mut Modes, &mut f64, &mut SVector<f64, Y>),
-    acc: &mut StepAccount,
+    (acc, tape): (&mut StepAccount, &mut Tape<Modes, Crossing, Y>),
     options: &LeggedOptions,
 ) -> Result<bool, LeggedError> {
     let system = Phase {
         walker,
         modes: *modes,
     };
+    tape.begin(*modes, *t, *y);
     let mut integrator = Dop853::new(&system, *t, *y, options.tolerances);
     let start = unpack_pair::<N, Y>(y);
     let mut watch = Watch::new(
@@ -402,11 +448,15 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
         taken += 1;
         let step = integrator.step(&system, options.max_step_time)?;
         let (t0, t1) = (step.t0(), step.t1());
+        tape.step(step.h(), t1);
         if let Some((event, te)) = earliest_event(walker, modes, &watch, &step, options) {
             *y = step.eval(te);
             *t = te;
             acc.phase(walker, modes, te - t0, &unpack::<N, Y>(y).0);
-            return handle_event(walker, event, (modes, *t, y), acc, options);
+            let before = *y;
+            let (ends, impulses) = handle_event(walker, event, (modes, *t, y), acc, options)?;
+            tape.end(te, Crossing { event, impulses }, before);
+            return Ok(ends);
         }
         let end = unpack_pair::<N, Y>(step.y1());
         acc.phase(walker, modes, t1 - t0, &end.0);
@@ -431,15 +481,18 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
     }
 }
 
-/// Handle `event` at `(t, y)`: the next phase's modes (and the impact's velocities in `y`); `Ok(true)` at the
-/// heel strike.
+/// The impulses an event's reset applied, in order ([`Crossing::impulses`]).
+type Impulses = [Option<Modes>; MOST_IMPULSES];
+
+/// Handle `event` at `(t, y)`: the next phase's modes (and the impact's velocities in `y`); `true` at the heel
+/// strike; with the impulses applied.
 fn handle_event<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
     event: Event,
     (modes, t, y): (&mut Modes, f64, &mut SVector<f64, Y>),
     acc: &mut StepAccount,
     options: &LeggedOptions,
-) -> Result<bool, LeggedError> {
+) -> Result<(bool, Impulses), LeggedError> {
     acc.events += 1;
     if acc.events > options.max_events {
         return Err(LeggedError::Chatter {
@@ -448,8 +501,9 @@ fn handle_event<W: Legged<N>, const N: usize, const Y: usize>(
         });
     }
     let (q, qd) = unpack::<N, Y>(y);
+    let mut impulses: Impulses = [None; MOST_IMPULSES];
     let closing = match event {
-        Event::Strike => return Ok(true),
+        Event::Strike => return Ok((true, impulses)),
         Event::Fall => return Err(LeggedError::Fell { time: t }),
         Event::RollBack => return Err(LeggedError::RolledBack { time: t }),
         Event::LiftOff(_) | Event::Unlock(_) => None,
@@ -464,29 +518,35 @@ fn handle_event<W: Legged<N>, const N: usize, const Y: usize>(
                 Closing::Tip(_) => acc.losses.landings += hit.loss,
                 _ => acc.losses.stoppers += hit.loss,
             }
+            impulses[0] = Some(hit.took);
             (hit.took, hit.qd_plus)
         }
     };
-    let (next, qd_plus) = settle_zeno(walker, (&q, qd_plus), start, t, acc)?;
+    let (next, qd_plus, locks) = settle_zeno(walker, (&q, qd_plus), start, t, acc)?;
+    for (slot, lock) in impulses.iter_mut().filter(|m| m.is_none()).zip(locks) {
+        *slot = Some(lock);
+    }
     *modes = next;
     *y = pack(&q, &qd_plus, y[2 * N]);
-    Ok(false)
+    Ok((false, impulses))
 }
 
 /// The phase after an impact, with the Zeno rule of docs/model.md section 5: a free leg at its stopper (within
 /// [`GUARD_GAP`]) that moves inward at `v` with `v^2 < 2 a GUARD_GAP`, `a` its outward acceleration in the phase
 /// that would follow, would come back within the guard: it is locked at once by a plastic stopper impact (each
-/// leg at most once), the other units candidates; the kinetic energy taken is a stopper loss.
+/// leg at most once), the other units candidates; the kinetic energy taken is a stopper loss. With the units
+/// that took each lock's impulse, in order.
 fn settle_zeno<W: Legged<N>, const N: usize>(
     walker: &W,
     (q, mut qd): (&SVector<f64, N>, SVector<f64, N>),
     start: Modes,
     t: f64,
     acc: &mut StepAccount,
-) -> Result<(Modes, SVector<f64, N>), LeggedError> {
+) -> Result<(Modes, SVector<f64, N>, Vec<Modes>), LeggedError> {
     let (mut modes, mut solved) = next_phase(walker, (q, &qd), &start, t)?;
     let strokes = walker.strokes();
     let mut locked = [false; 2];
+    let mut locks = Vec::new();
     while let Some(i) = (0..2).find(|&i| {
         let Some(s) = strokes[i] else { return false };
         let (v, a) = (-qd[s.coordinate], solved.qdd[s.coordinate]);
@@ -501,9 +561,10 @@ fn settle_zeno<W: Legged<N>, const N: usize>(
         let hit = impact(walker, (q, &qd), &modes, Closing::Stopper(i), t)?;
         acc.losses.stoppers += hit.loss;
         qd = hit.qd_plus;
+        locks.push(hit.took);
         (modes, solved) = next_phase(walker, (q, &qd), &hit.took, t)?;
     }
-    Ok((modes, qd))
+    Ok((modes, qd, locks))
 }
 
 /// The legs at their stoppers in `q`.
@@ -516,8 +577,18 @@ pub fn legs_held<W: Legged<N>, const N: usize>(walker: &W, q: &SVector<f64, N>) 
 /// One step of `walker` from `(q, q')` on the section (see the module documentation).
 pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
+    state: (&SVector<f64, N>, &SVector<f64, N>),
+    options: &LeggedOptions,
+) -> Result<LeggedStep<N>, LeggedError> {
+    legged_step_taped::<W, N, Y>(walker, state, options, &mut LeggedTape::new())
+}
+
+/// [`legged_step`], recorded on `tape` for its exact derivatives (`super::derivative`).
+pub fn legged_step_taped<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
     (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
     options: &LeggedOptions,
+    tape: &mut LeggedTape<Y>,
 ) -> Result<LeggedStep<N>, LeggedError> {
     let e0 = walker.energy(q, qd);
     let strike = heel_strike(walker, (q, qd), legs_held(walker, q), 0.0)?;
@@ -535,7 +606,16 @@ pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
     let mut modes = strike.next.0;
     let mut y = pack::<N, Y>(q, &strike.impact.qd_plus, 0.0);
     let mut t = 0.0;
-    while !run_phase(walker, (&mut modes, &mut t, &mut y), &mut acc, options)? {}
+    *tape = LeggedTape {
+        strike: strike.impact.took,
+        phases: Tape::new(Method::Dop853),
+    };
+    while !run_phase(
+        walker,
+        (&mut modes, &mut t, &mut y),
+        (&mut acc, &mut tape.phases),
+        options,
+    )? {}
     let (q1, qd1) = unpack::<N, Y>(&y);
     if modes.tips[0] != Tip::Stuck {
         return Err(LeggedError::StanceNotStuck {
