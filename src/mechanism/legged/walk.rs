@@ -236,7 +236,8 @@ fn event_values<W: Legged<N>, const N: usize>(
     out
 }
 
-/// The most impulses one event applies: its impact, then a Zeno lock of each leg (the Zeno rule of docs/model.md section 5).
+/// The most impulses one event applies: its impact, then a Zeno lock of each leg (the Zeno rule of
+/// docs/model.md section 5).
 pub const MOST_IMPULSES: usize = 3;
 
 /// An event as the step's exact derivatives replay it (`super::derivative`): which event, and the impulses its
