@@ -1,5 +1,5 @@
-//! `vrw gait` and `vrw continue` with `--model path/to/walker.toml` (docs/model.md section 13): the shipped
-//! compass gait description walks the built-in's gait, the shipped wheel says what it lacks, and a bad
+//! The jobs with `--model path/to/walker.toml` (docs/model.md section 13): the shipped compass gait description
+//! walks the built-in's gait (`gait`, `continue`) and walks (`simulate`, `sweep`, `orbit`, `plot`, `animate`), the shipped wheel says what it lacks, and a bad
 //! description stops the program with the line of the problem.
 
 use std::path::{Path, PathBuf};
@@ -155,4 +155,112 @@ fn the_described_compass_continues_in_the_slope() {
     let out = text(&run.stdout);
     assert!(run.status.success(), "{}", text(&run.stderr));
     assert!(out.contains("PD at slope = 0.076635632"), "{out}");
+}
+
+/// `vrw simulate`, `sweep` and `orbit` of the described compass gait walk the built-in's walk: the same files
+/// but the model's name and the drawing's points (the description's: its masses, feet and hinges), which lie
+/// where the built-in's do; `plot` and `animate` draw the run.
+#[test]
+fn the_described_compass_walks_every_walker_job() {
+    let path = model("compass.toml");
+    let path = path.to_str().unwrap();
+    let jobs: [&[&str]; 3] = [
+        &["simulate", "--steps", "3"],
+        &[
+            "sweep", "--param", "slope", "--from", "0.04", "--to", "0.06", "--points", "3",
+        ],
+        &[
+            "orbit", "--param", "slope", "--from", "0.06", "--to", "0.07", "--points", "3",
+        ],
+    ];
+    for job in jobs {
+        let (described, d1) = vrw(&[job, &["--model", path]].concat(), &[]);
+        let (built_in, d2) = vrw(&[job, &["--model", "compass"]].concat(), &[]);
+        assert!(
+            described.status.success(),
+            "{job:?}: {}",
+            text(&described.stderr)
+        );
+        assert!(
+            built_in.status.success(),
+            "{job:?}: {}",
+            text(&built_in.stderr)
+        );
+        let body = |o: &Output| {
+            text(&o.stdout)
+                .lines()
+                .skip(1)
+                .map(String::from)
+                .collect::<Vec<_>>()
+        };
+        let wrote = |o: &Output| {
+            body(o)
+                .into_iter()
+                .map(|l| {
+                    l.replace(&d1.path().display().to_string(), "")
+                        .replace(&d2.path().display().to_string(), "")
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(wrote(&described), wrote(&built_in), "{job:?}");
+        let csv = if job[0] == "simulate" {
+            "steps.csv"
+        } else {
+            &format!("{}.csv", job[0])
+        };
+        let read = |d: &tempfile::TempDir| {
+            std::fs::read_to_string(d.path().join("out").join(csv)).unwrap()
+        };
+        assert_eq!(read(&d1), read(&d2), "{job:?}: {csv}");
+    }
+    // The trajectory: the same coordinates and energies; the described hip and feet where the built-in's are.
+    let (_, d1) = vrw(&["simulate", "--steps", "2", "--model", path], &[]);
+    let (_, d2) = vrw(&["simulate", "--steps", "2", "--model", "compass"], &[]);
+    let table = |d: &tempfile::TempDir| {
+        let text = std::fs::read_to_string(d.path().join("out/trajectory.csv")).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        (header, rows)
+    };
+    let ((h1, r1), (h2, r2)) = (table(&d1), table(&d2));
+    assert_eq!(r1.len(), r2.len());
+    let column = |h: &[String], name: &str| {
+        h.iter()
+            .position(|c| c == name)
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    for (a, b) in [
+        ("energy", "energy"),
+        ("theta1", "theta1"),
+        ("hip_x", "hip_x"),
+        ("hip_z", "hip_z"),
+        ("foot1_x", "stance_foot_x"),
+        ("foot2_z", "swing_foot_z"),
+        ("theta1_hinge_z", "hip_z"),
+        ("leg2_x", "swing_leg_mass_x"),
+    ] {
+        let (i, j) = (column(&h1, a), column(&h2, b));
+        for (x, y) in r1.iter().zip(&r2) {
+            assert!(
+                (x[i] - y[j]).abs() < 1e-12,
+                "{a} {} against {b} {}",
+                x[i],
+                y[j]
+            );
+        }
+    }
+    for job in [&["plot"][..], &["animate", "--still", "0.5"]] {
+        let run = Command::new(env!("CARGO_BIN_EXE_vrw"))
+            .args(job)
+            .arg(d1.path().join("out"))
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{job:?}: {}", text(&run.stderr));
+    }
+    assert!(
+        d1.path().join("out/run.png").exists() && d1.path().join("out/walk-frame.png").exists()
+    );
 }

@@ -18,6 +18,7 @@ mod map;
 mod orbit;
 mod simulate;
 mod sweep;
+mod walker_described;
 mod walker_figures;
 mod walker_model;
 mod walker_orbit;

@@ -107,20 +107,20 @@ impl Walker {
 
     /// What the walker offers the jobs ([`WalkerModel`]): the one place a job meets the kind of walker.
     ///
-    /// A described walker walks in `vrw gait` and `vrw continue` only so far: the other jobs refuse it.
     pub fn model(&self) -> Result<Box<dyn WalkerModel + '_>, AppError> {
         Ok(match self {
             Walker::Simplest(w) => Box::new(RigidModel::<_, 2, 4>::new(w, Simplest::default_start)),
             Walker::Compass(w) => Box::new(RigidModel::<_, 4, 8>::new(w, Compass::default_start)),
             Walker::Described(w) => {
-                return Err(AppError::InvalidOption {
+                described::walkable(w.description()).map_err(|e| AppError::InvalidOption {
                     option: "model",
-                    reason: format!(
-                        "the described walker `{}` walks in `vrw gait` and `vrw continue` so far (docs/model.md \
-                         section 13)",
-                        w.description().name
-                    ),
-                })
+                    reason: e.to_string(),
+                })?;
+                crate::with_rigid_described!(
+                    w,
+                    w => Box::new(RigidModel::new(w, super::walker_described::described_start)),
+                    _ => unreachable_walk(w)?
+                )
             }
         })
     }

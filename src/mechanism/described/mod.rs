@@ -14,6 +14,7 @@
 mod check;
 mod check_gait;
 mod checker;
+mod drawing;
 mod error;
 pub mod expr;
 mod format;
@@ -37,6 +38,7 @@ use nalgebra::SVector;
 use super::{Equations, Mechanism, PointKinematics, Real};
 use crate::params::ConfigError;
 
+pub use drawing::Drawing;
 pub use error::{DescriptionError, Problem};
 pub use expr::{Expr, ExprError};
 pub use kinematics::Values;
