@@ -10,9 +10,9 @@ use serde::Serialize;
 
 use super::walkers::{as_map, named, TELESCOPIC};
 use super::{in_run, AppError, SearchEnded};
+use crate::mechanism::described::AnyDescribed;
 use crate::mechanism::legged::gait::{legged_gait, legged_step_map, LeggedGait, LeggedGaitError};
 use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
-use crate::mechanism::described::AnyDescribed;
 use crate::mechanism::legged::{Legged, LeggedError};
 use crate::mechanism::telescopic::Telescopic;
 use crate::output;
@@ -156,7 +156,10 @@ fn failure_kind(e: &LeggedGaitError) -> &'static str {
 
 /// The start (`initial`, or the model's), by the section's names, and the search from it: the gait's record, or
 /// why there is none.
-type Searched = (Vec<(String, f64)>, Result<LeggedGaitRecord, LeggedGaitError>);
+type Searched = (
+    Vec<(String, f64)>,
+    Result<LeggedGaitRecord, LeggedGaitError>,
+);
 
 /// The search of [`run_legged_gait`] for `walker`, from `job.initial` or `default_start`.
 fn compute<W: Legged<N>, const N: usize, const Y: usize>(
@@ -189,10 +192,7 @@ fn compute<W: Legged<N>, const N: usize, const Y: usize>(
     }
     let result = search::<W, N, Y>(walker, &start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
-    Ok((
-        named(&names, &start),
-        result.map(|g| record(walker, &g)),
-    ))
+    Ok((named(&names, &start), result.map(|g| record(walker, &g))))
 }
 
 /// Where a described walker's search starts (its `[gait]` table's `start`), checked on its section with the

@@ -51,7 +51,11 @@ fn run_walker(args: &GaitArgs, walker: LeggedWalker) -> Result<()> {
         .flatten()
         .map(|(k, v)| format!("{k} = {v}"))
         .collect();
-    println!("vrw gait --model {}: {}", summary.model, parameters.join(", "));
+    println!(
+        "vrw gait --model {}: {}",
+        summary.model,
+        parameters.join(", ")
+    );
     let Some(g) = &summary.gait else {
         super::super::print_wrote(&args.out);
         bail!(

@@ -5,9 +5,9 @@ use toml::Spanned;
 
 use super::checker::Checker;
 use super::error::{DescriptionError, Problem};
+use super::expr::Expr;
 use super::format;
 use super::intern;
-use super::expr::Expr;
 use super::model::{Description, Gait, LegStroke, Motion, State, STOPPERS_LINE};
 
 /// Positions fixed by the contact conditions on the section: the stance contact's `x` and `z`, the landing
@@ -49,7 +49,7 @@ pub fn gait(
     };
     let relabel = relabel(cx, &g.relabel, d)?;
     let strokes = match &g.strokes {
-        Some(raw) => Some(strokes(cx, raw, d, &relabel)?),
+        Some(raw) => Some(strokes(cx, raw, d, (&relabel, [stance, lands]))?),
         None => None,
     };
     let fore = strokes.as_ref().map(|[fore, _]| fore.coordinate);
@@ -123,12 +123,13 @@ fn guesses(
 }
 
 /// The legs' strokes: two free prismatic joints with an upper stopper and none below (the compliant walk holds
-/// a leg at its upper stopper only), exchanged by the relabeling, and no other joint with stoppers.
+/// a leg at its upper stopper only), each moving its leg's contact (`tips`: the stance and the landing
+/// contact), exchanged by the relabeling, and no other joint with stoppers.
 fn strokes(
     cx: &Checker,
     raw: &Spanned<format::Strokes>,
     d: &Description,
-    relabel: &[usize],
+    (relabel, tips): (&[usize], [usize; 2]),
 ) -> Result<[LegStroke; 2], DescriptionError> {
     let refuse = |offset: usize, reason: String| {
         cx.at(
@@ -141,7 +142,7 @@ fn strokes(
     };
     let s = raw.get_ref();
     let mut out = Vec::with_capacity(2);
-    for name in [&s.fore, &s.rear] {
+    for (name, tip) in [&s.fore, &s.rear].into_iter().zip(tips) {
         let k = cx.find(name, &d.coordinates, "coordinate")?;
         let n = name.get_ref();
         let at = name.span().start;
@@ -173,6 +174,16 @@ fn strokes(
                 ),
             ));
         };
+        if !moves(d, k, d.contacts[tip].body) {
+            return Err(refuse(
+                at,
+                format!(
+                    "`{n}` does not move the contact `{}`: a stroke is the length of the leg whose tip that \
+                     contact is (`fore` the stance contact's, `rear` the landing contact's)",
+                    d.contacts[tip].name
+                ),
+            ));
+        }
         out.push(LegStroke {
             coordinate: k,
             stopper,
@@ -245,6 +256,21 @@ fn relabel(
         ));
     }
     Ok(relabel)
+}
+
+/// Whether the free joint of `coordinate` lies on the path from `body` to the ground (the tree is checked).
+fn moves(d: &Description, coordinate: usize, body: usize) -> bool {
+    let mut next = Some(body);
+    while let Some(child) = next {
+        let Some(joint) = d.joints.iter().find(|j| j.child == child) else {
+            return false;
+        };
+        if matches!(&joint.state, State::Free(f) if f.coordinate == coordinate) {
+            return true;
+        }
+        next = joint.parent;
+    }
+    false
 }
 
 /// The sliding coordinate: a free prismatic joint from the ground.

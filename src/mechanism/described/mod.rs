@@ -26,6 +26,8 @@ mod values;
 mod walk;
 
 #[cfg(test)]
+mod compliant_tests;
+#[cfg(test)]
 mod refusal_tests;
 #[cfg(test)]
 mod tests;

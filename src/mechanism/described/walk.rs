@@ -235,7 +235,9 @@ impl<const N: usize> Described<N> {
         }
         let solved = |velocity: bool| -> Vec<usize> {
             (0..N)
-                .filter(|k| !g.section.contains(&(*k, velocity)) && held.map(|(h, _)| h) != Some(*k))
+                .filter(|k| {
+                    !g.section.contains(&(*k, velocity)) && held.map(|(h, _)| h) != Some(*k)
+                })
                 .collect()
         };
         self.solve_positions(g, &mut q, &solved(false))?;
