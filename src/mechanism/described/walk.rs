@@ -1,13 +1,16 @@
 //! A described biped with rigid legs walks as the built-in compass gait does (docs/model.md section 13): single
 //! support, heel strike and the legs' exchange by [`super::super::turns`] with the stance and landing contacts
-//! and the relabeling of its `[gait]` table, and a section of its own.
+//! and the relabeling of its `[gait]` table, and a section of its own. (One with two telescopic legs walks by
+//! the compliant walk, `compliant.rs`, on the section made here too.)
 //!
 //! The section holds the coordinates and velocities the table names; the others follow from the contact
-//! conditions just after a heel strike: the stance contact at the origin and held (`x = z = 0`, `J q' = 0`),
-//! the landing contact on the ground behind it (`z = 0`). The positions are solved by Newton's method on the
-//! contacts' positions from the table's guesses, the velocities by the linear solve of the stance contact's rows.
-//! A description that cannot walk this way (no `[gait]` table, or joints with springs, dampers or stoppers,
-//! which need the compliant walk) says what it lacks ([`NotWalkable`]).
+//! conditions: the stance contact at the origin (`x = z = 0`), the landing contact on the ground behind it
+//! (`z = 0`), and at rest (`J q' = 0`) the stance contact just after a rigid biped's heel strike, or the landing
+//! (rear) contact before a compliant walker's impact, whose fore leg is then at its stopper and not extending.
+//! The positions are solved by Newton's method on the contacts' positions from the table's guesses, the
+//! velocities by the linear solve of the resting contact's rows. A description that cannot walk (no `[gait]`
+//! table; joints with springs, dampers or stoppers and no legs' strokes; more than two telescopic legs) says
+//! what it lacks ([`NotWalkable`]).
 
 use nalgebra::{DVector, Matrix2, Matrix3, SVector, Vector2, Vector3};
 
