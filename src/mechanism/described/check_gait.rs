@@ -331,24 +331,22 @@ fn section(
                     },
                 )
             })?;
-        if fore == Some(k) {
+        let refused = if fore == Some(k) {
+            Some(format!(
+                "`{n}` is the fore leg's stroke or its rate: on the section that leg is at its stopper, not \
+                 extending"
+            ))
+        } else if section.contains(&(k, velocity)) {
+            Some(format!("`{n}` is named twice"))
+        } else {
+            None
+        };
+        if let Some(reason) = refused {
             return Err(cx.at(
                 name.span().start,
                 Problem::Field {
                     field: "section",
-                    reason: format!(
-                        "`{n}` is the fore leg's stroke or its rate: on the section that leg is at its stopper, \
-                         not extending"
-                    ),
-                },
-            ));
-        }
-        if section.contains(&(k, velocity)) {
-            return Err(cx.at(
-                name.span().start,
-                Problem::Field {
-                    field: "section",
-                    reason: format!("`{n}` is named twice"),
+                    reason,
                 },
             ));
         }
