@@ -10,7 +10,7 @@ use serde::Serialize;
 
 use super::walkers::{as_map, named, TELESCOPIC};
 use super::{in_run, AppError, SearchEnded};
-use crate::mechanism::described::AnyDescribed;
+use crate::mechanism::described::{walk, AnyDescribed, Walk};
 use crate::mechanism::legged::gait::{legged_gait, legged_step_map, LeggedGait, LeggedGaitError};
 use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
 use crate::mechanism::legged::{Legged, LeggedError};
@@ -196,8 +196,24 @@ fn compute<W: Legged<N>, const N: usize, const Y: usize>(
 }
 
 /// Where a described walker's search starts (its `[gait]` table's `start`), checked on its section with the
-/// contact conditions' reason where it is not (as `initial` where that is given with the section's length).
+/// contact conditions' reason where it is not (as `initial` where that is given with the section's length);
+/// a walker that does not walk by the compliant walk is refused, saying why.
 fn described_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<f64>, AppError> {
+    let model = |reason: String| AppError::InvalidOption {
+        option: "model",
+        reason,
+    };
+    match walk(w.description()) {
+        Ok(Walk::Compliant) => {}
+        Ok(Walk::Rigid) => {
+            return Err(model(format!(
+                "`{}` has rigid legs (its [gait] table names no strokes): it walks as a rigid biped, not by the \
+                 compliant walk",
+                w.description().name
+            )))
+        }
+        Err(e) => return Err(model(e.to_string())),
+    }
     let (names, start) = match w.description().gait.as_ref() {
         Some(g) => (g.section_names.clone(), g.start.clone()),
         None => (Vec::new(), Vec::new()),
