@@ -45,7 +45,9 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
-pub use legged::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary};
+pub use legged::{
+    run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary, LeggedWalker,
+};
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,

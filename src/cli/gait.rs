@@ -285,8 +285,14 @@ fn print_check(check: &JacobianCheck) -> Result<()> {
     )
 }
 
-/// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json.
+/// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json (a described
+/// walker with telescopic legs by the compliant walk, `legged`).
 fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
+    if let Walker::Described(w) = &walker {
+        if w.walks_compliant() {
+            return legged::run_described(args, w.clone());
+        }
+    }
     let initial = super::walker_initial(args.initial.as_deref())?;
     let job = WalkerGaitJob {
         walker,

@@ -96,16 +96,27 @@ pub fn transition<T: Real, M: Mechanism<N>, const N: usize>(
     let both = [Row::contact(turns.stance), Row::contact(turns.lands)].concat();
     let lambda_i4 = impulse_with(walker, c, (q, qd), &both)?.impulses[1];
     let traditional = impulse_with(walker, c, (q, qd), &Row::contact(turns.lands))?.qd_plus;
+    Ok(Transition {
+        lambda_i4,
+        q: exchanged(walker, turns, c, (q, qd)),
+        qd: turns.relabeled(&traditional),
+    })
+}
+
+/// The positions at a heel strike `(q, q')` in the new roles, with the constants `c`: relabeled, and slid so
+/// that the landing contact, the new stance contact, is at `x = 0`.
+pub fn exchanged<T: Real, M: Mechanism<N>, const N: usize>(
+    walker: &M,
+    turns: &Turns<N, T>,
+    c: &M::Constants<T>,
+    (q, qd): (&SVector<T, N>, &SVector<T, N>),
+) -> SVector<T, N> {
     let mut after = turns.relabeled(q);
     if let Some((k, per_unit)) = turns.shift {
         let new_foot = walker.contact(c, q, qd, turns.lands).position.x;
         after[k] -= new_foot / per_unit;
     }
-    Ok(Transition {
-        lambda_i4,
-        q: after,
-        qd: turns.relabeled(&traditional),
-    })
+    after
 }
 
 /// The heel strike at `(q, q'-)` (see the module documentation): the [`transition`] on `f64`, the walker

@@ -1,9 +1,11 @@
-//! `vrw gait --model telescopic`: the compass gait with the paper's telescopic legs (docs/model.md section 13).
+//! `vrw gait --model telescopic`: the compass gait with the paper's telescopic legs (docs/model.md section 13),
+//! and `--model walker.toml` for a described walker with telescopic legs.
 
 use anyhow::{bail, Context, Result};
 
 use super::GaitArgs;
-use vrw::app::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, TELESCOPIC};
+use vrw::app::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedWalker};
+use vrw::mechanism::described::AnyDescribed;
 use vrw::mechanism::telescopic::Telescopic;
 use vrw::params::read_walker_parameters;
 
@@ -12,15 +14,28 @@ const AUDIT_WARNING: f64 = 1e-6;
 
 /// Run `vrw gait --model telescopic` and print its gait.
 pub(super) fn run(args: &GaitArgs) -> Result<()> {
-    if args.parameter.is_some() || args.check_jacobian {
-        bail!(
-            "`parameter` and `check_jacobian` are not offered for the model `{TELESCOPIC}` yet: its gait's exact DP \
-             is checked against differences at every gait (gait.json's `jacobian_error`; docs/model.md section 13)"
-        );
-    }
     let walker: Telescopic =
         read_walker_parameters(args.params.config.as_deref(), &args.params.set)?;
     walker.validate()?;
+    run_walker(args, LeggedWalker::Telescopic(walker))
+}
+
+/// Run `vrw gait --model walker.toml` for a described walker with telescopic legs (its parameters already
+/// read) and print its gait.
+pub(super) fn run_described(args: &GaitArgs, walker: AnyDescribed) -> Result<()> {
+    run_walker(args, LeggedWalker::Described(walker))
+}
+
+/// The search for `walker`, its lines and `gait.json`.
+fn run_walker(args: &GaitArgs, walker: LeggedWalker) -> Result<()> {
+    if args.parameter.is_some() || args.check_jacobian {
+        bail!(
+            "`parameter` and `check_jacobian` are not offered for the model `{}` yet: its gait's DP is checked \
+             against differences at every gait (gait.json's `derivative` and `jacobian_error`; docs/model.md \
+             section 13)",
+            walker.name()
+        );
+    }
     let job = LeggedGaitJob {
         walker,
         initial: super::super::walker_initial(args.initial.as_deref())?,
@@ -31,13 +46,17 @@ pub(super) fn run(args: &GaitArgs) -> Result<()> {
     super::super::interrupt_flag();
     super::super::check_out(&job.out_dir, "gait", job.overwrite)?;
     let summary = run_legged_gait(&job).context("gait")?;
-    let parameters: Vec<String> = serde_json::to_value(summary.parameters)?
+    let parameters: Vec<String> = serde_json::to_value(&summary.parameters)?
         .as_object()
         .into_iter()
         .flatten()
         .map(|(k, v)| format!("{k} = {v}"))
         .collect();
-    println!("vrw gait --model {TELESCOPIC}: {}", parameters.join(", "));
+    println!(
+        "vrw gait --model {}: {}",
+        summary.model,
+        parameters.join(", ")
+    );
     let Some(g) = &summary.gait else {
         super::super::print_wrote(&args.out);
         bail!(

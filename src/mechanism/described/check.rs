@@ -56,6 +56,7 @@ pub fn description(file: &str, text: &str) -> Result<Description, DescriptionErr
     };
     if let Some(gait) = &raw.gait {
         d.gait = Some(super::check_gait::gait(&cx, gait, &d)?);
+        super::check_gait::legs_first(&mut d);
     }
     super::values::check_defaults(&cx, &d)?;
     Ok(d)

@@ -5,9 +5,10 @@ use toml::Spanned;
 
 use super::checker::Checker;
 use super::error::{DescriptionError, Problem};
+use super::expr::Expr;
 use super::format;
 use super::intern;
-use super::model::{Description, Gait, Motion, State};
+use super::model::{Description, Gait, LegStroke, Motion, State, STOPPERS_LINE};
 
 /// Positions fixed by the contact conditions on the section: the stance contact's `x` and `z`, the landing
 /// contact's `z`.
@@ -46,27 +47,14 @@ pub fn gait(
         Some(name) => Some(shift(cx, name, d)?),
         None => None,
     };
-    let (section_names, section) = section(cx, &g.section, d)?;
-    let positions: Vec<&str> = section
-        .iter()
-        .zip(&section_names)
-        .filter(|((_, velocity), _)| !velocity)
-        .map(|(_, n)| *n)
-        .collect();
-    let mut names: Vec<&str> = d.parameters.iter().map(|p| p.name).collect();
-    names.extend(&positions);
-    let mut guess = Vec::new();
-    for (name, value) in g.guess.iter().flat_map(|p| &p.0) {
-        let k = cx.find(name, &d.coordinates, "coordinate")?;
-        if section.contains(&(k, false)) {
-            return Err(field(
-                name.span().start,
-                "guess",
-                format!("`{}` is on the section: it needs no guess", name.get_ref()),
-            ));
-        }
-        guess.push((k, cx.expr(value, &names)?));
-    }
+    let relabel = relabel(cx, &g.relabel, d)?;
+    let strokes = match &g.strokes {
+        Some(raw) => Some(strokes(cx, raw, d, (&relabel, [stance, lands]))?),
+        None => None,
+    };
+    let fore = strokes.as_ref().map(|[fore, _]| fore.coordinate);
+    let (section_names, section) = section(cx, &g.section, d, fore)?;
+    let guess = guesses(cx, g, d, (&section_names, &section), fore)?;
     if g.start.get_ref().len() != section.len() {
         return Err(field(
             g.start.span().start,
@@ -82,7 +70,8 @@ pub fn gait(
     Ok(Gait {
         stance,
         lands,
-        relabel: relabel(cx, &g.relabel, d)?,
+        relabel,
+        strokes,
         shift,
         hip: cx.find(&g.hip, &bodies, "body")?,
         section_names,
@@ -90,6 +79,147 @@ pub fn gait(
         guess,
         start: g.start.get_ref().clone(),
     })
+}
+
+/// The guesses of the coordinates the contact conditions solve for: expressions over the parameters and the
+/// section's positions, for coordinates neither on the section nor the fore leg's stroke (held at its
+/// stopper).
+fn guesses(
+    cx: &Checker,
+    g: &format::Gait,
+    d: &Description,
+    (section_names, section): (&[&'static str], &[(usize, bool)]),
+    fore: Option<usize>,
+) -> Result<Vec<(usize, Expr)>, DescriptionError> {
+    let positions = section
+        .iter()
+        .zip(section_names)
+        .filter(|((_, velocity), _)| !velocity)
+        .map(|(_, n)| *n);
+    let mut names: Vec<&str> = d.parameters.iter().map(|p| p.name).collect();
+    names.extend(positions);
+    let mut guess = Vec::new();
+    for (name, value) in g.guess.iter().flat_map(|p| &p.0) {
+        let k = cx.find(name, &d.coordinates, "coordinate")?;
+        let given = if section.contains(&(k, false)) {
+            Some("is on the section")
+        } else if fore == Some(k) {
+            Some("is the fore leg's stroke, at its stopper on the section")
+        } else {
+            None
+        };
+        if let Some(given) = given {
+            return Err(cx.at(
+                name.span().start,
+                Problem::Field {
+                    field: "guess",
+                    reason: format!("`{}` {given}: it needs no guess", name.get_ref()),
+                },
+            ));
+        }
+        guess.push((k, cx.expr(value, &names)?));
+    }
+    Ok(guess)
+}
+
+/// The legs' strokes: two free prismatic joints with an upper stopper and none below (the compliant walk holds
+/// a leg at its upper stopper only), each moving its leg's contact (`tips`: the stance and the landing
+/// contact), exchanged by the relabeling, and no other joint with stoppers.
+fn strokes(
+    cx: &Checker,
+    raw: &Spanned<format::Strokes>,
+    d: &Description,
+    (relabel, tips): (&[usize], [usize; 2]),
+) -> Result<[LegStroke; 2], DescriptionError> {
+    let refuse = |offset: usize, reason: String| {
+        cx.at(
+            offset,
+            Problem::Field {
+                field: "strokes",
+                reason,
+            },
+        )
+    };
+    let s = raw.get_ref();
+    let mut out = Vec::with_capacity(2);
+    for (name, tip) in [&s.fore, &s.rear].into_iter().zip(tips) {
+        let k = cx.find(name, &d.coordinates, "coordinate")?;
+        let n = name.get_ref();
+        let at = name.span().start;
+        let Some((joint, free)) = d.free_joints().find(|(_, f)| f.coordinate == k) else {
+            return Err(refuse(at, format!("`{n}` is no free joint")));
+        };
+        if !matches!(joint.motion, Motion::Prismatic { .. }) {
+            return Err(refuse(
+                at,
+                format!("`{n}` is a revolute joint: a leg's stroke is a prismatic joint, the leg's length"),
+            ));
+        }
+        if free.stoppers[0].is_some() {
+            return Err(refuse(
+                at,
+                format!(
+                    "`{n}` has a lower stopper (line {}): the compliant walk stops a leg at its upper stopper \
+                     only, so a lower one would be ignored",
+                    joint.field_lines[STOPPERS_LINE]
+                ),
+            ));
+        }
+        let Some(stopper) = free.stoppers[1].clone() else {
+            return Err(refuse(
+                at,
+                format!(
+                    "`{n}` has no upper stopper: the compliant walk holds a leg at its stopper (give joint `{n}` \
+                     stoppers = {{ upper = ... }})"
+                ),
+            ));
+        };
+        if !moves(d, k, d.contacts[tip].body) {
+            return Err(refuse(
+                at,
+                format!(
+                    "`{n}` does not move the contact `{}`: a stroke is the length of the leg whose tip that \
+                     contact is (`fore` the stance contact's, `rear` the landing contact's)",
+                    d.contacts[tip].name
+                ),
+            ));
+        }
+        out.push(LegStroke {
+            coordinate: k,
+            stopper,
+        });
+    }
+    let (fore, rear) = (out[0].coordinate, out[1].coordinate);
+    if fore == rear {
+        return Err(refuse(
+            s.rear.span().start,
+            "the fore and the rear leg's strokes are one joint".to_string(),
+        ));
+    }
+    if relabel[fore] != rear || relabel[rear] != fore {
+        return Err(refuse(
+            raw.span().start,
+            format!(
+                "the relabeling must exchange `{}` and `{}` (the legs exchange roles at a heel strike)",
+                d.coordinates[fore], d.coordinates[rear]
+            ),
+        ));
+    }
+    let other = d.free_joints().find(|(_, f)| {
+        f.stoppers.iter().any(Option::is_some) && f.coordinate != fore && f.coordinate != rear
+    });
+    if let Some((joint, _)) = other {
+        return Err(refuse(
+            raw.span().start,
+            format!(
+                "joint `{}` has stoppers (line {}) but is no leg's stroke: the compliant walk stops only the \
+                 legs' strokes",
+                joint.name, joint.field_lines[STOPPERS_LINE]
+            ),
+        ));
+    }
+    let [fore, rear] = [out.remove(0), out.remove(0)];
+    Ok([fore, rear])
 }
 
 /// The relabeling as `new[i] = old[relabel[i]]`: each coordinate named once as a key and once as a value.
@@ -128,6 +258,21 @@ fn relabel(
     Ok(relabel)
 }
 
+/// Whether the free joint of `coordinate` lies on the path from `body` to the ground (the tree is checked).
+fn moves(d: &Description, coordinate: usize, body: usize) -> bool {
+    let mut next = Some(body);
+    while let Some(child) = next {
+        let Some(joint) = d.joints.iter().find(|j| j.child == child) else {
+            return false;
+        };
+        if matches!(&joint.state, State::Free(f) if f.coordinate == coordinate) {
+            return true;
+        }
+        next = joint.parent;
+    }
+    false
+}
+
 /// The sliding coordinate: a free prismatic joint from the ground.
 fn shift(cx: &Checker, name: &Spanned<String>, d: &Description) -> Result<usize, DescriptionError> {
     let k = cx.find(name, &d.coordinates, "coordinate")?;
@@ -152,12 +297,14 @@ fn shift(cx: &Checker, name: &Spanned<String>, d: &Description) -> Result<usize,
 }
 
 /// The section: names of coordinates and of velocities (`_dot`), such that the contact conditions fix the
-/// others ([`POSITION_CONDITIONS`] positions, [`VELOCITY_CONDITIONS`] velocities).
+/// others ([`POSITION_CONDITIONS`] positions, [`VELOCITY_CONDITIONS`] velocities), and with telescopic legs
+/// the fore leg's stroke `fore` at its stopper, not extending (one position and one velocity more).
 #[allow(clippy::type_complexity)]
 fn section(
     cx: &Checker,
     raw: &Spanned<Vec<Spanned<String>>>,
     d: &Description,
+    fore: Option<usize>,
 ) -> Result<(Vec<&'static str>, Vec<(usize, bool)>), DescriptionError> {
     let mut names = Vec::new();
     let mut section = Vec::new();
@@ -184,12 +331,22 @@ fn section(
                     },
                 )
             })?;
-        if section.contains(&(k, velocity)) {
+        let refused = if fore == Some(k) {
+            Some(format!(
+                "`{n}` is the fore leg's stroke or its rate: on the section that leg is at its stopper, not \
+                 extending"
+            ))
+        } else if section.contains(&(k, velocity)) {
+            Some(format!("`{n}` is named twice"))
+        } else {
+            None
+        };
+        if let Some(reason) = refused {
             return Err(cx.at(
                 name.span().start,
                 Problem::Field {
                     field: "section",
-                    reason: format!("`{n}` is named twice"),
+                    reason,
                 },
             ));
         }
@@ -197,8 +354,9 @@ fn section(
         section.push((k, velocity));
     }
     let n = d.coordinates.len();
-    let free_positions = n - section.iter().filter(|(_, v)| !v).count();
-    let free_velocities = n - section.iter().filter(|(_, v)| *v).count();
+    let held = usize::from(fore.is_some());
+    let free_positions = n - held - section.iter().filter(|(_, v)| !v).count();
+    let free_velocities = n - held - section.iter().filter(|(_, v)| *v).count();
     if free_positions != POSITION_CONDITIONS || free_velocities != VELOCITY_CONDITIONS {
         return Err(cx.at(
             raw.span().start,
@@ -206,13 +364,33 @@ fn section(
                 field: "section",
                 reason: format!(
                     "it leaves {free_positions} coordinates and {free_velocities} velocities to the contact \
-                     conditions, which fix {POSITION_CONDITIONS} and {VELOCITY_CONDITIONS} (the stance contact at \
-                     the origin and held, the landing contact on the ground): name {} coordinates and {} velocities",
-                    n.saturating_sub(POSITION_CONDITIONS),
-                    n.saturating_sub(VELOCITY_CONDITIONS)
+                     conditions, which fix {POSITION_CONDITIONS} and {VELOCITY_CONDITIONS} ({}): name {} \
+                     coordinates and {} velocities",
+                    if fore.is_some() {
+                        "the stance contact at the origin, the landing contact on the ground and at rest; the fore \
+                         leg's stroke is at its stopper"
+                    } else {
+                        "the stance contact at the origin and held, the landing contact on the ground"
+                    },
+                    n.saturating_sub(POSITION_CONDITIONS + held),
+                    n.saturating_sub(VELOCITY_CONDITIONS + held)
                 ),
             },
         ));
     }
     Ok((names, section))
+}
+
+/// With telescopic legs, the compliant walk takes contact point 0 as the stance leg's tip and 1 as the landing
+/// leg's (`crate::mechanism::legged`): the contacts of `d` are reordered so, the others after them in the
+/// file's order, and the gait's indices with them.
+pub fn legs_first(d: &mut Description) {
+    let Some(g) = d.gait.as_mut().filter(|g| g.strokes.is_some()) else {
+        return;
+    };
+    let (stance, lands) = (g.stance, g.lands);
+    let mut order = vec![stance, lands];
+    order.extend((0..d.contacts.len()).filter(|i| *i != stance && *i != lands));
+    d.contacts = order.iter().map(|&i| d.contacts[i].clone()).collect();
+    (g.stance, g.lands) = (0, 1);
 }

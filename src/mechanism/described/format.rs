@@ -261,7 +261,19 @@ pub struct Contact {
     pub at: Option<Vector>,
 }
 
-/// How a biped with rigid legs walks: single support on `stance`, heel strike of `lands`, the legs' exchange.
+/// The fore (stance) and the rear (landing) leg's strokes: each a free prismatic joint, the leg's length, with
+/// an upper stopper.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Strokes {
+    /// The stance leg's length.
+    pub fore: Spanned<String>,
+    /// The landing leg's length.
+    pub rear: Spanned<String>,
+}
+
+/// How a biped walks: single support on `stance`, heel strike of `lands`, the legs' exchange; with `strokes`,
+/// its legs are telescopic and it walks by the compliant walk.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Gait {
@@ -272,6 +284,9 @@ pub struct Gait {
     /// The relabeling at heel strike: each coordinate named here takes the value the named one had (a
     /// permutation); the others keep theirs.
     pub relabel: Spanned<Pairs<Spanned<String>>>,
+    /// The telescopic legs' strokes: present, the walker walks by the compliant walk (docs/model.md section
+    /// 13); absent, its legs are rigid.
+    pub strokes: Option<Spanned<Strokes>>,
     /// The coordinate moved so that the new stance contact is at `x = 0` (a floating base's slide along the
     /// slope).
     pub shift: Option<Spanned<String>>,

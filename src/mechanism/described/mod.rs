@@ -1,6 +1,6 @@
 //! Walkers described in a TOML file (docs/model.md section 13, "Described walkers"): parameters, bodies (point
 //! masses and rigid bodies) in a tree of revolute and prismatic joints rooted at the ground, free or fixed joints
-//! with springs, dampers and stoppers, contact points, and for a biped with rigid legs how its legs take turns.
+//! with springs, dampers and stoppers, contact points, and for a biped how its legs take turns.
 //!
 //! The file is read by serde (`format.rs`) and checked (`check.rs`, `checker.rs`, `tree.rs`, `check_gait.rs`,
 //! `values.rs`)
@@ -8,12 +8,14 @@
 //! any [`Real`] by the kinematics (`kinematics.rs`), so that a described walker is a [`Mechanism`] like the
 //! built-in ones, with exact derivatives through dual numbers. Its number of coordinates `N` is known only once
 //! the file is read, while the interface is `Mechanism<N>` with `N` a constant: [`load`] dispatches once over
-//! `1..=MAX_COORDINATES` into [`AnyDescribed`]. A described biped walks as the built-in compass gait does
-//! (`walk.rs`, through [`super::turns`]).
+//! `1..=MAX_COORDINATES` into [`AnyDescribed`]. A described biped with rigid legs walks as the built-in compass
+//! gait does (`walk.rs`, through [`super::turns`]), one with two telescopic legs by the compliant walk of
+//! [`super::legged`] as the built-in telescopic walker does (`compliant.rs`).
 
 mod check;
 mod check_gait;
 mod checker;
+mod compliant;
 mod drawing;
 mod error;
 pub mod expr;
@@ -24,6 +26,8 @@ mod tree;
 mod values;
 mod walk;
 
+#[cfg(test)]
+mod compliant_tests;
 #[cfg(test)]
 mod refusal_tests;
 #[cfg(test)]
@@ -43,7 +47,7 @@ pub use error::{DescriptionError, Problem};
 pub use expr::{Expr, ExprError};
 pub use kinematics::Values;
 pub use model::{Description, MAX_COORDINATES, MAX_PARAMETERS};
-pub use walk::{walkable, NotWalkable, SectionError};
+pub use walk::{walk, walkable, NotWalkable, SectionError, Walk};
 
 /// Most bytes a description file may have.
 pub const MAX_DESCRIPTION_BYTES: u64 = 1 << 20;

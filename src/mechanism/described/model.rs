@@ -127,7 +127,17 @@ pub struct Contact {
     pub at: Vector,
 }
 
-/// How a biped with rigid legs takes its steps.
+/// A telescopic leg's stroke: the coordinate that is its length and its upper stopper (the compliant walk's
+/// `Stroke`, with the stopper an expression over the parameters).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LegStroke {
+    /// The length's index in `q`.
+    pub coordinate: usize,
+    /// The stopper: the leg is at most this long.
+    pub stopper: Expr,
+}
+
+/// How a biped takes its steps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Gait {
     /// The stance contact.
@@ -136,6 +146,9 @@ pub struct Gait {
     pub lands: usize,
     /// The relabeling: after a heel strike, coordinate `i` takes the value coordinate `relabel[i]` had.
     pub relabel: Vec<usize>,
+    /// The fore (stance) and rear (landing) legs' strokes, for a walker with telescopic legs that walks by the
+    /// compliant walk; `None`: rigid legs.
+    pub strokes: Option<[LegStroke; 2]>,
     /// The coordinate that slides the whole walker along the slope, moved so that the new stance contact is
     /// at `x = 0` (a free prismatic joint from the ground along the slope).
     pub shift: Option<usize>,

@@ -201,3 +201,110 @@ fn bad_gait_tables_and_too_many_coordinates_name_their_line() {
         AnyDescribed::N8(_)
     ));
 }
+
+/// The refusals of a `[gait]` table with telescopic legs, at their lines: a stroke that is not a free prismatic
+/// joint of its leg with an upper stopper (and none below), strokes the relabeling does not exchange, another
+/// joint with stoppers, the fore leg's stroke on the section or guessed, a section of the wrong size, an
+/// unknown key.
+#[test]
+fn bad_strokes_name_their_line() {
+    let telescopic = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/models/telescopic.toml"
+    ))
+    .unwrap();
+    let strokes = "strokes = { fore = \"L1\", rear = \"L2\" }";
+    let marked = format!("{strokes} # HERE");
+    let stoppers = "stoppers = { upper = \"stopper_length\" }\n";
+    let section = "section = [\"theta1\", \"L2\", \"theta1_dot\", \"theta2_dot\", \"L2_dot\"]";
+    let guess = "guess = { theta2 = \"-theta1\" }";
+    let cases: Vec<(String, &str)> = vec![
+        (
+            telescopic.replace(
+                strokes,
+                "strokes = { fore = \"theta1\", rear = \"L2\" } # HERE",
+            ),
+            "`theta1` is a revolute joint: a leg's stroke is a prismatic joint",
+        ),
+        (
+            telescopic
+                .replacen(stoppers, "", 1)
+                .replace(strokes, &marked),
+            "`L1` has no upper stopper",
+        ),
+        (
+            telescopic
+                .replacen(
+                    stoppers,
+                    "stoppers = { lower = 0.5, upper = \"stopper_length\" }\n",
+                    1,
+                )
+                .replace(strokes, &marked),
+            "`L1` has a lower stopper",
+        ),
+        (
+            telescopic.replace(strokes, "strokes = { fore = \"L1\", rear = \"L1\" } # HERE"),
+            "`L1` does not move the contact `foot2`",
+        ),
+        (
+            telescopic.replace(strokes, "strokes = { fore = \"L2\", rear = \"L1\" } # HERE"),
+            "`L2` does not move the contact `foot1`",
+        ),
+        (
+            telescopic.replace(strokes, "strokes = { fore = \"L3\", rear = \"L2\" } # HERE"),
+            "unknown coordinate `L3`",
+        ),
+        (
+            telescopic.replace(
+                strokes,
+                "strokes = { fore = \"L1\", rear = \"L2\", side = \"x\" } # HERE",
+            ),
+            "unknown field `side`",
+        ),
+        (
+            telescopic
+                .replace(
+                    "relabel = { theta1 = \"theta2\", theta2 = \"theta1\", L1 = \"L2\", L2 = \"L1\" }",
+                    "relabel = { theta1 = \"theta2\", theta2 = \"theta1\" }",
+                )
+                .replace(strokes, &marked),
+            "the relabeling must exchange `L1` and `L2`",
+        ),
+        (
+            telescopic
+                .replacen(
+                    "angle = \"absolute\"\n",
+                    "angle = \"absolute\"\nstoppers = { upper = 1.2 }\n",
+                    1,
+                )
+                .replace(strokes, &marked),
+            "joint `theta1` has stoppers",
+        ),
+        (
+            telescopic.replace(
+                section,
+                "section = [\"theta1\", \"L1\", \"theta1_dot\", \"theta2_dot\", \"L2_dot\"] # HERE",
+            ),
+            "`L1` is the fore leg's stroke or its rate",
+        ),
+        (
+            telescopic.replace(
+                section,
+                "section = [\"theta1\", \"L2\", \"theta1_dot\", \"theta2_dot\"] # HERE",
+            ),
+            "name 2 coordinates and 3 velocities",
+        ),
+        (
+            telescopic.replace(guess, "guess = { theta2 = \"-theta1\", L1 = 0.9 } # HERE"),
+            "`L1` is the fore leg's stroke, at its stopper on the section: it needs no guess",
+        ),
+    ];
+    for (text, needle) in cases {
+        let line = 1 + text[..text.find("# HERE").unwrap()].matches('\n').count();
+        let e = parse("bad.toml", &text).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("bad.toml line {line}: ")) && e.contains(needle),
+            "want line {line} and {needle:?}: {e}"
+        );
+    }
+}

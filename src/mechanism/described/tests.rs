@@ -12,16 +12,16 @@ use crate::dynamics::Model;
 use crate::params::Params;
 
 /// The shipped description `models/NAME.toml`.
-fn shipped(name: &str) -> AnyDescribed {
+pub(super) fn shipped(name: &str) -> AnyDescribed {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("models/{name}.toml"));
     load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A reproducible stream of numbers in `[-1, 1)` (a linear congruential generator: the tests need no more).
-struct Stream(u64);
+pub(super) struct Stream(pub(super) u64);
 
 impl Stream {
-    fn next(&mut self) -> f64 {
+    pub(super) fn next(&mut self) -> f64 {
         self.0 = self
             .0
             .wrapping_mul(6_364_136_223_846_793_005)
@@ -29,13 +29,20 @@ impl Stream {
         (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
     }
 
-    fn vector<const N: usize>(&mut self, scale: [f64; N], offset: [f64; N]) -> SVector<f64, N> {
+    pub(super) fn vector<const N: usize>(
+        &mut self,
+        scale: [f64; N],
+        offset: [f64; N],
+    ) -> SVector<f64, N> {
         SVector::from_fn(|i, _| offset[i] + scale[i] * self.next())
     }
 }
 
 /// The largest difference between two sets of numbers.
-fn max_diff<'a>(a: impl IntoIterator<Item = &'a f64>, b: impl IntoIterator<Item = &'a f64>) -> f64 {
+pub(super) fn max_diff<'a>(
+    a: impl IntoIterator<Item = &'a f64>,
+    b: impl IntoIterator<Item = &'a f64>,
+) -> f64 {
     a.into_iter()
         .zip(b)
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
@@ -505,16 +512,25 @@ fn the_equations_differentiate_exactly_in_a_parameter() {
     }
 }
 
-/// The stoppers are kept (for the compliant walk to come) and the wheel, which has them, cannot walk through a
-/// description yet and says why.
+/// The wheel's description, three telescopic legs and no `[gait]` table, cannot walk through a description
+/// and says why: the compliant walk takes two legs that take turns, and the wheel walks built in.
 #[test]
-fn the_wheel_says_it_cannot_walk_yet() {
+fn the_wheel_says_why_it_cannot_walk() {
     let wheel = shipped("wheel");
     let e = wheel.walkable().unwrap_err().to_string();
-    for needle in ["L1, L2, L3", "compliant walk", "no [gait] table"] {
+    for needle in [
+        "its joints L1, L2, L3 have stoppers (3 telescopic legs)",
+        "takes two legs that take turns",
+        "`--model vrw`",
+    ] {
         assert!(e.contains(needle), "{e}");
     }
+    assert!(!wheel.walks_compliant());
     assert!(shipped("compass").walkable().is_ok());
+    let telescopic = shipped("telescopic");
+    assert!(telescopic.walks_compliant());
+    let e = telescopic.walkable().unwrap_err().to_string();
+    assert!(e.contains("walks by the compliant walk"), "{e}");
     let free: Vec<usize> = wheel
         .description()
         .free_joints()

@@ -1,13 +1,16 @@
 //! A described biped with rigid legs walks as the built-in compass gait does (docs/model.md section 13): single
 //! support, heel strike and the legs' exchange by [`super::super::turns`] with the stance and landing contacts
-//! and the relabeling of its `[gait]` table, and a section of its own.
+//! and the relabeling of its `[gait]` table, and a section of its own. (One with two telescopic legs walks by
+//! the compliant walk, `compliant.rs`, on the section made here too.)
 //!
 //! The section holds the coordinates and velocities the table names; the others follow from the contact
-//! conditions just after a heel strike: the stance contact at the origin and held (`x = z = 0`, `J q' = 0`),
-//! the landing contact on the ground behind it (`z = 0`). The positions are solved by Newton's method on the
-//! contacts' positions from the table's guesses, the velocities by the linear solve of the stance contact's rows.
-//! A description that cannot walk this way (no `[gait]` table, or joints with springs, dampers or stoppers,
-//! which need the compliant walk) says what it lacks ([`NotWalkable`]).
+//! conditions: the stance contact at the origin (`x = z = 0`), the landing contact on the ground behind it
+//! (`z = 0`), and at rest (`J q' = 0`) the stance contact just after a rigid biped's heel strike, or the landing
+//! (rear) contact before a compliant walker's impact, whose fore leg is then at its stopper and not extending.
+//! The positions are solved by Newton's method on the contacts' positions from the table's guesses, the
+//! velocities by the linear solve of the resting contact's rows. A description that cannot walk (no `[gait]`
+//! table; joints with springs, dampers or stoppers and no legs' strokes; more than two telescopic legs) says
+//! what it lacks ([`NotWalkable`]).
 
 use nalgebra::{DVector, Matrix2, Matrix3, SVector, Vector2, Vector3};
 
@@ -15,7 +18,7 @@ use super::super::constrained::ConstrainedError;
 use super::super::rigid::{HeelStrike, RigidOptions, RigidWalker, Transition};
 use super::super::rigid_derivative::{step_map_derivative, DerivativeError, StepMapDerivative};
 use super::super::turns::{self, Turns};
-use super::super::{Mechanism, Real};
+use super::super::{Mechanism, PointKinematics, Real};
 use super::kinematics::Values;
 use super::model::{Description, Gait, Motion, State};
 use super::{AnyDescribed, Described};
@@ -30,14 +33,15 @@ pub const SECTION_RESIDUAL_TOL: f64 = 1e-12;
 /// Most Newton iterations on the section's contact conditions.
 const SECTION_ITERATIONS: usize = 50;
 
-/// Why a description cannot walk (yet).
+/// Why a description cannot walk (yet), or not the walk asked for.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NotWalkable {
-    /// Joints with springs, dampers or stoppers: the compliant walk.
+    /// Joints with springs, dampers or stoppers, and a `[gait]` table that names no legs' strokes.
     #[error(
-        "`{name}` ({file}) cannot walk yet: its joints {joints} have springs, dampers or stoppers, which need \
-         the compliant walk (double support, stoppers: docs/model.md sections 3-5) that only the built-in \
-         wheel has so far; described walkers walk with rigid legs and point feet{gait}"
+        "`{name}` ({file}) cannot walk: its joints {joints} have springs, dampers or stoppers, and its [gait] \
+         table names no legs' strokes; a described walker walks with rigid legs and point feet, or with two \
+         telescopic legs named in its [gait] table (`strokes = {{ fore = ..., rear = ... }}`: prismatic joints with \
+         an upper stopper) by the compliant walk (docs/model.md section 13)"
     )]
     Compliant {
         /// The walker's name.
@@ -46,13 +50,39 @@ pub enum NotWalkable {
         file: String,
         /// The compliant joints.
         joints: String,
-        /// Whether a `[gait]` table is missing too, in words.
-        gait: String,
+    },
+    /// More than two joints with stoppers (telescopic legs) and no `[gait]` table naming two of them: the
+    /// compliant walk takes two legs that take turns.
+    #[error(
+        "`{name}` ({file}) cannot walk: its joints {joints} have stoppers ({count} telescopic legs), and the \
+         compliant walk of a described walker takes two legs that take turns (the fore and the rear leg's strokes \
+         in a [gait] table); the rimless wheel walks built in, as `--model vrw`"
+    )]
+    ManyLegs {
+        /// The walker's name.
+        name: String,
+        /// Its file.
+        file: String,
+        /// The joints with stoppers.
+        joints: String,
+        /// How many.
+        count: usize,
+    },
+    /// Telescopic legs: the walker walks by the compliant walk, not the rigid walk asked for.
+    #[error(
+        "`{name}` ({file}) has telescopic legs (its [gait] table names their strokes): it walks by the compliant \
+         walk (docs/model.md section 13), not as a biped with rigid legs, and only `vrw gait` takes it so far"
+    )]
+    Telescopic {
+        /// The walker's name.
+        name: String,
+        /// Its file.
+        file: String,
     },
     /// No `[gait]` table.
     #[error(
         "`{name}` ({file}) cannot walk: it has no [gait] table (which contact stands, which lands, the \
-         relabeling of its coordinates, its section)"
+         relabeling of its coordinates, its section, and for telescopic legs their strokes)"
     )]
     NoGait {
         /// The walker's name.
@@ -62,25 +92,61 @@ pub enum NotWalkable {
     },
 }
 
-/// Whether `d` can walk as a rigid biped, or what it lacks.
-pub fn walkable(d: &Description) -> Result<&Gait, NotWalkable> {
+/// How a description walks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Walk {
+    /// As a biped with rigid legs and point feet (`crate::mechanism::rigid`).
+    Rigid,
+    /// By the compliant walk of a walker with two telescopic legs (`crate::mechanism::legged`).
+    Compliant,
+}
+
+/// How `d` walks, or what it lacks.
+pub fn walk(d: &Description) -> Result<Walk, NotWalkable> {
+    let (name, file) = (d.name.to_string(), d.file.clone());
+    let strokes = d.gait.as_ref().is_some_and(|g| g.strokes.is_some());
+    let stopped: Vec<&str> = d
+        .free_joints()
+        .filter(|(_, f)| f.stoppers.iter().any(Option::is_some))
+        .map(|(j, _)| j.name.as_str())
+        .collect();
+    if stopped.len() > 2 && !strokes {
+        return Err(NotWalkable::ManyLegs {
+            name,
+            file,
+            joints: stopped.join(", "),
+            count: stopped.len(),
+        });
+    }
+    let Some(gait) = &d.gait else {
+        return Err(NotWalkable::NoGait { name, file });
+    };
+    if gait.strokes.is_some() {
+        return Ok(Walk::Compliant);
+    }
     let compliant = d.compliant_joints();
     if !compliant.is_empty() {
         return Err(NotWalkable::Compliant {
-            name: d.name.to_string(),
-            file: d.file.clone(),
+            name,
+            file,
             joints: compliant.join(", "),
-            gait: if d.gait.is_none() {
-                "; it also has no [gait] table (how its legs take turns)".to_string()
-            } else {
-                String::new()
-            },
         });
     }
-    d.gait.as_ref().ok_or_else(|| NotWalkable::NoGait {
-        name: d.name.to_string(),
-        file: d.file.clone(),
-    })
+    Ok(Walk::Rigid)
+}
+
+/// Whether `d` can walk as a rigid biped (its `[gait]` table), or what it lacks.
+pub fn walkable(d: &Description) -> Result<&Gait, NotWalkable> {
+    match walk(d)? {
+        Walk::Compliant => Err(NotWalkable::Telescopic {
+            name: d.name.to_string(),
+            file: d.file.clone(),
+        }),
+        Walk::Rigid => d.gait.as_ref().ok_or_else(|| NotWalkable::NoGait {
+            name: d.name.to_string(),
+            file: d.file.clone(),
+        }),
+    }
 }
 
 impl AnyDescribed {
@@ -89,10 +155,15 @@ impl AnyDescribed {
         walkable(self.description()).map(|_| ())
     }
 
-    /// Whether the section values `s` complete to a state just after a heel strike
-    /// ([`Described::section_state`]); a walker that cannot walk has no section.
+    /// Whether it walks by the compliant walk (two telescopic legs named in its `[gait]` table).
+    pub fn walks_compliant(&self) -> bool {
+        walk(self.description()) == Ok(Walk::Compliant)
+    }
+
+    /// Whether the section values `s` complete to a state on its section ([`Described::section_state`]); a
+    /// walker that cannot walk has no section.
     pub fn check_section(&self, s: &DVector<f64>) -> Result<(), SectionError> {
-        if self.walkable().is_err() {
+        if walk(self.description()).is_err() {
             return Err(SectionError::Singular);
         }
         crate::with_described!(self, w => w.section_state(s).map(|_| ()))
@@ -102,7 +173,7 @@ impl AnyDescribed {
 impl<const N: usize> Described<N> {
     /// Its `[gait]` table; a walker is checked [`walkable`] before it walks, and one without a table walks as
     /// one whose stance contact is its first (it cannot be asked to: the jobs check first).
-    fn gait(&self) -> &Gait {
+    pub(super) fn gait(&self) -> &Gait {
         self.description
             .gait
             .as_ref()
@@ -141,8 +212,8 @@ impl<const N: usize> Described<N> {
             .unwrap_or(T::one())
     }
 
-    /// The state just after a heel strike with the section values `s` (see the module documentation), or why
-    /// the contact conditions have no solution from the guesses.
+    /// The state on the section with the section values `s` (see the module documentation), or why the contact
+    /// conditions have no solution from the guesses.
     pub fn section_state(
         &self,
         s: &DVector<f64>,
@@ -161,22 +232,61 @@ impl<const N: usize> Described<N> {
         for (k, e) in &g.guess {
             q[*k] = e.eval(&names);
         }
-        let unknown: Vec<usize> = (0..N)
-            .filter(|k| !g.section.contains(&(*k, false)))
-            .collect();
-        self.solve_positions(g, &mut q, &unknown)?;
-        let unknown: Vec<usize> = (0..N)
-            .filter(|k| !g.section.contains(&(*k, true)))
-            .collect();
+        let held = self.held_on_section();
+        if let Some((k, stopper)) = held {
+            q[k] = stopper;
+        }
+        let solved = |velocity: bool| -> Vec<usize> {
+            (0..N)
+                .filter(|k| {
+                    !g.section.contains(&(*k, velocity)) && held.map(|(h, _)| h) != Some(*k)
+                })
+                .collect()
+        };
+        self.solve_positions(g, &mut q, &solved(false))?;
+        let unknown = solved(true);
         let c = self.constants_f64();
-        let stance = self.contact(&c, &q, &qd, g.stance).jacobian;
-        let a = Matrix2::from_fn(|r, i| stance[(r, unknown[i])]);
-        let rhs: Vector2<f64> = -(stance * qd);
+        let resting = self.contact(&c, &q, &qd, self.resting_contact()).jacobian;
+        let a = Matrix2::from_fn(|r, i| resting[(r, unknown[i])]);
+        let rhs: Vector2<f64> = -(resting * qd);
         let v = a.lu().solve(&rhs).ok_or(SectionError::Singular)?;
         for (i, k) in unknown.iter().enumerate() {
             qd[*k] = v[i];
         }
         Ok((q, qd))
+    }
+
+    /// With telescopic legs, the fore leg's stroke held at its stopper on the section: its coordinate and the
+    /// stopper's value (its rate is 0).
+    fn held_on_section(&self) -> Option<(usize, f64)> {
+        let [fore, _] = self.gait().strokes.as_ref()?;
+        Some((fore.coordinate, fore.stopper.eval(&self.values)))
+    }
+
+    /// The contact at rest on the section: the stance contact just after a rigid biped's heel strike, the rear
+    /// (landing) contact before a compliant walker's impact.
+    fn resting_contact(&self) -> usize {
+        let g = self.gait();
+        if g.strokes.is_some() {
+            g.lands
+        } else {
+            g.stance
+        }
+    }
+
+    /// The hip's point (its body's frame's origin) at `(q, q')`.
+    pub fn hip(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> PointKinematics<f64, N> {
+        let c = self.constants_f64();
+        super::kinematics::frames(&self.description, &c, q, qd)[self.gait().hip].origin
+    }
+
+    /// The section's values at `(q, q')`, over any [`Real`].
+    pub fn section_values<T: Real>(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> Vec<T> {
+        let g = self.gait();
+        g.section
+            .iter()
+            .map(|&(k, velocity)| if velocity { qd[k] } else { q[k] })
+            .collect()
     }
 
     /// Newton's method for the coordinates `unknown` of `q`: the stance contact at the origin, the landing
@@ -359,9 +469,7 @@ macro_rules! rigid_walker {
             }
 
             fn hip_height(&self, q: &SVector<f64, $n>) -> f64 {
-                let c = self.constants_f64();
-                let frames = super::kinematics::frames(&self.description, &c, q, &SVector::zeros());
-                frames[self.gait().hip].origin.position.y
+                self.hip(q, &SVector::zeros()).position.y
             }
 
             fn transition_with<T: Real>(
@@ -391,8 +499,7 @@ macro_rules! rigid_walker {
                 q: &SVector<T, $n>,
                 qd: &SVector<T, $n>,
             ) -> Vec<T> {
-                let g = self.gait();
-                g.section.iter().map(|&(k, velocity)| if velocity { qd[k] } else { q[k] }).collect()
+                self.section_values(q, qd)
             }
 
             /// [`Described::section_state_with`]: the contact conditions differentiated implicitly.
