@@ -18,7 +18,9 @@ mod map;
 mod orbit;
 mod simulate;
 mod sweep;
+mod walker_basin;
 mod walker_figures;
+mod walker_map;
 mod walker_model;
 mod walker_orbit;
 mod walker_simulate;
@@ -55,6 +57,13 @@ pub use simulate::{
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
+pub use walker_basin::{
+    run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob, WalkerBasinPoint,
+    WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS, MAX_WALKER_BASIN_STEPS,
+};
+pub use walker_map::{
+    run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary, WalkerMapThreshold,
+};
 pub use walker_model::{
     Body, FoundGait, RigidModel, Sampling, WalkerModel, WalkerSample, WalkerStep,
 };
