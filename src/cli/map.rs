@@ -349,11 +349,21 @@ fn run_walker(args: &MapArgs, walker: Walker) -> Result<()> {
         statuses.join(", "),
         started.elapsed().as_secs_f64()
     );
+    println!(
+        "  lambda_I4 >= 0 (double support kept) at {} gaits",
+        s.keeps_double_support
+    );
     for t in &s.thresholds {
         let th = &t.threshold;
         println!(
             "  {:<16} {} = {:.9} at {} = {}  (bracket [{}, {}])",
-            th.kind, args.x, th.value, args.y, t.y, th.bracket[0], th.bracket[1]
+            th.kind,
+            args.x,
+            th.value,
+            args.y,
+            vrw::fmt::short(t.y),
+            vrw::fmt::short(th.bracket[0]),
+            vrw::fmt::short(th.bracket[1])
         );
     }
     super::print_wrote(&args.out);
