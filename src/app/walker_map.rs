@@ -382,9 +382,13 @@ mod tests {
     use crate::app::{run_walker_continuation, WalkerContinueJob};
     use crate::continuation::SpecialKind;
 
-    /// The compass gait over `slope` (`nx` values from `from` to `to`) and `hip_mass` (8, 10, 12), written to
-    /// `out`.
-    fn compass_map(out: &std::path::Path, (from, to, nx): (f64, f64, usize)) -> WalkerMapJob {
+    /// The compass gait over `slope` (`nx` values from `from` to `to`) and `hip_mass` (`ny` values from `low` to
+    /// `high`), written to `out`.
+    fn compass_map(
+        out: &std::path::Path,
+        (from, to, nx): (f64, f64, usize),
+        (low, high, ny): (f64, f64, usize),
+    ) -> WalkerMapJob {
         let walker = Walker::load("compass", None, &[] as &[&str])
             .unwrap()
             .unwrap();
@@ -397,12 +401,37 @@ mod tests {
         WalkerMapJob {
             walker,
             x: range("slope", from, to, nx),
-            y: range("hip_mass", 8.0, 12.0, 3),
+            y: range("hip_mass", low, high, ny),
             initial: None,
             thresholds: true,
             out_dir: out.to_path_buf(),
             overwrite: false,
         }
+    }
+
+    /// The located period doubling of `vrw continue --model compass --param slope` from 0.04 to 0.09, started
+    /// at `slope = start`, with `hip_mass` at `hip_mass`.
+    fn continued_period_doubling(dir: &std::path::Path, hip_mass: f64, start: f64) -> f64 {
+        let walker = Walker::load("compass", None, &[format!("hip_mass={hip_mass}")])
+            .unwrap()
+            .unwrap();
+        let continued = run_walker_continuation(&WalkerContinueJob {
+            walker,
+            param: "slope".to_string(),
+            start: Some(start),
+            range: (0.04, 0.09),
+            max_points: 300,
+            max_step: 0.1,
+            out_dir: dir.join(format!("continue-{hip_mass}")),
+            overwrite: false,
+        })
+        .unwrap();
+        continued
+            .special_points
+            .iter()
+            .find(|s| s.kind == SpecialKind::PeriodDoubling && s.located)
+            .expect("a located period doubling")
+            .value
     }
 
     /// `map.csv`, `map.json` and `map.png` are the same bytes for 1 and 2 threads.
@@ -411,7 +440,7 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let files = |threads: usize| {
             let out = tmp.path().join(threads.to_string());
-            let job = compass_map(&out, (0.07, 0.08, 6));
+            let job = compass_map(&out, (0.07, 0.08, 6), (8.0, 12.0, 3));
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -428,31 +457,13 @@ mod tests {
     }
 
     /// At `hip_mass = 10` the map's stability boundary (the last stable and the first unstable point of the
-    /// row) brackets the period doubling `vrw continue --model compass --param slope` locates, and the row's
-    /// bisected threshold equals it to 1e-9.
+    /// row) brackets the period doubling `vrw continue --model compass --param slope` locates, and every row's
+    /// bisected threshold (`hip_mass` = 5, 10, 15, 20) equals continue's at that hip mass to 1e-9.
     #[test]
-    fn the_stability_boundary_at_hip_mass_10_is_the_period_doubling() {
+    fn the_stability_boundary_is_the_period_doubling_continue_locates() {
         let tmp = tempfile::tempdir().unwrap();
-        let job = compass_map(&tmp.path().join("map"), (0.04, 0.09, 11));
+        let job = compass_map(&tmp.path().join("map"), (0.04, 0.09, 11), (5.0, 20.0, 4));
         let summary = run_walker_map(&job, &|_| {}).unwrap();
-        let walker = job.walker.clone();
-        let continued = run_walker_continuation(&WalkerContinueJob {
-            walker,
-            param: "slope".to_string(),
-            start: None,
-            range: (0.04, 0.08),
-            max_points: 300,
-            max_step: 0.1,
-            out_dir: tmp.path().join("continue"),
-            overwrite: false,
-        })
-        .unwrap();
-        let pd = continued
-            .special_points
-            .iter()
-            .find(|s| s.kind == SpecialKind::PeriodDoubling && s.located)
-            .expect("a located period doubling")
-            .value;
         let csv = std::fs::read_to_string(tmp.path().join("map").join("map.csv")).unwrap();
         let row: Vec<(f64, String)> = csv
             .lines()
@@ -473,11 +484,16 @@ mod tests {
             .map(|r| r.0)
             .fold(f64::NAN, f64::min);
         assert!(first_unstable - last_stable < 0.005 + 1e-12, "{row:?}");
+        let pd = continued_period_doubling(tmp.path(), 10.0, last_stable);
         assert!(last_stable < pd && pd < first_unstable, "{pd} {row:?}");
-        let at_10: Vec<&WalkerMapThreshold> =
-            summary.thresholds.iter().filter(|t| t.y == 10.0).collect();
-        assert_eq!(at_10.len(), 1);
-        assert_eq!(at_10[0].threshold.kind, "period_doubling");
-        assert!((at_10[0].threshold.value - pd).abs() < 1e-9, "{pd}");
+        assert_eq!(summary.thresholds.len(), 4);
+        for t in &summary.thresholds {
+            assert_eq!(t.threshold.kind, "period_doubling");
+            // Started a grid step below the bracket's stable end: there the gait is well inside its stable
+            // side, while further down the stance foot lifts off at light hips.
+            let start = t.threshold.bracket[0] - 0.005;
+            let pd = continued_period_doubling(tmp.path(), t.y, start);
+            assert!((t.threshold.value - pd).abs() < 1e-9, "{}: {pd}", t.y);
+        }
     }
 }
