@@ -187,6 +187,21 @@ FIGURES: list[Figure] = [
         _in("out/orbit-compass", *ORBIT),
     ),
     Figure(
+        "map-compass",
+        (
+            "map --model compass --x slope --x-from 0.04 --x-to 0.09 --nx 26 --y hip_mass --y-from 4 "
+            "--y-to 20 --ny 17 --out out/compass-map",
+        ),
+        "out/compass-map/map.png",
+        _in("out/compass-map", "map.csv", "map.json"),
+    ),
+    Figure(
+        "basin-simplest",
+        ("basin --model simplest --set slope=0.009 --nx 201 --ny 201 --out out/basin-simplest",),
+        "out/basin-simplest/basin.png",
+        _in("out/basin-simplest", *BASIN),
+    ),
+    Figure(
         "map-no-preload-k5000",
         (
             "map --config readings/no-preload.toml --y-from 300 --y-to 5000 --nx 31 --ny 36 "

@@ -18,8 +18,10 @@ mod map;
 mod orbit;
 mod simulate;
 mod sweep;
+mod walker_basin;
 mod walker_described;
 mod walker_figures;
+mod walker_map;
 mod walker_model;
 mod walker_orbit;
 mod walker_simulate;
@@ -58,6 +60,13 @@ pub use simulate::{
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
+pub use walker_basin::{
+    run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob, WalkerBasinPoint,
+    WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS, MAX_WALKER_BASIN_STEPS,
+};
+pub use walker_map::{
+    run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary, WalkerMapThreshold,
+};
 pub use walker_model::{
     Body, FoundGait, RigidModel, Sampling, WalkerModel, WalkerSample, WalkerStep,
 };
@@ -72,9 +81,9 @@ pub use walker_sweep::{
     WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
 };
 pub use walkers::{
-    run_walker_continuation, run_walker_gait, wheel_only, Walker, WalkerContinueJob,
-    WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative,
-    WalkerSpecialPoint, MODELS, TELESCOPIC,
+    run_walker_continuation, run_walker_gait, Walker, WalkerContinueJob, WalkerContinueSummary,
+    WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative, WalkerSpecialPoint,
+    MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

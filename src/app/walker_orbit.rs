@@ -98,7 +98,7 @@ pub struct WalkerOrbitColumn {
 }
 
 /// The least `k` with which `returns` repeat to `tol` (largest coordinate difference), up to `max`.
-fn least_period(returns: &[DVector<f64>], max: usize, tol: f64) -> Option<usize> {
+pub(super) fn least_period(returns: &[DVector<f64>], max: usize, tol: f64) -> Option<usize> {
     (1..=max.min(returns.len().saturating_sub(1))).find(|&k| {
         returns
             .iter()
@@ -410,7 +410,7 @@ fn orbit_figure(
 }
 
 /// The parameters of `walker` that differ from its model's defaults (a figure's title names them).
-fn non_default_parameters(walker: &Walker) -> Vec<(String, f64)> {
+pub(super) fn non_default_parameters(walker: &Walker) -> Vec<(String, f64)> {
     let defaults: Vec<(String, f64)> = match walker {
         Walker::Simplest(_) => serde_pairs(&Walker::Simplest(Default::default())),
         Walker::Compass(_) => serde_pairs(&Walker::Compass(Default::default())),

@@ -310,7 +310,7 @@ pub(super) fn sweep_rows(
 }
 
 /// Every change of stability between two neighbouring values with gaits, bisected.
-fn thresholds(
+pub(super) fn thresholds(
     walker: &Walker,
     param: &str,
     names: &[String],

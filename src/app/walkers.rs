@@ -220,26 +220,6 @@ pub(super) fn start_of(
     }
 }
 
-/// `vrw JOB --model NAME` for a job that takes only the wheel so far: `Ok` for the wheel (`vrw`), else an error
-/// naming the model and the job (never the wheel's job run in its place).
-pub fn wheel_only(model: &str, job: &str) -> Result<(), AppError> {
-    if model == "vrw" {
-        return Ok(());
-    }
-    let walker = Walker::load(model, None, &[] as &[&str])?;
-    let name = walker
-        .as_ref()
-        .map_or(model.to_string(), |w| w.name().to_string());
-    Err(AppError::InvalidOption {
-        option: "model",
-        reason: format!(
-            "`vrw {job}` takes only the wheel (`vrw`) so far; the model `{name}` walks in `vrw simulate`, \
-             `vrw gait`, `vrw sweep`, `vrw orbit` and `vrw continue` (and `vrw plot` and `vrw animate` of \
-             its simulate run); docs/model.md section 13"
-        ),
-    })
-}
-
 /// What `vrw gait --model NAME` searches.
 #[derive(Debug, Clone)]
 pub struct WalkerGaitJob {

@@ -5,11 +5,10 @@ use std::path::PathBuf;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 
-use vrw::app::{run_map, MapJob, MapSummary};
+use vrw::app::{run_map, run_walker_map, MapJob, MapSummary, Walker, WalkerMapJob, WalkerRange};
 use vrw::gait::GaitOptions;
 use vrw::output::map_plot::MapMark;
 use vrw::study::{CurveMethod, MapSpec, SecondRoute, SweepSpec};
-use vrw::walk::SectionState;
 
 use super::{
     confirmed_count, interrupt_flag, print_warnings, progress_bar, second_route_words, ModelArgs,
@@ -19,11 +18,13 @@ use super::{
 pub(super) struct MapArgs {
     #[command(flatten)]
     params: ModelArgs,
-    /// The walker: only `vrw`, the wheel, so far; another model (`simplest`, `compass`) is refused, naming the
-    /// job (docs/model.md section 13).
+    /// The walker: `vrw` (default), `simplest` or `compass` (docs/model.md section 13): for the last two, the
+    /// gait at every point (continued from its neighbour's) with its stability, map.csv, map.json (with every
+    /// change of stability along the rows, bisected) and map.png; give the axes with --x, --y and their ranges.
     #[arg(long, default_value = "vrw")]
     model: String,
-    /// The parameter along the horizontal axis (rows), one of the keys `sweep --help` lists.
+    /// The parameter along the horizontal axis (rows), one of the keys `sweep --help` lists (for another model,
+    /// one of its parameters).
     #[arg(long, default_value = "viscosity")]
     x: String,
     /// First x value.
@@ -48,17 +49,19 @@ pub(super) struct MapArgs {
     #[arg(long, default_value_t = 21)]
     ny: usize,
     /// Where the search at the first point of every row starts, `L2,thetadot,L2dot` (with friction, `,slip` after
-    /// them for a slipping stance tip); default as for simulate.
+    /// them for a slipping stance tip); default as for simulate. For another model its section's coordinates
+    /// (the search at the first point only; the others continue their neighbours' gaits).
     #[arg(
         long,
         value_name = "L2,THETADOT,L2DOT[,SLIP]",
         allow_hyphen_values = true
     )]
-    initial: Option<SectionState>,
+    initial: Option<String>,
     /// Mark a point on the heat maps, `X,Y` or `X,Y,LABEL` (repeatable), e.g. `--mark "220,500,paper λ4+ = 0"`.
     #[arg(long, value_name = "X,Y[,LABEL]", allow_hyphen_values = true)]
     mark: Vec<MarkArg>,
-    /// Skip the threshold curves (map.csv and the heat maps only).
+    /// Skip the threshold curves (map.csv and the heat maps only); for another model, the bisected changes of
+    /// stability.
     #[arg(long)]
     no_curves: bool,
     /// Refine the curves' crossings on at most this many columns, evenly spread with both ends (every row is
@@ -115,7 +118,10 @@ impl std::str::FromStr for MarkArg {
 
 /// Run `vrw map` and print its summary.
 pub(super) fn run(args: MapArgs) -> Result<()> {
-    vrw::app::wheel_only(&args.model, "map")?;
+    let sets = &args.params.set;
+    if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
+        return run_walker(&args, walker);
+    }
     let job = map_job(&args)?;
     let routes = if args.second_route { 2 } else { 1 };
     let total = args.nx.saturating_mul(args.ny).saturating_mul(routes);
@@ -169,7 +175,7 @@ fn map_job(args: &MapArgs) -> Result<MapJob> {
                 points: args.ny,
             },
         },
-        initial: args.initial,
+        initial: super::wheel_initial("map", args.initial.as_deref()),
         // The refined Jacobian gives each gait's stability verdict its error estimate.
         options: GaitOptions::default(),
         curves: !args.no_curves,
@@ -283,4 +289,86 @@ fn print_second_route(args: &MapArgs, summary: &MapSummary) {
             );
         }
     }
+}
+
+/// `vrw map --model NAME` for a walker other than the wheel: its map, its summary, its files. The wheel's
+/// options for its curves and marks are refused, named.
+fn run_walker(args: &MapArgs, walker: Walker) -> Result<()> {
+    let wheel_only = [
+        ("--mark", !args.mark.is_empty()),
+        ("--second-route", args.second_route),
+        ("--curve-method", args.curve_method != "continuation"),
+        (
+            "--curve-columns",
+            args.curve_columns != vrw::study::map::DEFAULT_CURVE_COLUMNS as u64,
+        ),
+    ];
+    if let Some((flag, _)) = wheel_only.iter().find(|(_, given)| *given) {
+        bail!(
+            "`{flag}` is an option of the wheel's map; the model `{}` has no threshold curves (its \
+             changes of stability are bisected along the rows: `--no-curves` skips them)",
+            walker.name()
+        );
+    }
+    let range = |param: &String, from, to, points| WalkerRange {
+        param: param.clone(),
+        from,
+        to,
+        points,
+    };
+    let job = WalkerMapJob {
+        walker,
+        x: range(&args.x, args.x_from, args.x_to, args.nx),
+        y: range(&args.y, args.y_from, args.y_to, args.ny),
+        initial: super::walker_initial(args.initial.as_deref())?,
+        thresholds: !args.no_curves,
+        out_dir: args.out.clone(),
+        overwrite: args.overwrite,
+    };
+    interrupt_flag();
+    let bar = progress_bar(
+        Some(args.nx.saturating_mul(args.ny) as u64),
+        "{bar:40} {pos}/{len} points [{elapsed_precise}, eta {eta}]",
+    );
+    super::check_out(&job.out_dir, "map", job.overwrite)?;
+    let started = std::time::Instant::now();
+    let s = run_walker_map(&job, &|_| bar.inc(1)).context("map")?;
+    bar.finish_and_clear();
+    let statuses: Vec<String> = s.statuses.iter().map(|(k, n)| format!("{k} {n}")).collect();
+    println!(
+        "vrw map --model {}: {} from {} to {} ({}) x {} from {} to {} ({}): {}; {:.2} s",
+        s.model,
+        args.x,
+        args.x_from,
+        args.x_to,
+        args.nx,
+        args.y,
+        args.y_from,
+        args.y_to,
+        args.ny,
+        statuses.join(", "),
+        started.elapsed().as_secs_f64()
+    );
+    println!(
+        "  lambda_I4 >= 0 (double support kept) at {} gaits",
+        s.keeps_double_support
+    );
+    for t in &s.thresholds {
+        let th = &t.threshold;
+        println!(
+            "  {:<16} {} = {:.9} at {} = {}  (bracket [{}, {}])",
+            th.kind,
+            args.x,
+            th.value,
+            args.y,
+            vrw::fmt::short(t.y),
+            vrw::fmt::short(th.bracket[0]),
+            vrw::fmt::short(th.bracket[1])
+        );
+    }
+    super::print_wrote(&args.out);
+    if s.gaits_found == 0 {
+        bail!("no gait found anywhere on the map (see map.csv for the reasons)");
+    }
+    Ok(())
 }

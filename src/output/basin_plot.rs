@@ -33,6 +33,9 @@ pub(crate) fn outcome_color(outcome: &str) -> RGBColor {
         "stalled" => RGBColor(86, 180, 233),
         "rear_leg_in_contact" => RGBColor(240, 228, 66),
         "rear_leg_not_locked" => RGBColor(120, 80, 40),
+        // The walkers' failures (`vrw basin --model`).
+        "stance_lifts_off" => RGBColor(204, 102, 119),
+        "stops_in_double_support" => RGBColor(136, 34, 85),
         _ => COLOR_MARK,
     }
 }
@@ -69,7 +72,7 @@ pub(crate) struct BasinFigure {
 }
 
 /// Cell edges around the centres `v` (half a spacing beyond the ends).
-fn edges(v: &[f64]) -> Vec<f64> {
+pub(crate) fn edges(v: &[f64]) -> Vec<f64> {
     let n = v.len();
     if n < 2 {
         let c = v.first().copied().unwrap_or(0.0);
@@ -84,7 +87,8 @@ fn edges(v: &[f64]) -> Vec<f64> {
     e
 }
 
-fn span(e: &[f64]) -> Range<f64> {
+/// The range the cell edges `e` span, increasing.
+pub(crate) fn span(e: &[f64]) -> Range<f64> {
     let (a, b) = (e[0], e[e.len() - 1]);
     a.min(b)..a.max(b)
 }

@@ -259,7 +259,13 @@ impl MapFigure<'_> {
             let base = area.get_base_pixel();
             let top = py.start - base.1;
             let bottom = py.end - base.1;
-            self.colour_bar(area, (w as i32 - bar_w + 20, top, bottom), &range, desc)?;
+            colour_bar(
+                area,
+                (w as i32 - bar_w + 20, top, bottom),
+                &range,
+                0.0,
+                desc,
+            )?;
         }
         Ok(())
     }
@@ -386,53 +392,6 @@ impl MapFigure<'_> {
         Ok(())
     }
 
-    /// A vertical colour bar at `(x, top, bottom)` for `range`, with ticks and `desc`.
-    fn colour_bar<DB: DrawingBackend>(
-        &self,
-        area: &DrawingArea<DB, Shift>,
-        (x, top, bottom): (i32, i32, i32),
-        range: &Range<f64>,
-        desc: &str,
-    ) -> DrawResult<DB> {
-        const BAR: i32 = 28;
-        let span = (range.end - range.start).max(f64::MIN_POSITIVE);
-        let to_px =
-            |v: f64| bottom - ((v - range.start) / span * f64::from(bottom - top)).round() as i32;
-        for py in top..bottom {
-            let v = range.start + f64::from(bottom - py) / f64::from(bottom - top) * span;
-            area.draw(&Rectangle::new(
-                [(x, py), (x + BAR, py + 1)],
-                diverging(v, range).filled(),
-            ))?;
-        }
-        area.draw(&Rectangle::new(
-            [(x, top), (x + BAR, bottom)],
-            COLOR_FRAME.stroke_width(1),
-        ))?;
-        let mut ticks = vec![range.start, range.end];
-        if range.start < 0.0 && range.end > 0.0 {
-            ticks.push(0.0);
-        }
-        for v in ticks {
-            let py = to_px(v);
-            area.draw(&PathElement::new(
-                vec![(x + BAR, py), (x + BAR + 8, py)],
-                BLACK.stroke_width(2),
-            ))?;
-            area.draw(&Text::new(
-                bar_label(v),
-                (x + BAR + 12, py),
-                font(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
-            ))?;
-        }
-        area.draw(&Text::new(
-            desc.to_string(),
-            (x, top - 10),
-            font(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Bottom)),
-        ))?;
-        Ok(())
-    }
-
     /// The legends: curves, branches, no gait, unstable, marks.
     fn legends<DB: DrawingBackend>(
         &self,
@@ -546,6 +505,55 @@ impl MapFigure<'_> {
         ))?;
         Ok(())
     }
+}
+
+/// A vertical colour bar at `(x, top, bottom)` for the values `range` on the diverging scale white at `centre`
+/// ([`diverging`] of `v - centre`), with ticks at its ends and at `centre` (if inside) and `desc` above it.
+pub(crate) fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, top, bottom): (i32, i32, i32),
+    range: &Range<f64>,
+    centre: f64,
+    desc: &str,
+) -> DrawResult<DB> {
+    const BAR: i32 = 28;
+    let span = (range.end - range.start).max(f64::MIN_POSITIVE);
+    let shifted = (range.start - centre)..(range.end - centre);
+    let to_px =
+        |v: f64| bottom - ((v - range.start) / span * f64::from(bottom - top)).round() as i32;
+    for py in top..bottom {
+        let v = range.start + f64::from(bottom - py) / f64::from(bottom - top) * span;
+        area.draw(&Rectangle::new(
+            [(x, py), (x + BAR, py + 1)],
+            diverging(v - centre, &shifted).filled(),
+        ))?;
+    }
+    area.draw(&Rectangle::new(
+        [(x, top), (x + BAR, bottom)],
+        COLOR_FRAME.stroke_width(1),
+    ))?;
+    let mut ticks = vec![range.start, range.end];
+    if range.start < centre && range.end > centre {
+        ticks.push(centre);
+    }
+    for v in ticks {
+        let py = to_px(v);
+        area.draw(&PathElement::new(
+            vec![(x + BAR, py), (x + BAR + 8, py)],
+            BLACK.stroke_width(2),
+        ))?;
+        area.draw(&Text::new(
+            bar_label(v),
+            (x + BAR + 12, py),
+            font(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Center)),
+        ))?;
+    }
+    area.draw(&Text::new(
+        desc.to_string(),
+        (x, top - 10),
+        font(TICK_FONT).pos(Pos::new(HPos::Left, VPos::Bottom)),
+    ))?;
+    Ok(())
 }
 
 /// The width of `s` in the legend font \[px\].

@@ -25,6 +25,7 @@ pub(crate) mod signature_plot;
 pub mod steps_plot;
 pub mod style;
 pub(crate) mod tables;
+pub(crate) mod walker_map_plot;
 pub mod walker_plot;
 pub mod walker_run;
 

@@ -16,7 +16,7 @@ mod axes;
 mod clip;
 mod legend;
 
-pub(crate) use axes::{draw_axes_and_curves, Axes, AxisStyle, PlotArea};
+pub(crate) use axes::{draw_axes_and_curves, Axes, AxisStyle, PlotArea, RUN_AXES};
 pub(crate) use clip::Clip;
 pub(crate) use legend::{
     draw_legend, draw_legend_rows, draw_marker, Label, LegendRow, Marker, Sample,
