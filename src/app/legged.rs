@@ -11,8 +11,9 @@ use serde::Serialize;
 use super::walkers::{as_map, named, TELESCOPIC};
 use super::{in_run, AppError, SearchEnded};
 use crate::mechanism::described::{walk, AnyDescribed, Walk};
+use crate::mechanism::legged::derivative::LeggedDerivatives;
 use crate::mechanism::legged::gait::{
-    legged_gait, legged_gait_exact, legged_step_map, LeggedGait, LeggedGaitError,
+    legged_gait_exact, legged_step_map, LeggedGait, LeggedGaitError,
 };
 use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
 use crate::mechanism::legged::{Legged, LeggedError};
@@ -129,16 +130,11 @@ fn record<W: Legged<N>, const N: usize>(walker: &W, gait: &LeggedGait<N>) -> Leg
     }
 }
 
-/// How a walker's gait is found from a start: [`legged_gait_exact`] for a walker with exact derivatives,
-/// [`legged_gait`] for another.
-type GaitSearch<W, const N: usize> =
-    fn(&W, &DVector<f64>, &LeggedOptions) -> Result<LeggedGait<N>, LeggedGaitError>;
-
-/// The search from `start`: `transient` steps, then Newton's method (`gait`).
-fn search<W: Legged<N>, const N: usize, const Y: usize>(
+/// The search from `start`: `transient` steps, then Newton's method with the exact derivatives
+/// ([`legged_gait_exact`]).
+fn search<W: LeggedDerivatives<N>, const N: usize, const Y: usize>(
     walker: &W,
     (start, transient): (&DVector<f64>, usize),
-    gait: GaitSearch<W, N>,
 ) -> Result<LeggedGait<N>, LeggedGaitError> {
     let options = interruptible();
     let mut s = start.clone();
@@ -150,7 +146,7 @@ fn search<W: Legged<N>, const N: usize, const Y: usize>(
             })?
             .0;
     }
-    gait(walker, &s, &options)
+    legged_gait_exact::<_, N, Y>(walker, &s, &options)
 }
 
 /// The failure's short name.
@@ -170,11 +166,10 @@ type Searched = (
 );
 
 /// The search of [`run_legged_gait`] for `walker`, from `job.initial` or `default_start`.
-fn compute<W: Legged<N>, const N: usize, const Y: usize>(
+fn compute<W: LeggedDerivatives<N>, const N: usize, const Y: usize>(
     walker: &W,
     default_start: DVector<f64>,
     job: &LeggedGaitJob,
-    gait: GaitSearch<W, N>,
 ) -> Result<Searched, AppError> {
     let names = walker.section_names();
     let start = match &job.initial {
@@ -199,7 +194,7 @@ fn compute<W: Legged<N>, const N: usize, const Y: usize>(
             reason: format!("{}", LeggedError::OffSection),
         });
     }
-    let result = search::<W, N, Y>(walker, (&start, job.transient_steps), gait);
+    let result = search::<W, N, Y>(walker, (&start, job.transient_steps));
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
     Ok((named(&names, &start), result.map(|g| record(walker, &g))))
 }
@@ -251,13 +246,11 @@ fn described_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<
 pub fn run_legged_gait(job: &LeggedGaitJob) -> Result<LeggedGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
     let (initial, result) = match &job.walker {
-        LeggedWalker::Telescopic(w) => {
-            compute::<_, 6, 13>(w, w.default_start(), job, legged_gait_exact::<_, 6, 13>)?
-        }
+        LeggedWalker::Telescopic(w) => compute::<_, 6, 13>(w, w.default_start(), job)?,
         LeggedWalker::Described(any) => {
             let start = described_start(any, job.initial.as_deref())?;
             crate::with_legged_described!(
-                any, w, N, Y => compute::<_, N, Y>(w, start, job, legged_gait::<_, N, Y>)?,
+                any, w, N, Y => compute::<_, N, Y>(w, start, job)?,
                 _ => return Err(AppError::InvalidOption {
                     option: "model",
                     reason: format!(

@@ -356,7 +356,7 @@ impl Legged<6> for Telescopic {
         q: &SVector<f64, 6>,
         qd: &SVector<f64, 6>,
     ) -> (SVector<f64, 6>, SVector<f64, 6>) {
-        self.relabel_with(q, qd)
+        self.relabel_with(&self.constants_f64(), q, qd)
     }
 
     fn section_names(&self) -> Vec<&'static str> {
@@ -380,6 +380,7 @@ impl LeggedDerivatives<6> for Telescopic {
     /// Leg 2 becomes the fore leg at the origin: the hip moves back by its tip's `x`.
     fn relabel_with<T: Real>(
         &self,
+        _c: &TelescopicConstants<T>,
         q: &SVector<T, 6>,
         qd: &SVector<T, 6>,
     ) -> (SVector<T, 6>, SVector<T, 6>) {

@@ -14,9 +14,14 @@
 
 use nalgebra::{DVector, SVector};
 
+use super::super::legged::derivative::{
+    replayed_step_map, LeggedDerivative, LeggedDerivativeError, LeggedDerivatives,
+};
+use super::super::legged::walk::LeggedOptions;
 use super::super::legged::{Legged, Stroke};
 use super::super::turns;
-use super::super::Mechanism;
+use super::super::{Mechanism, Real};
+use super::kinematics::Values;
 use super::Described;
 
 impl<const N: usize> Legged<N> for Described<N> {
@@ -104,3 +109,63 @@ macro_rules! with_legged_described {
         }
     }};
 }
+
+/// The exact derivatives of a described compliant walker's step map, for each number of coordinates `$n` it can
+/// have: the walk's state `$y = 2 $n + 1`, the replay's `$z = 2 $n`, the section's `2 $n - 7` values (`$n - 4`
+/// coordinates, `$n - 3` rates) and the parameter's direction `$d = 2 $n - 6`, `$e = $d + 1`, `$a = $z + $z $d`
+/// ([`replayed_step_map`]).
+macro_rules! legged_derivatives {
+    ($($n:literal => $y:literal, $z:literal, $d:literal, $e:literal, $a:literal);*) => {$(
+        impl LeggedDerivatives<$n> for Described<$n> {
+            /// The stopper's expression over the constants.
+            fn stopper_with<T: Real>(&self, c: &Values<T>, leg: usize) -> T {
+                match &self.gait().strokes {
+                    Some(strokes) => c.of(&strokes[leg].stopper),
+                    None => T::lit(f64::NAN),
+                }
+            }
+
+            fn relabel_with<T: Real>(
+                &self,
+                c: &Values<T>,
+                q: &SVector<T, $n>,
+                qd: &SVector<T, $n>,
+            ) -> (SVector<T, $n>, SVector<T, $n>) {
+                let t = self.turns_with(c);
+                (turns::exchanged(self, &t, c, (q, qd)), t.relabeled(qd))
+            }
+
+            fn section_with<T: Real>(&self, q: &SVector<T, $n>, qd: &SVector<T, $n>) -> Vec<T> {
+                self.section_values(q, qd)
+            }
+
+            /// [`Described::section_state_with`]: the contact conditions differentiated implicitly; `None`
+            /// where they have no solution.
+            fn state_at_section_with<T: Real>(
+                &self,
+                c: &Values<T>,
+                s: &[T],
+            ) -> Option<(SVector<T, $n>, SVector<T, $n>)> {
+                let (q, qd) = self.section_state_with(c, s);
+                q.iter().chain(qd.iter()).all(|v| !v.value().is_nan()).then_some((q, qd))
+            }
+
+            fn exact_step_map(
+                &self,
+                x: &DVector<f64>,
+                param: Option<&str>,
+                options: &LeggedOptions,
+            ) -> Result<LeggedDerivative<$n>, LeggedDerivativeError> {
+                replayed_step_map::<_, $n, $y, $z, $d, $e, $a>(self, x, param, options)
+            }
+        }
+    )*};
+}
+
+legged_derivatives!(
+    4 => 9, 8, 2, 3, 24;
+    5 => 11, 10, 4, 5, 50;
+    6 => 13, 12, 6, 7, 84;
+    7 => 15, 14, 8, 9, 126;
+    8 => 17, 16, 10, 11, 176
+);

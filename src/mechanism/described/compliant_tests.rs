@@ -222,3 +222,41 @@ fn the_legs_contacts_are_put_first() {
     );
     assert!(difference(&Telescopic::default(), &w, &q, &qd) < RELATIVE);
 }
+
+/// The described walker's exact derivatives (its section differentiated implicitly from the contact conditions
+/// with the fore leg at its stopper) are the built-in's: `DP` and `dP/dp` at the gait for a parameter of the
+/// masses (`leg_mass`) and for the stoppers' length (which moves the section's held leg and the stopper events),
+/// each to 1e-8; and the described gait's multipliers are the built-in's exact ones to 1e-9.
+#[test]
+fn the_described_telescopic_walker_has_the_built_in_derivatives() {
+    use super::super::legged::derivative::LeggedDerivatives;
+    use super::super::legged::gait::{legged_gait_exact, EXACT_ROUTE};
+    let (built_in, described) = (Telescopic::default(), telescopic_toml());
+    let options = LeggedOptions::default();
+    let gait =
+        legged_gait_exact::<_, 6, 13>(&built_in, &built_in.default_start(), &options).unwrap();
+    for key in ["leg_mass", "stopper_length"] {
+        let a = built_in
+            .exact_step_map(&gait.section, Some(key), &options)
+            .unwrap();
+        let b = described
+            .exact_step_map(&gait.section, Some(key), &options)
+            .unwrap();
+        let dp = max_diff(a.jacobian.iter(), b.jacobian.iter());
+        let (pa, pb) = (a.dparam.unwrap(), b.dparam.unwrap());
+        let dpdp = max_diff(pa.iter(), pb.iter());
+        println!("{key}: DP {dp:e}, dP/dp {dpdp:e} (of {:e})", pa.amax());
+        assert!(
+            dp < 1e-8 && dpdp < 1e-8 * pa.amax().max(1.0),
+            "{key}: {dp:e}, {dpdp:e}"
+        );
+    }
+    let ours =
+        legged_gait_exact::<_, 6, 13>(&described, &built_in.default_start(), &options).unwrap();
+    assert_eq!(ours.derivative, EXACT_ROUTE);
+    let multipliers = max_diff(
+        gait.multipliers.iter().flatten(),
+        ours.multipliers.iter().flatten(),
+    );
+    assert!(multipliers < 1e-9, "{multipliers:e}");
+}

@@ -344,8 +344,9 @@ impl<const N: usize> Described<N> {
     /// [`Described::section_state`] over a [`Real`] with the constants `c`, differentiated implicitly: the
     /// positions solved on `f64`, then one Newton correction on `T` from that solution, which moves the values
     /// by the residual only and gives the derivative parts exactly (`dq_u = -J_u^-1 (J_s dq_s + dr/dp)`, the
-    /// implicit function theorem on the contact conditions `r`), and the velocities by the stance contact's rows
-    /// solved on `T` (Cramer's rule). A state of NaN where the conditions have no solution.
+    /// implicit function theorem on the contact conditions `r`), and the velocities by the resting contact's rows
+    /// solved on `T` (Cramer's rule); with telescopic legs, the fore leg held at its stopper. A state of NaN
+    /// where the conditions have no solution.
     pub fn section_state_with<T: Real>(
         &self,
         c: &Values<T>,
@@ -370,8 +371,13 @@ impl<const N: usize> Described<N> {
                 q[k] = v;
             }
         }
+        // With telescopic legs, the fore leg's stroke at its stopper (which may carry `d/dp`), its rate 0.
+        let held = g.strokes.as_ref().map(|[fore, _]| fore.coordinate);
+        if let Some([fore, _]) = &g.strokes {
+            q[fore.coordinate] = c.of(&fore.stopper);
+        }
         let unknown: Vec<usize> = (0..N)
-            .filter(|k| !g.section.contains(&(*k, false)))
+            .filter(|k| !g.section.contains(&(*k, false)) && held != Some(*k))
             .collect();
         let Some(inverse) = self.conditions_jacobian(g, &q0, &unknown).try_inverse() else {
             return nan();
@@ -386,9 +392,9 @@ impl<const N: usize> Described<N> {
             q[*k] -= (0..3).fold(T::zero(), |sum, j| sum + T::lit(inverse[(i, j)]) * r[j]);
         }
         let unknown: Vec<usize> = (0..N)
-            .filter(|k| !g.section.contains(&(*k, true)))
+            .filter(|k| !g.section.contains(&(*k, true)) && held != Some(*k))
             .collect();
-        let j = self.contact(c, &q, &qd, g.stance).jacobian;
+        let j = self.contact(c, &q, &qd, self.resting_contact()).jacobian;
         let rhs = -(j * qd);
         let a = |r: usize, i: usize| j[(r, unknown[i])];
         let det = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);

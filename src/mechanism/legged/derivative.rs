@@ -34,9 +34,10 @@ pub trait LeggedDerivatives<const N: usize>: Legged<N> {
     /// carry `d/dp`).
     fn stopper_with<T: Real>(&self, c: &Self::Constants<T>, leg: usize) -> T;
 
-    /// [`Legged::relabel`] over any [`Real`].
+    /// [`Legged::relabel`] over any [`Real`], with the constants `c`.
     fn relabel_with<T: Real>(
         &self,
+        c: &Self::Constants<T>,
         q: &SVector<T, N>,
         qd: &SVector<T, N>,
     ) -> (SVector<T, N>, SVector<T, N>);
@@ -82,6 +83,14 @@ pub enum LeggedDerivativeError {
     /// The walk went, but the map has no derivative there (or the replay could not give it).
     #[error(transparent)]
     NotDifferentiable(#[from] NotDifferentiable),
+    /// A section state of another size than the walker's section.
+    #[error("a section state of {given} values; the walker's section has {expected}")]
+    SectionSize {
+        /// The section's size.
+        expected: usize,
+        /// The state's.
+        given: usize,
+    },
     /// The parameter asked for is not one of the walker's constants.
     #[error("`{key}` is not a parameter of this walker")]
     UnknownParameter {
@@ -167,7 +176,7 @@ impl<W: LeggedDerivatives<N>, const N: usize> Hybrid<N> for Replay<'_, W, N> {
         (q, qd): (&SVector<T, N>, &SVector<T, N>),
     ) -> Result<(SVector<T, N>, SVector<T, N>), ConstrainedError> {
         if crossing.event == Event::Strike {
-            return Ok(self.0.relabel_with(q, qd));
+            return Ok(self.0.relabel_with(c, q, qd));
         }
         let strokes = self.0.strokes();
         let mut qd = *qd;

@@ -255,22 +255,31 @@ fn the_exact_derivatives_agree_with_differences() {
         gait.jacobian_error
     );
     assert!(dp < 1e-6, "DP differs by {dp:e}");
-    // dP/dc against differences in the parameter.
-    let c = w.viscosity;
-    let (dpdc, error) = richardson_jacobian(5, &[c], |_, t| {
-        let moved = w.with_parameter(key, c + t).unwrap();
-        Ok::<_, super::LeggedError>(
-            super::gait::legged_step_map::<_, 6, 13>(&moved, &gait.section, &options)?.0,
-        )
-    })
-    .unwrap();
-    let exact_dpdc = exact.dparam.expect("dP/dc asked for");
-    let diff = (&exact_dpdc - dpdc.column(0)).amax();
-    println!("dP/dc: exact {exact_dpdc:?}, against differences {diff:e} (their error {error:e})");
-    assert!(
-        diff < 1e-6 * exact_dpdc.amax().max(1.0),
-        "dP/dc differs by {diff:e}"
-    );
+    // dP/dp against differences in the parameter: a damper's, and the stoppers' length (which moves the
+    // section's held leg and every stopper event).
+    for key in [key, "stopper_length"] {
+        let exact = w
+            .exact_step_map(&gait.section, Some(key), &options)
+            .unwrap();
+        let p = crate::mechanism::legged::derivative::constant_value(&w, key).unwrap();
+        let (dpdp, error) = richardson_jacobian(5, &[p], |_, t| {
+            let moved = w.with_parameter(key, p + t).unwrap();
+            Ok::<_, super::LeggedError>(
+                super::gait::legged_step_map::<_, 6, 13>(&moved, &gait.section, &options)?.0,
+            )
+        })
+        .unwrap();
+        let exact_dpdp = exact.dparam.expect("dP/dp asked for");
+        let diff = (&exact_dpdp - dpdp.column(0)).amax();
+        println!(
+            "dP/d{key}: largest {:e}, against differences {diff:e} (their error {error:e})",
+            exact_dpdp.amax()
+        );
+        assert!(
+            diff < 1e-6 * exact_dpdp.amax().max(1.0),
+            "dP/d{key} differs by {diff:e}"
+        );
+    }
 }
 
 #[test]
