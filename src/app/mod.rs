@@ -44,7 +44,7 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
-pub use legged::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary};
+pub use legged::{LeggedModel, RICHARDSON_ROUTE};
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
@@ -56,7 +56,8 @@ pub use simulate::{
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 pub use walker_model::{
-    Body, FoundGait, RigidModel, Sampling, WalkerModel, WalkerSample, WalkerStep,
+    Body, FoundGait, RigidModel, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,
+    WalkerStep,
 };
 pub use walker_orbit::{
     run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary, MAX_WALKER_PERIOD,

@@ -9,20 +9,29 @@ use std::path::{Path, PathBuf};
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walker_model::{interruptible, search_gait, RigidModel, WalkerModel};
+use super::legged::{legged_interruptible, search_legged_gait, LeggedModel, RICHARDSON_ROUTE};
+use super::walker_model::{
+    found_rigid, interruptible, search_gait, FoundGait, RigidModel, WalkerGaitError, WalkerModel,
+};
 use super::{in_run, AppError, SearchEnded};
 use crate::continuation::{
-    continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
+    continue_family, ContinuationOptions, FamilyEnd, FamilyMap, FamilyPoint, SpecialKind,
 };
 use crate::mechanism::compass::Compass;
 use crate::mechanism::described::{self, AnyDescribed};
+use crate::mechanism::legged::family::{LeggedFamily, LeggedInfo};
+use crate::mechanism::legged::walk::StepAccount;
+use crate::mechanism::legged::Legged;
 use crate::mechanism::rigid::RigidWalker;
 use crate::mechanism::rigid_check::{check_rigid_derivatives, RigidDerivativeCheck};
 use crate::mechanism::rigid_derivative::{parameter_value, DerivativeError};
 use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
 use crate::mechanism::rigid_gait::{rigid_step_map, RigidGait, DIFFERENCE_STEP, EXACT_ROUTE};
 use crate::mechanism::simplest::Simplest;
+use crate::mechanism::telescopic::Telescopic;
+use crate::mechanism::Mechanism;
 use crate::output;
+use crate::output::walker_run::branch_text;
 use crate::params::read_walker_parameters;
 use crate::params::ConfigError;
 
@@ -42,6 +51,8 @@ pub enum Walker {
     Simplest(Simplest),
     /// The compass gait.
     Compass(Compass),
+    /// The compass gait with telescopic legs, walking by the legged walk.
+    Telescopic(Telescopic),
     /// A walker described in a file.
     Described(AnyDescribed),
 }
@@ -67,12 +78,9 @@ impl Walker {
                 Walker::Compass(w)
             }
             TELESCOPIC => {
-                return Err(AppError::InvalidOption {
-                    option: "model",
-                    reason: "the compass gait with telescopic legs (`telescopic`) walks in `vrw gait` only so \
-                             far (docs/model.md section 13)"
-                        .to_string(),
-                })
+                let w: Telescopic = read_walker_parameters(file, overrides)?;
+                w.validate()?;
+                Walker::Telescopic(w)
             }
             other if other.ends_with(".toml") || Path::new(other).is_file() => {
                 let model = |reason: String| AppError::InvalidOption {
@@ -101,6 +109,7 @@ impl Walker {
         match self {
             Walker::Simplest(w) => RigidWalker::name(w),
             Walker::Compass(w) => RigidWalker::name(w),
+            Walker::Telescopic(w) => Mechanism::name(w),
             Walker::Described(w) => w.description().name,
         }
     }
@@ -112,6 +121,9 @@ impl Walker {
         Ok(match self {
             Walker::Simplest(w) => Box::new(RigidModel::<_, 2, 4>::new(w, Simplest::default_start)),
             Walker::Compass(w) => Box::new(RigidModel::<_, 4, 8>::new(w, Compass::default_start)),
+            Walker::Telescopic(w) => {
+                Box::new(LeggedModel::<_, 6, 13>::new(w, Telescopic::default_start))
+            }
             Walker::Described(w) => {
                 return Err(AppError::InvalidOption {
                     option: "model",
@@ -130,6 +142,7 @@ impl Walker {
         match self {
             Walker::Simplest(w) => w.parameter_keys(),
             Walker::Compass(w) => w.parameter_keys(),
+            Walker::Telescopic(w) => w.parameter_keys(),
             Walker::Described(w) => w.parameters().into_iter().map(|(k, _)| k).collect(),
         }
     }
@@ -139,6 +152,7 @@ impl Walker {
         Ok(match self {
             Walker::Simplest(w) => Walker::Simplest(w.with_parameter(key, value)?),
             Walker::Compass(w) => Walker::Compass(w.with_parameter(key, value)?),
+            Walker::Telescopic(w) => Walker::Telescopic(w.with_parameter(key, value)?),
             Walker::Described(w) => Walker::Described(w.with_value(key, value)?),
         })
     }
@@ -318,6 +332,14 @@ pub struct WalkerGait {
     /// `dP/dp` at the gait for the parameter asked for ([`WalkerGaitJob::parameter`]).
     #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
     pub dp_dparam: Option<WalkerParamDerivative>,
+    /// The error estimate of `DP` where it was taken by Richardson-extrapolated differences (the multipliers'
+    /// accuracy is about as good); absent where `DP` is exact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian_error: Option<f64>,
+    /// A walker with compliant legs: its heel strike's DLS indicators and branch, its double support, the
+    /// impacts' losses, the dampers' work, the signed energy audit and the penetration; absent for rigid legs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub legged: Option<StepAccount>,
 }
 
 /// `dP/dp` of a walker's step map at its gait, by the section's coordinates.
@@ -342,6 +364,7 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
     let summary = match &job.walker {
         Walker::Simplest(w) => compute(w, w.default_start(), job)?,
         Walker::Compass(w) => compute(w, w.default_start(), job)?,
+        Walker::Telescopic(_) => compute_on_model(job)?,
         Walker::Described(w) => {
             let start = rigid_start(w, job.initial.as_deref())?;
             crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
@@ -402,14 +425,54 @@ fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
         initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
-            Err(e) => SearchEnded::Failed(super::walker_model::search_kind(e)),
+            Err(e) => SearchEnded::Failed(WalkerGaitError::from(e.clone()).kind()),
         },
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok().map(|g| WalkerGait {
             dp_dparam,
-            ..gait_record(&g, named(&names, &g.section))
+            ..gait_record(&found_rigid(walker, g), &names)
         }),
         jacobian_check,
+    })
+}
+
+/// The search of [`run_walker_gait`] on the walker's [`WalkerModel`] (a walker with compliant legs, whose `DP`
+/// is taken by Richardson-extrapolated differences: no `parameter` or `check_jacobian`, which take exact
+/// derivatives).
+fn compute_on_model(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
+    let exact_only = |option: &'static str| {
+        AppError::InvalidOption {
+        option,
+        reason: format!(
+            "takes exact derivatives; the model `{}` has its DP by Richardson-extrapolated central differences \
+             so far (docs/model.md section 13)",
+            job.walker.name()
+        ),
+    }
+    };
+    if job.parameter.is_some() {
+        return Err(exact_only("parameter"));
+    }
+    if job.check_jacobian {
+        return Err(exact_only("check_jacobian"));
+    }
+    let model = job.walker.model()?;
+    let start = start_of(model.as_ref(), job.initial.as_deref())?;
+    let result = model.gait(&start, job.transient_steps);
+    super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
+    let names = model.section_names();
+    Ok(WalkerGaitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        model: job.walker.name(),
+        parameters: job.walker.clone(),
+        initial: named(&names, &start),
+        status: match &result {
+            Ok(_) => SearchEnded::Found,
+            Err(e) => SearchEnded::Failed(e.kind()),
+        },
+        message: result.as_ref().err().map(ToString::to_string),
+        gait: result.ok().map(|g| gait_record(&g, &names)),
+        jacobian_check: None,
     })
 }
 
@@ -462,23 +525,25 @@ pub(super) fn named<S: AsRef<str>>(names: &[S], x: &DVector<f64>) -> Vec<(String
         .collect()
 }
 
-/// `gait.json`'s record of `g`.
-fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) -> WalkerGait {
+/// `gait.json`'s record of `g`, its section by `names`.
+fn gait_record<S: AsRef<str>>(g: &FoundGait, names: &[S]) -> WalkerGait {
     let largest = g.largest_multiplier();
     WalkerGait {
-        section,
+        section: named(names, &g.section),
         residual: g.residual,
         newton_iterations: g.iterations,
         period: g.step.period,
         floquet_multipliers: g.multipliers.clone(),
         largest_multiplier: largest,
         stability: if largest < 1.0 { "stable" } else { "unstable" },
-        derivative: g.derivative.to_string(),
+        derivative: g.derivative.clone(),
         lambda_i4: g.step.lambda_i4,
         impact_loss: g.step.impact_loss,
         energy_drift: g.step.energy_drift,
         scuffs: g.step.scuffs,
         dp_dparam: None,
+        jacobian_error: g.jacobian_error,
+        legged: g.step.legged,
     }
 }
 
@@ -564,6 +629,7 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
     let (summary, rows) = match &job.walker {
         Walker::Simplest(w) => follow(w, w.default_start(), job)?,
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
+        Walker::Telescopic(w) => follow_legged::<_, 6, 13>(w, w.default_start(), job)?,
         Walker::Described(w) => {
             let start = rigid_start(w, None)?;
             crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
@@ -578,7 +644,8 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
     })
 }
 
-/// The family of [`run_walker_continuation`] for `walker`, and the rows of `branch.csv` (its header first).
+/// The family of [`run_walker_continuation`] for the rigid walker `walker` (its first gait searched from
+/// `section`), and the rows of `branch.csv` (its header first).
 fn follow<W, const N: usize, const Y: usize>(
     walker: &W,
     section: DVector<f64>,
@@ -587,17 +654,66 @@ fn follow<W, const N: usize, const Y: usize>(
 where
     W: RigidWalker<N, Y> + Parametrized + Sync,
 {
-    let invalid = |reason: String| AppError::InvalidOption {
-        option: "param",
-        reason,
-    };
     let family: RigidFamily<W, N, Y> = RigidFamily::new(walker, &job.param)
-        .map_err(|e| invalid(e.to_string()))?
+        .map_err(|e| param_error(e.to_string()))?
         .with_options(interruptible());
     let start = job.start.unwrap_or(current_value(job)?);
     let at_start = walker.with_parameter(&job.param, start)?;
     let gait = search_gait(&at_start, &section, TRANSIENT_STEPS)
-        .map_err(|e| invalid(format!("no gait at {} = {start}: {e}", job.param)))?;
+        .map_err(|e| param_error(format!("no gait at {} = {start}: {e}", job.param)))?;
+    follow_family(
+        &family,
+        (&gait.section, start),
+        &walker.section_names(),
+        job,
+    )
+}
+
+/// The family of [`run_walker_continuation`] for the walker with compliant legs `walker` (its first gait
+/// searched from `section`), and the rows of `branch.csv` (its header first).
+fn follow_legged<W, const N: usize, const Y: usize>(
+    walker: &W,
+    section: DVector<f64>,
+    job: &WalkerContinueJob,
+) -> Result<(WalkerContinueSummary, Vec<Vec<String>>), AppError>
+where
+    W: Legged<N> + Parametrized + Sync,
+{
+    let family: LeggedFamily<W, N, Y> = LeggedFamily::new(walker, &job.param)
+        .map_err(|e| param_error(e.to_string()))?
+        .with_options(legged_interruptible());
+    let start = job.start.unwrap_or(current_value(job)?);
+    let at_start = walker.with_parameter(&job.param, start)?;
+    let gait = search_legged_gait::<W, N, Y>(&at_start, &section, TRANSIENT_STEPS)
+        .map_err(|e| param_error(format!("no gait at {} = {start}: {e}", job.param)))?;
+    follow_family(
+        &family,
+        (&gait.section, start),
+        &walker.section_names(),
+        job,
+    )
+}
+
+/// An error of `continue --param`.
+fn param_error(reason: String) -> AppError {
+    AppError::InvalidOption {
+        option: "param",
+        reason,
+    }
+}
+
+/// The family of `family` from its gait `(section, start)` (the parameter's value), followed as `job` asks;
+/// its summary and the rows of `branch.csv`, the section by `names`.
+fn follow_family<F>(
+    family: &F,
+    (section, start): (&DVector<f64>, f64),
+    names: &[&str],
+    job: &WalkerContinueJob,
+) -> Result<(WalkerContinueSummary, Vec<Vec<String>>), AppError>
+where
+    F: FamilyMap,
+    F::Info: PointRecord,
+{
     let mut continuation = ContinuationOptions::for_range(job.range.0, job.range.1);
     continuation.max_points = job.max_points;
     continuation.max_step = job.max_step;
@@ -607,13 +723,12 @@ where
         "while searching the first gait",
         super::NOTHING_WRITTEN,
     )?;
-    let followed = continue_family(&family, &gait.section, start, &continuation)
-        .map_err(|e| invalid(e.to_string()))?;
+    let followed = continue_family(family, section, start, &continuation)
+        .map_err(|e| param_error(e.to_string()))?;
     super::check_phase_interrupted(None, "while following the family", super::NOTHING_WRITTEN)?;
-    let names = walker.section_names();
     let summary = WalkerContinueSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
-        model: walker.name(),
+        model: job.walker.name(),
         parameters: job.walker.clone(),
         param: job.param.clone(),
         start,
@@ -628,29 +743,106 @@ where
                 located: s.located,
                 note: s.note.clone(),
                 multipliers: s.multipliers.iter().map(|z| [z.re, z.im]).collect(),
-                section: named(&names, &s.x),
+                section: named(names, &s.x),
             })
             .collect(),
-        derivative: family_route(&followed.points),
+        derivative: F::Info::route(&followed.points),
     };
-    let rows = branch_rows(&job.param, &names, &followed.points);
+    let rows = branch_rows(&job.param, names, &followed.points);
     Ok((summary, rows))
 }
 
+/// What a walker's `branch.csv` and `special_points.json` say of a family's point beyond its parameter,
+/// section and largest multiplier.
+trait PointRecord: Sized {
+    /// The columns' names.
+    fn columns() -> Vec<&'static str>;
+    /// The point's values, as the columns.
+    fn values(&self) -> Vec<String>;
+    /// How the family's `DP` and `dP/dp` were taken, in words.
+    fn route(points: &[FamilyPoint<Self>]) -> String;
+}
+
+impl PointRecord for RigidInfo {
+    /// The step's period and `lambda_I4`.
+    fn columns() -> Vec<&'static str> {
+        vec!["period", "lambda_I4"]
+    }
+
+    fn values(&self) -> Vec<String> {
+        [self.period, self.lambda_i4]
+            .map(|v| v.to_string())
+            .to_vec()
+    }
+
+    fn route(points: &[FamilyPoint<Self>]) -> String {
+        family_route(points)
+    }
+}
+
+impl PointRecord for LeggedInfo {
+    /// The step's period, the heel strike's DLS indicators and branch, the double support's duration and the
+    /// error estimate of the point's derivatives.
+    fn columns() -> Vec<&'static str> {
+        vec![
+            "period",
+            "lambda_I4",
+            "lambda_2+",
+            "lambda_4+",
+            "branch",
+            "dls_duration",
+            "derivative_error",
+        ]
+    }
+
+    fn values(&self) -> Vec<String> {
+        let a = &self.account;
+        let text = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
+        vec![
+            self.period.to_string(),
+            a.lambda_i4.to_string(),
+            text(a.lambda_2_plus),
+            text(a.lambda_4_plus),
+            branch_text(a.branch),
+            a.dls_duration.to_string(),
+            text(Some(self.derivative_error).filter(|e| e.is_finite())),
+        ]
+    }
+
+    /// Richardson-extrapolated central differences at every point, with the largest error estimate.
+    fn route(points: &[FamilyPoint<Self>]) -> String {
+        let error = points
+            .iter()
+            .map(|p| p.info.derivative_error)
+            .filter(|e| e.is_finite())
+            .fold(0.0, f64::max);
+        format!(
+            "{RICHARDSON_ROUTE}: DP and dP/dp by Richardson-extrapolated central differences at every point \
+             (largest error estimate {error:.0e})"
+        )
+    }
+}
+
 /// The rows of a walker's `branch.csv`, its header first: the parameter, the section's coordinates, the largest
-/// multiplier, the step's period and `lambda_I4`.
-fn branch_rows(param: &str, names: &[&str], points: &[FamilyPoint<RigidInfo>]) -> Vec<Vec<String>> {
+/// multiplier, and the point's record ([`PointRecord`]).
+fn branch_rows<I: PointRecord>(
+    param: &str,
+    names: &[&str],
+    points: &[FamilyPoint<I>],
+) -> Vec<Vec<String>> {
     let header = [param.to_string()]
         .into_iter()
         .chain(names.iter().map(|n| n.to_string()))
-        .chain(["largest_multiplier", "period", "lambda_I4"].map(String::from))
+        .chain(["largest_multiplier".to_string()])
+        .chain(I::columns().into_iter().map(String::from))
         .collect();
-    let row = |p: &FamilyPoint<RigidInfo>| {
+    let row = |p: &FamilyPoint<I>| {
         [p.param]
             .into_iter()
             .chain(p.x.iter().copied())
-            .chain([p.max_multiplier(), p.info.period, p.info.lambda_i4])
+            .chain([p.max_multiplier()])
             .map(|v| v.to_string())
+            .chain(p.info.values())
             .collect()
     };
     std::iter::once(header)

@@ -91,9 +91,6 @@ fn wheel_parameter(key: Option<&str>) -> Result<Option<&'static str>> {
 /// Run `vrw gait` and print its summary.
 pub(super) fn run(args: GaitArgs) -> Result<()> {
     let sets = &args.params.set;
-    if args.model == vrw::app::TELESCOPIC {
-        return legged::run(&args);
-    }
     if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
         return run_walker(&args, walker);
     }
@@ -413,6 +410,10 @@ fn print_walker_gait(g: &WalkerGait) {
         g.residual,
         g.newton_iterations
     );
+    if let Some(account) = &g.legged {
+        legged::print_legged_gait(g, account);
+        return;
+    }
     println!(
         "period {:.9}, lambda_I4 = {:.9} (the rear foot leaves), impact loss {:.6e}, energy audit {:.1e}, \
          {} scuff(s) per step",

@@ -210,6 +210,7 @@ fn bad_telescopic_parameters_name_every_key() {
     for key in ["foot_mass", "leg_mass_offset", "viscosity"] {
         assert!(text.contains(key), "{key} not named in: {text}");
     }
+    use crate::mechanism::rigid_family::Parametrized;
     assert!(Telescopic::default()
         .with_parameter("stifness", 1.0)
         .is_err());

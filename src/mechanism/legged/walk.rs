@@ -372,6 +372,10 @@ fn swing_below<W: Legged<N>, const N: usize>(
     modes.tips[1] == Tip::Free && walker.contact(&c, q, &SVector::zeros(), 1).position.y < 0.0
 }
 
+/// What watches a step's integration ([`legged_step_observed`]): each accepted integrator step with the time it
+/// is taken to (its end, or the event that ends the phase within it).
+pub type Observer<'a, const Y: usize> = &'a mut dyn FnMut(&DenseStep<Y>, f64);
+
 /// Integrate the phase `modes` from `(t, y)` to its first event and handle it; `Ok(true)` at the heel strike
 /// that ends the step (`t`, `y` there).
 fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
@@ -379,6 +383,7 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
     (modes, t, y): (&mut Modes, &mut f64, &mut SVector<f64, Y>),
     acc: &mut StepAccount,
     options: &LeggedOptions,
+    observe: Observer<'_, Y>,
 ) -> Result<bool, LeggedError> {
     let system = Phase {
         walker,
@@ -403,11 +408,13 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
         let step = integrator.step(&system, options.max_step_time)?;
         let (t0, t1) = (step.t0(), step.t1());
         if let Some((event, te)) = earliest_event(walker, modes, &watch, &step, options) {
+            observe(&step, te);
             *y = step.eval(te);
             *t = te;
             acc.phase(walker, modes, te - t0, &unpack::<N, Y>(y).0);
             return handle_event(walker, event, (modes, *t, y), acc, options);
         }
+        observe(&step, t1);
         let end = unpack_pair::<N, Y>(step.y1());
         acc.phase(walker, modes, t1 - t0, &end.0);
         for (event, g) in event_values(walker, modes, end.as_refs()) {
@@ -516,8 +523,19 @@ pub fn legs_held<W: Legged<N>, const N: usize>(walker: &W, q: &SVector<f64, N>) 
 /// One step of `walker` from `(q, q')` on the section (see the module documentation).
 pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
+    state: (&SVector<f64, N>, &SVector<f64, N>),
+    options: &LeggedOptions,
+) -> Result<LeggedStep<N>, LeggedError> {
+    legged_step_observed::<W, N, Y>(walker, state, options, &mut |_, _| {})
+}
+
+/// [`legged_step`], each accepted integrator step passed to `observe` as it is taken (a drawing's samples are
+/// taken on the walk's own steps).
+pub fn legged_step_observed<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
     (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
     options: &LeggedOptions,
+    observe: Observer<'_, Y>,
 ) -> Result<LeggedStep<N>, LeggedError> {
     let e0 = walker.energy(q, qd);
     let strike = heel_strike(walker, (q, qd), legs_held(walker, q), 0.0)?;
@@ -535,7 +553,13 @@ pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
     let mut modes = strike.next.0;
     let mut y = pack::<N, Y>(q, &strike.impact.qd_plus, 0.0);
     let mut t = 0.0;
-    while !run_phase(walker, (&mut modes, &mut t, &mut y), &mut acc, options)? {}
+    while !run_phase(
+        walker,
+        (&mut modes, &mut t, &mut y),
+        &mut acc,
+        options,
+        &mut *observe,
+    )? {}
     let (q1, qd1) = unpack::<N, Y>(&y);
     if modes.tips[0] != Tip::Stuck {
         return Err(LeggedError::StanceNotStuck {
