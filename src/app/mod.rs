@@ -18,6 +18,7 @@ mod map;
 mod orbit;
 mod simulate;
 mod sweep;
+mod walker_continue;
 mod walker_figures;
 mod walker_model;
 mod walker_orbit;
@@ -55,6 +56,9 @@ pub use simulate::{
     DEFAULT_SAMPLE_DT, MAX_SIMULATE_STEPS, MIN_SAMPLE_DT, SAMPLE_DT_RANGE,
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
+pub use walker_continue::{
+    run_walker_continuation, WalkerContinueJob, WalkerContinueSummary, WalkerSpecialPoint,
+};
 pub use walker_model::{
     Body, FoundGait, RigidModel, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,
     WalkerStep,
@@ -70,9 +74,8 @@ pub use walker_sweep::{
     WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
 };
 pub use walkers::{
-    run_walker_continuation, run_walker_gait, wheel_only, Walker, WalkerContinueJob,
-    WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative,
-    WalkerSpecialPoint, MODELS, TELESCOPIC,
+    run_walker_gait, wheel_only, Walker, WalkerGait, WalkerGaitJob, WalkerGaitSummary,
+    WalkerParamDerivative, MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

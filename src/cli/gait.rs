@@ -23,7 +23,8 @@ pub(super) struct GaitArgs {
     #[command(flatten)]
     params: ModelArgs,
     /// The walker: `vrw`, the viscoelastic-legged rimless wheel (default); `simplest`, the simplest walking
-    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al.; or a walker described in a TOML
+    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al.; `telescopic`, the compass gait
+    /// with the paper's telescopic viscoelastic legs; or a walker described in a TOML
     /// file (`models/compass.toml`; docs/model.md section 13). For all but the wheel, --config and --set take
     /// their parameters and gait.json names the section by their coordinates.
     #[arg(long, default_value = "vrw")]
