@@ -1,4 +1,4 @@
-//! The jobs of the walkers other than the wheel (`--model simplest|compass`; docs/model.md section 13), run
+//! The jobs of the walkers other than the wheel (`--model simplest|compass|telescopic`; docs/model.md section 13), run
 //! through the binary: `simulate`, `sweep`, `orbit`, `plot` and `animate` of their runs, Ctrl-C, and the jobs
 //! a walker cannot do yet refusing it by name.
 
@@ -377,11 +377,17 @@ fn the_telescopic_biped_walks_with_double_support() {
     assert_eq!(gait["model"], "telescopic");
     assert_eq!(gait["status"], "found");
     let g = &gait["gait"];
-    assert_eq!(g["branch"], "DLS");
-    assert!(g["lambda_i4"].as_f64().unwrap() > 0.0);
-    assert!(g["dls_duration"].as_f64().unwrap() > 1e-3, "{g}");
-    assert!(g["energy_residual"].as_f64().unwrap().abs() < 1e-9, "{g}");
-    assert!(g["max_floquet"].as_f64().unwrap() < 1.0, "{g}");
+    let legged = &g["legged"];
+    assert_eq!(legged["branch"], "DLS");
+    assert!(g["lambda_I4"].as_f64().unwrap() > 0.0);
+    assert!(legged["dls_duration"].as_f64().unwrap() > 1e-3, "{g}");
+    assert!(
+        legged["energy_residual"].as_f64().unwrap().abs() < 1e-9,
+        "{g}"
+    );
+    assert!(g["largest_multiplier"].as_f64().unwrap() < 1.0, "{g}");
+    assert_eq!(g["derivative"], "richardson_differences");
+    assert!(g["jacobian_error"].as_f64().unwrap() < 1e-6, "{g}");
     let section: Vec<&str> = g["section"]
         .as_object()
         .unwrap()
@@ -457,5 +463,155 @@ fn the_simplest_walker_has_no_short_spurious_gait_at_slope_0_014() {
     for row in &rows {
         let p: f64 = row[column].parse().unwrap();
         assert!(p > 3.0, "a step of {p} time units: {rows:?}");
+    }
+}
+
+/// `vrw simulate --model telescopic` writes the legged walk's account in `steps.csv` (branch, DLS duration,
+/// audits) and its springs in the drawing, and `vrw plot` and `vrw animate` draw it; `--initial` of the wrong
+/// length and an unknown `--param` are refused by name.
+#[test]
+fn the_telescopic_biped_simulates_and_is_drawn() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("sim");
+    let o = out.to_str().unwrap();
+    let args = [
+        "simulate",
+        "--model",
+        "telescopic",
+        "--steps",
+        "3",
+        "--out",
+        o,
+    ];
+    ok(&vrw(&args, tmp.path()));
+    let (header, rows) = table(&out.join("steps.csv"));
+    assert_eq!(
+        &header[2..7],
+        ["theta1", "L2", "theta1_dot", "theta2_dot", "L2_dot"]
+    );
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r[col("branch")], "DLS");
+        assert!(r[col("dls_duration")].parse::<f64>().unwrap() > 1e-3);
+        assert!(r[col("energy_residual")].parse::<f64>().unwrap().abs() < 1e-9);
+    }
+    let (trajectory, _) = table(&out.join("trajectory.csv"));
+    assert_eq!(
+        &trajectory[3..9],
+        ["x", "z", "theta1", "theta2", "L1", "L2"]
+    );
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["figure"]["springs"].as_array().unwrap().len(), 2);
+    assert!(
+        summary["last_step"]["legged"]["dls_duration"]
+            .as_f64()
+            .unwrap()
+            > 1e-3
+    );
+    ok(&vrw(&["plot", o], tmp.path()));
+    ok(&vrw(&["animate", o, "--still", "1.0"], tmp.path()));
+    let wrong = vrw(
+        &[
+            "simulate",
+            "--model",
+            "telescopic",
+            "--initial",
+            "0.28,1",
+            "--out",
+            "w",
+        ],
+        tmp.path(),
+    );
+    assert_error(
+        &wrong,
+        &[
+            "initial",
+            "2 values",
+            "theta1, L2, theta1_dot, theta2_dot, L2_dot",
+        ],
+    );
+    let unknown = vrw(
+        &[
+            "continue",
+            "--model",
+            "telescopic",
+            "--param",
+            "stifness",
+            "--out",
+            "c",
+        ],
+        tmp.path(),
+    );
+    assert_error(&unknown, &["stifness", "stiffness", "viscosity"]);
+    let unknown = vrw(
+        &[
+            "sweep",
+            "--model",
+            "telescopic",
+            "--param",
+            "leg_length",
+            "--out",
+            "s",
+        ],
+        tmp.path(),
+    );
+    assert_error(&unknown, &["leg_length", "stopper_length"]);
+}
+
+/// `vrw continue --model telescopic --param viscosity`: a gait on the family (`branch.csv`) is the gait
+/// `vrw gait --set viscosity=VALUE` finds there, to 1e-9, and the family's derivatives are said to be
+/// Richardson differences.
+#[test]
+fn the_telescopic_family_holds_the_gaits_of_vrw_gait() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("cont");
+    let args = [
+        "continue",
+        "--model",
+        "telescopic",
+        "--param",
+        "viscosity",
+        "--from",
+        "950",
+        "--to",
+        "1050",
+        "--max-points",
+        "3",
+        "--out",
+    ];
+    let o = out.to_str().unwrap();
+    ok(&vrw(
+        &args.iter().copied().chain([o]).collect::<Vec<_>>(),
+        tmp.path(),
+    ));
+    let summary = json(&out.join("special_points.json"));
+    let route = summary["derivative"].as_str().unwrap();
+    assert!(route.starts_with("richardson_differences"), "{route}");
+    let (header, rows) = table(&out.join("branch.csv"));
+    assert_eq!(
+        &header[1..6],
+        ["theta1", "L2", "theta1_dot", "theta2_dot", "L2_dot"]
+    );
+    let row = rows
+        .iter()
+        .find(|r| r[0] != "1000")
+        .expect("a point off the start");
+    let gait_out = tmp.path().join("gait");
+    let set = format!("viscosity={}", row[0]);
+    let gait_args = ["gait", "--model", "telescopic", "--set", &set, "--out"];
+    let g = gait_out.to_str().unwrap();
+    ok(&vrw(
+        &gait_args.iter().copied().chain([g]).collect::<Vec<_>>(),
+        tmp.path(),
+    ));
+    let gait = json(&gait_out.join("gait.json"));
+    for (k, name) in header[1..6].iter().enumerate() {
+        let family: f64 = row[1 + k].parse().unwrap();
+        let found = gait["gait"]["section"][name].as_f64().unwrap();
+        assert!(
+            (family - found).abs() < 1e-9,
+            "{name}: {family} against {found}"
+        );
     }
 }

@@ -1,282 +1,306 @@
-//! `vrw gait --model telescopic` (and `--model walker.toml` for a described walker with telescopic legs): the
-//! gait of a walker with compliant legs ([`crate::mechanism::legged`], docs/model.md section 13), its
-//! multipliers, the DLS indicators and branch of its heel strike, its double support and the audits of its
-//! step, in `gait.json`.
+//! A walker with compliant legs as a [`WalkerModel`] (docs/model.md section 13): [`LeggedModel`], the legged
+//! walk ([`crate::mechanism::legged`]) on the section at a heel strike before its impact, for every job of a
+//! walker (`simulate`, `sweep`, `orbit`, `plot`/`animate` of its runs). Its steps carry the legged walk's account
+//! ([`WalkerStep::legged`]: the heel strike's branch and DLS indicators, the double support, the audits), its
+//! samples the spring's energy in the potential, and its gaits the multipliers of the exact `DP`, checked
+//! against Richardson-extrapolated central differences (their largest difference is the error stated).
 
-use std::path::PathBuf;
+use nalgebra::{DVector, SVector};
 
-use nalgebra::DVector;
-use serde::Serialize;
-
-use super::walkers::{as_map, named, TELESCOPIC};
-use super::{in_run, AppError, SearchEnded};
-use crate::mechanism::described::{walk, AnyDescribed, Walk};
+use super::walker_model::{
+    Body, FoundGait, Grid, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,
+    WalkerStep,
+};
 use crate::mechanism::legged::derivative::LeggedDerivatives;
 use crate::mechanism::legged::gait::{
     legged_gait_exact, legged_step_map, LeggedGait, LeggedGaitError,
 };
-use crate::mechanism::legged::walk::{LeggedOptions, StepAccount};
+use crate::mechanism::legged::walk::{legged_step_observed, LeggedOptions, LeggedStep};
 use crate::mechanism::legged::{Legged, LeggedError};
-use crate::mechanism::telescopic::Telescopic;
-use crate::output;
+use crate::mechanism::telescopic::{Telescopic, LENGTH1, LENGTH2, THETA1, THETA2, X, Z};
+use crate::mechanism::Mechanism;
+use crate::output::walker_run::StickFigure;
 
-/// A walker with compliant legs, with its parameters (`gait.json` writes them by key).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum LeggedWalker {
-    /// The compass gait with telescopic legs.
-    Telescopic(Telescopic),
-    /// A walker described in a file whose `[gait]` table names its legs' strokes
-    /// ([`AnyDescribed::walks_compliant`]).
-    Described(AnyDescribed),
-}
-
-impl LeggedWalker {
-    /// The model's name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            LeggedWalker::Telescopic(_) => TELESCOPIC,
-            LeggedWalker::Described(w) => w.description().name,
-        }
-    }
-}
-
-/// What `vrw gait --model telescopic` searches.
-#[derive(Debug, Clone)]
-pub struct LeggedGaitJob {
-    /// The walker.
-    pub walker: LeggedWalker,
-    /// Where the search starts on the section; default the model's start.
-    pub initial: Option<Vec<f64>>,
-    /// Steps walked before Newton's method starts.
-    pub transient_steps: usize,
-    /// Output directory for `gait.json`.
-    pub out_dir: PathBuf,
-    /// Replace a run of another command in `out_dir`.
-    pub overwrite: bool,
-}
-
-/// A legged walker's gait, as `gait.json` holds it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LeggedGaitRecord {
-    /// The fixed point, by the section's names (the heel strike before its impact).
-    #[serde(serialize_with = "as_map")]
-    pub section: Vec<(String, f64)>,
-    /// `max |P(s) - s|` there.
-    pub residual: f64,
-    /// Newton iterations.
-    pub iterations: usize,
-    /// The step's duration \[s\].
-    pub period: f64,
-    /// The Floquet multipliers `[re, im]`, largest modulus first.
-    pub floquet_multipliers: Vec<[f64; 2]>,
-    /// Their largest modulus.
-    pub max_floquet: f64,
-    /// How `DP` was taken.
-    pub derivative: &'static str,
-    /// Its error estimate (the multipliers' accuracy is about as good): for exact derivatives, their largest
-    /// difference from Richardson-extrapolated differences.
-    pub jacobian_error: f64,
-    /// The step's heel strike and audits.
-    #[serde(flatten)]
-    pub step: StepAccount,
-}
-
-/// `gait.json` of a legged walker: the gait, or why there is none.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LeggedGaitSummary {
-    /// vrw's version.
-    pub vrw_version: &'static str,
-    /// The model's name.
-    pub model: &'static str,
-    /// Its parameters.
-    pub parameters: LeggedWalker,
-    /// The start, by the section's names.
-    #[serde(serialize_with = "as_map")]
-    pub initial: Vec<(String, f64)>,
-    /// `found`, or the failure's kind.
-    #[serde(serialize_with = "crate::fmt::as_text")]
-    pub status: SearchEnded,
-    /// Why not.
-    pub message: Option<String>,
-    /// The gait.
-    pub gait: Option<LeggedGaitRecord>,
-}
-
-/// The walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
-fn interruptible() -> LeggedOptions {
+/// The legged walk's options with the library's interrupt flag (Ctrl-C) asked whether to stop.
+pub(crate) fn legged_interruptible() -> LeggedOptions {
     LeggedOptions {
         stop: Some(crate::walk::interrupted),
         ..LeggedOptions::default()
     }
 }
 
-/// The record of `gait`.
-fn record<W: Legged<N>, const N: usize>(walker: &W, gait: &LeggedGait<N>) -> LeggedGaitRecord {
-    let step = &gait.step;
-    LeggedGaitRecord {
-        section: named(&walker.section_names(), &gait.section),
-        residual: gait.residual,
-        iterations: gait.iterations,
-        period: step.period,
-        max_floquet: gait
-            .multipliers
-            .first()
-            .map_or(f64::NAN, |[re, im]| re.hypot(*im)),
-        floquet_multipliers: gait.multipliers.clone(),
-        derivative: gait.derivative,
-        jacobian_error: gait.jacobian_error,
-        step: step.account,
-    }
-}
-
-/// The search from `start`: `transient` steps, then Newton's method with the exact derivatives
-/// ([`legged_gait_exact`]).
-fn search<W: LeggedDerivatives<N>, const N: usize, const Y: usize>(
+/// The gait of `walker` searched from the section state `start`: `transient` steps walked, then Newton's
+/// method with the exact derivatives ([`legged_gait_exact`]), each walk answering the interrupt flag.
+pub(crate) fn search_legged_gait<W: LeggedDerivatives<N>, const N: usize, const Y: usize>(
     walker: &W,
-    (start, transient): (&DVector<f64>, usize),
+    start: &DVector<f64>,
+    transient: usize,
 ) -> Result<LeggedGait<N>, LeggedGaitError> {
-    let options = interruptible();
+    let options = legged_interruptible();
     let mut s = start.clone();
     for _ in 0..transient {
-        s = legged_step_map::<_, N, Y>(walker, &s, &options)
+        s = legged_step_map::<W, N, Y>(walker, &s, &options)
             .map_err(|source| LeggedGaitError::Step {
                 iteration: 0,
                 source,
             })?
             .0;
     }
-    legged_gait_exact::<_, N, Y>(walker, &s, &options)
+    legged_gait_exact::<W, N, Y>(walker, &s, &options)
 }
 
-/// The failure's short name.
-fn failure_kind(e: &LeggedGaitError) -> &'static str {
-    match e {
-        LeggedGaitError::Step { source, .. } => source.kind(),
-        LeggedGaitError::Singular { .. } => "singular",
-        LeggedGaitError::NoConvergence { .. } => "no_convergence",
+/// A point at `length` from `from` along a leg of angle `angle` (from the slope's downward normal).
+fn along(from: [f64; 2], angle: f64, length: f64) -> [f64; 2] {
+    [
+        from[0] + length * angle.sin(),
+        from[1] - length * angle.cos(),
+    ]
+}
+
+impl Body<6> for Telescopic {
+    fn coordinate_names(&self) -> [&'static str; 6] {
+        self.coordinates()
+    }
+
+    fn kinetic(&self, q: &SVector<f64, 6>, qd: &SVector<f64, 6>) -> f64 {
+        self.kinetic_energy(q, qd)
+    }
+
+    fn slope_angle(&self) -> f64 {
+        self.slope
+    }
+
+    fn stick_figure(&self) -> StickFigure {
+        StickFigure::telescopic_legs()
+    }
+
+    /// The feet at each leg's length from the hip, the sleeves' ends at their masses (`stopper_length -
+    /// leg_mass_offset` from the hip), the rods' tops `leg_mass_offset / 2` above the feet (a drawing's choice:
+    /// the spring between sleeve and rod shortens as the leg does).
+    fn points(&self, q: &SVector<f64, 6>) -> Vec<[f64; 2]> {
+        let hip = [q[X], q[Z]];
+        let sleeve = self.stopper_length - self.leg_mass_offset;
+        let rod = 0.5 * self.leg_mass_offset;
+        vec![
+            along(hip, q[THETA1], q[LENGTH1]),
+            hip,
+            along(hip, q[THETA2], q[LENGTH2]),
+            along(hip, q[THETA1], sleeve),
+            along(hip, q[THETA2], sleeve),
+            along(hip, q[THETA1], q[LENGTH1] - rod),
+            along(hip, q[THETA2], q[LENGTH2] - rod),
+        ]
     }
 }
 
-/// The start (`initial`, or the model's), by the section's names, and the search from it: the gait's record, or
-/// why there is none.
-type Searched = (
-    Vec<(String, f64)>,
-    Result<LeggedGaitRecord, LeggedGaitError>,
-);
-
-/// The search of [`run_legged_gait`] for `walker`, from `job.initial` or `default_start`.
-fn compute<W: LeggedDerivatives<N>, const N: usize, const Y: usize>(
-    walker: &W,
-    default_start: DVector<f64>,
-    job: &LeggedGaitJob,
-) -> Result<Searched, AppError> {
-    let names = walker.section_names();
-    let start = match &job.initial {
-        Some(values) if values.len() != names.len() => {
-            return Err(AppError::InvalidOption {
-                option: "initial",
-                reason: format!(
-                    "{} values given; the section of `{}` has {}: {}",
-                    values.len(),
-                    job.walker.name(),
-                    names.len(),
-                    names.join(", ")
-                ),
-            })
-        }
-        Some(values) => DVector::from_column_slice(values),
-        None => default_start,
-    };
-    if walker.state_at_section(&start).is_none() {
-        return Err(AppError::InvalidOption {
-            option: "initial",
-            reason: format!("{}", LeggedError::OffSection),
-        });
-    }
-    let result = search::<W, N, Y>(walker, (&start, job.transient_steps));
-    super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
-    Ok((named(&names, &start), result.map(|g| record(walker, &g))))
+/// A walker with compliant legs as a [`WalkerModel`].
+#[derive(Debug, Clone, Copy)]
+pub struct LeggedModel<'w, W, const N: usize, const Y: usize> {
+    walker: &'w W,
+    start: fn(&W) -> DVector<f64>,
 }
 
-/// Where a described walker's search starts (its `[gait]` table's `start`), checked on its section with the
-/// contact conditions' reason where it is not (as `initial` where that is given with the section's length);
-/// a walker that does not walk by the compliant walk is refused, saying why.
-fn described_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<f64>, AppError> {
-    let model = |reason: String| AppError::InvalidOption {
-        option: "model",
-        reason,
-    };
-    match walk(w.description()) {
-        Ok(Walk::Compliant) => {}
-        Ok(Walk::Rigid) => {
-            return Err(model(format!(
-                "`{}` has rigid legs (its [gait] table names no strokes): it walks as a rigid biped, not by the \
-                 compliant walk",
-                w.description().name
-            )))
-        }
-        Err(e) => return Err(model(e.to_string())),
+impl<'w, W, const N: usize, const Y: usize> LeggedModel<'w, W, N, Y> {
+    /// `walker`, its searches and walks starting at `start(walker)` by default.
+    pub fn new(walker: &'w W, start: fn(&W) -> DVector<f64>) -> LeggedModel<'w, W, N, Y> {
+        LeggedModel { walker, start }
     }
-    let (names, start) = match w.description().gait.as_ref() {
-        Some(g) => (g.section_names.clone(), g.start.clone()),
-        None => (Vec::new(), Vec::new()),
-    };
-    let start = DVector::from_vec(start);
-    let (option, checked) = match initial {
-        Some(values) if values.len() == start.len() => {
-            ("initial", DVector::from_column_slice(values))
-        }
-        _ => ("model", start.clone()),
-    };
-    w.check_section(&checked).map_err(|e| {
-        let at: Vec<String> = named(&names, &checked)
-            .iter()
-            .map(|(n, v)| format!("{n} = {v}"))
-            .collect();
-        AppError::InvalidOption {
-            option,
-            reason: format!("at the section's {}: {e}", at.join(", ")),
-        }
-    })?;
-    Ok(start)
 }
 
-/// `vrw gait --model telescopic` (or a described walker with telescopic legs): the search, then `gait.json`.
-pub fn run_legged_gait(job: &LeggedGaitJob) -> Result<LeggedGaitSummary, AppError> {
-    crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
-    let (initial, result) = match &job.walker {
-        LeggedWalker::Telescopic(w) => compute::<_, 6, 13>(w, w.default_start(), job)?,
-        LeggedWalker::Described(any) => {
-            let start = described_start(any, job.initial.as_deref())?;
-            crate::with_legged_described!(
-                any, w, N, Y => compute::<_, N, Y>(w, start, job)?,
-                _ => return Err(AppError::InvalidOption {
-                    option: "model",
-                    reason: format!(
-                        "`{}` has {} coordinates: a walker with telescopic legs needs at least 4",
-                        any.description().name,
-                        any.description().coordinates.len()
-                    ),
-                })
+impl<W: Legged<N> + Body<N>, const N: usize, const Y: usize> LeggedModel<'_, W, N, Y> {
+    /// The record of `step`, started at `(q, q')` on the section: the stride is the new stance tip's distance
+    /// ahead of the old one (behind the new one just after the relabeling), the energy audit the step's
+    /// residual's size.
+    fn record(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        step: &LeggedStep<N>,
+    ) -> WalkerStep {
+        let w = self.walker;
+        let rear = w.contact(&w.constants_f64(), &step.q, &step.qd, 1).position;
+        let account = step.account;
+        WalkerStep {
+            section: w.section_of(&step.q, &step.qd),
+            period: step.period,
+            stride: -rear.x,
+            lambda_i4: account.lambda_i4,
+            impact_loss: account.losses.heel_strike,
+            energy_start: w.energy(q, qd),
+            energy_drift: account.energy_residual.abs(),
+            scuffs: account.scuffs,
+            legged: Some(account),
+        }
+    }
+
+    /// The sample of `(q, q')` at the walk's time `time`.
+    fn sample(&self, time: f64, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> WalkerSample {
+        WalkerSample {
+            time,
+            q: q.iter().copied().collect(),
+            qd: qd.iter().copied().collect(),
+            kinetic: self.walker.kinetic(q, qd),
+            potential: self.walker.potential_energy(q),
+            points: self.walker.points(q),
+        }
+    }
+
+    /// The step from `(q, q')` on the section, its states passed to `sampling`'s sink: at its start (the
+    /// section's state, before the heel strike's impact), at the multiples of the sampling interval inside it
+    /// and just before the next heel strike, on the walk's own integrator steps.
+    fn sampled(
+        &self,
+        (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+        options: &LeggedOptions,
+        sampling: Sampling<'_>,
+    ) -> Result<LeggedStep<N>, LeggedError> {
+        let Sampling { start, dt, sink } = sampling;
+        sink(self.sample(start, q, qd));
+        let mut grid = Grid::new(start, dt);
+        let mut last = None;
+        let split = |y: &SVector<f64, Y>| {
+            (
+                SVector::<f64, N>::from_iterator(y.rows(0, N).iter().copied()),
+                SVector::<f64, N>::from_iterator(y.rows(N, N).iter().copied()),
             )
+        };
+        let step =
+            legged_step_observed::<W, N, Y>(self.walker, (q, qd), options, &mut |s, end| {
+                grid.through(end, |t| {
+                    let (q, qd) = split(&s.eval(t));
+                    sink(self.sample(start + t, &q, &qd));
+                });
+                last = Some(if end >= s.t1() { *s.y1() } else { s.eval(end) });
+            })?;
+        if let Some(y) = last {
+            let (q, qd) = split(&y);
+            sink(self.sample(start + step.period, &q, &qd));
         }
-    };
-    let summary = LeggedGaitSummary {
-        vrw_version: env!("CARGO_PKG_VERSION"),
-        model: job.walker.name(),
-        parameters: job.walker.clone(),
-        initial,
-        status: match &result {
-            Ok(_) => SearchEnded::Found,
-            Err(e) => SearchEnded::Failed(failure_kind(e)),
-        },
-        message: result.as_ref().err().map(ToString::to_string),
-        gait: result.ok(),
-    };
-    in_run(&job.out_dir, job.overwrite, "gait", |run| {
-        output::write_json(&run.path("gait.json"), &summary)?;
-        run.add("gait.json");
-        Ok((summary, None))
-    })
+        Ok(step)
+    }
+}
+
+impl<W, const N: usize, const Y: usize> WalkerModel for LeggedModel<'_, W, N, Y>
+where
+    W: LeggedDerivatives<N> + Body<N>,
+{
+    fn name(&self) -> &str {
+        Mechanism::name(self.walker)
+    }
+
+    fn coordinates(&self) -> Vec<String> {
+        self.walker
+            .coordinate_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect()
+    }
+
+    fn section_names(&self) -> Vec<String> {
+        self.walker
+            .section_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect()
+    }
+
+    fn default_start(&self) -> DVector<f64> {
+        (self.start)(self.walker)
+    }
+
+    fn slope(&self) -> f64 {
+        self.walker.slope_angle()
+    }
+
+    fn figure(&self) -> StickFigure {
+        self.walker.stick_figure()
+    }
+
+    fn step(
+        &self,
+        s: &DVector<f64>,
+        sampling: Option<Sampling<'_>>,
+    ) -> Result<WalkerStep, WalkerError> {
+        let options = legged_interruptible();
+        if options.stop.is_some_and(|stop| stop()) {
+            return Err(LeggedError::Interrupted.into());
+        }
+        let (q, qd) = self
+            .walker
+            .state_at_section(s)
+            .ok_or(LeggedError::OffSection)?;
+        let step = match sampling {
+            Some(sampling) => self.sampled((&q, &qd), &options, sampling)?,
+            None => {
+                legged_step_observed::<W, N, Y>(self.walker, (&q, &qd), &options, &mut |_, _| {})?
+            }
+        };
+        Ok(self.record(&q, &qd, &step))
+    }
+
+    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, WalkerGaitError> {
+        let g = search_legged_gait::<W, N, Y>(self.walker, start, transient)?;
+        let (q, qd) = self
+            .walker
+            .state_at_section(&g.section)
+            .ok_or(LeggedGaitError::Step {
+                iteration: g.iterations,
+                source: LeggedError::OffSection,
+            })?;
+        Ok(FoundGait {
+            step: self.record(&q, &qd, &g.step),
+            derivative: g.derivative.to_string(),
+            jacobian_error: Some(g.jacobian_error),
+            section: g.section,
+            residual: g.residual,
+            iterations: g.iterations,
+            multipliers: g.multipliers,
+        })
+    }
+
+    fn legged(&self) -> bool {
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step of `vrw simulate --model telescopic` is the gait search's step map bit for bit, with its samples
+    /// or without (the observer changes nothing of the walk); its first sample holds the step's starting
+    /// energy, its last is at the heel strike, where the swing foot is one stride ahead.
+    #[test]
+    fn a_simulated_step_is_the_gait_searchs_step_map() {
+        let w = Telescopic::default();
+        let model = LeggedModel::<_, 6, 13>::new(&w, Telescopic::default_start);
+        let s = w.default_start();
+        let (p, walked) = legged_step_map::<_, 6, 13>(&w, &s, &LeggedOptions::default()).unwrap();
+        let mut samples = Vec::new();
+        let mut sink = |x| samples.push(x);
+        let sampling = Sampling {
+            start: 0.0,
+            dt: 0.01,
+            sink: &mut sink,
+        };
+        let step = model.step(&s, Some(sampling)).unwrap();
+        assert_eq!(step.section, p);
+        assert_eq!(model.step(&s, None).unwrap().section, p);
+        assert_eq!(step.period, walked.period);
+        assert_eq!(step.legged, Some(walked.account));
+        let first = &samples[0];
+        assert!((first.kinetic + first.potential - step.energy_start).abs() < 1e-12);
+        let last = samples.last().unwrap();
+        assert_eq!(last.time, step.period);
+        // The figure's swing foot (point 2) at the heel strike: on the ground, one stride ahead of the stance
+        // foot (point 0, within the contact's drift of the origin).
+        let [stance, swing] = [last.points[0], last.points[2]];
+        assert!(
+            (swing[0] - stance[0] - step.stride).abs() < 1e-12,
+            "{last:?}"
+        );
+        assert!(stance[0].abs() < 1e-8, "{last:?}");
+        assert!(last.points[2][1].abs() < 1e-9, "{last:?}");
+        assert!(samples.len() > 80, "{}", samples.len());
+    }
 }

@@ -19,6 +19,7 @@ mod orbit;
 mod simulate;
 mod sweep;
 mod walker_basin;
+mod walker_continue;
 mod walker_described;
 mod walker_figures;
 mod walker_map;
@@ -47,9 +48,7 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
-pub use legged::{
-    run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary, LeggedWalker,
-};
+pub use legged::LeggedModel;
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
@@ -64,11 +63,15 @@ pub use walker_basin::{
     run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob, WalkerBasinPoint,
     WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS, MAX_WALKER_BASIN_STEPS,
 };
+pub use walker_continue::{
+    run_walker_continuation, WalkerContinueJob, WalkerContinueSummary, WalkerSpecialPoint,
+};
 pub use walker_map::{
     run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary, WalkerMapThreshold,
 };
 pub use walker_model::{
-    Body, FoundGait, RigidModel, Sampling, WalkerModel, WalkerSample, WalkerStep,
+    Body, FoundGait, RigidModel, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,
+    WalkerStep,
 };
 pub use walker_orbit::{
     run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary, MAX_WALKER_PERIOD,
@@ -81,8 +84,7 @@ pub use walker_sweep::{
     WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
 };
 pub use walkers::{
-    run_walker_continuation, run_walker_gait, Walker, WalkerContinueJob, WalkerContinueSummary,
-    WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative, WalkerSpecialPoint,
+    run_walker_gait, Walker, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative,
     MODELS, TELESCOPIC,
 };
 

@@ -6,7 +6,7 @@
 use nalgebra::{DVector, SVector};
 
 use super::walker_model::Body;
-use crate::mechanism::described::{walkable, Described};
+use crate::mechanism::described::Described;
 use crate::mechanism::Mechanism;
 use crate::output::walker_run::StickFigure;
 
@@ -31,6 +31,7 @@ impl<const N: usize> Body<N> for Described<N> {
             links: drawing.links,
             masses: drawing.masses,
             feet: drawing.contacts,
+            springs: Vec::new(),
         }
     }
 
@@ -39,11 +40,10 @@ impl<const N: usize> Body<N> for Described<N> {
     }
 }
 
-/// The start of its `[gait]` table (the jobs check that it has one before they take it:
-/// [`super::Walker::model`]).
+/// The start of its `[gait]` table (the jobs check that it walks before they take it: [`super::Walker::model`]).
 pub(super) fn described_start<const N: usize>(w: &Described<N>) -> DVector<f64> {
-    walkable(&w.description).map_or_else(
-        |_| DVector::zeros(0),
-        |gait| DVector::from_column_slice(&gait.start),
+    w.description.gait.as_ref().map_or_else(
+        || DVector::zeros(0),
+        |g| DVector::from_column_slice(&g.start),
     )
 }

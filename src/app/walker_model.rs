@@ -2,13 +2,18 @@
 //! runs; docs/model.md section 13): [`WalkerModel`], an object-safe interface on section states, so that a job
 //! is written once for every walker. The built-in walkers (the simplest walker and the compass gait) give it
 //! through [`RigidModel`], their rigid-leg walk ([`crate::mechanism::rigid`]) with what a drawing and the
-//! energy split need ([`Body`]); another kind of walker slots in by implementing [`WalkerModel`] and being
-//! returned by [`super::Walker::model`].
+//! energy split need ([`Body`]), the walkers with compliant legs through `LeggedModel` (`super::legged`);
+//! another kind of walker slots in by implementing [`WalkerModel`] and being returned by
+//! [`super::Walker::model`]. A step's or a search's failure is one [`WalkerError`] or [`WalkerGaitError`]
+//! whatever the walk, with the kinds of the walk's own errors (`fell`, `rolled_back`, `no_convergence`, ...).
 
 use nalgebra::{DVector, SVector};
 
 use crate::integrate::{Dop853, OdeSystem};
 use crate::mechanism::compass::{Compass, THETA1, THETA2, X, Z};
+use crate::mechanism::legged::gait::LeggedGaitError;
+use crate::mechanism::legged::walk::StepAccount;
+use crate::mechanism::legged::LeggedError;
 use crate::mechanism::rigid::{rigid_step, RigidError, RigidOptions, RigidStep, RigidWalker};
 use crate::mechanism::rigid_gait::{rigid_gait, RigidGait, RigidGaitError};
 use crate::mechanism::simplest::{Simplest, INTER_LEG_ANGLE, STANCE_ANGLE};
@@ -34,6 +39,69 @@ pub struct WalkerStep {
     pub energy_drift: f64,
     /// Crossings of the ground by the swing foot ignored as scuffing.
     pub scuffs: usize,
+    /// What a step of a walker with compliant legs has besides (its heel strike's branch and `lambda_2+`,
+    /// `lambda_4+`, the double support's duration, the impacts' losses, the dampers' work, the signed energy
+    /// audit, the penetration); `None` for a rigid-legged walker.
+    pub legged: Option<StepAccount>,
+}
+
+/// Why a walker's step failed: the rigid or the legged walk's error, with its kind.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WalkerError {
+    /// A rigid-legged walker's step.
+    #[error(transparent)]
+    Rigid(#[from] RigidError),
+    /// A step of a walker with compliant legs.
+    #[error(transparent)]
+    Legged(#[from] LeggedError),
+}
+
+impl WalkerError {
+    /// Short machine-readable name: the walk's own (`fell`, `rolled_back`, `stalled`, ...).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            WalkerError::Rigid(e) => e.kind(),
+            WalkerError::Legged(e) => e.kind(),
+        }
+    }
+
+    /// Did the caller ask the walk to stop (Ctrl-C)?
+    pub fn is_interrupted(&self) -> bool {
+        matches!(
+            self,
+            WalkerError::Rigid(RigidError::Interrupted)
+                | WalkerError::Legged(LeggedError::Interrupted)
+        )
+    }
+}
+
+/// Why a walker's gait search failed: the rigid or the legged search's error, with its kind.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WalkerGaitError {
+    /// A rigid-legged walker's search.
+    #[error(transparent)]
+    Rigid(#[from] RigidGaitError),
+    /// The search of a walker with compliant legs.
+    #[error(transparent)]
+    Legged(#[from] LeggedGaitError),
+}
+
+impl WalkerGaitError {
+    /// Short machine-readable name: a failed step's kind, `singular_jacobian`, `no_convergence` or
+    /// `not_differentiable`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            WalkerGaitError::Rigid(RigidGaitError::Step { source, .. }) => source.kind(),
+            WalkerGaitError::Legged(LeggedGaitError::Step { source, .. }) => source.kind(),
+            WalkerGaitError::Rigid(RigidGaitError::Singular { .. })
+            | WalkerGaitError::Legged(LeggedGaitError::Singular { .. }) => "singular_jacobian",
+            WalkerGaitError::Rigid(RigidGaitError::NoConvergence { .. })
+            | WalkerGaitError::Legged(LeggedGaitError::NoConvergence { .. }) => "no_convergence",
+            WalkerGaitError::Rigid(RigidGaitError::NotDifferentiable { .. }) => {
+                "not_differentiable"
+            }
+        }
+    }
 }
 
 /// A walker's state at one instant of a step, for `trajectory.csv` and the drawings.
@@ -47,7 +115,7 @@ pub struct WalkerSample {
     pub qd: Vec<f64>,
     /// Kinetic energy.
     pub kinetic: f64,
-    /// Potential energy (gravity, from the stance foot's height).
+    /// Potential energy (gravity, from the stance foot's height, and the legs' springs where they have some).
     pub potential: f64,
     /// The points of the drawing ([`StickFigure::points`]) in the slope frame, the stance foot at the origin.
     pub points: Vec<[f64; 2]>,
@@ -64,6 +132,10 @@ pub struct FoundGait {
     pub iterations: usize,
     /// The Floquet multipliers `[re, im]`, largest modulus first.
     pub multipliers: Vec<[f64; 2]>,
+    /// How `DP` was taken, in words (`gait.json`'s `derivative`).
+    pub derivative: String,
+    /// The error estimate of `DP`, where it was taken by Richardson-extrapolated differences.
+    pub jacobian_error: Option<f64>,
     /// The step from the fixed point.
     pub step: WalkerStep,
 }
@@ -77,8 +149,8 @@ impl FoundGait {
     }
 }
 
-/// What a walker offers the jobs, on its Poincare section just after a heel strike. Every walk answers the
-/// library's interrupt flag (Ctrl-C) with [`RigidError::Interrupted`].
+/// What a walker offers the jobs, on its Poincare section at a heel strike. Every walk answers the library's
+/// interrupt flag (Ctrl-C) with an interrupted [`WalkerError`] ([`WalkerError::is_interrupted`]).
 pub trait WalkerModel {
     /// The model's name.
     fn name(&self) -> &str;
@@ -98,9 +170,13 @@ pub trait WalkerModel {
         &self,
         s: &DVector<f64>,
         sampling: Option<Sampling<'_>>,
-    ) -> Result<WalkerStep, RigidError>;
+    ) -> Result<WalkerStep, WalkerError>;
     /// The gait near `start` (a section state), after `transient` steps.
-    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, RigidGaitError>;
+    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, WalkerGaitError>;
+    /// Do its steps carry [`WalkerStep::legged`] (`steps.csv`'s extra columns)?
+    fn legged(&self) -> bool {
+        false
+    }
 }
 
 /// What the jobs need of a rigid-legged walker besides its walk: the names of its coordinates, its kinetic
@@ -227,21 +303,6 @@ impl<W, const N: usize, const Y: usize> RigidModel<'_, W, N, Y>
 where
     W: RigidWalker<N, Y> + Body<N>,
 {
-    /// The record of `step`, started at `(q, q')`.
-    fn record(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>, step: &RigidStep<N>) -> WalkerStep {
-        WalkerStep {
-            section: self.walker.section_of(&step.q, &step.qd),
-            period: step.period,
-            // Just after the strike the old stance foot is the swing foot, behind the new one.
-            stride: -self.walker.swing_foot(&step.q).1,
-            lambda_i4: step.lambda_i4,
-            impact_loss: step.impact_loss,
-            energy_start: self.walker.mechanical_energy(q, qd),
-            energy_drift: step.energy_drift,
-            scuffs: step.scuffs,
-        }
-    }
-
     /// The sample of the state `y` at time `time` of a step.
     fn sample(&self, time: f64, y: &SVector<f64, Y>) -> WalkerSample {
         let (q, qd) = split::<N, Y>(y);
@@ -271,25 +332,48 @@ where
         let mut integrator = Dop853::new(&field, 0.0, y0, options.tolerances);
         let Sampling { start, dt, sink } = sampling;
         sink(self.sample(start, &y0));
-        // The walk's grid times k dt inside the step.
-        let mut k = (start / dt).floor() as u64 + 1;
+        let mut grid = Grid::new(start, dt);
         loop {
             if options.stop.is_some_and(|stop| stop()) {
                 return Err(RigidError::Interrupted);
             }
             let step = integrator.step(&field, options.max_step_time)?;
-            let end = step.t1().min(period);
-            while (k as f64) * dt - start < end {
-                let t = (k as f64) * dt - start;
-                if t > 0.0 {
-                    sink(self.sample(start + t, &step.eval(t)));
-                }
-                k += 1;
-            }
+            grid.through(step.t1().min(period), |t| {
+                sink(self.sample(start + t, &step.eval(t)))
+            });
             if step.t1() >= period {
                 sink(self.sample(start + period, &step.eval(period)));
                 return Ok(());
             }
+        }
+    }
+}
+
+/// The walk's grid times `k dt` inside a step started at the walk's time `start`, met in order.
+pub(super) struct Grid {
+    start: f64,
+    dt: f64,
+    next: u64,
+}
+
+impl Grid {
+    /// The grid of the sampling interval `dt`, from the step started at `start`.
+    pub(super) fn new(start: f64, dt: f64) -> Grid {
+        Grid {
+            start,
+            dt,
+            next: (start / dt).floor() as u64 + 1,
+        }
+    }
+
+    /// Passes each grid time not yet met before `end` (the step's own time, after its start) to `at`.
+    pub(super) fn through(&mut self, end: f64, mut at: impl FnMut(f64)) {
+        while (self.next as f64) * self.dt - self.start < end {
+            let t = (self.next as f64) * self.dt - self.start;
+            if t > 0.0 {
+                at(t);
+            }
+            self.next += 1;
         }
     }
 }
@@ -345,30 +429,63 @@ where
         &self,
         s: &DVector<f64>,
         sampling: Option<Sampling<'_>>,
-    ) -> Result<WalkerStep, RigidError> {
+    ) -> Result<WalkerStep, WalkerError> {
         let options = interruptible();
         // Asked at every step too: a step takes fewer integrator steps than the walk's own check waits for.
         if options.stop.is_some_and(|stop| stop()) {
-            return Err(RigidError::Interrupted);
+            return Err(RigidError::Interrupted.into());
         }
         let (q, qd) = self.walker.state_at_section(s);
         let step = rigid_step(self.walker, &q, &qd, &options)?;
         if let Some(sampling) = sampling {
             self.sampled((&q, &qd), step.period, sampling)?;
         }
-        Ok(self.record(&q, &qd, &step))
+        Ok(rigid_record(self.walker, &q, &qd, &step))
     }
 
-    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, RigidGaitError> {
-        let g: RigidGait<N> = search_gait(self.walker, start, transient)?;
-        let (q, qd) = self.walker.state_at_section(&g.section);
-        Ok(FoundGait {
-            step: self.record(&q, &qd, &g.step),
-            section: g.section,
-            residual: g.residual,
-            iterations: g.iterations,
-            multipliers: g.multipliers,
-        })
+    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, WalkerGaitError> {
+        Ok(found_rigid(
+            self.walker,
+            search_gait(self.walker, start, transient)?,
+        ))
+    }
+}
+
+/// The record of a rigid walker's `step`, started at `(q, q')`.
+fn rigid_record<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    q: &SVector<f64, N>,
+    qd: &SVector<f64, N>,
+    step: &RigidStep<N>,
+) -> WalkerStep {
+    WalkerStep {
+        section: walker.section_of(&step.q, &step.qd),
+        period: step.period,
+        // Just after the strike the old stance foot is the swing foot, behind the new one.
+        stride: -walker.swing_foot(&step.q).1,
+        lambda_i4: step.lambda_i4,
+        impact_loss: step.impact_loss,
+        energy_start: walker.mechanical_energy(q, qd),
+        energy_drift: step.energy_drift,
+        scuffs: step.scuffs,
+        legged: None,
+    }
+}
+
+/// The rigid walker's gait `g` as the jobs hold a gait.
+pub(super) fn found_rigid<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
+    walker: &W,
+    g: RigidGait<N>,
+) -> FoundGait {
+    let (q, qd) = walker.state_at_section(&g.section);
+    FoundGait {
+        step: rigid_record(walker, &q, &qd, &g.step),
+        derivative: g.derivative.to_string(),
+        jacobian_error: None,
+        section: g.section,
+        residual: g.residual,
+        iterations: g.iterations,
+        multipliers: g.multipliers,
     }
 }
 
@@ -402,15 +519,5 @@ pub(crate) fn interruptible() -> RigidOptions {
         stop: Some(crate::walk::interrupted),
         difference_fallback: true,
         ..RigidOptions::default()
-    }
-}
-
-/// The kind of a failed search.
-pub(super) fn search_kind(e: &RigidGaitError) -> &'static str {
-    match e {
-        RigidGaitError::Step { source, .. } => source.kind(),
-        RigidGaitError::Singular { .. } => "singular_jacobian",
-        RigidGaitError::NoConvergence { .. } => "no_convergence",
-        RigidGaitError::NotDifferentiable { .. } => "not_differentiable",
     }
 }

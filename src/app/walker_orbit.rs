@@ -13,11 +13,11 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
+use super::walker_model::WalkerError;
 use super::walker_model::WalkerStep;
 use super::walker_sweep::{walker_gaits, WalkerRange, WalkerSweepPoint};
 use super::walkers::{write_rows, Walker};
 use super::{check_interrupted, in_run, AppError};
-use crate::mechanism::rigid::RigidError;
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
 use crate::study::grid::{run_rows, Evaluated};
@@ -142,7 +142,7 @@ fn walk_column(
         None => FRESH_TRANSIENT_FACTOR * job.transient,
     };
     let mut s = start.clone();
-    let walked: Result<(), RigidError> = (|| {
+    let walked: Result<(), WalkerError> = (|| {
         for _ in 0..transient {
             s = model.step(&s, None)?.section;
         }
@@ -414,6 +414,7 @@ pub(super) fn non_default_parameters(walker: &Walker) -> Vec<(String, f64)> {
     let defaults: Vec<(String, f64)> = match walker {
         Walker::Simplest(_) => serde_pairs(&Walker::Simplest(Default::default())),
         Walker::Compass(_) => serde_pairs(&Walker::Compass(Default::default())),
+        Walker::Telescopic(_) => serde_pairs(&Walker::Telescopic(Default::default())),
         Walker::Described(w) => w
             .description()
             .parameters

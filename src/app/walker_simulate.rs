@@ -13,8 +13,10 @@ use serde::Serialize;
 use super::walker_model::{Sampling, WalkerModel, WalkerSample, WalkerStep};
 use super::walkers::{as_map, named, Walker};
 use super::{in_run, AppError, WalkEnded, MAX_SIMULATE_STEPS, SAMPLE_DT_RANGE};
-use crate::mechanism::rigid::RigidError;
-use crate::output::walker_run::{walker_steps_header, walker_trajectory_header, StickFigure};
+use crate::mechanism::legged::walk::StepAccount;
+use crate::output::walker_run::{
+    legged_step_values, walker_steps_header, walker_trajectory_header, StickFigure,
+};
 use crate::output::{self, CsvStream};
 
 /// What `vrw simulate --model NAME` runs.
@@ -91,6 +93,9 @@ pub struct WalkerStepRecord {
     pub energy_drift: f64,
     /// Crossings of the ground by the swing foot ignored as scuffing.
     pub scuffs: usize,
+    /// What a step of a walker with compliant legs has besides ([`WalkerStep::legged`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub legged: Option<StepAccount>,
 }
 
 impl WalkerStepRecord {
@@ -113,6 +118,7 @@ impl WalkerStepRecord {
             energy_start: s.energy_start,
             energy_drift: s.energy_drift,
             scuffs: s.scuffs,
+            legged: s.legged,
         }
     }
 
@@ -133,6 +139,9 @@ impl WalkerStepRecord {
             .map(output::num),
         );
         row.push(self.scuffs.to_string());
+        if let Some(a) = &self.legged {
+            row.extend(legged_step_values(a));
+        }
         row
     }
 }
@@ -195,7 +204,10 @@ pub fn run_walker_simulate(job: &WalkerSimulateJob) -> Result<WalkerSimulateSumm
         let names: Vec<&str> = files.iter().map(String::as_str).collect();
         run.add_streaming(&names)?;
         let section = model.section_names();
-        let mut steps = CsvStream::create(&run.path("steps.csv"), walker_steps_header(&section))?;
+        let mut steps = CsvStream::create(
+            &run.path("steps.csv"),
+            walker_steps_header(&section, model.legged()),
+        )?;
         let mut trajectory = match job.trajectory {
             true => Some(CsvStream::create(
                 &run.path("trajectory.csv"),
@@ -268,9 +280,9 @@ fn walk(
         let step = match model.step(&s, sampling) {
             Ok(step) => step,
             Err(e) => {
-                summary.status = match e {
-                    RigidError::Interrupted => WalkEnded::Interrupted,
-                    _ => WalkEnded::Failed(e.kind()),
+                summary.status = match e.is_interrupted() {
+                    true => WalkEnded::Interrupted,
+                    false => WalkEnded::Failed(e.kind()),
                 };
                 summary.message = Some(format!("step {k}: {e}"));
                 break;

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walker_model::{search_kind, FoundGait};
+use super::walker_model::FoundGait;
 use super::walkers::{as_map, named, Walker};
 use super::{check_interrupted, in_run, AppError};
 use crate::output;
@@ -139,7 +139,7 @@ pub(super) fn gait_at(
     };
     WalkerSweepPoint {
         value,
-        failure: gait.as_ref().err().map(search_kind),
+        failure: gait.as_ref().err().map(|e| e.kind()),
         gait: gait.map_err(|e| e.to_string()),
     }
 }

@@ -9,19 +9,22 @@ use std::path::{Path, PathBuf};
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walker_model::{interruptible, search_gait, RigidModel, WalkerModel};
-use super::{in_run, AppError, SearchEnded};
-use crate::continuation::{
-    continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
+use super::legged::LeggedModel;
+use super::walker_model::{
+    found_rigid, interruptible, search_gait, FoundGait, RigidModel, WalkerGaitError, WalkerModel,
 };
+use super::{in_run, AppError, SearchEnded};
 use crate::mechanism::compass::Compass;
-use crate::mechanism::described::{self, AnyDescribed};
+use crate::mechanism::described::{self, AnyDescribed, Walk};
+use crate::mechanism::legged::walk::StepAccount;
 use crate::mechanism::rigid::RigidWalker;
 use crate::mechanism::rigid_check::{check_rigid_derivatives, RigidDerivativeCheck};
 use crate::mechanism::rigid_derivative::{parameter_value, DerivativeError};
-use crate::mechanism::rigid_family::{Parametrized, RigidFamily, RigidInfo};
+use crate::mechanism::rigid_family::Parametrized;
 use crate::mechanism::rigid_gait::{rigid_step_map, RigidGait, DIFFERENCE_STEP, EXACT_ROUTE};
 use crate::mechanism::simplest::Simplest;
+use crate::mechanism::telescopic::Telescopic;
+use crate::mechanism::Mechanism;
 use crate::output;
 use crate::params::read_walker_parameters;
 use crate::params::ConfigError;
@@ -42,6 +45,8 @@ pub enum Walker {
     Simplest(Simplest),
     /// The compass gait.
     Compass(Compass),
+    /// The compass gait with telescopic legs, walking by the legged walk.
+    Telescopic(Telescopic),
     /// A walker described in a file.
     Described(AnyDescribed),
 }
@@ -67,12 +72,9 @@ impl Walker {
                 Walker::Compass(w)
             }
             TELESCOPIC => {
-                return Err(AppError::InvalidOption {
-                    option: "model",
-                    reason: "the compass gait with telescopic legs (`telescopic`) walks in `vrw gait` only so \
-                             far (docs/model.md section 13)"
-                        .to_string(),
-                })
+                let w: Telescopic = read_walker_parameters(file, overrides)?;
+                w.validate()?;
+                Walker::Telescopic(w)
             }
             other if other.ends_with(".toml") || Path::new(other).is_file() => {
                 let model = |reason: String| AppError::InvalidOption {
@@ -101,6 +103,7 @@ impl Walker {
         match self {
             Walker::Simplest(w) => RigidWalker::name(w),
             Walker::Compass(w) => RigidWalker::name(w),
+            Walker::Telescopic(w) => Mechanism::name(w),
             Walker::Described(w) => w.description().name,
         }
     }
@@ -111,16 +114,27 @@ impl Walker {
         Ok(match self {
             Walker::Simplest(w) => Box::new(RigidModel::<_, 2, 4>::new(w, Simplest::default_start)),
             Walker::Compass(w) => Box::new(RigidModel::<_, 4, 8>::new(w, Compass::default_start)),
+            Walker::Telescopic(w) => {
+                Box::new(LeggedModel::<_, 6, 13>::new(w, Telescopic::default_start))
+            }
             Walker::Described(w) => {
-                described::walkable(w.description()).map_err(|e| AppError::InvalidOption {
-                    option: "model",
-                    reason: e.to_string(),
-                })?;
-                crate::with_rigid_described!(
-                    w,
-                    w => Box::new(RigidModel::new(w, super::walker_described::described_start)),
-                    _ => unreachable_walk(w)?
-                )
+                let walk =
+                    described::walk(w.description()).map_err(|e| AppError::InvalidOption {
+                        option: "model",
+                        reason: e.to_string(),
+                    })?;
+                use super::walker_described::described_start as start;
+                match walk {
+                    Walk::Rigid => crate::with_rigid_described!(
+                        w,
+                        w => Box::new(RigidModel::new(w, start)),
+                        _ => unreachable_walk(w)?
+                    ),
+                    Walk::Compliant => crate::with_legged_described!(
+                        w, w, N, Y => Box::new(LeggedModel::<_, N, Y>::new(w, start)),
+                        _ => unreachable_walk(w)?
+                    ),
+                }
             }
         })
     }
@@ -130,6 +144,7 @@ impl Walker {
         match self {
             Walker::Simplest(w) => w.parameter_keys(),
             Walker::Compass(w) => w.parameter_keys(),
+            Walker::Telescopic(w) => w.parameter_keys(),
             Walker::Described(w) => w.parameters().into_iter().map(|(k, _)| k).collect(),
         }
     }
@@ -139,6 +154,7 @@ impl Walker {
         Ok(match self {
             Walker::Simplest(w) => Walker::Simplest(w.with_parameter(key, value)?),
             Walker::Compass(w) => Walker::Compass(w.with_parameter(key, value)?),
+            Walker::Telescopic(w) => Walker::Telescopic(w.with_parameter(key, value)?),
             Walker::Described(w) => Walker::Described(w.with_value(key, value)?),
         })
     }
@@ -298,6 +314,14 @@ pub struct WalkerGait {
     /// `dP/dp` at the gait for the parameter asked for ([`WalkerGaitJob::parameter`]).
     #[serde(rename = "dP_dparam", skip_serializing_if = "Option::is_none")]
     pub dp_dparam: Option<WalkerParamDerivative>,
+    /// The error estimate of `DP` where it was taken by Richardson-extrapolated differences (the multipliers'
+    /// accuracy is about as good); absent where `DP` is exact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jacobian_error: Option<f64>,
+    /// A walker with compliant legs: its heel strike's DLS indicators and branch, its double support, the
+    /// impacts' losses, the dampers' work, the signed energy audit and the penetration; absent for rigid legs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub legged: Option<StepAccount>,
 }
 
 /// `dP/dp` of a walker's step map at its gait, by the section's coordinates.
@@ -322,6 +346,8 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
     let summary = match &job.walker {
         Walker::Simplest(w) => compute(w, w.default_start(), job)?,
         Walker::Compass(w) => compute(w, w.default_start(), job)?,
+        Walker::Telescopic(_) => compute_on_model(job)?,
+        Walker::Described(w) if w.walks_compliant() => compute_on_model(job)?,
         Walker::Described(w) => {
             let start = rigid_start(w, job.initial.as_deref())?;
             crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
@@ -382,14 +408,53 @@ fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
         initial: named(&names, &start),
         status: match &result {
             Ok(_) => SearchEnded::Found,
-            Err(e) => SearchEnded::Failed(super::walker_model::search_kind(e)),
+            Err(e) => SearchEnded::Failed(WalkerGaitError::from(e.clone()).kind()),
         },
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok().map(|g| WalkerGait {
             dp_dparam,
-            ..gait_record(&g, named(&names, &g.section))
+            ..gait_record(&found_rigid(walker, g), &names)
         }),
         jacobian_check,
+    })
+}
+
+/// The search of [`run_walker_gait`] on the walker's [`WalkerModel`] (a walker with compliant legs, whose exact
+/// `DP` is checked against Richardson-extrapolated differences at every gait; `parameter` and `check_jacobian`
+/// are not offered for it yet).
+fn compute_on_model(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
+    let exact_only = |option: &'static str| AppError::InvalidOption {
+        option,
+        reason: format!(
+            "is not offered for the model `{}` yet: its gait's exact DP is checked against \
+             Richardson-extrapolated differences at every gait (gait.json's `derivative` and \
+             `jacobian_error`; docs/model.md section 13)",
+            job.walker.name()
+        ),
+    };
+    if job.parameter.is_some() {
+        return Err(exact_only("parameter"));
+    }
+    if job.check_jacobian {
+        return Err(exact_only("check_jacobian"));
+    }
+    let model = job.walker.model()?;
+    let start = start_of(model.as_ref(), job.initial.as_deref())?;
+    let result = model.gait(&start, job.transient_steps);
+    super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
+    let names = model.section_names();
+    Ok(WalkerGaitSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        model: job.walker.name(),
+        parameters: job.walker.clone(),
+        initial: named(&names, &start),
+        status: match &result {
+            Ok(_) => SearchEnded::Found,
+            Err(e) => SearchEnded::Failed(e.kind()),
+        },
+        message: result.as_ref().err().map(ToString::to_string),
+        gait: result.ok().map(|g| gait_record(&g, &names)),
+        jacobian_check: None,
     })
 }
 
@@ -442,23 +507,25 @@ pub(super) fn named<S: AsRef<str>>(names: &[S], x: &DVector<f64>) -> Vec<(String
         .collect()
 }
 
-/// `gait.json`'s record of `g`.
-fn gait_record<const N: usize>(g: &RigidGait<N>, section: Vec<(String, f64)>) -> WalkerGait {
+/// `gait.json`'s record of `g`, its section by `names`.
+fn gait_record<S: AsRef<str>>(g: &FoundGait, names: &[S]) -> WalkerGait {
     let largest = g.largest_multiplier();
     WalkerGait {
-        section,
+        section: named(names, &g.section),
         residual: g.residual,
         newton_iterations: g.iterations,
         period: g.step.period,
         floquet_multipliers: g.multipliers.clone(),
         largest_multiplier: largest,
         stability: if largest < 1.0 { "stable" } else { "unstable" },
-        derivative: g.derivative.to_string(),
+        derivative: g.derivative.clone(),
         lambda_i4: g.step.lambda_i4,
         impact_loss: g.step.impact_loss,
         energy_drift: g.step.energy_drift,
         scuffs: g.step.scuffs,
         dp_dparam: None,
+        jacobian_error: g.jacobian_error,
+        legged: g.step.legged,
     }
 }
 
@@ -473,169 +540,6 @@ pub(super) fn as_map<S: serde::Serializer>(
         map.serialize_entry(name, value)?;
     }
     map.end()
-}
-
-/// What `vrw continue --model NAME` follows.
-#[derive(Debug, Clone)]
-pub struct WalkerContinueJob {
-    /// The walker.
-    pub walker: Walker,
-    /// The parameter followed.
-    pub param: String,
-    /// Where the first gait is searched (default the parameter's value in the walker).
-    pub start: Option<f64>,
-    /// The range followed.
-    pub range: (f64, f64),
-    /// Most points in each direction.
-    pub max_points: usize,
-    /// Largest continuation step (scaled unknowns).
-    pub max_step: f64,
-    /// Output directory for `branch.csv` and `special_points.json`.
-    pub out_dir: PathBuf,
-    /// Replace a run of another command in `out_dir`.
-    pub overwrite: bool,
-}
-
-/// `special_points.json` of a walker's family.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct WalkerContinueSummary {
-    /// vrw's version.
-    pub vrw_version: &'static str,
-    /// The model's name.
-    pub model: &'static str,
-    /// Its parameters (the followed one at the start's value).
-    pub parameters: Walker,
-    /// The parameter followed.
-    pub param: String,
-    /// Where the family was started.
-    pub start: f64,
-    /// Points on the family (rows of `branch.csv`).
-    pub points: usize,
-    /// How the family ends at its first point and at its last.
-    pub ends: [FamilyEnd; 2],
-    /// Its special points.
-    pub special_points: Vec<WalkerSpecialPoint>,
-    /// How `DP` was taken.
-    pub derivative: String,
-}
-
-/// A special point of a walker's family.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct WalkerSpecialPoint {
-    /// `LP`, `PD`, `NS` or `BC` (the DLS indicator `lambda_I4` crossing zero).
-    pub kind: SpecialKind,
-    /// The parameter's value.
-    pub value: f64,
-    /// Solved for (`true`), or only bracketed between two points of the family.
-    pub located: bool,
-    /// Why it is not located, or how it was.
-    pub note: Option<String>,
-    /// The multipliers there `[re, im]`.
-    pub multipliers: Vec<[f64; 2]>,
-    /// The fixed point, by the section's coordinates.
-    #[serde(serialize_with = "as_map")]
-    pub section: Vec<(String, f64)>,
-}
-
-/// Follow the family of `job.walker`'s gait in `job.param` by pseudo-arclength continuation and write
-/// `branch.csv` (a row per point) and `special_points.json`, after the output directory is checked.
-pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinueSummary, AppError> {
-    crate::output::manifest::check_out_dir(&job.out_dir, "continue", job.overwrite)?;
-    let (summary, rows) = match &job.walker {
-        Walker::Simplest(w) => follow(w, w.default_start(), job)?,
-        Walker::Compass(w) => follow(w, w.default_start(), job)?,
-        Walker::Described(w) => {
-            let start = rigid_start(w, None)?;
-            crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
-        }
-    };
-    in_run(&job.out_dir, job.overwrite, "continue", |run| {
-        write_rows(&run.path("branch.csv"), &rows)?;
-        run.add("branch.csv");
-        output::write_json(&run.path("special_points.json"), &summary)?;
-        run.add("special_points.json");
-        Ok((summary, None))
-    })
-}
-
-/// The family of [`run_walker_continuation`] for `walker`, and the rows of `branch.csv` (its header first).
-fn follow<W, const N: usize, const Y: usize>(
-    walker: &W,
-    section: DVector<f64>,
-    job: &WalkerContinueJob,
-) -> Result<(WalkerContinueSummary, Vec<Vec<String>>), AppError>
-where
-    W: RigidWalker<N, Y> + Parametrized + Sync,
-{
-    let invalid = |reason: String| AppError::InvalidOption {
-        option: "param",
-        reason,
-    };
-    let family: RigidFamily<W, N, Y> = RigidFamily::new(walker, &job.param)
-        .map_err(|e| invalid(e.to_string()))?
-        .with_options(interruptible());
-    let start = job.start.unwrap_or(current_value(job)?);
-    let at_start = walker.with_parameter(&job.param, start)?;
-    let gait = search_gait(&at_start, &section, TRANSIENT_STEPS)
-        .map_err(|e| invalid(format!("no gait at {} = {start}: {e}", job.param)))?;
-    let mut continuation = ContinuationOptions::for_range(job.range.0, job.range.1);
-    continuation.max_points = job.max_points;
-    continuation.max_step = job.max_step;
-    continuation.initial_step = continuation.initial_step.min(job.max_step);
-    super::check_phase_interrupted(
-        None,
-        "while searching the first gait",
-        super::NOTHING_WRITTEN,
-    )?;
-    let followed = continue_family(&family, &gait.section, start, &continuation)
-        .map_err(|e| invalid(e.to_string()))?;
-    super::check_phase_interrupted(None, "while following the family", super::NOTHING_WRITTEN)?;
-    let names = walker.section_names();
-    let summary = WalkerContinueSummary {
-        vrw_version: env!("CARGO_PKG_VERSION"),
-        model: walker.name(),
-        parameters: job.walker.clone(),
-        param: job.param.clone(),
-        start,
-        points: followed.points.len(),
-        ends: followed.ends.clone(),
-        special_points: followed
-            .special
-            .iter()
-            .map(|s| WalkerSpecialPoint {
-                kind: s.kind,
-                value: s.param,
-                located: s.located,
-                note: s.note.clone(),
-                multipliers: s.multipliers.iter().map(|z| [z.re, z.im]).collect(),
-                section: named(&names, &s.x),
-            })
-            .collect(),
-        derivative: family_route(&followed.points),
-    };
-    let rows = branch_rows(&job.param, &names, &followed.points);
-    Ok((summary, rows))
-}
-
-/// The rows of a walker's `branch.csv`, its header first: the parameter, the section's coordinates, the largest
-/// multiplier, the step's period and `lambda_I4`.
-fn branch_rows(param: &str, names: &[&str], points: &[FamilyPoint<RigidInfo>]) -> Vec<Vec<String>> {
-    let header = [param.to_string()]
-        .into_iter()
-        .chain(names.iter().map(|n| n.to_string()))
-        .chain(["largest_multiplier", "period", "lambda_I4"].map(String::from))
-        .collect();
-    let row = |p: &FamilyPoint<RigidInfo>| {
-        [p.param]
-            .into_iter()
-            .chain(p.x.iter().copied())
-            .chain([p.max_multiplier(), p.info.period, p.info.lambda_i4])
-            .map(|v| v.to_string())
-            .collect()
-    };
-    std::iter::once(header)
-        .chain(points.iter().map(row))
-        .collect()
 }
 
 /// Write the table `rows` (its header first) as the CSV file `path`, atomically.
@@ -653,28 +557,13 @@ pub(super) fn write_rows(path: &Path, rows: &[Vec<String>]) -> Result<(), AppErr
     })
 }
 
-/// The transient walk before a family's first gait is searched.
-const TRANSIENT_STEPS: usize = 20;
-
-/// The followed parameter's value in the job's walker.
-fn current_value(job: &WalkerContinueJob) -> Result<f64, AppError> {
-    let value = serde_json::to_value(&job.walker)
-        .ok()
-        .and_then(|v| v.get(&job.param).and_then(serde_json::Value::as_f64));
-    value.ok_or_else(|| AppError::InvalidOption {
-        option: "param",
-        reason: format!(
-            "the model `{}` has no parameter {:?}",
-            job.walker.name(),
-            crate::fmt::clip(&job.param)
-        ),
-    })
-}
-
 /// Where a described walker's gait search starts (its `[gait]` table's `start`), or why it cannot walk: no
 /// `[gait]` table, or joints that need the compliant walk ([`described::NotWalkable`]); and whether that start
 /// (or `initial`, where given with the section's length) completes to a state after a heel strike.
-fn rigid_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<f64>, AppError> {
+pub(super) fn rigid_start(
+    w: &AnyDescribed,
+    initial: Option<&[f64]>,
+) -> Result<DVector<f64>, AppError> {
     let invalid = |option: &'static str, reason: String| AppError::InvalidOption { option, reason };
     let gait = described::walkable(w.description()).map_err(|e| invalid("model", e.to_string()))?;
     let start = DVector::from_column_slice(&gait.start);
@@ -699,7 +588,7 @@ fn rigid_start(w: &AnyDescribed, initial: Option<&[f64]>) -> Result<DVector<f64>
 
 /// The error for a described walker with fewer than 3 coordinates, which its `[gait]` check already refuses
 /// (the contact conditions fix three positions on the section).
-fn unreachable_walk<T>(w: &AnyDescribed) -> Result<T, AppError> {
+pub(super) fn unreachable_walk<T>(w: &AnyDescribed) -> Result<T, AppError> {
     Err(AppError::InvalidOption {
         option: "model",
         reason: format!(
@@ -708,21 +597,4 @@ fn unreachable_walk<T>(w: &AnyDescribed) -> Result<T, AppError> {
             w.description().coordinates.len()
         ),
     })
-}
-
-/// How a family's `DP` and `dP/dp` were taken: exactly, or by central differences at the points where the
-/// step map has no derivative (counted).
-fn family_route<I>(points: &[FamilyPoint<I>]) -> String {
-    let by_differences = points
-        .iter()
-        .filter(|p| p.has_derivatives() && !p.exact)
-        .count();
-    if by_differences == 0 {
-        EXACT_ROUTE.to_string()
-    } else {
-        format!(
-            "{EXACT_ROUTE}; central differences, relative step {DIFFERENCE_STEP:e}, at {by_differences} \
-             point(s) where the step map is not differentiable"
-        )
-    }
 }

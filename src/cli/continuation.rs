@@ -19,7 +19,7 @@ use vrw::app::{run_walker_continuation, Walker, WalkerContinueJob};
 pub(super) struct ContinueArgs {
     #[command(flatten)]
     params: ModelArgs,
-    /// The walker: `vrw` (default), `simplest`, `compass` or a walker described in a TOML file
+    /// The walker: `vrw` (default), `simplest`, `compass`, `telescopic` or a walker described in a TOML file
     /// (`models/compass.toml`; docs/model.md section 13); for all but the wheel the family of the start's gait
     /// alone, branch.csv and special_points.json (no figure yet).
     #[arg(long, default_value = "vrw")]

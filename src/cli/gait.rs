@@ -23,7 +23,8 @@ pub(super) struct GaitArgs {
     #[command(flatten)]
     params: ModelArgs,
     /// The walker: `vrw`, the viscoelastic-legged rimless wheel (default); `simplest`, the simplest walking
-    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al.; or a walker described in a TOML
+    /// model of Garcia et al.; `compass`, the compass gait of Goswami et al.; `telescopic`, the compass gait
+    /// with the paper's telescopic viscoelastic legs; or a walker described in a TOML
     /// file (`models/compass.toml`; docs/model.md section 13). For all but the wheel, --config and --set take
     /// their parameters and gait.json names the section by their coordinates.
     #[arg(long, default_value = "vrw")]
@@ -91,9 +92,6 @@ fn wheel_parameter(key: Option<&str>) -> Result<Option<&'static str>> {
 /// Run `vrw gait` and print its summary.
 pub(super) fn run(args: GaitArgs) -> Result<()> {
     let sets = &args.params.set;
-    if args.model == vrw::app::TELESCOPIC {
-        return legged::run(&args);
-    }
     if let Some(walker) = Walker::load(&args.model, args.params.config.as_deref(), sets)? {
         return run_walker(&args, walker);
     }
@@ -285,14 +283,8 @@ fn print_check(check: &JacobianCheck) -> Result<()> {
     )
 }
 
-/// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json (a described
-/// walker with telescopic legs by the compliant walk, `legged`).
+/// `vrw gait --model NAME` for a walker other than the wheel: the search, its summary, gait.json.
 fn run_walker(args: &GaitArgs, walker: Walker) -> Result<()> {
-    if let Walker::Described(w) = &walker {
-        if w.walks_compliant() {
-            return legged::run_described(args, w.clone());
-        }
-    }
     let initial = super::walker_initial(args.initial.as_deref())?;
     let job = WalkerGaitJob {
         walker,
@@ -419,6 +411,10 @@ fn print_walker_gait(g: &WalkerGait) {
         g.residual,
         g.newton_iterations
     );
+    if let Some(account) = &g.legged {
+        legged::print_legged_gait(g, account);
+        return;
+    }
     println!(
         "period {:.9}, lambda_I4 = {:.9} (the rear foot leaves), impact loss {:.6e}, energy audit {:.1e}, \
          {} scuff(s) per step",

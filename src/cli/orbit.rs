@@ -15,7 +15,8 @@ use super::{interrupt_flag, progress_bar, ModelArgs};
 pub(super) struct OrbitArgs {
     #[command(flatten)]
     params: ModelArgs,
-    /// The walker: `vrw` (default), `simplest` or `compass` (docs/model.md section 13): for the last two the
+    /// The walker: `vrw` (default), `simplest`, `compass` or `telescopic` (docs/model.md section 13): for all
+    /// but the wheel the
     /// diagram draws the section's first coordinate (the stance angle) and lambda_I4 along `--param`.
     #[arg(long, default_value = "vrw")]
     model: String,

@@ -16,8 +16,8 @@ use super::{interrupt_flag, progress_bar, ModelArgs};
 pub(super) struct SimulateArgs {
     #[command(flatten)]
     params: ModelArgs,
-    /// The walker: `vrw`, the viscoelastic-legged rimless wheel (default); `simplest` or `compass` (docs/model.md
-    /// section 13), whose run names its coordinates (steps.csv, trajectory.csv, summary.json).
+    /// The walker: `vrw`, the viscoelastic-legged rimless wheel (default); `simplest`, `compass` or
+    /// `telescopic` (docs/model.md section 13), whose run names its coordinates (steps.csv, trajectory.csv, summary.json).
     #[arg(long, default_value = "vrw")]
     model: String,
     /// Number of steps (touchdowns) to walk.
@@ -185,6 +185,19 @@ fn run_walker(args: &SimulateArgs, walker: Walker) -> Result<()> {
             last.impact_loss,
             last.scuffs
         );
+        if let Some(a) = &last.legged {
+            let force = |x: Option<f64>| x.map_or("undefined".to_string(), |x| format!("{x:.6} N"));
+            println!(
+                "its heel strike: branch {}, lambda_2+ = {}, lambda_4+ = {}; DLS {:.6} s; dampers {:.6} J; \
+                 energy audit {:.1e} J",
+                vrw::output::walker_run::branch_text(a.branch),
+                force(a.lambda_2_plus),
+                force(a.lambda_4_plus),
+                a.dls_duration,
+                a.damper_work,
+                a.energy_residual
+            );
+        }
     }
     super::print_wrote(&args.out);
     match &s.message {

@@ -18,7 +18,8 @@ use super::{
 pub(super) struct SweepArgs {
     #[command(flatten)]
     params: ModelArgs,
-    /// The walker: `vrw` (default), `simplest` or `compass` (docs/model.md section 13): for the last two, the
+    /// The walker: `vrw` (default), `simplest`, `compass` or `telescopic` (docs/model.md section 13): for all
+    /// but the wheel, the
     /// gait along `--param` (one of the model's keys) continued from value to value, sweep.csv and
     /// thresholds.json (where the largest multiplier crosses 1, bisected).
     #[arg(long, default_value = "vrw")]

@@ -196,32 +196,6 @@ impl Telescopic {
         ConfigError::all(errors)
     }
 
-    /// The walker with the parameter `key` set to `value`, checked.
-    pub fn with_parameter(&self, key: &str, value: f64) -> Result<Telescopic, ConfigError> {
-        let mut walker = *self;
-        let field = match key {
-            "hip_mass" => &mut walker.hip_mass,
-            "leg_mass" => &mut walker.leg_mass,
-            "leg_mass_offset" => &mut walker.leg_mass_offset,
-            "foot_mass" => &mut walker.foot_mass,
-            "stopper_length" => &mut walker.stopper_length,
-            "spring_natural_length" => &mut walker.spring_natural_length,
-            "stiffness" => &mut walker.stiffness,
-            "viscosity" => &mut walker.viscosity,
-            "gravity" => &mut walker.gravity,
-            "slope" => &mut walker.slope,
-            _ => {
-                return Err(ConfigError::UnknownKey {
-                    key: key.to_string(),
-                    known: KEYS.join(", "),
-                })
-            }
-        };
-        *field = value;
-        walker.validate()?;
-        Ok(walker)
-    }
-
     /// Where a gait search starts (the section of [`Legged::section_of`]): the gait with the default
     /// parameters (`theta1 = 0.28196`, `L2 = 0.99728` m, `theta1' = -1.65060`, `theta2' = -1.47117` rad/s,
     /// `L2' = 0.00937` m/s).
@@ -253,6 +227,39 @@ impl Telescopic {
             foot(THETA1, LENGTH1),
             foot(THETA2, LENGTH2),
         ]
+    }
+}
+
+/// Its parameters by key ([`KEYS`]), each settable for `vrw sweep`, `orbit` and `continue --param`.
+impl super::rigid_family::Parametrized for Telescopic {
+    fn parameter_keys(&self) -> Vec<&'static str> {
+        KEYS.to_vec()
+    }
+
+    /// The walker with the parameter `key` set to `value`, checked (its domain: [`Telescopic::validate`]).
+    fn with_parameter(&self, key: &str, value: f64) -> Result<Telescopic, ConfigError> {
+        let mut walker = *self;
+        let field = match key {
+            "hip_mass" => &mut walker.hip_mass,
+            "leg_mass" => &mut walker.leg_mass,
+            "leg_mass_offset" => &mut walker.leg_mass_offset,
+            "foot_mass" => &mut walker.foot_mass,
+            "stopper_length" => &mut walker.stopper_length,
+            "spring_natural_length" => &mut walker.spring_natural_length,
+            "stiffness" => &mut walker.stiffness,
+            "viscosity" => &mut walker.viscosity,
+            "gravity" => &mut walker.gravity,
+            "slope" => &mut walker.slope,
+            _ => {
+                return Err(ConfigError::UnknownKey {
+                    key: key.to_string(),
+                    known: KEYS.join(", "),
+                })
+            }
+        };
+        *field = value;
+        walker.validate()?;
+        Ok(walker)
     }
 }
 

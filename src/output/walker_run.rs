@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::read::ReadError;
+use crate::mechanism::legged::impact::Branch;
+use crate::mechanism::legged::walk::StepAccount;
 
 /// What a drawing of a walker shows: named points, the links between them (legs), which points are masses
 /// (dots) and which are feet. The first link is the stance leg, the second the swing leg; they exchange roles
@@ -26,6 +28,10 @@ pub struct StickFigure {
     pub masses: Vec<usize>,
     /// The feet.
     pub feet: Vec<usize>,
+    /// Springs (with their dampers) `[from, to]` between points, drawn as coils; the first and every other one
+    /// on the stance leg, as the links. None for rigid legs (and then not written).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub springs: Vec<[usize; 2]>,
 }
 
 impl StickFigure {
@@ -42,6 +48,30 @@ impl StickFigure {
             masses: std::iter::once(1).chain(3..points.len()).collect(),
             feet: vec![0, 2],
             points,
+            springs: Vec::new(),
+        }
+    }
+
+    /// Two telescopic legs from the hip: the points `stance_foot`, `hip`, `swing_foot`, each leg's sleeve end
+    /// (where its mass is: `stance_leg_mass`, `swing_leg_mass`) and the top of its sliding rod
+    /// (`stance_rod_top`, `swing_rod_top`); the sleeves from the hip and the rods to the feet are links, the
+    /// spring and damper of each leg joins its sleeve's end to its rod's top.
+    pub fn telescopic_legs() -> StickFigure {
+        let points = [
+            "stance_foot",
+            "hip",
+            "swing_foot",
+            "stance_leg_mass",
+            "swing_leg_mass",
+            "stance_rod_top",
+            "swing_rod_top",
+        ];
+        StickFigure {
+            points: points.iter().map(|p| p.to_string()).collect(),
+            links: vec![[1, 3], [1, 4], [5, 0], [6, 2]],
+            masses: vec![1, 3, 4],
+            feet: vec![0, 2],
+            springs: vec![[3, 5], [4, 6]],
         }
     }
 
@@ -66,9 +96,51 @@ pub fn walker_trajectory_header(coordinates: &[String], figure: &StickFigure) ->
         .collect()
 }
 
+/// The columns a walker with compliant legs adds to `steps.csv` (named as the wheel's), in the order of
+/// [`legged_step_values`].
+pub const LEGGED_STEP_COLUMNS: [&str; 11] = [
+    "lambda_2_plus",
+    "lambda_4_plus",
+    "branch",
+    "dls_duration",
+    "rear_contact_duration",
+    "stopper_loss",
+    "landing_loss",
+    "damper_loss",
+    "energy_residual",
+    "penetration",
+    "events",
+];
+
+/// A heel strike's branch as the outputs write it (`DLS`, `SLS`, `SLS_B3`, `BOUNCE`: its serialization).
+pub fn branch_text(branch: Branch) -> String {
+    serde_json::to_value(branch)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
+/// The values of [`LEGGED_STEP_COLUMNS`] of a step's account (an indicator not defined on its branch empty).
+pub fn legged_step_values(a: &StepAccount) -> [String; 11] {
+    let maybe = |v: Option<f64>| v.map_or(String::new(), super::num);
+    [
+        maybe(a.lambda_2_plus),
+        maybe(a.lambda_4_plus),
+        branch_text(a.branch),
+        super::num(a.dls_duration),
+        super::num(a.rear_contact_duration),
+        super::num(a.losses.stoppers),
+        super::num(a.losses.landings),
+        super::num(a.damper_work),
+        super::num(a.energy_residual),
+        super::num(a.penetration),
+        a.events.to_string(),
+    ]
+}
+
 /// The header of a walker's `steps.csv` for the section's coordinates `section` (the state at the step's
-/// start).
-pub fn walker_steps_header(section: &[String]) -> Vec<String> {
+/// start), with [`LEGGED_STEP_COLUMNS`] for a walker with compliant legs (`legged`).
+pub fn walker_steps_header(section: &[String], legged: bool) -> Vec<String> {
     ["step", "time"]
         .iter()
         .map(|c| c.to_string())
@@ -85,6 +157,12 @@ pub fn walker_steps_header(section: &[String]) -> Vec<String> {
                 "scuffs",
             ]
             .map(String::from),
+        )
+        .chain(
+            LEGGED_STEP_COLUMNS
+                .iter()
+                .filter(|_| legged)
+                .map(|c| c.to_string()),
         )
         .collect()
 }

@@ -7,6 +7,7 @@ use nalgebra::{DVector, SVector};
 use super::super::legged::gait::{legged_gait, legged_step_map};
 use super::super::legged::walk::LeggedOptions;
 use super::super::legged::Legged;
+use super::super::rigid_family::Parametrized;
 use super::super::telescopic::{Telescopic, KEYS};
 use super::super::Mechanism;
 use super::tests::{max_diff, shipped, Stream};

@@ -17,6 +17,7 @@
 //! The wheel walks by `crate::walk` still; this walk is to become the one walk (docs/model.md section 13).
 
 pub mod derivative;
+pub mod family;
 pub mod forces;
 pub mod gait;
 pub mod impact;

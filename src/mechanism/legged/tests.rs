@@ -215,6 +215,7 @@ fn bad_telescopic_parameters_name_every_key() {
     for key in ["foot_mass", "leg_mass_offset", "viscosity"] {
         assert!(text.contains(key), "{key} not named in: {text}");
     }
+    use crate::mechanism::rigid_family::Parametrized;
     assert!(Telescopic::default()
         .with_parameter("stifness", 1.0)
         .is_err());
@@ -238,6 +239,7 @@ fn a_step_answers_the_stop_at_its_first_phase() {
 fn the_exact_derivatives_agree_with_differences() {
     use super::derivative::LeggedDerivatives;
     use crate::mechanism::rigid_check::richardson_jacobian;
+    use crate::mechanism::rigid_family::Parametrized;
     let w = Telescopic::default();
     let options = LeggedOptions::default();
     let gait = gait_at(1e-11);

@@ -418,6 +418,10 @@ fn swing_below<W: Legged<N>, const N: usize>(
     modes.tips[1] == Tip::Free && walker.contact(&c, q, &SVector::zeros(), 1).position.y < 0.0
 }
 
+/// What watches a step's integration ([`legged_step_observed`]): each accepted integrator step with the time it
+/// is taken to (its end, or the event that ends the phase within it).
+pub type Observer<'a, const Y: usize> = &'a mut dyn FnMut(&DenseStep<Y>, f64);
+
 /// Integrate the phase `modes` from `(t, y)` to its first event and handle it; `Ok(true)` at the heel strike
 /// that ends the step (`t`, `y` there).
 fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
@@ -425,6 +429,7 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
     (modes, t, y): (&mut Modes, &mut f64, &mut SVector<f64, Y>),
     (acc, tape): (&mut StepAccount, &mut Tape<Modes, Crossing, Y>),
     options: &LeggedOptions,
+    observe: Observer<'_, Y>,
 ) -> Result<bool, LeggedError> {
     let system = Phase {
         walker,
@@ -451,6 +456,7 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
         let (t0, t1) = (step.t0(), step.t1());
         tape.step(step.h(), t1);
         if let Some((event, te)) = earliest_event(walker, modes, &watch, &step, options) {
+            observe(&step, te);
             *y = step.eval(te);
             *t = te;
             acc.phase(walker, modes, te - t0, &unpack::<N, Y>(y).0);
@@ -459,6 +465,7 @@ fn run_phase<W: Legged<N>, const N: usize, const Y: usize>(
             tape.end(te, Crossing { event, impulses }, before);
             return Ok(ends);
         }
+        observe(&step, t1);
         let end = unpack_pair::<N, Y>(step.y1());
         acc.phase(walker, modes, t1 - t0, &end.0);
         for (event, g) in event_values(walker, modes, end.as_refs()) {
@@ -581,15 +588,41 @@ pub fn legged_step<W: Legged<N>, const N: usize, const Y: usize>(
     state: (&SVector<f64, N>, &SVector<f64, N>),
     options: &LeggedOptions,
 ) -> Result<LeggedStep<N>, LeggedError> {
-    legged_step_taped::<W, N, Y>(walker, state, options, &mut LeggedTape::new())
+    legged_step_recorded::<W, N, Y>(
+        walker,
+        state,
+        options,
+        (&mut LeggedTape::new(), &mut |_, _| {}),
+    )
 }
 
 /// [`legged_step`], recorded on `tape` for its exact derivatives (`super::derivative`).
 pub fn legged_step_taped<W: Legged<N>, const N: usize, const Y: usize>(
     walker: &W,
-    (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    state: (&SVector<f64, N>, &SVector<f64, N>),
     options: &LeggedOptions,
     tape: &mut LeggedTape<Y>,
+) -> Result<LeggedStep<N>, LeggedError> {
+    legged_step_recorded::<W, N, Y>(walker, state, options, (tape, &mut |_, _| {}))
+}
+
+/// [`legged_step`], each accepted integrator step passed to `observe` as it is taken (a drawing's samples are
+/// taken on the walk's own steps).
+pub fn legged_step_observed<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    state: (&SVector<f64, N>, &SVector<f64, N>),
+    options: &LeggedOptions,
+    observe: Observer<'_, Y>,
+) -> Result<LeggedStep<N>, LeggedError> {
+    legged_step_recorded::<W, N, Y>(walker, state, options, (&mut LeggedTape::new(), observe))
+}
+
+/// [`legged_step`], recorded on `tape`, each accepted integrator step passed to `observe`.
+fn legged_step_recorded<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    options: &LeggedOptions,
+    (tape, observe): (&mut LeggedTape<Y>, Observer<'_, Y>),
 ) -> Result<LeggedStep<N>, LeggedError> {
     let e0 = walker.energy(q, qd);
     let strike = heel_strike(walker, (q, qd), legs_held(walker, q), 0.0)?;
@@ -616,6 +649,7 @@ pub fn legged_step_taped<W: Legged<N>, const N: usize, const Y: usize>(
         (&mut modes, &mut t, &mut y),
         (&mut acc, &mut tape.phases),
         options,
+        &mut *observe,
     )? {}
     let (q1, qd1) = unpack::<N, Y>(&y);
     if modes.tips[0] != Tip::Stuck {

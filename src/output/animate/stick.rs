@@ -111,6 +111,13 @@ fn draw_frame<DB: DrawingBackend>(
             colour.stroke_width(5),
         ))?;
     }
+    for (k, [a, b]) in figure.springs.iter().enumerate() {
+        let colour = colours[(k + step) % 2];
+        root.draw(&PathElement::new(
+            coil(view.px(points[*a]), view.px(points[*b])),
+            colour.stroke_width(2),
+        ))?;
+    }
     for (k, &f) in figure.feet.iter().enumerate() {
         let fill = if k == 0 { COLOR_GREEN } else { WHITE };
         root.draw(&Circle::new(view.px(points[f]), 5, fill.filled()))?;
@@ -140,6 +147,35 @@ fn draw_frame<DB: DrawingBackend>(
         font(0.75 * text),
     ))?;
     Ok(())
+}
+
+/// Zigzag turns of a drawn spring.
+const COIL_TURNS: usize = 6;
+
+/// Half the width of a drawn spring \[px\].
+const COIL_HALF_WIDTH: f64 = 6.0;
+
+/// A spring (and its damper) from `a` to `b` in pixels, drawn as a zigzag of [`COIL_TURNS`] turns: it
+/// tightens as the leg shortens.
+fn coil(a: (i32, i32), b: (i32, i32)) -> Vec<(i32, i32)> {
+    let (dx, dy) = (f64::from(b.0 - a.0), f64::from(b.1 - a.1));
+    let length = dx.hypot(dy).max(1e-9);
+    let (nx, ny) = (
+        -dy / length * COIL_HALF_WIDTH,
+        dx / length * COIL_HALF_WIDTH,
+    );
+    let corners = 2 * COIL_TURNS;
+    let mut path = vec![a];
+    for i in 0..corners {
+        let along = (i as f64 + 0.5) / corners as f64;
+        let side = if i % 2 == 0 { 1.0 } else { -1.0 };
+        path.push((
+            (f64::from(a.0) + along * dx + side * nx).round() as i32,
+            (f64::from(a.1) + along * dy + side * ny).round() as i32,
+        ));
+    }
+    path.push(b);
+    path
 }
 
 /// The hip's largest height above the ground over the run (the frame's scale).
