@@ -296,3 +296,33 @@ fn a_walker_without_exact_derivatives_takes_differences() {
     let error = by_differences.jacobian_error.max(1e-9);
     assert!((&by_differences.jacobian - &exact.jacobian).amax() < 2.0 * error);
 }
+
+/// The period doubling in the viscosity that `vrw continue --model telescopic` locates at 662.442241790: the
+/// exact `DP`'s multiplier passes through -1 between 662.44214 and 662.44234, and Richardson's differences'
+/// (a second route, whose multipliers differ from the exact ones by up to 1e-7 here) between 662.4412 and
+/// 662.4432.
+#[test]
+fn the_period_doubling_in_the_viscosity_is_bracketed_by_both_routes() {
+    use crate::mechanism::rigid_family::Parametrized;
+    let w = Telescopic::default();
+    let options = LeggedOptions::default();
+    let largest = |c: f64, exact: bool| {
+        let at = w.with_parameter("viscosity", c).unwrap();
+        let g = if exact {
+            legged_gait_exact::<_, 6, 13>(&at, &w.default_start(), &options)
+        } else {
+            legged_gait::<_, 6, 13>(&at, &w.default_start(), &options)
+        };
+        let m = g.unwrap().multipliers[0];
+        assert_eq!(m[1], 0.0, "c = {c}: {m:?}");
+        m[0]
+    };
+    for (below, above, exact) in [(662.44214, 662.44234, true), (662.4412, 662.4432, false)] {
+        let (a, b) = (largest(below, exact), largest(above, exact));
+        println!("exact {exact}: {a} at {below}, {b} at {above}");
+        assert!(
+            a < -1.0 && b > -1.0,
+            "exact {exact}: {a} at {below}, {b} at {above}"
+        );
+    }
+}
