@@ -134,6 +134,17 @@ fn failure_kind(e: &LeggedGaitError) -> &'static str {
 /// `vrw gait --model telescopic`: the search, then `gait.json`.
 pub fn run_legged_gait(job: &LeggedGaitJob) -> Result<LeggedGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
+    let summary = compute_legged_gait(job)?;
+    in_run(&job.out_dir, job.overwrite, "gait", |run| {
+        output::write_json(&run.path("gait.json"), &summary)?;
+        run.add("gait.json");
+        Ok((summary, None))
+    })
+}
+
+/// The search of [`run_legged_gait`] without its file (the Python binding): `gait.json`'s fields (`job.out_dir`
+/// and `job.overwrite` are not read).
+pub fn compute_legged_gait(job: &LeggedGaitJob) -> Result<LeggedGaitSummary, AppError> {
     let walker = &job.walker;
     let names = walker.section_names();
     let start = match &job.initial {
@@ -159,7 +170,7 @@ pub fn run_legged_gait(job: &LeggedGaitJob) -> Result<LeggedGaitSummary, AppErro
     }
     let result = search(walker, &start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
-    let summary = LeggedGaitSummary {
+    Ok(LeggedGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
         model: TELESCOPIC,
         parameters: *walker,
@@ -170,10 +181,5 @@ pub fn run_legged_gait(job: &LeggedGaitJob) -> Result<LeggedGaitSummary, AppErro
         },
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok().map(|g| record(walker, &g)),
-    };
-    in_run(&job.out_dir, job.overwrite, "gait", |run| {
-        output::write_json(&run.path("gait.json"), &summary)?;
-        run.add("gait.json");
-        Ok((summary, None))
     })
 }

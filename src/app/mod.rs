@@ -44,7 +44,9 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
-pub use legged::{run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary};
+pub use legged::{
+    compute_legged_gait, run_legged_gait, LeggedGaitJob, LeggedGaitRecord, LeggedGaitSummary,
+};
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
@@ -59,19 +61,21 @@ pub use walker_model::{
     Body, FoundGait, RigidModel, Sampling, WalkerModel, WalkerSample, WalkerStep,
 };
 pub use walker_orbit::{
-    run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary, MAX_WALKER_PERIOD,
+    compute_walker_orbit, run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary,
+    MAX_WALKER_PERIOD,
 };
 pub use walker_simulate::{
-    run_walker_simulate, WalkerSimulateJob, WalkerSimulateSummary, WalkerStepRecord,
+    compute_walker_simulate, run_walker_simulate, WalkerSimulateJob, WalkerSimulateSummary,
+    WalkerStepRecord,
 };
 pub use walker_sweep::{
-    run_walker_sweep, WalkerRange, WalkerSweepJob, WalkerSweepPoint, WalkerSweepSummary,
-    WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
+    compute_walker_sweep, run_walker_sweep, WalkerRange, WalkerSweepJob, WalkerSweepPoint,
+    WalkerSweepSummary, WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
 };
 pub use walkers::{
-    run_walker_continuation, run_walker_gait, wheel_only, Walker, WalkerContinueJob,
-    WalkerContinueSummary, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative,
-    WalkerSpecialPoint, MODELS, TELESCOPIC,
+    compute_walker_continuation, compute_walker_gait, run_walker_continuation, run_walker_gait,
+    wheel_only, Walker, WalkerContinueJob, WalkerContinueSummary, WalkerGait, WalkerGaitJob,
+    WalkerGaitSummary, WalkerOutput, WalkerParamDerivative, WalkerSpecialPoint, MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

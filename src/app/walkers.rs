@@ -336,21 +336,27 @@ pub struct WalkerParamDerivative {
 /// output directory is checked.
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
+    let summary = compute_walker_gait(job)?;
+    in_run(&job.out_dir, job.overwrite, "gait", |run| {
+        output::write_json(&run.path("gait.json"), &summary)?;
+        run.add("gait.json");
+        Ok((summary, None))
+    })
+}
+
+/// The search of [`run_walker_gait`] without its file (the Python binding): `gait.json`'s fields (`job.out_dir`
+/// and `job.overwrite` are not read).
+pub fn compute_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     if let Some(key) = &job.parameter {
         job.walker.check_parameter(key, "parameter")?;
     }
-    let summary = match &job.walker {
+    Ok(match &job.walker {
         Walker::Simplest(w) => compute(w, w.default_start(), job)?,
         Walker::Compass(w) => compute(w, w.default_start(), job)?,
         Walker::Described(w) => {
             let start = rigid_start(w, job.initial.as_deref())?;
             crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
         }
-    };
-    in_run(&job.out_dir, job.overwrite, "gait", |run| {
-        output::write_json(&run.path("gait.json"), &summary)?;
-        run.add("gait.json");
-        Ok((summary, None))
     })
 }
 
@@ -561,6 +567,23 @@ pub struct WalkerSpecialPoint {
 /// `branch.csv` (a row per point) and `special_points.json`, after the output directory is checked.
 pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinueSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "continue", job.overwrite)?;
+    let WalkerOutput { summary, tables } = compute_walker_continuation(job)?;
+    in_run(&job.out_dir, job.overwrite, "continue", |run| {
+        for (name, rows) in &tables {
+            write_rows(&run.path(name), rows)?;
+            run.add(name);
+        }
+        output::write_json(&run.path("special_points.json"), &summary)?;
+        run.add("special_points.json");
+        Ok((summary, None))
+    })
+}
+
+/// The family of [`run_walker_continuation`] without its files (the Python binding): `special_points.json`'s
+/// fields and the rows of `branch.csv` (`job.out_dir` and `job.overwrite` are not read).
+pub fn compute_walker_continuation(
+    job: &WalkerContinueJob,
+) -> Result<WalkerOutput<WalkerContinueSummary>, AppError> {
     let (summary, rows) = match &job.walker {
         Walker::Simplest(w) => follow(w, w.default_start(), job)?,
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
@@ -569,13 +592,20 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
             crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
         }
     };
-    in_run(&job.out_dir, job.overwrite, "continue", |run| {
-        write_rows(&run.path("branch.csv"), &rows)?;
-        run.add("branch.csv");
-        output::write_json(&run.path("special_points.json"), &summary)?;
-        run.add("special_points.json");
-        Ok((summary, None))
+    Ok(WalkerOutput {
+        summary,
+        tables: vec![("branch.csv", rows)],
     })
+}
+
+/// What a walker's job computes, without its files (the Python binding): its JSON file's fields and the rows
+/// of its CSV files (each its header first), by file name, in the order the job writes them.
+#[derive(Debug, Clone)]
+pub struct WalkerOutput<S> {
+    /// The JSON file's fields.
+    pub summary: S,
+    /// The CSV files' names and rows.
+    pub tables: Vec<(&'static str, Vec<Vec<String>>)>,
 }
 
 /// The family of [`run_walker_continuation`] for `walker`, and the rows of `branch.csv` (its header first).
