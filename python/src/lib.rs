@@ -174,9 +174,9 @@ impl Params {
             Model::Walker(w) => Err(walkers::option_error(
                 "model",
                 format!(
-                    "`vrw.{job}` takes only the wheel (`vrw`) so far; the model \
-                 `{}` walks in `vrw.find_gait`, `vrw.simulate`, `vrw.sweep`, `vrw.orbit` and \
-                 `vrw.continue_family` (docs/model.md section 13)",
+                    "`vrw.{job}` takes only the wheel (`vrw`) so far; the model `{}` walks in \
+                     `vrw.find_gait`, `vrw.simulate`, `vrw.sweep`, `vrw.orbit` and `vrw.continue_family` \
+                     (docs/model.md section 13)",
                     w.name()
                 ),
             )),

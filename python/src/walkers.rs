@@ -290,6 +290,47 @@ fn flatten_gait(py: Python<'_>, result: &Bound<'_, PyDict>) -> PyResult<()> {
     Ok(())
 }
 
+/// A walker's gait-search settings: `find_gait`'s keywords.
+struct Search {
+    /// Steps walked before Newton's method (the command line's `--transient`).
+    transient_steps: usize,
+    /// `dP/dp` for this parameter too (`--parameter`).
+    parameter: Option<String>,
+}
+
+impl Search {
+    /// The keywords `options` (`transient_steps`, `parameter`), the transient checked by the library's rule.
+    fn new(params: &WalkerParams, options: Option<&Bound<'_, PyDict>>) -> PyResult<Search> {
+        let mut search = Search {
+            transient_steps: GaitOptions::default().transient_steps,
+            parameter: None,
+        };
+        for (key, value) in options.into_iter().flat_map(|d| d.iter()) {
+            let key: String = key.extract()?;
+            match key.as_str() {
+                "transient_steps" => search.transient_steps = count(&key, &value)?,
+                "parameter" => search.parameter = value.extract()?,
+                _ => return Err(unexpected(&key, params)),
+            }
+        }
+        let checked = GaitOptions {
+            transient_steps: search.transient_steps,
+            ..GaitOptions::default()
+        };
+        checked.validate().map_err(config_error)?;
+        Ok(search)
+    }
+}
+
+/// The error of a keyword `find_gait` does not take for a walker.
+fn unexpected(key: &str, params: &WalkerParams) -> PyErr {
+    PyTypeError::new_err(format!(
+        "unexpected keyword argument `{key}` for the model `{}` (its search options: transient_steps, \
+         parameter)",
+        params.name()
+    ))
+}
+
 /// `vrw.find_gait` of a walker: `vrw gait --model NAME` without its file. Options: `transient_steps` (the
 /// command line's `--transient`) and `parameter` (`dP/dp` as `dP_dparam`; not for `telescopic`).
 pub(crate) fn find_gait<'py>(
@@ -298,39 +339,19 @@ pub(crate) fn find_gait<'py>(
     initial: Option<Vec<f64>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut transient_steps = GaitOptions::default().transient_steps;
-    let mut parameter: Option<String> = None;
-    for (key, value) in options.into_iter().flat_map(|d| d.iter()) {
-        let key: String = key.extract()?;
-        match key.as_str() {
-            "transient_steps" => transient_steps = count(&key, &value)?,
-            "parameter" => parameter = value.extract()?,
-            _ => {
-                return Err(PyTypeError::new_err(format!(
-                    "unexpected keyword argument `{key}` for the model `{}` (its search options: \
-                     transient_steps, parameter)",
-                    params.name()
-                )))
-            }
-        }
-    }
-    if transient_steps > MAX_TRANSIENT {
-        return Err(config_error(LibConfigError::InvalidValue {
-            key: "transient_steps".to_string(),
-            value: transient_steps.to_string(),
-            reason: format!("must be at most {MAX_TRANSIENT}"),
-        }));
-    }
+    let Search {
+        transient_steps,
+        parameter,
+    } = Search::new(params, options)?;
     let flag = vrw::gait::interrupt_flag();
     let result = match &params.walker {
         Walking::Telescopic(walker) => {
             if parameter.is_some() {
-                return Err(option_error(
-                    "parameter",
-                    format!(
+                let reason = format!(
                     "`parameter` takes exact derivatives; the model `{TELESCOPIC}` has its DP by central \
                      differences so far (docs/model.md section 13)"
-                )));
+                );
+                return Err(option_error("parameter", reason));
             }
             let job = LeggedGaitJob {
                 walker: *walker,
@@ -361,9 +382,6 @@ pub(crate) fn find_gait<'py>(
     flatten_gait(py, &result)?;
     Ok(result)
 }
-
-/// The longest transient of a gait search (the command line's `gait --transient` limit).
-const MAX_TRANSIENT: usize = 100_000;
 
 /// `vrw.simulate` of a walker: `vrw simulate --model NAME` without its files.
 pub(crate) fn simulate<'py>(
@@ -398,12 +416,12 @@ fn wheel_options(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<()> {
     if progress.is_some() {
-        return Err(option_error(
-            "progress",
-            format!(
-            "`progress` is reported by the wheel's jobs only so far; `vrw.{job}` of the model `{}` runs without it",
+        let reason = format!(
+            "`progress` is reported by the wheel's jobs only so far; `vrw.{job}` of the model `{}` runs \
+             without it",
             params.name()
-        )));
+        );
+        return Err(option_error("progress", reason));
     }
     if let Some(key) = options.and_then(|d| d.keys().iter().next()) {
         return Err(PyTypeError::new_err(format!(
@@ -483,13 +501,12 @@ pub(crate) fn continue_family<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let walker = params.rigid("continue_family")?;
     if options.wheel_only {
-        return Err(option_error(
-            "model",
-            format!(
+        let reason = format!(
             "`two_param`, `initial` and `period` take the wheel's continuation; the model `{}` follows its \
              start's family only so far (docs/model.md section 13)",
             params.name()
-        )));
+        );
+        return Err(option_error("model", reason));
     }
     let job = WalkerContinueJob {
         walker: walker.clone(),
@@ -520,12 +537,11 @@ pub(crate) fn orbit<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     wheel_options(params, "orbit", &progress, None)?;
     if part {
-        return Err(option_error(
-            "part",
-            format!(
+        let reason = format!(
             "`part` splits the wheel's orbit diagram; the model `{}` draws its diagram whole so far",
             params.name()
-        )));
+        );
+        return Err(option_error("part", reason));
     }
     let job = WalkerOrbitJob {
         walker: params.rigid("orbit")?.clone(),

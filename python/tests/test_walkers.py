@@ -322,6 +322,19 @@ def test_orbit_is_vrw_orbit_model(cli, tmp_path):
                                      branch=False)
 
 
+def test_a_grid_of_sweeps_takes_a_walker():
+    from vrw.grid import gait_grid, orbit_grid
+
+    p = vrw.Params(model="compass")
+    x = vrw.linspace(0.05, 0.06, 3)
+    grid = gait_grid(None, p, x=("slope", x), y=("hip_mass", [8.0, 10.0]))
+    for i, hip_mass in enumerate([8.0, 10.0]):
+        row = vrw.sweep(p.replace(hip_mass=hip_mass), "slope", x)
+        assert np.array_equal(grid["sweep"]["period"][i], row["sweep"]["period"])
+    with pytest.raises(vrw.ConfigError, match="model `compass`"):
+        orbit_grid(None, p, "slope", range=(0.05, 0.06), points=3)
+
+
 @pytest.mark.parametrize(
     "job",
     [

@@ -17,7 +17,7 @@ line's ``--model`` jobs on it, with the same numbers; their sections and tables 
 coordinates and their results carry ``model``. The telescopic walker has ``find_gait`` only so far, a
 described one ``find_gait`` and ``continue_family``; ``map``, ``basin`` and ``animate`` take only the wheel so
 far. A job a model does not run raises ``ConfigError`` naming the model and the job. ``vrw.plot.sweep``,
-``vrw.plot.orbit`` and ``vrw.plot.run`` draw a walker's results.
+``vrw.plot.orbit`` and ``vrw.plot.run`` draw a walker's results, and ``vrw.grid.gait_grid`` spreads its sweeps.
 
 **Long jobs.** ``sweep``, ``map``, ``orbit`` and ``basin`` take ``progress``: a callable ``progress(done,
 total)`` called on the calling thread as points finish, or ``True`` for a tqdm bar (``pip install tqdm``).

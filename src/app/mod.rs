@@ -21,6 +21,7 @@ mod sweep;
 mod walker_figures;
 mod walker_model;
 mod walker_orbit;
+mod walker_output;
 mod walker_simulate;
 mod walker_sweep;
 mod walkers;
@@ -64,6 +65,7 @@ pub use walker_orbit::{
     compute_walker_orbit, run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary,
     MAX_WALKER_PERIOD,
 };
+pub use walker_output::WalkerOutput;
 pub use walker_simulate::{
     compute_walker_simulate, run_walker_simulate, WalkerSimulateJob, WalkerSimulateSummary,
     WalkerStepRecord,
@@ -75,7 +77,7 @@ pub use walker_sweep::{
 pub use walkers::{
     compute_walker_continuation, compute_walker_gait, run_walker_continuation, run_walker_gait,
     wheel_only, Walker, WalkerContinueJob, WalkerContinueSummary, WalkerGait, WalkerGaitJob,
-    WalkerGaitSummary, WalkerOutput, WalkerParamDerivative, WalkerSpecialPoint, MODELS, TELESCOPIC,
+    WalkerGaitSummary, WalkerParamDerivative, WalkerSpecialPoint, MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

@@ -14,8 +14,9 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::walker_model::WalkerStep;
+use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::{walker_gaits, WalkerRange, WalkerSweepPoint};
-use super::walkers::{write_rows, Walker, WalkerOutput};
+use super::walkers::Walker;
 use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
 use crate::mechanism::rigid::RigidError;
 use crate::output;

@@ -11,7 +11,8 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::walker_model::{Sampling, WalkerModel, WalkerSample, WalkerStep};
-use super::walkers::{as_map, named, Walker, WalkerOutput};
+use super::walker_output::WalkerOutput;
+use super::walkers::{as_map, named, Walker};
 use super::{in_run, AppError, WalkEnded, MAX_SIMULATE_STEPS, SAMPLE_DT_RANGE};
 use crate::mechanism::rigid::RigidError;
 use crate::output::walker_run::{walker_steps_header, walker_trajectory_header, StickFigure};

@@ -11,7 +11,8 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::walker_model::{search_kind, FoundGait};
-use super::walkers::{as_map, named, Walker, WalkerOutput};
+use super::walker_output::{write_rows, WalkerOutput};
+use super::walkers::{as_map, named, Walker};
 use super::{check_interrupted, in_run, AppError};
 use crate::output;
 use crate::study::grid::{run_rows, Evaluated};
@@ -213,7 +214,7 @@ pub fn run_walker_sweep(job: &WalkerSweepJob) -> Result<WalkerSweepSummary, AppE
     in_run(&job.out_dir, job.overwrite, "sweep", |run| {
         let points = walker_gaits(&job.walker, &job.range.param, &values, &start);
         let rows = sweep_rows(&job.range.param, &names, &points);
-        super::walkers::write_rows(&run.path("sweep.csv"), &rows)?;
+        write_rows(&run.path("sweep.csv"), &rows)?;
         run.add("sweep.csv");
         check_interrupted(points.len(), values.len(), "sweep.csv")?;
         let summary = sweep_summary(

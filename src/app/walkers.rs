@@ -10,6 +10,7 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::walker_model::{interruptible, search_gait, RigidModel, WalkerModel};
+use super::walker_output::{write_rows, WalkerOutput};
 use super::{in_run, AppError, SearchEnded};
 use crate::continuation::{
     continue_family, ContinuationOptions, FamilyEnd, FamilyPoint, SpecialKind,
@@ -598,16 +599,6 @@ pub fn compute_walker_continuation(
     })
 }
 
-/// What a walker's job computes, without its files (the Python binding): its JSON file's fields and the rows
-/// of its CSV files (each its header first), by file name, in the order the job writes them.
-#[derive(Debug, Clone)]
-pub struct WalkerOutput<S> {
-    /// The JSON file's fields.
-    pub summary: S,
-    /// The CSV files' names and rows.
-    pub tables: Vec<(&'static str, Vec<Vec<String>>)>,
-}
-
 /// The family of [`run_walker_continuation`] for `walker`, and the rows of `branch.csv` (its header first).
 fn follow<W, const N: usize, const Y: usize>(
     walker: &W,
@@ -686,21 +677,6 @@ fn branch_rows(param: &str, names: &[&str], points: &[FamilyPoint<RigidInfo>]) -
     std::iter::once(header)
         .chain(points.iter().map(row))
         .collect()
-}
-
-/// Write the table `rows` (its header first) as the CSV file `path`, atomically.
-pub(super) fn write_rows(path: &Path, rows: &[Vec<String>]) -> Result<(), AppError> {
-    output::write_atomic(path, |path| -> Result<(), AppError> {
-        let mut w = output::csv_writer(path)?;
-        for row in rows {
-            output::write_record(&mut w, path, row)?;
-        }
-        w.flush().map_err(|source| crate::output::OutputError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Ok(())
-    })
 }
 
 /// The transient walk before a family's first gait is searched.
