@@ -61,7 +61,7 @@ pub(crate) fn animate<'py>(
         .validate()
         .map_err(|e| animate_error(AppError::Animate(e)))?;
     let job = SimulateJob {
-        config: params.config.clone(),
+        config: params.wheel("animate")?.clone(),
         initial: section(initial)?,
         steps,
         sample_dt,

@@ -20,12 +20,14 @@ use pythonize::pythonize;
 mod animate;
 mod parts;
 mod progress;
+mod walkers;
 
 use progress::{interruptible_keeping, interruptible_with, Progress};
 use vrw::app::{
     compute_basin_part, compute_continuation, compute_gait, compute_map, compute_map_part,
     compute_orbit, compute_orbit_part, compute_simulation, compute_sweep, curve_rows, family_rows,
     AppError, BasinJob, ContinueJob, GaitJob, MapJob, OrbitJob, OrbitJobPart, SimulateJob,
+    WalkerRange,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -43,6 +45,7 @@ use vrw::study::MAX_SWEEP_POINTS;
 use vrw::study::{MapSpec, SweepSpec};
 use vrw::walk::SectionState;
 use vrw::walk::WalkError as LibWalkError;
+use walkers::WalkerParams;
 
 create_exception!(
     vrw,
@@ -138,47 +141,124 @@ fn apply_keys(config: Config, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Conf
     Ok(config)
 }
 
-/// The model's parameters and the solver's settings: every key of a vrw TOML file.
+/// The model's parameters and the solver's settings: every key of a vrw TOML file, or another walker's
+/// parameters.
 ///
 /// `Params(viscosity=37, slope=0.05)` starts from the defaults (the paper's Table 1, c = 50 N s/m) and
 /// applies each keyword as a TOML key, validated as `vrw --config FILE --set key=value` does: an unknown key or
 /// a bad value raises `vrw.ConfigError` (a `ValueError`) with the command line's message.
+/// `Params(model="compass", slope=0.05)` (`"simplest"`, `"compass"`, `"telescopic"` or the path of a walker's
+/// description, `.toml`) holds another walker's parameters, validated as `vrw --model NAME --set key=value`
+/// does; `model="vrw"` (the default) is the wheel.
 #[pyclass(module = "vrw", name = "Params", frozen, eq)]
 #[derive(Clone, PartialEq)]
 struct Params {
-    config: Config,
+    model: Model,
+}
+
+/// What a [`Params`] holds.
+#[derive(Clone, PartialEq)]
+enum Model {
+    /// The wheel's configuration.
+    Wheel(Config),
+    /// Another walker's parameters.
+    Walker(WalkerParams),
+}
+
+impl Params {
+    /// The wheel's configuration, or the error of a job (`vrw.{job}`) that takes only the wheel so far, naming
+    /// the model.
+    fn wheel(&self, job: &str) -> PyResult<&Config> {
+        match &self.model {
+            Model::Wheel(config) => Ok(config),
+            Model::Walker(w) => Err(walkers::option_error(
+                "model",
+                format!(
+                    "`vrw.{job}` takes only the wheel (`vrw`) so far; the model `{}` walks in \
+                     `vrw.find_gait`, `vrw.simulate`, `vrw.sweep`, `vrw.orbit` and `vrw.continue_family` \
+                     (docs/model.md section 13)",
+                    w.name()
+                ),
+            )),
+        }
+    }
+
+    /// The walker's parameters, if the model is not the wheel.
+    fn walker(&self) -> Option<&WalkerParams> {
+        match &self.model {
+            Model::Wheel(_) => None,
+            Model::Walker(w) => Some(w),
+        }
+    }
+
+    /// The model `model` (`None` or `"vrw"`: the wheel) with its parameters from `file` and `keys`.
+    fn load(
+        model: Option<&str>,
+        file: Option<&std::path::Path>,
+        keys: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Params> {
+        let model = match model {
+            None | Some("vrw") => {
+                let config = match file {
+                    Some(path) => Config::from_file(path).map_err(config_error)?,
+                    None => Config::default(),
+                };
+                Model::Wheel(apply_keys(config, keys)?)
+            }
+            Some(name) => {
+                let overrides = walkers::overrides(keys)?;
+                Model::Walker(WalkerParams::load(name, None, file, &overrides)?)
+            }
+        };
+        Ok(Params { model })
+    }
 }
 
 #[pymethods]
 impl Params {
     #[new]
-    #[pyo3(signature = (**keys))]
-    fn new(keys: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
-        Ok(Params {
-            config: apply_keys(Config::default(), keys)?,
-        })
+    #[pyo3(signature = (*, model = None, **keys))]
+    fn new(model: Option<&str>, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
+        Params::load(model, None, keys)
     }
 
-    /// Read a flat TOML file of parameters (as `vrw --config FILE`).
+    /// Read a flat TOML file of parameters (as `vrw --config FILE`, with `--model model`).
     #[staticmethod]
-    fn from_toml(path: PathBuf) -> PyResult<Params> {
-        Ok(Params {
-            config: Config::from_file(&path).map_err(config_error)?,
-        })
+    #[pyo3(signature = (path, model = None))]
+    fn from_toml(path: PathBuf, model: Option<&str>) -> PyResult<Params> {
+        Params::load(model, Some(&path), None)
+    }
+
+    /// The model: `"vrw"` (the wheel), a built-in walker's name, or a description's path as given.
+    #[getter]
+    fn model(&self) -> String {
+        self.walker()
+            .map_or_else(|| "vrw".to_string(), |w| w.model.clone())
     }
 
     /// Every key and its value, as a TOML file (or `summary.json`'s `config`) holds them (with the keys files
-    /// leave out at their defaults too).
+    /// leave out at their defaults too); a walker's parameters.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        every_key(py, &self.config)
+        match &self.model {
+            Model::Wheel(config) => every_key(py, config),
+            Model::Walker(w) => {
+                let dict = PyDict::new(py);
+                for (key, value) in w.parameters() {
+                    dict.set_item(key, value)?;
+                }
+                Ok(dict.into_any())
+            }
+        }
     }
 
     /// A copy with the given keys changed (validated as in the constructor).
     #[pyo3(signature = (**keys))]
     fn replace(&self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
-        Ok(Params {
-            config: apply_keys(self.config.clone(), keys)?,
-        })
+        let model = match &self.model {
+            Model::Wheel(config) => Model::Wheel(apply_keys(config.clone(), keys)?),
+            Model::Walker(w) => Model::Walker(w.replaced(&walkers::overrides(keys)?)?),
+        };
+        Ok(Params { model })
     }
 
     /// The value of one key.
@@ -190,26 +270,52 @@ impl Params {
         }
     }
 
-    /// The keys holding a real number (the parameters a sweep or a grid can vary).
+    /// The wheel's keys holding a real number (the parameters a sweep or a grid can vary).
     #[staticmethod]
     fn numeric_keys() -> Vec<&'static str> {
         Config::numeric_keys().to_vec()
     }
 
-    fn __reduce__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyAny>,))> {
+    /// The keys this model's sweeps, continuations and orbit diagrams can vary: the wheel's `numeric_keys()`,
+    /// or a walker's parameters.
+    fn parameter_keys(&self) -> Vec<&'static str> {
+        match &self.model {
+            Model::Wheel(_) => Config::numeric_keys().to_vec(),
+            Model::Walker(w) => w.parameters().into_iter().map(|(k, _)| k).collect(),
+        }
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         // Pickle as `_params_from_dict(to_dict())`, for every protocol (`__getnewargs_ex__` served only
-        // protocols 2 and up): the keys are re-read as the constructor reads them.
-        let rebuild = py.import("vrw._vrw")?.getattr("_params_from_dict")?;
-        Ok((rebuild, (self.to_dict(py)?,)))
+        // protocols 2 and up): the keys are re-read as the constructor reads them. A walker's as
+        // `_walker_params(model, text, to_dict())`, a description with its text.
+        let module = py.import("vrw._vrw")?;
+        Ok(match &self.model {
+            Model::Wheel(_) => (
+                module.getattr("_params_from_dict")?,
+                (self.to_dict(py)?,).into_pyobject(py)?.into_any(),
+            ),
+            Model::Walker(w) => (
+                module.getattr("_walker_params")?,
+                (w.model.clone(), w.text(), self.to_dict(py)?)
+                    .into_pyobject(py)?
+                    .into_any(),
+            ),
+        })
     }
 
     fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
         let all = self.to_dict(py)?;
-        let defaults = every_key(py, &Config::default())?;
-        let mut changed = Vec::new();
+        let (defaults, mut changed) = match &self.model {
+            Model::Wheel(_) => (every_key(py, &Config::default())?, Vec::new()),
+            Model::Walker(w) => {
+                let defaults = Params {
+                    model: Model::Walker(w.defaults()?),
+                };
+                let model = PyString::new(py, &w.model).repr()?;
+                (defaults.to_dict(py)?, vec![format!("model={model}")])
+            }
+        };
         for (key, value) in all.downcast::<PyDict>()?.iter() {
             if !value.eq(defaults.get_item(&key)?)? {
                 changed.push(format!("{}={}", key.str()?, value.repr()?));
@@ -405,7 +511,8 @@ fn sample_dt_arg(value: &Bound<'_, PyAny>) -> PyResult<f64> {
 /// `initial` is the Poincare-section state `(L2, thetadot, L2dot)` (default: the command line's). Returns the
 /// fields of `summary.json`, with `steps` a dict of numpy arrays keyed like `steps.csv` and `trajectory` one
 /// keyed like `trajectory.csv` (`None` without `trajectory`). A walk that stops early is a `status`; an
-/// invalid initial state raises `vrw.WalkError`.
+/// invalid initial state raises `vrw.WalkError`. Another walker's (`Params(model=...)`): `vrw simulate
+/// --model`'s files, the tables named by the model's coordinates, `initial` its section's coordinates.
 #[pyfunction]
 #[pyo3(signature = (params, steps = 20, initial = None, trajectory = true, sample_dt = 0.005))]
 fn simulate<'py>(
@@ -416,8 +523,12 @@ fn simulate<'py>(
     trajectory: bool,
     #[pyo3(from_py_with = sample_dt_arg)] sample_dt: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(w) = params.walker() {
+        return walkers::simulate(py, w, (steps, initial), (trajectory, sample_dt));
+    }
+    let config = params.wheel("simulate")?;
     let job = SimulateJob {
-        config: params.config.clone(),
+        config: config.clone(),
         initial: section(initial)?,
         steps,
         sample_dt,
@@ -430,8 +541,8 @@ fn simulate<'py>(
     let (summary, samples) =
         interruptible(py, &flag, || compute_simulation(&job, trajectory))?.map_err(app_error)?;
     let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
-    let columns = StepsColumns::of(&params.config.params);
-    let rear_exit = params.config.params.rear_exit;
+    let columns = StepsColumns::of(&config.params);
+    let rear_exit = config.params.rear_exit;
     let rows: Vec<Vec<Cell>> = summary
         .steps
         .iter()
@@ -458,7 +569,10 @@ fn simulate<'py>(
 /// `status` is `found` or why no gait was found (with `message`, as the command line reports it); a found
 /// gait adds its fields, `floquet_multipliers` as a complex numpy array and `jacobian` as a 2-D array.
 /// Keyword options: `transient_steps`, `max_iterations`, `tolerance`, `fd_step`, `refine_jacobian`,
-/// `parameter` (`dP/dp` of the gait for that key, as `dP_dparam`).
+/// `parameter` (`dP/dp` of the gait for that key, as `dP_dparam`). Another walker's (`Params(model=...)`):
+/// `vrw gait --model`'s `gait.json` with its gait's fields at the top (`section` by the model's coordinates,
+/// `period`, `lambda_I4`, `impact_loss`, `energy_drift`, `stable`, ...); options `transient_steps` and
+/// `parameter` only.
 #[pyfunction]
 #[pyo3(signature = (params, initial = None, **options))]
 fn find_gait<'py>(
@@ -467,8 +581,11 @@ fn find_gait<'py>(
     initial: Option<Vec<f64>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(w) = params.walker() {
+        return walkers::find_gait(py, w, initial, options);
+    }
     let job = GaitJob {
-        config: params.config.clone(),
+        config: params.wheel("find_gait")?.clone(),
         initial: section(initial)?,
         options: gait_options(GaitOptions::default(), options)?,
         out_dir: PathBuf::new(),
@@ -497,7 +614,9 @@ fn find_gait<'py>(
 /// Returns `param`, `sweep` (the columns of `sweep.csv` as numpy arrays), `thresholds` (the entries of
 /// `thresholds.json`), `gaits_found` and `seconds`. `progress`: a callable `progress(done, total)`, called on
 /// this thread as points finish. Keyword options as for `find_gait`, defaulting to the
-/// command line's sweep settings. `vrw.linspace` gives the command line's values.
+/// command line's sweep settings. `vrw.linspace` gives the command line's values. Another walker's
+/// (`Params(model=...)`): `vrw sweep --model`'s `thresholds.json` fields and `sweep`, at these values; no
+/// options, no `progress` yet.
 #[pyfunction]
 #[pyo3(signature = (params, param, values, *, initial = None, progress = None, **options))]
 fn sweep<'py>(
@@ -509,8 +628,11 @@ fn sweep<'py>(
     progress: Option<Py<PyAny>>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(w) = params.walker() {
+        return walkers::sweep(py, w, (param, values, initial), progress, options);
+    }
     let options = gait_options(GaitOptions::for_sweeps(), options)?;
-    let config = &params.config;
+    let config = params.wheel("sweep")?;
     let progress = Progress::new(progress, values.len());
     let initial = section(initial)?;
     let result = interruptible_with(py, vrw::gait::interrupt_flag(), Some(&progress), || {
@@ -576,7 +698,7 @@ fn basin<'py>(
             .map_err(|e| ConfigError::new_err(format!("invalid value {value:?} for `{name}`: {e}")))
     };
     let job = BasinJob {
-        config: params.config.clone(),
+        config: params.wheel("basin")?.clone(),
         initial: section(initial)?,
         coordinates: [coordinate("x", x)?, coordinate("y", y)?],
         ranges: [x_range, y_range],
@@ -666,7 +788,7 @@ fn gait_map<'py>(
         points,
     };
     let job = MapJob {
-        config: params.config.clone(),
+        config: params.wheel("map")?.clone(),
         spec: MapSpec {
             x: axis(x, x_range, nx),
             y: axis(y, y_range, ny),
@@ -733,7 +855,8 @@ fn map_result<'py>(
 /// line's `(1, 150)`), `points` (300), `transient` (32), `steps` (64), `initial`, `branch`; and `progress` (a
 /// callable `progress(done, total)`, called on this thread as the values' walks finish). `part` computes one
 /// part of the job apart (a study spread over processes, see `vrw.grid.orbit_grid`): `"coarse"`, `("fill",
-/// k, left)` or `"branch"`; the result then also has `ends` and `column_rows` (see `parts`).
+/// k, left)` or `"branch"`; the result then also has `ends` and `column_rows` (see `parts`). Another walker's
+/// (`Params(model=...)`): `vrw orbit --model`'s, without `progress` and `part` yet.
 #[pyfunction]
 #[pyo3(signature = (params, param = "viscosity", *, range = None, points = 300, transient = 32, steps = 64, initial = None, branch = true, progress = None, part = None))]
 #[allow(clippy::too_many_arguments)]
@@ -751,8 +874,27 @@ fn orbit<'py>(
     #[pyo3(from_py_with = parts::orbit_part_arg)] part: Option<OrbitJobPart>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (from, to) = range.unwrap_or((1.0, 150.0));
+    if let Some(w) = params.walker() {
+        let range = WalkerRange {
+            param: param.to_string(),
+            from,
+            to,
+            points,
+        };
+        let walk = (transient, steps);
+        return walkers::orbit(
+            py,
+            w,
+            range,
+            walk,
+            initial,
+            branch,
+            progress,
+            part.is_some(),
+        );
+    }
     let job = OrbitJob {
-        config: params.config.clone(),
+        config: params.wheel("orbit")?.clone(),
         spec: OrbitSpec {
             range: SweepSpec {
                 param: param.to_string(),
@@ -829,7 +971,8 @@ fn curve_columns_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
 /// command line's `(1, 300)`), `initial`, `period`, `max_points`, `max_step`, `switch` (follow the families born at period
 /// doublings, border collisions and ends; the command line's `--no-switch` is `switch=False`), `two_param`
 /// (`(name, from, to)`: the command line's `--two-param name --two-range from,to`; the curves' points are then
-/// `curve_points`, the columns of `curves.csv`).
+/// `curve_points`, the columns of `curves.csv`). Another walker's (`Params(model=...)`): `vrw continue
+/// --model`'s, its start's family only (no `initial`, `period`, `two_param`).
 #[pyfunction]
 #[pyo3(signature = (params, param = "viscosity", *, start = None, range = None, initial = None, period = None, max_points = 300, max_step = 0.1, switch = true, two_param = None))]
 #[allow(clippy::too_many_arguments)]
@@ -848,8 +991,18 @@ fn continue_family<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let flag = Arc::new(AtomicBool::new(false));
     let range = range.unwrap_or((1.0, 300.0));
+    if let Some(w) = params.walker() {
+        let options = walkers::FamilyOptions {
+            start,
+            range,
+            max_points,
+            max_step,
+            wheel_only: initial.is_some() || period.is_some() || two_param.is_some(),
+        };
+        return walkers::continue_family(py, w, param, options);
+    }
     let job = ContinueJob {
-        config: params.config.clone(),
+        config: params.wheel("continue_family")?.clone(),
         param: param.to_string(),
         start,
         from: range.0,
@@ -911,7 +1064,18 @@ fn tolerance_arg(value: &Bound<'_, PyAny>) -> PyResult<f64> {
 /// `Params(**keys)`: how a pickled `Params` is rebuilt (`Params.__reduce__`).
 #[pyfunction]
 fn _params_from_dict(keys: &Bound<'_, PyDict>) -> PyResult<Params> {
-    Params::new(Some(keys))
+    Params::new(None, Some(keys))
+}
+
+/// `Params(model=model, **keys)`, a description read from its `text`: how a pickled walker's `Params` is
+/// rebuilt (`Params.__reduce__`).
+#[pyfunction]
+#[pyo3(signature = (model, text, keys))]
+fn _walker_params(model: &str, text: Option<&str>, keys: &Bound<'_, PyDict>) -> PyResult<Params> {
+    let overrides = walkers::overrides(Some(keys))?;
+    Ok(Params {
+        model: Model::Walker(WalkerParams::load(model, text, None, &overrides)?),
+    })
 }
 
 /// Run `work` with the GIL released, Ctrl-C stopping it ([`progress::interruptible_with`] without a progress
@@ -962,6 +1126,7 @@ fn _vrw(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add_class::<Params>()?;
     m.add_function(wrap_pyfunction!(_params_from_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(_walker_params, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(find_gait, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;

@@ -1,4 +1,4 @@
-"""vrw: passive dynamic walking of a viscoelastic-legged rimless wheel, from Python.
+"""vrw: passive dynamic walking of a viscoelastic-legged rimless wheel, and of other planar walkers, from Python.
 
 A front to the vrw Rust library: the same parameters (``Params``, every key of a vrw TOML file), the same
 jobs as the command line (``simulate``, ``find_gait``, ``sweep``, ``map``, ``orbit``, ``basin``,
@@ -7,6 +7,16 @@ jobs as the command line (``simulate``, ``find_gait``, ``sweep``, ``map``, ``orb
 ``.to_xarray()``). ``vrw.plot`` draws the command line's figures on matplotlib axes; ``vrw.grid`` spreads maps,
 orbit diagrams, basins and grids of sweeps over a Dask cluster. Computation runs in Rust with the GIL released;
 ``Params`` and every result pickle, so they travel to worker processes.
+
+**Other walkers.** ``Params(model="simplest")`` (Garcia's simplest walking model), ``"compass"`` (Goswami's
+compass gait), ``"telescopic"`` (the compass gait with the paper's viscoelastic legs) or the path of a walker
+described in a TOML file (``"models/compass.toml"``) holds that walker's parameters (``Params(model="compass",
+slope=0.05, hip_mass=10)``; ``.model``, ``.parameter_keys()``), validated as ``vrw --model NAME --set
+key=value`` does. ``find_gait``, ``simulate``, ``sweep``, ``continue_family`` and ``orbit`` run the command
+line's ``--model`` jobs on it, with the same numbers; their sections and tables are named by the model's
+coordinates and their results carry ``model``; ``map``, ``basin`` and ``animate`` take only the wheel so far
+(the command line has them for every walker). A job a model does not run raises ``ConfigError`` naming the model and the job. ``vrw.plot.sweep``,
+``vrw.plot.orbit`` and ``vrw.plot.run`` draw a walker's results, and ``vrw.grid.gait_grid`` spreads its sweeps.
 
 **Long jobs.** ``sweep``, ``map``, ``orbit`` and ``basin`` take ``progress``: a callable ``progress(done,
 total)`` called on the calling thread as points finish, or ``True`` for a tqdm bar (``pip install tqdm``).
@@ -19,8 +29,11 @@ what a long study has computed, split it into several calls (e.g. a map in parts
 >>> import vrw
 >>> p = vrw.Params(viscosity=37)
 >>> gait = vrw.find_gait(p)
->>> gait["status"], gait["stable"], abs(gait["floquet_multipliers"]).max() < 1
+>>> gait["status"], gait["stable"], bool(abs(gait["floquet_multipliers"]).max() < 1)
 ('found', True, True)
+>>> walker = vrw.find_gait(vrw.Params(model="simplest", slope=0.009))
+>>> walker["model"], round(walker["section"]["theta"], 9), round(walker["period"], 9), walker["stable"]
+('simplest', 0.200310901, 3.882463753, True)
 """
 
 from typing import Any, Optional, Sequence, Union

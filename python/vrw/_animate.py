@@ -38,6 +38,12 @@ def _section(state: Mapping[str, float]) -> List[float]:
 def _walk_of(run_or_gait: Mapping[str, Any]) -> Dict[str, Any]:
     """The arguments of the walk to draw (see ``animate``)."""
     recorded = getattr(run_or_gait, WALK_ATTRIBUTE, None)
+    model = run_or_gait.get("model", "vrw")
+    if model != "vrw":
+        raise ValueError(
+            f"vrw.animate draws the wheel's walks only so far; the model `{model}` is drawn by `vrw animate DIR` "
+            f"of its `vrw simulate --model` run"
+        )
     if isinstance(run_or_gait, Run) and isinstance(recorded, dict):
         return recorded
     if isinstance(run_or_gait, GaitResult) or "period_k" in run_or_gait:

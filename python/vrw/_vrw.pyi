@@ -14,6 +14,7 @@ __all__ = [
     "WalkError",
     "__version__",
     "_params_from_dict",
+    "_walker_params",
     "animate",
     "basin",
     "continue_family",
@@ -50,29 +51,45 @@ class WalkError(RuntimeError):
 def _params_from_dict(keys: Dict[str, Value]) -> "Params":
     """``Params(**keys)``: how a pickled ``Params`` is rebuilt."""
 
+def _walker_params(model: str, text: Optional[str], keys: Dict[str, Value]) -> "Params":
+    """``Params(model=model, **keys)``, a description read from its ``text``: how a pickled walker's
+    ``Params`` is rebuilt."""
+
 @final
 class Params:
-    """The model's parameters and the solver's settings: every key of a vrw TOML file.
+    """The model's parameters and the solver's settings: every key of a vrw TOML file, or another walker's
+    parameters.
 
     ``Params(viscosity=37)`` starts from the defaults (the paper's Table 1, c = 50 N s/m) and applies each
     keyword as a TOML key, validated as the command line does; an unknown key or a bad value raises
-    ``ConfigError`` (a ``ValueError``) with the command line's message. Immutable, comparable, picklable.
+    ``ConfigError`` (a ``ValueError``) with the command line's message. ``Params(model="compass",
+    slope=0.05)`` (``"simplest"``, ``"compass"``, ``"telescopic"`` or a description's path, ``.toml``) holds
+    another walker's parameters, validated as ``vrw --model NAME --set key=value`` does. Immutable,
+    comparable, picklable.
     """
 
-    def __new__(cls, **keys: Value) -> "Params": ...
+    def __new__(cls, *, model: Optional[str] = None, **keys: Value) -> "Params": ...
     @staticmethod
-    def from_toml(path: Union[str, "PathLike[str]"]) -> "Params":
-        """Read a flat TOML file of parameters (as ``vrw --config FILE``)."""
+    def from_toml(path: Union[str, "PathLike[str]"], model: Optional[str] = None) -> "Params":
+        """Read a flat TOML file of parameters (as ``vrw --config FILE``, with ``--model model``)."""
+    @property
+    def model(self) -> str:
+        """``"vrw"`` (the wheel), a built-in walker's name, or a description's path as given."""
     def to_dict(self) -> Dict[str, Value]:
-        """Every key and its value, as a TOML file (or ``summary.json``'s ``config``) holds them."""
+        """Every key and its value, as a TOML file (or ``summary.json``'s ``config``) holds them; a walker's
+        parameters."""
     def replace(self, **keys: Value) -> "Params":
         """A copy with the given keys changed (validated as in the constructor)."""
     def __getitem__(self, key: str, /) -> Value: ...
-    def __reduce__(self) -> Tuple[Callable[[Dict[str, Value]], "Params"], Tuple[Dict[str, Value]]]:
-        """Pickle as ``Params(**to_dict())``, for every pickle protocol."""
+    def __reduce__(self) -> Tuple[Callable[..., "Params"], Tuple[Any, ...]]:
+        """Pickle as ``Params(**to_dict())`` (a walker's with its model and description), for every pickle
+        protocol."""
     @staticmethod
     def numeric_keys() -> List[str]:
-        """The keys holding a real number (what a sweep or a grid can vary)."""
+        """The wheel's keys holding a real number (what a sweep or a grid can vary)."""
+    def parameter_keys(self) -> List[str]:
+        """The keys this model's sweeps, continuations and orbit diagrams can vary: the wheel's
+        ``numeric_keys()``, or a walker's parameters."""
     def __eq__(self, other: object, /) -> bool: ...
 
 def simulate(
@@ -91,7 +108,8 @@ def simulate(
     ``end_time``, ``config``, ...) with ``steps`` replaced by a dict of numpy arrays keyed like the columns
     of ``steps.csv`` and ``trajectory`` a dict of numpy arrays keyed like ``trajectory.csv`` (``None`` if
     ``trajectory=False``). A walk that stops early is a status, not an exception; an invalid initial state
-    raises ``WalkError``.
+    raises ``WalkError``. Another walker's (``Params(model=...)``): ``vrw simulate --model``'s files, the
+    tables named by the model's coordinates, ``initial`` its section's coordinates.
     """
 
 def find_gait(
@@ -104,7 +122,10 @@ def find_gait(
     ``status`` is ``found`` or why no gait was found (``message`` says it in words, as the command line
     does); a found gait adds its fields (``section``, ``lambda_I4``, ``lambda_2_plus``, ..., ``stable``),
     with ``floquet_multipliers`` as a complex numpy array and ``jacobian`` as a 2-D numpy array. Options
-    not given take the library's defaults (see ``GaitOptions``).
+    not given take the library's defaults (see ``GaitOptions``). Another walker's (``Params(model=...)``):
+    ``vrw gait --model``'s ``gait.json`` with its gait's fields at the top (``section`` by the model's
+    coordinates, ``period``, ``lambda_I4``, ``impact_loss``, ``energy_drift``, ``stable``, ...); options
+    ``transient_steps`` and ``parameter`` only.
     """
 
 def sweep(
@@ -124,6 +145,8 @@ def sweep(
     float64 with NaN if a cell is empty; a column with no value at all as float64 NaN), ``thresholds`` the entries of
     ``thresholds.json`` as dicts. Options default to the command line's sweep settings (one central
     difference for the final Jacobian). ``vrw.linspace`` gives the command line's evenly spaced values.
+    Another walker's (``Params(model=...)``): ``vrw sweep --model``'s ``thresholds.json`` fields and
+    ``sweep``, at these values; no options, no ``progress`` yet.
     """
 
 def linspace(start: float, stop: float, points: int) -> List[float]:
@@ -147,7 +170,9 @@ def continue_family(
     without the figure): the fields of ``special_points.json`` and ``branch``, the columns of ``branch.csv``.
     ``range`` is ``(from, to)``, default ``(1, 300)``; ``two_param`` ``(name, from, to)`` also follows every
     border collision's curve in that second parameter (``curves`` in
-    ``special_points.json``'s form, and ``curve_points``, the columns of ``curves.csv``)."""
+    ``special_points.json``'s form, and ``curve_points``, the columns of ``curves.csv``). Another walker's
+    (``Params(model=...)``): ``vrw continue --model``'s, its start's family only (no ``initial``, ``period``,
+    ``two_param``)."""
 
 def map(
     params: Params,
@@ -191,7 +216,8 @@ def orbit(
     ``orbit`` (the columns of ``orbit.csv``) and, with ``branch``, ``branch`` (the columns of ``branch.csv``).
     ``range`` defaults to the command line's ``(1, 150)``. ``progress(done, total)`` is called on this thread as
     values finish; ``part`` (``"coarse"``, ``("fill", k, left)`` or ``"branch"``) computes one part of the job,
-    for ``vrw.grid.orbit_grid``, and adds ``ends`` and ``column_rows``."""
+    for ``vrw.grid.orbit_grid``, and adds ``ends`` and ``column_rows``. Another walker's
+    (``Params(model=...)``): ``vrw orbit --model``'s, without ``progress`` and ``part`` yet."""
 
 def basin(
     params: Params,

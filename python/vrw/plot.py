@@ -31,7 +31,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
-__all__ = ["fig2", "run", "steps", "map", "orbit", "basin"]
+__all__ = ["fig2", "sweep", "run", "steps", "map", "orbit", "basin"]
 
 AxesArg = Union["Axes", Sequence["Axes"], None]
 Panels = List[Tuple[str, List[Tuple[str, str]]]]  # y label, series (column, colour)
@@ -224,6 +224,7 @@ def fig2(sweep: Mapping[str, Any], ax: AxesArg = None, panels: int = 2, **option
     array of axes."""
     if panels not in (2, 4):
         raise ValueError(f"panels is 2 (the paper's Fig. 2) or 4 (with period and multipliers), not {panels}")
+    _wheel_only(sweep, "fig2", "vrw.plot.sweep draws its lambda_I4, period and multipliers")
     axes = _axes(ax, panels, (8, 1.2 + 2.6 * panels))
     table, key = sweep["sweep"], sweep["param"]
     order = np.argsort(np.asarray(table[key], dtype=float), kind="stable")
@@ -264,6 +265,66 @@ def fig2(sweep: Mapping[str, Any], ax: AxesArg = None, panels: int = 2, **option
     return axes
 
 
+def _wheel_only(result: Mapping[str, Any], figure: str, instead: str) -> None:
+    """A ``ValueError`` naming the model if ``result`` is another walker's (``vrw.Params(model=...)``), whose
+    tables lack the wheel's columns this figure draws; ``instead`` says what draws it."""
+    model = result.get("model")
+    if model is not None and model != "vrw":
+        raise ValueError(f"vrw.plot.{figure} draws the wheel's results; the model `{model}` has other columns: "
+                         f"{instead}")
+
+
+def sweep(result: Mapping[str, Any], ax: AxesArg = None, **options: Any) -> np.ndarray:
+    """A sweep of any model (``vrw.sweep``, the wheel's or another walker's) against its parameter: lambda_I4,
+    the step's period and the largest modulus of the Floquet multipliers (1 drawn: the stability border),
+    black where the gait is stable, vermillion where not; each threshold a dashed line, values without a gait
+    shaded. ``ax``: 3 Axes. Returns their array."""
+    table, key = result["sweep"], result["param"]
+    order = np.argsort(np.asarray(table[key], dtype=float), kind="stable")
+    x = np.asarray(table[key], dtype=float)[order]
+    stable = np.asarray(table["stability"])[order] == "stable"
+    cuts = [t["value"] for t in result["thresholds"] if isinstance(t.get("value"), (int, float))
+            and math.isfinite(t["value"])]
+    axes = _axes(ax, 3, (8, 8))
+    for axis, (name, reference) in zip(axes, [("lambda_I4", 0.0), ("period", None), ("max_floquet", 1.0)]):
+        y = np.asarray(table[name], dtype=float)[order]
+        axis.plot(x, y, **{"color": MARK, "lw": 1, **options}, label="_nolegend_")
+        for members, color, label in ((stable, BLACK, "stable"), (~stable, VERMILLION, "unstable")):
+            axis.plot(x, np.where(members, y, np.nan), **{"ls": "", "marker": "o", "ms": 4, "color": color,
+                                                          **options}, label=label)
+        if reference is not None:
+            axis.axhline(reference, color="black", linewidth=1)
+        _spans(axis, _no_gait(x, np.isfinite(np.asarray(table["period"], dtype=float)[order]), cuts),
+               NO_GAIT_BAND, "no gait")
+        _vlines(axis, cuts)
+        axis.set_ylabel(_label(name) if name != "max_floquet" else "max |μ|")
+    _legend(axes[0])
+    axes[-1].set_xlim(x.min(), x.max())
+    axes[-1].set_xlabel(_label(key))
+    return axes
+
+
+def _walker_run(run: Mapping[str, Any], ax: AxesArg, **options: Any) -> np.ndarray:
+    """``vrw plot``'s run figure of another walker (src/output/walker_plot.rs): each coordinate against time,
+    then the energies T, V and T + V; every heel strike dashed, the curves broken there."""
+    trajectory = run["trajectory"]
+    coordinates = list(run["coordinates"])
+    axes = _axes(ax, len(coordinates) + 1, (10, 2.2 * (len(coordinates) + 1)))
+    cut = np.flatnonzero(np.diff(trajectory["step"]) != 0) + 1  # where the legs exchange roles
+    broken = {c: np.insert(np.asarray(v, dtype=float), cut, np.nan) for c, v in trajectory.items()}
+    panels: Panels = [(c, [(c, BLUE)]) for c in coordinates]
+    panels.append(("energy", [("kinetic", BLUE), ("potential", VERMILLION), ("energy", BLACK)]))
+    _panels(axes, broken["time"], broken, panels, **options)
+    for axis in axes:
+        _vlines(axis, np.asarray(run["steps"]["time"])[1:])
+    _legend(axes[-1])
+    t = np.asarray(trajectory["time"], dtype=float)
+    axes[-1].set_xlim(t[0], t[-1])
+    axes[-1].set_xlabel("time")
+    axes[0].set_title(f"{run['model']}: {run['steps_completed']} steps")
+    return axes
+
+
 def run(run: Mapping[str, Any], ax: AxesArg = None, **options: Any) -> np.ndarray:
     """The run figure of ``vrw plot`` (``run.png``) from a ``Run`` with its trajectory: against time, theta of
     Leg 1, its rate, the leg lengths with the stopper length L0 dashed, the normal forces lambda_2, lambda_4
@@ -273,6 +334,8 @@ def run(run: Mapping[str, Any], ax: AxesArg = None, **options: Any) -> np.ndarra
     trajectory = run.get("trajectory")
     if not trajectory:
         raise ValueError("the run has no trajectory: simulate with trajectory=True")
+    if run.get("model", "vrw") != "vrw":
+        return _walker_run(run, ax, **options)
     axes = _axes(ax, 5, (10, 12))
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
@@ -314,6 +377,8 @@ def steps(run: Mapping[str, Any], ax: AxesArg = None, **options: Any) -> np.ndar
     table = run["steps"]
     if not len(table["step"]):
         raise ValueError("the run has no step")
+    _wheel_only(run, "steps", "vrw.plot.run draws its coordinates and energies; its steps table holds "
+                "lambda_I4, period, stride and the energy audit per step")
     axes = _axes(ax, 6, (14, 8), side=True)
     from matplotlib.collections import LineCollection
     from matplotlib.ticker import MaxNLocator
@@ -403,13 +468,19 @@ def map(result: Mapping[str, Any], column: str = "lambda_4_plus", ax: AxesArg = 
 
 
 def orbit(result: Mapping[str, Any], ax: AxesArg = None, branch: bool = True,
-          columns: Sequence[str] = ("thetadot", "lambda_I4"), **options: Any) -> Any:
+          columns: Optional[Sequence[str]] = None, **options: Any) -> Any:
     """The orbit diagram of ``vrw orbit`` (``orbit.png``) from an ``OrbitResult``: for each of ``columns`` of
     ``orbit.csv`` (the command line's: dtheta/dt on the section and lambda_I4), the recorded steps against the
     parameter as small blue dots, grey where the walk fails, and with ``branch`` the period-1 branch (black
     solid where stable, vermillion dashed where unstable, grey dashed where uncertain). ``ax``: an Axes per
-    column. An unknown column is a ``ValueError``. Returns the Axes (one column) or their array."""
-    table, span = result["orbit"], result["spec"]["range"]
+    column. An unknown column is a ``ValueError``. Returns the Axes (one column) or their array. Another
+    walker's diagram (``vrw.Params(model=...)``) draws by default its section's first coordinate and
+    lambda_I4, as ``vrw orbit --model`` does."""
+    table = result["orbit"]
+    span = result["spec"]["range"] if "spec" in result else result["range"]  # the wheel's, a walker's
+    if columns is None:
+        walker = "spec" not in result
+        columns = (list(table)[4], "lambda_I4") if walker else ("thetadot", "lambda_I4")
     key, lo, hi = span["param"], min(span["from"], span["to"]), max(span["from"], span["to"])
     valid = [c for c, v in table.items() if c != key and np.asarray(v).dtype.kind == "f"]
     if any(c not in valid for c in columns):

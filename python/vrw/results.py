@@ -92,6 +92,15 @@ class GaitResult(Result):
     def __repr__(self) -> str:
         if self.get("status") != "found":
             return f"GaitResult(status={self.get('status')!r}, message={self.get('message')!r})"
+        if "model" in self:
+            # Another walker's gait (``vrw.Params(model=...)``): its section by the model's coordinates.
+            moduli = np.abs(np.asarray(self.get("floquet_multipliers")))
+            section = ", ".join(f"{k}={v:.6g}" for k, v in self.get("section", {}).items())
+            return (
+                f"GaitResult({self['model']}, found, {section}, period {self.get('period'):.6g}, "
+                f"lambda_I4={self.get('lambda_I4'):.6g}, {'stable' if self.get('stable') else 'unstable'}, "
+                f"max |multiplier| {moduli.max() if moduli.size else float('nan'):.6g})"
+            )
         return (
             f"GaitResult(found, period {self.get('period_k')}, branch {self.get('branch')}, "
             f"lambda_I4={self.get('lambda_I4'):.6g}, lambda_2_plus={self.get('lambda_2_plus'):.6g}, "
@@ -217,7 +226,8 @@ class OrbitResult(_WithTable):
     _table = "orbit"
 
     def __repr__(self) -> str:
-        spec = self.get("spec", {}).get("range", {})
+        # The wheel's orbit.json has the range under ``spec``; another walker's has it at the top.
+        spec = self.get("spec", {}).get("range", self.get("range", {}))
         return (
             f"OrbitResult({spec.get('param')}: {spec.get('points')} values, outcomes "
             f"{dict(self.get('outcomes', {}))})"
@@ -232,6 +242,12 @@ class FamilyResult(_WithTable):
 
     def __repr__(self) -> str:
         kinds = [p["kind"] for p in self.get("special_points", [])]
+        if "model" in self:
+            # Another walker's family: one family, from its start.
+            return (
+                f"FamilyResult({self['model']}, {self.get('param')}: {self['branch'].rows} points, "
+                f"special points {kinds})"
+            )
         return (
             f"FamilyResult({self.get('param')}: {len(self.get('families', []))} families, "
             f"{self['branch'].rows} points, special points {kinds})"

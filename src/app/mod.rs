@@ -25,6 +25,7 @@ mod walker_figures;
 mod walker_map;
 mod walker_model;
 mod walker_orbit;
+mod walker_output;
 mod walker_simulate;
 mod walker_sweep;
 mod walkers;
@@ -64,7 +65,8 @@ pub use walker_basin::{
     WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS, MAX_WALKER_BASIN_STEPS,
 };
 pub use walker_continue::{
-    run_walker_continuation, WalkerContinueJob, WalkerContinueSummary, WalkerSpecialPoint,
+    compute_walker_continuation, run_walker_continuation, WalkerContinueJob, WalkerContinueSummary,
+    WalkerSpecialPoint,
 };
 pub use walker_map::{
     run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary, WalkerMapThreshold,
@@ -74,18 +76,21 @@ pub use walker_model::{
     WalkerStep,
 };
 pub use walker_orbit::{
-    run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary, MAX_WALKER_PERIOD,
+    compute_walker_orbit, run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary,
+    MAX_WALKER_PERIOD,
 };
+pub use walker_output::WalkerOutput;
 pub use walker_simulate::{
-    run_walker_simulate, WalkerSimulateJob, WalkerSimulateSummary, WalkerStepRecord,
+    compute_walker_simulate, run_walker_simulate, WalkerSimulateJob, WalkerSimulateSummary,
+    WalkerStepRecord,
 };
 pub use walker_sweep::{
-    run_walker_sweep, WalkerRange, WalkerSweepJob, WalkerSweepPoint, WalkerSweepSummary,
-    WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
+    compute_walker_sweep, run_walker_sweep, WalkerRange, WalkerSweepJob, WalkerSweepPoint,
+    WalkerSweepSummary, WalkerThreshold, MAX_WALKER_SWEEP_POINTS,
 };
 pub use walkers::{
-    run_walker_gait, Walker, WalkerGait, WalkerGaitJob, WalkerGaitSummary, WalkerParamDerivative,
-    MODELS, TELESCOPIC,
+    compute_walker_gait, run_walker_gait, Walker, WalkerGait, WalkerGaitJob, WalkerGaitSummary,
+    WalkerParamDerivative, MODELS, TELESCOPIC,
 };
 
 use crate::dynamics::Model;

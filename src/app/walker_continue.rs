@@ -11,7 +11,8 @@ use serde::Serialize;
 
 use super::legged::{legged_interruptible, search_legged_gait};
 use super::walker_model::{interruptible, search_gait};
-use super::walkers::{as_map, named, rigid_start, unreachable_walk, write_rows, Walker};
+use super::walker_output::{write_rows, WalkerOutput};
+use super::walkers::{as_map, named, rigid_start, unreachable_walk, Walker};
 use super::{in_run, AppError};
 use crate::continuation::{
     continue_family, ContinuationOptions, FamilyEnd, FamilyMap, FamilyPoint, SpecialKind,
@@ -90,6 +91,23 @@ pub struct WalkerSpecialPoint {
 /// `branch.csv` (a row per point) and `special_points.json`, after the output directory is checked.
 pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinueSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "continue", job.overwrite)?;
+    let WalkerOutput { summary, tables } = compute_walker_continuation(job)?;
+    in_run(&job.out_dir, job.overwrite, "continue", |run| {
+        for (name, rows) in &tables {
+            write_rows(&run.path(name), rows)?;
+            run.add(name);
+        }
+        output::write_json(&run.path("special_points.json"), &summary)?;
+        run.add("special_points.json");
+        Ok((summary, None))
+    })
+}
+
+/// The family of [`run_walker_continuation`] without its files (the Python binding): `special_points.json`'s
+/// fields and the rows of `branch.csv` (`job.out_dir` and `job.overwrite` are not read).
+pub fn compute_walker_continuation(
+    job: &WalkerContinueJob,
+) -> Result<WalkerOutput<WalkerContinueSummary>, AppError> {
     let (summary, rows) = match &job.walker {
         Walker::Simplest(w) => follow(w, w.default_start(), job)?,
         Walker::Compass(w) => follow(w, w.default_start(), job)?,
@@ -103,12 +121,9 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
             crate::with_rigid_described!(w, w => follow(w, start, job)?, _ => unreachable_walk(w)?)
         }
     };
-    in_run(&job.out_dir, job.overwrite, "continue", |run| {
-        write_rows(&run.path("branch.csv"), &rows)?;
-        run.add("branch.csv");
-        output::write_json(&run.path("special_points.json"), &summary)?;
-        run.add("special_points.json");
-        Ok((summary, None))
+    Ok(WalkerOutput {
+        summary,
+        tables: vec![("branch.csv", rows)],
     })
 }
 

@@ -26,7 +26,8 @@ use serde::Serialize;
 use super::walker_sweep::{
     gait_at, sweep_rows, thresholds, walker_gaits, WalkerRange, WalkerSweepPoint, WalkerThreshold,
 };
-use super::walkers::{start_of, write_rows, Walker};
+use super::walker_output::write_rows;
+use super::walkers::{start_of, Walker};
 use super::{check_interrupted, check_phase_interrupted, in_run, AppError};
 use crate::output;
 use crate::output::walker_map_plot::{write_walker_map_figure, MapCell, WalkerMapFigure};

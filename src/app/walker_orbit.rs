@@ -15,9 +15,10 @@ use serde::Serialize;
 
 use super::walker_model::WalkerError;
 use super::walker_model::WalkerStep;
+use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::{walker_gaits, WalkerRange, WalkerSweepPoint};
-use super::walkers::{write_rows, Walker};
-use super::{check_interrupted, in_run, AppError};
+use super::walkers::Walker;
+use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
 use crate::study::grid::{run_rows, Evaluated};
@@ -199,17 +200,7 @@ pub fn run_walker_orbit(job: &WalkerOrbitJob) -> Result<WalkerOrbitSummary, AppE
     let names = model.section_names();
     output::manifest::check_out_dir(&job.out_dir, "orbit", job.overwrite)?;
     in_run(&job.out_dir, job.overwrite, "orbit", |run| {
-        let columns = run_rows(1, values.len(), |cell, from| {
-            let (start, from) = match from {
-                Some((col, end)) => (end, Some(values[col])),
-                None => (&start, None),
-            };
-            let (point, carry) = walk_column(job, values[cell.col], (start, from));
-            Evaluated { point, carry }
-        })
-        .into_iter()
-        .next()
-        .unwrap_or_default();
+        let columns = diagram(job, &values, &start);
         write_rows(
             &run.path("orbit.csv"),
             &orbit_rows(&job.range.param, &names, &columns),
@@ -249,6 +240,48 @@ pub fn run_walker_orbit(job: &WalkerOrbitJob) -> Result<WalkerOrbitSummary, AppE
         run.add("orbit.json");
         Ok((summary, None))
     })
+}
+
+/// The orbit diagram of [`run_walker_orbit`] without its files and figure (the Python binding): `orbit.json`'s
+/// fields (`files` the tables') and the rows of `orbit.csv` and, with `job.branch`, `branch.csv` (`job.out_dir`
+/// and `job.overwrite` are not read). Ctrl-C: an error, nothing kept.
+pub fn compute_walker_orbit(
+    job: &WalkerOrbitJob,
+) -> Result<WalkerOutput<WalkerOrbitSummary>, AppError> {
+    let values = job.values()?;
+    let model = job.walker.model()?;
+    let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
+    let names = model.section_names();
+    let columns = diagram(job, &values, &start);
+    check_phase_interrupted(None, "while walking the diagram", NOTHING_WRITTEN)?;
+    let mut tables = vec![("orbit.csv", orbit_rows(&job.range.param, &names, &columns))];
+    let branch = match job.branch {
+        true => walker_gaits(&job.walker, &job.range.param, &values, &start),
+        false => Vec::new(),
+    };
+    check_phase_interrupted(None, "while searching the branch", NOTHING_WRITTEN)?;
+    if job.branch {
+        tables.push(("branch.csv", branch_rows(&job.range.param, &names, &branch)));
+    }
+    let files = tables.iter().map(|(name, _)| name.to_string()).collect();
+    let summary = summary(job, model.name(), &columns, &branch, files);
+    Ok(WalkerOutput { summary, tables })
+}
+
+/// The walks of the diagram at `values`, each from where its neighbour's ended (the first from `start`);
+/// cut to their complete prefix by Ctrl-C.
+fn diagram(job: &WalkerOrbitJob, values: &[f64], start: &DVector<f64>) -> Vec<WalkerOrbitColumn> {
+    run_rows(1, values.len(), |cell, from| {
+        let (start, from) = match from {
+            Some((col, end)) => (end, Some(values[col])),
+            None => (start, None),
+        };
+        let (point, carry) = walk_column(job, values[cell.col], (start, from));
+        Evaluated { point, carry }
+    })
+    .into_iter()
+    .next()
+    .unwrap_or_default()
 }
 
 /// `orbit.json`'s fields.

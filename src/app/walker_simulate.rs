@@ -11,6 +11,7 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::walker_model::{Sampling, WalkerModel, WalkerSample, WalkerStep};
+use super::walker_output::WalkerOutput;
 use super::walkers::{as_map, named, Walker};
 use super::{in_run, AppError, WalkEnded, MAX_SIMULATE_STEPS, SAMPLE_DT_RANGE};
 use crate::mechanism::legged::walk::StepAccount;
@@ -215,13 +216,16 @@ pub fn run_walker_simulate(job: &WalkerSimulateJob) -> Result<WalkerSimulateSumm
             )?),
             false => None,
         };
-        walk(
-            job,
-            model.as_ref(),
-            start,
-            &mut summary,
-            (&mut steps, trajectory.as_mut()),
-        )?;
+        let mut to_steps = |row| steps.write(row).map_err(AppError::from);
+        let mut to_trajectory = |row| match trajectory.as_mut() {
+            Some(csv) => csv.write(row).map_err(AppError::from),
+            None => Ok(()),
+        };
+        let sinks = RowSinks {
+            steps: &mut to_steps,
+            trajectory: job.trajectory.then_some(&mut to_trajectory),
+        };
+        walk(job, model.as_ref(), start, &mut summary, sinks)?;
         output::write_json(&run.path("summary.json"), &summary)?;
         let interrupted = (summary.status == WalkEnded::Interrupted).then(|| {
             format!(
@@ -231,6 +235,48 @@ pub fn run_walker_simulate(job: &WalkerSimulateJob) -> Result<WalkerSimulateSumm
         });
         Ok((summary, interrupted))
     })
+}
+
+/// The walk of [`run_walker_simulate`] without its files (the Python binding): `summary.json`'s fields (`files`
+/// empty) and the rows of `steps.csv` and, with `job.trajectory`, `trajectory.csv` (`job.out_dir` and
+/// `job.overwrite` are not read). A walk interrupted (Ctrl-C) or ended early says so in its `status`, as the
+/// command line's.
+pub fn compute_walker_simulate(
+    job: &WalkerSimulateJob,
+) -> Result<WalkerOutput<WalkerSimulateSummary>, AppError> {
+    job.validate()?;
+    let model = job.walker.model()?;
+    let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
+    let mut summary = WalkerSimulateSummary::start(job, model.as_ref(), &start);
+    let mut steps = vec![walker_steps_header(&model.section_names())];
+    let mut trajectory = vec![walker_trajectory_header(
+        &model.coordinates(),
+        &model.figure(),
+    )];
+    let mut to_steps = |row| {
+        steps.push(row);
+        Ok(())
+    };
+    let mut to_trajectory = |row| {
+        trajectory.push(row);
+        Ok(())
+    };
+    let sinks = RowSinks {
+        steps: &mut to_steps,
+        trajectory: job.trajectory.then_some(&mut to_trajectory),
+    };
+    walk(job, model.as_ref(), start, &mut summary, sinks)?;
+    let mut tables = vec![("steps.csv", steps)];
+    if job.trajectory {
+        tables.push(("trajectory.csv", trajectory));
+    }
+    Ok(WalkerOutput { summary, tables })
+}
+
+/// Where a walk's rows go as it walks: `steps.csv`'s, and `trajectory.csv`'s (`None`: no trajectory).
+struct RowSinks<'a> {
+    steps: &'a mut dyn FnMut(Vec<String>) -> Result<(), AppError>,
+    trajectory: Option<&'a mut dyn FnMut(Vec<String>) -> Result<(), AppError>>,
 }
 
 impl WalkerSimulateSummary {
@@ -264,8 +310,12 @@ fn walk(
     model: &dyn WalkerModel,
     mut s: DVector<f64>,
     summary: &mut WalkerSimulateSummary,
-    (steps, mut trajectory): (&mut CsvStream, Option<&mut CsvStream>),
+    sinks: RowSinks<'_>,
 ) -> Result<(), AppError> {
+    let RowSinks {
+        steps,
+        mut trajectory,
+    } = sinks;
     let names = model.section_names();
     let (mut time, mut stance_x) = (0.0, 0.0);
     summary.status = WalkEnded::Completed;
@@ -288,13 +338,13 @@ fn walk(
                 break;
             }
         };
-        if let Some(csv) = trajectory.as_deref_mut() {
+        if let Some(sink) = trajectory.as_deref_mut() {
             for sample in &samples {
-                csv.write(trajectory_row(k, stance_x, sample))?;
+                sink(trajectory_row(k, stance_x, sample))?;
             }
         }
         let record = WalkerStepRecord::new(k, time, (&names, &s), &step);
-        steps.write(record.row())?;
+        steps(record.row())?;
         time += step.period;
         stance_x += step.stride;
         summary.steps_completed = k;

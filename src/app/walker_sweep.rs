@@ -11,6 +11,7 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::walker_model::FoundGait;
+use super::walker_output::{write_rows, WalkerOutput};
 use super::walkers::{as_map, named, Walker};
 use super::{check_interrupted, in_run, AppError};
 use crate::output;
@@ -213,28 +214,59 @@ pub fn run_walker_sweep(job: &WalkerSweepJob) -> Result<WalkerSweepSummary, AppE
     in_run(&job.out_dir, job.overwrite, "sweep", |run| {
         let points = walker_gaits(&job.walker, &job.range.param, &values, &start);
         let rows = sweep_rows(&job.range.param, &names, &points);
-        super::walkers::write_rows(&run.path("sweep.csv"), &rows)?;
+        write_rows(&run.path("sweep.csv"), &rows)?;
         run.add("sweep.csv");
         check_interrupted(points.len(), values.len(), "sweep.csv")?;
-        let thresholds = thresholds(&job.walker, &job.range.param, &names, &points);
-        super::check_phase_interrupted(
-            None,
-            "while bisecting the thresholds",
+        let summary = sweep_summary(
+            job,
+            (model.name(), &names),
+            &points,
             "sweep.csv is complete",
         )?;
-        let summary = WalkerSweepSummary {
-            vrw_version: env!("CARGO_PKG_VERSION"),
-            model: model.name().to_string(),
-            parameters: job.walker.clone(),
-            range: job.range.clone(),
-            gaits_found: points.iter().filter(|p| p.gait.is_ok()).count(),
-            stable: points.iter().filter(|p| p.status() == "stable").count(),
-            thresholds,
-            files: vec!["sweep.csv".to_string(), "thresholds.json".to_string()],
-        };
         output::write_json(&run.path("thresholds.json"), &summary)?;
         run.add("thresholds.json");
         Ok((summary, None))
+    })
+}
+
+/// The sweep of [`run_walker_sweep`] at `values` (the range's, [`WalkerRange::values`], or others the caller
+/// checked: the Python binding's list) without its files: `thresholds.json`'s fields and the rows of
+/// `sweep.csv` (`job.out_dir` and `job.overwrite` are not read). Ctrl-C: an error, nothing kept.
+pub fn compute_walker_sweep(
+    job: &WalkerSweepJob,
+    values: &[f64],
+) -> Result<WalkerOutput<WalkerSweepSummary>, AppError> {
+    let model = job.walker.model()?;
+    let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
+    let names = model.section_names();
+    let points = walker_gaits(&job.walker, &job.range.param, values, &start);
+    super::check_phase_interrupted(None, "while sweeping", super::NOTHING_WRITTEN)?;
+    let summary = sweep_summary(job, (model.name(), &names), &points, super::NOTHING_WRITTEN)?;
+    Ok(WalkerOutput {
+        summary,
+        tables: vec![("sweep.csv", sweep_rows(&job.range.param, &names, &points))],
+    })
+}
+
+/// `thresholds.json`'s fields for the gaits `points` of `job` (the model's name and section's names given),
+/// their thresholds bisected; an error if Ctrl-C cut the bisection short (`kept`: what the job has written).
+fn sweep_summary(
+    job: &WalkerSweepJob,
+    (model, names): (&str, &[String]),
+    points: &[WalkerSweepPoint],
+    kept: &str,
+) -> Result<WalkerSweepSummary, AppError> {
+    let thresholds = thresholds(&job.walker, &job.range.param, names, points);
+    super::check_phase_interrupted(None, "while bisecting the thresholds", kept)?;
+    Ok(WalkerSweepSummary {
+        vrw_version: env!("CARGO_PKG_VERSION"),
+        model: model.to_string(),
+        parameters: job.walker.clone(),
+        range: job.range.clone(),
+        gaits_found: points.iter().filter(|p| p.gait.is_ok()).count(),
+        stable: points.iter().filter(|p| p.status() == "stable").count(),
+        thresholds,
+        files: vec!["sweep.csv".to_string(), "thresholds.json".to_string()],
     })
 }
 

@@ -340,10 +340,21 @@ pub struct WalkerParamDerivative {
 /// output directory is checked.
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
+    let summary = compute_walker_gait(job)?;
+    in_run(&job.out_dir, job.overwrite, "gait", |run| {
+        output::write_json(&run.path("gait.json"), &summary)?;
+        run.add("gait.json");
+        Ok((summary, None))
+    })
+}
+
+/// The search of [`run_walker_gait`] without its file (the Python binding): `gait.json`'s fields (`job.out_dir`
+/// and `job.overwrite` are not read).
+pub fn compute_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     if let Some(key) = &job.parameter {
         job.walker.check_parameter(key, "parameter")?;
     }
-    let summary = match &job.walker {
+    Ok(match &job.walker {
         Walker::Simplest(w) => compute(w, w.default_start(), job)?,
         Walker::Compass(w) => compute(w, w.default_start(), job)?,
         Walker::Telescopic(_) => compute_on_model(job)?,
@@ -352,11 +363,6 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
             let start = rigid_start(w, job.initial.as_deref())?;
             crate::with_rigid_described!(w, w => compute(w, start, job)?, _ => unreachable_walk(w)?)
         }
-    };
-    in_run(&job.out_dir, job.overwrite, "gait", |run| {
-        output::write_json(&run.path("gait.json"), &summary)?;
-        run.add("gait.json");
-        Ok((summary, None))
     })
 }
 
@@ -540,21 +546,6 @@ pub(super) fn as_map<S: serde::Serializer>(
         map.serialize_entry(name, value)?;
     }
     map.end()
-}
-
-/// Write the table `rows` (its header first) as the CSV file `path`, atomically.
-pub(super) fn write_rows(path: &Path, rows: &[Vec<String>]) -> Result<(), AppError> {
-    output::write_atomic(path, |path| -> Result<(), AppError> {
-        let mut w = output::csv_writer(path)?;
-        for row in rows {
-            output::write_record(&mut w, path, row)?;
-        }
-        w.flush().map_err(|source| crate::output::OutputError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        Ok(())
-    })
 }
 
 /// Where a described walker's gait search starts (its `[gait]` table's `start`), or why it cannot walk: no
