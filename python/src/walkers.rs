@@ -13,9 +13,10 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt};
 use pythonize::pythonize;
 
 use vrw::app::{
-    compute_walker_continuation, compute_walker_gait, compute_walker_orbit, compute_walker_simulate,
-    compute_walker_sweep, AppError, Walker, WalkerContinueJob, WalkerGaitJob, WalkerOrbitJob,
-    WalkerOutput, WalkerRange, WalkerSimulateJob, WalkerSweepJob, MAX_WALKER_SWEEP_POINTS,
+    compute_walker_continuation, compute_walker_gait, compute_walker_orbit,
+    compute_walker_simulate, compute_walker_sweep, AppError, Walker, WalkerContinueJob,
+    WalkerGaitJob, WalkerOrbitJob, WalkerOutput, WalkerRange, WalkerSimulateJob, WalkerSweepJob,
+    MAX_WALKER_SWEEP_POINTS,
 };
 use vrw::gait::GaitOptions;
 use vrw::mechanism::described;
@@ -307,22 +308,17 @@ pub(crate) fn find_gait<'py>(
         parameter,
     } = Search::new(params, options)?;
     let flag = vrw::gait::interrupt_flag();
-    let result = match &params.walker {
-        walker => {
-            let job = WalkerGaitJob {
-                walker: walker.clone(),
-                initial,
-                transient_steps,
-                parameter,
-                check_jacobian: false,
-                out_dir: PathBuf::new(),
-                overwrite: false,
-            };
-            let summary =
-                interruptible(py, flag, || compute_walker_gait(&job))?.map_err(app_error)?;
-            pythonize(py, &summary)?.downcast_into::<PyDict>()?
-        }
+    let job = WalkerGaitJob {
+        walker: params.walker.clone(),
+        initial,
+        transient_steps,
+        parameter,
+        check_jacobian: false,
+        out_dir: PathBuf::new(),
+        overwrite: false,
     };
+    let summary = interruptible(py, flag, || compute_walker_gait(&job))?.map_err(app_error)?;
+    let result = pythonize(py, &summary)?.downcast_into::<PyDict>()?;
     flatten_gait(py, &result)?;
     Ok(result)
 }

@@ -22,8 +22,8 @@ use serde::Serialize;
 
 use super::walker_model::FoundGait;
 use super::walker_orbit::least_period;
-use super::walker_sweep::FRESH_TRANSIENT;
 use super::walker_output::write_rows;
+use super::walker_sweep::FRESH_TRANSIENT;
 use super::walkers::{as_map, named, start_of, Walker};
 use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
 use crate::gait::periodicity::{MAX_PERIOD, RETURN_WINDOW};

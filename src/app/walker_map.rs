@@ -23,10 +23,10 @@ use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::walker_output::write_rows;
 use super::walker_sweep::{
     gait_at, sweep_rows, thresholds, walker_gaits, WalkerRange, WalkerSweepPoint, WalkerThreshold,
 };
-use super::walker_output::write_rows;
 use super::walkers::{start_of, Walker};
 use super::{check_interrupted, check_phase_interrupted, in_run, AppError};
 use crate::output;

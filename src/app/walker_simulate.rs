@@ -248,7 +248,7 @@ pub fn compute_walker_simulate(
     let model = job.walker.model()?;
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     let mut summary = WalkerSimulateSummary::start(job, model.as_ref(), &start);
-    let mut steps = vec![walker_steps_header(&model.section_names())];
+    let mut steps = vec![walker_steps_header(&model.section_names(), model.legged())];
     let mut trajectory = vec![walker_trajectory_header(
         &model.coordinates(),
         &model.figure(),
