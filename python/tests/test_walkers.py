@@ -199,9 +199,11 @@ def test_the_telescopic_walker_walks_from_python_as_on_the_command_line(cli, tmp
         vrw.find_gait(vrw.Params(model="simplest"), tolerance=1e-9)
 
 
-def test_a_described_walker_refuses_the_jobs_it_does_not_walk_yet():
-    with pytest.raises(vrw.ConfigError, match="compass-toml"):
-        vrw.simulate(vrw.Params(model=COMPASS_TOML), steps=1)
+def test_a_described_walker_walks_as_its_built_in(cli, tmp_path):
+    run = vrw.simulate(vrw.Params(model=COMPASS_TOML), steps=2)
+    assert run["model"] == "compass-toml"
+    cli("simulate", "--model", "compass", "--steps", "2", "--out", tmp_path / "c")
+    assert_table_equals_csv(run.steps, tmp_path / "c" / "steps.csv")
 
 
 # --- The jobs, against the command line -----------------------------------------------------------------
