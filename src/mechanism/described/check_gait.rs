@@ -122,6 +122,17 @@ fn guesses(
     Ok(guess)
 }
 
+/// A refusal of the `strokes` key at `offset`.
+fn refuse_strokes(cx: &Checker, offset: usize, reason: String) -> DescriptionError {
+    cx.at(
+        offset,
+        Problem::Field {
+            field: "strokes",
+            reason,
+        },
+    )
+}
+
 /// The legs' strokes: two free prismatic joints with an upper stopper and none below (the compliant walk holds
 /// a leg at its upper stopper only), each moving its leg's contact (`tips`: the stance and the landing
 /// contact), exchanged by the relabeling, and no other joint with stoppers.
@@ -131,85 +142,33 @@ fn strokes(
     d: &Description,
     (relabel, tips): (&[usize], [usize; 2]),
 ) -> Result<[LegStroke; 2], DescriptionError> {
-    let refuse = |offset: usize, reason: String| {
-        cx.at(
-            offset,
-            Problem::Field {
-                field: "strokes",
-                reason,
-            },
-        )
-    };
     let s = raw.get_ref();
-    let mut out = Vec::with_capacity(2);
-    for (name, tip) in [&s.fore, &s.rear].into_iter().zip(tips) {
-        let k = cx.find(name, &d.coordinates, "coordinate")?;
-        let n = name.get_ref();
-        let at = name.span().start;
-        let Some((joint, free)) = d.free_joints().find(|(_, f)| f.coordinate == k) else {
-            return Err(refuse(at, format!("`{n}` is no free joint")));
-        };
-        if !matches!(joint.motion, Motion::Prismatic { .. }) {
-            return Err(refuse(
-                at,
-                format!("`{n}` is a revolute joint: a leg's stroke is a prismatic joint, the leg's length"),
-            ));
-        }
-        if free.stoppers[0].is_some() {
-            return Err(refuse(
-                at,
-                format!(
-                    "`{n}` has a lower stopper (line {}): the compliant walk stops a leg at its upper stopper \
-                     only, so a lower one would be ignored",
-                    joint.field_lines[STOPPERS_LINE]
-                ),
-            ));
-        }
-        let Some(stopper) = free.stoppers[1].clone() else {
-            return Err(refuse(
-                at,
-                format!(
-                    "`{n}` has no upper stopper: the compliant walk holds a leg at its stopper (give joint `{n}` \
-                     stoppers = {{ upper = ... }})"
-                ),
-            ));
-        };
-        if !moves(d, k, d.contacts[tip].body) {
-            return Err(refuse(
-                at,
-                format!(
-                    "`{n}` does not move the contact `{}`: a stroke is the length of the leg whose tip that \
-                     contact is (`fore` the stance contact's, `rear` the landing contact's)",
-                    d.contacts[tip].name
-                ),
-            ));
-        }
-        out.push(LegStroke {
-            coordinate: k,
-            stopper,
-        });
-    }
-    let (fore, rear) = (out[0].coordinate, out[1].coordinate);
-    if fore == rear {
-        return Err(refuse(
+    let fore = stroke(cx, d, &s.fore, tips[0])?;
+    let rear = stroke(cx, d, &s.rear, tips[1])?;
+    let (f, r) = (fore.coordinate, rear.coordinate);
+    if f == r {
+        return Err(refuse_strokes(
+            cx,
             s.rear.span().start,
             "the fore and the rear leg's strokes are one joint".to_string(),
         ));
     }
-    if relabel[fore] != rear || relabel[rear] != fore {
-        return Err(refuse(
+    if relabel[f] != r || relabel[r] != f {
+        return Err(refuse_strokes(
+            cx,
             raw.span().start,
             format!(
                 "the relabeling must exchange `{}` and `{}` (the legs exchange roles at a heel strike)",
-                d.coordinates[fore], d.coordinates[rear]
+                d.coordinates[f], d.coordinates[r]
             ),
         ));
     }
-    let other = d.free_joints().find(|(_, f)| {
-        f.stoppers.iter().any(Option::is_some) && f.coordinate != fore && f.coordinate != rear
+    let other = d.free_joints().find(|(_, j)| {
+        j.stoppers.iter().any(Option::is_some) && j.coordinate != f && j.coordinate != r
     });
     if let Some((joint, _)) = other {
-        return Err(refuse(
+        return Err(refuse_strokes(
+            cx,
             raw.span().start,
             format!(
                 "joint `{}` has stoppers (line {}) but is no leg's stroke: the compliant walk stops only the \
@@ -218,8 +177,52 @@ fn strokes(
             ),
         ));
     }
-    let [fore, rear] = [out.remove(0), out.remove(0)];
     Ok([fore, rear])
+}
+
+/// One leg's stroke `name`: a free prismatic joint with an upper stopper and none below, moving the contact
+/// `tip`.
+fn stroke(
+    cx: &Checker,
+    d: &Description,
+    name: &Spanned<String>,
+    tip: usize,
+) -> Result<LegStroke, DescriptionError> {
+    let k = cx.find(name, &d.coordinates, "coordinate")?;
+    let n = name.get_ref();
+    let refuse = |reason: String| refuse_strokes(cx, name.span().start, reason);
+    let Some((joint, free)) = d.free_joints().find(|(_, f)| f.coordinate == k) else {
+        return Err(refuse(format!("`{n}` is no free joint")));
+    };
+    if !matches!(joint.motion, Motion::Prismatic { .. }) {
+        return Err(refuse(format!(
+            "`{n}` is a revolute joint: a leg's stroke is a prismatic joint, the leg's length"
+        )));
+    }
+    if free.stoppers[0].is_some() {
+        return Err(refuse(format!(
+            "`{n}` has a lower stopper (line {}): the compliant walk stops a leg at its upper stopper only, so a \
+             lower one would be ignored",
+            joint.field_lines[STOPPERS_LINE]
+        )));
+    }
+    let Some(stopper) = free.stoppers[1].clone() else {
+        return Err(refuse(format!(
+            "`{n}` has no upper stopper: the compliant walk holds a leg at its stopper (give joint `{n}` \
+             stoppers = {{ upper = ... }})"
+        )));
+    };
+    if !moves(d, k, d.contacts[tip].body) {
+        return Err(refuse(format!(
+            "`{n}` does not move the contact `{}`: a stroke is the length of the leg whose tip that contact is \
+             (`fore` the stance contact's, `rear` the landing contact's)",
+            d.contacts[tip].name
+        )));
+    }
+    Ok(LegStroke {
+        coordinate: k,
+        stopper,
+    })
 }
 
 /// The relabeling as `new[i] = old[relabel[i]]`: each coordinate named once as a key and once as a value.
