@@ -121,25 +121,7 @@ pub fn legged_gait<W: Legged<N>, const N: usize, const Y: usize>(
     start: &DVector<f64>,
     options: &LeggedOptions,
 ) -> Result<LeggedGait<N>, LeggedGaitError> {
-    let map = |s: &DVector<f64>, iteration: usize| {
-        legged_step_map::<W, N, Y>(walker, s, options)
-            .map_err(|source| LeggedGaitError::Step { iteration, source })
-    };
-    let (section, residual, iterations, step) = damped_newton(start, NEWTON_TOL, map, |s, i| {
-        central_jacobian(s, |x| Ok(map(x, i)?.0))
-    })?;
-    let (jacobian, jacobian_error) =
-        differences::<W, N, Y>(walker, &section, iterations + 1, options)?;
-    Ok(LeggedGait {
-        multipliers: multipliers(&jacobian),
-        section,
-        residual,
-        iterations,
-        jacobian,
-        derivative: DIFFERENCES_ROUTE,
-        jacobian_error,
-        step,
-    })
+    gait_with::<W, N, Y>(walker, start, options, |_| None)
 }
 
 /// The gait near `start` of a walker with exact derivatives: Newton's method with the exact `DP` (central
@@ -152,25 +134,40 @@ pub fn legged_gait_exact<W: LeggedDerivatives<N>, const N: usize, const Y: usize
     start: &DVector<f64>,
     options: &LeggedOptions,
 ) -> Result<LeggedGait<N>, LeggedGaitError> {
+    gait_with::<W, N, Y>(walker, start, options, |s| {
+        walker
+            .exact_step_map(s, None, options)
+            .ok()
+            .map(|d| d.jacobian)
+    })
+}
+
+/// The gait near `start` with `exact(s)`, the exact `DP` at `s` where there is one: Newton's method with it (or
+/// central differences), and at the fixed point its multipliers checked against Richardson-extrapolated
+/// differences (or those differences' `DP` with their own error estimate).
+fn gait_with<W: Legged<N>, const N: usize, const Y: usize>(
+    walker: &W,
+    start: &DVector<f64>,
+    options: &LeggedOptions,
+    exact: impl Fn(&DVector<f64>) -> Option<DMatrix<f64>>,
+) -> Result<LeggedGait<N>, LeggedGaitError> {
     let map = |s: &DVector<f64>, iteration: usize| {
         legged_step_map::<W, N, Y>(walker, s, options)
             .map_err(|source| LeggedGaitError::Step { iteration, source })
     };
-    let (section, residual, iterations, step) = damped_newton(start, NEWTON_TOL, map, |s, i| {
-        match walker.exact_step_map(s, None, options) {
-            Ok(d) => Ok(d.jacobian),
-            Err(_) => central_jacobian(s, |x| Ok(map(x, i)?.0)),
-        }
-    })?;
+    let (section, residual, iterations, step) =
+        damped_newton(start, NEWTON_TOL, map, |s, i| match exact(s) {
+            Some(jacobian) => Ok(jacobian),
+            None => central_jacobian(s, |x| Ok(map(x, i)?.0)),
+        })?;
     let (second, spread) = differences::<W, N, Y>(walker, &section, iterations + 1, options)?;
-    let (jacobian, derivative, jacobian_error) =
-        match walker.exact_step_map(&section, None, options) {
-            Ok(d) => {
-                let error = (&d.jacobian - &second).amax();
-                (d.jacobian, EXACT_ROUTE, error)
-            }
-            Err(_) => (second, DIFFERENCES_ROUTE, spread),
-        };
+    let (jacobian, derivative, jacobian_error) = match exact(&section) {
+        Some(jacobian) => {
+            let error = (&jacobian - &second).amax();
+            (jacobian, EXACT_ROUTE, error)
+        }
+        None => (second, DIFFERENCES_ROUTE, spread),
+    };
     Ok(LeggedGait {
         multipliers: multipliers(&jacobian),
         section,
