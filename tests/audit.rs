@@ -2,7 +2,7 @@
 //! never push a leg outward, no impulse pulls, and no tip goes below the ground, on every step of every walk.
 //! Also the regression test of the bilateral stopper-lock impact.
 
-use vrw::contact::{impulse, ActiveSet, Leg, Stop};
+use vrw::contact::{impulse, ActiveSet, Role, Stop};
 use vrw::dynamics::{Coords, Model, L1, L2, THETA};
 use vrw::params::Config;
 use vrw::reference::default_initial;
@@ -186,9 +186,9 @@ fn stopper_locking_while_the_rear_tip_slides_lifts_the_tip_and_never_pulls() {
     };
     let old = impulse(&model, &q, &qd, &held).unwrap();
     assert!(
-        old.normal_impulse(Leg::Two) < -0.01,
+        old.normal_impulse(Role::Rear) < -0.01,
         "the situation must be the one of the defect (a held tip is pulled), got {} N s",
-        old.normal_impulse(Leg::Two)
+        old.normal_impulse(Role::Rear)
     );
 
     // The impulse-level complementarity problem lets the tip go.
@@ -197,7 +197,7 @@ fn stopper_locking_while_the_rear_tip_slides_lifts_the_tip_and_never_pulls() {
         &q,
         &qd,
         sliding,
-        Unit::Stop(Leg::Two, Stop::Extension),
+        Unit::Stop(Role::Rear, Stop::Extension),
     )
     .unwrap()
     .expect("a consistent active set after the lock");
@@ -223,7 +223,7 @@ fn stopper_locking_while_the_rear_tip_slides_lifts_the_tip_and_never_pulls() {
         "the tip must leave with a positive normal velocity, got {normal_velocity} m/s"
     );
     // Leg 1's contact takes a pushing impulse (or none).
-    assert!(closed.impulses[Leg::One.normal_row()] >= -PULL_IMPULSE_TOL);
+    assert!(closed.impulses[Role::Fore.normal_row()] >= -PULL_IMPULSE_TOL);
     // The impact does not add kinetic energy.
     assert!(closed.loss >= 0.0);
 }

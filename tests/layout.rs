@@ -927,13 +927,13 @@ const WHEEL_NAMES: &[&str] = &["NQ", "L1", "L2", "L3", "THETA", "LegIndex", "Leg
 /// count may only fall (lower it as the walk, the contact solves and the derivatives move onto the interface).
 const WHEEL_NAMES_LEFT: &[(&str, usize)] = &[
     ("mechanism/", 0),
-    ("contact/", 96),
-    ("walk/", 133),
-    ("variational/", 73),
+    ("contact/", 39),
+    ("walk/", 60),
+    ("variational/", 58),
     ("gait/", 5),
     ("family/", 0),
     ("study/", 5),
-    ("output/", 7),
+    ("output/", 3),
     ("app/", 1),
 ];
 

@@ -3,7 +3,7 @@
 use approx::assert_relative_eq;
 use nalgebra::Vector2;
 
-use vrw::contact::{ActiveSet, Leg};
+use vrw::contact::{ActiveSet, Role};
 use vrw::dynamics::{Coords, Model, L1, L2, THETA, Z};
 use vrw::integrate::{Dopri5, Tolerances};
 use vrw::params::{Config, ImpactModel, Params, SolverOptions};
@@ -183,7 +183,7 @@ fn touchdown_is_located_on_the_ground_and_the_section_is_consistent() {
         // The new Leg 1 touched down: its tip is on the ground to the event tolerance.
         assert!(state.q[Z].abs() < 1e-11, "tip height {:e}", state.q[Z]);
         // Leg 2 (the old stance leg) is on the ground and at rest at the section.
-        let tip = model.tip(&state.q, &state.qd, Leg::Two.index());
+        let tip = model.tip(&state.q, &state.qd, Role::Rear.index());
         assert!(
             tip.position.y.abs() < 1e-9,
             "rear tip height {:e}",
@@ -384,7 +384,7 @@ fn airborne_tips_never_penetrate_and_free_legs_never_pass_their_stoppers() {
         let l0 = config.params.stopper_length;
         let events = run.steps.iter().map(|s| s.events).sum::<usize>() + 200;
         for s in &trajectory.samples {
-            for leg in Leg::BOTH {
+            for leg in Role::BOTH {
                 if !s.active.contact(leg) {
                     let h = model.tip_height(&s.q, leg.index());
                     // each disarmed re-contact may start a further gap lower: bounded by the event count

@@ -26,7 +26,7 @@ use nalgebra::SMatrix;
 
 use super::solve::{complete_held_leg_one, constraint_rows, held_leg_one_system, Rows};
 use super::{
-    ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, NROWS,
+    ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Multipliers, Role, NROWS,
     REDUNDANCY_TOL,
 };
 use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, NQ};
@@ -95,8 +95,8 @@ fn rear_slip<const R: usize>(
     // places in the stacking, each row and column as L^-1 of itself.
     let mut rows: Vec<([f64; R], [f64; R], f64, usize)> = Vec::with_capacity(3);
     for (held, coordinate, stacked) in [
-        (active.length_held(Leg::One), L1, 4),
-        (active.length_held(Leg::Two), L2, 5),
+        (active.length_held(Role::Fore), L1, 4),
+        (active.length_held(Role::Rear), L2, 5),
     ] {
         if held {
             let mut unit = [0.0; R];
@@ -166,7 +166,7 @@ pub(crate) fn force_columns(
 ) -> Rows {
     let mu = model.params().friction;
     let mut columns = *rows;
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         let s = active.slip(leg);
         if s != 0 && active.contact(leg) {
             let tip = model.tip(q, qd, leg.index());
@@ -182,7 +182,7 @@ pub(crate) fn force_columns(
 /// The friction force (impulse) `-s mu lambda_n` of each slipping contact in its tangential row.
 fn with_friction(model: &Model, active: &ActiveSet, mut lam: Multipliers) -> Multipliers {
     let mu = model.params().friction;
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         let s = active.slip(leg);
         if s != 0 && active.contact(leg) {
             let n = leg.normal_row();
@@ -221,7 +221,7 @@ fn solve(
         }
     }
     let slipping = |i: usize| {
-        Leg::BOTH
+        Role::BOTH
             .into_iter()
             .any(|leg| active.slip(leg) != 0 && active.contact(leg) && leg.normal_row() == i)
     };
@@ -322,7 +322,7 @@ mod tests {
                 contact1: true,
                 ..Default::default()
             };
-            active.set_slipping(Leg::Two, s);
+            active.set_slipping(Role::Rear, s);
             let d = constrained_dynamics(&model, &q, &qd, &active).unwrap();
             let (m, h) = model.mass_and_bias(&q, &qd);
             // The full rows, the tangential one of Leg 2 included, carry the friction force.
@@ -374,7 +374,7 @@ mod tests {
                     lock2,
                     ..Default::default()
                 };
-                active.set_slipping(Leg::Two, s);
+                active.set_slipping(Role::Rear, s);
                 let (m, h) = model.mass_and_bias(&q, &qd);
                 let (rows, jdq) = constraint_rows(&model, &q, &qd, &active);
                 let columns = force_columns(&model, &q, &qd, &active, &rows);
@@ -408,12 +408,12 @@ mod tests {
             contact1: true,
             ..Default::default()
         };
-        slide.set_sliding(Leg::Two);
+        slide.set_sliding(Role::Rear);
         let expected = constrained_dynamics(&model, &q, &qd, &slide).unwrap();
         let expected_impulse = impulse(&model, &q, &qd, &slide).unwrap();
         for s in [1, -1] {
             let mut active = slide;
-            active.set_slipping(Leg::Two, s);
+            active.set_slipping(Role::Rear, s);
             let d = constrained_dynamics(&model, &q, &qd, &active).unwrap();
             assert_relative_eq!(d.qdd, expected.qdd, epsilon = 1e-10);
             assert_relative_eq!(d.multipliers, expected.multipliers, epsilon = 1e-9);
@@ -436,9 +436,9 @@ mod tests {
                 contact1: true,
                 ..Default::default()
             };
-            active.set_slipping(Leg::Two, s);
+            active.set_slipping(Role::Rear, s);
             let sol = impulse(&model, &q, &qd, &active).unwrap();
-            let tip = model.tip(&q, &qd, Leg::Two.index());
+            let tip = model.tip(&q, &qd, Role::Rear.index());
             let v = tip.velocity(&sol.qd_plus);
             assert_relative_eq!(v.y, 0.0, epsilon = 1e-12);
             assert_relative_eq!(
@@ -492,7 +492,7 @@ mod tests {
                     lock2: true,
                     ..Default::default()
                 };
-                active.set_slipping(Leg::One, s);
+                active.set_slipping(Role::Fore, s);
                 match constrained_dynamics(&model, &q, &qd, &active) {
                     Err(ContactError::Painleve(_)) => {
                         assert!(w <= 1e-12, "theta {i}: w = {w}");

@@ -17,7 +17,8 @@
 use nalgebra::SVector;
 use serde::Serialize;
 
-use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2};
+use crate::dynamics::{Coords, EquationsOfMotion, Model};
+pub(crate) use crate::mechanism::Role;
 
 mod coulomb;
 mod solve;
@@ -34,35 +35,8 @@ pub(crate) type Multipliers = SVector<f64, NROWS>;
 /// redundant (linearly dependent rows).
 pub(crate) const REDUNDANCY_TOL: f64 = 1e-12;
 
-/// One of the two legs in `q`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Leg {
-    /// Leg 1, the fore stance leg (`j = 0`).
-    One,
-    /// Leg 2, the rear leg (`j = 1`).
-    Two,
-}
-
-impl Leg {
-    /// Both legs, Leg 1 first.
-    pub const BOTH: [Leg; 2] = [Leg::One, Leg::Two];
-
-    /// The leg index `j` of docs/model.md section 1.
-    pub fn index(self) -> usize {
-        match self {
-            Leg::One => 0,
-            Leg::Two => 1,
-        }
-    }
-
-    /// Index of this leg's length in `q`.
-    pub fn length_coordinate(self) -> usize {
-        match self {
-            Leg::One => L1,
-            Leg::Two => L2,
-        }
-    }
-
+/// The rows of a leg's units in the fixed stacking of the multipliers.
+impl Role {
     /// Row of this leg's tangential contact force in the multiplier vector.
     pub fn tangential_row(self) -> usize {
         2 * self.index()
@@ -146,49 +120,49 @@ fn is_zero(x: &i8) -> bool {
 
 impl ActiveSet {
     /// Is the ground contact of `leg` active?
-    pub fn contact(&self, leg: Leg) -> bool {
+    pub fn contact(&self, leg: Role) -> bool {
         match leg {
-            Leg::One => self.contact1,
-            Leg::Two => self.contact2,
+            Role::Fore => self.contact1,
+            Role::Rear => self.contact2,
         }
     }
 
     /// Is the stopper of `leg` active?
-    pub fn lock(&self, leg: Leg) -> bool {
+    pub fn lock(&self, leg: Role) -> bool {
         match leg {
-            Leg::One => self.lock1,
-            Leg::Two => self.lock2,
+            Role::Fore => self.lock1,
+            Role::Rear => self.lock2,
         }
     }
 
     /// Is `leg` held at its `stop`?
-    pub fn held(&self, leg: Leg, stop: Stop) -> bool {
+    pub fn held(&self, leg: Role, stop: Stop) -> bool {
         match (stop, leg) {
             (Stop::Extension, _) => self.lock(leg),
-            (Stop::Compression, Leg::One) => self.compression1,
-            (Stop::Compression, Leg::Two) => self.compression2,
+            (Stop::Compression, Role::Fore) => self.compression1,
+            (Stop::Compression, Role::Rear) => self.compression2,
         }
     }
 
     /// Is `leg` held at either of its stops (its length constraint row active)?
-    pub(crate) fn length_held(&self, leg: Leg) -> bool {
+    pub(crate) fn length_held(&self, leg: Role) -> bool {
         self.held(leg, Stop::Extension) || self.held(leg, Stop::Compression)
     }
 
     /// Does the contact of `leg` slide (normal constraint only)?
-    pub(crate) fn slide(&self, leg: Leg) -> bool {
+    pub(crate) fn slide(&self, leg: Role) -> bool {
         match leg {
-            Leg::One => self.slide1,
-            Leg::Two => self.slide2,
+            Role::Fore => self.slide1,
+            Role::Rear => self.slide2,
         }
     }
 
     /// The direction in which the tip of `leg` slips with Coulomb friction (`+1` down the slope, `-1` up), 0
     /// when it does not (a sticking or open contact, or a frictionless slide).
-    pub fn slip(&self, leg: Leg) -> i8 {
+    pub fn slip(&self, leg: Role) -> i8 {
         match leg {
-            Leg::One => self.slip1,
-            Leg::Two => self.slip2,
+            Role::Fore => self.slip1,
+            Role::Rear => self.slip2,
         }
     }
 
@@ -198,42 +172,42 @@ impl ActiveSet {
     }
 
     /// Set the ground contact of `leg` as a no-slip contact (`on`) or open it.
-    pub(crate) fn set_contact(&mut self, leg: Leg, on: bool) {
+    pub(crate) fn set_contact(&mut self, leg: Role, on: bool) {
         self.set_slide(leg, on, false, 0);
     }
 
     /// Make the contact of `leg` a frictionless sliding one (normal row only).
-    pub(crate) fn set_sliding(&mut self, leg: Leg) {
+    pub(crate) fn set_sliding(&mut self, leg: Role) {
         self.set_slide(leg, true, true, 0);
     }
 
     /// Make the contact of `leg` slip in `direction` (`+1` or `-1`) with Coulomb friction: its normal row, and
     /// a tangential force `-direction mu lambda_n`.
-    pub(crate) fn set_slipping(&mut self, leg: Leg, direction: i8) {
+    pub(crate) fn set_slipping(&mut self, leg: Role, direction: i8) {
         self.set_slide(leg, true, true, direction);
     }
 
-    fn set_slide(&mut self, leg: Leg, contact: bool, slide: bool, slip: i8) {
+    fn set_slide(&mut self, leg: Role, contact: bool, slide: bool, slip: i8) {
         match leg {
-            Leg::One => (self.contact1, self.slide1, self.slip1) = (contact, slide, slip),
-            Leg::Two => (self.contact2, self.slide2, self.slip2) = (contact, slide, slip),
+            Role::Fore => (self.contact1, self.slide1, self.slip1) = (contact, slide, slip),
+            Role::Rear => (self.contact2, self.slide2, self.slip2) = (contact, slide, slip),
         }
     }
 
     /// Set the stopper of `leg`.
-    pub(crate) fn set_lock(&mut self, leg: Leg, on: bool) {
+    pub(crate) fn set_lock(&mut self, leg: Role, on: bool) {
         match leg {
-            Leg::One => self.lock1 = on,
-            Leg::Two => self.lock2 = on,
+            Role::Fore => self.lock1 = on,
+            Role::Rear => self.lock2 = on,
         }
     }
 
     /// Hold `leg` at its `stop` (`on`) or free it from that stop.
-    pub(crate) fn set_held(&mut self, leg: Leg, stop: Stop, on: bool) {
+    pub(crate) fn set_held(&mut self, leg: Role, stop: Stop, on: bool) {
         match (stop, leg) {
             (Stop::Extension, _) => self.set_lock(leg, on),
-            (Stop::Compression, Leg::One) => self.compression1 = on,
-            (Stop::Compression, Leg::Two) => self.compression2 = on,
+            (Stop::Compression, Role::Fore) => self.compression1 = on,
+            (Stop::Compression, Role::Rear) => self.compression2 = on,
         }
     }
 
@@ -244,8 +218,8 @@ impl ActiveSet {
             self.contact1,
             self.contact2 && !self.slide2,
             self.contact2,
-            self.length_held(Leg::One),
-            self.length_held(Leg::Two),
+            self.length_held(Role::Fore),
+            self.length_held(Role::Rear),
         ]
     }
 
@@ -412,13 +386,13 @@ pub struct ConstrainedDynamics {
 
 impl ConstrainedDynamics {
     /// Normal ground force on `leg` \[N\] (positive pushes up).
-    pub(crate) fn normal_force(&self, leg: Leg) -> f64 {
+    pub(crate) fn normal_force(&self, leg: Role) -> f64 {
         self.multipliers[leg.normal_row()]
     }
 
     /// Reaction of `leg`'s `stop` \[N\], positive when it pushes the leg the way that stop may (inward for the
     /// stopper, outward for the compression stop).
-    pub(crate) fn stop_reaction(&self, leg: Leg, stop: Stop) -> f64 {
+    pub(crate) fn stop_reaction(&self, leg: Role, stop: Stop) -> f64 {
         -stop.sign() * self.multipliers[leg.stopper_row()]
     }
 }
@@ -434,7 +408,7 @@ pub(crate) fn largest_pull(
     bilateral_stoppers: bool,
 ) -> f64 {
     let mut pull: f64 = 0.0;
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         if active.contact(leg) {
             pull = pull.max(-multipliers[leg.normal_row()]);
         }
@@ -559,7 +533,7 @@ pub(crate) fn cone_excess(multipliers: &Multipliers, active: &ActiveSet, mu: f64
         return 0.0;
     }
     let mut excess: f64 = 0.0;
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         if active.contact(leg) && !active.slide(leg) {
             let (t, n) = (
                 multipliers[leg.tangential_row()],
@@ -582,12 +556,12 @@ pub struct ImpulseSolution {
 
 impl ImpulseSolution {
     /// Normal impulse on `leg` \[N s\].
-    pub fn normal_impulse(&self, leg: Leg) -> f64 {
+    pub fn normal_impulse(&self, leg: Role) -> f64 {
         self.impulses[leg.normal_row()]
     }
 
     /// Impulse of `leg`'s `stop` \[N s\], positive in the direction that stop may push.
-    pub(crate) fn stop_impulse(&self, leg: Leg, stop: Stop) -> f64 {
+    pub(crate) fn stop_impulse(&self, leg: Role, stop: Stop) -> f64 {
         -stop.sign() * self.impulses[leg.stopper_row()]
     }
 }

@@ -4,7 +4,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{
-    ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Multipliers, NROWS,
+    ActiveSet, ConstrainedDynamics, ContactError, ImpulseSolution, Multipliers, Role, NROWS,
     REDUNDANCY_TOL,
 };
 use crate::dynamics::{Coords, EquationsOfMotion, Model, L1, L2, L3, NQ, X, Z};
@@ -21,7 +21,7 @@ pub(super) fn constraint_rows(
     let mut rows = Rows::zeros();
     let mut jdq = Multipliers::zeros();
     let hub = model.hub(q, qd);
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         if active.contact(leg) {
             let tip = model.leg_point_from_hub(model.mechanics(), &hub, (q, qd), leg.index(), 0.0);
             let r = 2 * leg.index();
@@ -33,7 +33,7 @@ pub(super) fn constraint_rows(
             }
         }
         if active.length_held(leg) {
-            rows[(leg.stopper_row(), leg.length_coordinate())] = 1.0;
+            rows[(leg.stopper_row(), Model::stroke_coordinate(leg))] = 1.0;
         }
     }
     (rows, jdq)
@@ -647,7 +647,7 @@ mod tests {
         assert_relative_eq!(sol.qdd[X], 0.0, epsilon = SOLVE_TOL);
         assert_relative_eq!(sol.qdd[Z], 0.0, epsilon = SOLVE_TOL);
         // the hub is supported: both normal forces push up, summing to roughly the weight
-        assert!(sol.normal_force(Leg::One) > 0.0 && sol.normal_force(Leg::Two) > 0.0);
+        assert!(sol.normal_force(Role::Fore) > 0.0 && sol.normal_force(Role::Rear) > 0.0);
         assert!(sol.qdd[THETA].is_finite());
     }
 

@@ -50,6 +50,32 @@ pub struct Equations<T: Real, const N: usize> {
     pub bias: SVector<T, N>,
 }
 
+/// A leg's role in a step of a walker whose legs take turns (docs/model.md section 13): the fore (stance) leg,
+/// whose tip is contact point 0, and the rear leg (contact point 1), which lands ahead as the next fore leg
+/// once it has left the ground and swung. The contact layer, the walk and its derivatives name a leg by its
+/// role; which coordinates are its stroke and its tip is the walker's (the wheel's Leg 1 and Leg 2 of
+/// docs/model.md section 1 are the fore and rear roles).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Role {
+    /// The fore (stance) leg: contact point 0.
+    Fore,
+    /// The rear leg: contact point 1.
+    Rear,
+}
+
+impl Role {
+    /// Both roles, the fore leg first.
+    pub const BOTH: [Role; 2] = [Role::Fore, Role::Rear];
+
+    /// The role's contact point (`0` fore, `1` rear), and its place in per-role arrays.
+    pub fn index(self) -> usize {
+        match self {
+            Role::Fore => 0,
+            Role::Rear => 1,
+        }
+    }
+}
+
 /// A planar walker with `N` generalized coordinates, as the engine sees it.
 ///
 /// The constants of its equations (masses, lengths, stiffnesses, the slope and gravity) are a

@@ -4,7 +4,7 @@
 
 use nalgebra::SVector;
 
-use super::{Equations, Mechanism, PointKinematics, Real};
+use super::{Equations, Mechanism, PointKinematics, Real, Role};
 use crate::dynamics::{Mechanics, Model, L1, L2, L3, NQ};
 
 impl Mechanism<NQ> for Model {
@@ -64,11 +64,23 @@ impl Mechanism<NQ> for Model {
     }
 }
 
+/// The wheel's strokes as the walk asks for them.
+impl Model {
+    /// The coordinate that is the length of the leg in `role` (its stroke: the row of its stopper and of its
+    /// compression stop): `L1` for the fore leg, `L2` for the rear one.
+    pub fn stroke_coordinate(role: Role) -> usize {
+        match role {
+            Role::Fore => L1,
+            Role::Rear => L2,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::constrained::{accelerations, impulse, Row};
     use super::*;
-    use crate::contact::{constrained_dynamics, ActiveSet, Leg, Stop};
+    use crate::contact::{constrained_dynamics, ActiveSet, Role, Stop};
     use crate::dynamics::{Coords, THETA, X, Z};
     use crate::params::Params;
 
@@ -99,11 +111,11 @@ mod tests {
         let model = Model::new(&Params::default()).unwrap();
         let (q, qd) = state(&model);
         let mut single = ActiveSet::default();
-        single.set_contact(Leg::One, true);
+        single.set_contact(Role::Fore, true);
         let mut double = single;
-        double.set_contact(Leg::Two, true);
+        double.set_contact(Role::Rear, true);
         let mut locked = double;
-        locked.set_held(Leg::Two, Stop::Extension, true);
+        locked.set_held(Role::Rear, Stop::Extension, true);
         let cases: [(ActiveSet, Vec<Row>); 3] = [
             (single, Row::contact(0).to_vec()),
             (double, [Row::contact(0), Row::contact(1)].concat()),
@@ -141,8 +153,8 @@ mod tests {
         let model = Model::new(&Params::default()).unwrap();
         let (q, qd) = state(&model);
         let mut double = ActiveSet::default();
-        double.set_contact(Leg::One, true);
-        double.set_contact(Leg::Two, true);
+        double.set_contact(Role::Fore, true);
+        double.set_contact(Role::Rear, true);
         let own = crate::contact::impulse(&model, &q, &qd, &double).unwrap();
         let rows = [Row::contact(0), Row::contact(1)].concat();
         let general = impulse(&model, &q, &qd, &rows).unwrap();

@@ -22,7 +22,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::contact::{
-    factor_no_slip, force_columns, ActiveSet, Leg, NoSlipKkt, NoSlipSystem, Solved, NROWS,
+    factor_no_slip, force_columns, ActiveSet, NoSlipKkt, NoSlipSystem, Role, Solved, NROWS,
 };
 use crate::dynamics::{
     Coords, CoordsOf, EquationsOfMotion, Mechanics, Model, PointJacobian, Real, L1, L2, NQ, X, Z,
@@ -247,14 +247,14 @@ fn add_friction_parts<const D: usize>(
     friction: &Dual<D>,
     lam: &SVector<f64, NROWS>,
 ) {
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         let s = f64::from(active.slip(leg));
         if s != 0.0 && active.contact(leg) {
             let lambda_n = lam[leg.normal_row()];
             for j in 0..NQ {
                 let jt = match leg {
-                    Leg::One => f64::from(u8::from(j == X)),
-                    Leg::Two => eom.rear_tip.jacobian[(0, j)],
+                    Role::Fore => f64::from(u8::from(j == X)),
+                    Role::Rear => eom.rear_tip.jacobian[(0, j)],
                 };
                 for c in 0..D {
                     r1[(j, c)] += s * lambda_n * jt * friction.eps[c];
@@ -272,7 +272,7 @@ fn friction_derivatives<const D: usize>(
     lam: &SVector<f64, NROWS>,
     dlam: &mut SMatrix<f64, NROWS, D>,
 ) {
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         let s = f64::from(active.slip(leg));
         if s != 0.0 && active.contact(leg) {
             let (t, n) = (leg.tangential_row(), leg.normal_row());
@@ -463,7 +463,7 @@ mod tests {
                 .into_iter()
                 .filter_map(move |(s1, s2)| {
                     let mut set = set;
-                    for (leg, s) in [(Leg::One, s1), (Leg::Two, s2)] {
+                    for (leg, s) in [(Role::Fore, s1), (Role::Rear, s2)] {
                         if s != 0 {
                             if !set.contact(leg) {
                                 return None;

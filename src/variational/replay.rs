@@ -30,7 +30,7 @@ use std::cell::Cell;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::contact::{cone_distance, impulse, ActiveSet, Leg, NROWS};
+use crate::contact::{cone_distance, impulse, ActiveSet, Role, NROWS};
 use crate::dynamics::{
     swinging, Coords, CoordsOf, LegIndex, Mechanics, Model, Real, L1, NQ, THETA,
 };
@@ -139,7 +139,7 @@ pub(crate) fn slip_derivative<const D: usize>(
 ) -> SVector<f64, D> {
     let (q, qd) = duals(&crate::walk::pack(q, qd, 0.0), s);
     eps(&model
-        .tip_with(mech, &q, &qd, Leg::Two.index())
+        .tip_with(mech, &q, &qd, Role::Rear.index())
         .velocity(&qd)
         .x)
 }
@@ -250,7 +250,7 @@ fn impulse_border(
     if !model.params().has_friction() {
         return Ok(());
     }
-    for leg in Leg::BOTH.into_iter().filter(|&leg| set.contact(leg)) {
+    for leg in Role::BOTH.into_iter().filter(|&leg| set.contact(leg)) {
         let (what, value) = if set.slip(leg) != 0 {
             let v = model.tip(q, qd_plus, leg.index()).velocity(qd_plus).x;
             ("slip_after", f64::from(set.slip(leg)) * v)
@@ -457,10 +457,10 @@ fn guard<T: Real>(
     match kind {
         EventKind::Touchdown => Some(model.tip_height_with(mech, q, touching)),
         EventKind::Landing(leg) => Some(model.tip_height_with(mech, q, leg.index())),
-        EventKind::StopperHit(leg) => Some(mech.stopper_length - q[leg.length_coordinate()]),
+        EventKind::StopperHit(leg) => Some(mech.stopper_length - q[Model::stroke_coordinate(leg)]),
         // `min_length` is not a differentiable key: a constant here.
         EventKind::CompressionHit(leg) => {
-            Some(q[leg.length_coordinate()] - T::lit(model.params().min_length))
+            Some(q[Model::stroke_coordinate(leg)] - T::lit(model.params().min_length))
         }
         EventKind::LiftOff(_)
         | EventKind::Unlock(_)

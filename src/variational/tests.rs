@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 use nalgebra::DMatrix;
 
-use crate::contact::{impulse, ActiveSet, Leg};
+use crate::contact::{impulse, ActiveSet, Role};
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS};
 use crate::gait::{DerivativeError, StepMap};
 use crate::params::Config;
@@ -123,7 +123,7 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
     }
     for (segment, next) in tape.segments.iter().zip(tape.segments.iter().skip(1)) {
         let reversed = |leg| segment.active.slip(leg) * next.active.slip(leg) < 0;
-        if reversed(Leg::One) || reversed(Leg::Two) {
+        if reversed(Role::Fore) || reversed(Role::Rear) {
             kinds.insert("slip reversal".to_string());
         }
     }
@@ -136,11 +136,11 @@ fn kinds(tape: &StepTape) -> BTreeSet<String> {
         }
         if let Some(end) = &segment.end {
             let name = match end.kind {
-                EventKind::LiftOff(Leg::One) => "fore lift-off",
-                EventKind::LiftOff(Leg::Two) => "rear lift-off",
+                EventKind::LiftOff(Role::Fore) => "fore lift-off",
+                EventKind::LiftOff(Role::Rear) => "rear lift-off",
                 EventKind::Unlock(_) => "stopper unlock",
-                EventKind::Landing(Leg::One) => "landing of Leg 1",
-                EventKind::Landing(Leg::Two) => "rear re-contact",
+                EventKind::Landing(Role::Fore) => "landing of Leg 1",
+                EventKind::Landing(Role::Rear) => "rear re-contact",
                 EventKind::StopperHit(_) => "stopper lock",
                 EventKind::CompressionHit(_) => "compression lock",
                 EventKind::CompressionUnlock(_) => "compression unlock",

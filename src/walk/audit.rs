@@ -2,7 +2,7 @@
 //! the ground on the dense output (at the event search's points, [`sample_count`] per integrator step), and
 //! legs past their stoppers or compression stops.
 
-use crate::contact::{Leg, Stop};
+use crate::contact::{Role, Stop};
 use crate::dynamics::{swinging, Model, L3};
 use crate::integrate::DenseStep;
 use crate::params::SolverOptions;
@@ -27,14 +27,15 @@ impl ContactAudit {
     pub(crate) fn see_tips(&mut self, model: &Model, y: &WalkVector) {
         let (q, _) = unpack(y);
         self.penetration = self.penetration.max(-model.lowest_tip_height(&q));
-        for leg in Leg::BOTH {
+        for leg in Role::BOTH {
             // Rigid legs' bilateral stoppers are audited too (a rigid leg has no compression stop).
             let audited = |stop| match stop {
                 Stop::Extension => has_stopper(model, leg),
                 Stop::Compression => has_stop(model, leg, stop),
             };
             for stop in Stop::BOTH.into_iter().filter(|&s| audited(s)) {
-                let past = stop.sign() * (q[leg.length_coordinate()] - stop_length(model, stop));
+                let past =
+                    stop.sign() * (q[Model::stroke_coordinate(leg)] - stop_length(model, stop));
                 self.stopper_overrun = self.stopper_overrun.max(past);
             }
         }

@@ -12,7 +12,7 @@
 
 use crate::contact::{
     cone_distance, constrained_dynamics, dynamics_through_painleve, impulse, ActiveSet,
-    ConstrainedDynamics, ContactError, ImpulseSolution, Leg, Stop,
+    ConstrainedDynamics, ContactError, ImpulseSolution, Role, Stop,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
@@ -31,9 +31,9 @@ pub(crate) const STICK_SPEED_TOL: f64 = 1e-8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Unit {
     /// Ground contact of a leg tip.
-    Contact(Leg),
+    Contact(Role),
     /// One of a leg's stroke limits: its stopper or its compression stop.
-    Stop(Leg, Stop),
+    Stop(Role, Stop),
 }
 
 /// State of a unit in an active set.
@@ -53,7 +53,7 @@ pub(crate) enum Mode {
 
 impl Unit {
     /// The units of `leg`: its ground contact, its stopper and its compression stop.
-    pub(crate) fn of(leg: Leg) -> [Unit; 3] {
+    pub(crate) fn of(leg: Role) -> [Unit; 3] {
         [
             Unit::Contact(leg),
             Unit::Stop(leg, Stop::Extension),
@@ -85,7 +85,7 @@ impl Unit {
 
 /// What a candidate unit is doing at the moment its mode is resolved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Role {
+pub(crate) enum Part {
     /// Present before (or touching after an impact): any mode its kind allows.
     Keep,
     /// Its normal force has just fallen through zero (a lift-off event), or, with Coulomb friction, its
@@ -108,7 +108,7 @@ pub(crate) struct Candidate {
     /// Preferred mode.
     pub preferred: Mode,
     /// What the unit is doing.
-    pub role: Role,
+    pub role: Part,
 }
 
 impl Candidate {
@@ -122,36 +122,36 @@ impl Candidate {
         Candidate {
             unit,
             preferred,
-            role: Role::Keep,
+            role: Part::Keep,
         }
     }
 
     /// A contact whose normal force has just reached zero: preferably it leaves; it may slide (under
     /// [`ContactInconsistency::Slide`], or slip with Coulomb friction), but it cannot stay a no-slip contact.
-    pub(crate) fn releasing(leg: Leg) -> Candidate {
+    pub(crate) fn releasing(leg: Role) -> Candidate {
         Candidate::released(leg, Mode::Off)
     }
 
     /// A sticking contact whose tangential force has just reached the edge of the friction cone: preferably
     /// it slips in `direction` (against the force that reached the edge); it may leave, but not stick.
-    pub(crate) fn cone_reached(leg: Leg, direction: i8) -> Candidate {
+    pub(crate) fn cone_reached(leg: Role, direction: i8) -> Candidate {
         Candidate::released(leg, Mode::Slip(direction))
     }
 
-    fn released(leg: Leg, preferred: Mode) -> Candidate {
+    fn released(leg: Role, preferred: Mode) -> Candidate {
         Candidate {
             unit: Unit::Contact(leg),
             preferred,
-            role: Role::Releasing,
+            role: Part::Releasing,
         }
     }
 
-    /// The unit an impact closes, preferably no-slip (see [`Role::Closing`]).
+    /// The unit an impact closes, preferably no-slip (see [`Part::Closing`]).
     pub(crate) fn closing(unit: Unit, model: &Model) -> Candidate {
         Candidate {
             unit,
             preferred: Mode::On,
-            role: Role::Closing {
+            role: Part::Closing {
                 allow_slide: model.params().inconsistent_contact == ContactInconsistency::Slide,
             },
         }
@@ -169,26 +169,26 @@ impl Candidate {
         let contact = matches!(self.unit, Unit::Contact(_));
         if contact && level.friction() {
             return match self.role {
-                Role::Closing { .. } => &[Mode::On, Mode::Slip(1), Mode::Slip(-1)],
-                Role::Releasing => &[Mode::Off, Mode::Slip(1), Mode::Slip(-1)],
-                Role::Keep => &[Mode::Off, Mode::On, Mode::Slip(1), Mode::Slip(-1)],
+                Part::Closing { .. } => &[Mode::On, Mode::Slip(1), Mode::Slip(-1)],
+                Part::Releasing => &[Mode::Off, Mode::Slip(1), Mode::Slip(-1)],
+                Part::Keep => &[Mode::Off, Mode::On, Mode::Slip(1), Mode::Slip(-1)],
             };
         }
         match (self.role, level) {
-            (Role::Closing { allow_slide: true }, _) if contact => &[Mode::On, Mode::Slide],
-            (Role::Closing { .. }, _) => &[Mode::On],
+            (Part::Closing { allow_slide: true }, _) if contact => &[Mode::On, Mode::Slide],
+            (Part::Closing { .. }, _) => &[Mode::On],
             (
-                Role::Releasing,
+                Part::Releasing,
                 Level::Force {
                     allow_slide: true, ..
                 },
             ) => &[Mode::Off, Mode::Slide],
-            (Role::Releasing, _) => &[Mode::Off],
-            (Role::Keep, Level::Impulse { .. }) if contact && self.preferred == Mode::Slide => {
+            (Part::Releasing, _) => &[Mode::Off],
+            (Part::Keep, Level::Impulse { .. }) if contact && self.preferred == Mode::Slide => {
                 &[Mode::Off, Mode::Slide]
             }
             (
-                Role::Keep,
+                Part::Keep,
                 Level::Force {
                     allow_slide: true, ..
                 },
@@ -364,7 +364,7 @@ pub(crate) fn plastic_impact_by(
                 }
                 (Unit::Contact(leg), _) => sol.normal_impulse(leg) >= -COMPLEMENTARITY_TOL,
                 (Unit::Stop(leg, stop), Mode::Off) => {
-                    stop.sign() * sol.qd_plus[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+                    stop.sign() * sol.qd_plus[Model::stroke_coordinate(leg)] <= COMPLEMENTARITY_TOL
                 }
                 (Unit::Stop(leg, stop), _) => sol.stop_impulse(leg, stop) >= -COMPLEMENTARITY_TOL,
             })
@@ -442,7 +442,7 @@ pub(crate) fn consistent_active_set(
                 }
                 (Unit::Contact(leg), _) => dynamics.normal_force(leg) >= -COMPLEMENTARITY_TOL,
                 (Unit::Stop(leg, stop), Mode::Off) => {
-                    stop.sign() * dynamics.qdd[leg.length_coordinate()] <= COMPLEMENTARITY_TOL
+                    stop.sign() * dynamics.qdd[Model::stroke_coordinate(leg)] <= COMPLEMENTARITY_TOL
                 }
                 (Unit::Stop(leg, stop), _) => {
                     dynamics.stop_reaction(leg, stop) >= -COMPLEMENTARITY_TOL
@@ -511,7 +511,7 @@ mod tests {
         for (mu, sticks) in [(slope.tan() * 1.001, true), (slope.tan() * 0.999, false)] {
             let model = rigid(mu, slope);
             let q = Coords::new(0.0, 0.0, -slope, 1.0, 1.0, 0.0);
-            let candidates = [Candidate::new(Unit::Contact(Leg::One), Mode::On)];
+            let candidates = [Candidate::new(Unit::Contact(Role::Fore), Mode::On)];
             let (set, d) =
                 consistent_active_set(&model, &q, &Coords::zeros(), bilateral(), &candidates)
                     .unwrap()
@@ -541,7 +541,7 @@ mod tests {
             for (vx, vz, thetadot) in [(0.3, -0.5, 0.4), (-0.2, -0.7, 1.1), (0.9, -0.2, -0.3)] {
                 let model = rigid(mu, 0.1);
                 let qd = Coords::new(vx, vz, thetadot, 0.0, 0.0, 0.0);
-                let closing = [Candidate::closing(Unit::Contact(Leg::One), &model)];
+                let closing = [Candidate::closing(Unit::Contact(Role::Fore), &model)];
                 let (set, sol) = plastic_impact(&model, &q, &qd, bilateral(), &closing).unwrap();
                 // W = J P J^T with P the inverse mass with the stoppers held (L1, L2, L3 fixed).
                 let m = model.mass_matrix(&q);
@@ -599,14 +599,14 @@ mod tests {
             // Sliding down the slope, not turning: gravity pulls the tip into the ground.
             let qd = Coords::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.0);
             let mut slipping = bilateral();
-            slipping.set_slipping(Leg::One, 1);
+            slipping.set_slipping(Role::Fore, 1);
             if !matches!(
                 crate::contact::constrained_dynamics(&model, &q, &qd, &slipping),
                 Err(ContactError::Painleve(_))
             ) {
                 continue;
             }
-            let candidates = [Candidate::keep(Unit::Contact(Leg::One), &slipping)];
+            let candidates = [Candidate::keep(Unit::Contact(Role::Fore), &slipping)];
             let result = consistent_active_set(&model, &q, &qd, bilateral(), &candidates);
             let Err(error) = result else {
                 panic!("theta {i}: {result:?}");
@@ -636,8 +636,8 @@ mod tests {
                     // The tip's velocity along the ground (the x of the tip, with the hub's turn).
                     let tip_v = model.tip(&q, &qd, 0).velocity(&qd).x;
                     let mut slipping = bilateral();
-                    slipping.set_slipping(Leg::One, if tip_v > 0.0 { 1 } else { -1 });
-                    let candidates = [Candidate::keep(Unit::Contact(Leg::One), &slipping)];
+                    slipping.set_slipping(Role::Fore, if tip_v > 0.0 { 1 } else { -1 });
+                    let candidates = [Candidate::keep(Unit::Contact(Role::Fore), &slipping)];
                     let result = consistent_active_set(&model, &q, &qd, bilateral(), &candidates);
                     let Err(error @ ContactError::PainleveSlip { slip, other }) = result else {
                         continue;
@@ -646,7 +646,7 @@ mod tests {
                     // The slip's forces through the negative pivot push, and the tip slips its way.
                     let dynamics =
                         crate::contact::dynamics_through_painleve(&model, &q, &qd, &slip).unwrap();
-                    assert!(dynamics.normal_force(Leg::One) >= 0.0, "{dynamics:?}");
+                    assert!(dynamics.normal_force(Role::Fore) >= 0.0, "{dynamics:?}");
                     assert!(matches!(
                         crate::contact::constrained_dynamics(&model, &q, &qd, &slip),
                         Err(ContactError::Painleve(_))
@@ -680,14 +680,14 @@ mod tests {
         let q = Coords::new(0.0, 0.0, -0.2, 1.0, 1.0, 0.0);
         let qd = Coords::new(0.1, 0.3, 0.0, 0.0, 0.0, 0.0);
         let frictionless = rigid(f64::INFINITY, 0.1);
-        let closing = [Candidate::closing(Unit::Contact(Leg::One), &frictionless)];
+        let closing = [Candidate::closing(Unit::Contact(Role::Fore), &frictionless)];
         let (_, sol) = plastic_impact(&frictionless, &q, &qd, bilateral(), &closing).unwrap();
         assert!(
-            sol.normal_impulse(Leg::One) < 0.0,
+            sol.normal_impulse(Role::Fore) < 0.0,
             "the closing impulse pulls"
         );
         let model = rigid(0.6, 0.1);
-        let closing = [Candidate::closing(Unit::Contact(Leg::One), &model)];
+        let closing = [Candidate::closing(Unit::Contact(Role::Fore), &model)];
         let error = plastic_impact(&model, &q, &qd, bilateral(), &closing).unwrap_err();
         assert!(
             matches!(error, ContactError::InconsistentImpact(_)),

@@ -2,7 +2,7 @@
 //! a slip start at the edge of the cone and a slip stop, each resolved by the force-level complementarity
 //! problem with every other active unit kept.
 
-use crate::contact::{constrained_dynamics, ActiveSet, Leg, Stop};
+use crate::contact::{constrained_dynamics, ActiveSet, Role, Stop};
 use crate::dynamics::{Coords, Model};
 
 use super::complementarity::{consistent_active_set, Candidate, Mode, Unit};
@@ -60,7 +60,7 @@ fn release_contact(
     let phase = active.phase();
     let forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         if active.contact(leg) {
             candidates.push(if Unit::Contact(leg) == changing.unit {
                 changing

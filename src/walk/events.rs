@@ -5,7 +5,7 @@
 
 use crate::contact::{
     cone_distance, cone_excess, constrained_dynamics, largest_pull, ActiveSet, ConstrainedDynamics,
-    Leg, Stop,
+    Role, Stop,
 };
 use crate::dynamics::{swinging, Coords, Model, L3, THETA};
 use crate::params::SolverOptions;
@@ -59,14 +59,14 @@ pub(crate) enum EventKind {
     Touchdown,
     Fall,
     RollBack,
-    LiftOff(Leg),
-    Unlock(Leg),
-    Landing(Leg),
-    StopperHit(Leg),
+    LiftOff(Role),
+    Unlock(Role),
+    Landing(Role),
+    StopperHit(Role),
     /// A free leg reaches its compression stop (`L = min_length`).
-    CompressionHit(Leg),
+    CompressionHit(Role),
     /// The compression stop's reaction on a held leg falls to zero.
-    CompressionUnlock(Leg),
+    CompressionUnlock(Role),
     /// The swinging leg (`L3`, `rear_exit = "continue"`) reaches its stopper (`L3 = L0`).
     SwingLock,
     /// The tip of the swinging leg reaches the ground (the walk stops; with three legs it is the next leg to
@@ -74,14 +74,14 @@ pub(crate) enum EventKind {
     SwingLanding,
     /// With Coulomb friction, a sticking tip's tangential force reaches the edge of the cone:
     /// `mu lambda_n - |lambda_t| = 0`.
-    ConeLimit(Leg),
+    ConeLimit(Role),
     /// With Coulomb friction, a slipping tip comes to rest: its slip velocity reaches 0.
-    SlipStop(Leg),
+    SlipStop(Role),
 }
 
 impl EventKind {
     /// The event at which a free leg reaches `stop`.
-    pub(crate) fn hit(leg: Leg, stop: Stop) -> EventKind {
+    pub(crate) fn hit(leg: Role, stop: Stop) -> EventKind {
         match stop {
             Stop::Extension => EventKind::StopperHit(leg),
             Stop::Compression => EventKind::CompressionHit(leg),
@@ -89,7 +89,7 @@ impl EventKind {
     }
 
     /// The event at which `stop`'s reaction on a held leg falls to zero.
-    pub(crate) fn unlock(leg: Leg, stop: Stop) -> EventKind {
+    pub(crate) fn unlock(leg: Role, stop: Stop) -> EventKind {
         match stop {
             Stop::Extension => EventKind::Unlock(leg),
             Stop::Compression => EventKind::CompressionUnlock(leg),
@@ -97,7 +97,7 @@ impl EventKind {
     }
 
     /// The leg and stop of a stop hit, if this is one.
-    pub(crate) fn stop_hit(self) -> Option<(Leg, Stop)> {
+    pub(crate) fn stop_hit(self) -> Option<(Role, Stop)> {
         match self {
             EventKind::StopperHit(leg) => Some((leg, Stop::Extension)),
             EventKind::CompressionHit(leg) => Some((leg, Stop::Compression)),
@@ -106,7 +106,7 @@ impl EventKind {
     }
 
     /// The leg and stop of an unlock, if this is one.
-    pub(crate) fn stop_unlock(self) -> Option<(Leg, Stop)> {
+    pub(crate) fn stop_unlock(self) -> Option<(Role, Stop)> {
         match self {
             EventKind::Unlock(leg) => Some((leg, Stop::Extension)),
             EventKind::CompressionUnlock(leg) => Some((leg, Stop::Compression)),
@@ -178,7 +178,7 @@ impl<'a> EventSet<'a> {
     ) -> EventSet<'a> {
         let (q, qd) = unpack(y);
         let mut kinds = vec![EventKind::Touchdown, EventKind::Fall, EventKind::RollBack];
-        for leg in Leg::BOTH {
+        for leg in Role::BOTH {
             kinds.push(if active.contact(leg) {
                 EventKind::LiftOff(leg)
             } else {
@@ -277,7 +277,7 @@ impl<'a> EventSet<'a> {
                 self.model.tip(q, qd, leg.index()).velocity(qd).y < -COMPLEMENTARITY_TOL
             }
             _ => kind.stop_hit().is_some_and(|(leg, stop)| {
-                stop.sign() * qd[leg.length_coordinate()] > COMPLEMENTARITY_TOL
+                stop.sign() * qd[Model::stroke_coordinate(leg)] > COMPLEMENTARITY_TOL
             }),
         }
     }
@@ -289,7 +289,7 @@ impl<'a> EventSet<'a> {
             return qd[L3] < -COMPLEMENTARITY_TOL;
         }
         kind.stop_hit().is_some_and(|(leg, stop)| {
-            stop.sign() * qd[leg.length_coordinate()] < -COMPLEMENTARITY_TOL
+            stop.sign() * qd[Model::stroke_coordinate(leg)] < -COMPLEMENTARITY_TOL
         })
     }
 
@@ -328,8 +328,8 @@ impl<'a> EventSet<'a> {
     }
 
     /// How far a free leg is from `stop` (positive on the allowed side): `L0 - L` or `L - min_length`.
-    fn room(&self, leg: Leg, stop: Stop, q: &Coords) -> f64 {
-        stop.sign() * (stop_length(self.model, stop) - q[leg.length_coordinate()])
+    fn room(&self, leg: Role, stop: Stop, q: &Coords) -> f64 {
+        stop.sign() * (stop_length(self.model, stop) - q[Model::stroke_coordinate(leg)])
     }
 
     /// The value of event `e` at `(q, q')`: its function measured from its floor.

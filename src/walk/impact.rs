@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::contact::{
     cone_excess, constrained_dynamics, largest_pull, swing_lock_impulse, ActiveSet, ContactError,
-    ImpulseSolution, Leg, Multipliers, Stop,
+    ImpulseSolution, Multipliers, Role, Stop,
 };
 use crate::dynamics::{Coords, LegIndex, Model, L3, THETA};
 use crate::params::ImpactModel;
@@ -118,8 +118,8 @@ pub(crate) fn touchdown_leg(model: &Model, q: &Coords) -> LegIndex {
 /// leg, unless they act both ways (`rigid_legs`, then they are forced).
 fn touchdown_candidates(model: &Model, before: &ActiveSet) -> Vec<Candidate> {
     let bilateral = bilateral_stoppers(model);
-    let mut candidates = vec![Candidate::closing(Unit::Contact(Leg::One), model)];
-    for leg in Leg::BOTH {
+    let mut candidates = vec![Candidate::closing(Unit::Contact(Role::Fore), model)];
+    for leg in Role::BOTH {
         for stop in Stop::BOTH {
             if before.held(leg, stop) && !bilateral.held(leg, stop) {
                 candidates.push(Candidate::new(Unit::Stop(leg, stop), Mode::Off));
@@ -252,16 +252,19 @@ fn dls_collision(
 ) -> Result<DlsCollision, ContactError> {
     let (set, sol) = if model.params().has_friction() {
         let mut with_rear = candidates.to_vec();
-        with_rear.push(Candidate::closing(Unit::Contact(Leg::Two), model));
+        with_rear.push(Candidate::closing(Unit::Contact(Role::Rear), model));
         plastic_impact(model, q, qd, rear_off, &with_rear)?
     } else {
         plastic_impact(model, q, qd, rear_on, candidates)?
     };
-    let lambda_i4 = sol.normal_impulse(Leg::Two);
+    let lambda_i4 = sol.normal_impulse(Role::Rear);
     // (B1) forces just after the DLS collision, Eqs. (6)-(7).
     let (lambda_2_plus, lambda_4_plus) = if lambda_i4 >= 0.0 {
         let after = constrained_dynamics(model, q, &sol.qd_plus, &set)?;
-        (after.normal_force(Leg::One), after.normal_force(Leg::Two))
+        (
+            after.normal_force(Role::Fore),
+            after.normal_force(Role::Rear),
+        )
     } else {
         (f64::NAN, f64::NAN)
     };
@@ -277,14 +280,14 @@ fn dls_collision(
 }
 
 /// Does `leg` have its extension stopper? Leg 1 always; Leg 2 unless `rear_stopper = false`.
-pub(crate) fn has_stopper(model: &Model, leg: Leg) -> bool {
-    leg == Leg::One || model.params().rear_stopper
+pub(crate) fn has_stopper(model: &Model, leg: Role) -> bool {
+    leg == Role::Fore || model.params().rear_stopper
 }
 
 /// Does `leg` have `stop` as a unilateral limit with its own events? The stopper as [`has_stopper`] says, the
 /// compression stop where `min_length > 0`; neither with `rigid_legs` (the stoppers are then bilateral and
 /// always active, and the legs never shorten).
-pub(crate) fn has_stop(model: &Model, leg: Leg, stop: Stop) -> bool {
+pub(crate) fn has_stop(model: &Model, leg: Role, stop: Stop) -> bool {
     let params = model.params();
     !params.rigid_legs
         && match stop {
@@ -329,7 +332,7 @@ pub(crate) fn post_impact_candidates(
 ) -> (ActiveSet, Vec<Candidate>) {
     let forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         let contact = Unit::Contact(leg);
         if impulse_set.contact(leg) {
             candidates.push(Candidate::keep(contact, preferred));
@@ -346,7 +349,7 @@ pub(crate) fn post_impact_candidates(
             if impulse_set.held(leg, stop) {
                 candidates.push(Candidate::new(unit, Mode::On));
             } else if present.held(leg, stop)
-                && qd_plus[leg.length_coordinate()].abs() <= COMPLEMENTARITY_TOL
+                && qd_plus[Model::stroke_coordinate(leg)].abs() <= COMPLEMENTARITY_TOL
             {
                 candidates.push(Candidate::new(unit, Mode::Off));
             }
@@ -395,7 +398,7 @@ pub fn close_unit(
 ) -> Result<Option<UnitImpact>, ContactError> {
     let forced = bilateral_stoppers(model);
     let mut candidates = vec![Candidate::closing(unit, model)];
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         for other in Unit::of(leg) {
             if other != unit && other.mode(&active) != Mode::Off && other.mode(&forced) == Mode::Off
             {
@@ -451,7 +454,7 @@ pub(crate) fn lock_swinging_leg(
     active: ActiveSet,
 ) -> Result<Option<SwingLock>, ContactError> {
     let forced = bilateral_stoppers(model);
-    let candidates: Vec<Candidate> = Leg::BOTH
+    let candidates: Vec<Candidate> = Role::BOTH
         .into_iter()
         .flat_map(Unit::of)
         .filter(|u| u.mode(&active) != Mode::Off && u.mode(&forced) == Mode::Off)

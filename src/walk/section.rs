@@ -12,7 +12,7 @@
 use serde::Serialize;
 
 use super::WalkError;
-use crate::contact::{ActiveSet, Leg};
+use crate::contact::{ActiveSet, Role};
 use crate::dynamics::{lit, Coords, CoordsOf, Mechanics, Model, Real, L2, THETA, X, Z};
 
 /// With `rigid_legs`, how far `L2` may be from `L0` (and `dL2/dt` from 0) at the section: the locked legs drift
@@ -290,7 +290,7 @@ impl SectionState {
         active: &ActiveSet,
     ) -> SectionState {
         let slip = if active.contact2 && active.slip2 != 0 {
-            model.tip(q, qd, Leg::Two.index()).velocity(qd).x
+            model.tip(q, qd, Role::Rear.index()).velocity(qd).x
         } else {
             0.0
         };
@@ -314,7 +314,7 @@ impl SectionState {
             ..Default::default()
         };
         if self.slips() {
-            active.set_slipping(Leg::Two, if self.slip > 0.0 { 1 } else { -1 });
+            active.set_slipping(Role::Rear, if self.slip > 0.0 { 1 } else { -1 });
         }
         active
     }
@@ -346,7 +346,7 @@ pub(crate) fn section_coords<T: Real>(
     let q = CoordsOf::<T>::new(zero, zero, theta, l0, l2, zero);
     let mut qd = CoordsOf::<T>::new(zero, zero, theta_dot, zero, l2_dot, zero);
     let v = model
-        .tip_with(mech, &q, &qd, Leg::Two.index())
+        .tip_with(mech, &q, &qd, Role::Rear.index())
         .velocity(&qd);
     // (`-v.x` itself without slip: the same bits as before the slip coordinate, signed zeros included.)
     qd[X] = match slip {

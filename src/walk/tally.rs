@@ -1,7 +1,7 @@
 //! The bookkeeping of a step in progress ([`StepTally`]): durations, the contact audit, flags and the energy
 //! lost in impacts, which the step's report is made of.
 
-use crate::contact::{constrained_dynamics, ActiveSet, Leg};
+use crate::contact::{constrained_dynamics, ActiveSet, Role};
 use crate::dynamics::Model;
 use crate::integrate::DenseStep;
 
@@ -127,7 +127,7 @@ impl StepTally {
     /// Account for the plastic impact `closed` that closed `unit` of `leg` at a landing or a stopper hit: its
     /// pulls to the contact audit, its kinetic energy loss as a ground impact's or a stopper's, and Leg 2
     /// landing or sliding through it as scuffing.
-    pub(super) fn see_closed_unit(&mut self, closed: &UnitImpact, unit: Unit, leg: Leg) {
+    pub(super) fn see_closed_unit(&mut self, closed: &UnitImpact, unit: Unit, leg: Role) {
         self.audit.pull_impulse = self.audit.pull_impulse.max(closed.pull_impulse);
         self.see_cone_impulse(closed.cone_impulse);
         match unit {
@@ -135,7 +135,7 @@ impl StepTally {
             Unit::Stop(..) => self.stopper_loss += closed.loss,
         }
         self.scuffing |=
-            (leg == Leg::Two && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
+            (leg == Role::Rear && matches!(unit, Unit::Contact(_))) || closed.active.slide2;
     }
 
     /// Account for a Zeno lock (docs/model.md section 5): its kinetic energy loss is a stopper loss, its impulse
@@ -182,7 +182,7 @@ fn slip_work(model: &Model, active: ActiveSet, step: &DenseStep<NY>, until: f64)
         let Ok(d) = constrained_dynamics(model, &q, &qd, &active) else {
             return (f64::NAN, f64::NAN);
         };
-        let power: f64 = Leg::BOTH
+        let power: f64 = Role::BOTH
             .into_iter()
             .filter(|&leg| active.slip(leg) != 0)
             .map(|leg| {

@@ -3,7 +3,7 @@
 //! each phase. With it, `crate::variational` integrates the variational equations over the very steps the walk
 //! took and composes the saltation matrix of every event, without deciding anything again.
 
-use crate::contact::{ActiveSet, Leg, Stop};
+use crate::contact::{ActiveSet, Role, Stop};
 
 use super::events::EventKind;
 use super::phase::{StageLog, WalkVector};
@@ -120,12 +120,12 @@ impl StepTape {
     /// of the step map; a family whose signature changes crossed a border between pieces.
     pub(crate) fn signature(&self, branch: impl std::fmt::Display) -> String {
         let mut words = vec!["TD".to_string(), branch.to_string()];
-        let number = |leg: Leg| match leg {
-            Leg::One => 1,
-            Leg::Two => 2,
+        let number = |leg: Role| match leg {
+            Role::Fore => 1,
+            Role::Rear => 2,
         };
         if let Some(first) = self.segments.first() {
-            for leg in Leg::BOTH {
+            for leg in Role::BOTH {
                 if first.active.slip(leg) != 0 {
                     words.push(format!("SLIP{}", number(leg)));
                 }
@@ -133,14 +133,14 @@ impl StepTape {
         }
         for pair in self.segments.windows(2) {
             let (a, b) = (pair[0].active, pair[1].active);
-            for leg in Leg::BOTH {
+            for leg in Role::BOTH {
                 let n = number(leg);
                 if a.slip(leg) * b.slip(leg) < 0 {
                     words.push(format!("REVERSE{n}"));
                 }
                 let slide = |s: &ActiveSet| match leg {
-                    Leg::One => s.slide1,
-                    Leg::Two => s.slide2,
+                    Role::Fore => s.slide1,
+                    Role::Rear => s.slide2,
                 };
                 let changes = [
                     (a.contact(leg), b.contact(leg), "LAND", "LIFT"),

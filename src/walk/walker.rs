@@ -6,7 +6,7 @@
 use std::cell::Cell;
 use std::sync::atomic::AtomicBool;
 
-use crate::contact::{ActiveSet, Leg, Phase, Stop};
+use crate::contact::{ActiveSet, Phase, Role, Stop};
 use crate::dynamics::{swinging, Model, L3, NQ, THETA, X};
 use crate::integrate::{locate_root, DenseStep, Integrator, Tolerances};
 use crate::params::SolverOptions;
@@ -128,7 +128,7 @@ impl<'m> Walker<'m> {
                 rate: qd[L3],
             });
         }
-        let v = self.model.tip(q, qd, Leg::Two.index()).velocity(qd);
+        let v = self.model.tip(q, qd, Role::Rear.index()).velocity(qd);
         // A tip slipping with Coulomb friction is on the section with its slip velocity: only its normal
         // velocity must vanish.
         let slips = self.state.active.slip2 != 0;
@@ -218,7 +218,7 @@ impl<'m> Walker<'m> {
         }
         let mut tally = StepTally::after_touchdown(model, &td);
         let mut present = start.active;
-        present.set_contact(Leg::One, true);
+        present.set_contact(Role::Fore, true);
         let (forced, candidates) = post_impact_candidates(
             model,
             &start.q,
@@ -618,7 +618,7 @@ impl<'a> Phases<'a> {
             }
             EventKind::LiftOff(leg) | EventKind::ConeLimit(leg) | EventKind::SlipStop(leg) => {
                 self.active = contact_event(model, t, (&q, &qd), self.active, kind)?;
-                self.tally.bounce |= leg == Leg::One && !self.active.contact(Leg::One);
+                self.tally.bounce |= leg == Role::Fore && !self.active.contact(Role::Fore);
                 self.tally.scuffing |= self.active.slide2;
             }
             EventKind::Unlock(leg) => self.active.set_held(leg, Stop::Extension, false),
@@ -644,7 +644,12 @@ impl<'a> Phases<'a> {
     /// A landing or a stopper hit of `leg` (the event `kind`, in `phase`) at the current point: the unit closes
     /// by a plastic impact ([`close_unit`], docs/model.md section 5), then the Zeno rule may lock the legs and
     /// tips the impact kicked off ([`lock_zeno_stoppers`]).
-    fn close_at_event(&mut self, leg: Leg, kind: EventKind, phase: Phase) -> Result<(), WalkError> {
+    fn close_at_event(
+        &mut self,
+        leg: Role,
+        kind: EventKind,
+        phase: Phase,
+    ) -> Result<(), WalkError> {
         let (model, t) = (self.model, self.t);
         let (q, qd) = unpack(&self.y);
         let unit = match kind.stop_hit() {
@@ -737,8 +742,8 @@ mod tests {
         } else {
             -1
         };
-        active.set_slipping(Leg::One, direction);
-        active.set_slipping(Leg::Two, direction);
+        active.set_slipping(Role::Fore, direction);
+        active.set_slipping(Role::Rear, direction);
         walker.state = WalkState {
             q,
             qd,

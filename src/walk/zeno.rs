@@ -28,8 +28,8 @@
 //! both tips on the ground.
 
 use crate::contact::{
-    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ContactError, ImpulseSolution, Leg,
-    Stop,
+    cone_excess, constrained_dynamics, largest_pull, ActiveSet, ContactError, ImpulseSolution,
+    Role, Stop,
 };
 use crate::dynamics::{Coords, Model};
 use crate::params::ContactInconsistency;
@@ -94,8 +94,8 @@ fn zeno_units(
         }
         Ok(dynamics.expect("just computed"))
     };
-    for leg in Leg::BOTH {
-        let i = leg.length_coordinate();
+    for leg in Role::BOTH {
+        let i = Model::stroke_coordinate(leg);
         // A compression stop the same way, mirrored: a free leg within `stopper_gap` above `min_length`,
         // moving outward slower than its inward acceleration can turn round within the gap.
         for stop in Stop::BOTH {
@@ -156,7 +156,7 @@ fn zeno_impact_units(
 ) -> (ActiveSet, Vec<Candidate>) {
     let mut forced = bilateral_stoppers(model);
     let mut candidates = Vec::new();
-    for leg in Leg::BOTH {
+    for leg in Role::BOTH {
         for stop in Stop::BOTH {
             if closing.held(leg, stop) {
                 forced.set_held(leg, stop, true);
@@ -260,7 +260,7 @@ fn zeno_impact(
     loop {
         let (forced, candidates) = zeno_impact_units(model, (q, qd), &legs, active);
         let (set, sol) = plastic_impact(model, q, qd, forced, &candidates)?;
-        let pulled = Leg::BOTH.into_iter().find(|&leg| {
+        let pulled = Role::BOTH.into_iter().find(|&leg| {
             legs.contact(leg) && !legs.slide(leg) && sol.normal_impulse(leg) < -ZENO_IMPULSE_WARNING
         });
         if let (Some(leg), ContactInconsistency::Slide, false) = (
@@ -308,7 +308,7 @@ impl Locks {
             impulse_set,
             sol,
         } = impact;
-        for leg in Leg::BOTH {
+        for leg in Role::BOTH {
             for stop in Stop::BOTH {
                 if legs.held(leg, stop) {
                     self.locked.set_held(leg, stop, true);
@@ -321,7 +321,7 @@ impl Locks {
         self.impulse_sets.push(*impulse_set);
         let mut others = *impulse_set;
         let mut present = active;
-        for leg in Leg::BOTH {
+        for leg in Role::BOTH {
             for stop in Stop::BOTH {
                 if legs.held(leg, stop) {
                     others.set_held(leg, stop, false);

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::{fixed_names, row, Cell, Column};
-use crate::contact::{ActiveSet, Leg, Stop};
+use crate::contact::{ActiveSet, Role, Stop};
 use crate::dynamics::L3;
 use crate::output::{CsvStream, OutputError};
 use crate::params::RearExit;
@@ -18,7 +18,7 @@ fn bit(b: bool) -> Cell {
 }
 
 /// Which stop holds `leg`: 1 the stopper, 2 the compression stop, 0 none.
-fn stop_state(active: &ActiveSet, leg: Leg) -> Cell {
+fn stop_state(active: &ActiveSet, leg: Role) -> Cell {
     Count(if active.held(leg, Stop::Compression) {
         2
     } else {
@@ -65,12 +65,12 @@ pub(crate) const TRAJECTORY: [Column<Sample>; 24] = [
     Column::new(
         "lock1",
         "1 if Leg 1 is held on its stopper, 2 if on its compression stop (min_length), else 0.",
-        |s| stop_state(&s.active, Leg::One),
+        |s| stop_state(&s.active, Role::Fore),
     ),
     Column::new(
         "lock2",
         "1 if Leg 2 is held on its stopper, 2 if on its compression stop (min_length), else 0.",
-        |s| stop_state(&s.active, Leg::Two),
+        |s| stop_state(&s.active, Role::Rear),
     ),
     Column::new("lambda_1", "Tangential force on Leg 1's tip [N].", |s| {
         Real(s.multipliers[0])
