@@ -18,7 +18,7 @@ use super::gait::legged_step_map;
 use super::walk::{LeggedOptions, StepAccount};
 use super::{Legged, LeggedError};
 use crate::continuation::{Evaluation, FamilyMap, MapFailure};
-use crate::mechanism::rigid_check::richardson_jacobian;
+use crate::mechanism::derivative_check::richardson_jacobian;
 use crate::mechanism::rigid_family::{FreeParameter, Parametrized};
 use crate::params::ConfigError;
 
