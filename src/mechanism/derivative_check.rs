@@ -370,8 +370,8 @@ pub struct ParameterDerivative {
 }
 
 /// `dP/dp` of `map` at `s` in its parameter `key`: exact, or where the map has no derivative there
-/// ([`DerivativeFailure::not_differentiable`]) Richardson-extrapolated central differences with their error estimate,
-/// said in [`ParameterDerivative::derivative`].
+/// ([`DerivativeFailure::not_differentiable`]) Richardson-extrapolated central differences with their error
+/// estimate, said in [`ParameterDerivative::derivative`].
 pub fn parameter_derivative<M: CheckedMap>(
     map: &M,
     s: &DVector<f64>,
@@ -384,17 +384,16 @@ pub fn parameter_derivative<M: CheckedMap>(
             derivative: M::EXACT.to_string(),
             error: None,
         }),
-        Err(CheckError::Derivative(e)) if e.not_differentiable().is_some() => {
-            let reason = e.not_differentiable().map(ToString::to_string);
+        Err(CheckError::Derivative(e)) => {
+            let Some(reason) = e.not_differentiable() else {
+                return Err(CheckError::Derivative(e));
+            };
             let p = map.parameter(key).unwrap_or(f64::NAN);
             let (column, error) =
                 richardson_jacobian(n, &[p], |_, t| map.value(s, Some((key, p + t))))?;
             Ok(ParameterDerivative {
                 values: column.column(0).into_owned(),
-                derivative: format!(
-                    "richardson_differences (no exact derivative: {})",
-                    reason.unwrap_or_default()
-                ),
+                derivative: format!("richardson_differences (no exact derivative: {reason})"),
                 error: Some(error),
             })
         }
