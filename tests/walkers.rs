@@ -410,6 +410,76 @@ fn the_telescopic_biped_walks_with_double_support() {
     assert_error(&refused, &["foot_mass"]);
 }
 
+/// `vrw gait --model telescopic --parameter viscosity --check-jacobian` writes the exact `dP/dp` (`dP_dparam`,
+/// said exact) and the check of the exact `DP | dP/dp` against Richardson-extrapolated differences
+/// (`jacobian_check`, agreeing within their error estimates), and the walker's description in
+/// `models/telescopic.toml` gives the same numbers to 1e-9; a key the walker does not have is refused, naming
+/// its keys.
+#[test]
+fn the_telescopic_walkers_derivatives_are_checked() {
+    let tmp = tempfile::tempdir().unwrap();
+    let description = concat!(env!("CARGO_MANIFEST_DIR"), "/models/telescopic.toml");
+    let run = |model: &str, out: &str| {
+        let out = tmp.path().join(out);
+        let args = [
+            "gait",
+            "--model",
+            model,
+            "--parameter",
+            "viscosity",
+            "--check-jacobian",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let printed = ok(&vrw(&args, tmp.path()));
+        assert!(printed.contains("dP/dviscosity = [theta1 "), "{printed}");
+        assert!(printed.contains(": agree"), "{printed}");
+        json(&out.join("gait.json"))
+    };
+    let (built_in, described) = (run("telescopic", "b"), run(description, "d"));
+    let numbers = |gait: &Value| -> Vec<f64> {
+        let check = &gait["jacobian_check"];
+        assert_eq!(check["agree"], true, "{check}");
+        assert_eq!(check["parameter"], "viscosity");
+        let difference = check["difference"].as_f64().unwrap();
+        let errors = check["exact_error"].as_f64().unwrap()
+            + check["finite_difference_error"].as_f64().unwrap();
+        assert!(difference <= errors && difference < 1e-7, "{check}");
+        let exact: Vec<Vec<f64>> = serde_json::from_value(check["exact"].clone()).unwrap();
+        assert_eq!((exact.len(), exact[0].len()), (5, 6), "{check}");
+        let d = &gait["gait"]["dP_dparam"];
+        assert_eq!(d["parameter"], "viscosity");
+        assert_eq!(d["derivative"], "exact_replay");
+        assert!(d.get("error").is_none(), "{d}");
+        let section = ["theta1", "L2", "theta1_dot", "theta2_dot", "L2_dot"];
+        let values: Vec<f64> = section
+            .iter()
+            .map(|n| d["values"][n].as_f64().unwrap())
+            .collect();
+        // The check's exact last column is dP/dp.
+        let column: Vec<f64> = exact.iter().map(|row| row[5]).collect();
+        assert_eq!(values, column);
+        exact.into_iter().flatten().collect()
+    };
+    let (a, b) = (numbers(&built_in), numbers(&described));
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-3), "{x} against {y}");
+    }
+    for model in ["telescopic", description] {
+        let refused = vrw(
+            &["gait", "--model", model, "--parameter", "stifness"],
+            tmp.path(),
+        );
+        assert_error(
+            &refused,
+            &[
+                "`stifness` is not a parameter of the model",
+                "viscosity, gravity",
+            ],
+        );
+    }
+}
+
 /// Regression (the spurious heel strike at the legs' coincidence): at slope 0.014 from the default start,
 /// `vrw gait --model simplest` once found a 1.69-time-unit "gait" and `vrw simulate` walked onto it; every
 /// step of either is now a real heel strike (the paper's steps last about 3 time units or more: this start's

@@ -296,7 +296,7 @@ fn unexpected(key: &str, params: &WalkerParams) -> PyErr {
 }
 
 /// `vrw.find_gait` of a walker: `vrw gait --model NAME` without its file. Options: `transient_steps` (the
-/// command line's `--transient`) and `parameter` (`dP/dp` as `dP_dparam`; not for `telescopic`).
+/// command line's `--transient`) and `parameter` (`dP/dp` as `dP_dparam`).
 pub(crate) fn find_gait<'py>(
     py: Python<'py>,
     params: &WalkerParams,

@@ -193,8 +193,6 @@ def test_the_telescopic_walker_walks_from_python_as_on_the_command_line(cli, tmp
     cli("simulate", "--model", "telescopic", "--steps", "2", "--out", tmp_path / "t")
     assert_table_equals_csv(run.steps, tmp_path / "t" / "steps.csv")
     assert list(run.steps["branch"]) == ["DLS", "DLS"]
-    with pytest.raises(vrw.ConfigError, match="parameter.*not offered for the model `telescopic`"):
-        vrw.find_gait(p, parameter="slope")
     with pytest.raises(TypeError, match="tolerance"):
         vrw.find_gait(vrw.Params(model="simplest"), tolerance=1e-9)
 
@@ -235,6 +233,16 @@ def test_find_gait_takes_the_transient_and_dp_dparam(cli, tmp_path):
                          "--initial", "0.27,-1.09,-0.38")
     assert json_equal(gait["dP_dparam"], expected["gait"]["dP_dparam"])
     assert json_equal(gait["section"], expected["gait"]["section"])
+
+
+def test_find_gait_of_the_telescopic_walker_takes_dp_dparam(cli, tmp_path):
+    p = vrw.Params(model="telescopic")
+    gait = vrw.find_gait(p, parameter="stopper_length")
+    expected = gait_json(cli, tmp_path, "--model", "telescopic", "--parameter", "stopper_length")
+    assert gait["dP_dparam"]["derivative"] == "exact_replay"
+    assert json_equal(gait["dP_dparam"], expected["gait"]["dP_dparam"])
+    with pytest.raises(vrw.ConfigError, match="`stifness` is not a parameter of the model `telescopic`"):
+        vrw.find_gait(p, parameter="stifness")
 
 
 def test_find_gait_of_the_telescopic_walker_is_vrw_gait(cli, tmp_path):

@@ -20,6 +20,7 @@ mod simulate;
 mod sweep;
 mod walker_basin;
 mod walker_continue;
+mod walker_derivatives;
 mod walker_described;
 mod walker_figures;
 mod walker_map;

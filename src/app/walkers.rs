@@ -10,18 +10,19 @@ use nalgebra::DVector;
 use serde::Serialize;
 
 use super::legged::LeggedModel;
+use super::walker_derivatives::{
+    legged_gait_derivatives, rigid_gait_derivatives, Asked, GaitDerivatives,
+};
 use super::walker_model::{
-    found_rigid, interruptible, search_gait, FoundGait, RigidModel, WalkerGaitError, WalkerModel,
+    found_rigid, search_gait, FoundGait, RigidModel, WalkerGaitError, WalkerModel,
 };
 use super::{in_run, AppError, SearchEnded};
 use crate::mechanism::compass::Compass;
+use crate::mechanism::derivative_check::{DerivativeCheck, ParameterDerivative};
 use crate::mechanism::described::{self, AnyDescribed, Walk};
 use crate::mechanism::legged::walk::StepAccount;
 use crate::mechanism::rigid::RigidWalker;
-use crate::mechanism::rigid_check::{check_rigid_derivatives, RigidDerivativeCheck};
-use crate::mechanism::rigid_derivative::{parameter_value, DerivativeError};
 use crate::mechanism::rigid_family::Parametrized;
-use crate::mechanism::rigid_gait::{rigid_step_map, RigidGait, DIFFERENCE_STEP, EXACT_ROUTE};
 use crate::mechanism::simplest::Simplest;
 use crate::mechanism::telescopic::Telescopic;
 use crate::mechanism::Mechanism;
@@ -276,7 +277,7 @@ pub struct WalkerGaitSummary {
     pub gait: Option<WalkerGait>,
     /// The exact derivatives against central differences, if asked for ([`WalkerGaitJob::check_jacobian`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub jacobian_check: Option<RigidDerivativeCheck>,
+    pub jacobian_check: Option<DerivativeCheck>,
 }
 
 /// A walker's gait as `gait.json` holds it.
@@ -332,8 +333,12 @@ pub struct WalkerParamDerivative {
     /// `dP/dp`, one value per section coordinate.
     #[serde(serialize_with = "as_map")]
     pub values: Vec<(String, f64)>,
-    /// How it was taken.
+    /// How it was taken: exactly (as the gait's exact `derivative` says), or by Richardson-extrapolated central
+    /// differences where the map has no derivative at the gait, and why.
     pub derivative: String,
+    /// The differences' error estimate where they were taken; absent where exact.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<f64>,
 }
 
 /// Search the gait of `job.walker` and write `gait.json` (also without a gait, with the reason), after the
@@ -391,21 +396,9 @@ fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
     };
     let result = search_gait(walker, &start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
-    let jacobian_check = match (&result, job.check_jacobian) {
-        (Ok(g), true) => Some(
-            check_rigid_derivatives(
-                walker,
-                &g.section,
-                job.parameter.as_deref(),
-                &interruptible(),
-            )
-            .unwrap_or_else(|e| RigidDerivativeCheck::failed(e.to_string())),
-        ),
-        _ => None,
-    };
-    let dp_dparam = match (&result, &job.parameter) {
-        (Ok(g), Some(key)) => Some(param_derivative(walker, g, key)?),
-        _ => None,
+    let derivatives = match &result {
+        Ok(g) => rigid_gait_derivatives(walker, &g.section, asked(job))?,
+        Err(_) => GaitDerivatives::default(),
     };
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
@@ -418,36 +411,27 @@ fn compute<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
         },
         message: result.as_ref().err().map(ToString::to_string),
         gait: result.ok().map(|g| WalkerGait {
-            dp_dparam,
+            dp_dparam: named_derivative(&names, job, derivatives.dp_dparam),
             ..gait_record(&found_rigid(walker, g), &names)
         }),
-        jacobian_check,
+        jacobian_check: derivatives.jacobian_check,
     })
 }
 
 /// The search of [`run_walker_gait`] on the walker's [`WalkerModel`] (a walker with compliant legs, whose exact
-/// `DP` is checked against Richardson-extrapolated differences at every gait; `parameter` and `check_jacobian`
-/// are not offered for it yet).
+/// `DP` is checked against Richardson-extrapolated differences at every gait), with the derivatives the job
+/// asks for.
 fn compute_on_model(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
-    let exact_only = |option: &'static str| AppError::InvalidOption {
-        option,
-        reason: format!(
-            "is not offered for the model `{}` yet: its gait's exact DP is checked against \
-             Richardson-extrapolated differences at every gait (gait.json's `derivative` and \
-             `jacobian_error`; docs/model.md section 13)",
-            job.walker.name()
-        ),
-    };
-    if job.parameter.is_some() {
-        return Err(exact_only("parameter"));
-    }
-    if job.check_jacobian {
-        return Err(exact_only("check_jacobian"));
-    }
     let model = job.walker.model()?;
     let start = start_of(model.as_ref(), job.initial.as_deref())?;
     let result = model.gait(&start, job.transient_steps);
     super::check_phase_interrupted(None, "while searching the gait", super::NOTHING_WRITTEN)?;
+    let derivatives = match &result {
+        Ok(g) if job.parameter.is_some() || job.check_jacobian => {
+            legged_derivatives(&job.walker, &g.section, asked(job))?
+        }
+        _ => GaitDerivatives::default(),
+    };
     let names = model.section_names();
     Ok(WalkerGaitSummary {
         vrw_version: env!("CARGO_PKG_VERSION"),
@@ -459,48 +443,53 @@ fn compute_on_model(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> 
             Err(e) => SearchEnded::Failed(e.kind()),
         },
         message: result.as_ref().err().map(ToString::to_string),
-        gait: result.ok().map(|g| gait_record(&g, &names)),
-        jacobian_check: None,
+        gait: result.ok().map(|g| WalkerGait {
+            dp_dparam: named_derivative(&names, job, derivatives.dp_dparam),
+            ..gait_record(&g, &names)
+        }),
+        jacobian_check: derivatives.jacobian_check,
     })
 }
 
-/// `dP/dp` of `walker`'s step map at its gait `g` in the parameter `key`: exact, or central differences where
-/// the map is not differentiable there (said in `derivative`).
-fn param_derivative<W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>(
-    walker: &W,
-    g: &RigidGait<N>,
-    key: &str,
-) -> Result<WalkerParamDerivative, AppError> {
-    let options = interruptible();
-    let names = walker.section_names();
-    let failed = |reason: String| AppError::InvalidOption {
-        option: "parameter",
-        reason,
-    };
-    let (values, derivative) = match walker.step_map_derivative(&g.section, Some(key), 1, &options)
-    {
-        Ok(d) => (d.dparam.unwrap_or_default(), EXACT_ROUTE.to_string()),
-        Err(DerivativeError::NotDifferentiable(reason)) => {
-            let value = parameter_value(walker, key).unwrap_or(f64::NAN);
-            let h = DIFFERENCE_STEP * value.abs().max(1.0);
-            let at = |p: f64| -> Result<DVector<f64>, AppError> {
-                let moved = walker.with_parameter(key, p)?;
-                Ok(rigid_step_map(&moved, &g.section, &options)
-                    .map_err(|e| failed(e.to_string()))?
-                    .0)
-            };
-            let values = (at(value + h)? - at(value - h)?) / (2.0 * h);
-            let route = format!(
-                "central differences, relative step {DIFFERENCE_STEP:e} (no exact derivative: {reason})"
-            );
-            (values, route)
-        }
-        Err(e) => return Err(failed(e.to_string())),
-    };
-    Ok(WalkerParamDerivative {
-        parameter: key.to_string(),
-        values: named(&names, &values),
-        derivative,
+/// What `job` asks of its gait's derivatives.
+fn asked(job: &WalkerGaitJob) -> Asked<'_> {
+    Asked {
+        parameter: job.parameter.as_deref(),
+        check: job.check_jacobian,
+    }
+}
+
+/// The derivatives `asked` of `walker`, a walker with compliant legs, at its gait `section`.
+fn legged_derivatives(
+    walker: &Walker,
+    section: &DVector<f64>,
+    asked: Asked<'_>,
+) -> Result<GaitDerivatives, AppError> {
+    match walker {
+        Walker::Telescopic(w) => legged_gait_derivatives::<_, 6, 13>(w, section, asked),
+        Walker::Described(any) if any.walks_compliant() => crate::with_legged_described!(
+            any, w, N, Y => legged_gait_derivatives::<_, N, Y>(w, section, asked),
+            _ => unreachable_walk(any)
+        ),
+        _ => Err(AppError::InvalidOption {
+            option: "model",
+            reason: format!("`{}` has rigid legs", walker.name()),
+        }),
+    }
+}
+
+/// `dP/dp` of `job.parameter`, by the section's coordinate `names`.
+fn named_derivative<S: AsRef<str>>(
+    names: &[S],
+    job: &WalkerGaitJob,
+    d: Option<ParameterDerivative>,
+) -> Option<WalkerParamDerivative> {
+    let (key, d) = job.parameter.clone().zip(d)?;
+    Some(WalkerParamDerivative {
+        parameter: key,
+        values: named(names, &d.values),
+        derivative: d.derivative,
+        error: d.error,
     })
 }
 

@@ -8,7 +8,7 @@ use clap::Args;
 use vrw::app::{run_gait, run_walker_gait, GaitJob, Walker, WalkerGait, WalkerGaitJob};
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::gait::{Gait, GaitOptions, JacobianCheck};
-use vrw::mechanism::rigid_check::RigidDerivativeCheck;
+use vrw::mechanism::derivative_check::DerivativeCheck;
 use vrw::walk::SectionState;
 
 use super::{progress_bar, ModelArgs};
@@ -331,7 +331,7 @@ pub(super) fn parameters_in_words(walker: &Walker) -> Result<String> {
 }
 
 /// Print a walker's check of `--check-jacobian`; an error if the two routes disagree.
-fn print_walker_check(check: &RigidDerivativeCheck) -> Result<()> {
+fn print_walker_check(check: &DerivativeCheck) -> Result<()> {
     if let Some(failure) = &check.failure {
         bail!("Jacobian check failed: {failure}");
     }
@@ -413,6 +413,7 @@ fn print_walker_gait(g: &WalkerGait) {
     );
     if let Some(account) = &g.legged {
         legged::print_legged_gait(g, account);
+        print_dp_dparam(g);
         return;
     }
     println!(
@@ -428,14 +429,22 @@ fn print_walker_gait(g: &WalkerGait) {
         g.largest_multiplier,
         g.stability
     );
+    print_dp_dparam(g);
+}
+
+/// A walker's `dP/dp` at its gait, if asked for (with the differences' error estimate where they stand in).
+fn print_dp_dparam(g: &WalkerGait) {
     if let Some(d) = &g.dp_dparam {
         let values: Vec<String> = d
             .values
             .iter()
             .map(|(n, v)| format!("{n} {v:.9e}"))
             .collect();
+        let error = d
+            .error
+            .map_or(String::new(), |e| format!(", error estimate {e:.1e}"));
         println!(
-            "dP/d{} = [{}] ({})",
+            "dP/d{} = [{}] ({}{error})",
             d.parameter,
             values.join(", "),
             d.derivative

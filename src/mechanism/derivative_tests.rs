@@ -7,8 +7,8 @@ use nalgebra::{DVector, SMatrix, SVector};
 
 use super::compass::Compass;
 use super::constrained::ConstrainedError;
+use super::derivative_check::check_rigid_derivatives;
 use super::rigid::{rigid_step_taped, RigidOptions, RigidTape, RigidWalker};
-use super::rigid_check::check_rigid_derivatives;
 use super::rigid_derivative::DerivativeError;
 use super::rigid_gait::{difference_jacobian, multipliers, rigid_gait, JacobianRoute};
 use super::sensitivity::{replay, Hybrid, NotDifferentiable, Sensitivity, Tape};

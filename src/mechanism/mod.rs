@@ -12,7 +12,7 @@
 //! Walkers with rigid legs and point feet walk by [`rigid`] (single support between heel strikes) and have their
 //! gaits by [`rigid_gait`]: the compass gait and the simplest walking model of Garcia et al. ([`simplest`]),
 //! whose massless legs leave it only reduced equations. Their step maps have exact derivatives
-//! ([`rigid_derivative`], checked against differences by [`rigid_check`]) from a replay of the walk's own steps
+//! ([`rigid_derivative`], checked against differences by [`derivative_check`]) from a replay of the walk's own steps
 //! that knows only phases, guards and resets ([`sensitivity`]), and their families are followed by
 //! [`rigid_family`]. Walkers with compliant legs walk by [`legged`]: the paper's whole procedure (phases chosen
 //! by force-level complementarity, every impact an impulse-level complementarity problem, the DLS indicators at
@@ -24,10 +24,10 @@
 pub mod assembly;
 pub mod compass;
 pub mod constrained;
+pub mod derivative_check;
 pub mod described;
 pub mod legged;
 pub mod rigid;
-pub mod rigid_check;
 pub mod rigid_derivative;
 pub mod rigid_family;
 pub mod rigid_gait;

@@ -22,7 +22,8 @@ use super::rigid::{
 };
 pub use super::rigid::{DerivativeError, StepMapDerivative};
 use super::sensitivity::{
-    replay, seeded, sensitivity_of, state_duals, Hybrid, NotDifferentiable, Sensitivity, BORDER_TOL,
+    constant_value, replay, seeded, sensitivity_of, state_duals, Hybrid, NotDifferentiable,
+    Sensitivity, BORDER_TOL,
 };
 use super::Real;
 use crate::dynamics::Dual;
@@ -75,14 +76,7 @@ pub fn parameter_value<W: RigidWalker<N, Y>, const N: usize, const Y: usize>(
     walker: &W,
     key: &str,
 ) -> Option<f64> {
-    let found = std::cell::Cell::new(None);
-    walker.rigid_constants::<f64>(&|k, v| {
-        if k == key {
-            found.set(Some(v));
-        }
-        v
-    });
-    found.get()
+    constant_value(&Rigid::<W, Y>(walker, PhantomData), key)
 }
 
 /// `P^period(x)` of `walker` with its exact `DP` and, if `param` names one of the walker's constants, `dP/dp`

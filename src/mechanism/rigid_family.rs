@@ -27,6 +27,57 @@ pub trait Parametrized: Sized {
     fn with_parameter(&self, key: &str, value: f64) -> Result<Self, ConfigError>;
 }
 
+/// A walker with one of its parameters free: the family's walker and key, and the walker at a value of it.
+#[derive(Debug)]
+pub struct FreeParameter<'a, W> {
+    walker: &'a W,
+    key: &'static str,
+}
+
+impl<W> Clone for FreeParameter<'_, W> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<W> Copy for FreeParameter<'_, W> {}
+
+impl<'a, W: Parametrized> FreeParameter<'a, W> {
+    /// `walker` with `key` free (one of its [`Parametrized::parameter_keys`], else an error naming them).
+    pub fn new(walker: &'a W, key: &str) -> Result<FreeParameter<'a, W>, ConfigError> {
+        let keys = walker.parameter_keys();
+        let key =
+            keys.iter()
+                .copied()
+                .find(|k| *k == key)
+                .ok_or_else(|| ConfigError::UnknownKey {
+                    key: key.to_string(),
+                    known: keys.join(", "),
+                })?;
+        Ok(FreeParameter { walker, key })
+    }
+
+    /// The walker.
+    pub fn walker(&self) -> &'a W {
+        self.walker
+    }
+
+    /// The free key.
+    pub fn key(&self) -> &'static str {
+        self.key
+    }
+
+    /// The walker at the parameter value `p` (an invalid value fails the point, `invalid_parameter`).
+    pub fn at(&self, p: f64) -> Result<W, MapFailure> {
+        self.walker
+            .with_parameter(self.key, p)
+            .map_err(|e| MapFailure {
+                kind: "invalid_parameter".to_string(),
+                message: e.to_string(),
+            })
+    }
+}
+
 /// What the family records of a point: its step's duration and DLS indicator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidInfo {
@@ -39,8 +90,7 @@ pub struct RigidInfo {
 /// The step map `P` (or `P^k`) of `walker` in the parameter `key`.
 #[derive(Debug)]
 pub struct RigidFamily<'a, W, const N: usize, const Y: usize> {
-    walker: &'a W,
-    key: &'static str,
+    free: FreeParameter<'a, W>,
     period: usize,
     options: RigidOptions,
     dims: PhantomData<[(); N]>,
@@ -59,18 +109,8 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
 {
     /// The family of `walker` in `key` (one of its [`Parametrized::parameter_keys`]).
     pub fn new(walker: &'a W, key: &str) -> Result<RigidFamily<'a, W, N, Y>, ConfigError> {
-        let keys = walker.parameter_keys();
-        let key =
-            keys.iter()
-                .copied()
-                .find(|k| *k == key)
-                .ok_or_else(|| ConfigError::UnknownKey {
-                    key: key.to_string(),
-                    known: keys.join(", "),
-                })?;
         Ok(RigidFamily {
-            walker,
-            key,
+            free: FreeParameter::new(walker, key)?,
             period: 1,
             options: RigidOptions::default(),
             dims: PhantomData,
@@ -80,16 +120,6 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
     /// The same family walked with `options` (an interrupt, tolerances).
     pub fn with_options(self, options: RigidOptions) -> RigidFamily<'a, W, N, Y> {
         RigidFamily { options, ..self }
-    }
-
-    /// The walker at the parameter value `p`.
-    fn at(&self, p: f64) -> Result<W, MapFailure> {
-        self.walker
-            .with_parameter(self.key, p)
-            .map_err(|e| MapFailure {
-                kind: "invalid_parameter".to_string(),
-                message: e.to_string(),
-            })
     }
 
     /// `P^k(x)` with `DP` and `dP/dp` by central differences ([`DIFFERENCE_STEP`]), not exact.
@@ -102,8 +132,9 @@ impl<'a, W: RigidWalker<N, Y> + Parametrized, const N: usize, const Y: usize>
         let (value, info) = self.walked(walker, x)?;
         let jacobian = central_jacobian(x, |x| Ok(self.walked(walker, x)?.0))?;
         let h = DIFFERENCE_STEP * p.abs().max(1.0);
-        let at =
-            |p: f64| -> Result<DVector<f64>, MapFailure> { Ok(self.walked(&self.at(p)?, x)?.0) };
+        let at = |p: f64| -> Result<DVector<f64>, MapFailure> {
+            Ok(self.walked(&self.free.at(p)?, x)?.0)
+        };
         let dparam = (at(p + h)? - at(p - h)?) / (2.0 * h);
         Ok(Evaluation {
             value,
@@ -153,12 +184,12 @@ where
     type Info = RigidInfo;
 
     fn dim(&self) -> usize {
-        self.walker.section_names().len()
+        self.free.walker().section_names().len()
     }
 
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<RigidInfo>, MapFailure> {
-        let walker = self.at(p)?;
-        match walker.step_map_derivative(x, Some(self.key), self.period, &self.options) {
+        let walker = self.free.at(p)?;
+        match walker.step_map_derivative(x, Some(self.free.key()), self.period, &self.options) {
             Ok(d) => Ok(Evaluation {
                 value: d.value,
                 jacobian: d.jacobian,
@@ -185,7 +216,7 @@ where
     }
 
     fn value(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
-        let walker = self.at(p)?;
+        let walker = self.free.at(p)?;
         Ok(self.walked(&walker, x)?.0)
     }
 

@@ -6,7 +6,7 @@
 //! Newton's method takes central differences instead (relative step [`DIFFERENCE_STEP`]: a Newton matrix need
 //! not be exact), and the gait's multipliers do so only where the caller asks
 //! ([`RigidOptions::difference_fallback`]), saying so ([`JacobianRoute`]). The central differences also check
-//! the exact `DP` ([`super::rigid_check::check_rigid_derivatives`], `vrw gait --model NAME --check-jacobian`).
+//! the exact `DP` ([`super::derivative_check::check_rigid_derivatives`], `vrw gait --model NAME --check-jacobian`).
 
 use nalgebra::{DMatrix, DVector};
 

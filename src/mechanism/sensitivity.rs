@@ -234,6 +234,19 @@ pub(crate) fn seeded<H: Hybrid<N>, const N: usize, const D: usize>(
     })
 }
 
+/// The value of `model`'s constant `key` (as its constants read it), `None` for no such key: the parameters
+/// [`seeded`] can carry `d/dp`.
+pub(crate) fn constant_value<H: Hybrid<N>, const N: usize>(model: &H, key: &str) -> Option<f64> {
+    let found = std::cell::Cell::new(None);
+    model.hybrid_constants::<f64>(&|k, v| {
+        if k == key {
+            found.set(Some(v));
+        }
+        v
+    });
+    found.get()
+}
+
 /// `(q, q')` as duals: the values `y`, the derivative parts the rows of `s`.
 pub(crate) fn state_duals<const N: usize, const Y: usize, const D: usize>(
     y: &SVector<f64, Y>,

@@ -22,10 +22,10 @@ use super::{Legged, LeggedError, Modes};
 use crate::dynamics::Dual;
 use crate::mechanism::constrained::{accelerations_with, impulse_with, ConstrainedError, Row};
 use crate::mechanism::sensitivity::{
-    replay, seeded, sensitivity_of, state_duals, Hybrid, NotDifferentiable, Segment, SegmentEnd,
-    Sensitivity, Tape, BORDER_TOL,
+    self, replay, seeded, sensitivity_of, state_duals, Hybrid, NotDifferentiable, Segment,
+    SegmentEnd, Sensitivity, Tape, BORDER_TOL,
 };
-use crate::mechanism::{Mechanism, Real};
+use crate::mechanism::Real;
 
 /// What the exact derivatives need of a legged walker beyond its walk: its stoppers, the legs' exchange and
 /// its section over any [`Real`] (its [`Legged`] methods are these on `f64`).
@@ -216,15 +216,11 @@ fn without_work<const Y: usize, const Z: usize>(
 }
 
 /// The value of `walker`'s constant `key` (as its constants read it), `None` for no such key.
-pub fn constant_value<W: Mechanism<N>, const N: usize>(walker: &W, key: &str) -> Option<f64> {
-    let found = std::cell::Cell::new(None);
-    walker.constants::<f64>(&|k, v| {
-        if k == key {
-            found.set(Some(v));
-        }
-        v
-    });
-    found.get()
+pub fn constant_value<W: LeggedDerivatives<N>, const N: usize>(
+    walker: &W,
+    key: &str,
+) -> Option<f64> {
+    sensitivity::constant_value(&Replay::<W, N>(walker), key)
 }
 
 /// The DLS indicators of a step's heel strike within [`BORDER_TOL`] of zero put it on the border between two

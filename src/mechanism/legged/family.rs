@@ -18,8 +18,8 @@ use super::gait::legged_step_map;
 use super::walk::{LeggedOptions, StepAccount};
 use super::{Legged, LeggedError};
 use crate::continuation::{Evaluation, FamilyMap, MapFailure};
-use crate::mechanism::rigid_check::richardson_jacobian;
-use crate::mechanism::rigid_family::Parametrized;
+use crate::mechanism::derivative_check::richardson_jacobian;
+use crate::mechanism::rigid_family::{FreeParameter, Parametrized};
 use crate::params::ConfigError;
 
 /// What the family records of a point: its (first) step's duration and heel strike, and the error estimate of
@@ -38,8 +38,7 @@ pub struct LeggedInfo {
 /// The step map `P` (or `P^k`) of a legged walker in the parameter `key`.
 #[derive(Debug)]
 pub struct LeggedFamily<'a, W, const N: usize, const Y: usize> {
-    walker: &'a W,
-    key: &'static str,
+    free: FreeParameter<'a, W>,
     period: usize,
     options: LeggedOptions,
     dims: PhantomData<[(); N]>,
@@ -56,18 +55,8 @@ impl<W, const N: usize, const Y: usize> Copy for LeggedFamily<'_, W, N, Y> {}
 impl<'a, W: Legged<N> + Parametrized, const N: usize, const Y: usize> LeggedFamily<'a, W, N, Y> {
     /// The family of `walker` in `key` (one of its [`Parametrized::parameter_keys`]).
     pub fn new(walker: &'a W, key: &str) -> Result<LeggedFamily<'a, W, N, Y>, ConfigError> {
-        let keys = walker.parameter_keys();
-        let key =
-            keys.iter()
-                .copied()
-                .find(|k| *k == key)
-                .ok_or_else(|| ConfigError::UnknownKey {
-                    key: key.to_string(),
-                    known: keys.join(", "),
-                })?;
         Ok(LeggedFamily {
-            walker,
-            key,
+            free: FreeParameter::new(walker, key)?,
             period: 1,
             options: LeggedOptions::default(),
             dims: PhantomData,
@@ -77,16 +66,6 @@ impl<'a, W: Legged<N> + Parametrized, const N: usize, const Y: usize> LeggedFami
     /// The same family walked with `options` (an interrupt, tolerances).
     pub fn with_options(self, options: LeggedOptions) -> LeggedFamily<'a, W, N, Y> {
         LeggedFamily { options, ..self }
-    }
-
-    /// The walker at the parameter value `p`.
-    fn at(&self, p: f64) -> Result<W, MapFailure> {
-        self.walker
-            .with_parameter(self.key, p)
-            .map_err(|e| MapFailure {
-                kind: "invalid_parameter".to_string(),
-                message: e.to_string(),
-            })
     }
 
     /// `P^k(x)` of `walker` and the first step's record.
@@ -140,7 +119,7 @@ impl<W: LeggedDerivatives<N> + Parametrized, const N: usize, const Y: usize>
             (x.clone(), DMatrix::identity(n, n), DVector::zeros(n));
         let mut info = None;
         for _ in 0..self.period {
-            let d = match walker.exact_step_map(&s, Some(self.key), &self.options) {
+            let d = match walker.exact_step_map(&s, Some(self.free.key()), &self.options) {
                 Ok(d) => d,
                 Err(LeggedDerivativeError::Walk(e)) => return Err(failure(e)),
                 Err(_) => return Ok(None),
@@ -172,14 +151,14 @@ where
     type Info = LeggedInfo;
 
     fn dim(&self) -> usize {
-        self.walker.section_names().len()
+        self.free.walker().section_names().len()
     }
 
     /// `P^k(x; p)` with its exact `DP` and `dP/dp`, or where the map has none Richardson-extrapolated central
     /// differences ([`richardson_jacobian`]: the columns of `x`'s coordinates and of the parameter, each relative
     /// to its size).
     fn eval(&self, x: &DVector<f64>, p: f64) -> Result<Evaluation<LeggedInfo>, MapFailure> {
-        let walker = self.at(p)?;
+        let walker = self.free.at(p)?;
         if let Some(exact) = self.exact(&walker, x)? {
             return Ok(exact);
         }
@@ -192,7 +171,7 @@ where
                 moved[k] += t;
                 Ok(self.walked(&walker, &moved)?.0)
             } else {
-                Ok(self.walked(&self.at(p + t)?, x)?.0)
+                Ok(self.walked(&self.free.at(p + t)?, x)?.0)
             }
         })?;
         info.derivative_error = error;
@@ -206,7 +185,7 @@ where
     }
 
     fn value(&self, x: &DVector<f64>, p: f64) -> Result<DVector<f64>, MapFailure> {
-        let walker = self.at(p)?;
+        let walker = self.free.at(p)?;
         Ok(self.walked(&walker, x)?.0)
     }
 

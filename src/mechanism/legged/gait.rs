@@ -2,7 +2,7 @@
 //! ([`Legged::section_of`]) by Newton's method, and their Floquet multipliers, the eigenvalues of `DP` at the
 //! fixed point. A walker with exact derivatives ([`LeggedDerivatives`], the replay of `super::derivative`) has
 //! them in Newton's method and for its multipliers, Richardson-extrapolated central differences
-//! ([`crate::mechanism::rigid_check::richardson_jacobian`]) their second route ([`legged_gait_exact`]); another
+//! ([`crate::mechanism::derivative_check::richardson_jacobian`]) their second route ([`legged_gait_exact`]); another
 //! has its `DP` by central differences in Newton's method
 //! ([`crate::mechanism::rigid_gait::central_jacobian`]) and by Richardson's at the fixed point with their error
 //! estimate ([`legged_gait`]).
@@ -12,7 +12,7 @@ use nalgebra::{DMatrix, DVector};
 use super::derivative::LeggedDerivatives;
 use super::walk::{legged_step, LeggedOptions, LeggedStep};
 use super::{Legged, LeggedError};
-use crate::mechanism::rigid_check::richardson_jacobian;
+use crate::mechanism::derivative_check::richardson_jacobian;
 use crate::mechanism::rigid_gait::{central_jacobian, damped_newton, multipliers, FixedPointError};
 
 /// [`LeggedGait::derivative`] of exact derivatives (the replay of the walk's step).

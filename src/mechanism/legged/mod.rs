@@ -16,6 +16,7 @@
 //!
 //! The wheel walks by `crate::walk` still; this walk is to become the one walk (docs/model.md section 13).
 
+pub mod check;
 pub mod derivative;
 pub mod family;
 pub mod forces;

@@ -238,7 +238,7 @@ fn a_step_answers_the_stop_at_its_first_phase() {
 #[test]
 fn the_exact_derivatives_agree_with_differences() {
     use super::derivative::LeggedDerivatives;
-    use crate::mechanism::rigid_check::richardson_jacobian;
+    use crate::mechanism::derivative_check::richardson_jacobian;
     use crate::mechanism::rigid_family::Parametrized;
     let w = Telescopic::default();
     let options = LeggedOptions::default();
