@@ -286,8 +286,8 @@ fn the_described_telescopic_walker_walks_from_the_command_line() {
             .skip(1)
             .filter(|l| !l.starts_with("wrote") && !l.starts_with("energy audit"))
             .map(|l| l.split(" (residual").next().unwrap_or(l).to_string())
-            // The built-in's DP is exact and the described walker's by differences so far: the three multipliers
-            // that are not 0 alone, after the route (the two at 0 come out real or as a pair at 1e-9).
+            // Both DPs are exact, from two section maps: the three multipliers that are not 0 alone, after the
+            // route (the two at 0 come out real or as a pair at 1e-9).
             .map(|l| match l.strip_prefix("Floquet multipliers (") {
                 Some(rest) => rest.split_once("): ").map_or(l.clone(), |(_, m)| {
                     m.split(", ").take(3).collect::<Vec<_>>().join(", ")
