@@ -52,6 +52,7 @@ mod error;
 mod events;
 pub mod impact;
 pub mod interrupt;
+pub mod meter;
 mod phase;
 mod reindex;
 pub(crate) mod report;
