@@ -242,9 +242,9 @@ fn curves_on_fewer_columns_keep_every_row_crossing() {
 /// the job walked (counted apart, by a meter around the whole job), the span at most the work, the tasks one per point and row (gaits), and all of it the same for 1, 2 and 3 threads.
 #[test]
 fn map_work_and_span_are_deterministic() {
+    use vrw::meter::StepMeter;
     use vrw::study::map::{map_curves_measured, map_gaits_measured};
     use vrw::study::map_curves::continue_map_curves_measured;
-    use vrw::walk::meter::StepMeter;
     let config = Config::default();
     let start = default_initial(&config);
     let spec = spec();

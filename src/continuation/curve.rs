@@ -15,7 +15,7 @@
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use crate::walk::meter::carried;
+use crate::meter::carried;
 use serde::Serialize;
 
 use super::corrector::tangent;

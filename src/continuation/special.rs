@@ -22,7 +22,7 @@
 use nalgebra::{Complex, DMatrix, DVector};
 use rayon::prelude::*;
 
-use crate::walk::meter::carried;
+use crate::meter::carried;
 use serde::Serialize;
 
 use super::corrector::{

@@ -22,7 +22,7 @@ use std::sync::{Arc, Mutex};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use crate::walk::meter::carried;
+use crate::meter::carried;
 
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, THETA};
 use crate::params::ImpactModel;

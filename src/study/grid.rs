@@ -44,8 +44,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use super::parallelism::{measured, Cost, TaskGraph};
+use crate::meter::carried;
 use crate::walk::interrupt::interrupt_flag;
-use crate::walk::meter::carried;
 
 /// Stride of the coarse continuation pass along a row.
 pub(crate) const COARSE_STRIDE: usize = 10;
@@ -523,7 +523,7 @@ mod tests {
     #[test]
     fn task_graphs_follow_the_schedule() {
         let eval = |cell: Cell, _: Option<(usize, &())>| {
-            (0..=cell.col).for_each(|_| crate::walk::meter::count_step());
+            (0..=cell.col).for_each(|_| crate::meter::count_step());
             Evaluated {
                 point: cell.col,
                 carry: Some(()),

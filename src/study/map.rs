@@ -34,8 +34,8 @@ use super::thresholds::{find_thresholds_costed, Threshold};
 use crate::family::Parameter;
 use crate::fmt::short;
 use crate::gait::limit_cycle::GaitOptions;
+use crate::meter::carried;
 use crate::params::{Config, ConfigError, NumericKey};
-use crate::walk::meter::carried;
 use crate::walk::SectionState;
 
 /// The most values along one axis of a map.

@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use super::parallelism::{measured, Cost, TaskGraph};
-use crate::walk::meter::carried;
+use crate::meter::carried;
 
 use super::map::NearMiss;
 use super::map::{Along, LineThreshold, RefinedOn};

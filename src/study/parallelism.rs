@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::walk::meter::StepMeter;
+use crate::meter::StepMeter;
 
 /// What one task cost.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -31,11 +31,11 @@ pub struct Cost {
 /// Run `f` as one task: its result and what it cost (the steps walked under a fresh [`StepMeter`], and the
 /// wall time). Its steps count to the thread's meter too, so that a task measured inside another is part of
 /// the other's work (a parallel iterator's closure that measures its tasks is [`carried`] by the caller's
-/// meter: [`crate::walk::meter::carried`]).
+/// meter: [`crate::meter::carried`]).
 ///
-/// [`carried`]: crate::walk::meter::carried
+/// [`carried`]: crate::meter::carried
 pub(crate) fn measured<R>(f: impl FnOnce() -> R) -> (R, Cost) {
-    let outer = crate::walk::meter::current();
+    let outer = crate::meter::current();
     let meter = StepMeter::new();
     let clock = Instant::now();
     let out = meter.run(f);

@@ -31,8 +31,8 @@ use crate::gait::limit_cycle::{
 use crate::gait::period_k::{find_gait_any_period, periodic_gait_at};
 use crate::gait::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
 use crate::gait::step_map::free_coordinates;
+use crate::meter::carried;
 use crate::params::{Config, ConfigError, NumericKey};
-use crate::walk::meter::carried;
 use crate::walk::{SectionState, SECTION_COORDINATES};
 
 /// The most points a sweep may have.

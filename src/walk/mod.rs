@@ -52,7 +52,6 @@ mod error;
 mod events;
 pub mod impact;
 pub mod interrupt;
-pub mod meter;
 mod phase;
 mod reindex;
 pub(crate) mod report;

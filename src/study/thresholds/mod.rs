@@ -24,8 +24,8 @@ use std::cell::{Cell, RefCell};
 
 use rayon::prelude::*;
 
+use crate::meter::carried;
 use crate::study::parallelism::{measured, Cost};
-use crate::walk::meter::carried;
 use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 

@@ -2,9 +2,9 @@
 //! evaluation of the step map `P`, failed steps included), whichever threads ran them.
 //!
 //! A grid job ([`crate::study`]) runs each of its tasks (a point of a row, a threshold's refinement, a continued
-//! curve) under a meter of its own ([`StepMeter::run`]); every [`super::Walker`] step adds one to the meter of
+//! curve) under a meter of its own ([`StepMeter::run`]); every [`crate::walk::Walker`] step adds one to the meter of
 //! the task that runs it. The meter is the thread's while the task runs, and a task's own parallel work carries
-//! it to the threads that run it ([`join`], [`carried`]), so that a thread that picks up another task's work
+//! it to the threads that run it (`join`, `carried`), so that a thread that picks up another task's work
 //! while it waits counts that work to the other task. The counts are therefore a deterministic function of
 //! the tasks, the same for any number of threads, and with the task graph of the job's schedule they give its
 //! work and span ([`crate::study::parallelism`]).
@@ -39,7 +39,7 @@ impl StepMeter {
     }
 
     /// Run `f` with this meter counting the steps it walks (on this thread, and on the threads its parallel
-    /// work reaches through [`join`] and [`carried`]).
+    /// work reaches through `join` and `carried`).
     pub fn run<R>(&self, f: impl FnOnce() -> R) -> R {
         with_meter(Some(self.clone()), f)
     }
