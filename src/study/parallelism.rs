@@ -7,7 +7,7 @@
 //! - **Seconds**, the wall time of each task: they vary from run to run, so they are printed, never written.
 //!
 //! A phase is a graph of tasks ([`TaskGraph`]): a task runs after the tasks it continues from or needs, as the
-//! grid runner's schedule orders them ([`super::grid`]). Its **work** is the sum of its tasks' costs, its
+//! grid runner's schedule orders them (`study/grid.rs`). Its **work** is the sum of its tasks' costs, its
 //! **span** the costliest chain of dependent tasks: no schedule on any number of threads finishes the phase in
 //! less than its span, and `work / span` is the most threads it can keep busy. A task's own parallel work
 //! (the two exact Jacobians of a gait, the refinements inside a line's threshold search) is counted in its
