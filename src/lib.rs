@@ -13,6 +13,7 @@
 //!
 //! | stage | module |
 //! |---|---|
+//! | (beneath the pipeline) the step meter of a grid job's task | [`meter`] |
 //! | numerical integration with event location | [`integrate`] |
 //! | (beside the pipeline, importing none of the wheel) the continuation engine | [`continuation`] |
 //! | parameters and options | [`params`] |
@@ -58,7 +59,8 @@
 //!   below), and the verified natural continuation the sweeps use, [`family::natural`].
 //! - **Studies over parameters**: sweeps [`study::sweep()`] over a [`study::SweepSpec`] and their thresholds
 //!   [`study::find_thresholds`]; two-parameter maps [`study::map_gaits`] and [`study::map_curves()`]; orbit
-//!   diagrams [`study::orbit::orbit_diagram`]; basins of attraction [`study::basin::basin`].
+//!   diagrams [`study::orbit::orbit_diagram`]; basins of attraction [`study::basin::basin`]; the work and span
+//!   of their phases [`study::parallelism`] (measured with a [`meter::StepMeter`] per task).
 //! - **Bifurcation analysis**: [`continuation::continue_family`] over any [`continuation::FamilyMap`] (the
 //!   VRW's is [`family::GaitFamily`]) with [`continuation::ContinuationOptions`], giving a
 //!   [`continuation::Family`] of [`continuation::FamilyPoint`]s with its [`continuation::SpecialPoint`]s and
@@ -126,6 +128,7 @@ pub mod fmt;
 pub mod gait;
 pub mod integrate;
 pub mod mechanism;
+pub mod meter;
 pub mod output;
 pub mod params;
 pub mod reference;

@@ -237,3 +237,50 @@ fn curves_on_fewer_columns_keep_every_row_crossing() {
         assert!(r.along == Along::X || refined.contains(&r.line), "{r:?}");
     }
 }
+
+/// The work and span of a map's phases ([`vrw::study::parallelism`]), in steps walked: the work is every step
+/// the job walked (counted apart, by a meter around the whole job), the span at most the work, the tasks one per point and row (gaits), and all of it the same for 1, 2 and 3 threads.
+#[test]
+fn map_work_and_span_are_deterministic() {
+    use vrw::meter::StepMeter;
+    use vrw::study::map::{map_curves_measured, map_gaits_measured};
+    use vrw::study::map_curves::continue_map_curves_measured;
+    let config = Config::default();
+    let start = default_initial(&config);
+    let spec = spec();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let whole = StepMeter::new();
+            let (map, gaits) = whole
+                .run(|| map_gaits_measured(&config, &spec, 0..4, &start, &options(), &|_| {}))
+                .unwrap();
+            let gaits = gaits.work_span();
+            assert_eq!(gaits.work_steps, whole.steps(), "{threads} threads");
+            assert_eq!(gaits.tasks, 5 * 4 + 4);
+            let crossings = StepMeter::new();
+            let (mut curves, graph) = crossings
+                .run(|| map_curves_measured(&config, &map, &options(), DEFAULT_CURVE_COLUMNS))
+                .unwrap();
+            let lines = graph.work_span();
+            assert_eq!(lines.work_steps, crossings.steps(), "{threads} threads");
+            let continued = StepMeter::new();
+            let (_, graph) =
+                continued.run(|| continue_map_curves_measured(&config, &map, &mut curves));
+            let followed = graph.work_span();
+            assert_eq!(followed.work_steps, continued.steps(), "{threads} threads");
+            [gaits, lines, followed].map(|w| (w.tasks, w.work_steps, w.span_steps))
+        })
+    };
+    let one = run(1);
+    for (tasks, work, span) in one {
+        assert!(span <= work && (tasks == 0) == (work == 0), "{one:?}");
+    }
+    // Gaits and crossings walk (this small map has no curve to continue).
+    assert!(one[0].2 > 0 && one[1].2 > 0, "{one:?}");
+    assert_eq!(run(2), one);
+    assert_eq!(run(3), one);
+}

@@ -12,8 +12,9 @@ use crate::gait::{find_gait_any_period, Gait, GaitOptions, StepMap, MAX_PERIOD};
 use crate::output;
 use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::params::Config;
-use crate::study::basin::{basin, basin_part, Axis, BasinPoint, BasinSpec, Coordinate};
+use crate::study::basin::{basin_measured, Axis, BasinPoint, BasinSpec, Coordinate};
 use crate::study::check_part;
+use crate::study::parallelism::{measured, Cost, PhaseWork, TaskGraph, WithParallelism};
 use crate::walk::SectionState;
 
 use super::{check_interrupted, check_phase_interrupted, in_run, prepared, AppError};
@@ -77,6 +78,21 @@ pub struct BasinSummary {
     /// Wall-clock seconds of the grid (printed, not written).
     #[serde(skip)]
     pub seconds: f64,
+    /// The work and span of the gait's search and of the walks from the starts
+    /// ([`crate::study::parallelism`]); written to `basin.json` (after these fields) by [`run_basin`], in
+    /// steps walked.
+    #[serde(skip)]
+    pub parallelism: Vec<PhaseWork>,
+}
+
+impl BasinSummary {
+    /// `basin.json`: the summary with its phases' work and span.
+    pub fn with_parallelism(&self) -> WithParallelism<'_, BasinSummary> {
+        WithParallelism {
+            summary: self,
+            parallelism: &self.parallelism,
+        }
+    }
 }
 
 impl BasinJob {
@@ -139,9 +155,10 @@ pub fn run_basin(
     job: &BasinJob,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<BasinSummary, AppError> {
-    let (model, gait, spec) = prepare_basin(job)?;
+    let (prepared, search) = measured(|| prepare_basin(job));
+    let (model, gait, spec) = prepared?;
     in_run(&job.out_dir, job.overwrite, "basin", |run| {
-        basin_into(job, &model, gait, spec, run, progress).map(|s| (s, None))
+        basin_into(job, &model, (gait, search), spec, run, progress).map(|s| (s, None))
     })
 }
 
@@ -163,11 +180,12 @@ pub fn compute_basin_part(
     part: Option<Range<usize>>,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<(BasinSummary, Vec<Vec<BasinPoint>>), AppError> {
-    let (model, gait, spec) = prepare_basin(job)?;
+    let (prepared, search) = measured(|| prepare_basin(job));
+    let (model, gait, spec) = prepared?;
     let part = part.unwrap_or(0..spec.y.points);
     check_part(&part, spec.y.points)?;
     let clock = std::time::Instant::now();
-    let grid = basin_part(
+    let (grid, starts) = basin_measured(
         &model,
         &job.config.solver,
         &gait,
@@ -189,8 +207,19 @@ pub fn compute_basin_part(
         outcomes: outcome_counts(&grid),
         files: Vec::new(),
         seconds,
+        parallelism: basin_parallelism(search, &starts),
     };
     Ok((summary, grid))
+}
+
+/// The phases of a basin: the gait's search (one task) and the walks from the starts.
+fn basin_parallelism(search: Cost, starts: &TaskGraph) -> Vec<PhaseWork> {
+    let mut gait = TaskGraph::new();
+    gait.task(search, &[]);
+    vec![
+        PhaseWork::of("gait", &gait),
+        PhaseWork::of("starts", starts),
+    ]
 }
 
 /// The number of grid points per outcome.
@@ -239,13 +268,15 @@ fn prepare_basin(job: &BasinJob) -> Result<(crate::dynamics::Model, Gait, BasinS
 fn basin_into(
     job: &BasinJob,
     model: &crate::dynamics::Model,
-    gait: Gait,
+    (gait, search): (Gait, Cost),
     spec: BasinSpec,
     run: &mut RunDir,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Result<BasinSummary, AppError> {
     let clock = std::time::Instant::now();
-    let grid = basin(model, &job.config.solver, &gait, &spec, progress);
+    let all_rows = 0..spec.y.points;
+    let (grid, starts) =
+        basin_measured(model, &job.config.solver, &gait, &spec, all_rows, progress);
     let seconds = clock.elapsed().as_secs_f64();
     let outcomes = outcome_counts(&grid);
     let friction = crate::output::friction_columns(&job.config, &[]);
@@ -300,8 +331,9 @@ fn basin_into(
             .map(String::from)
             .to_vec(),
         seconds,
+        parallelism: basin_parallelism(search, &starts),
     };
-    output::write_json(&run.path("basin.json"), &summary)?;
+    output::write_json(&run.path("basin.json"), &summary.with_parallelism())?;
     run.add("basin.json");
     Ok(summary)
 }

@@ -13,11 +13,11 @@ use crate::output::map_plot::{write_map_figure, MapFigure, MapMark};
 use crate::output::signature_plot::write_signature_figure;
 use crate::output::{self, write_map_csv};
 use crate::params::Config;
+use crate::study::map::{map_curves_measured, map_gaits_measured};
 use crate::study::map::{LineThreshold, ThresholdCurve};
-use crate::study::map_curves::continue_map_curves;
-use crate::study::{
-    map_curves, map_gaits, map_gaits_part, GaitMap, MapSpec, SecondRoute, SweepPoint,
-};
+use crate::study::map_curves::continue_map_curves_measured;
+use crate::study::parallelism::{PhaseWork, TaskGraph, WithParallelism};
+use crate::study::{map_curves, map_gaits, GaitMap, MapSpec, SecondRoute, SweepPoint};
 use crate::walk::SectionState;
 
 use super::{
@@ -84,6 +84,11 @@ pub struct MapSummary {
     /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
     #[serde(skip)]
     pub second_route_seconds: f64,
+    /// The work and span of the gaits, the crossings of the rows and columns and the continued curves
+    /// ([`crate::study::parallelism`]); written to `curves.json` (beside these fields) by [`run_map`], in
+    /// steps walked.
+    #[serde(skip)]
+    pub parallelism: Vec<PhaseWork>,
     /// Where the interrupt flag stopped the job and what is kept ([`compute_map`]: the gaits without curves);
     /// `None` (and not written) when it did not.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -124,7 +129,9 @@ pub fn compute_map(
             curves: false,
             ..job.clone()
         };
-        let mut gaits = map_summary(&gaits_only, &map, summary.seconds[0])?;
+        let mut gaits = map_summary(&gaits_only, &map, (summary.seconds[0], &TaskGraph::new()))?;
+        // The gaits' work and span, as measured.
+        gaits.parallelism = summary.parallelism[..1].to_vec();
         gaits.interrupted = Some(format!("{during}; {kept}"));
         return Ok((gaits, map));
     }
@@ -162,7 +169,7 @@ fn summarized_rows(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<(MapSummary, GaitMap), AppError> {
     let clock = std::time::Instant::now();
-    let map = map_gaits_part(
+    let (map, gaits) = map_gaits_measured(
         &job.config,
         &job.spec,
         part,
@@ -172,7 +179,7 @@ fn summarized_rows(
     )?;
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "the map")?;
-    let summary = map_summary(job, &map, clock.elapsed().as_secs_f64())?;
+    let summary = map_summary(job, &map, (clock.elapsed().as_secs_f64(), &gaits))?;
     Ok((summary, map))
 }
 
@@ -202,17 +209,25 @@ fn map_into(
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<MapSummary, AppError> {
     let clock = std::time::Instant::now();
-    let map = map_gaits(&job.config, &job.spec, initial, &job.options, progress)?;
+    let all_rows = 0..job.spec.y.points;
+    let (map, gaits) = map_gaits_measured(
+        &job.config,
+        &job.spec,
+        all_rows,
+        initial,
+        &job.options,
+        progress,
+    )?;
     let gait_seconds = clock.elapsed().as_secs_f64();
     let friction = output::friction_columns(&job.config, &[&job.spec.x.param, &job.spec.y.param]);
     write_map_csv(&run.path("map.csv"), &map, friction)?;
     run.add("map.csv");
     let points = map.xs.len() * map.ys.len();
     check_interrupted(map.rows.iter().map(Vec::len).sum(), points, "map.csv")?;
-    let mut summary = map_summary(job, &map, gait_seconds)?;
+    let mut summary = map_summary(job, &map, (gait_seconds, &gaits))?;
     check_curves_interrupted("map.csv holds every point of the map")?;
     let curves_json = run.path("curves.json");
-    output::write_json(&curves_json, &summary)?;
+    output::write_json(&curves_json, &summary.with_parallelism())?;
     run.add("curves.json");
     write_figure(job, &map, &summary.curves, friction)?;
     run.add("map.svg");
@@ -224,7 +239,7 @@ fn map_into(
     if job.second_route && job.curves {
         // Everything of the first route is written: nothing is lost if this fails.
         second_route(job, initial, progress, &mut summary)?;
-        output::write_json(&curves_json, &summary)?;
+        output::write_json(&curves_json, &summary.with_parallelism())?;
     }
     Ok(summary)
 }
@@ -239,17 +254,38 @@ fn check_curves_interrupted(kept: &str) -> Result<(), AppError> {
     )
 }
 
-/// The curves of `map` (with `job.curves`) and the summary of the map and its curves.
-fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> Result<MapSummary, AppError> {
+impl MapSummary {
+    /// `curves.json`: the summary with its phases' work and span.
+    pub fn with_parallelism(&self) -> WithParallelism<'_, MapSummary> {
+        WithParallelism {
+            summary: self,
+            parallelism: &self.parallelism,
+        }
+    }
+}
+
+/// The curves of `map` (with `job.curves`) and the summary of the map and its curves; `gaits` the seconds
+/// and the task graph of the map's gaits.
+fn map_summary(
+    job: &MapJob,
+    map: &GaitMap,
+    gaits: (f64, &TaskGraph),
+) -> Result<MapSummary, AppError> {
+    let (gait_seconds, gait_graph) = gaits;
     let clock = std::time::Instant::now();
     let mut curve_warnings = Vec::new();
     let mut continuation_seconds = 0.0;
+    let mut parallelism = vec![PhaseWork::of("gaits", gait_graph)];
     let (curves, thresholds) = if job.curves {
-        let mut c = map_curves(&job.config, map, &job.options, job.curve_columns)?;
+        let (mut c, crossings) =
+            map_curves_measured(&job.config, map, &job.options, job.curve_columns)?;
+        parallelism.push(PhaseWork::of("crossings", &crossings));
         if job.continue_curves {
             let clock = std::time::Instant::now();
-            curve_warnings = continue_map_curves(&job.config, map, &mut c);
+            let (warnings, continued) = continue_map_curves_measured(&job.config, map, &mut c);
+            curve_warnings = warnings;
             continuation_seconds = clock.elapsed().as_secs_f64();
+            parallelism.push(PhaseWork::of("continued_curves", &continued));
         }
         (c.curves, c.thresholds)
     } else {
@@ -272,6 +308,7 @@ fn map_summary(job: &MapJob, map: &GaitMap, gait_seconds: f64) -> Result<MapSumm
         seconds: [gait_seconds, curve_seconds],
         continuation_seconds,
         second_route_seconds: 0.0,
+        parallelism,
         interrupted: None,
         warnings: super::gait_warnings(map.ys.iter().zip(&map.rows).flat_map(|(y, row)| {
             row.iter().map(move |p| {

@@ -7,15 +7,16 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
+use super::sweep::swept_row;
 use crate::fmt::short;
 use crate::gait::{Gait, GaitOptions, Stability};
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
 use crate::params::Config;
 use crate::study::orbit::{
-    orbit_diagram, orbit_part, OrbitColumn, OrbitPart, OrbitSpec, WalkStatus,
+    orbit_diagram_measured, orbit_part, OrbitColumn, OrbitPart, OrbitSpec, WalkStatus,
 };
-use crate::study::sweep;
+use crate::study::parallelism::{PhaseWork, TaskGraph, WithParallelism};
 use crate::walk::{SectionState, StepReport};
 
 use super::{axis_label, check_interrupted, in_run, prepared, AppError};
@@ -85,6 +86,20 @@ pub struct OrbitSummary {
     /// Wall-clock seconds of the diagram and of the branch (printed, not written).
     #[serde(skip)]
     pub seconds: [f64; 2],
+    /// The work and span of the diagram's walks and of the branch's gaits ([`crate::study::parallelism`]);
+    /// written to `orbit.json` (after these fields) by [`run_orbit`], in steps walked.
+    #[serde(skip)]
+    pub parallelism: Vec<PhaseWork>,
+}
+
+impl OrbitSummary {
+    /// `orbit.json`: the summary with its phases' work and span.
+    pub fn with_parallelism(&self) -> WithParallelism<'_, OrbitSummary> {
+        WithParallelism {
+            summary: self,
+            parallelism: &self.parallelism,
+        }
+    }
 }
 
 /// Run `vrw orbit`. `progress` is called after every value of the diagram.
@@ -114,17 +129,18 @@ pub fn compute_orbit(
     job.spec.validate(&job.config)?;
     job.validate()?;
     let clock = std::time::Instant::now();
-    let columns = orbit_diagram(&job.config, &job.spec, &initial, progress)?;
+    let (columns, walks) = orbit_diagram_measured(&job.config, &job.spec, &initial, progress)?;
     let orbit_seconds = clock.elapsed().as_secs_f64();
     let total = job.spec.range.points;
     check_interrupted(columns.len(), total, "the orbit diagram")?;
     let clock = std::time::Instant::now();
-    let branch = period_one_branch(job, &initial)?;
+    let (branch, gaits) = period_one_branch(job, &initial)?;
     if job.branch {
         check_interrupted(branch.len(), total, "the branch")?;
     }
     let seconds = [orbit_seconds, clock.elapsed().as_secs_f64()];
-    let summary = orbit_summary(job, &columns, &branch, Vec::new(), seconds);
+    let mut summary = orbit_summary(job, &columns, &branch, Vec::new(), seconds);
+    summary.parallelism = orbit_parallelism(job, &walks, &gaits);
     Ok((summary, columns, branch))
 }
 
@@ -166,7 +182,7 @@ pub fn compute_orbit_part(
             (columns, ends, Vec::new())
         }
         OrbitJobPart::Branch => {
-            let branch = period_one_branch(job, &initial)?;
+            let (branch, _) = period_one_branch(job, &initial)?;
             check_interrupted(branch.len(), total, "the branch")?;
             (Vec::new(), Vec::new(), branch)
         }
@@ -176,20 +192,38 @@ pub fn compute_orbit_part(
 }
 
 /// The period-1 branch over the diagram's values (a sweep with continuation), with `job.branch`; else empty.
-fn period_one_branch(job: &OrbitJob, initial: &SectionState) -> Result<Branch, AppError> {
+/// With the task graph of its gaits.
+fn period_one_branch(
+    job: &OrbitJob,
+    initial: &SectionState,
+) -> Result<(Branch, TaskGraph), AppError> {
     if !job.branch {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), TaskGraph::new()));
     }
-    Ok(sweep(
+    let range = &job.spec.range;
+    range.validate(&job.config)?;
+    let options = GaitOptions::default();
+    let (points, graph) = swept_row(
         &job.config,
-        &job.spec.range,
-        initial,
-        &GaitOptions::default(),
+        &range.param,
+        &range.values(),
+        (initial, &options),
         &|_| {},
-    )?
-    .into_iter()
-    .map(|p| (p.value, p.gait.filter(|g| g.period_k == 1)))
-    .collect())
+    )?;
+    let branch = points
+        .into_iter()
+        .map(|p| (p.value, p.gait.filter(|g| g.period_k == 1)))
+        .collect();
+    Ok((branch, graph))
+}
+
+/// The phases of an orbit diagram: its walks, and the branch's gaits with `job.branch`.
+fn orbit_parallelism(job: &OrbitJob, walks: &TaskGraph, gaits: &TaskGraph) -> Vec<PhaseWork> {
+    let mut phases = vec![PhaseWork::of("walks", walks)];
+    if job.branch {
+        phases.push(PhaseWork::of("branch", gaits));
+    }
+    phases
 }
 
 /// `orbit.json`'s fields: how each value's walk ended, and the branch's gaits.
@@ -222,6 +256,7 @@ fn orbit_summary(
         branch_gaits,
         files,
         seconds,
+        parallelism: Vec::new(),
     }
 }
 
@@ -233,7 +268,7 @@ fn orbit_into(
     progress: &(dyn Fn(&OrbitColumn) + Sync),
 ) -> Result<OrbitSummary, AppError> {
     let clock = std::time::Instant::now();
-    let columns = orbit_diagram(&job.config, &job.spec, initial, progress)?;
+    let (columns, walks) = orbit_diagram_measured(&job.config, &job.spec, initial, progress)?;
     let orbit_seconds = clock.elapsed().as_secs_f64();
     let param = &job.spec.range.param;
     let mut files = vec!["orbit.csv".to_string()];
@@ -243,7 +278,7 @@ fn orbit_into(
     let total = job.spec.range.points;
     check_interrupted(columns.len(), total, "orbit.csv")?;
     let clock = std::time::Instant::now();
-    let branch = period_one_branch(job, initial)?;
+    let (branch, gaits) = period_one_branch(job, initial)?;
     let branch_seconds = clock.elapsed().as_secs_f64();
     if job.branch {
         write_branch_csv(&run.path("branch.csv"), param, friction, &branch)?;
@@ -261,14 +296,15 @@ fn orbit_into(
         Err(e) => return Err(e.into()),
     }
     files.push("orbit.json".to_string());
-    let summary = orbit_summary(
+    let mut summary = orbit_summary(
         job,
         &columns,
         &branch,
         files,
         [orbit_seconds, branch_seconds],
     );
-    output::write_json(&run.path("orbit.json"), &summary)?;
+    summary.parallelism = orbit_parallelism(job, &walks, &gaits);
+    output::write_json(&run.path("orbit.json"), &summary.with_parallelism())?;
     run.add("orbit.json");
     Ok(summary)
 }

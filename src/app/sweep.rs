@@ -12,8 +12,11 @@ use crate::output;
 use crate::output::plot::{
     write_fig2 as write_fig2_files, Fig2Spec, IndicatorPoint, ThresholdMark,
 };
-use crate::params::Config;
-use crate::study::{find_thresholds, sweep_values, SecondRoute, SweepPoint, SweepSpec, Threshold};
+use crate::params::{Config, ConfigError};
+use crate::study::parallelism::{PhaseWork, TaskGraph, WithParallelism};
+use crate::study::sweep::{checked_row, gait_rows_measured};
+use crate::study::thresholds::find_thresholds_costed;
+use crate::study::{SecondRoute, SweepPoint, SweepSpec, Threshold};
 use crate::walk::SectionState;
 
 use super::{
@@ -66,11 +69,25 @@ pub struct SweepSummary {
     /// Wall-clock seconds spent on the second route (0 without it; printed, not written).
     #[serde(skip)]
     pub second_route_seconds: f64,
+    /// The work and span of the gaits and of the thresholds ([`crate::study::parallelism`]); written to
+    /// `thresholds.json` (after these fields) by [`run_sweep`], in steps walked.
+    #[serde(skip)]
+    pub parallelism: Vec<PhaseWork>,
     /// The files this run wrote into the output directory (Fig. 2 only if some point has a gait; an earlier
     /// run's figure is removed rather than left beside this run's tables).
     pub files: Vec<String>,
     /// Every audit value above its tolerance in the steps of the gaits found (empty when every law holds).
     pub warnings: Vec<String>,
+}
+
+impl SweepSummary {
+    /// `thresholds.json`: the summary with its phases' work and span.
+    pub fn with_parallelism(&self) -> WithParallelism<'_, SweepSummary> {
+        WithParallelism {
+            summary: self,
+            parallelism: &self.parallelism,
+        }
+    }
 }
 
 /// Run `vrw sweep`: the sweep, its thresholds, `sweep.csv`, `thresholds.json` and Fig. 2. `progress` is called
@@ -124,6 +141,7 @@ fn sweep_into(
         thresholds: result.thresholds,
         seconds: result.seconds,
         second_route_seconds: 0.0,
+        parallelism: result.parallelism,
         files,
         warnings: super::gait_warnings(
             result
@@ -133,7 +151,7 @@ fn sweep_into(
         ),
     };
     let thresholds_json = run.path("thresholds.json");
-    output::write_json(&thresholds_json, &summary)?;
+    output::write_json(&thresholds_json, &summary.with_parallelism())?;
     run.add("thresholds.json");
     if gaits_found > 0 {
         write_fig2(job, &result.points, &summary.thresholds)?;
@@ -144,7 +162,7 @@ fn sweep_into(
     if job.second_route {
         // Everything of the first route is written: nothing is lost if this fails.
         second_route(job, initial, progress, &mut summary)?;
-        output::write_json(&thresholds_json, &summary)?;
+        output::write_json(&thresholds_json, &summary.with_parallelism())?;
     }
     Ok(summary)
 }
@@ -194,6 +212,8 @@ pub struct SweepResult {
     pub thresholds: Vec<Threshold>,
     /// Wall-clock seconds spent on the sweep and on the thresholds.
     pub seconds: [f64; 2],
+    /// The work and span of the gaits and of the thresholds' refinements ([`crate::study::parallelism`]).
+    pub parallelism: Vec<PhaseWork>,
 }
 
 /// The computation of [`run_sweep`] without writing anything: sweep `param` over `values` with continuation
@@ -212,12 +232,13 @@ pub fn compute_sweep(
 ) -> Result<SweepResult, AppError> {
     let (_, initial) = prepared(config, initial)?;
     let clock = std::time::Instant::now();
-    let points = sweep_values(config, param, values, &initial, options, progress)?;
+    let (points, gaits) = swept_row(config, param, values, (&initial, options), progress)?;
     let sweep_seconds = clock.elapsed().as_secs_f64();
     swept(&points)?;
     check_interrupted(points.len(), values.len(), "sweep.csv")?;
     let clock = std::time::Instant::now();
-    let mut thresholds = find_thresholds(Parameter::named(config, param)?, &points, options);
+    let (mut thresholds, refinements) =
+        find_thresholds_costed(Parameter::named(config, param)?, &points, options);
     // Thresholds searched while the flag was set are not results (their walks were cut short).
     check_phase_interrupted(
         None,
@@ -226,11 +247,33 @@ pub fn compute_sweep(
     )?;
     let threshold_seconds = clock.elapsed().as_secs_f64();
     thresholds.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let mut refined = TaskGraph::new();
+    for cost in refinements {
+        refined.task(cost, &[]);
+    }
     Ok(SweepResult {
         points,
         thresholds,
         seconds: [sweep_seconds, threshold_seconds],
+        parallelism: vec![
+            PhaseWork::of("gaits", &gaits),
+            PhaseWork::of("thresholds", &refined),
+        ],
     })
+}
+
+/// The sweep of `param` over `values` from `initial` with `options` (as [`crate::study::sweep_values`]), with
+/// its task graph.
+pub(crate) fn swept_row(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    (initial, options): (&SectionState, &GaitOptions),
+    progress: &(dyn Fn(&SweepPoint) + Sync),
+) -> Result<(Vec<SweepPoint>, TaskGraph), ConfigError> {
+    let row = checked_row(config, param, values, options)?;
+    let (mut rows, graph) = gait_rows_measured(&[row], 0..1, initial, options, progress);
+    Ok((rows.pop().unwrap_or_default(), graph))
 }
 
 /// Write Fig. 2 (`fig2.svg`, `fig2.png`) of the sweep's `points` and `thresholds` into the job's directory.

@@ -115,6 +115,7 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
     for (kind, n) in &summary.outcomes {
         println!("  {kind:<20} {n}");
     }
+    super::print_parallelism(&summary.parallelism);
     println!(
         "wrote {}/{{{}}}",
         args.out.display(),

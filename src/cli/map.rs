@@ -137,6 +137,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     bar.finish_and_clear();
     print_totals(&args, &summary, started.elapsed().as_secs_f64());
     print_curves(&summary);
+    super::print_parallelism(&summary.parallelism);
     if args.second_route {
         print_second_route(&args, &summary);
     }

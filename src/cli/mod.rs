@@ -321,6 +321,13 @@ fn confirmed_count<'a>(thresholds: impl Iterator<Item = &'a Threshold>) -> Strin
     words
 }
 
+/// Print a grid job's work and span, a line per phase (`vrw::study::parallelism`).
+fn print_parallelism(phases: &[vrw::study::parallelism::PhaseWork]) {
+    for p in phases {
+        println!("  parallelism of the {p}");
+    }
+}
+
 /// The most audit warnings a command prints; the file it names lists them all.
 const PRINTED_WARNINGS: usize = 20;
 

@@ -118,6 +118,7 @@ pub(super) fn run(args: OrbitArgs) -> Result<()> {
         summary.seconds[0],
         summary.seconds[1]
     );
+    super::print_parallelism(&summary.parallelism);
     if !args.no_branch {
         println!(
             "period-1 branch: a gait at {} values, stable at {}",

@@ -101,6 +101,7 @@ pub(super) fn run(args: SweepArgs) -> Result<()> {
     for t in &summary.thresholds {
         print_threshold(&args.param, t);
     }
+    super::print_parallelism(&summary.parallelism);
     if args.second_route {
         println!(
             "  second route: {:.2} s; {}",

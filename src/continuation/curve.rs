@@ -14,6 +14,8 @@
 
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+
+use crate::meter::carried;
 use serde::Serialize;
 
 use super::corrector::tangent;
@@ -217,33 +219,38 @@ impl<I: Clone + Send> CurveProblem<'_, I> {
     ) -> Result<DMatrix<f64>, MapFailure> {
         let n = u.len() - 2;
         // Central differences: dP/dp2 (column n + 1) and the gradient of g (all columns).
-        let shifted: Vec<(DVector<f64>, f64)> = (0..n + 2)
+        // Every difference is computed, a failure or not, and the first failure in order is the error: the same
+        // work for any number of threads.
+        let shifted: Vec<Result<(DVector<f64>, f64), MapFailure>> = (0..n + 2)
             .into_par_iter()
-            .map(|i| -> Result<(DVector<f64>, f64), MapFailure> {
-                let step = CURVE_FD_STEP * u[i].abs().max(1.0);
-                let at = |sign: f64| {
-                    let mut v = u.clone();
-                    v[i] += sign * step;
-                    self.residual_at(&v, o, self.offset, false).map(|(r, _)| r)
-                };
-                // A difference whose walk fails, or that lands on the other side of a border (g + offset of
-                // the opposite sign to offset), is replaced by the one-sided difference on the other side.
-                let usable = |r: &Result<DVector<f64>, MapFailure>| match r {
-                    Ok(r) => self.offset == 0.0 || (r[n] + self.offset) * self.offset >= 0.0,
-                    Err(_) => false,
-                };
-                let (plus, minus) = (at(1.0), at(-1.0));
-                let here = || self.residual_at(u, o, self.offset, false).map(|(r, _)| r);
-                let d = match (usable(&plus), usable(&minus), plus, minus) {
-                    (true, true, Ok(p), Ok(m)) => (p - m) / (2.0 * step),
-                    (false, true, _, Ok(m)) => (here()? - m) / step,
-                    (true, false, Ok(p), _) => (p - here()?) / step,
-                    (_, _, Err(e), _) | (_, _, _, Err(e)) => return Err(e),
-                    _ => return Err(failure("both differences cross the border")),
-                };
-                Ok((d.rows(0, n).into_owned(), d[n]))
-            })
-            .collect::<Result<_, _>>()?;
+            .map(carried(
+                |i: usize| -> Result<(DVector<f64>, f64), MapFailure> {
+                    let step = CURVE_FD_STEP * u[i].abs().max(1.0);
+                    let at = |sign: f64| {
+                        let mut v = u.clone();
+                        v[i] += sign * step;
+                        self.residual_at(&v, o, self.offset, false).map(|(r, _)| r)
+                    };
+                    // A difference whose walk fails, or that lands on the other side of a border (g + offset of
+                    // the opposite sign to offset), is replaced by the one-sided difference on the other side.
+                    let usable = |r: &Result<DVector<f64>, MapFailure>| match r {
+                        Ok(r) => self.offset == 0.0 || (r[n] + self.offset) * self.offset >= 0.0,
+                        Err(_) => false,
+                    };
+                    let (plus, minus) = (at(1.0), at(-1.0));
+                    let here = || self.residual_at(u, o, self.offset, false).map(|(r, _)| r);
+                    let d = match (usable(&plus), usable(&minus), plus, minus) {
+                        (true, true, Ok(p), Ok(m)) => (p - m) / (2.0 * step),
+                        (false, true, _, Ok(m)) => (here()? - m) / step,
+                        (true, false, Ok(p), _) => (p - here()?) / step,
+                        (_, _, Err(e), _) | (_, _, _, Err(e)) => return Err(e),
+                        _ => return Err(failure("both differences cross the border")),
+                    };
+                    Ok((d.rows(0, n).into_owned(), d[n]))
+                },
+            ))
+            .collect();
+        let shifted = shifted.into_iter().collect::<Result<Vec<_>, _>>()?;
         let mut j = DMatrix::zeros(n + 1, n + 2);
         for r in 0..n {
             for c in 0..n {

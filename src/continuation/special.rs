@@ -21,6 +21,8 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 use rayon::prelude::*;
+
+use crate::meter::carried;
 use serde::Serialize;
 
 use super::corrector::{
@@ -414,10 +416,11 @@ fn newton_extended<M: FamilyMap>(
         if !g.is_finite() {
             return Err(format!("the test function is not defined at p = {p}"));
         }
-        // Central differences of the test function in each unknown, on both cores.
-        let gradient: Vec<f64> = (0..=n)
+        // Central differences of the test function in each unknown, on both cores (every one computed, the first
+        // failure in order the error: the same work for any number of threads).
+        let gradient: Vec<Result<f64, String>> = (0..=n)
             .into_par_iter()
-            .map(|i| {
+            .map(carried(|i: usize| {
                 let step = LOCATE_FD_STEP * z[i].abs().max(1.0);
                 let at = |sign: f64| -> Result<f64, String> {
                     let mut zs = z.clone();
@@ -426,8 +429,9 @@ fn newton_extended<M: FamilyMap>(
                     Ok(test(&map.eval(&xs, ps).map_err(|e| e.message)?))
                 };
                 Ok((at(1.0)? - at(-1.0)?) / (2.0 * step))
-            })
-            .collect::<Result<_, String>>()?;
+            }))
+            .collect();
+        let gradient = gradient.into_iter().collect::<Result<Vec<f64>, String>>()?;
         let m = bordered(
             &augmented(&ev.jacobian, &ev.dparam, sigma),
             &DVector::from_vec(gradient),

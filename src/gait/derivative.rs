@@ -70,7 +70,7 @@ pub(crate) fn gait_jacobian(
     let other_map = map.with_tolerances_scaled(second_tolerance_factor(map));
     let other_param = param.filter(|_| estimate.1);
     // The two computations are independent: both cores.
-    let (at, other) = rayon::join(
+    let (at, other) = crate::meter::join(
         || map.eval_with_derivatives(s, param),
         || {
             estimate
@@ -181,7 +181,7 @@ pub fn check_jacobian(
     let other = map.with_tolerances_scaled(factor);
     // The two sets of walks are independent: both cores.
     let (at_run, at_other) =
-        rayon::join(|| map.jacobian(s, fd_step), || other.jacobian(s, fd_step));
+        crate::meter::join(|| map.jacobian(s, fd_step), || other.jacobian(s, fd_step));
     let (at_run, at_other) = (at_run?, at_other?);
     let noise = (&at_run.0 - &at_other.0).amax();
     let ((fd, spread), tighter) = if factor < 1.0 {

@@ -22,6 +22,8 @@ use std::sync::{Arc, Mutex};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
+use crate::meter::carried;
+
 use crate::dynamics::{Model, DIFFERENTIABLE_KEYS, L2, THETA};
 use crate::params::ImpactModel;
 use crate::params::SolverOptions;
@@ -423,16 +425,19 @@ impl<'m> StepMap<'m> {
         let n = x.len();
         let steps: Vec<f64> = x.iter().map(|v| h * v.abs().max(1.0)).collect();
         // The 2n evaluations are independent: run them in parallel (the result does not depend on the
-        // number of threads, since each evaluation is the same computation wherever it runs).
-        let images: Vec<DVector<f64>> = (0..2 * n)
+        // number of threads, since each evaluation is the same computation wherever it runs). All of them
+        // run, a failure or not, and the first failure in order is the error: the work is the same for any
+        // number of threads too.
+        let images: Vec<Result<DVector<f64>, WalkError>> = (0..2 * n)
             .into_par_iter()
-            .map(|k| {
+            .map(carried(|k| {
                 let (j, sign) = (k / 2, if k % 2 == 0 { 1.0 } else { -1.0 });
                 let mut shifted = x.clone();
                 shifted[j] += sign * steps[j];
                 Ok(self.reduce(&self.eval(&self.expand(s, &shifted))?.next))
-            })
-            .collect::<Result<_, WalkError>>()?;
+            }))
+            .collect();
+        let images = images.into_iter().collect::<Result<Vec<_>, _>>()?;
         let mut jac = DMatrix::zeros(n, n);
         for j in 0..n {
             jac.set_column(

@@ -18,7 +18,8 @@ use std::ops::Range;
 
 use serde::Serialize;
 
-use super::grid::{run_rows_part, Evaluated};
+use super::grid::run_independent;
+use super::parallelism::TaskGraph;
 use crate::dynamics::Model;
 use crate::gait::limit_cycle::Gait;
 use crate::gait::periodicity::{least_period, MAX_PERIOD};
@@ -256,37 +257,35 @@ pub fn basin(
     spec: &BasinSpec,
     progress: &(dyn Fn(&BasinPoint) + Sync),
 ) -> Vec<Vec<BasinPoint>> {
-    basin_part(model, opts, gait, spec, 0..spec.y.points, progress)
+    basin_measured(model, opts, gait, spec, 0..spec.y.points, progress).0
 }
 
 /// The rows `part` (indices of `y` values, within `0..spec.y.points`) of [`basin`], each point exactly as the
-/// whole basin has it (a basin computed in parts, a study spread over processes, is the basin).
-pub fn basin_part(
+/// whole basin has it (a basin computed in parts, a study spread over processes, is the basin), with the task
+/// graph ([`super::parallelism`]): every start is a task of its own, and all of them run in parallel (none
+/// continues another).
+pub fn basin_measured(
     model: &Model,
     opts: &SolverOptions,
     gait: &Gait,
     spec: &BasinSpec,
     part: Range<usize>,
     progress: &(dyn Fn(&BasinPoint) + Sync),
-) -> Vec<Vec<BasinPoint>> {
-    run_rows_part(
-        part,
-        spec.y.points,
-        spec.x.points,
-        |cell, _: Option<(usize, &())>| {
-            // The other coordinates (and a slipping tip's `slip`) are the gait's.
-            let start = spec
-                .through
-                .with_coordinate(spec.x.coordinate.index(), spec.x.value(cell.col))
-                .with_coordinate(spec.y.coordinate.index(), spec.y.value(cell.row));
-            let point = BasinPoint {
-                ix: cell.col,
-                iy: cell.row,
-                start,
-                outcome: classify(model, opts, gait, &start, spec.max_steps, spec.tolerance),
-            };
-            progress(&point);
-            Evaluated { point, carry: None }
-        },
-    )
+) -> (Vec<Vec<BasinPoint>>, TaskGraph) {
+    let run = run_independent(part, spec.x.points, |cell| {
+        // The other coordinates (and a slipping tip's `slip`) are the gait's.
+        let start = spec
+            .through
+            .with_coordinate(spec.x.coordinate.index(), spec.x.value(cell.col))
+            .with_coordinate(spec.y.coordinate.index(), spec.y.value(cell.row));
+        let point = BasinPoint {
+            ix: cell.col,
+            iy: cell.row,
+            start,
+            outcome: classify(model, opts, gait, &start, spec.max_steps, spec.tolerance),
+        };
+        progress(&point);
+        point
+    });
+    (run.rows, run.graph)
 }

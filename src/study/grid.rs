@@ -1,7 +1,7 @@
 //! The grid runner: evaluate something at every point of a grid of rows, each row continued from left to right,
 //! rows in parallel, with results bitwise identical for any number of threads.
 //!
-//! Sweeps and maps ([`super::sweep::gait_rows`]) and any other "evaluate the step map over a grid, continuing
+//! Sweeps and maps ([`super::sweep::gait_rows_measured`]) and any other "evaluate the step map over a grid, continuing
 //! along rows" job use this one runner. A job supplies the evaluation of one point as a closure
 //! `eval(cell, from) -> Evaluated { point, carry }`:
 //!
@@ -23,6 +23,10 @@
 //! cell and on what it continues, so as long as `eval` is a deterministic function of its arguments the results
 //! do not depend on the number of threads or on the order in which rayon runs the work.
 //!
+//! **Measured parallelism.** Every point's evaluation is a task, run under a step meter and timed
+//! ([`super::parallelism`]); the runner returns with the points the graph of these tasks as its schedule orders
+//! them (`run_rows_measured`), from which a job reports its work and span.
+//!
 //! **Interruption.** The runner checks the library's interrupt flag ([`interrupt_flag`], set by the command
 //! line's Ctrl-C handler and by the Python binding's signal watcher) before every point and after it. Once it
 //! is set, no new point starts; the points under way stop (their walks read the flag too) and are dropped,
@@ -36,10 +40,11 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
+use super::parallelism::{measured, Cost, TaskGraph};
+use crate::meter::carried;
 use crate::walk::interrupt::interrupt_flag;
 
 /// Stride of the coarse continuation pass along a row.
@@ -63,6 +68,19 @@ pub(crate) struct Evaluated<P, C> {
     pub carry: Option<C>,
 }
 
+/// The points of a grid run and its task graph ([`super::parallelism`]): one task per point, after the point
+/// it continues from on the schedule (in a row in order, after the point before, whether or not that handed
+/// anything on: the schedule waits for it).
+#[derive(Debug, Clone)]
+pub(crate) struct GridRun<P> {
+    /// The points, row by row, as [`run_rows`] returns them.
+    pub rows: Vec<Vec<P>>,
+    /// One task per point.
+    pub graph: TaskGraph,
+    /// For each row (in the order of `rows`), the node of `graph` at which all its points are done.
+    pub row_done: Vec<usize>,
+}
+
 /// Evaluate every point of a grid of `rows` rows of `cols` points each, continuing along rows (see the module
 /// documentation for the schedule). Returns the points row by row, in column order; once the library's
 /// [`interrupt_flag`] is set, rows are cut to their complete prefix. `eval` must be a deterministic function of
@@ -73,24 +91,30 @@ where
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    run_rows_until(rows, cols, interrupt_flag(), eval)
+    run_part_until(0..rows, rows, cols, interrupt_flag(), eval).rows
 }
 
 /// [`run_rows`] stopped by `stop` instead of the library's interrupt flag.
+#[cfg(test)]
 pub fn run_rows_until<P, C, F>(rows: usize, cols: usize, stop: &AtomicBool, eval: F) -> Vec<Vec<P>>
 where
     P: Send,
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    run_part_until(0..rows, rows, cols, stop, eval)
+    run_part_until(0..rows, rows, cols, stop, eval).rows
 }
 
 /// The rows `part` of a grid of `rows` rows (a chunk of a study spread over processes, see
-/// [`super::map::map_gaits_part`]): every point of these rows exactly as [`run_rows`] computes it for the
+/// [`super::map::map_gaits_measured`]): every point of these rows exactly as [`run_rows`] computes it for the
 /// whole grid (the schedule is the whole grid's: a grid of one row is split, the rows of a larger one run in
-/// order), returned in the order of `part`. `part` must lie within `0..rows`.
-pub fn run_rows_part<P, C, F>(part: Range<usize>, rows: usize, cols: usize, eval: F) -> Vec<Vec<P>>
+/// order), returned in the order of `part`, with the task graph. `part` must lie within `0..rows`.
+pub(crate) fn run_rows_measured<P, C, F>(
+    part: Range<usize>,
+    rows: usize,
+    cols: usize,
+    eval: F,
+) -> GridRun<P>
 where
     P: Send,
     C: Send + Sync,
@@ -99,27 +123,110 @@ where
     run_part_until(part, rows, cols, interrupt_flag(), eval)
 }
 
+/// The rows `part` of a grid whose points continue nothing (each starts afresh, as a basin's do): every point
+/// in parallel, each exactly as [`run_rows_measured`] computes it, with the task graph (independent tasks). Rows
+/// are cut to their complete prefix once the library's [`interrupt_flag`] is set.
+pub(crate) fn run_independent<P, F>(part: Range<usize>, cols: usize, eval: F) -> GridRun<P>
+where
+    P: Send,
+    F: Fn(Cell) -> P + Sync,
+{
+    let stop = interrupt_flag();
+    let cells: Vec<Cell> = part
+        .clone()
+        .flat_map(|row| (0..cols).map(move |col| Cell { row, col }))
+        .collect();
+    let points: Vec<Option<(P, Cost)>> = cells
+        .par_iter()
+        .map(carried(|&cell: &Cell| {
+            if stopped(stop) {
+                return None;
+            }
+            let out = measured(|| eval(cell));
+            (!stopped(stop)).then_some(out)
+        }))
+        .collect();
+    let mut points = points.into_iter();
+    let mut run = GridRun {
+        rows: Vec::with_capacity(part.len()),
+        graph: TaskGraph::new(),
+        row_done: Vec::with_capacity(part.len()),
+    };
+    for _ in part {
+        let cells: Vec<Option<(P, Cost)>> = points.by_ref().take(cols).collect();
+        // The complete prefix.
+        let row: Vec<(P, Cost)> = cells.into_iter().map_while(|p| p).collect();
+        let nodes: Vec<usize> = row.iter().map(|p| run.graph.task(p.1, &[])).collect();
+        run.row_done.push(run.graph.join(&nodes));
+        run.rows.push(row.into_iter().map(|p| p.0).collect());
+    }
+    run
+}
+
 fn run_part_until<P, C, F>(
     part: Range<usize>,
     rows: usize,
     cols: usize,
     stop: &AtomicBool,
     eval: F,
-) -> Vec<Vec<P>>
+) -> GridRun<P>
 where
     P: Send,
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
     debug_assert!(part.end <= rows, "rows {part:?} of a grid of {rows}");
-    if rows == 1 {
-        return part
+    let split = rows == 1;
+    let costed: Vec<Vec<(P, Cost)>> = match split {
+        true => part
             .map(|row| run_split_row(row, cols, stop, &eval))
-            .collect();
+            .collect(),
+        false => part
+            .into_par_iter()
+            .map(carried(|row| run_row_in_order(row, cols, stop, &eval)))
+            .collect(),
+    };
+    let mut graph = TaskGraph::new();
+    let mut row_done = Vec::with_capacity(costed.len());
+    let rows = costed
+        .into_iter()
+        .map(|row| {
+            let costs: Vec<Cost> = row.iter().map(|p| p.1).collect();
+            row_done.push(schedule(&mut graph, &costs, split));
+            row.into_iter().map(|p| p.0).collect()
+        })
+        .collect();
+    GridRun {
+        rows,
+        graph,
+        row_done,
     }
-    part.into_par_iter()
-        .map(|row| run_row_in_order(row, cols, stop, &eval))
-        .collect()
+}
+
+/// Add the tasks of one row's points (their `costs`, in column order) to `graph` as the schedule runs them
+/// (`split`: the coarse pass and the fills, else in order); the node at which the row is done.
+fn schedule(graph: &mut TaskGraph, costs: &[Cost], split: bool) -> usize {
+    let mut ends = Vec::new();
+    let mut coarse: Option<usize> = None;
+    let mut last: Option<usize> = None;
+    for (col, &cost) in costs.iter().enumerate() {
+        let after = match (split, col % COARSE_STRIDE == 0) {
+            (true, true) => coarse,
+            (true, false) if col % COARSE_STRIDE == 1 => coarse,
+            _ => last,
+        };
+        let node = graph.task(cost, after.as_slice());
+        if split && col % COARSE_STRIDE == 0 {
+            coarse = Some(node);
+            ends.push(node);
+        }
+        if split && (col + 1) % COARSE_STRIDE == 0 {
+            ends.push(node);
+        }
+        last = Some(node);
+    }
+    ends.extend(last);
+    graph.join(&ends)
 }
 
 /// Has the run been stopped? Checked before a point starts and again after it returns: a point whose
@@ -129,8 +236,16 @@ fn stopped(stop: &AtomicBool) -> bool {
     stop.load(Ordering::Relaxed)
 }
 
-/// One row in order, every point continuing the one before.
-fn run_row_in_order<P, C, F>(row: usize, cols: usize, stop: &AtomicBool, eval: &F) -> Vec<P>
+/// One point's evaluation as a task: the evaluation and what it cost.
+fn eval_task<P, C, F>(eval: &F, cell: Cell, from: Option<(usize, &C)>) -> (Evaluated<P, C>, Cost)
+where
+    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
+{
+    measured(|| eval(cell, from))
+}
+
+/// One row in order, every point continuing the one before; each point with its cost.
+fn run_row_in_order<P, C, F>(row: usize, cols: usize, stop: &AtomicBool, eval: &F) -> Vec<(P, Cost)>
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
@@ -140,33 +255,37 @@ where
         if stopped(stop) {
             break;
         }
-        let e = eval(Cell { row, col }, last.as_ref().map(|(j, c)| (*j, c)));
+        let (e, cost) = eval_task(eval, Cell { row, col }, last.as_ref().map(|(j, c)| (*j, c)));
         if stopped(stop) {
             break;
         }
-        points.push(e.point);
+        points.push((e.point, cost));
         last = e.carry.map(|c| (col, c));
     }
     points
 }
 
-/// One row split for parallelism: the coarse pass, then the intervals between coarse points in parallel.
-fn run_split_row<P, C, F>(row: usize, cols: usize, stop: &AtomicBool, eval: &F) -> Vec<P>
+/// One row split for parallelism: the coarse pass, then the intervals between coarse points in parallel; each
+/// point with its cost.
+fn run_split_row<P, C, F>(row: usize, cols: usize, stop: &AtomicBool, eval: &F) -> Vec<(P, Cost)>
 where
     P: Send,
     C: Send + Sync,
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C> + Sync,
 {
-    let (coarse_points, carries, took) = coarse_pass_timed(row, cols, stop, eval);
+    let (coarse_points, carries) = coarse_pass_until(row, cols, stop, eval);
     // The intervals are independent: they start longest first, each as long as the coarse step over it took
     // (the one with a family's end in it takes the longest, and started last it was the wall time's tail).
     // Only the order of the work depends on the clock, never a result.
+    let took = |k: usize| coarse_points.get(k + 1).map_or(0.0, |p| p.1.seconds);
     let mut order: Vec<usize> = (0..carries.len()).collect();
-    order.sort_by_key(|&k| std::cmp::Reverse(took.get(k + 1).copied().unwrap_or_default()));
-    let mut fills: Vec<(usize, Vec<P>)> = order
+    order.sort_by(|&a, &b| took(b).total_cmp(&took(a)));
+    let mut fills: Vec<(usize, Vec<(P, Cost)>)> = order
         .into_par_iter()
         .with_max_len(1)
-        .map(|k| (k, fill_until(row, cols, k, carries[k].as_ref(), stop, eval)))
+        .map(carried(|k| {
+            (k, fill_until(row, cols, k, carries[k].as_ref(), stop, eval))
+        }))
         .collect();
     fills.sort_by_key(|(k, _)| *k);
     let fills = fills.into_iter().map(|(_, fill)| fill);
@@ -198,37 +317,24 @@ pub(crate) fn coarse_pass<P, C, F>(row: usize, cols: usize, eval: &F) -> (Vec<P>
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
-    coarse_pass_until(row, cols, interrupt_flag(), eval)
+    let (points, carries) = coarse_pass_until(row, cols, interrupt_flag(), eval);
+    (points.into_iter().map(|p| p.0).collect(), carries)
 }
 
+/// [`coarse_pass`] stopped by `stop`, each point with its cost.
+#[allow(clippy::type_complexity)]
 fn coarse_pass_until<P, C, F>(
     row: usize,
     cols: usize,
     stop: &AtomicBool,
     eval: &F,
-) -> (Vec<P>, Vec<Option<C>>)
-where
-    F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
-{
-    let (points, carries, _) = coarse_pass_timed(row, cols, stop, eval);
-    (points, carries)
-}
-
-/// [`coarse_pass_until`] with the time each coarse point took.
-#[allow(clippy::type_complexity)]
-fn coarse_pass_timed<P, C, F>(
-    row: usize,
-    cols: usize,
-    stop: &AtomicBool,
-    eval: &F,
-) -> (Vec<P>, Vec<Option<C>>, Vec<Duration>)
+) -> (Vec<(P, Cost)>, Vec<Option<C>>)
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
     let n = cols.div_ceil(COARSE_STRIDE);
-    let mut points: Vec<P> = Vec::with_capacity(n);
+    let mut points = Vec::with_capacity(n);
     let mut carries: Vec<Option<C>> = Vec::with_capacity(n);
-    let mut took = Vec::with_capacity(n);
     for col in (0..cols).step_by(COARSE_STRIDE) {
         if stopped(stop) {
             break;
@@ -236,16 +342,14 @@ where
         let from = carries
             .last()
             .and_then(|c| c.as_ref().map(|c| (col - COARSE_STRIDE, c)));
-        let start = Instant::now();
-        let e = eval(Cell { row, col }, from);
+        let (e, cost) = eval_task(eval, Cell { row, col }, from);
         if stopped(stop) {
             break;
         }
-        took.push(start.elapsed());
-        points.push(e.point);
+        points.push((e.point, cost));
         carries.push(e.carry);
     }
-    (points, carries, took)
+    (points, carries)
 }
 
 /// The points between coarse point `k` (which handed on `left`) and the next, in order, each continuing the
@@ -254,7 +358,8 @@ pub(crate) fn fill<P, C, F>(row: usize, cols: usize, k: usize, left: Option<&C>,
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
-    fill_until(row, cols, k, left, interrupt_flag(), eval)
+    let points = fill_until(row, cols, k, left, interrupt_flag(), eval);
+    points.into_iter().map(|p| p.0).collect()
 }
 
 fn fill_until<P, C, F>(
@@ -264,7 +369,7 @@ fn fill_until<P, C, F>(
     left: Option<&C>,
     stop: &AtomicBool,
     eval: &F,
-) -> Vec<P>
+) -> Vec<(P, Cost)>
 where
     F: Fn(Cell, Option<(usize, &C)>) -> Evaluated<P, C>,
 {
@@ -279,11 +384,11 @@ where
             None => left.map(|c| (first, c)),
             Some((j, c)) => c.as_ref().map(|c| (*j, c)),
         };
-        let e = eval(Cell { row, col }, from);
+        let (e, cost) = eval_task(eval, Cell { row, col }, from);
         if stopped(stop) {
             break;
         }
-        points.push(e.point);
+        points.push((e.point, cost));
         last = Some((col, e.carry));
     }
     points
@@ -386,7 +491,7 @@ mod tests {
             let whole = run_rows(rows, cols, eval);
             for part in [0..rows, rows - 1..rows, 0..0] {
                 assert_eq!(
-                    run_rows_part(part.clone(), rows, cols, eval),
+                    run_rows_measured(part.clone(), rows, cols, eval).rows,
                     whole[part].to_vec()
                 );
             }
@@ -409,6 +514,56 @@ mod tests {
                 parts.extend(fill(0, cols, k, left.as_ref(), &eval));
             }
             assert_eq!(parts, whole, "{cols} points");
+        }
+    }
+
+    /// The task graph follows the schedule: rows in order are chains, a split row is its coarse chain with
+    /// each fill after its coarse point, independent points are independent; work and span are counted in the
+    /// steps each task walks (here `col + 1`), the same for any number of threads.
+    #[test]
+    fn task_graphs_follow_the_schedule() {
+        let eval = |cell: Cell, _: Option<(usize, &())>| {
+            (0..=cell.col).for_each(|_| crate::meter::count_step());
+            Evaluated {
+                point: cell.col,
+                carry: Some(()),
+            }
+        };
+        let cols = 2 * COARSE_STRIDE + 3;
+        let row = (1..=cols as u64).sum::<u64>();
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (rows, split, independent) = pool.install(|| {
+                (
+                    run_rows_measured(0..3, 3, cols, eval).graph.work_span(),
+                    run_rows_measured(0..1, 1, cols, eval).graph.work_span(),
+                    run_independent(0..2, cols, |cell| eval(cell, None).point)
+                        .graph
+                        .work_span(),
+                )
+            });
+            assert_eq!(
+                (rows.tasks, rows.work_steps, rows.span_steps),
+                (3 * cols, 3 * row, row)
+            );
+            // The fill of the second interval, after the first two coarse points: 1 + 11 + (12 + ... + 20).
+            let fill = (12..=20).sum::<u64>();
+            assert_eq!(
+                (split.tasks, split.work_steps, split.span_steps),
+                (cols, row, 1 + 11 + fill)
+            );
+            let cols64 = cols as u64;
+            assert_eq!(
+                (
+                    independent.tasks,
+                    independent.work_steps,
+                    independent.span_steps
+                ),
+                (2 * cols, 2 * row, cols64)
+            );
         }
     }
 

@@ -1,14 +1,14 @@
 //! Maps over two parameters: the gait at every point of an `x` by `y` grid, and the threshold curves across
 //! the plane (docs/model.md section 6).
 //!
-//! **Gaits.** Every row (fixed `y`) is a sweep along `x` with the sweep's rules (`gait_rows` on
+//! **Gaits.** Every row (fixed `y`) is a sweep along `x` with the sweep's rules (`gait_rows_measured` on
 //! the `grid` runner): continuation from the left neighbour, a search from the initial state where the
 //! family ends, backward fill and family numbers. Rows run in parallel and the map is bitwise identical for any
 //! number of threads. So row `j` of a map is exactly the sweep along `x` at `y_j`.
 //!
 //! **Curves.** The threshold curves (`lambda_4+ = 0`, `lambda_2+ = 0`, `lambda_I4 = 0`, loss of stability, the
 //! end of existence, branch switches, folds) are never read off the grid. Every row is searched for the 1-D
-//! thresholds of [`find_thresholds`] (refined to `PARAM_TOL` in `x`; the family ends come
+//! thresholds of [`find_thresholds`](super::find_thresholds) (refined to `PARAM_TOL` in `x`; the family ends come
 //! from the continuations that found the row's gaits, [`super::sweep::SweepPoint::attempts`]), and so are the
 //! columns [`curve_columns`] picks, at most `max_columns` of them, evenly spread with both ends (fixed `x`,
 //! refined to `PARAM_TOL` in `y`; the column's gaits are those of the rows, and neighbours
@@ -26,11 +26,15 @@ use std::ops::Range;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::sweep::{gait_rows_part, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec};
-use super::thresholds::{find_thresholds, Threshold};
+use super::parallelism::{measured, Cost, TaskGraph};
+use super::sweep::{
+    gait_rows_measured, number_families, GaitRow, RangeNames, SweepPoint, SweepSpec,
+};
+use super::thresholds::{find_thresholds_costed, Threshold};
 use crate::family::Parameter;
 use crate::fmt::short;
 use crate::gait::limit_cycle::GaitOptions;
+use crate::meter::carried;
 use crate::params::{Config, ConfigError, NumericKey};
 use crate::walk::SectionState;
 
@@ -145,20 +149,22 @@ pub fn map_gaits(
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<GaitMap, ConfigError> {
-    map_gaits_part(config, spec, 0..spec.y.points, initial, options, progress)
+    let all = 0..spec.y.points;
+    map_gaits_measured(config, spec, all, initial, options, progress).map(|m| m.0)
 }
 
 /// The rows `part` (indices of `y` values, within `0..spec.y.points`) of [`map_gaits`]: each row's points
 /// exactly as the whole map has them, so a map computed in parts (a study spread over processes) is the map.
-/// The returned map has those rows and their `ys` only.
-pub fn map_gaits_part(
+/// The returned map has those rows and their `ys` only. With their task graph: a task per point on the grid
+/// runner's schedule and one per row (its backward fill and family numbers) ([`super::parallelism`]).
+pub fn map_gaits_measured(
     config: &Config,
     spec: &MapSpec,
     part: Range<usize>,
     initial: &SectionState,
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
-) -> Result<GaitMap, ConfigError> {
+) -> Result<(GaitMap, TaskGraph), ConfigError> {
     spec.validate(config)?;
     options.validate()?;
     check_part(&part, spec.y.points)?;
@@ -173,13 +179,14 @@ pub fn map_gaits_part(
             values: xs.clone(),
         })
         .collect();
-    let rows = gait_rows_part(&rows, part.clone(), initial, options, progress);
-    Ok(GaitMap {
+    let (rows, graph) = gait_rows_measured(&rows, part.clone(), initial, options, progress);
+    let map = GaitMap {
         spec: spec.clone(),
         xs,
         ys: ys[part].to_vec(),
         rows,
-    })
+    };
+    Ok((map, graph))
 }
 
 /// A part of a grid's rows must be a non-empty range of its `rows` rows.
@@ -355,26 +362,79 @@ pub fn map_curves(
     options: &GaitOptions,
     max_columns: usize,
 ) -> Result<MapCurves, ConfigError> {
+    map_curves_measured(config, map, options, max_columns).map(|c| c.0)
+}
+
+/// [`map_curves`] with its task graph ([`super::parallelism`]): every refinement of a row's or column's
+/// threshold search is a task (a column's after the task that numbers its families). The rows and the columns
+/// are searched together, all lines in parallel.
+pub fn map_curves_measured(
+    config: &Config,
+    map: &GaitMap,
+    options: &GaitOptions,
+    max_columns: usize,
+) -> Result<(MapCurves, TaskGraph), ConfigError> {
     let columns = curve_columns(map.xs.len(), max_columns);
     let spec = &map.spec;
-    let (x_key, y_key) = (
+    let keys = (
         NumericKey::new(&spec.x.param)?,
         NumericKey::new(&spec.y.param)?,
     );
-    let rows: Vec<Vec<LineThreshold>> = map
-        .rows
-        .par_iter()
-        .enumerate()
-        .map(|(j, points)| {
-            let c = spec.with_y(config, map.ys[j]);
-            let parameter = Parameter::new(&c, x_key);
-            line_thresholds(Along::X, j, find_thresholds(parameter, points, options))
-        })
+    let lines: Vec<(Along, usize)> = (0..map.rows.len())
+        .map(|j| (Along::X, j))
+        .chain(columns.iter().map(|&i| (Along::Y, i)))
         .collect();
-    let cols: Vec<Vec<LineThreshold>> = columns
+    let searched: Vec<LineSearch> = lines
         .par_iter()
-        .map(|&i| {
-            let c = spec.with_x(config, map.xs[i]);
+        .with_max_len(1)
+        .map(carried(|&(along, line): &(Along, usize)| {
+            line_search(config, map, options, keys, along, line)
+        }))
+        .collect();
+    let mut graph = TaskGraph::new();
+    let mut thresholds: Vec<LineThreshold> = Vec::new();
+    for s in searched {
+        let after: Vec<usize> = s.families.map(|c| graph.task(c, &[])).into_iter().collect();
+        for cost in s.refinements {
+            graph.task(cost, &after);
+        }
+        thresholds.extend(s.thresholds);
+    }
+    let curves = connect(&map.xs, &map.ys, &columns, &thresholds);
+    Ok((MapCurves { curves, thresholds }, graph))
+}
+
+/// One line's threshold search and its tasks.
+struct LineSearch {
+    thresholds: Vec<LineThreshold>,
+    /// A column's family numbers (a row's come with its gaits).
+    families: Option<Cost>,
+    /// Each refinement.
+    refinements: Vec<Cost>,
+}
+
+/// The thresholds of row `line` (`Along::X`) or column `line` (`Along::Y`) of `map`, `keys` the `x` and `y`
+/// keys.
+fn line_search(
+    config: &Config,
+    map: &GaitMap,
+    options: &GaitOptions,
+    keys: (NumericKey, NumericKey),
+    along: Along,
+    line: usize,
+) -> LineSearch {
+    let spec = &map.spec;
+    let (thresholds, families) = match along {
+        Along::X => {
+            let c = spec.with_y(config, map.ys[line]);
+            let parameter = Parameter::new(&c, keys.0);
+            (
+                find_thresholds_costed(parameter, &map.rows[line], options),
+                None,
+            )
+        }
+        Along::Y => {
+            let c = spec.with_x(config, map.xs[line]);
             let mut points: Vec<SweepPoint> = map
                 .rows
                 .iter()
@@ -385,17 +445,22 @@ pub fn map_curves(
                     family: None,
                     // The rows' continuations were along x: none of them is a step along this column.
                     attempts: Vec::new(),
-                    ..row[i].clone()
+                    ..row[line].clone()
                 })
                 .collect();
-            let parameter = Parameter::new(&c, y_key);
-            number_families(parameter, &mut points, options);
-            line_thresholds(Along::Y, i, find_thresholds(parameter, &points, options))
-        })
-        .collect();
-    let thresholds: Vec<LineThreshold> = rows.into_iter().chain(cols).flatten().collect();
-    let curves = connect(&map.xs, &map.ys, &columns, &thresholds);
-    Ok(MapCurves { curves, thresholds })
+            let parameter = Parameter::new(&c, keys.1);
+            let ((), families) = measured(|| number_families(parameter, &mut points, options));
+            (
+                find_thresholds_costed(parameter, &points, options),
+                Some(families),
+            )
+        }
+    };
+    LineSearch {
+        thresholds: line_thresholds(along, line, thresholds.0),
+        families,
+        refinements: thresholds.1,
+    }
 }
 
 fn line_thresholds(along: Along, line: usize, thresholds: Vec<Threshold>) -> Vec<LineThreshold> {

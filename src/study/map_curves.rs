@@ -9,6 +9,9 @@
 
 use rayon::prelude::*;
 
+use super::parallelism::{measured, Cost, TaskGraph};
+use crate::meter::carried;
+
 use super::map::NearMiss;
 use super::map::{Along, LineThreshold, RefinedOn};
 use super::{
@@ -67,83 +70,139 @@ const MAX_FAILED_SEEDS: usize = 4;
 /// lines' crossings (see the module documentation). Returns the warnings: a continuation that failed
 /// from a crossing inside a family.
 pub fn continue_map_curves(config: &Config, map: &GaitMap, curves: &mut MapCurves) -> Vec<String> {
+    continue_map_curves_measured(config, map, curves).0
+}
+
+/// [`continue_map_curves`] with its task graph ([`super::parallelism`]): the curves of the five conditions are
+/// followed at the same time (each reads only the lines' thresholds); within one, every continuation from a
+/// crossing is a task after the one before (which crossings are left to start from depends on the curves
+/// already followed).
+pub fn continue_map_curves_measured(
+    config: &Config,
+    map: &GaitMap,
+    curves: &mut MapCurves,
+) -> (Vec<String>, TaskGraph) {
+    let thresholds = &curves.thresholds;
+    let followed: Vec<Followed> = CONTINUED_CURVES
+        .par_iter()
+        .with_max_len(1)
+        .map(carried(|&(name, condition): &(&str, Condition)| {
+            follow_condition(config, map, thresholds, name, condition)
+        }))
+        .collect();
     let mut warnings = Vec::new();
-    for (name, condition) in CONTINUED_CURVES {
-        // A crossing where the row's family ends (the indicator vanishes with the family, at the same value as
-        // the end's threshold): the curve may run along the end of existence, where a curve of
-        // `lambda = offset` can often be followed but not always; where it cannot, the crossing silently stays
-        // with the curves through the crossings.
-        let at_family_end = |t: &LineThreshold| {
-            curves.thresholds.iter().any(|o| {
-                o.along == t.along
-                    && o.line == t.line
-                    && o.threshold.value == t.threshold.value
-                    && FAMILY_END_NAMES.contains(&o.threshold.name.as_str())
-            })
-        };
-        // The crossings of rows and columns (rows' first: the curves start from them where they can).
-        let seeds: Vec<&LineThreshold> = curves
-            .thresholds
-            .iter()
-            .filter(|t| t.threshold.name == name && t.threshold.value.is_finite())
-            .collect();
-        let mut covered = vec![false; seeds.len()];
-        // Crossings within a grid cell of a continued curve but not on it: a different border nearby (e.g. a
-        // period-2 family's where the curve is a period-1 family's). Continuing from one would most likely
-        // follow the same curve again.
-        let mut near = vec![false; seeds.len()];
-        // Failures at family ends and elsewhere.
-        let mut failures = [0, 0];
-        let mut continued = Vec::new();
-        for k in 0..seeds.len() {
-            let end = usize::from(!at_family_end(seeds[k]));
-            if covered[k] || near[k] || failures[end] >= MAX_FAILED_SEEDS {
-                continue;
-            }
-            match follow_from_crossing(config, map, &seeds, k, condition) {
-                Ok((curve, hits, misses)) => {
-                    for h in hits {
-                        covered[h] = true;
-                    }
-                    for m in misses {
-                        near[m] = true;
-                    }
-                    continued.push(curve);
-                }
-                Err(_) if end == 0 => failures[0] += 1,
-                Err(message) => {
-                    failures[1] += 1;
-                    let (line, param) = match seeds[k].along {
-                        Along::X => ("row", &map.spec.x.param),
-                        Along::Y => ("column", &map.spec.y.param),
-                    };
-                    warnings.push(format!(
-                        "{name}: no curve continued from the crossing of {line} {} at {param} = {}: \
-                         {message}; its curve is drawn through the crossings",
-                        seeds[k].line, seeds[k].threshold.value
-                    ));
-                }
-            }
+    let mut graph = TaskGraph::new();
+    for ((name, _), f) in CONTINUED_CURVES.iter().zip(followed) {
+        let mut last: Option<usize> = None;
+        for &cost in &f.costs {
+            last = Some(graph.task(cost, last.as_slice()));
         }
+        warnings.extend(f.warnings);
         // The crossings a continued curve covers leave the curves through the crossings, which split into the
         // runs of the crossings left.
-        let covered_points: Vec<[f64; 2]> = seeds
-            .iter()
-            .zip(&covered)
-            .filter(|(_, &c)| c)
-            .map(|(t, _)| crossing_point(map, t))
-            .collect();
         let (own, others): (Vec<ThresholdCurve>, Vec<ThresholdCurve>) =
             std::mem::take(&mut curves.curves)
                 .into_iter()
-                .partition(|c| c.name == name);
+                .partition(|c| c.name == *name);
         curves.curves = others;
         for c in own {
-            curves.curves.extend(uncovered_runs(c, &covered_points));
+            curves.curves.extend(uncovered_runs(c, &f.covered_points));
         }
-        curves.curves.extend(continued);
+        curves.curves.extend(f.continued);
     }
-    warnings
+    (warnings, graph)
+}
+
+/// The curves of one condition continued from the lines' crossings, and what they cover.
+struct Followed {
+    /// The continued curves, in the order their seeds come.
+    continued: Vec<ThresholdCurve>,
+    /// The points of the crossings they cover.
+    covered_points: Vec<[f64; 2]>,
+    /// The continuations that failed from a crossing inside a family.
+    warnings: Vec<String>,
+    /// The cost of each continuation tried, in order.
+    costs: Vec<Cost>,
+}
+
+/// The curves of the threshold `name` continued from the crossings of `thresholds` (rows' first), each from the
+/// first crossing no curve followed before covers (see [`continue_map_curves`]).
+fn follow_condition(
+    config: &Config,
+    map: &GaitMap,
+    thresholds: &[LineThreshold],
+    name: &str,
+    condition: Condition,
+) -> Followed {
+    // A crossing where the row's family ends (the indicator vanishes with the family, at the same value as
+    // the end's threshold): the curve may run along the end of existence, where a curve of
+    // `lambda = offset` can often be followed but not always; where it cannot, the crossing silently stays
+    // with the curves through the crossings.
+    let at_family_end = |t: &LineThreshold| {
+        thresholds.iter().any(|o| {
+            o.along == t.along
+                && o.line == t.line
+                && o.threshold.value == t.threshold.value
+                && FAMILY_END_NAMES.contains(&o.threshold.name.as_str())
+        })
+    };
+    // The crossings of rows and columns (rows' first: the curves start from them where they can).
+    let seeds: Vec<&LineThreshold> = thresholds
+        .iter()
+        .filter(|t| t.threshold.name == name && t.threshold.value.is_finite())
+        .collect();
+    let mut covered = vec![false; seeds.len()];
+    // Crossings within a grid cell of a continued curve but not on it: a different border nearby (e.g. a
+    // period-2 family's where the curve is a period-1 family's). Continuing from one would most likely
+    // follow the same curve again.
+    let mut near = vec![false; seeds.len()];
+    // Failures at family ends and elsewhere.
+    let mut failures = [0, 0];
+    let mut out = Followed {
+        continued: Vec::new(),
+        covered_points: Vec::new(),
+        warnings: Vec::new(),
+        costs: Vec::new(),
+    };
+    for k in 0..seeds.len() {
+        let end = usize::from(!at_family_end(seeds[k]));
+        if covered[k] || near[k] || failures[end] >= MAX_FAILED_SEEDS {
+            continue;
+        }
+        let (result, cost) = measured(|| follow_from_crossing(config, map, &seeds, k, condition));
+        out.costs.push(cost);
+        match result {
+            Ok((curve, hits, misses)) => {
+                for h in hits {
+                    covered[h] = true;
+                }
+                for m in misses {
+                    near[m] = true;
+                }
+                out.continued.push(curve);
+            }
+            Err(_) if end == 0 => failures[0] += 1,
+            Err(message) => {
+                failures[1] += 1;
+                let (line, param) = match seeds[k].along {
+                    Along::X => ("row", &map.spec.x.param),
+                    Along::Y => ("column", &map.spec.y.param),
+                };
+                out.warnings.push(format!(
+                    "{name}: no curve continued from the crossing of {line} {} at {param} = {}: \
+                     {message}; its curve is drawn through the crossings",
+                    seeds[k].line, seeds[k].threshold.value
+                ));
+            }
+        }
+    }
+    out.covered_points = seeds
+        .iter()
+        .zip(&covered)
+        .filter(|(_, &c)| c)
+        .map(|(t, _)| crossing_point(map, t))
+        .collect();
+    out
 }
 
 /// The curve through the crossing `seeds[k]` (a row's or a column's), the indices of the crossings in `seeds` it covers, and
@@ -405,7 +464,7 @@ fn check_crossings(
         .collect();
     let differences: Vec<f64> = candidates
         .par_iter()
-        .map(|&m| {
+        .map(carried(|&m: &usize| {
             let s = seeds[m];
             let v = s.threshold.value;
             let on_curve = match s.along {
@@ -413,7 +472,7 @@ fn check_crossings(
                 Along::Y => curve_at(problem, curve, (0, map.xs[s.line]), v, options).map(|p| p.p2),
             };
             on_curve.map_or(f64::NAN, |v| (v - s.threshold.value).abs())
-        })
+        }))
         .collect();
     candidates
         .into_iter()

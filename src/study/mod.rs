@@ -1,7 +1,7 @@
 //! Studies over parameters (docs/model.md section 6): the grid runner every study shares (`grid`: rows continued
 //! point to point, bitwise identical for any thread count), the sweep of one parameter and its thresholds, the
 //! map over two parameters and its curves (`map`, `map_curves`), the orbit diagram and the basin of
-//! attraction. They are built on the step map and its fixed points ([`crate::gait`]) and the families of
+//! attraction, and the measured parallelism of their phases (`parallelism`: work and span). They are built on the step map and its fixed points ([`crate::gait`]) and the families of
 //! [`crate::continuation`].
 
 pub mod basin;
@@ -9,11 +9,12 @@ pub(crate) mod grid;
 pub mod map;
 pub mod map_curves;
 pub mod orbit;
+pub mod parallelism;
 pub(crate) mod sweep;
 pub(crate) mod thresholds;
 
 pub use map::{
-    check_part, map_curves, map_gaits, map_gaits_part, ContinuedCurve, CurveMethod, GaitMap,
+    check_part, map_curves, map_gaits, map_gaits_measured, ContinuedCurve, CurveMethod, GaitMap,
     MapCurves, MapSpec, ThresholdCurve, LINE_CHECK_TOL,
 };
 pub use sweep::{

@@ -13,7 +13,8 @@
 
 use serde::Serialize;
 
-use super::grid::{coarse_pass, fill, run_rows, Cell, Evaluated, COARSE_STRIDE};
+use super::grid::{coarse_pass, fill, run_rows_measured, Cell, Evaluated, COARSE_STRIDE};
+use super::parallelism::TaskGraph;
 use super::sweep::{RangeNames, SweepSpec};
 use crate::family::Parameter;
 use crate::gait::periodicity::{least_period, MAX_PERIOD};
@@ -211,12 +212,23 @@ pub fn orbit_diagram(
     initial: &SectionState,
     progress: &(dyn Fn(&OrbitColumn) + Sync),
 ) -> Result<Vec<OrbitColumn>, ConfigError> {
+    orbit_diagram_measured(config, spec, initial, progress).map(|d| d.0)
+}
+
+/// [`orbit_diagram`] with its task graph: one task per value, on the grid runner's schedule
+/// ([`super::parallelism`]).
+pub fn orbit_diagram_measured(
+    config: &Config,
+    spec: &OrbitSpec,
+    initial: &SectionState,
+    progress: &(dyn Fn(&OrbitColumn) + Sync),
+) -> Result<(Vec<OrbitColumn>, TaskGraph), ConfigError> {
     spec.validate(config)?;
     let values = spec.range.values();
     let parameter = Parameter::named(config, &spec.range.param)?;
     let eval = column_eval(parameter, spec, initial, &values, progress);
-    let mut rows = run_rows(1, values.len(), eval);
-    Ok(rows.pop().unwrap_or_default())
+    let mut run = run_rows_measured(0..1, 1, values.len(), eval);
+    Ok((run.rows.pop().unwrap_or_default(), run.graph))
 }
 
 /// A part of an orbit diagram computed apart (a study spread over processes): the diagram's coarse pass, or

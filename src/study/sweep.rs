@@ -8,7 +8,7 @@
 //! continuation, so a change of family between neighbours is a branch switch, never a silent jump.
 //!
 //! Parallelism (rayon) with results bitwise identical for any number of threads comes from the grid runner
-//! ([`super::grid`]): a sweep is one row of [`gait_rows`], which continues every [`COARSE_STRIDE`]-th point in
+//! ([`super::grid`]): a sweep is one row of [`gait_rows_measured`], which continues every [`COARSE_STRIDE`]-th point in
 //! order (the coarse pass) and then the points between two coarse points from the left one, all intervals in
 //! parallel; a map is many rows, run in parallel. Inside each point the exact Jacobian and the second one of
 //! its error estimate run in parallel as well.
@@ -19,7 +19,8 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::grid::{run_rows_part, Evaluated};
+use super::grid::{run_rows_measured, Evaluated, GridRun};
+use super::parallelism::{measured, Cost, TaskGraph};
 use crate::dynamics::DIFFERENTIABLE_KEYS;
 use crate::family::natural::{FollowOutcome, GaitPoint, NaturalContinuation, Tangent, PARAM_TOL};
 use crate::family::Parameter;
@@ -30,6 +31,7 @@ use crate::gait::limit_cycle::{
 use crate::gait::period_k::{find_gait_any_period, periodic_gait_at};
 use crate::gait::periodicity::{MAX_PERIOD, SAME_GAIT_TOL};
 use crate::gait::step_map::free_coordinates;
+use crate::meter::carried;
 use crate::params::{Config, ConfigError, NumericKey};
 use crate::walk::{SectionState, SECTION_COORDINATES};
 
@@ -478,32 +480,30 @@ pub(crate) struct GaitRow {
     pub values: Vec<f64>,
 }
 
-/// The gaits along every row, each row continued with the sweep's rules (see the module documentation):
-/// continuation from the left neighbour on the [`super::grid`] runner's schedule, a search from `initial` where
-/// the family does not reach, then the backward fill of misses and family numbers within the row. Rows run in
-/// parallel, and the results are bitwise identical for any number of threads. `progress` is called after every
-/// point. A row's values that leave the valid domain give points with the status `invalid_parameter`. Once the
-/// library's [`interrupt_flag`](super::grid::interrupt_flag) is set, each row is cut to its complete prefix,
-/// without the backward fill and the family numbers (also where the flag was set during them).
-pub fn gait_rows(
-    rows: &[GaitRow],
-    initial: &SectionState,
-    options: &GaitOptions,
-    progress: &(dyn Fn(&SweepPoint) + Sync),
-) -> Vec<Vec<SweepPoint>> {
-    gait_rows_part(rows, 0..rows.len(), initial, options, progress)
-}
-
-/// The rows `part` of [`gait_rows`] of `rows` (within `0..rows.len()`), each exactly as the whole grid has it.
-pub(crate) fn gait_rows_part(
+/// The gaits along the rows `part` (within `0..rows.len()`) of `rows`, each row continued with the sweep's rules
+/// (see the module documentation), each exactly as the whole grid has it: continuation from the left neighbour
+/// on the [`super::grid`] runner's schedule, a search from `initial` where the family does not reach, then the
+/// backward fill of misses and family numbers within the row. Rows run in parallel, and the results are
+/// bitwise identical for any number of threads. `progress` is called after every point. A row's values that
+/// leave the valid domain give points with the status `invalid_parameter`. Once the library's
+/// [`interrupt_flag`](super::grid::interrupt_flag) is set, each row is cut to its complete prefix, without the
+/// backward fill and the family numbers (also where the flag was set during them).
+///
+/// With the rows, their task graph ([`super::parallelism`]): a task per point on the grid runner's schedule,
+/// then one per row (its backward fill and family numbers) after the row's points.
+pub(crate) fn gait_rows_measured(
     rows: &[GaitRow],
     part: Range<usize>,
     initial: &SectionState,
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
-) -> Vec<Vec<SweepPoint>> {
+) -> (Vec<Vec<SweepPoint>>, TaskGraph) {
     let cols = rows.iter().map(|r| r.values.len()).max().unwrap_or(0);
-    let mut points = run_rows_part(
+    let GridRun {
+        rows: mut points,
+        mut graph,
+        row_done,
+    } = run_rows_measured(
         part.clone(),
         rows.len(),
         cols,
@@ -541,30 +541,43 @@ pub(crate) fn gait_rows_part(
             }
         },
     );
-    rows[part]
+    let finished: Vec<(Vec<SweepPoint>, Cost)> = rows[part]
         .par_iter()
         .zip(points.par_iter_mut())
-        .map(|(row, points)| {
-            let mut points: Vec<SweepPoint> = points.drain(..).flatten().collect();
-            // An interrupted row keeps its points as computed (no further searches); so does a row whose
-            // backward fill or family numbers the flag cut short (their walks stop with it).
-            if crate::walk::interrupted() {
-                return points;
-            }
-            let computed = points.clone();
-            let parameter = Parameter::new(&row.config, row.key);
-            backfill(parameter, &mut points, options);
-            number_families(parameter, &mut points, options);
-            if crate::walk::interrupted() {
-                return computed;
-            }
+        .map(carried(
+            |(row, points): (&GaitRow, &mut Vec<Option<SweepPoint>>)| {
+                measured(|| {
+                    let mut points: Vec<SweepPoint> = points.drain(..).flatten().collect();
+                    // An interrupted row keeps its points as computed (no further searches); so does a row whose
+                    // backward fill or family numbers the flag cut short (their walks stop with it).
+                    if crate::walk::interrupted() {
+                        return points;
+                    }
+                    let computed = points.clone();
+                    let parameter = Parameter::new(&row.config, row.key);
+                    backfill(parameter, &mut points, options);
+                    number_families(parameter, &mut points, options);
+                    if crate::walk::interrupted() {
+                        return computed;
+                    }
+                    points
+                })
+            },
+        ))
+        .collect();
+    let rows = finished
+        .into_iter()
+        .zip(row_done)
+        .map(|((points, cost), done)| {
+            graph.task(cost, &[done]);
             points
         })
-        .collect()
+        .collect();
+    (rows, graph)
 }
 
 /// Sweep `spec.param` over its range with continuation, calling `progress` after each point: one row of
-/// `gait_rows`.
+/// `gait_rows_measured`.
 pub fn sweep(
     config: &Config,
     spec: &SweepSpec,
@@ -635,7 +648,7 @@ pub fn check_values(
 }
 
 /// Sweep the real-valued key `param` over the given `values` (in the order given) with continuation, as
-/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of `gait_rows`.
+/// [`sweep`] does over a [`SweepSpec`]'s evenly spaced values: one row of `gait_rows_measured`.
 ///
 /// Before anything is computed, the values are checked against the parameter's domain ([`check_values`])
 /// and the settings against their ranges ([`GaitOptions::validate`]): a value outside the domain is an error
@@ -648,14 +661,24 @@ pub fn sweep_values(
     options: &GaitOptions,
     progress: &(dyn Fn(&SweepPoint) + Sync),
 ) -> Result<Vec<SweepPoint>, ConfigError> {
+    let row = checked_row(config, param, values, options)?;
+    let (mut rows, _) = gait_rows_measured(&[row], 0..1, initial, options, progress);
+    Ok(rows.pop().unwrap_or_default())
+}
+
+/// The row of [`sweep_values`] (`param` over `values` on `config`), its values and `options` checked first;
+/// [`gait_rows_measured`] of it alone is the sweep with its task graph.
+pub(crate) fn checked_row(
+    config: &Config,
+    param: &str,
+    values: &[f64],
+    options: &GaitOptions,
+) -> Result<GaitRow, ConfigError> {
     check_values(config, param, values, "sweep", MAX_SWEEP_POINTS)?;
     options.validate()?;
-    let row = GaitRow {
+    Ok(GaitRow {
         config: config.clone(),
         key: NumericKey::new(param)?,
         values: values.to_vec(),
-    };
-    Ok(gait_rows(&[row], initial, options, progress)
-        .pop()
-        .unwrap_or_default())
+    })
 }

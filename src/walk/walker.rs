@@ -175,6 +175,7 @@ impl<'m> Walker<'m> {
             return Err(e.clone());
         }
         let start = self.state.clone();
+        crate::meter::count_step();
         let mut work = WorkCounts {
             steps: 1,
             ..WorkCounts::ZERO

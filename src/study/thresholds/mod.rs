@@ -23,6 +23,9 @@
 use std::cell::{Cell, RefCell};
 
 use rayon::prelude::*;
+
+use crate::meter::carried;
+use crate::study::parallelism::{measured, Cost};
 use roots::{find_root_brent, Convergency};
 use serde::Serialize;
 
@@ -205,6 +208,15 @@ pub fn find_thresholds(
     points: &[SweepPoint],
     options: &GaitOptions,
 ) -> Vec<Threshold> {
+    find_thresholds_costed(parameter, points, options).0
+}
+
+/// [`find_thresholds`], with the cost of each of its refinements (independent tasks, run in parallel).
+pub(crate) fn find_thresholds_costed(
+    parameter: Parameter,
+    points: &[SweepPoint],
+    options: &GaitOptions,
+) -> (Vec<Threshold>, Vec<Cost>) {
     let mut tasks = Vec::new();
     for pair in points.windows(2) {
         let (a, b) = (&pair[0], &pair[1]);
@@ -228,16 +240,21 @@ pub fn find_thresholds(
         }
     }
     let gait_before = |v: f64| points.iter().any(|p| p.gait.is_some() && p.value < v);
-    let found: Vec<Threshold> = tasks
+    let found: Vec<(Vec<Threshold>, Cost)> = tasks
         .par_iter()
-        .flat_map_iter(|task| match task {
-            Task::Root(q, a, b) => vec![refine_root(parameter, *q, a, b, options)],
-            Task::End(from, toward) => {
-                refine_end(parameter, from, toward, options, gait_before(from.value))
-            }
-        })
+        .map(carried(|task: &Task| {
+            measured(|| match task {
+                Task::Root(q, a, b) => vec![refine_root(parameter, *q, a, b, options)],
+                Task::End(from, toward) => {
+                    refine_end(parameter, from, toward, options, gait_before(from.value))
+                }
+            })
+        }))
         .collect();
-    every_family_change_named(parameter.key(), points, without_repeats(found))
+    let costs = found.iter().map(|f| f.1).collect();
+    let found = found.into_iter().flat_map(|f| f.0).collect();
+    let thresholds = every_family_change_named(parameter.key(), points, without_repeats(found));
+    (thresholds, costs)
 }
 
 /// `thresholds` without the repeats of one end found from both sides (the same name within [`PARAM_TOL`] in
