@@ -54,7 +54,7 @@ pub struct SideRecord {
 pub struct SpecialRecord {
     /// The family it lies on.
     pub family: usize,
-    /// `LP`, `PD`, `NS` or `BC`.
+    /// `LP`, `PD`, `NS`, `BC` or `EX`.
     pub kind: SpecialKind,
     /// The parameter.
     pub param: f64,
@@ -86,6 +86,9 @@ pub struct SpecialRecord {
     /// Why it is not located, or what else is worth knowing.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// For an extremum of a monitored quantity (`EX`, `--extremum`): which, its kind and value.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extremum: Option<super::family_extrema::ExtremumRecord>,
 }
 
 /// A special point as written.
@@ -127,6 +130,7 @@ pub(crate) fn special_record(family: usize, s: &SpecialPoint<GaitInfo>) -> Speci
             .map(|sides| sides.iter().map(side).collect()),
         signature: s.info.as_ref().map(|i| i.signature.clone()),
         note: s.note.clone(),
+        extremum: None,
     }
 }
 

@@ -9,6 +9,7 @@
 
 mod basin;
 mod family;
+mod family_extrema;
 mod family_output;
 mod family_records;
 mod figures;
@@ -39,6 +40,7 @@ pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
     MAX_FAMILY_POINTS,
 };
+pub use family_extrema::{monitored_header, monitored_rows, ExtremumRecord, FamilyExtrema};
 pub use family_output::{curve_rows, family_rows, run_continuation};
 pub use family_records::{FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND};
 pub use figures::{
