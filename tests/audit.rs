@@ -2,8 +2,9 @@
 //! never push a leg outward, no impulse pulls, and no tip goes below the ground, on every step of every walk.
 //! Also the regression test of the bilateral stopper-lock impact.
 
-use vrw::contact::{impulse, ActiveSet, Role, Stop};
+use vrw::contact::{impulse, ActiveSet, Stop};
 use vrw::dynamics::{Coords, Model, L1, L2, THETA};
+use vrw::mechanism::Role;
 use vrw::params::Config;
 use vrw::reference::default_initial;
 use vrw::walk::impact::{close_unit, Unit};

@@ -3,9 +3,10 @@
 use approx::assert_relative_eq;
 use nalgebra::Vector2;
 
-use vrw::contact::{ActiveSet, Role};
+use vrw::contact::ActiveSet;
 use vrw::dynamics::{Coords, Model, L1, L2, THETA, Z};
 use vrw::integrate::{Dopri5, Tolerances};
+use vrw::mechanism::Role;
 use vrw::params::{Config, ImpactModel, Params, SolverOptions};
 use vrw::reference::RigidRimlessWheel;
 use vrw::walk::{simulate, Branch, PhaseSystem, SectionState, WalkVector, Walker};
@@ -395,7 +396,7 @@ fn airborne_tips_never_penetrate_and_free_legs_never_pass_their_stoppers() {
                     );
                 }
                 if !s.active.lock(leg) {
-                    let l = s.q[leg.length_coordinate()];
+                    let l = s.q[vrw::dynamics::Model::stroke_coordinate(leg)];
                     assert!(l < l0 + 1e-7, "{mode:?} t = {}: {leg:?} length {l}", s.time);
                 }
             }
