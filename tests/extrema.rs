@@ -15,22 +15,12 @@ use vrw::walk::SectionState;
 /// `vrw continue --no-switch --param KEY --start START --from A --to B --extremum ...`.
 fn continued(key: &str, start: f64, (from, to): (f64, f64), names: &[&str]) -> ContinueResult {
     let job = ContinueJob {
-        config: Config::default(),
         param: key.to_string(),
         start: Some(start),
         from,
         to,
-        initial: None,
-        period: None,
-        max_points: 300,
-        max_step: 0.1,
-        switch: false,
-        plot: "thetadot".to_string(),
-        out_dir: PathBuf::new(),
-        overwrite: false,
-        interrupt: None,
-        two_param: None,
         extremum: names.iter().map(|n| n.to_string()).collect(),
+        ..continued_job()
     };
     compute_continuation(&job).unwrap()
 }

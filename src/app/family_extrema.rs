@@ -2,12 +2,10 @@
 //! followed, with their derivatives along the family (`monitored.csv`), and the extrema of the named ones as
 //! special points (`EX` in `special_points.json`, after the others).
 
-use serde::Serialize;
-
-use super::family_records::{special_record, SpecialRecord};
+use super::family_records::{special_record, ExtremumRecord, SpecialRecord};
 use super::AppError;
 use crate::continuation::monitor::{
-    extrema, monitor_family, Extremum, ExtremumKind, Monitor, Monitored, EXTREMUM_TOL, MONITOR_STEP,
+    extrema, monitor_family, Extremum, Monitor, Monitored, EXTREMUM_TOL, MONITOR_STEP,
 };
 use crate::family::diagram::FollowedFamily;
 use crate::family::monitor::{GaitQuantity, MONITORED_QUANTITIES};
@@ -18,28 +16,6 @@ use crate::output::Cell;
 pub const DERIVATIVE_METHOD: &str = "dq/ds = grad q . t along the arclength s in the scaled unknowns \
     (x, p / sigma): the unit tangent t from the exact DP and dP/dp, grad q . t by central differences of q \
     along t (no exact derivative of the quantities themselves)";
-
-/// The extremum part of a special point in `special_points.json`.
-#[derive(Debug, Clone, Serialize)]
-pub struct ExtremumRecord {
-    /// The monitored quantity.
-    pub quantity: String,
-    /// `max` or `min`.
-    pub extremum: ExtremumKind,
-    /// `smooth` (a zero of its derivative along the family) or `corner` (it is not smooth there).
-    pub shape: &'static str,
-    /// At a corner: why the quantity is not smooth there.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub corner: Option<String>,
-    /// The quantity there.
-    pub value: f64,
-    /// The parameters of the located bracket (width at most `1e-8`).
-    pub located_bracket: [f64; 2],
-    /// The gait's speed there \[m/s\].
-    pub speed: f64,
-    /// How its derivative along the family was computed, with the step.
-    pub derivative: String,
-}
 
 /// The monitored quantities of every family and the extrema of the named ones.
 #[derive(Debug, Clone, Default)]

@@ -74,15 +74,19 @@ fn of_kind<I>(family: &Family<I>, kind: SpecialKind) -> Vec<&SpecialPoint<I>> {
     family.special.iter().filter(|s| s.kind == kind).collect()
 }
 
-#[test]
-fn quadratic_family_through_its_fold_and_period_doubling() {
-    let map = quadratic();
+/// The quadratic family from its upper fixed point at `p = 0.3`, followed over `[-0.5, 1]`.
+fn quadratic_through_fold() -> Family<()> {
     let start = DVector::from_column_slice(&QuadraticFamily.upper_fixed_point(0.3));
     let options = ContinuationOptions {
         max_points: 1000,
         ..ContinuationOptions::for_range(-0.5, 1.0)
     };
-    let family = continue_family(&map, &start, 0.3, &options).unwrap();
+    continue_family(&quadratic(), &start, 0.3, &options).unwrap()
+}
+
+#[test]
+fn quadratic_family_through_its_fold_and_period_doubling() {
+    let family = quadratic_through_fold();
     // Through the fold at p = -1/4 onto the lower branch, then out of the range at p = 1 on both ends.
     assert_eq!(family.ends[0], FamilyEnd::LeftRange { bound: 1.0 });
     assert_eq!(family.ends[1], FamilyEnd::LeftRange { bound: 1.0 });
@@ -257,12 +261,7 @@ impl monitor::Monitor<()> for Quantity {
 /// on the lower one.
 fn quadratic_extrema(q: &Quantity) -> (Family<()>, Vec<monitor::Extremum<()>>) {
     let map = quadratic();
-    let start = DVector::from_column_slice(&QuadraticFamily.upper_fixed_point(0.3));
-    let options = ContinuationOptions {
-        max_points: 1000,
-        ..ContinuationOptions::for_range(-0.5, 1.0)
-    };
-    let family = continue_family(&map, &start, 0.3, &options).unwrap();
+    let family = quadratic_through_fold();
     let monitored: Vec<monitor::Monitored> = monitor::monitor_family(&map, &family, &[q])
         .into_iter()
         .map(|m| m[0])
