@@ -254,16 +254,10 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         drop_unlocated(&mut families, &mut warnings);
     }
     let (records, mut special_points, stability) = family_records(job, &families, &mut warnings);
-    // Not after an interrupt: the families may be cut short.
-    let extrema = family_extrema(&job.extremum, &families, interrupted.is_some());
+    let extrema = family_extrema(&job.extremum, &families, interrupted.is_some(), flag);
     special_points.extend(extrema.records());
     if stop_requested(flag) {
-        let note = "the stability verdicts within 1e-3 of the unit circle judged after it are `uncertain` \
-                    (their DP's error estimate was not computed)";
-        interrupted = Some(match interrupted {
-            Some(words) => format!("{words}; {note}"),
-            None => format!("while judging the families' stability: {note}"),
-        });
+        interrupted = Some(stopped_after_following(job, interrupted));
     }
     let (curve_records, curves) = match (&job.two_param, &interrupted) {
         (Some(second), None) => {
@@ -307,6 +301,22 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         curves,
         extrema,
     })
+}
+
+/// What an interrupt that came after the families were followed (while their stability was judged or their
+/// extrema located) leaves, after what an earlier one (`interrupted`) left.
+fn stopped_after_following(job: &ContinueJob, interrupted: Option<String>) -> String {
+    let mut note =
+        "the stability verdicts within 1e-3 of the unit circle judged after it are `uncertain` \
+                    (their DP's error estimate was not computed)"
+            .to_string();
+    if !job.extremum.is_empty() {
+        note.push_str("; no extremum is kept");
+    }
+    match interrupted {
+        Some(words) => format!("{words}; {note}"),
+        None => format!("while judging the families' stability: {note}"),
+    }
 }
 
 /// The gait the first family is followed from (period at most `job.period`, or any up to [`MAX_PERIOD`]); an

@@ -2,6 +2,8 @@
 //! followed, with their derivatives along the family (`monitored.csv`), and the extrema of the named ones as
 //! special points (`EX` in `special_points.json`, after the others).
 
+use std::sync::atomic::AtomicBool;
+
 use super::family_records::{special_record, ExtremumRecord, SpecialRecord};
 use super::AppError;
 use crate::continuation::monitor::{
@@ -11,6 +13,7 @@ use crate::family::diagram::FollowedFamily;
 use crate::family::monitor::{GaitQuantity, MONITORED_QUANTITIES};
 use crate::family::GaitInfo;
 use crate::output::Cell;
+use crate::walk::interrupt::stop_requested;
 
 /// How `dq/ds` is computed, as `special_points.json` says it.
 pub const DERIVATIVE_METHOD: &str = "dq/ds = grad q . t along the arclength s in the scaled unknowns \
@@ -52,11 +55,14 @@ impl FamilyExtrema {
 }
 
 /// Every quantity of [`MONITORED_QUANTITIES`] along every family, and the extrema of those of `names`
-/// (a name given twice counts once); nothing without names or when `skip`.
+/// (a name given twice counts once); nothing without names or when `skip` (an interrupt came before: the
+/// families may be cut short), and nothing kept if the interrupt `flag` is set while they are located (an
+/// interrupted probe leaves its extremum out).
 pub(super) fn family_extrema(
     names: &[String],
     families: &[FollowedFamily],
     skip: bool,
+    flag: Option<&AtomicBool>,
 ) -> FamilyExtrema {
     if names.is_empty() || skip {
         return FamilyExtrema::default();
@@ -81,6 +87,9 @@ pub(super) fn family_extrema(
             );
         }
         out.monitored.push(monitored);
+    }
+    if stop_requested(flag) {
+        return FamilyExtrema::default();
     }
     out
 }

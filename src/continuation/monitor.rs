@@ -342,7 +342,12 @@ fn locate<M: FamilyMap>(
             special.method = found.method;
             special.iterations = found.probes;
             special.residual = p.residual;
-            special.test_value = found.at.derivative;
+            // At a corner dq/ds has no value (the central difference there straddles it).
+            special.test_value = if found.corner.is_some() {
+                f64::NAN
+            } else {
+                found.at.derivative
+            };
             special.multipliers = p.multipliers.clone();
             special.info = Some(p.info.clone());
             special.direction = found.at.tangent.clone();
