@@ -26,8 +26,8 @@ use progress::{interruptible_keeping, interruptible_with, Progress};
 use vrw::app::{
     compute_basin_part, compute_continuation, compute_gait, compute_map, compute_map_part,
     compute_orbit, compute_orbit_part, compute_simulation, compute_sweep, curve_rows, family_rows,
-    AppError, BasinJob, ContinueJob, GaitJob, MapJob, OrbitJob, OrbitJobPart, SimulateJob,
-    WalkerRange,
+    monitored_header, monitored_rows, AppError, BasinJob, ContinueJob, GaitJob, MapJob, OrbitJob,
+    OrbitJobPart, SimulateJob, WalkerRange,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -971,10 +971,12 @@ fn curve_columns_arg(value: &Bound<'_, PyAny>) -> PyResult<usize> {
 /// command line's `(1, 300)`), `initial`, `period`, `max_points`, `max_step`, `switch` (follow the families born at period
 /// doublings, border collisions and ends; the command line's `--no-switch` is `switch=False`), `two_param`
 /// (`(name, from, to)`: the command line's `--two-param name --two-range from,to`; the curves' points are then
-/// `curve_points`, the columns of `curves.csv`). Another walker's (`Params(model=...)`): `vrw continue
+/// `curve_points`, the columns of `curves.csv`), `extremum` (a list of monitored quantities: the command line's
+/// `--extremum`, each located extremum a special point `EX` with its `extremum` record, and `monitored`, the
+/// columns of `monitored.csv`). Another walker's (`Params(model=...)`): `vrw continue
 /// --model`'s, its start's family only (no `initial`, `period`, `two_param`).
 #[pyfunction]
-#[pyo3(signature = (params, param = "viscosity", *, start = None, range = None, initial = None, period = None, max_points = 300, max_step = 0.1, switch = true, two_param = None))]
+#[pyo3(signature = (params, param = "viscosity", *, start = None, range = None, initial = None, period = None, max_points = 300, max_step = 0.1, switch = true, two_param = None, extremum = None))]
 #[allow(clippy::too_many_arguments)]
 fn continue_family<'py>(
     py: Python<'py>,
@@ -988,16 +990,21 @@ fn continue_family<'py>(
     max_step: f64,
     switch: bool,
     two_param: Option<(String, f64, f64)>,
+    extremum: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let flag = Arc::new(AtomicBool::new(false));
     let range = range.unwrap_or((1.0, 300.0));
+    let extremum = extremum.unwrap_or_default();
     if let Some(w) = params.walker() {
         let options = walkers::FamilyOptions {
             start,
             range,
             max_points,
             max_step,
-            wheel_only: initial.is_some() || period.is_some() || two_param.is_some(),
+            wheel_only: initial.is_some()
+                || period.is_some()
+                || two_param.is_some()
+                || !extremum.is_empty(),
         };
         return walkers::continue_family(py, w, param, options);
     }
@@ -1017,6 +1024,7 @@ fn continue_family<'py>(
         overwrite: false,
         interrupt: Some(Arc::clone(&flag)),
         two_param,
+        extremum,
     };
     let result = interruptible(py, &flag, || compute_continuation(&job))?.map_err(app_error)?;
     let out = pythonize(py, &result.summary)?.downcast_into::<PyDict>()?;
@@ -1028,6 +1036,10 @@ fn continue_family<'py>(
         .map(|r| family_row(r, friction))
         .collect();
     out.set_item("branch", table(py, &family_header(param, friction), &rows)?)?;
+    if !result.extrema.monitored.is_empty() {
+        let rows = monitored_rows(&result.families, &result.extrema.monitored);
+        out.set_item("monitored", table(py, &monitored_header(param), &rows)?)?;
+    }
     if let Some(first) = result.summary.curves.first() {
         let rows: Vec<Vec<Cell>> = curve_rows(&result).iter().map(curve_row).collect();
         let header = curve_header((param, &first.param2));

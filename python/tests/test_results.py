@@ -8,7 +8,7 @@ import pytest
 
 import vrw
 from vrw.grid import gait_grid
-from conftest import ROOT
+from conftest import ROOT, assert_table_equals_csv
 
 pd = pytest.importorskip("pandas")
 xr = pytest.importorskip("xarray")
@@ -132,6 +132,28 @@ def test_continue_family_equals_branch_csv(cli, tmp_path):
         vrw.continue_family(vrw.Params(), "slope", start=0.5, range=(0.3, 0.34))
     with pytest.raises(vrw.ConfigError, match="max_points"):
         vrw.continue_family(vrw.Params(), max_points=-1)
+
+
+def test_continue_family_extremum_equals_the_command_line(cli, tmp_path):
+    args = ["--param", "slope", "--from", "0.2", "--to", "0.3", "--start", "0.25", "--no-switch"]
+    cli("continue", *args, "--extremum", "lambda_2_plus", "--extremum", "speed", "--out", tmp_path)
+    result = vrw.continue_family(
+        vrw.Params(), "slope", start=0.25, range=(0.2, 0.3), switch=False, extremum=["lambda_2_plus", "speed"]
+    )
+    expected = __import__("json").loads((tmp_path / "special_points.json").read_text())
+    found = [p for p in result.special_points if p["kind"] == "EX"]
+    assert len(found) == 1 and found[0]["extremum"]["quantity"] == "lambda_2_plus"
+    assert found[0]["extremum"]["extremum"] == "max" and found[0]["extremum"]["shape"] == "smooth"
+    written = [p for p in expected["special_points"] if p["kind"] == "EX"]
+    assert [p["param"] for p in found] == [p["param"] for p in written]
+    assert [list(p["extremum"]["located_bracket"]) for p in found] == [
+        p["extremum"]["located_bracket"] for p in written
+    ]
+    assert [p["extremum"]["value"] for p in found] == [p["extremum"]["value"] for p in written]
+    assert_table_equals_csv(result["monitored"], tmp_path / "monitored.csv")
+    assert "monitored" not in vrw.continue_family(vrw.Params(), "slope", start=0.25, range=(0.2, 0.3), switch=False)
+    with pytest.raises(ValueError, match="unknown quantity .* max_floquet"):
+        vrw.continue_family(vrw.Params(), extremum=["fastness"])
 
 
 def test_continue_family_curves_equal_curves_csv(cli, tmp_path):

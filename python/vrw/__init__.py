@@ -116,9 +116,11 @@ def continue_family(params: Params, param: str = "viscosity", **options: Any) ->
     """Follow the gait family through the gait at ``start`` in ``param`` by pseudo-arclength continuation
     (``vrw continue``): a ``FamilyResult``, the fields of ``special_points.json`` with ``branch`` (the columns of
     ``branch.csv``) as a ``Table``, and with ``two_param`` ``curve_points`` (the columns of ``curves.csv``) as a
-    ``Table``. See ``vrw._vrw.continue_family`` for the options."""
+    ``Table``; with ``extremum`` (a list of monitored quantities) their extrema are special points ``EX`` and
+    ``monitored`` (the columns of ``monitored.csv``) a ``Table``. See ``vrw._vrw.continue_family`` for the
+    options."""
     result = FamilyResult(_vrw.continue_family(params, param, **options))
-    wrap_tables(result, ["branch", "curve_points"])
+    wrap_tables(result, ["branch", "curve_points", "monitored"])
     return result
 
 

@@ -165,14 +165,17 @@ def continue_family(
     max_step: float = 0.1,
     switch: bool = True,
     two_param: Optional[Tuple[str, float, float]] = None,
+    extremum: Optional[List[str]] = None,
 ) -> Dict[str, Any]:
     """Follow the gait family through the gait at ``start`` by pseudo-arclength continuation (``vrw continue``,
     without the figure): the fields of ``special_points.json`` and ``branch``, the columns of ``branch.csv``.
     ``range`` is ``(from, to)``, default ``(1, 300)``; ``two_param`` ``(name, from, to)`` also follows every
     border collision's curve in that second parameter (``curves`` in
-    ``special_points.json``'s form, and ``curve_points``, the columns of ``curves.csv``). Another walker's
+    ``special_points.json``'s form, and ``curve_points``, the columns of ``curves.csv``); ``extremum`` (names of
+    monitored quantities, ``--extremum``) locates their extrema along every family, special points ``EX`` with
+    an ``extremum`` record, and gives ``monitored``, the columns of ``monitored.csv``. Another walker's
     (``Params(model=...)``): ``vrw continue --model``'s, its start's family only (no ``initial``, ``period``,
-    ``two_param``)."""
+    ``two_param``, ``extremum``)."""
 
 def map(
     params: Params,

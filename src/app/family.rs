@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
+use super::family_extrema::{check_extremum_names, family_extrema, FamilyExtrema};
 use super::family_records::{point_stability, special_record, FamilyRecord, SpecialRecord};
 use super::{prepared, AppError};
 use crate::continuation::{ContinuationError, ContinuationOptions, Curve, Family};
@@ -78,6 +79,11 @@ pub struct ContinueJob {
     /// Neimark-Sacker points) in a second parameter over its range (`name`, from, to): `curves.csv`,
     /// `curves.png`.
     pub two_param: Option<(String, f64, f64)>,
+    /// Locate the extrema of these monitored quantities
+    /// ([`MONITORED_QUANTITIES`](crate::family::monitor::MONITORED_QUANTITIES)) along every family: special
+    /// points `EX` after the others, and `monitored.csv`, every monitored quantity at every point with its
+    /// derivative along the family. Empty: neither.
+    pub extremum: Vec<String>,
 }
 
 /// `special_points.json`: what was followed, the families and their special points.
@@ -97,7 +103,7 @@ pub struct ContinueSummary {
     pub options: ContinuationOptions,
     /// The families.
     pub families: Vec<FamilyRecord>,
-    /// Their special points, by family and arclength.
+    /// Their special points, by family and arclength (then the extrema of `extremum`, by family and quantity).
     pub special_points: Vec<SpecialRecord>,
     /// The two-parameter curves followed (`two_param`), in `curves.csv`'s order.
     pub curves: Vec<CurveRecord>,
@@ -124,6 +130,8 @@ pub struct ContinueResult {
     pub stability: Vec<Vec<Stability>>,
     /// The two-parameter curves, as the summary's `curves`.
     pub curves: Vec<Curve<GaitInfo>>,
+    /// With `extremum`: the monitored quantities along the families and their extrema (empty without).
+    pub extrema: FamilyExtrema,
 }
 
 impl ContinueJob {
@@ -189,6 +197,7 @@ impl ContinueJob {
         if let Some(second) = &self.two_param {
             check_two_param(&self.param, &self.config, second)?;
         }
+        check_extremum_names(&self.extremum)?;
         let start = match self.start {
             Some(v) => v,
             None => self.config.get_numeric(&self.param)?,
@@ -244,14 +253,11 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
     if interrupted.is_some() {
         drop_unlocated(&mut families, &mut warnings);
     }
-    let (records, special_points, stability) = family_records(job, &families, &mut warnings);
+    let (records, mut special_points, stability) = family_records(job, &families, &mut warnings);
+    let extrema = family_extrema(&job.extremum, &families, interrupted.is_some(), flag);
+    special_points.extend(extrema.records());
     if stop_requested(flag) {
-        let note = "the stability verdicts within 1e-3 of the unit circle judged after it are `uncertain` \
-                    (their DP's error estimate was not computed)";
-        interrupted = Some(match interrupted {
-            Some(words) => format!("{words}; {note}"),
-            None => format!("while judging the families' stability: {note}"),
-        });
+        interrupted = Some(stopped_after_following(job, interrupted));
     }
     let (curve_records, curves) = match (&job.two_param, &interrupted) {
         (Some(second), None) => {
@@ -293,7 +299,24 @@ pub fn compute_continuation(job: &ContinueJob) -> Result<ContinueResult, AppErro
         families: families.into_iter().map(|f| f.family).collect(),
         stability,
         curves,
+        extrema,
     })
+}
+
+/// What an interrupt that came after the families were followed (while their stability was judged or their
+/// extrema located) leaves, after what an earlier one (`interrupted`) left.
+fn stopped_after_following(job: &ContinueJob, interrupted: Option<String>) -> String {
+    let mut note =
+        "the stability verdicts within 1e-3 of the unit circle judged after it are `uncertain` \
+                    (their DP's error estimate was not computed)"
+            .to_string();
+    if !job.extremum.is_empty() {
+        note.push_str("; no extremum is kept");
+    }
+    match interrupted {
+        Some(words) => format!("{words}; {note}"),
+        None => format!("while judging the families' stability: {note}"),
+    }
 }
 
 /// The gait the first family is followed from (period at most `job.period`, or any up to [`MAX_PERIOD`]); an

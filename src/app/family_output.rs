@@ -2,8 +2,9 @@
 //! bifurcation diagram `bifurcation.{svg,png}`.
 
 use super::family::{compute_continuation, ContinueJob, ContinueResult};
+use super::family_extrema::{monitored_header, monitored_rows};
 use super::{axis_label, in_run, AppError};
-use crate::continuation::{Family, FamilyEnd};
+use crate::continuation::{Family, FamilyEnd, SpecialPoint};
 use crate::family::GaitInfo;
 use crate::gait::Stability;
 use crate::output::bifurcation_plot::{
@@ -106,6 +107,15 @@ fn write_continuation(
     for name in ["bifurcation.svg", "bifurcation.png"] {
         run.add(name);
         files.push(name.to_string());
+    }
+    if !result.extrema.monitored.is_empty() {
+        crate::output::write_table(
+            &run.path("monitored.csv"),
+            &monitored_header(param),
+            monitored_rows(&result.families, &result.extrema.monitored),
+        )?;
+        run.add("monitored.csv");
+        files.push("monitored.csv".to_string());
     }
     if !result.curves.is_empty() {
         let param2 = result.summary.curves[0].param2.clone();
@@ -279,27 +289,43 @@ fn diagram_family(
     }
 }
 
-/// The special points of every family, at the value the diagram draws.
+/// The special points of every family, at the value the diagram draws; then the located extrema of
+/// `--extremum`, labelled `max` or `min` (`corner min` at a corner) and the quantity.
 fn diagram_specials(job: &ContinueJob, result: &ContinueResult) -> Vec<DiagramSpecial> {
-    result
+    let drawn = |k: usize, s: &SpecialPoint<GaitInfo>, label: String| DiagramSpecial {
+        family: k,
+        param: s.param,
+        value: match job.plot.as_str() {
+            "max_floquet" => s.multipliers.first().map_or(f64::NAN, |m| m.norm()),
+            q => s
+                .info
+                .as_ref()
+                .map_or(f64::NAN, |i| quantity_of_report(&i.report, q)),
+        },
+        label,
+    };
+    let mut special: Vec<DiagramSpecial> = result
         .families
         .iter()
         .enumerate()
         .flat_map(|(k, f)| {
-            f.special.iter().map(move |s| DiagramSpecial {
-                family: k,
-                param: s.param,
-                value: match job.plot.as_str() {
-                    "max_floquet" => s.multipliers.first().map_or(f64::NAN, |m| m.norm()),
-                    q => s
-                        .info
-                        .as_ref()
-                        .map_or(f64::NAN, |i| quantity_of_report(&i.report, q)),
-                },
-                label: s.kind.label().to_string(),
-            })
+            f.special
+                .iter()
+                .map(move |s| drawn(k, s, s.kind.label().to_string()))
         })
-        .collect()
+        .collect();
+    special.extend(
+        result
+            .extrema
+            .extrema
+            .iter()
+            .filter(|(_, e)| e.special.located)
+            .map(|(k, e)| {
+                let corner = if e.corner.is_some() { "corner " } else { "" };
+                drawn(*k, &e.special, format!("{corner}{} {}", e.kind, e.quantity))
+            }),
+    );
+    special
 }
 
 /// The axis label of a quantity of [`super::DIAGRAM_QUANTITIES`], with its unit.

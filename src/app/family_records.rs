@@ -3,6 +3,7 @@
 
 use serde::Serialize;
 
+use crate::continuation::monitor::ExtremumKind;
 use crate::continuation::special::Side;
 use crate::continuation::{SpecialKind, SpecialPoint};
 use crate::family::diagram::EndRecord;
@@ -54,7 +55,7 @@ pub struct SideRecord {
 pub struct SpecialRecord {
     /// The family it lies on.
     pub family: usize,
-    /// `LP`, `PD`, `NS` or `BC`.
+    /// `LP`, `PD`, `NS`, `BC` or `EX`.
     pub kind: SpecialKind,
     /// The parameter.
     pub param: f64,
@@ -86,6 +87,31 @@ pub struct SpecialRecord {
     /// Why it is not located, or what else is worth knowing.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// For an extremum of a monitored quantity (`EX`, `--extremum`): which, its kind and value.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extremum: Option<ExtremumRecord>,
+}
+
+/// The extremum part of a special point in `special_points.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ExtremumRecord {
+    /// The monitored quantity.
+    pub quantity: String,
+    /// `max` or `min`.
+    pub extremum: ExtremumKind,
+    /// `smooth` (a zero of its derivative along the family) or `corner` (it is not smooth there).
+    pub shape: &'static str,
+    /// At a corner: why the quantity is not smooth there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub corner: Option<String>,
+    /// The quantity there.
+    pub value: f64,
+    /// The parameters of the located bracket (width at most `1e-8`).
+    pub located_bracket: [f64; 2],
+    /// The gait's speed there \[m/s\].
+    pub speed: f64,
+    /// How its derivative along the family was computed, with the step.
+    pub derivative: String,
 }
 
 /// A special point as written.
@@ -127,6 +153,7 @@ pub(crate) fn special_record(family: usize, s: &SpecialPoint<GaitInfo>) -> Speci
             .map(|sides| sides.iter().map(side).collect()),
         signature: s.info.as_ref().map(|i| i.signature.clone()),
         note: s.note.clone(),
+        extremum: None,
     }
 }
 

@@ -9,6 +9,7 @@
 
 mod basin;
 mod family;
+mod family_extrema;
 mod family_output;
 mod family_records;
 mod figures;
@@ -40,8 +41,11 @@ pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
     MAX_FAMILY_POINTS,
 };
+pub use family_extrema::{monitored_header, monitored_rows, FamilyExtrema};
 pub use family_output::{curve_rows, family_rows, run_continuation};
-pub use family_records::{FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND};
+pub use family_records::{
+    ExtremumRecord, FamilyRecord, SectionRecord, SideRecord, SpecialRecord, STABILITY_BAND,
+};
 pub use figures::{
     checked_run, run_animate, run_plot, run_still, AnimateJob, AnimateOutcome, PlotReport,
     MAX_ANIMATION_FRAMES,

@@ -6,9 +6,11 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use vrw::app::{
-    run_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
+    run_continuation, ContinueJob, ContinueResult, ContinueSummary, ExtremumRecord, SpecialRecord,
+    DIAGRAM_QUANTITIES,
 };
 use vrw::continuation::{CurveEnd, CurvePoint, FamilyEnd};
+use vrw::family::monitor::MONITORED_QUANTITIES;
 use vrw::family::GaitInfo;
 use vrw::walk::SectionState;
 
@@ -69,6 +71,11 @@ pub(super) struct ContinueArgs {
     /// The second parameter's range, `A,B`.
     #[arg(long, value_name = "A,B", value_parser = super::parse_range, allow_hyphen_values = true)]
     two_range: Option<(f64, f64)>,
+    /// Locate where this gait quantity is stationary along every family (repeatable): its maxima and minima,
+    /// smooth or at a corner, as special points EX in special_points.json and the diagram, and every monitored
+    /// quantity with its derivative along the family in monitored.csv.
+    #[arg(long, value_name = "NAME", help = extremum_help())]
+    extremum: Vec<String>,
     /// Output directory for branch.csv, special_points.json and bifurcation.{svg,png}.
     #[arg(long, default_value = "out/continue")]
     out: PathBuf,
@@ -83,6 +90,16 @@ fn plot_help() -> String {
     format!(
         "The quantity the diagram draws against the parameter, one of: {}",
         DIAGRAM_QUANTITIES.join(", ")
+    )
+}
+
+/// Help of `continue --extremum`.
+fn extremum_help() -> String {
+    format!(
+        "Locate where this gait quantity is stationary along every family (repeatable): maxima and minima, \
+         smooth or at a corner, as special points EX in special_points.json and the diagram, and every \
+         monitored quantity with its derivative along the family in monitored.csv. One of: {}",
+        MONITORED_QUANTITIES.join(", ")
     )
 }
 
@@ -155,9 +172,13 @@ pub(super) fn run(args: ContinueArgs) -> Result<()> {
 /// `vrw continue --model NAME` for a walker other than the wheel: its start's family, branch.csv and
 /// special_points.json.
 fn run_walker(args: &ContinueArgs, walker: Walker) -> Result<()> {
-    if args.two_param.is_some() || args.initial.is_some() || args.period.is_some() {
+    if args.two_param.is_some()
+        || args.initial.is_some()
+        || args.period.is_some()
+        || !args.extremum.is_empty()
+    {
         bail!(
-            "`two_param`, `initial` and `period` take the wheel's continuation; the model `{}` follows its \
+            "`two_param`, `initial`, `period` and `extremum` take the wheel's continuation; the model `{}` follows its \
              start's family only so far (docs/model.md section 13)",
             walker.name()
         );
@@ -238,12 +259,17 @@ fn continue_job(args: &ContinueArgs) -> Result<ContinueJob> {
             .clone()
             .zip(args.two_range)
             .map(|(name, (a, b))| (name, a, b)),
+        extremum: args.extremum.clone(),
     })
 }
 
 /// One line per special point: its kind, family, parameter, border or modulus, and whether it was located.
 fn print_special_points(s: &ContinueSummary) {
     for sp in &s.special_points {
+        if let Some(e) = &sp.extremum {
+            print_extremum(s, sp, e);
+            continue;
+        }
         let located = if sp.located {
             ""
         } else {
@@ -270,6 +296,38 @@ fn print_special_points(s: &ContinueSummary) {
             sp.param,
         );
     }
+}
+
+/// The line of an extremum of `--extremum`: its kind and quantity, where, its value and the speed there, or
+/// why it was not located.
+fn print_extremum(s: &ContinueSummary, sp: &SpecialRecord, e: &ExtremumRecord) {
+    let kind = serde_json::to_value(e.extremum)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default();
+    if !sp.located {
+        println!(
+            "  EX family {}: {kind} of {} between {} = {:.9} and {:.9}, not located: {}",
+            sp.family,
+            e.quantity,
+            s.param,
+            sp.bracket[0],
+            sp.bracket[1],
+            sp.note.as_deref().unwrap_or("no reason given")
+        );
+        return;
+    }
+    let shape = match &e.corner {
+        Some(why) => format!(
+            "a corner ({why}) in [{:.9}, {:.9}]",
+            e.located_bracket[0], e.located_bracket[1]
+        ),
+        None => "smooth".to_string(),
+    };
+    println!(
+        "  EX family {}: {kind} of {} at {} = {:.9}, {} = {:.9}, speed = {:.9} m/s; {shape}",
+        sp.family, e.quantity, s.param, sp.param, e.quantity, e.value, e.speed
+    );
 }
 
 /// One line per two-parameter curve: its condition, family, points and where and why it ends.

@@ -2,7 +2,8 @@
 //! of fixed points of a map `P(x; p)` followed by pseudo-arclength continuation through folds ([`arclength`],
 //! with its [`corrector`]), branch switching at period doublings and border collisions ([`switch`]), special
 //! points detected by test functions and located by solving an extended system ([`special`]), and the curves
-//! of special points in two parameters ([`curve`]). The wheel's step map as such a family is
+//! of special points in two parameters ([`curve`]), and quantities monitored along a family with their extrema
+//! ([`monitor`]). The wheel's step map as such a family is
 //! `crate::family::GaitFamily`.
 //!
 //! Everything here works on any [`FamilyMap`]: a map of `R^n` with one parameter that gives its value, its
@@ -15,6 +16,7 @@
 pub mod arclength;
 pub mod corrector;
 pub mod curve;
+pub mod monitor;
 pub mod special;
 pub mod switch;
 #[cfg(test)]

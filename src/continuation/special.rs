@@ -58,16 +58,20 @@ pub enum SpecialKind {
     /// Border collision (`BC`).
     #[serde(rename = "BC")]
     BorderCollision,
+    /// Extremum of a monitored quantity (`EX`, [`super::monitor`]).
+    #[serde(rename = "EX")]
+    Extremum,
 }
 
 impl SpecialKind {
-    /// The label: `LP`, `PD`, `NS` or `BC`.
+    /// The label: `LP`, `PD`, `NS`, `BC` or `EX`.
     pub fn label(&self) -> &'static str {
         match self {
             SpecialKind::Fold => "LP",
             SpecialKind::PeriodDoubling => "PD",
             SpecialKind::NeimarkSacker => "NS",
             SpecialKind::BorderCollision => "BC",
+            SpecialKind::Extremum => "EX",
         }
     }
 }
@@ -127,22 +131,18 @@ pub struct SpecialPoint<I> {
 
 impl std::fmt::Display for SpecialKind {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            SpecialKind::Fold => "LP",
-            SpecialKind::PeriodDoubling => "PD",
-            SpecialKind::NeimarkSacker => "NS",
-            SpecialKind::BorderCollision => "BC",
-        })
+        f.write_str(self.label())
     }
 }
 
-/// The test function of `DP` whose zero is a special point of `kind` (`None` for a border collision).
+/// The test function of `DP` whose zero is a special point of `kind` (`None` for a border collision or an
+/// extremum).
 pub fn test_function(kind: SpecialKind) -> Option<fn(&DMatrix<f64>) -> f64> {
     match kind {
         SpecialKind::Fold => Some(fold_test),
         SpecialKind::PeriodDoubling => Some(flip_test),
         SpecialKind::NeimarkSacker => Some(neimark_sacker_test),
-        SpecialKind::BorderCollision => None,
+        SpecialKind::BorderCollision | SpecialKind::Extremum => None,
     }
 }
 
@@ -153,6 +153,7 @@ pub fn test_name(kind: SpecialKind) -> &'static str {
         SpecialKind::PeriodDoubling => "det(DP + I)",
         SpecialKind::NeimarkSacker => "bialternate product",
         SpecialKind::BorderCollision => "border",
+        SpecialKind::Extremum => "dq/ds",
     }
 }
 

@@ -74,15 +74,19 @@ fn of_kind<I>(family: &Family<I>, kind: SpecialKind) -> Vec<&SpecialPoint<I>> {
     family.special.iter().filter(|s| s.kind == kind).collect()
 }
 
-#[test]
-fn quadratic_family_through_its_fold_and_period_doubling() {
-    let map = quadratic();
+/// The quadratic family from its upper fixed point at `p = 0.3`, followed over `[-0.5, 1]`.
+fn quadratic_through_fold() -> Family<()> {
     let start = DVector::from_column_slice(&QuadraticFamily.upper_fixed_point(0.3));
     let options = ContinuationOptions {
         max_points: 1000,
         ..ContinuationOptions::for_range(-0.5, 1.0)
     };
-    let family = continue_family(&map, &start, 0.3, &options).unwrap();
+    continue_family(&quadratic(), &start, 0.3, &options).unwrap()
+}
+
+#[test]
+fn quadratic_family_through_its_fold_and_period_doubling() {
+    let family = quadratic_through_fold();
     // Through the fold at p = -1/4 onto the lower branch, then out of the range at p = 1 on both ends.
     assert_eq!(family.ends[0], FamilyEnd::LeftRange { bound: 1.0 });
     assert_eq!(family.ends[1], FamilyEnd::LeftRange { bound: 1.0 });
@@ -229,4 +233,126 @@ fn invalid_options_and_starts_are_refused() {
         continue_family(&map, &start, -0.9, &options),
         Err(arclength::ContinuationError::NoStart { .. })
     ));
+}
+
+/// A quantity of the quadratic family's points, monitored along it.
+struct Quantity {
+    name: &'static str,
+    value: fn(&DVector<f64>, f64) -> f64,
+    /// Its smooth pieces (none: one formula everywhere).
+    shape: Option<fn(&DVector<f64>) -> &'static str>,
+}
+
+impl monitor::Monitor<()> for Quantity {
+    fn name(&self) -> &str {
+        self.name
+    }
+
+    fn value(&self, at: &monitor::At<'_, ()>) -> f64 {
+        (self.value)(at.x, at.p)
+    }
+
+    fn shape(&self, at: &monitor::At<'_, ()>) -> String {
+        self.shape.map_or(String::new(), |f| f(at.x).to_string())
+    }
+}
+
+/// The extrema of `q` along the quadratic family from `p = 1` on the upper branch through the fold to `p = 1`
+/// on the lower one.
+fn quadratic_extrema(q: &Quantity) -> (Family<()>, Vec<monitor::Extremum<()>>) {
+    let map = quadratic();
+    let family = quadratic_through_fold();
+    let monitored: Vec<monitor::Monitored> = monitor::monitor_family(&map, &family, &[q])
+        .into_iter()
+        .map(|m| m[0])
+        .collect();
+    let found = monitor::extrema(&map, &family, q, &monitored);
+    (family, found)
+}
+
+/// The parameter along the family is least at the fold, `p = -1/4`, and `(x - 0.2)^2` at `x = 0.2`, `p = 0.24`:
+/// smooth minima, located to `1e-8`; the derivatives along the family agree with the closed form's
+/// `dp/ds = sigma t_p` and `dq/ds = 2 (x - 0.2) t_x`.
+#[test]
+fn smooth_extrema_of_monitored_quantities_on_the_quadratic_family() {
+    let p = Quantity {
+        name: "p",
+        value: |_, p| p,
+        shape: None,
+    };
+    let (family, found) = quadratic_extrema(&p);
+    assert_eq!(found.len(), 1, "{found:?}");
+    let e = &found[0];
+    assert_eq!(e.kind, monitor::ExtremumKind::Min);
+    assert!(e.corner.is_none() && e.special.located, "{e:?}");
+    assert!(
+        (e.special.param - QuadraticFamily::FOLD.0).abs() < 1e-8,
+        "{}",
+        e.special.param
+    );
+    assert!((e.located_bracket[1] - e.located_bracket[0]).abs() <= monitor::EXTREMUM_TOL);
+    assert_eq!(e.special.kind, SpecialKind::Extremum);
+    // The derivative along the family, against the tangent's own component (oriented along the arclength).
+    let sigma = family.options.param_scale;
+    let monitored = monitor::monitor_family(&quadratic(), &family, &[&p]);
+    for (i, m) in monitored
+        .iter()
+        .enumerate()
+        .skip(1)
+        .take(family.points.len() - 2)
+    {
+        let chord = family.points[i + 1].param - family.points[i - 1].param;
+        let t_p = family.points[i].tangent[2] * sigma;
+        let along = if chord == 0.0 {
+            t_p
+        } else {
+            t_p.abs() * chord.signum()
+        };
+        assert!(
+            (m[0].derivative - along).abs() < 1e-9,
+            "{} {along}",
+            m[0].derivative
+        );
+    }
+    let bowl = Quantity {
+        name: "bowl",
+        value: |x, _| (x[0] - 0.2).powi(2),
+        shape: None,
+    };
+    let (_, found) = quadratic_extrema(&bowl);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(found[0].kind, monitor::ExtremumKind::Min);
+    assert!(found[0].corner.is_none());
+    assert!(
+        (found[0].special.param - 0.24).abs() < 1e-8,
+        "{}",
+        found[0].special.param
+    );
+    assert!(found[0].value.abs() < 1e-12, "{}", found[0].value);
+}
+
+/// `|x - 0.3|` has a corner at `x = 0.3` (`p = 0.39`): with its two pieces named it is bracketed by bisection
+/// on the change of piece; without, the one-sided differences at the zero of the smoothed derivative show it.
+/// Either way a corner minimum, never a smooth one.
+#[test]
+fn a_corner_of_a_monitored_quantity_is_reported_as_a_corner() {
+    for shape in [
+        None,
+        Some((|x| if x[0] < 0.3 { "left" } else { "right" }) as fn(&DVector<f64>) -> &'static str),
+    ] {
+        let q = Quantity {
+            name: "kink",
+            value: |x, _| (x[0] - 0.3).abs(),
+            shape,
+        };
+        let (_, found) = quadratic_extrema(&q);
+        assert_eq!(found.len(), 1, "{found:?}");
+        let e = &found[0];
+        assert!(e.special.located, "{e:?}");
+        assert_eq!(e.kind, monitor::ExtremumKind::Min);
+        assert!(e.corner.is_some(), "{e:?}");
+        let [a, b] = e.located_bracket;
+        assert!((b - a).abs() <= monitor::EXTREMUM_TOL, "{a} {b}");
+        assert!((e.special.param - 0.39).abs() < 1e-8, "{}", e.special.param);
+    }
 }

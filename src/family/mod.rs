@@ -6,6 +6,7 @@
 pub mod curves;
 pub mod diagram;
 pub(crate) mod end_search;
+pub mod monitor;
 pub mod natural;
 pub mod parameter;
 
