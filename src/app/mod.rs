@@ -61,15 +61,17 @@ pub use simulate::{
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 pub use walker_basin::{
-    run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob, WalkerBasinPoint,
-    WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS, MAX_WALKER_BASIN_STEPS,
+    compute_walker_basin, run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob,
+    WalkerBasinPoint, WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS,
+    MAX_WALKER_BASIN_STEPS,
 };
 pub use walker_continue::{
     compute_walker_continuation, run_walker_continuation, WalkerContinueJob, WalkerContinueSummary,
     WalkerSpecialPoint,
 };
 pub use walker_map::{
-    run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary, WalkerMapThreshold,
+    compute_walker_map, run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary,
+    WalkerMapThreshold,
 };
 pub use walker_model::{
     Body, FoundGait, RigidModel, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,

@@ -20,9 +20,9 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walker_model::FoundGait;
+use super::walker_model::{FoundGait, WalkerModel};
 use super::walker_orbit::least_period;
-use super::walker_output::write_rows;
+use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::FRESH_TRANSIENT;
 use super::walkers::{as_map, named, start_of, Walker};
 use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
@@ -169,6 +169,28 @@ pub struct WalkerBasinSummary {
 }
 
 impl WalkerBasinJob {
+    /// The slice's coordinates `x` and `y` as given, or else the first and the second of `walker`'s section
+    /// (the defaults of `vrw basin --model` and `vrw.basin`).
+    pub fn slice_coordinates(
+        walker: &Walker,
+        [x, y]: [Option<&str>; 2],
+    ) -> Result<[String; 2], AppError> {
+        let names = walker.model()?.section_names();
+        if names.len() < 2 {
+            return Err(Self::invalid(
+                "model",
+                format!(
+                    "the section of `{}` has one coordinate ({}): a basin's slice needs two",
+                    walker.name(),
+                    names.join(", ")
+                ),
+            ));
+        }
+        let pick =
+            |given: Option<&str>, k: usize| given.map_or_else(|| names[k].clone(), String::from);
+        Ok([pick(x, 0), pick(y, 1)])
+    }
+
     fn invalid(option: &'static str, reason: String) -> AppError {
         AppError::InvalidOption { option, reason }
     }
@@ -332,6 +354,34 @@ pub(super) fn walker_basin_points(
     })
 }
 
+/// What a basin's grid runs on: the section's coordinates, the gait and the slice's axes.
+struct Slice {
+    names: Vec<String>,
+    found: FoundGait,
+    axes: [WalkerBasinAxis; 2],
+}
+
+/// The slice of `job` on `model`, after the options are checked and, between the checks and the gait search,
+/// `before_search` (the command line's check of its output directory).
+fn slice(
+    job: &WalkerBasinJob,
+    model: &dyn WalkerModel,
+    before_search: impl FnOnce() -> Result<(), AppError>,
+) -> Result<Slice, AppError> {
+    let names = model.section_names();
+    let indices = job.validate(&names)?;
+    let start = start_of(model, job.initial.as_deref())?;
+    before_search()?;
+    let found = model.gait(&start, FRESH_TRANSIENT);
+    check_phase_interrupted(None, "while searching the gait", NOTHING_WRITTEN)?;
+    let found = found.map_err(|e| AppError::InvalidOption {
+        option: "basin",
+        reason: format!("no gait to draw the basin of: {e}"),
+    })?;
+    let axes = job.axes(indices, &found.section);
+    Ok(Slice { names, found, axes })
+}
+
 /// Draw the basin of `job.walker`'s gait and write `basin.csv`, `basin.json` and `basin.png`, after the
 /// options, the gait and the output directory are checked. `progress` is called after every start.
 /// Interrupted (Ctrl-C) among the starts, `basin.csv` keeps the complete ones of every row.
@@ -340,17 +390,10 @@ pub fn run_walker_basin(
     progress: &(dyn Fn(&WalkerBasinPoint) + Sync),
 ) -> Result<WalkerBasinSummary, AppError> {
     let model = job.walker.model()?;
-    let names = model.section_names();
-    let indices = job.validate(&names)?;
-    let start = start_of(model.as_ref(), job.initial.as_deref())?;
-    output::manifest::check_out_dir(&job.out_dir, "basin", job.overwrite)?;
-    let found = model.gait(&start, FRESH_TRANSIENT);
-    check_phase_interrupted(None, "while searching the gait", NOTHING_WRITTEN)?;
-    let found = found.map_err(|e| AppError::InvalidOption {
-        option: "basin",
-        reason: format!("no gait to draw the basin of: {e}"),
+    let Slice { names, found, axes } = slice(job, model.as_ref(), || {
+        output::manifest::check_out_dir(&job.out_dir, "basin", job.overwrite)?;
+        Ok(())
     })?;
-    let axes = job.axes(indices, &found.section);
     in_run(&job.out_dir, job.overwrite, "basin", |run| {
         let grid = walker_basin_points(
             &job.walker,
@@ -369,6 +412,31 @@ pub fn run_walker_basin(
         run.add("basin.json");
         Ok((summary, None))
     })
+}
+
+/// The basin of [`run_walker_basin`] without its files and figure (the Python binding): `basin.json`'s fields
+/// (`files` the table's) and the rows of `basin.csv` (`job.out_dir` and `job.overwrite` are not read).
+/// `progress` is called after every start. Interrupted (Ctrl-C): an error, nothing kept.
+pub fn compute_walker_basin(
+    job: &WalkerBasinJob,
+    progress: &(dyn Fn(&WalkerBasinPoint) + Sync),
+) -> Result<WalkerOutput<WalkerBasinSummary>, AppError> {
+    let model = job.walker.model()?;
+    let Slice { names, found, axes } = slice(job, model.as_ref(), || Ok(()))?;
+    let grid = walker_basin_points(
+        &job.walker,
+        (&found.section, &axes),
+        (job.max_steps, job.tolerance),
+        progress,
+    );
+    let total = axes[0].points * axes[1].points;
+    check_interrupted(grid.iter().map(Vec::len).sum(), total, "no file")?;
+    let tables = vec![("basin.csv", basin_rows(&names, &grid))];
+    let summary = WalkerBasinSummary {
+        files: vec!["basin.csv".to_string()],
+        ..summary(job, (model.name(), &names), &found, axes, &grid)
+    };
+    Ok(WalkerOutput { summary, tables })
 }
 
 /// `basin.json`'s fields.
@@ -495,6 +563,24 @@ mod tests {
             out_dir: out.to_path_buf(),
             overwrite: false,
         }
+    }
+
+    /// The basin without its files ([`compute_walker_basin`], the Python binding's) is the one `vrw basin
+    /// --model` writes: its table is `basin.csv` cell for cell, its summary `basin.json` but for the files
+    /// listed.
+    #[test]
+    fn the_computed_basin_is_the_written_one() {
+        let tmp = tempfile::tempdir().unwrap();
+        let job = simplest_basin(&tmp.path().join("basin"), 5);
+        let written = run_walker_basin(&job, &|_| {}).unwrap();
+        let computed = compute_walker_basin(&job, &|_| {}).unwrap();
+        let csv = std::fs::read_to_string(tmp.path().join("basin").join("basin.csv")).unwrap();
+        let rows: Vec<String> = computed.tables[0].1.iter().map(|r| r.join(",")).collect();
+        assert_eq!(computed.tables[0].0, "basin.csv");
+        assert_eq!(csv.lines().collect::<Vec<_>>(), rows);
+        let mut summary = serde_json::to_value(&computed.summary).unwrap();
+        summary["files"] = serde_json::to_value(&written.files).unwrap();
+        assert_eq!(summary, serde_json::to_value(&written).unwrap());
     }
 
     /// `basin.csv`, `basin.json` and `basin.png` are the same bytes for 1 and 2 threads.

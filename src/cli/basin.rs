@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 
 use vrw::app::{run_basin, run_walker_basin, BasinJob, Walker, WalkerBasinJob};
@@ -125,21 +125,10 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
 
 /// `vrw basin --model NAME` for a walker other than the wheel: the basin of its gait, its summary, its files.
 fn run_walker(args: &BasinArgs, walker: Walker) -> Result<()> {
-    let names = walker.model()?.section_names();
-    let pick = |given: &Option<String>, k: usize| {
-        given
-            .clone()
-            .unwrap_or_else(|| names.get(k).cloned().unwrap_or_default())
-    };
-    if names.len() < 2 {
-        bail!(
-            "the section of `{}` has one coordinate ({}): a basin's slice needs two",
-            walker.name(),
-            names.join(", ")
-        );
-    }
+    let coordinates =
+        WalkerBasinJob::slice_coordinates(&walker, [args.x.as_deref(), args.y.as_deref()])?;
     let job = WalkerBasinJob {
-        coordinates: [pick(&args.x, 0), pick(&args.y, 1)],
+        coordinates,
         walker,
         initial: super::walker_initial(args.initial.as_deref())?,
         ranges: [args.x_range, args.y_range],

@@ -45,7 +45,9 @@ use super::read::RunData;
 use super::style::{png_bytes, require_font, save_png, PlotError};
 use draw::Renderer;
 pub use plan::{plan_frames, FrameTime, SlowMotion, MAX_ANIMATION_FRAMES};
-pub use stick::{write_walker_animation, write_walker_still};
+pub use stick::{
+    walker_still_png, write_walker_animation, write_walker_animation_to, write_walker_still,
+};
 
 /// Largest frame rate: GIF delays are whole hundredths of a second and viewers slow down delays below
 /// 0.02 s, so faster frame rates would not play at their speed.
