@@ -27,7 +27,7 @@ use vrw::app::{
     compute_basin_part, compute_continuation, compute_gait, compute_map, compute_map_part,
     compute_orbit, compute_orbit_part, compute_simulation, compute_sweep, curve_rows, family_rows,
     AppError, BasinJob, ContinueJob, GaitJob, MapJob, OrbitJob, OrbitJobPart, SimulateJob,
-    WalkerRange,
+    SliceGrid, WalkerRange,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -167,17 +167,15 @@ enum Model {
 }
 
 impl Params {
-    /// The wheel's configuration, or the error of a job (`vrw.{job}`) that takes only the wheel so far, naming
-    /// the model.
+    /// The wheel's configuration, for the wheel's part of the job `vrw.{job}` (every job takes another walker
+    /// before it: this error names the job and the model should one not).
     fn wheel(&self, job: &str) -> PyResult<&Config> {
         match &self.model {
             Model::Wheel(config) => Ok(config),
             Model::Walker(w) => Err(walkers::option_error(
                 "model",
                 format!(
-                    "`vrw.{job}` takes only the wheel (`vrw`) so far; the model `{}` walks in \
-                     `vrw.find_gait`, `vrw.simulate`, `vrw.sweep`, `vrw.orbit` and `vrw.continue_family` \
-                     (docs/model.md section 13)",
+                    "`vrw.{job}` took the model `{}` for the wheel's (docs/model.md section 13)",
                     w.name()
                 ),
             )),
@@ -695,16 +693,19 @@ fn basin<'py>(
     rows: Option<(usize, usize)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let grid = SliceGrid {
+        ranges: [x_range, y_range],
+        points: [nx, ny],
+        max_steps,
+        tolerance,
+    };
     if let Some(w) = params.walker() {
         if rows.is_some() {
             return Err(walkers::whole_only(w, "rows", "basin"));
         }
         let options = walkers::BasinOptions {
             coordinates: [x, y],
-            ranges: [x_range, y_range],
-            points: [nx, ny],
-            max_steps,
-            tolerance,
+            grid,
             initial,
         };
         return walkers::basin(py, w, options, progress);
@@ -721,10 +722,7 @@ fn basin<'py>(
             coordinate("x", x.unwrap_or("L2"))?,
             coordinate("y", y.unwrap_or("thetadot"))?,
         ],
-        ranges: [x_range, y_range],
-        points: [nx, ny],
-        max_steps,
-        tolerance,
+        grid,
         out_dir: PathBuf::new(),
         overwrite: false,
     };

@@ -14,9 +14,9 @@ use pythonize::pythonize;
 
 use vrw::app::{
     compute_walker_basin, compute_walker_continuation, compute_walker_gait, compute_walker_map,
-    compute_walker_orbit, compute_walker_simulate, compute_walker_sweep, AppError, Walker,
-    WalkerBasinJob, WalkerContinueJob, WalkerGaitJob, WalkerMapJob, WalkerOrbitJob, WalkerOutput,
-    WalkerRange, WalkerSimulateJob, WalkerSweepJob, MAX_WALKER_SWEEP_POINTS,
+    compute_walker_orbit, compute_walker_simulate, compute_walker_sweep, AppError, SliceGrid,
+    Walker, WalkerBasinJob, WalkerContinueJob, WalkerGaitJob, WalkerMapJob, WalkerOrbitJob,
+    WalkerOutput, WalkerRange, WalkerSimulateJob, WalkerSweepJob, MAX_WALKER_SWEEP_POINTS,
 };
 use vrw::gait::GaitOptions;
 use vrw::mechanism::described;
@@ -576,14 +576,9 @@ pub(crate) fn map<'py>(
 pub(crate) struct BasinOptions<'a> {
     /// The slice's coordinates (`None`: the section's first and second).
     pub(crate) coordinates: [Option<&'a str>; 2],
-    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0).
-    pub(crate) ranges: [Option<(f64, f64)>; 2],
-    /// Grid points along x and y.
-    pub(crate) points: [usize; 2],
-    /// Steps walked at most from each start.
-    pub(crate) max_steps: usize,
-    /// A return this close to the gait has reached it.
-    pub(crate) tolerance: f64,
+    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0), the grid, and when a
+    /// walk ends.
+    pub(crate) grid: SliceGrid,
     /// Where the gait search starts.
     pub(crate) initial: Option<Vec<f64>>,
 }
@@ -603,14 +598,11 @@ pub(crate) fn basin<'py>(
         walker: params.walker.clone(),
         initial: options.initial,
         coordinates,
-        ranges: options.ranges,
-        points: options.points,
-        max_steps: options.max_steps,
-        tolerance: options.tolerance,
+        grid: options.grid,
         out_dir: PathBuf::new(),
         overwrite: false,
     };
-    let [nx, ny] = job.points;
+    let [nx, ny] = job.grid.points;
     let progress = Progress::new(progress, nx.saturating_mul(ny));
     let flag = vrw::gait::interrupt_flag();
     let out = interruptible_with(py, flag, Some(&progress), || {

@@ -3,14 +3,10 @@ library, every job the command line runs for them with its numbers (compared wit
 ``vrw ... --model`` command, value for value), pickling, the errors of bad input, and the wheel's API
 unchanged."""
 
-import _thread
 import doctest
 import json
 import pickle
 import shutil
-import signal
-import threading
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,9 +14,6 @@ import pytest
 
 import vrw
 from conftest import ROOT, assert_table_equals_csv, json_equal, read_csv
-
-# Ctrl-C is what some tests here are about: Python's own SIGINT handler (see test_interrupt.py).
-signal.signal(signal.SIGINT, signal.default_int_handler)
 
 COMPASS_TOML = str(ROOT / "models" / "compass.toml")
 THREE_DEGREES = 0.0523598775598
@@ -475,71 +468,6 @@ def test_a_grid_of_sweeps_takes_a_walker():
         assert np.array_equal(grid["sweep"]["period"][i], row["sweep"]["period"])
     with pytest.raises(vrw.ConfigError, match="model `compass`"):
         orbit_grid(None, p, "slope", range=(0.05, 0.06), points=3)
-
-
-@pytest.mark.parametrize(
-    "job",
-    [
-        lambda: vrw.simulate(vrw.Params(model="simplest"), steps=1_000_000, trajectory=False),
-        lambda: vrw.sweep(vrw.Params(model="compass"), "slope", vrw.linspace(0.01, 0.09, 20000)),
-        lambda: vrw.find_gait(vrw.Params(model="telescopic"), transient_steps=100_000),
-        lambda: vrw.map(vrw.Params(model="compass"), x="slope", x_range=(0.05, 0.09), nx=200, y="hip_mass",
-                        y_range=(5.0, 20.0), ny=200),
-        lambda: vrw.basin(vrw.Params(model="compass"), nx=400, ny=400),
-        lambda: vrw.animate(vrw.simulate(vrw.Params(model="compass"), steps=2000, trajectory=False), fps=50),
-    ],
-    ids=["simulate", "sweep", "find_gait telescopic", "map", "basin", "animate"],
-)
-def test_ctrl_c_stops_a_walkers_job_within_a_second(job):
-    delay = 0.5
-    timer = threading.Timer(delay, _thread.interrupt_main)
-    start = time.monotonic()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        job()
-    assert time.monotonic() - start < delay + 1.0
-    assert vrw.find_gait(vrw.Params(model="simplest"))["status"] == "found"
-
-
-@pytest.mark.parametrize(
-    "job, total",
-    [
-        (lambda progress: vrw.map(vrw.Params(model="compass"), x="slope", x_range=(0.05, 0.06), nx=4,
-                                  y="hip_mass", y_range=(9.0, 10.0), ny=3, progress=progress), 12),
-        (lambda progress: vrw.basin(vrw.Params(model="simplest"), nx=4, ny=5, max_steps=10, progress=progress),
-         20),
-    ],
-    ids=["map", "basin"],
-)
-def test_a_walkers_progress_is_reported_on_the_calling_thread_up_to_the_total(job, total):
-    calls = []
-    job(lambda done, of: calls.append((done, of, threading.get_ident())))
-    assert calls, "never reported"
-    assert all(of == total for _, of, _ in calls)
-    done = [d for d, _, _ in calls]
-    assert done == sorted(set(done)) and done[-1] == total
-    assert {t for _, _, t in calls} == {threading.get_ident()}
-
-
-def test_ctrl_c_while_a_walkers_thresholds_are_bisected_keeps_its_gaits():
-    """As the wheel's map keeps its gaits when Ctrl-C stops its curves: a walker's map stopped while its
-    thresholds are bisected hands its complete gaits on with the KeyboardInterrupt (as ``partial``)."""
-    grid = dict(x="slope", x_range=(0.07, 0.08), nx=5, y="hip_mass", y_range=(8.0, 12.0), ny=8)
-    started = []
-
-    def progress(done, total):
-        # When the last gait is in, the thresholds (about two thirds of the work) follow: interrupt them.
-        if done == total and not started:
-            started.append(True)
-            threading.Timer(0.3, _thread.interrupt_main).start()
-
-    with pytest.raises(KeyboardInterrupt) as stopped:
-        vrw.map(vrw.Params(model="compass"), progress=progress, **grid)
-    partial = stopped.value.partial
-    assert "while bisecting the thresholds" in partial["interrupted"] and partial["thresholds"] == []
-    whole = vrw.map(vrw.Params(model="compass"), curves=False, **grid)
-    assert same(partial["map"], whole["map"])
-    assert partial["gaits_found"] == whole["gaits_found"] == 40
 
 
 # --- Figures and docs -----------------------------------------------------------------------------------

@@ -20,6 +20,7 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
+use super::basin::SliceGrid;
 use super::walker_model::{FoundGait, WalkerModel};
 use super::walker_orbit::least_period;
 use super::walker_output::{write_rows, WalkerOutput};
@@ -32,12 +33,6 @@ use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::study::basin::{OutcomeKind, SETTLED_TOL};
 use crate::study::grid::{run_rows, Evaluated};
 
-/// The most grid points along one axis of a walker's basin (as the wheel's).
-pub const MAX_WALKER_BASIN_POINTS: usize = 2000;
-
-/// The most steps walked from one start (as the wheel's).
-pub const MAX_WALKER_BASIN_STEPS: usize = 100_000;
-
 /// What `vrw basin --model NAME` runs.
 #[derive(Debug, Clone)]
 pub struct WalkerBasinJob {
@@ -47,14 +42,9 @@ pub struct WalkerBasinJob {
     pub initial: Option<Vec<f64>>,
     /// The horizontal and vertical coordinates of the slice (names of the model's section coordinates).
     pub coordinates: [String; 2],
-    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0).
-    pub ranges: [Option<(f64, f64)>; 2],
-    /// Grid points along x and y.
-    pub points: [usize; 2],
-    /// Steps walked at most from each start.
-    pub max_steps: usize,
-    /// Distance to the gait's section state that counts as reaching it (largest coordinate difference).
-    pub tolerance: f64,
+    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0), the grid, and when
+    /// a walk ends.
+    pub grid: SliceGrid,
     /// Output directory for `basin.csv`, `basin.json` and `basin.png`.
     pub out_dir: PathBuf,
     /// Replace a run of another command in `out_dir`.
@@ -195,8 +185,8 @@ impl WalkerBasinJob {
         AppError::InvalidOption { option, reason }
     }
 
-    /// Check the options that do not depend on the gait: the coordinates against the section's `names`, the
-    /// ranges, grid sizes, steps and tolerance.
+    /// Check the options that do not depend on the gait: the coordinates against the section's `names`, and the
+    /// grid ([`SliceGrid::validate`]).
     fn validate(&self, names: &[String]) -> Result<[usize; 2], AppError> {
         let index = |option: &'static str, c: &str| {
             names.iter().position(|n| n == c).ok_or_else(|| {
@@ -224,38 +214,7 @@ impl WalkerBasinJob {
                 ),
             ));
         }
-        for (option, n) in [("nx", self.points[0]), ("ny", self.points[1])] {
-            if !(2..=MAX_WALKER_BASIN_POINTS).contains(&n) {
-                return Err(Self::invalid(
-                    option,
-                    format!("{n} grid points; use 2 to {MAX_WALKER_BASIN_POINTS}"),
-                ));
-            }
-        }
-        for (option, range) in [("x_range", self.ranges[0]), ("y_range", self.ranges[1])] {
-            if let Some((a, b)) = range.filter(|(a, b)| !(a.is_finite() && b.is_finite() && a != b))
-            {
-                return Err(Self::invalid(
-                    option,
-                    format!("{a},{b} is not a range with two different finite ends"),
-                ));
-            }
-        }
-        if !(1..=MAX_WALKER_BASIN_STEPS).contains(&self.max_steps) {
-            return Err(Self::invalid(
-                "max_steps",
-                format!(
-                    "{} steps; use 1 to {MAX_WALKER_BASIN_STEPS}",
-                    self.max_steps
-                ),
-            ));
-        }
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(Self::invalid(
-                "tolerance",
-                format!("{} is not a positive distance", self.tolerance),
-            ));
-        }
+        self.grid.validate()?;
         Ok(axes)
     }
 
@@ -263,7 +222,7 @@ impl WalkerBasinJob {
     fn axes(&self, indices: [usize; 2], through: &DVector<f64>) -> [WalkerBasinAxis; 2] {
         [0, 1].map(|k| {
             let at = through[indices[k]];
-            let (from, to) = self.ranges[k].unwrap_or(if at == 0.0 {
+            let (from, to) = self.grid.ranges[k].unwrap_or(if at == 0.0 {
                 (-1.0, 1.0)
             } else {
                 (0.0, 2.0 * at)
@@ -273,7 +232,7 @@ impl WalkerBasinJob {
                 index: indices[k],
                 from,
                 to,
-                points: self.points[k],
+                points: self.grid.points[k],
             }
         })
     }
@@ -398,7 +357,7 @@ pub fn run_walker_basin(
         let grid = walker_basin_points(
             &job.walker,
             (&found.section, &axes),
-            (job.max_steps, job.tolerance),
+            (job.grid.max_steps, job.grid.tolerance),
             progress,
         );
         write_rows(&run.path("basin.csv"), &basin_rows(&names, &grid))?;
@@ -426,7 +385,7 @@ pub fn compute_walker_basin(
     let grid = walker_basin_points(
         &job.walker,
         (&found.section, &axes),
-        (job.max_steps, job.tolerance),
+        (job.grid.max_steps, job.grid.tolerance),
         progress,
     );
     let total = axes[0].points * axes[1].points;
@@ -466,8 +425,8 @@ fn summary(
         x,
         y,
         through: named(names, &found.section),
-        max_steps: job.max_steps,
-        tolerance: job.tolerance,
+        max_steps: job.grid.max_steps,
+        tolerance: job.grid.tolerance,
         outcomes,
         files: ["basin.csv", "basin.png", "basin.json"]
             .map(String::from)
@@ -556,10 +515,12 @@ mod tests {
             walker,
             initial: None,
             coordinates: ["theta".to_string(), "theta_dot".to_string()],
-            ranges: [Some((0.15, 0.25)), Some((-0.25, -0.15))],
-            points: [n, n],
-            max_steps: 100,
-            tolerance: 1e-3,
+            grid: SliceGrid {
+                ranges: [Some((0.15, 0.25)), Some((-0.25, -0.15))],
+                points: [n, n],
+                max_steps: 100,
+                tolerance: 1e-3,
+            },
             out_dir: out.to_path_buf(),
             overwrite: false,
         }

@@ -314,25 +314,10 @@ fn walker_still_rgb(
     time: f64,
     path: &Path,
 ) -> Result<Vec<u8>, AnimateError> {
-    opts.validate()?;
-    let (start, end) = run.time_span();
-    if !(start..=end).contains(&time) {
-        return Err(AnimateError::EmptyWindow {
-            path: run.dir.join("trajectory.csv"),
-            from: time,
-            to: time,
-            start,
-            end,
-        });
-    }
-    require_font(path)?;
-    let size = (opts.width, opts.height);
-    let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+    let walk = (time, run.time_span(), run.dir.join("trajectory.csv"));
+    super::frame_rgb(opts, walk, path, |root| {
         let fail = PlotError::draw_at(path);
-        draw_frame(&root, run, opts, (time, hip_height(run))).map_err(|e| fail(e.to_string()))?;
-        root.present().map_err(|e| fail(e.to_string()))?;
-    }
-    Ok(rgb)
+        draw_frame(root, run, opts, (time, hip_height(run))).map_err(|e| fail(e.to_string()))?;
+        Ok(root.present().map_err(|e| fail(e.to_string()))?)
+    })
 }
