@@ -216,6 +216,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::app::WalkerModel;
 
     /// A step of `vrw simulate --model telescopic` is the gait search's step map bit for bit, with its samples
     /// or without (the observer changes nothing of the walk); its first sample holds the step's starting

@@ -138,7 +138,7 @@ fn run_walker(args: &BasinArgs, walker: Walker) -> Result<()> {
         coordinates,
         walker,
         initial: super::walker_initial(args.initial.as_deref())?,
-        grid: slice_grid(&args),
+        grid: slice_grid(args),
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
     };
