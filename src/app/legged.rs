@@ -85,7 +85,7 @@ impl Body<6> for Telescopic {
     }
 }
 
-/// A walker with compliant legs as a [`WalkerModel`].
+/// A walker with compliant legs as a [`super::WalkerModel`].
 pub type LeggedModel<'w, W, const N: usize, const Y: usize> = Walking<'w, W, Compliant, N, Y>;
 
 /// The compliant-leg walk ([`crate::mechanism::legged`]), for [`Walking`].
