@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use vrw::app::{run_basin, run_orbit, BasinJob, OrbitJob};
+use vrw::app::{run_basin, run_orbit, BasinJob, OrbitJob, SliceGrid};
 use vrw::dynamics::Model;
 use vrw::family::natural::section_distance;
 use vrw::gait::{find_gait, GaitOptions, StepMap};
@@ -136,10 +136,12 @@ fn basin_job(dir: &Path) -> BasinJob {
         config: Config::default(),
         initial: None,
         coordinates: [Coordinate::L2, Coordinate::ThetaDot],
-        ranges: [None, None],
-        points: [3, 3],
-        max_steps: 30,
-        tolerance: TOLERANCE,
+        grid: SliceGrid {
+            ranges: [None, None],
+            points: [3, 3],
+            max_steps: 30,
+            tolerance: TOLERANCE,
+        },
         out_dir: dir.to_path_buf(),
         overwrite: false,
     }
@@ -167,11 +169,11 @@ fn basin_job_refuses_bad_options() {
     let e = run_basin(&job, &|_| {}).unwrap_err().to_string();
     assert!(e.contains("`x/y`") && e.contains("different"), "{e}");
     let mut job = basin_job(dir.path());
-    job.points = [1, 3];
+    job.grid.points = [1, 3];
     let e = run_basin(&job, &|_| {}).unwrap_err().to_string();
     assert!(e.contains("`nx`"), "{e}");
     let mut job = basin_job(dir.path());
-    job.ranges[1] = Some((1.0, f64::NAN));
+    job.grid.ranges[1] = Some((1.0, f64::NAN));
     let e = run_basin(&job, &|_| {}).unwrap_err().to_string();
     assert!(e.contains("`y_range`"), "{e}");
 }

@@ -12,9 +12,15 @@ use std::path::{Path, PathBuf};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
-use vrw::app::{compute_simulation, AppError, SimulateJob};
-use vrw::output::animate::{still_png, write_animation_to, AnimateError, AnimateOptions};
+use vrw::app::{
+    compute_simulation, compute_walker_simulate, AppError, SimulateJob, WalkerSimulateJob,
+};
+use vrw::output::animate::{
+    still_png, walker_still_png, write_animation_to, write_walker_animation_to, AnimateError,
+    AnimateOptions,
+};
 use vrw::output::read::run_from_walk;
+use vrw::output::walker_run::walker_run_from_walk;
 
 use super::{
     app_error, config_error, count, interruptible, real, sample_dt_arg, section, steps_arg,
@@ -29,7 +35,8 @@ use super::{
 /// option out of range, more than `MAX_ANIMATION_FRAMES` frames or a time window outside the walk raises
 /// `vrw.ConfigError` (before the walk, where the options alone tell). The GIL is released while the walk is
 /// computed and drawn; Ctrl-C raises `KeyboardInterrupt` (the walk stops at once, the drawing between two
-/// chunks of frames).
+/// chunks of frames). Another walker's (`Params(model=...)`): its walk of `vrw simulate --model` (`initial` its
+/// section's coordinates) drawn as `vrw animate` draws that run's directory: its stick figure.
 #[pyfunction]
 #[pyo3(signature = (params, steps = 20, initial = None, sample_dt = 0.005, *, fps = 25, speed = 1.0, from_ = None, to = None, width = 640, height = 360, horizontal = false, still = None))]
 #[allow(clippy::too_many_arguments)]
@@ -60,6 +67,22 @@ pub(crate) fn animate<'py>(
     options
         .validate()
         .map_err(|e| animate_error(AppError::Animate(e)))?;
+    // The library's flag: the walk and the encoding of the frames both read it.
+    let flag = vrw::gait::interrupt_flag();
+    if let Some(w) = params.walker() {
+        let job = WalkerSimulateJob {
+            walker: w.walker.clone(),
+            initial,
+            steps,
+            sample_dt,
+            trajectory: true,
+            out_dir: PathBuf::new(),
+            overwrite: false,
+        };
+        let bytes = interruptible(py, flag, || draw_walker(&job, &options, still))?
+            .map_err(animate_error)?;
+        return Ok(PyBytes::new(py, &bytes));
+    }
     let job = SimulateJob {
         config: params.wheel("animate")?.clone(),
         initial: section(initial)?,
@@ -70,8 +93,6 @@ pub(crate) fn animate<'py>(
         overwrite: false,
         interrupt: None,
     };
-    // The library's flag: the walk and the encoding of the frames both read it.
-    let flag = vrw::gait::interrupt_flag();
     let bytes = interruptible(py, flag, || draw(&job, &options, still))?.map_err(animate_error)?;
     Ok(PyBytes::new(py, &bytes))
 }
@@ -95,6 +116,30 @@ fn draw(
         None => {
             let mut gif = Vec::new();
             write_animation_to(&run, options, &mut gif, Path::new("walk.gif"))?;
+            gif
+        }
+    })
+}
+
+/// The walk of a walker's `job` (`vrw simulate --model`'s), drawn as `vrw animate` draws its directory: the GIF,
+/// or the PNG of the frame at `still`.
+fn draw_walker(
+    job: &WalkerSimulateJob,
+    options: &AnimateOptions,
+    still: Option<f64>,
+) -> Result<Vec<u8>, AppError> {
+    let out = compute_walker_simulate(job)?;
+    let trajectory = out
+        .tables
+        .iter()
+        .find(|(name, _)| *name == "trajectory.csv")
+        .map_or(&[] as &[Vec<String>], |(_, rows)| rows);
+    let run = walker_run_from_walk(&out.summary, trajectory)?;
+    Ok(match still {
+        Some(time) => walker_still_png(&run, options, time, Path::new("walk-frame.png"))?,
+        None => {
+            let mut gif = Vec::new();
+            write_walker_animation_to(&run, options, &mut gif, Path::new("walk.gif"))?;
             gif
         }
     })

@@ -22,12 +22,12 @@ mod parts;
 mod progress;
 mod walkers;
 
-use progress::{interruptible_keeping, interruptible_with, Progress};
+use progress::{interruptible_keeping, interruptible_with, keeping_partial, Progress};
 use vrw::app::{
     compute_basin_part, compute_continuation, compute_gait, compute_map, compute_map_part,
     compute_orbit, compute_orbit_part, compute_simulation, compute_sweep, curve_rows, family_rows,
     monitored_header, monitored_rows, AppError, BasinJob, ContinueJob, GaitJob, MapJob, OrbitJob,
-    OrbitJobPart, SimulateJob, WalkerRange,
+    OrbitJobPart, SimulateJob, SliceGrid, WalkerRange,
 };
 use vrw::dynamics::DIFFERENTIABLE_KEYS;
 use vrw::fmt::short;
@@ -40,6 +40,7 @@ use vrw::output::{
 };
 use vrw::params::{Config, ConfigError as LibConfigError};
 use vrw::study::basin::Coordinate;
+use vrw::study::map::DEFAULT_CURVE_COLUMNS;
 use vrw::study::orbit::OrbitSpec;
 use vrw::study::MAX_SWEEP_POINTS;
 use vrw::study::{MapSpec, SweepSpec};
@@ -166,17 +167,15 @@ enum Model {
 }
 
 impl Params {
-    /// The wheel's configuration, or the error of a job (`vrw.{job}`) that takes only the wheel so far, naming
-    /// the model.
+    /// The wheel's configuration, for the wheel's part of the job `vrw.{job}` (every job takes another walker
+    /// before it: this error names the job and the model should one not).
     fn wheel(&self, job: &str) -> PyResult<&Config> {
         match &self.model {
             Model::Wheel(config) => Ok(config),
             Model::Walker(w) => Err(walkers::option_error(
                 "model",
                 format!(
-                    "`vrw.{job}` takes only the wheel (`vrw`) so far; the model `{}` walks in \
-                     `vrw.find_gait`, `vrw.simulate`, `vrw.sweep`, `vrw.orbit` and `vrw.continue_family` \
-                     (docs/model.md section 13)",
+                    "`vrw.{job}` took the model `{}` for the wheel's (docs/model.md section 13)",
                     w.name()
                 ),
             )),
@@ -669,19 +668,21 @@ fn sweep<'py>(
 ///
 /// Returns the fields of `basin.json` (`spec`, `gait`, `outcomes`, ...) and `points`, the columns of
 /// `basin.csv` as numpy arrays (one row per grid point, row by row). Keyword arguments as the command line's
-/// options: `x`, `y` (`"L2"`, `"thetadot"`, `"L2dot"`), `x_range`, `y_range` (`(from, to)`, default the command
-/// line's), `nx`, `ny`, `max_steps`, `tolerance`, `initial` (where the gait search starts); and `rows`
-/// (`(start, end)`: only the grid rows `start..end`, each point as the whole basin has it, `outcomes` counting
-/// them: a part of a study spread over processes, see `vrw.grid`) and `progress` (a callable
-/// `progress(done, total)`, called on this thread as grid points finish).
+/// options: `x`, `y` (`"L2"`, `"thetadot"`, `"L2dot"`; default `"L2"` and `"thetadot"`), `x_range`, `y_range`
+/// (`(from, to)`, default the command line's), `nx`, `ny`, `max_steps`, `tolerance`, `initial` (where the gait
+/// search starts); and `rows` (`(start, end)`: only the grid rows `start..end`, each point as the whole basin
+/// has it, `outcomes` counting them: a part of a study spread over processes, see `vrw.grid`) and `progress` (a
+/// callable `progress(done, total)`, called on this thread as grid points finish). Another walker's
+/// (`Params(model=...)`): `vrw basin --model`'s `basin.json` fields and `points`, `x` and `y` two of its
+/// section's coordinates (default its first and second), `initial` its section's coordinates; no `rows` yet.
 #[pyfunction]
-#[pyo3(signature = (params, *, x = "L2", y = "thetadot", x_range = None, y_range = None, nx = 61, ny = 61, max_steps = 100, tolerance = 1e-3, initial = None, rows = None, progress = None))]
+#[pyo3(signature = (params, *, x = None, y = None, x_range = None, y_range = None, nx = 61, ny = 61, max_steps = 100, tolerance = 1e-3, initial = None, rows = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn basin<'py>(
     py: Python<'py>,
     params: &Params,
-    x: &str,
-    y: &str,
+    x: Option<&str>,
+    y: Option<&str>,
     x_range: Option<(f64, f64)>,
     y_range: Option<(f64, f64)>,
     #[pyo3(from_py_with = nx_arg)] nx: usize,
@@ -692,6 +693,23 @@ fn basin<'py>(
     rows: Option<(usize, usize)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let grid = SliceGrid {
+        ranges: [x_range, y_range],
+        points: [nx, ny],
+        max_steps,
+        tolerance,
+    };
+    if let Some(w) = params.walker() {
+        if rows.is_some() {
+            return Err(walkers::whole_only(w, "rows", "basin"));
+        }
+        let options = walkers::BasinOptions {
+            coordinates: [x, y],
+            grid,
+            initial,
+        };
+        return walkers::basin(py, w, options, progress);
+    }
     let coordinate = |name: &str, value: &str| {
         value
             .parse::<Coordinate>()
@@ -700,11 +718,11 @@ fn basin<'py>(
     let job = BasinJob {
         config: params.wheel("basin")?.clone(),
         initial: section(initial)?,
-        coordinates: [coordinate("x", x)?, coordinate("y", y)?],
-        ranges: [x_range, y_range],
-        points: [nx, ny],
-        max_steps,
-        tolerance,
+        coordinates: [
+            coordinate("x", x.unwrap_or("L2"))?,
+            coordinate("y", y.unwrap_or("thetadot"))?,
+        ],
+        grid,
         out_dir: PathBuf::new(),
         overwrite: false,
     };
@@ -737,7 +755,10 @@ fn basin<'py>(
 /// `second_route`, `initial` (where every row's first search starts); and `rows` (`(start, end)`: only the
 /// gaits of the rows `start..end` of `y`, each point as the whole map has it, with `curves=False`: a part of a
 /// study spread over processes, see `vrw.grid`) and `progress` (a callable `progress(done, total)`, called on
-/// this thread as grid points finish; the curves, after the gaits, are not counted).
+/// this thread as grid points finish; the curves, after the gaits, are not counted). Another walker's
+/// (`Params(model=...)`): `vrw map --model`'s `map.json` fields and `map`, `x` and `y` two of its parameters,
+/// `curves` its changes of stability bisected along the rows (`thresholds`), `initial` its section's
+/// coordinates; no `curve_columns`, `curve_method`, `second_route` or `rows`.
 #[pyfunction]
 #[pyo3(name = "map", signature = (params, *, x = "viscosity", y = "stiffness", x_range = None, y_range = None, nx = 21, ny = 21, curves = true, curve_columns = 25, curve_method = "continuation", second_route = false, initial = None, rows = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
@@ -758,6 +779,37 @@ fn gait_map<'py>(
     rows: Option<(usize, usize)>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let (x_range, y_range) = (
+        x_range.unwrap_or((1.0, 300.0)),
+        y_range.unwrap_or((300.0, 1500.0)),
+    );
+    let axis = |param: &str, (from, to): (f64, f64), points: usize| SweepSpec {
+        param: param.to_string(),
+        from,
+        to,
+        points,
+    };
+    let spec = MapSpec {
+        x: axis(x, x_range, nx),
+        y: axis(y, y_range, ny),
+    };
+    if let Some(w) = params.walker() {
+        if rows.is_some() {
+            return Err(walkers::whole_only(w, "rows", "map"));
+        }
+        let wheel_only = [
+            ("curve_columns", curve_columns != DEFAULT_CURVE_COLUMNS),
+            ("curve_method", curve_method != "continuation"),
+            ("second_route", second_route),
+        ];
+        let options = walkers::MapOptions {
+            axes: spec,
+            thresholds: curves,
+            initial,
+            wheel_only: wheel_only.iter().find(|(_, given)| *given).map(|(o, _)| *o),
+        };
+        return walkers::map(py, w, options, progress);
+    }
     let continue_curves = match curve_method {
         "continuation" => true,
         "crossings" => false,
@@ -777,22 +829,9 @@ fn gait_map<'py>(
             "`second_route` searches the curves' thresholds again: it needs `curves=True`",
         ));
     }
-    let (x_range, y_range) = (
-        x_range.unwrap_or((1.0, 300.0)),
-        y_range.unwrap_or((300.0, 1500.0)),
-    );
-    let axis = |param: &str, (from, to): (f64, f64), points: usize| SweepSpec {
-        param: param.to_string(),
-        from,
-        to,
-        points,
-    };
     let job = MapJob {
         config: params.wheel("map")?.clone(),
-        spec: MapSpec {
-            x: axis(x, x_range, nx),
-            y: axis(y, y_range, ny),
-        },
+        spec,
         initial: section(initial)?,
         options: GaitOptions::default(),
         curves,
@@ -806,29 +845,19 @@ fn gait_map<'py>(
     let part = rows.map(|(start, end)| start..end);
     let points = nx * part.as_ref().map_or(ny, |p| p.len());
     let progress = Progress::new(progress, points * if second_route { 2 } else { 1 });
-    let (computed, raised) =
-        interruptible_keeping(py, vrw::gait::interrupt_flag(), Some(&progress), || {
-            let tick = |_: &_| progress.tick();
-            match part {
-                Some(part) => compute_map_part(&job, part, &tick),
-                None => compute_map(&job, &tick),
-            }
-        });
-    let (summary, map) = match (computed, raised) {
-        (Ok(Ok(result)), raised) if result.0.interrupted.is_some() => {
-            // Ctrl-C while the curves were traced: the complete gaits go with the exception, as `partial`.
-            let e = raised.unwrap_or_else(|| {
-                let during = result.0.interrupted.clone().unwrap_or_default();
-                pyo3::exceptions::PyKeyboardInterrupt::new_err(during)
-            });
-            let partial = map_result(py, &result.0, &result.1, &job.config, (x, y))?;
-            e.value(py).setattr("partial", partial)?;
-            return Err(e);
+    let done = interruptible_keeping(py, vrw::gait::interrupt_flag(), Some(&progress), || {
+        let tick = |_: &_| progress.tick();
+        match part {
+            Some(part) => compute_map_part(&job, part, &tick),
+            None => compute_map(&job, &tick),
         }
-        (_, Some(e)) => return Err(e),
-        (computed, None) => computed?.map_err(app_error)?,
-    };
-    map_result(py, &summary, &map, &job.config, (x, y))
+    });
+    keeping_partial(
+        py,
+        done,
+        |(summary, _)| summary.interrupted.clone(),
+        |(summary, map)| map_result(py, summary, map, &job.config, (x, y)),
+    )
 }
 
 /// What `vrw.map` returns: the fields of `curves.json` and the columns of `map.csv` as `map`.

@@ -112,3 +112,29 @@ pub(crate) fn interruptible_keeping<T: Send>(
         })
     })
 }
+
+/// The result of a job run by [`interruptible_keeping`] whose complete part survives Ctrl-C (`vrw.map`): its
+/// conversion by `convert`, or the exception raised meanwhile. A result that says it was stopped
+/// (`interrupted`: where, and what it kept) goes with the exception (a `KeyboardInterrupt` saying so if none
+/// was raised) as its attribute `partial`, converted.
+pub(crate) fn keeping_partial<'py, T>(
+    py: Python<'py>,
+    (computed, raised): (PyResult<Result<T, vrw::app::AppError>>, Option<PyErr>),
+    interrupted: impl Fn(&T) -> Option<String>,
+    convert: impl Fn(&T) -> PyResult<Bound<'py, pyo3::types::PyDict>>,
+) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    match (computed, raised) {
+        (Ok(Ok(result)), raised) => match (interrupted(&result), raised) {
+            (Some(during), raised) => {
+                let e = raised
+                    .unwrap_or_else(|| pyo3::exceptions::PyKeyboardInterrupt::new_err(during));
+                e.value(py).setattr("partial", convert(&result)?)?;
+                Err(e)
+            }
+            (None, Some(e)) => Err(e),
+            (None, None) => convert(&result),
+        },
+        (_, Some(e)) => Err(e),
+        (computed, None) => convert(&computed?.map_err(crate::app_error)?),
+    }
+}

@@ -1,8 +1,8 @@
 //! The walkers other than the wheel from Python (`vrw.Params(model=...)`, docs/model.md section 13): their
 //! parameters, loaded and validated by the library as `--model NAME --config FILE --set key=value` loads them,
 //! and the library's walker jobs (`vrw::app::compute_walker_*`, the jobs of `vrw gait`, `simulate`, `sweep`,
-//! `continue` and `orbit --model NAME` without their files) with their results converted at the edge: the
-//! fields of their JSON files, and their CSV files' rows as tables keyed by the same header.
+//! `continue`, `orbit`, `map` and `basin --model NAME` without their files) with their results converted at
+//! the edge: the fields of their JSON files, and their CSV files' rows as tables keyed by the same header.
 
 use std::path::{Path, PathBuf};
 
@@ -13,16 +13,18 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt};
 use pythonize::pythonize;
 
 use vrw::app::{
-    compute_walker_continuation, compute_walker_gait, compute_walker_orbit,
-    compute_walker_simulate, compute_walker_sweep, AppError, Walker, WalkerContinueJob,
-    WalkerGaitJob, WalkerOrbitJob, WalkerOutput, WalkerRange, WalkerSimulateJob, WalkerSweepJob,
-    MAX_WALKER_SWEEP_POINTS,
+    compute_walker_basin, compute_walker_continuation, compute_walker_gait, compute_walker_map,
+    compute_walker_orbit, compute_walker_simulate, compute_walker_sweep, AppError, SliceGrid,
+    Walker, WalkerBasinJob, WalkerContinueJob, WalkerGaitJob, WalkerMapJob, WalkerOrbitJob,
+    WalkerOutput, WalkerRange, WalkerSimulateJob, WalkerSweepJob, MAX_WALKER_SWEEP_POINTS,
 };
 use vrw::gait::GaitOptions;
 use vrw::mechanism::described;
 use vrw::output::Cell;
 use vrw::params::ConfigError as LibConfigError;
+use vrw::study::{MapSpec, SweepSpec};
 
+use crate::progress::{interruptible_keeping, interruptible_with, keeping_partial, Progress};
 use crate::{app_error, config_error, count, interruptible, table};
 
 /// What `vrw.Params(model=...)` holds for a walker other than the wheel.
@@ -118,11 +120,6 @@ impl WalkerParams {
     pub(crate) fn defaults(&self) -> PyResult<WalkerParams> {
         WalkerParams::load(&self.model, self.text(), None, &[])
     }
-
-    /// The library's [`Walker`] (every job takes every walker; the name of the job is kept for the callers).
-    fn rigid(&self, _job: &str) -> PyResult<&Walker> {
-        Ok(&self.walker)
-    }
 }
 
 /// A bad `model`, in the command line's words.
@@ -164,12 +161,20 @@ fn number(key: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
 }
 
 /// The rows of a CSV file (its header first) as a table of numpy arrays keyed by the header: the columns of
-/// words (`status`, `stability`, `message`) as strings, of counts (`step`, `iterations`, `scuffs`,
-/// `period_k`) as integers, every other one as floats (the files write the shortest text that reads back to
-/// the same float, so the values are the job's).
+/// words (`status`, `stability`, `message`, `outcome`) as strings, of counts (`step`, `iterations`, `scuffs`,
+/// `period_k`, `steps`, and a basin's grid indices `ix`, `iy`) as integers, every other one as floats (the files
+/// write the shortest text that reads back to the same float, so the values are the job's).
 fn rows_table<'py>(py: Python<'py>, rows: &[Vec<String>]) -> PyResult<Bound<'py, PyDict>> {
-    const WORDS: [&str; 3] = ["status", "stability", "message"];
-    const COUNTS: [&str; 4] = ["step", "iterations", "scuffs", "period_k"];
+    const WORDS: [&str; 4] = ["status", "stability", "message", "outcome"];
+    const COUNTS: [&str; 7] = [
+        "step",
+        "iterations",
+        "scuffs",
+        "period_k",
+        "steps",
+        "ix",
+        "iy",
+    ];
     let Some((header, rows)) = rows.split_first() else {
         return Ok(PyDict::new(py));
     };
@@ -331,7 +336,7 @@ pub(crate) fn simulate<'py>(
     (trajectory, sample_dt): (bool, f64),
 ) -> PyResult<Bound<'py, PyDict>> {
     let job = WalkerSimulateJob {
-        walker: params.rigid("simulate")?.clone(),
+        walker: params.walker.clone(),
         initial,
         steps,
         sample_dt,
@@ -382,7 +387,7 @@ pub(crate) fn sweep<'py>(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     wheel_options(params, "sweep", &progress, options)?;
-    let walker = params.rigid("sweep")?;
+    let walker = &params.walker;
     walker
         .checked_parameter("param", param)
         .map_err(app_error)?;
@@ -439,7 +444,7 @@ pub(crate) fn continue_family<'py>(
     param: &str,
     options: FamilyOptions,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let walker = params.rigid("continue_family")?;
+    let walker = &params.walker;
     if options.wheel_only {
         let reason = format!(
             "`two_param`, `initial` and `period` take the wheel's continuation; the model `{}` follows its \
@@ -477,14 +482,10 @@ pub(crate) fn orbit<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     wheel_options(params, "orbit", &progress, None)?;
     if part {
-        let reason = format!(
-            "`part` splits the wheel's orbit diagram; the model `{}` draws its diagram whole so far",
-            params.name()
-        );
-        return Err(option_error("part", reason));
+        return Err(whole_only(params, "part", "orbit diagram"));
     }
     let job = WalkerOrbitJob {
-        walker: params.rigid("orbit")?.clone(),
+        walker: params.walker.clone(),
         range,
         transient,
         steps,
@@ -501,4 +502,112 @@ pub(crate) fn orbit<'py>(
         &["orbit"]
     };
     output(pythonize(py, &out.summary)?, &out, names)
+}
+
+/// A part of a study spread over processes (`rows`, `part`) is the wheel's only so far: the error naming the
+/// option and the model.
+pub(crate) fn whole_only(params: &WalkerParams, option: &'static str, job: &str) -> PyErr {
+    let reason = format!(
+        "`{option}` splits the wheel's {job}; the model `{}` computes its {job} whole so far",
+        params.name()
+    );
+    option_error(option, reason)
+}
+
+/// What `vrw.map` of a walker takes besides its walker.
+pub(crate) struct MapOptions {
+    /// The parameters along the rows (`x`) and the columns (`y`) and their values.
+    pub(crate) axes: MapSpec,
+    /// Bisect every change of stability along the rows (`curves`; the command line's `--no-curves`).
+    pub(crate) thresholds: bool,
+    /// Where the search at the first point starts.
+    pub(crate) initial: Option<Vec<f64>>,
+    /// The first of the wheel's options for its curves given (`curve_columns`, `curve_method`,
+    /// `second_route`), which a walker's map refuses.
+    pub(crate) wheel_only: Option<&'static str>,
+}
+
+/// `vrw.map` of a walker: `vrw map --model NAME` without its files and figure (`map.json`'s fields and `map`, the
+/// columns of `map.csv`). `progress` counts the points; Ctrl-C while the thresholds are bisected hands the
+/// complete gaits on with the `KeyboardInterrupt` (as `partial`), as the wheel's map does.
+pub(crate) fn map<'py>(
+    py: Python<'py>,
+    params: &WalkerParams,
+    options: MapOptions,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if let Some(option) = options.wheel_only {
+        let reason = format!(
+            "is an option of the wheel's map; the model `{}` has no threshold curves (its changes of \
+             stability are bisected along the rows: `curves=False` skips them)",
+            params.name()
+        );
+        return Err(option_error(option, reason));
+    }
+    let range = |s: SweepSpec| WalkerRange {
+        param: s.param,
+        from: s.from,
+        to: s.to,
+        points: s.points,
+    };
+    let job = WalkerMapJob {
+        walker: params.walker.clone(),
+        x: range(options.axes.x),
+        y: range(options.axes.y),
+        initial: options.initial,
+        thresholds: options.thresholds,
+        out_dir: PathBuf::new(),
+        overwrite: false,
+    };
+    let progress = Progress::new(progress, job.x.points.saturating_mul(job.y.points));
+    let flag = vrw::gait::interrupt_flag();
+    let done = interruptible_keeping(py, flag, Some(&progress), || {
+        compute_walker_map(&job, &|_| progress.tick())
+    });
+    keeping_partial(
+        py,
+        done,
+        |out| out.summary.interrupted.clone(),
+        |out| output(pythonize(py, &out.summary)?, out, &["map"]),
+    )
+}
+
+/// What `vrw.basin` of a walker takes besides its walker.
+pub(crate) struct BasinOptions<'a> {
+    /// The slice's coordinates (`None`: the section's first and second).
+    pub(crate) coordinates: [Option<&'a str>; 2],
+    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0), the grid, and when a
+    /// walk ends.
+    pub(crate) grid: SliceGrid,
+    /// Where the gait search starts.
+    pub(crate) initial: Option<Vec<f64>>,
+}
+
+/// `vrw.basin` of a walker: `vrw basin --model NAME` without its files and figure (`basin.json`'s fields and
+/// `points`, the columns of `basin.csv`). `progress` counts the starts; Ctrl-C: `KeyboardInterrupt`, nothing
+/// kept, as the wheel's basin.
+pub(crate) fn basin<'py>(
+    py: Python<'py>,
+    params: &WalkerParams,
+    options: BasinOptions<'_>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let coordinates = WalkerBasinJob::slice_coordinates(&params.walker, options.coordinates)
+        .map_err(app_error)?;
+    let job = WalkerBasinJob {
+        walker: params.walker.clone(),
+        initial: options.initial,
+        coordinates,
+        grid: options.grid,
+        out_dir: PathBuf::new(),
+        overwrite: false,
+    };
+    let [nx, ny] = job.grid.points;
+    let progress = Progress::new(progress, nx.saturating_mul(ny));
+    let flag = vrw::gait::interrupt_flag();
+    let out = interruptible_with(py, flag, Some(&progress), || {
+        compute_walker_basin(&job, &|_| progress.tick())
+    })?
+    .map_err(app_error)?;
+    output(pythonize(py, &out.summary)?, &out, &["points"])
 }

@@ -166,10 +166,13 @@ def test_a_malformed_description_names_its_line(tmp_path):
 @pytest.mark.parametrize(
     "job, words",
     [
-        (lambda p: vrw.map(p, nx=2, ny=2), "`vrw.map` takes only the wheel"),
-        (lambda p: vrw.basin(p, nx=2, ny=2), "`vrw.basin` takes only the wheel"),
-        (lambda p: vrw.animate(vrw.simulate(p, steps=1)), "vrw.animate draws the wheel's walks only"),
-        (lambda p: vrw.animate(vrw.find_gait(p)), "vrw.animate draws the wheel's walks only"),
+        (lambda p: vrw.map(p, x="slope", y="viscosity", nx=2, ny=2), "has no parameter \"viscosity\""),
+        (lambda p: vrw.map(p, x="slope", y="slope"), "different parameters"),
+        (lambda p: vrw.map(p, x="slope", x_range=(0.01, 0.02), curve_method="crossings"), "`curve_method`"),
+        (lambda p: vrw.map(p, x="slope", x_range=(0.01, 0.02), second_route=True), "`second_route`"),
+        (lambda p: vrw.map(p, x="slope", x_range=(0.01, 0.02), curves=False, rows=(0, 1)), "`rows`"),
+        (lambda p: vrw.basin(p, x="L2"), "\"L2\" is not a coordinate of the section of `simplest`"),
+        (lambda p: vrw.basin(p, nx=2, ny=2, rows=(0, 1)), "`rows`"),
         (lambda p: vrw.sweep(p, "hip_mass", [1, 2]), "has no parameter \"hip_mass\""),
         (lambda p: vrw.sweep(p, "slope", [0.01, 2.0]), "between -pi/2 and pi/2"),
         (lambda p: vrw.sweep(p, "slope", [0.01, 0.02], progress=print), "`progress`"),
@@ -178,8 +181,8 @@ def test_a_malformed_description_names_its_line(tmp_path):
          "`two_param`"),
         (lambda p: vrw.orbit(p, "slope", range=(0.01, 0.011), points=2, part="coarse"), "`part`"),
     ],
-    ids=["map", "basin", "animate run", "animate gait", "sweep key", "sweep value", "progress", "initial",
-         "two_param", "part"],
+    ids=["map key", "map axes", "curve_method", "second_route", "map rows", "basin coordinate", "basin rows",
+         "sweep key", "sweep value", "progress", "initial", "two_param", "part"],
 )
 def test_a_job_a_walker_does_not_run_raises_config_error_naming_the_model(job, words):
     with pytest.raises(ValueError, match=words.replace("(", r"\(")) as raised:
@@ -331,6 +334,137 @@ def test_orbit_is_vrw_orbit_model(cli, tmp_path):
                                      branch=False)
 
 
+def map_args(grid):
+    """`vrw map --model ...`'s options for the axes of `grid` (`x`, `x_range`, `nx`, `y`, ...)."""
+    args = []
+    for a in "xy":
+        lo, hi = grid[f"{a}_range"]
+        args += [f"--{a}", grid[a], f"--{a}-from", lo, f"--{a}-to", hi, f"--n{a}", grid[f"n{a}"]]
+    return args
+
+
+@pytest.mark.parametrize(
+    "model, grid",
+    [
+        ("compass", dict(x="slope", x_range=(0.07, 0.08), nx=5, y="hip_mass", y_range=(8.0, 12.0), ny=3)),
+        ("telescopic", dict(x="viscosity", x_range=(800.0, 1200.0), nx=3, y="stiffness",
+                            y_range=(18000.0, 22000.0), ny=2)),
+    ],
+)
+def test_map_is_vrw_map_model(cli, tmp_path, model, grid):
+    result = vrw.map(vrw.Params(model=model), **grid)
+    cli("map", "--model", model, *map_args(grid), "--out", tmp_path)
+    assert isinstance(result, vrw.MapResult) and result["model"] == model
+    assert_table_equals_csv(result["map"], tmp_path / "map.csv")
+    expected = read_json(tmp_path / "map.json")
+    assert set(result) == set(expected) - {"files"} | {"map"}
+    for key, value in expected.items():
+        if key != "files":
+            assert json_equal(result[key], value), key
+    # The grid over both parameters, each point the table's row.
+    data = result.to_xarray()
+    x, y = grid["x"], grid["y"]
+    assert data["period"].dims == (y, x) and data["period"].shape == (grid["ny"], grid["nx"])
+    table = result["map"].to_pandas()
+    row = table.iloc[grid["nx"] + 1]
+    assert data["period"].sel({x: row[x], y: row[y]}).item() == row["period"]
+    assert model in repr(result)
+
+
+def test_a_walkers_map_without_thresholds_is_vrw_map_no_curves(cli, tmp_path):
+    grid = dict(x="slope", x_range=(0.07, 0.08), nx=4, y="hip_mass", y_range=(8.0, 12.0), ny=2)
+    result = vrw.map(vrw.Params(model="compass"), curves=False, initial=[0.29, -1.14, -0.2], **grid)
+    cli("map", "--model", "compass", *map_args(grid), "--no-curves", "--initial", "0.29,-1.14,-0.2",
+        "--out", tmp_path)
+    assert_table_equals_csv(result["map"], tmp_path / "map.csv")
+    assert result["thresholds"] == [] == read_json(tmp_path / "map.json")["thresholds"]
+
+
+@pytest.mark.parametrize(
+    "model, options, args",
+    [
+        ("simplest", dict(x_range=(0.15, 0.25), y_range=(-0.25, -0.15), nx=6, ny=5),
+         ["--x-range", "0.15,0.25", "--y-range=-0.25,-0.15", "--nx", "6", "--ny", "5"]),
+        ("compass", dict(x="theta1_dot", y="theta2_dot", nx=4, ny=3, max_steps=30, tolerance=1e-4),
+         ["--x", "theta1_dot", "--y", "theta2_dot", "--nx", "4", "--ny", "3", "--max-steps", "30",
+          "--tolerance", "1e-4"]),
+        (COMPASS_TOML, dict(nx=3, ny=3), ["--nx", "3", "--ny", "3"]),
+    ],
+    ids=["simplest", "compass", "described"],
+)
+def test_basin_is_vrw_basin_model(cli, tmp_path, model, options, args):
+    result = vrw.basin(vrw.Params(model=model), **options)
+    cli("basin", "--model", model, *args, "--out", tmp_path)
+    assert isinstance(result, vrw.BasinResult)
+    assert_table_equals_csv(result["points"], tmp_path / "basin.csv")
+    expected = read_json(tmp_path / "basin.json")
+    assert set(result) == set(expected) - {"files"} | {"points"}
+    for key, value in expected.items():
+        if key != "files":
+            assert json_equal(result[key], value), key
+    assert sum(result["outcomes"].values()) == options["nx"] * options["ny"]
+    # The grid over the slice's coordinates, each start the table's row.
+    data = result.to_xarray()
+    x, y = result["x"]["coordinate"], result["y"]["coordinate"]
+    assert data["outcome"].dims == (y, x)
+    points = result["points"]
+    last = points.rows - 1
+    at = {x: points[x][last], y: points[y][last]}
+    assert data["outcome"].sel(at).item() == points["outcome"][last]
+
+
+def test_a_walkers_results_of_map_and_basin_pickle():
+    basin = vrw.basin(vrw.Params(model="simplest"), nx=2, ny=2, max_steps=5)
+    gait_map = vrw.map(vrw.Params(model="compass"), x="slope", x_range=(0.05, 0.06), nx=2, y="hip_mass",
+                       y_range=(9.0, 10.0), ny=2)
+    for result in (basin, gait_map):
+        again = pickle.loads(pickle.dumps(result))
+        assert same(again, result), type(result)
+
+
+#: Small, quick options of the animations compared.
+QUICK = {"fps": 10, "width": 320, "height": 180}
+
+
+def quick_args():
+    return [a for k, v in QUICK.items() for a in (f"--{k}", v)]
+
+
+@pytest.mark.parametrize("model", ["compass", "telescopic", "models/telescopic.toml"])
+def test_animate_draws_a_walkers_run_as_vrw_animate(cli, tmp_path, model):
+    model = str(ROOT / model) if model.endswith(".toml") else model
+    run = vrw.simulate(vrw.Params(model=model), steps=2)
+    cli("simulate", "--model", model, "--steps", 2, "--out", tmp_path)
+    cli("animate", tmp_path, *quick_args())
+    data = vrw.animate(run, tmp_path / "python.gif", **QUICK).read_bytes()
+    assert data.startswith(b"GIF89a") and data == (tmp_path / "walk.gif").read_bytes()
+    cli("animate", tmp_path, "--still", 0.4, "--width", 320, "--height", 180)
+    png = vrw.animate(run, tmp_path / "python.png", still=0.4, width=320, height=180).read_bytes()
+    assert png == (tmp_path / "walk-frame.png").read_bytes()
+    # A run rebuilt from its fields alone walks again from its initial state (a described walker's names no
+    # file: its model is the description's name).
+    if not model.endswith(".toml"):
+        assert vrw.animate(vrw.Run(dict(run)), tmp_path / "again.gif", **QUICK).read_bytes() == data
+    else:
+        with pytest.raises(ValueError, match="does not say which file describes it"):
+            vrw.animate(vrw.Run(dict(run)))
+
+
+def test_animate_draws_a_walkers_gait_from_its_fixed_point(cli, tmp_path):
+    params = vrw.Params(model="simplest", slope=0.009)
+    gait = vrw.find_gait(params)
+    data = vrw.animate(gait, tmp_path / "gait.gif", **QUICK).read_bytes()
+    # Two periods (7.8 model time units: more than 2) from the fixed point, as `vrw simulate --initial`.
+    section = ",".join(repr(v) for v in gait["section"].values())
+    cli("simulate", "--model", "simplest", "--set", "slope=0.009", "--steps", 2, "--initial", section,
+        "--out", tmp_path / "walk")
+    cli("animate", tmp_path / "walk", *quick_args())
+    assert data == (tmp_path / "walk" / "walk.gif").read_bytes()
+    assert vrw.animate(vrw.GaitResult(dict(gait)), tmp_path / "again.gif", **QUICK).read_bytes() == data
+    with pytest.raises(ValueError, match="found no gait"):
+        vrw.animate(vrw.GaitResult(model="compass", status="fell", message="the walker fell"))
+
+
 def test_a_grid_of_sweeps_takes_a_walker():
     from vrw.grid import gait_grid, orbit_grid
 
@@ -342,32 +476,6 @@ def test_a_grid_of_sweeps_takes_a_walker():
         assert np.array_equal(grid["sweep"]["period"][i], row["sweep"]["period"])
     with pytest.raises(vrw.ConfigError, match="model `compass`"):
         orbit_grid(None, p, "slope", range=(0.05, 0.06), points=3)
-
-
-@pytest.mark.parametrize(
-    "job",
-    [
-        lambda: vrw.simulate(vrw.Params(model="simplest"), steps=1_000_000, trajectory=False),
-        lambda: vrw.sweep(vrw.Params(model="compass"), "slope", vrw.linspace(0.01, 0.09, 20000)),
-        lambda: vrw.find_gait(vrw.Params(model="telescopic"), transient_steps=100_000),
-    ],
-    ids=["simulate", "sweep", "find_gait telescopic"],
-)
-def test_ctrl_c_stops_a_walkers_job_within_a_second(job):
-    import _thread
-    import signal
-    import threading
-    import time
-
-    signal.signal(signal.SIGINT, signal.default_int_handler)  # as test_interrupt.py: Ctrl-C handled
-    delay = 0.5
-    timer = threading.Timer(delay, _thread.interrupt_main)
-    start = time.monotonic()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        job()
-    assert time.monotonic() - start < delay + 1.0
-    assert vrw.find_gait(vrw.Params(model="simplest"))["status"] == "found"
 
 
 # --- Figures and docs -----------------------------------------------------------------------------------

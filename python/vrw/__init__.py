@@ -12,13 +12,15 @@ orbit diagrams, basins and grids of sweeps over a Dask cluster. Computation runs
 compass gait), ``"telescopic"`` (the compass gait with the paper's viscoelastic legs) or the path of a walker
 described in a TOML file (``"models/compass.toml"``) holds that walker's parameters (``Params(model="compass",
 slope=0.05, hip_mass=10)``; ``.model``, ``.parameter_keys()``), validated as ``vrw --model NAME --set
-key=value`` does. ``find_gait``, ``simulate``, ``sweep``, ``continue_family`` and ``orbit`` run the command
-line's ``--model`` jobs on it, with the same numbers; their sections and tables are named by the model's
-coordinates and their results carry ``model``; ``map``, ``basin`` and ``animate`` take only the wheel so far
-(the command line has them for every walker). A job a model does not run raises ``ConfigError`` naming the model and the job. ``vrw.plot.sweep``,
-``vrw.plot.orbit`` and ``vrw.plot.run`` draw a walker's results, and ``vrw.grid.gait_grid`` spreads its sweeps.
+key=value`` does. ``find_gait``, ``simulate``, ``sweep``, ``continue_family``, ``orbit``, ``map`` and ``basin``
+run the command line's ``--model`` jobs on it, with the same numbers, and ``animate`` draws its walks as ``vrw
+animate`` draws its ``vrw simulate --model`` runs; their sections and tables are named by the model's
+coordinates and their results carry ``model``. An option a model does not take raises ``ConfigError`` naming
+the model and the option. ``vrw.plot.sweep``, ``vrw.plot.orbit`` and ``vrw.plot.run`` draw a walker's results,
+and ``vrw.grid.gait_grid`` spreads its sweeps.
 
-**Long jobs.** ``sweep``, ``map``, ``orbit`` and ``basin`` take ``progress``: a callable ``progress(done,
+**Long jobs.** ``sweep``, ``map``, ``orbit`` and ``basin`` (another walker's ``map`` and ``basin``) take
+``progress``: a callable ``progress(done,
 total)`` called on the calling thread as points finish, or ``True`` for a tqdm bar (``pip install tqdm``).
 Ctrl-C (``KeyboardInterrupt``) stops any job within about a second: the job stops starting points, the
 points under way stop, and what was computed is discarded (a result is whole or not returned at all), but for
@@ -49,7 +51,7 @@ from ._vrw import (
     linspace,
 )
 from . import plot
-from ._animate import animate, record_walk
+from ._animate import animate, record_params, record_walk
 from .results import (
     BasinResult,
     FamilyResult,
@@ -84,7 +86,9 @@ def simulate(
 def find_gait(params: Params, initial: Optional[Sequence[float]] = None, **options: Any) -> GaitResult:
     """Find the gait (``vrw gait``): a ``GaitResult``, the fields of ``gait.json``. See
     ``vrw._vrw.find_gait``."""
-    return GaitResult(_vrw.find_gait(params, initial, **options))
+    result = GaitResult(_vrw.find_gait(params, initial, **options))
+    record_params(result, params)
+    return result
 
 
 def sweep(
@@ -126,9 +130,19 @@ def continue_family(params: Params, param: str = "viscosity", **options: Any) ->
 
 def map(params: Params, **options: Any) -> MapResult:
     """The gait over a grid of two parameters and the threshold curves across it (``vrw map``, without the
-    figure): a ``MapResult``, the fields of ``curves.json`` with ``map`` (the columns of ``map.csv``) as a
-    ``Table``; ``to_xarray()`` gives the grid over both parameters. See ``vrw._vrw.map`` for the options."""
-    result = MapResult(_vrw.map(params, **_progress.resolve(options, "map")))
+    figure): a ``MapResult``, the fields of ``curves.json`` (another walker's: of its ``map.json``) with ``map``
+    (the columns of ``map.csv``) as a ``Table``; ``to_xarray()`` gives the grid over both parameters. Ctrl-C
+    while the curves (thresholds) are traced raises ``KeyboardInterrupt`` with the complete gaits as its
+    ``partial``, a ``MapResult`` too. See ``vrw._vrw.map`` for the options."""
+    try:
+        result = MapResult(_vrw.map(params, **_progress.resolve(options, "map")))
+    except KeyboardInterrupt as stopped:
+        # The complete gaits that go with Ctrl-C, as the result they are.
+        partial = getattr(stopped, "partial", None)
+        if isinstance(partial, dict):
+            stopped.partial = MapResult(partial)
+            wrap_tables(stopped.partial, ["map"])
+        raise
     wrap_tables(result, ["map"])
     return result
 

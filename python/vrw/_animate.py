@@ -24,49 +24,76 @@ SAMPLE_DT = 0.005
 WALK_ATTRIBUTE = "_walk"
 
 
+#: What ``vrw.find_gait`` records in a walker's ``GaitResult`` (an attribute, not a field of ``gait.json``): the
+#: ``Params`` it searched with, for ``animate`` (a described walker's result names its model, not its file).
+PARAMS_ATTRIBUTE = "_params"
+
+#: The walkers built in, whose results rebuild their ``Params`` from ``model`` and ``parameters``.
+BUILT_IN_WALKERS = ("simplest", "compass", "telescopic")
+
+
 def record_walk(run: Run, params: Params, steps: int, initial: Any, sample_dt: float) -> None:
     """Keep the arguments ``vrw.simulate`` walked ``run`` with, for ``animate``."""
     setattr(run, WALK_ATTRIBUTE, {"params": params, "steps": steps, "initial": initial, "sample_dt": sample_dt})
 
 
-def _section(state: Mapping[str, float]) -> List[float]:
-    """A section state of ``summary.json`` or ``gait.json`` (``{"L2", "thetadot", "L2dot", ...}``) as the
-    ``initial`` of a walk."""
+def record_params(gait: GaitResult, params: Params) -> None:
+    """Keep the ``Params`` ``vrw.find_gait`` searched ``gait`` with, for ``animate``."""
+    setattr(gait, PARAMS_ATTRIBUTE, params)
+
+
+def _section(state: Mapping[str, float], model: str) -> List[float]:
+    """A section state of ``summary.json`` or ``gait.json`` as the ``initial`` of a walk: the wheel's
+    ``{"L2", "thetadot", "L2dot", ...}``, or another walker's coordinates in their order."""
+    if model != "vrw":
+        return list(state.values())
     return [state["L2"], state["thetadot"], state["L2dot"]]
+
+
+def _params_of(result: Mapping[str, Any], model: str) -> Params:
+    """The ``Params`` of a result: recorded by ``vrw.find_gait``, or rebuilt from its ``config`` (the wheel)
+    or its ``model`` and ``parameters`` (a built-in walker)."""
+    recorded = getattr(result, PARAMS_ATTRIBUTE, None)
+    if isinstance(recorded, Params):
+        return recorded
+    if model == "vrw":
+        return Params(**result["config"])
+    if model in BUILT_IN_WALKERS:
+        return Params(model=model, **result["parameters"])
+    raise ValueError(
+        f"the result of the described walker `{model}` does not say which file describes it: animate the result "
+        f"vrw.simulate or vrw.find_gait returned, or vrw.simulate(vrw.Params(model=PATH, ...), initial=...)"
+    )
 
 
 def _walk_of(run_or_gait: Mapping[str, Any]) -> Dict[str, Any]:
     """The arguments of the walk to draw (see ``animate``)."""
     recorded = getattr(run_or_gait, WALK_ATTRIBUTE, None)
     model = run_or_gait.get("model", "vrw")
-    if model != "vrw":
-        raise ValueError(
-            f"vrw.animate draws the wheel's walks only so far; the model `{model}` is drawn by `vrw animate DIR` "
-            f"of its `vrw simulate --model` run"
-        )
     if isinstance(run_or_gait, Run) and isinstance(recorded, dict):
         return recorded
-    if isinstance(run_or_gait, GaitResult) or "period_k" in run_or_gait:
+    if isinstance(run_or_gait, GaitResult) or "period_k" in run_or_gait or "newton_iterations" in run_or_gait:
         if run_or_gait.get("status") != "found":
             raise ValueError(
                 f"the gait search found no gait ({run_or_gait.get('status')}: {run_or_gait.get('message')}): "
                 "there is no walk to draw"
             )
-        k = run_or_gait["period_k"]
+        # Another walker's gaits are of period 1.
+        k = run_or_gait.get("period_k", 1)
         cycle = run_or_gait.get("cycle") or []
         duration = sum(step["period"] for step in cycle) or k * run_or_gait["period"]
         periods = max(GAIT_PERIODS, math.ceil(GAIT_SECONDS / duration))
         return {
-            "params": Params(**run_or_gait["config"]),
+            "params": _params_of(run_or_gait, model),
             "steps": periods * k,
-            "initial": _section(run_or_gait["section"]),
+            "initial": _section(run_or_gait["section"], model),
             "sample_dt": SAMPLE_DT,
         }
     if isinstance(run_or_gait, Run) or "steps_requested" in run_or_gait:
         return {
-            "params": Params(**run_or_gait["config"]),
+            "params": _params_of(run_or_gait, model),
             "steps": run_or_gait["steps_requested"],
-            "initial": _section(run_or_gait["initial"]),
+            "initial": _section(run_or_gait["initial"], model),
             "sample_dt": SAMPLE_DT,
         }
     raise TypeError(
@@ -103,6 +130,12 @@ def animate(
       ``config``, sampled every 0.005 s as ``vrw gait`` samples its period: two periods of ``period_k``
       steps, or as many more whole periods as make at least 2 s of walking (``vrw gait``'s own directory
       holds one period). A search that found no gait raises ``ValueError``.
+
+    Another walker's (``vrw.Params(model=...)``) ``Run`` or ``GaitResult`` is walked the same way (its gait of
+    period 1, in the model's time unit) and drawn as ``vrw animate`` draws the directory of ``vrw simulate
+    --model`` with those arguments: its stick figure (legs, masses, feet, the springs of compliant legs). Its
+    ``Params`` are those the result was computed with; a result rebuilt from its fields alone gets them from
+    its ``model`` and ``parameters`` (a built-in walker; a described walker's result names no file).
 
     The options are the command line's, with its defaults: ``fps`` (frames per second of playback, 1 to 50),
     ``speed`` (simulated seconds per second of playback), ``from_`` and ``to`` (the window of simulated time

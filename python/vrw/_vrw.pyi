@@ -200,7 +200,10 @@ def map(
     ``"crossings"``. ``rows=(start, end)`` computes only those rows' gaits (with ``curves=False``), each point
     as the whole map has it; ``progress(done, total)`` is called on this thread as points finish. Ctrl-C
     while the curves are traced raises ``KeyboardInterrupt`` with the complete gaits as its ``partial`` (this
-    result without curves, with ``interrupted``)."""
+    result without curves, with ``interrupted``). Another walker's (``Params(model=...)``): ``vrw map
+    --model``'s ``map.json`` fields and ``map``, ``x`` and ``y`` two of its parameters, ``curves`` its changes
+    of stability bisected along the rows (``thresholds``; Ctrl-C while they are bisected hands the gaits on as
+    ``partial``), without ``curve_columns``, ``curve_method``, ``second_route`` and ``rows``."""
 
 def orbit(
     params: Params,
@@ -225,8 +228,8 @@ def orbit(
 def basin(
     params: Params,
     *,
-    x: str = "L2",
-    y: str = "thetadot",
+    x: Optional[str] = None,
+    y: Optional[str] = None,
     x_range: Optional[Tuple[float, float]] = None,
     y_range: Optional[Tuple[float, float]] = None,
     nx: int = 61,
@@ -241,10 +244,13 @@ def basin(
 
     Returns the fields of ``basin.json`` (``spec``, ``gait``, ``outcomes``, ...) and ``points``: the columns
     of ``basin.csv`` as numpy arrays, one row per grid point, row by row. The options are the command line's
-    (``x``, ``y``: ``"L2"``, ``"thetadot"``, ``"L2dot"``; ``x_range``, ``y_range``: ``(from, to)``, default
-    the command line's), validated as it validates them. ``rows=(start, end)`` computes only those grid
-    rows, each point as the whole basin has it; ``progress(done, total)`` is called on this thread as points
-    finish. Ctrl-C raises ``KeyboardInterrupt`` within about a second.
+    (``x``, ``y``: ``"L2"``, ``"thetadot"``, ``"L2dot"``, default ``"L2"`` and ``"thetadot"``; ``x_range``,
+    ``y_range``: ``(from, to)``, default the command line's), validated as it validates them.
+    ``rows=(start, end)`` computes only those grid rows, each point as the whole basin has it;
+    ``progress(done, total)`` is called on this thread as points finish. Ctrl-C raises ``KeyboardInterrupt``
+    within about a second. Another walker's (``Params(model=...)``): ``vrw basin --model``'s ``basin.json``
+    fields and ``points``, ``x`` and ``y`` two of its section's coordinates (default its first and second),
+    without ``rows``.
     """
 
 def animate(
@@ -266,4 +272,6 @@ def animate(
     the bytes of the GIF ``walk.gif`` it writes for the directory of ``vrw simulate``, or with ``still`` (a
     time [s]) those of the PNG of that frame (``vrw animate --still``). The options are the command line's
     (``from_`` is ``--from``), with its defaults and ranges; a bad one, more than 90000 frames or a window
-    outside the walk raises ``ConfigError`` with the command line's message. See ``vrw.animate``."""
+    outside the walk raises ``ConfigError`` with the command line's message. Another walker's
+    (``Params(model=...)``): its ``vrw simulate --model`` walk (``initial`` its section's coordinates) drawn as
+    ``vrw animate`` draws that run. See ``vrw.animate``."""

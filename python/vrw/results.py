@@ -158,7 +158,8 @@ class Grid(Result):
 
 
 class BasinResult(_WithTable):
-    """``vrw.basin``: the fields of ``basin.json``, with ``points`` (the columns of ``basin.csv``) a ``Table``."""
+    """``vrw.basin``: the fields of ``basin.json`` (the wheel's or another walker's), with ``points`` (the
+    columns of ``basin.csv``) a ``Table``."""
 
     _table = "points"
 
@@ -166,7 +167,8 @@ class BasinResult(_WithTable):
         """The grid as an ``xarray.Dataset`` over the slice's two coordinates (``y`` by ``x``): the outcome,
         the steps, the period and the end state of every start."""
         xr = _optional("xarray")
-        spec, points = self["spec"], self["points"]
+        # The wheel's basin.json has the axes under ``spec``; another walker's has them at the top.
+        spec, points = self.get("spec", self), self["points"]
         x, y = spec["x"]["coordinate"], spec["y"]["coordinate"]
         nx, ny = spec["x"]["points"], spec["y"]["points"]
         ix, iy = np.asarray(points["ix"]), np.asarray(points["iy"])
@@ -188,8 +190,8 @@ class BasinResult(_WithTable):
 
 class MapResult(_WithTable):
     """``vrw.map``: the fields of ``curves.json`` (``spec``, ``points``, ``gaits_found``, ``curves``,
-    ``thresholds``, ``warnings``, ...), with ``map`` (the columns of ``map.csv``: one row per grid point, row by
-    row in ``y``) a ``Table``."""
+    ``thresholds``, ``warnings``, ...; another walker's: of its ``map.json``), with ``map`` (the columns of
+    ``map.csv``: one row per grid point, row by row in ``y``) a ``Table``."""
 
     _table = "map"
 
@@ -197,7 +199,8 @@ class MapResult(_WithTable):
         """The grid as an ``xarray.Dataset`` over the two parameters (``y`` by ``x``, named by their keys):
         every other column of ``map.csv`` as a variable."""
         xr = _optional("xarray")
-        spec, points = self["spec"], self["map"]
+        # The wheel's curves.json has the axes under ``spec``; another walker's map.json has them at the top.
+        spec, points = self.get("spec", self), self["map"]
         x, y = spec["x"]["param"], spec["y"]["param"]
         nx, ny = spec["x"]["points"], spec["y"]["points"]
         xs = np.asarray(points[x])[:nx]
@@ -210,6 +213,13 @@ class MapResult(_WithTable):
         return xr.Dataset(data, coords={x: xs, y: ys})
 
     def __repr__(self) -> str:
+        if "model" in self:
+            # Another walker's map: its changes of stability along the rows, bisected.
+            kinds = sorted({t["kind"] for t in self.get("thresholds", [])})
+            return (
+                f"MapResult({self['model']}, {self['x']['param']} x {self['y']['param']}: gait at "
+                f"{self.get('gaits_found')} of {self.get('points')} points, thresholds {kinds})"
+            )
         spec = self.get("spec", {})
         names = sorted({c["name"] for c in self.get("curves", [])})
         return (

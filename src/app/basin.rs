@@ -33,8 +33,66 @@ pub fn default_basin_range(config: &Config, coordinate: Coordinate, at: f64) -> 
     }
 }
 
-/// The most grid points along one axis of a basin.
-pub(crate) const MAX_BASIN_POINTS: usize = 2000;
+/// The most grid points along one axis of a basin (every walker's).
+pub const MAX_BASIN_POINTS: usize = 2000;
+
+/// The most steps walked from one start of a basin (every walker's).
+pub const MAX_BASIN_STEPS: usize = 100_000;
+
+/// The grid of a basin's slice and when a walk from one of its starts ends, as every walker's basin takes them
+/// (`vrw basin`, with `--model` too).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SliceGrid {
+    /// The ranges of the horizontal and the vertical coordinate (`None`: the job's default).
+    pub ranges: [Option<(f64, f64)>; 2],
+    /// Grid points along x and y.
+    pub points: [usize; 2],
+    /// Steps walked at most from each start.
+    pub max_steps: usize,
+    /// Distance to a gait state that counts as reaching it (largest coordinate difference).
+    pub tolerance: f64,
+}
+
+impl SliceGrid {
+    /// Check the grid sizes, the ranges, the steps and the tolerance.
+    pub(crate) fn validate(&self) -> Result<(), AppError> {
+        let invalid = |option, reason| Err(AppError::InvalidOption { option, reason });
+        for (option, n) in [("nx", self.points[0]), ("ny", self.points[1])] {
+            if !(2..=MAX_BASIN_POINTS).contains(&n) {
+                return invalid(
+                    option,
+                    format!("{n} grid points; use 2 to {MAX_BASIN_POINTS}"),
+                );
+            }
+        }
+        for (option, range) in [("x_range", self.ranges[0]), ("y_range", self.ranges[1])] {
+            if let Some((a, b)) = range.filter(|(a, b)| !(a.is_finite() && b.is_finite() && a != b))
+            {
+                return invalid(
+                    option,
+                    format!(
+                        "{},{} is not a range with two different finite ends",
+                        short(a),
+                        short(b)
+                    ),
+                );
+            }
+        }
+        if !(1..=MAX_BASIN_STEPS).contains(&self.max_steps) {
+            return invalid(
+                "max_steps",
+                format!("{} steps; use 1 to {MAX_BASIN_STEPS}", self.max_steps),
+            );
+        }
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
+            return invalid(
+                "tolerance",
+                format!("{} is not a positive distance", short(self.tolerance)),
+            );
+        }
+        Ok(())
+    }
+}
 
 /// What `vrw basin` runs.
 #[derive(Debug, Clone)]
@@ -45,14 +103,8 @@ pub struct BasinJob {
     pub initial: Option<SectionState>,
     /// Horizontal and vertical coordinates of the slice.
     pub coordinates: [Coordinate; 2],
-    /// Their ranges (`None`: [`default_basin_range`]).
-    pub ranges: [Option<(f64, f64)>; 2],
-    /// Grid points along x and y.
-    pub points: [usize; 2],
-    /// Steps walked at most from each start.
-    pub max_steps: usize,
-    /// Distance to a gait state that counts as reaching it.
-    pub tolerance: f64,
+    /// Their ranges (`None`: [`default_basin_range`]), the grid, and when a walk ends.
+    pub grid: SliceGrid,
     /// Where `basin.csv`, `basin.json` and `basin.png` go.
     pub out_dir: PathBuf,
     /// Replace a run of another command in `out_dir` (its files are removed and listed in the manifest);
@@ -96,56 +148,18 @@ impl BasinSummary {
 }
 
 impl BasinJob {
-    fn invalid(option: &'static str, reason: String) -> AppError {
-        AppError::InvalidOption { option, reason }
-    }
-
     /// Check the options that do not depend on the gait.
     fn validate(&self) -> Result<(), AppError> {
         if self.coordinates[0] == self.coordinates[1] {
-            return Err(Self::invalid(
-                "x/y",
-                format!(
+            return Err(AppError::InvalidOption {
+                option: "x/y",
+                reason: format!(
                     "the two axes must be different coordinates (both are {})",
                     self.coordinates[0].name()
                 ),
-            ));
+            });
         }
-        for (option, n) in [("nx", self.points[0]), ("ny", self.points[1])] {
-            if !(2..=MAX_BASIN_POINTS).contains(&n) {
-                return Err(Self::invalid(
-                    option,
-                    format!("{n} grid points; use 2 to {MAX_BASIN_POINTS}"),
-                ));
-            }
-        }
-        for (option, range) in [("x_range", self.ranges[0]), ("y_range", self.ranges[1])] {
-            if let Some((a, b)) = range {
-                if !(a.is_finite() && b.is_finite() && a != b) {
-                    return Err(Self::invalid(
-                        option,
-                        format!(
-                            "{},{} is not a range with two different finite ends",
-                            short(a),
-                            short(b)
-                        ),
-                    ));
-                }
-            }
-        }
-        if !(1..=100_000).contains(&self.max_steps) {
-            return Err(Self::invalid(
-                "max_steps",
-                format!("{} steps; use 1 to 100000", self.max_steps),
-            ));
-        }
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(Self::invalid(
-                "tolerance",
-                format!("{} is not a positive distance", short(self.tolerance)),
-            ));
-        }
-        Ok(())
+        self.grid.validate()
     }
 }
 
@@ -245,21 +259,21 @@ fn prepare_basin(job: &BasinJob) -> Result<(crate::dynamics::Model, Gait, BasinS
     let through = gait.section.to_array();
     let axis = |k: usize| {
         let c = job.coordinates[k];
-        let (from, to) = job.ranges[k]
+        let (from, to) = job.grid.ranges[k]
             .unwrap_or_else(|| default_basin_range(&job.config, c, through[c.index()]));
         Axis {
             coordinate: c,
             from,
             to,
-            points: job.points[k],
+            points: job.grid.points[k],
         }
     };
     let spec = BasinSpec {
         x: axis(0),
         y: axis(1),
         through: gait.section,
-        max_steps: job.max_steps,
-        tolerance: job.tolerance,
+        max_steps: job.grid.max_steps,
+        tolerance: job.grid.tolerance,
     };
     Ok((model, gait, spec))
 }

@@ -1,4 +1,4 @@
-//! A walker with compliant legs as a [`WalkerModel`] (docs/model.md section 13): [`LeggedModel`], the legged
+//! A walker with compliant legs as a [`super::WalkerModel`] (docs/model.md section 13): [`LeggedModel`], the legged
 //! walk ([`crate::mechanism::legged`]) on the section at a heel strike before its impact, for every job of a
 //! walker (`simulate`, `sweep`, `orbit`, `plot`/`animate` of its runs). Its steps carry the legged walk's account
 //! ([`WalkerStep::legged`]: the heel strike's branch and DLS indicators, the double support, the audits), its
@@ -8,8 +8,8 @@
 use nalgebra::{DVector, SVector};
 
 use super::walker_model::{
-    Body, FoundGait, Grid, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,
-    WalkerStep,
+    along, split, Body, FoundGait, Grid, Sampling, Walk, WalkerError, WalkerGaitError, WalkerStep,
+    Walking,
 };
 use crate::mechanism::legged::derivative::LeggedDerivatives;
 use crate::mechanism::legged::gait::{
@@ -49,14 +49,6 @@ pub(crate) fn search_legged_gait<W: LeggedDerivatives<N>, const N: usize, const 
     legged_gait_exact::<W, N, Y>(walker, &s, &options)
 }
 
-/// A point at `length` from `from` along a leg of angle `angle` (from the slope's downward normal).
-fn along(from: [f64; 2], angle: f64, length: f64) -> [f64; 2] {
-    [
-        from[0] + length * angle.sin(),
-        from[1] - length * angle.cos(),
-    ]
-}
-
 impl Body<6> for Telescopic {
     fn coordinate_names(&self) -> [&'static str; 6] {
         self.coordinates()
@@ -93,21 +85,14 @@ impl Body<6> for Telescopic {
     }
 }
 
-/// A walker with compliant legs as a [`WalkerModel`].
+/// A walker with compliant legs as a [`super::WalkerModel`].
+pub type LeggedModel<'w, W, const N: usize, const Y: usize> = Walking<'w, W, Compliant, N, Y>;
+
+/// The compliant-leg walk ([`crate::mechanism::legged`]), for [`Walking`].
 #[derive(Debug, Clone, Copy)]
-pub struct LeggedModel<'w, W, const N: usize, const Y: usize> {
-    walker: &'w W,
-    start: fn(&W) -> DVector<f64>,
-}
+pub struct Compliant;
 
-impl<'w, W, const N: usize, const Y: usize> LeggedModel<'w, W, N, Y> {
-    /// `walker`, its searches and walks starting at `start(walker)` by default.
-    pub fn new(walker: &'w W, start: fn(&W) -> DVector<f64>) -> LeggedModel<'w, W, N, Y> {
-        LeggedModel { walker, start }
-    }
-}
-
-impl<W: Legged<N> + Body<N>, const N: usize, const Y: usize> LeggedModel<'_, W, N, Y> {
+impl<W: LeggedDerivatives<N> + Body<N>, const N: usize, const Y: usize> LeggedModel<'_, W, N, Y> {
     /// The record of `step`, started at `(q, q')` on the section: the stride is the new stance tip's distance
     /// ahead of the old one (behind the new one just after the relabeling), the energy audit the step's
     /// residual's size.
@@ -133,18 +118,6 @@ impl<W: Legged<N> + Body<N>, const N: usize, const Y: usize> LeggedModel<'_, W, 
         }
     }
 
-    /// The sample of `(q, q')` at the walk's time `time`.
-    fn sample(&self, time: f64, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> WalkerSample {
-        WalkerSample {
-            time,
-            q: q.iter().copied().collect(),
-            qd: qd.iter().copied().collect(),
-            kinetic: self.walker.kinetic(q, qd),
-            potential: self.walker.potential_energy(q),
-            points: self.walker.points(q),
-        }
-    }
-
     /// The step from `(q, q')` on the section, its states passed to `sampling`'s sink: at its start (the
     /// section's state, before the heel strike's impact), at the multiples of the sampling interval inside it
     /// and just before the next heel strike, on the walk's own integrator steps.
@@ -155,69 +128,46 @@ impl<W: Legged<N> + Body<N>, const N: usize, const Y: usize> LeggedModel<'_, W, 
         sampling: Sampling<'_>,
     ) -> Result<LeggedStep<N>, LeggedError> {
         let Sampling { start, dt, sink } = sampling;
-        sink(self.sample(start, q, qd));
+        sink(self.sample(start, (q, qd)));
         let mut grid = Grid::new(start, dt);
         let mut last = None;
-        let split = |y: &SVector<f64, Y>| {
-            (
-                SVector::<f64, N>::from_iterator(y.rows(0, N).iter().copied()),
-                SVector::<f64, N>::from_iterator(y.rows(N, N).iter().copied()),
-            )
-        };
         let step =
             legged_step_observed::<W, N, Y>(self.walker, (q, qd), options, &mut |s, end| {
                 grid.through(end, |t| {
-                    let (q, qd) = split(&s.eval(t));
-                    sink(self.sample(start + t, &q, &qd));
+                    let (q, qd) = split::<N, Y>(&s.eval(t));
+                    sink(self.sample(start + t, (&q, &qd)));
                 });
                 last = Some(if end >= s.t1() { *s.y1() } else { s.eval(end) });
             })?;
         if let Some(y) = last {
-            let (q, qd) = split(&y);
-            sink(self.sample(start + step.period, &q, &qd));
+            let (q, qd) = split::<N, Y>(&y);
+            sink(self.sample(start + step.period, (&q, &qd)));
         }
         Ok(step)
     }
 }
 
-impl<W, const N: usize, const Y: usize> WalkerModel for LeggedModel<'_, W, N, Y>
+impl<W, const N: usize, const Y: usize> Walk<W, N, Y> for Compliant
 where
     W: LeggedDerivatives<N> + Body<N>,
 {
-    fn name(&self) -> &str {
-        Mechanism::name(self.walker)
+    const LEGGED: bool = true;
+
+    fn name(walker: &W) -> &'static str {
+        Mechanism::name(walker)
     }
 
-    fn coordinates(&self) -> Vec<String> {
-        self.walker
-            .coordinate_names()
-            .iter()
-            .map(|n| n.to_string())
-            .collect()
+    fn section_names(walker: &W) -> Vec<&'static str> {
+        Legged::section_names(walker)
     }
 
-    fn section_names(&self) -> Vec<String> {
-        self.walker
-            .section_names()
-            .iter()
-            .map(|n| n.to_string())
-            .collect()
-    }
-
-    fn default_start(&self) -> DVector<f64> {
-        (self.start)(self.walker)
-    }
-
-    fn slope(&self) -> f64 {
-        self.walker.slope_angle()
-    }
-
-    fn figure(&self) -> StickFigure {
-        self.walker.stick_figure()
+    /// Gravity's and the springs' potential energy.
+    fn potential(walker: &W, q: &SVector<f64, N>, _qd: &SVector<f64, N>) -> f64 {
+        walker.potential_energy(q)
     }
 
     fn step(
-        &self,
+        model: &LeggedModel<'_, W, N, Y>,
         s: &DVector<f64>,
         sampling: Option<Sampling<'_>>,
     ) -> Result<WalkerStep, WalkerError> {
@@ -225,22 +175,26 @@ where
         if options.stop.is_some_and(|stop| stop()) {
             return Err(LeggedError::Interrupted.into());
         }
-        let (q, qd) = self
+        let (q, qd) = model
             .walker
             .state_at_section(s)
             .ok_or(LeggedError::OffSection)?;
         let step = match sampling {
-            Some(sampling) => self.sampled((&q, &qd), &options, sampling)?,
+            Some(sampling) => model.sampled((&q, &qd), &options, sampling)?,
             None => {
-                legged_step_observed::<W, N, Y>(self.walker, (&q, &qd), &options, &mut |_, _| {})?
+                legged_step_observed::<W, N, Y>(model.walker, (&q, &qd), &options, &mut |_, _| {})?
             }
         };
-        Ok(self.record(&q, &qd, &step))
+        Ok(model.record(&q, &qd, &step))
     }
 
-    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, WalkerGaitError> {
-        let g = search_legged_gait::<W, N, Y>(self.walker, start, transient)?;
-        let (q, qd) = self
+    fn gait(
+        model: &LeggedModel<'_, W, N, Y>,
+        start: &DVector<f64>,
+        transient: usize,
+    ) -> Result<FoundGait, WalkerGaitError> {
+        let g = search_legged_gait::<W, N, Y>(model.walker, start, transient)?;
+        let (q, qd) = model
             .walker
             .state_at_section(&g.section)
             .ok_or(LeggedGaitError::Step {
@@ -248,7 +202,7 @@ where
                 source: LeggedError::OffSection,
             })?;
         Ok(FoundGait {
-            step: self.record(&q, &qd, &g.step),
+            step: model.record(&q, &qd, &g.step),
             derivative: g.derivative.to_string(),
             jacobian_error: Some(g.jacobian_error),
             section: g.section,
@@ -257,15 +211,12 @@ where
             multipliers: g.multipliers,
         })
     }
-
-    fn legged(&self) -> bool {
-        true
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::app::WalkerModel;
 
     /// A step of `vrw simulate --model telescopic` is the gait search's step map bit for bit, with its samples
     /// or without (the observer changes nothing of the walk); its first sample holds the step's starting

@@ -36,6 +36,7 @@ pub use crate::family::curves::CurveRecord;
 pub use crate::family::diagram::{EndRecord, KNOWN_GAIT_TOL, MAX_FAMILIES, SAME_END_TOL};
 pub use basin::{
     compute_basin, compute_basin_part, default_basin_range, run_basin, BasinJob, BasinSummary,
+    SliceGrid, MAX_BASIN_POINTS, MAX_BASIN_STEPS,
 };
 pub use family::{
     compute_continuation, ContinueJob, ContinueResult, ContinueSummary, DIAGRAM_QUANTITIES,
@@ -54,7 +55,7 @@ pub use gait::{
     compute_gait, run_gait, write_gait_period, GaitJob, GaitSummary, SearchEnded,
     MIN_GAIT_TOLERANCE,
 };
-pub use legged::LeggedModel;
+pub use legged::{Compliant, LeggedModel};
 pub use map::{compute_map, compute_map_part, run_map, MapJob, MapSummary};
 pub use orbit::{
     compute_orbit, compute_orbit_part, run_orbit, OrbitJob, OrbitJobPart, OrbitPartResult,
@@ -66,19 +67,20 @@ pub use simulate::{
 };
 pub use sweep::{compute_sweep, run_sweep, SweepJob, SweepResult, SweepSummary};
 pub use walker_basin::{
-    run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob, WalkerBasinPoint,
-    WalkerBasinSummary, WalkerOutcome, MAX_WALKER_BASIN_POINTS, MAX_WALKER_BASIN_STEPS,
+    compute_walker_basin, run_walker_basin, WalkerBasinAxis, WalkerBasinGait, WalkerBasinJob,
+    WalkerBasinPoint, WalkerBasinSummary, WalkerOutcome,
 };
 pub use walker_continue::{
     compute_walker_continuation, run_walker_continuation, WalkerContinueJob, WalkerContinueSummary,
     WalkerSpecialPoint,
 };
 pub use walker_map::{
-    run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary, WalkerMapThreshold,
+    compute_walker_map, run_walker_map, WalkerMap, WalkerMapJob, WalkerMapSummary,
+    WalkerMapThreshold,
 };
 pub use walker_model::{
-    Body, FoundGait, RigidModel, Sampling, WalkerError, WalkerGaitError, WalkerModel, WalkerSample,
-    WalkerStep,
+    Body, FoundGait, Rigid, RigidModel, Sampling, Walk, WalkerError, WalkerGaitError, WalkerModel,
+    WalkerSample, WalkerStep, Walking,
 };
 pub use walker_orbit::{
     compute_walker_orbit, run_walker_orbit, WalkerOrbitColumn, WalkerOrbitJob, WalkerOrbitSummary,

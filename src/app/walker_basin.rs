@@ -20,9 +20,10 @@ use std::path::PathBuf;
 use nalgebra::DVector;
 use serde::Serialize;
 
-use super::walker_model::FoundGait;
+use super::basin::SliceGrid;
+use super::walker_model::{FoundGait, WalkerModel};
 use super::walker_orbit::least_period;
-use super::walker_output::write_rows;
+use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::FRESH_TRANSIENT;
 use super::walkers::{as_map, named, start_of, Walker};
 use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
@@ -31,12 +32,6 @@ use crate::output;
 use crate::output::basin_plot::{write_basin_figure, BasinFigure};
 use crate::study::basin::{OutcomeKind, SETTLED_TOL};
 use crate::study::grid::{run_rows, Evaluated};
-
-/// The most grid points along one axis of a walker's basin (as the wheel's).
-pub const MAX_WALKER_BASIN_POINTS: usize = 2000;
-
-/// The most steps walked from one start (as the wheel's).
-pub const MAX_WALKER_BASIN_STEPS: usize = 100_000;
 
 /// What `vrw basin --model NAME` runs.
 #[derive(Debug, Clone)]
@@ -47,14 +42,9 @@ pub struct WalkerBasinJob {
     pub initial: Option<Vec<f64>>,
     /// The horizontal and vertical coordinates of the slice (names of the model's section coordinates).
     pub coordinates: [String; 2],
-    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0).
-    pub ranges: [Option<(f64, f64)>; 2],
-    /// Grid points along x and y.
-    pub points: [usize; 2],
-    /// Steps walked at most from each start.
-    pub max_steps: usize,
-    /// Distance to the gait's section state that counts as reaching it (largest coordinate difference).
-    pub tolerance: f64,
+    /// Their ranges (`None`: from 0 to twice the gait's value, or -1 to 1 where that is 0), the grid, and when
+    /// a walk ends.
+    pub grid: SliceGrid,
     /// Output directory for `basin.csv`, `basin.json` and `basin.png`.
     pub out_dir: PathBuf,
     /// Replace a run of another command in `out_dir`.
@@ -169,12 +159,34 @@ pub struct WalkerBasinSummary {
 }
 
 impl WalkerBasinJob {
+    /// The slice's coordinates `x` and `y` as given, or else the first and the second of `walker`'s section
+    /// (the defaults of `vrw basin --model` and `vrw.basin`).
+    pub fn slice_coordinates(
+        walker: &Walker,
+        [x, y]: [Option<&str>; 2],
+    ) -> Result<[String; 2], AppError> {
+        let names = walker.model()?.section_names();
+        if names.len() < 2 {
+            return Err(Self::invalid(
+                "model",
+                format!(
+                    "the section of `{}` has one coordinate ({}): a basin's slice needs two",
+                    walker.name(),
+                    names.join(", ")
+                ),
+            ));
+        }
+        let pick =
+            |given: Option<&str>, k: usize| given.map_or_else(|| names[k].clone(), String::from);
+        Ok([pick(x, 0), pick(y, 1)])
+    }
+
     fn invalid(option: &'static str, reason: String) -> AppError {
         AppError::InvalidOption { option, reason }
     }
 
-    /// Check the options that do not depend on the gait: the coordinates against the section's `names`, the
-    /// ranges, grid sizes, steps and tolerance.
+    /// Check the options that do not depend on the gait: the coordinates against the section's `names`, and the
+    /// grid ([`SliceGrid::validate`]).
     fn validate(&self, names: &[String]) -> Result<[usize; 2], AppError> {
         let index = |option: &'static str, c: &str| {
             names.iter().position(|n| n == c).ok_or_else(|| {
@@ -202,38 +214,7 @@ impl WalkerBasinJob {
                 ),
             ));
         }
-        for (option, n) in [("nx", self.points[0]), ("ny", self.points[1])] {
-            if !(2..=MAX_WALKER_BASIN_POINTS).contains(&n) {
-                return Err(Self::invalid(
-                    option,
-                    format!("{n} grid points; use 2 to {MAX_WALKER_BASIN_POINTS}"),
-                ));
-            }
-        }
-        for (option, range) in [("x_range", self.ranges[0]), ("y_range", self.ranges[1])] {
-            if let Some((a, b)) = range.filter(|(a, b)| !(a.is_finite() && b.is_finite() && a != b))
-            {
-                return Err(Self::invalid(
-                    option,
-                    format!("{a},{b} is not a range with two different finite ends"),
-                ));
-            }
-        }
-        if !(1..=MAX_WALKER_BASIN_STEPS).contains(&self.max_steps) {
-            return Err(Self::invalid(
-                "max_steps",
-                format!(
-                    "{} steps; use 1 to {MAX_WALKER_BASIN_STEPS}",
-                    self.max_steps
-                ),
-            ));
-        }
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
-            return Err(Self::invalid(
-                "tolerance",
-                format!("{} is not a positive distance", self.tolerance),
-            ));
-        }
+        self.grid.validate()?;
         Ok(axes)
     }
 
@@ -241,7 +222,7 @@ impl WalkerBasinJob {
     fn axes(&self, indices: [usize; 2], through: &DVector<f64>) -> [WalkerBasinAxis; 2] {
         [0, 1].map(|k| {
             let at = through[indices[k]];
-            let (from, to) = self.ranges[k].unwrap_or(if at == 0.0 {
+            let (from, to) = self.grid.ranges[k].unwrap_or(if at == 0.0 {
                 (-1.0, 1.0)
             } else {
                 (0.0, 2.0 * at)
@@ -251,7 +232,7 @@ impl WalkerBasinJob {
                 index: indices[k],
                 from,
                 to,
-                points: self.points[k],
+                points: self.grid.points[k],
             }
         })
     }
@@ -332,6 +313,34 @@ pub(super) fn walker_basin_points(
     })
 }
 
+/// What a basin's grid runs on: the section's coordinates, the gait and the slice's axes.
+struct Slice {
+    names: Vec<String>,
+    found: FoundGait,
+    axes: [WalkerBasinAxis; 2],
+}
+
+/// The slice of `job` on `model`, after the options are checked and, between the checks and the gait search,
+/// `before_search` (the command line's check of its output directory).
+fn slice(
+    job: &WalkerBasinJob,
+    model: &dyn WalkerModel,
+    before_search: impl FnOnce() -> Result<(), AppError>,
+) -> Result<Slice, AppError> {
+    let names = model.section_names();
+    let indices = job.validate(&names)?;
+    let start = start_of(model, job.initial.as_deref())?;
+    before_search()?;
+    let found = model.gait(&start, FRESH_TRANSIENT);
+    check_phase_interrupted(None, "while searching the gait", NOTHING_WRITTEN)?;
+    let found = found.map_err(|e| AppError::InvalidOption {
+        option: "basin",
+        reason: format!("no gait to draw the basin of: {e}"),
+    })?;
+    let axes = job.axes(indices, &found.section);
+    Ok(Slice { names, found, axes })
+}
+
 /// Draw the basin of `job.walker`'s gait and write `basin.csv`, `basin.json` and `basin.png`, after the
 /// options, the gait and the output directory are checked. `progress` is called after every start.
 /// Interrupted (Ctrl-C) among the starts, `basin.csv` keeps the complete ones of every row.
@@ -340,22 +349,15 @@ pub fn run_walker_basin(
     progress: &(dyn Fn(&WalkerBasinPoint) + Sync),
 ) -> Result<WalkerBasinSummary, AppError> {
     let model = job.walker.model()?;
-    let names = model.section_names();
-    let indices = job.validate(&names)?;
-    let start = start_of(model.as_ref(), job.initial.as_deref())?;
-    output::manifest::check_out_dir(&job.out_dir, "basin", job.overwrite)?;
-    let found = model.gait(&start, FRESH_TRANSIENT);
-    check_phase_interrupted(None, "while searching the gait", NOTHING_WRITTEN)?;
-    let found = found.map_err(|e| AppError::InvalidOption {
-        option: "basin",
-        reason: format!("no gait to draw the basin of: {e}"),
+    let Slice { names, found, axes } = slice(job, model.as_ref(), || {
+        output::manifest::check_out_dir(&job.out_dir, "basin", job.overwrite)?;
+        Ok(())
     })?;
-    let axes = job.axes(indices, &found.section);
     in_run(&job.out_dir, job.overwrite, "basin", |run| {
         let grid = walker_basin_points(
             &job.walker,
             (&found.section, &axes),
-            (job.max_steps, job.tolerance),
+            (job.grid.max_steps, job.grid.tolerance),
             progress,
         );
         write_rows(&run.path("basin.csv"), &basin_rows(&names, &grid))?;
@@ -369,6 +371,31 @@ pub fn run_walker_basin(
         run.add("basin.json");
         Ok((summary, None))
     })
+}
+
+/// The basin of [`run_walker_basin`] without its files and figure (the Python binding): `basin.json`'s fields
+/// (`files` the table's) and the rows of `basin.csv` (`job.out_dir` and `job.overwrite` are not read).
+/// `progress` is called after every start. Interrupted (Ctrl-C): an error, nothing kept.
+pub fn compute_walker_basin(
+    job: &WalkerBasinJob,
+    progress: &(dyn Fn(&WalkerBasinPoint) + Sync),
+) -> Result<WalkerOutput<WalkerBasinSummary>, AppError> {
+    let model = job.walker.model()?;
+    let Slice { names, found, axes } = slice(job, model.as_ref(), || Ok(()))?;
+    let grid = walker_basin_points(
+        &job.walker,
+        (&found.section, &axes),
+        (job.grid.max_steps, job.grid.tolerance),
+        progress,
+    );
+    let total = axes[0].points * axes[1].points;
+    check_interrupted(grid.iter().map(Vec::len).sum(), total, "no file")?;
+    let tables = vec![("basin.csv", basin_rows(&names, &grid))];
+    let summary = WalkerBasinSummary {
+        files: vec!["basin.csv".to_string()],
+        ..summary(job, (model.name(), &names), &found, axes, &grid)
+    };
+    Ok(WalkerOutput { summary, tables })
 }
 
 /// `basin.json`'s fields.
@@ -398,8 +425,8 @@ fn summary(
         x,
         y,
         through: named(names, &found.section),
-        max_steps: job.max_steps,
-        tolerance: job.tolerance,
+        max_steps: job.grid.max_steps,
+        tolerance: job.grid.tolerance,
         outcomes,
         files: ["basin.csv", "basin.png", "basin.json"]
             .map(String::from)
@@ -488,13 +515,33 @@ mod tests {
             walker,
             initial: None,
             coordinates: ["theta".to_string(), "theta_dot".to_string()],
-            ranges: [Some((0.15, 0.25)), Some((-0.25, -0.15))],
-            points: [n, n],
-            max_steps: 100,
-            tolerance: 1e-3,
+            grid: SliceGrid {
+                ranges: [Some((0.15, 0.25)), Some((-0.25, -0.15))],
+                points: [n, n],
+                max_steps: 100,
+                tolerance: 1e-3,
+            },
             out_dir: out.to_path_buf(),
             overwrite: false,
         }
+    }
+
+    /// The basin without its files ([`compute_walker_basin`], the Python binding's) is the one `vrw basin
+    /// --model` writes: its table is `basin.csv` cell for cell, its summary `basin.json` but for the files
+    /// listed.
+    #[test]
+    fn the_computed_basin_is_the_written_one() {
+        let tmp = tempfile::tempdir().unwrap();
+        let job = simplest_basin(&tmp.path().join("basin"), 5);
+        let written = run_walker_basin(&job, &|_| {}).unwrap();
+        let computed = compute_walker_basin(&job, &|_| {}).unwrap();
+        let csv = std::fs::read_to_string(tmp.path().join("basin").join("basin.csv")).unwrap();
+        let rows: Vec<String> = computed.tables[0].1.iter().map(|r| r.join(",")).collect();
+        assert_eq!(computed.tables[0].0, "basin.csv");
+        assert_eq!(csv.lines().collect::<Vec<_>>(), rows);
+        let mut summary = serde_json::to_value(&computed.summary).unwrap();
+        summary["files"] = serde_json::to_value(&written.files).unwrap();
+        assert_eq!(summary, serde_json::to_value(&written).unwrap());
     }
 
     /// `basin.csv`, `basin.json` and `basin.png` are the same bytes for 1 and 2 threads.

@@ -23,7 +23,7 @@ use nalgebra::DVector;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::walker_output::write_rows;
+use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::{
     gait_at, sweep_rows, thresholds, walker_gaits, WalkerRange, WalkerSweepPoint, WalkerThreshold,
 };
@@ -102,6 +102,10 @@ pub struct WalkerMapSummary {
     pub thresholds: Vec<WalkerMapThreshold>,
     /// The files written.
     pub files: Vec<String>,
+    /// Where the interrupt flag stopped the job and what is kept ([`compute_walker_map`]: the gaits without
+    /// thresholds); `None` (and not written) when it did not.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<String>,
 }
 
 /// The axis `range` checked against `walker` as the sweep checks it, its errors naming the map's options
@@ -276,6 +280,46 @@ pub fn run_walker_map(
     })
 }
 
+/// The map of [`run_walker_map`] without its files and figure (the Python binding): `map.json`'s fields (`files`
+/// the table's) and the rows of `map.csv` (`job.out_dir` and `job.overwrite` are not read). `progress` is called
+/// after every point.
+///
+/// Interrupted (Ctrl-C) while the thresholds are bisected (the gaits being complete), it returns the gaits with
+/// no threshold and says so in [`WalkerMapSummary::interrupted`] (the Python front hands them on with its
+/// `KeyboardInterrupt`, as the wheel's map); interrupted among the gaits, it is [`AppError::Interrupted`].
+pub fn compute_walker_map(
+    job: &WalkerMapJob,
+    progress: &(dyn Fn(&WalkerSweepPoint) + Sync),
+) -> Result<WalkerOutput<WalkerMapSummary>, AppError> {
+    let values = job.values()?;
+    let model = job.walker.model()?;
+    let start = start_of(model.as_ref(), job.initial.as_deref())?;
+    let names = model.section_names();
+    let map = walker_map_gaits(job, values, &start, progress)?;
+    let done = map.rows.iter().map(Vec::len).sum();
+    check_interrupted(done, map.xs.len() * map.ys.len(), "no file")?;
+    let thresholds = match job.thresholds {
+        true => row_thresholds(job, &names, &map)?,
+        false => Vec::new(),
+    };
+    let stopped = check_phase_interrupted(
+        None,
+        "while bisecting the thresholds",
+        "the map's gaits are complete; no threshold is kept",
+    );
+    let tables = vec![("map.csv", map_rows(job, &names, &map))];
+    let files = vec!["map.csv".to_string()];
+    let summary = match stopped {
+        Ok(()) => summary(job, model.name(), &map, thresholds, files),
+        Err(AppError::Interrupted { during, kept }) => WalkerMapSummary {
+            interrupted: Some(format!("{during}; {kept}")),
+            ..summary(job, model.name(), &map, Vec::new(), files)
+        },
+        Err(e) => return Err(e),
+    };
+    Ok(WalkerOutput { summary, tables })
+}
+
 /// `map.json`'s fields.
 fn summary(
     job: &WalkerMapJob,
@@ -303,6 +347,7 @@ fn summary(
             .count(),
         thresholds,
         files,
+        interrupted: None,
     }
 }
 
@@ -433,6 +478,24 @@ mod tests {
             .find(|s| s.kind == SpecialKind::PeriodDoubling && s.located)
             .expect("a located period doubling")
             .value
+    }
+
+    /// The map without its files ([`compute_walker_map`], the Python binding's) is the one `vrw map --model`
+    /// writes: its table is `map.csv` cell for cell, its summary `map.json` but for the files listed.
+    #[test]
+    fn the_computed_map_is_the_written_one() {
+        let tmp = tempfile::tempdir().unwrap();
+        let job = compass_map(&tmp.path().join("map"), (0.07, 0.08, 3), (8.0, 12.0, 2));
+        let written = run_walker_map(&job, &|_| {}).unwrap();
+        let computed = compute_walker_map(&job, &|_| {}).unwrap();
+        let csv = std::fs::read_to_string(tmp.path().join("map").join("map.csv")).unwrap();
+        let rows: Vec<String> = computed.tables[0].1.iter().map(|r| r.join(",")).collect();
+        assert_eq!(computed.tables[0].0, "map.csv");
+        assert_eq!(csv.lines().collect::<Vec<_>>(), rows);
+        let mut summary = serde_json::to_value(&computed.summary).unwrap();
+        summary["files"] = serde_json::to_value(&written.files).unwrap();
+        assert_eq!(summary, serde_json::to_value(&written).unwrap());
+        assert_eq!(computed.summary.thresholds.len(), 2);
     }
 
     /// `map.csv`, `map.json` and `map.png` are the same bytes for 1 and 2 threads.

@@ -1,11 +1,14 @@
 //! What a walker offers the jobs of `--model` (`simulate`, `sweep`, `orbit`, and `plot`/`animate` of their
 //! runs; docs/model.md section 13): [`WalkerModel`], an object-safe interface on section states, so that a job
-//! is written once for every walker. The built-in walkers (the simplest walker and the compass gait) give it
-//! through [`RigidModel`], their rigid-leg walk ([`crate::mechanism::rigid`]) with what a drawing and the
-//! energy split need ([`Body`]), the walkers with compliant legs through `LeggedModel` (`super::legged`);
-//! another kind of walker slots in by implementing [`WalkerModel`] and being returned by
-//! [`super::Walker::model`]. A step's or a search's failure is one [`WalkerError`] or [`WalkerGaitError`]
+//! is written once for every walker. Every walker gives it as [`Walking`]: the walker with what a drawing and
+//! the energy split need ([`Body`], written once for every walk) and its walk ([`Walk`]): the rigid-leg walk
+//! ([`Rigid`], [`crate::mechanism::rigid`]: the simplest walker, the compass gait, [`RigidModel`]) or the
+//! compliant-leg walk ([`super::Compliant`], in `super::legged`: [`super::LeggedModel`]); another kind of walk
+//! slots in by implementing [`Walk`], another kind of walker by implementing [`WalkerModel`] and being returned
+//! by [`super::Walker::model`]. A step's or a search's failure is one [`WalkerError`] or [`WalkerGaitError`]
 //! whatever the walk, with the kinds of the walk's own errors (`fell`, `rolled_back`, `no_convergence`, ...).
+
+use std::marker::PhantomData;
 
 use nalgebra::{DVector, SVector};
 
@@ -196,7 +199,7 @@ pub trait Body<const N: usize> {
 
 /// A point at `length` along a leg of angle `angle` (from the slope's downward normal, positive down the slope)
 /// from `from`.
-fn along(from: [f64; 2], angle: f64, length: f64) -> [f64; 2] {
+pub(super) fn along(from: [f64; 2], angle: f64, length: f64) -> [f64; 2] {
     [
         from[0] + length * angle.sin(),
         from[1] - length * angle.cos(),
@@ -261,19 +264,58 @@ impl Body<4> for Compass {
     }
 }
 
-/// A rigid-legged walker as a [`WalkerModel`].
+/// A walker as a [`WalkerModel`]: the walker, where its walks start by default, and how it walks (`K`: the
+/// rigid-leg walk, [`Rigid`], or the compliant-leg walk, [`super::Compliant`]). What describes the
+/// walker to the jobs (its names, slope, drawing and samples) is written here once, for every walk; its steps
+/// and gaits are its walk's ([`Walk`]).
 #[derive(Debug, Clone, Copy)]
-pub struct RigidModel<'w, W, const N: usize, const Y: usize> {
-    walker: &'w W,
+pub struct Walking<'w, W, K, const N: usize, const Y: usize> {
+    pub(super) walker: &'w W,
     start: fn(&W) -> DVector<f64>,
+    walk: PhantomData<K>,
 }
 
-impl<'w, W, const N: usize, const Y: usize> RigidModel<'w, W, N, Y> {
+impl<'w, W, K, const N: usize, const Y: usize> Walking<'w, W, K, N, Y> {
     /// `walker`, its searches and walks starting at `start(walker)` by default.
-    pub fn new(walker: &'w W, start: fn(&W) -> DVector<f64>) -> RigidModel<'w, W, N, Y> {
-        RigidModel { walker, start }
+    pub fn new(walker: &'w W, start: fn(&W) -> DVector<f64>) -> Walking<'w, W, K, N, Y> {
+        Walking {
+            walker,
+            start,
+            walk: PhantomData,
+        }
     }
 }
+
+/// A rigid-legged walker as a [`WalkerModel`].
+pub type RigidModel<'w, W, const N: usize, const Y: usize> = Walking<'w, W, Rigid, N, Y>;
+
+/// How a kind of walker walks, for [`Walking`]: what differs between the rigid-leg and the compliant-leg walk.
+pub trait Walk<W, const N: usize, const Y: usize>: Sized {
+    /// Do its steps carry [`WalkerStep::legged`] ([`WalkerModel::legged`])?
+    const LEGGED: bool;
+    /// The model's name.
+    fn name(walker: &W) -> &'static str;
+    /// The names of the section's coordinates.
+    fn section_names(walker: &W) -> Vec<&'static str>;
+    /// The potential energy at `(q, q')` (gravity, and the legs' springs where they have some).
+    fn potential(walker: &W, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64;
+    /// [`WalkerModel::step`].
+    fn step(
+        model: &Walking<'_, W, Self, N, Y>,
+        s: &DVector<f64>,
+        sampling: Option<Sampling<'_>>,
+    ) -> Result<WalkerStep, WalkerError>;
+    /// [`WalkerModel::gait`].
+    fn gait(
+        model: &Walking<'_, W, Self, N, Y>,
+        start: &DVector<f64>,
+        transient: usize,
+    ) -> Result<FoundGait, WalkerGaitError>;
+}
+
+/// The rigid-leg walk ([`crate::mechanism::rigid`]), for [`Walking`].
+#[derive(Debug, Clone, Copy)]
+pub struct Rigid;
 
 /// The single-support field of a rigid walker, as the walk integrates it (the jobs' sampling integrates it
 /// again, with the same integrator, tolerances and stop, so its steps are the walk's).
@@ -290,7 +332,7 @@ impl<W: RigidWalker<N, Y>, const N: usize, const Y: usize> OdeSystem<Y> for Fiel
 }
 
 /// `(q, q')` of an integrated state.
-fn split<const N: usize, const Y: usize>(
+pub(super) fn split<const N: usize, const Y: usize>(
     y: &SVector<f64, Y>,
 ) -> (SVector<f64, N>, SVector<f64, N>) {
     (
@@ -299,22 +341,32 @@ fn split<const N: usize, const Y: usize>(
     )
 }
 
-impl<W, const N: usize, const Y: usize> RigidModel<'_, W, N, Y>
-where
-    W: RigidWalker<N, Y> + Body<N>,
-{
-    /// The sample of the state `y` at time `time` of a step.
-    fn sample(&self, time: f64, y: &SVector<f64, Y>) -> WalkerSample {
-        let (q, qd) = split::<N, Y>(y);
-        let kinetic = self.walker.kinetic(&q, &qd);
+impl<W: Body<N>, K: Walk<W, N, Y>, const N: usize, const Y: usize> Walking<'_, W, K, N, Y> {
+    /// The sample of the state `(q, q')` at the walk's time `time`.
+    pub(super) fn sample(
+        &self,
+        time: f64,
+        (q, qd): (&SVector<f64, N>, &SVector<f64, N>),
+    ) -> WalkerSample {
         WalkerSample {
             time,
             q: q.iter().copied().collect(),
             qd: qd.iter().copied().collect(),
-            kinetic,
-            potential: self.walker.mechanical_energy(&q, &qd) - kinetic,
-            points: self.walker.points(&q),
+            kinetic: self.walker.kinetic(q, qd),
+            potential: K::potential(self.walker, q, qd),
+            points: self.walker.points(q),
         }
+    }
+}
+
+impl<W, const N: usize, const Y: usize> RigidModel<'_, W, N, Y>
+where
+    W: RigidWalker<N, Y> + Body<N>,
+{
+    /// The sample of the integrated state `y` at the walk's time `time`.
+    fn sample_of(&self, time: f64, y: &SVector<f64, Y>) -> WalkerSample {
+        let (q, qd) = split::<N, Y>(y);
+        self.sample(time, (&q, &qd))
     }
 
     /// The states of the step from `(q, q')` lasting `period`, started at the walk's time `sampling.start`:
@@ -331,7 +383,7 @@ where
         let y0 = SVector::from_iterator(q.iter().chain(qd.iter()).copied());
         let mut integrator = Dop853::new(&field, 0.0, y0, options.tolerances);
         let Sampling { start, dt, sink } = sampling;
-        sink(self.sample(start, &y0));
+        sink(self.sample_of(start, &y0));
         let mut grid = Grid::new(start, dt);
         loop {
             if options.stop.is_some_and(|stop| stop()) {
@@ -339,10 +391,10 @@ where
             }
             let step = integrator.step(&field, options.max_step_time)?;
             grid.through(step.t1().min(period), |t| {
-                sink(self.sample(start + t, &step.eval(t)))
+                sink(self.sample_of(start + t, &step.eval(t)))
             });
             if step.t1() >= period {
-                sink(self.sample(start + period, &step.eval(period)));
+                sink(self.sample_of(start + period, &step.eval(period)));
                 return Ok(());
             }
         }
@@ -389,12 +441,13 @@ pub struct Sampling<'a> {
     pub sink: &'a mut dyn FnMut(WalkerSample),
 }
 
-impl<W, const N: usize, const Y: usize> WalkerModel for RigidModel<'_, W, N, Y>
+impl<W, K, const N: usize, const Y: usize> WalkerModel for Walking<'_, W, K, N, Y>
 where
-    W: RigidWalker<N, Y> + Body<N>,
+    W: Body<N>,
+    K: Walk<W, N, Y>,
 {
     fn name(&self) -> &str {
-        self.walker.name()
+        K::name(self.walker)
     }
 
     fn coordinates(&self) -> Vec<String> {
@@ -406,8 +459,7 @@ where
     }
 
     fn section_names(&self) -> Vec<String> {
-        self.walker
-            .section_names()
+        K::section_names(self.walker)
             .iter()
             .map(|n| n.to_string())
             .collect()
@@ -430,23 +482,63 @@ where
         s: &DVector<f64>,
         sampling: Option<Sampling<'_>>,
     ) -> Result<WalkerStep, WalkerError> {
+        K::step(self, s, sampling)
+    }
+
+    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, WalkerGaitError> {
+        K::gait(self, start, transient)
+    }
+
+    fn legged(&self) -> bool {
+        K::LEGGED
+    }
+}
+
+impl<W, const N: usize, const Y: usize> Walk<W, N, Y> for Rigid
+where
+    W: RigidWalker<N, Y> + Body<N>,
+{
+    const LEGGED: bool = false;
+
+    fn name(walker: &W) -> &'static str {
+        RigidWalker::name(walker)
+    }
+
+    fn section_names(walker: &W) -> Vec<&'static str> {
+        RigidWalker::section_names(walker)
+    }
+
+    /// `T + V` less `T`: the walk's energy less the drawing's kinetic energy.
+    fn potential(walker: &W, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> f64 {
+        walker.mechanical_energy(q, qd) - walker.kinetic(q, qd)
+    }
+
+    fn step(
+        model: &RigidModel<'_, W, N, Y>,
+        s: &DVector<f64>,
+        sampling: Option<Sampling<'_>>,
+    ) -> Result<WalkerStep, WalkerError> {
         let options = interruptible();
         // Asked at every step too: a step takes fewer integrator steps than the walk's own check waits for.
         if options.stop.is_some_and(|stop| stop()) {
             return Err(RigidError::Interrupted.into());
         }
-        let (q, qd) = self.walker.state_at_section(s);
-        let step = rigid_step(self.walker, &q, &qd, &options)?;
+        let (q, qd) = model.walker.state_at_section(s);
+        let step = rigid_step(model.walker, &q, &qd, &options)?;
         if let Some(sampling) = sampling {
-            self.sampled((&q, &qd), step.period, sampling)?;
+            model.sampled((&q, &qd), step.period, sampling)?;
         }
-        Ok(rigid_record(self.walker, &q, &qd, &step))
+        Ok(rigid_record(model.walker, &q, &qd, &step))
     }
 
-    fn gait(&self, start: &DVector<f64>, transient: usize) -> Result<FoundGait, WalkerGaitError> {
+    fn gait(
+        model: &RigidModel<'_, W, N, Y>,
+        start: &DVector<f64>,
+        transient: usize,
+    ) -> Result<FoundGait, WalkerGaitError> {
         Ok(found_rigid(
-            self.walker,
-            search_gait(self.walker, start, transient)?,
+            model.walker,
+            search_gait(model.walker, start, transient)?,
         ))
     }
 }

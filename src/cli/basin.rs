@@ -2,10 +2,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 
-use vrw::app::{run_basin, run_walker_basin, BasinJob, Walker, WalkerBasinJob};
+use vrw::app::{run_basin, run_walker_basin, BasinJob, SliceGrid, Walker, WalkerBasinJob};
 use vrw::study::basin::Coordinate;
 
 use super::{interrupt_flag, parse_range, progress_bar, ModelArgs};
@@ -63,6 +63,16 @@ pub(super) struct BasinArgs {
     overwrite: bool,
 }
 
+/// The grid and the walks' end the options give (every walker's).
+fn slice_grid(args: &BasinArgs) -> SliceGrid {
+    SliceGrid {
+        ranges: [args.x_range, args.y_range],
+        points: [args.nx, args.ny],
+        max_steps: args.max_steps,
+        tolerance: args.tolerance,
+    }
+}
+
 /// Run `vrw basin` and print its summary.
 pub(super) fn run(args: BasinArgs) -> Result<()> {
     let sets = &args.params.set;
@@ -83,10 +93,7 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
         config: args.params.load()?,
         initial: super::wheel_initial("basin", args.initial.as_deref()),
         coordinates: [x, y],
-        ranges: [args.x_range, args.y_range],
-        points: [args.nx, args.ny],
-        max_steps: args.max_steps,
-        tolerance: args.tolerance,
+        grid: slice_grid(&args),
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
     };
@@ -126,27 +133,13 @@ pub(super) fn run(args: BasinArgs) -> Result<()> {
 
 /// `vrw basin --model NAME` for a walker other than the wheel: the basin of its gait, its summary, its files.
 fn run_walker(args: &BasinArgs, walker: Walker) -> Result<()> {
-    let names = walker.model()?.section_names();
-    let pick = |given: &Option<String>, k: usize| {
-        given
-            .clone()
-            .unwrap_or_else(|| names.get(k).cloned().unwrap_or_default())
-    };
-    if names.len() < 2 {
-        bail!(
-            "the section of `{}` has one coordinate ({}): a basin's slice needs two",
-            walker.name(),
-            names.join(", ")
-        );
-    }
+    let coordinates =
+        WalkerBasinJob::slice_coordinates(&walker, [args.x.as_deref(), args.y.as_deref()])?;
     let job = WalkerBasinJob {
-        coordinates: [pick(&args.x, 0), pick(&args.y, 1)],
+        coordinates,
         walker,
         initial: super::walker_initial(args.initial.as_deref())?,
-        ranges: [args.x_range, args.y_range],
-        points: [args.nx, args.ny],
-        max_steps: args.max_steps,
-        tolerance: args.tolerance,
+        grid: slice_grid(args),
         out_dir: args.out.clone(),
         overwrite: args.overwrite,
     };

@@ -259,7 +259,18 @@ pub fn read_walker_run(dir: &Path) -> Result<WalkerRun, ReadError> {
         source,
     })?;
     let trajectory = file("trajectory.csv")?;
-    let (columns, rows, warnings) = read_numbers(&trajectory)?;
+    let table = read_numbers(&trajectory)?;
+    walker_run(dir, info, table, trajectory)
+}
+
+/// The walker run of `info` (its `summary.json`) with the trajectory `table` (read from `trajectory`, named in
+/// errors), checked: the header is the one the model writes, and it has rows.
+fn walker_run(
+    dir: &Path,
+    info: WalkerRunInfo,
+    (columns, rows, warnings): NumericTable,
+    trajectory: PathBuf,
+) -> Result<WalkerRun, ReadError> {
     let expected = walker_trajectory_header(&info.coordinates, &info.figure);
     if columns != expected {
         return Err(ReadError::Csv {
@@ -281,6 +292,38 @@ pub fn read_walker_run(dir: &Path) -> Result<WalkerRun, ReadError> {
         rows,
         warnings,
     })
+}
+
+/// A walker's run computed in memory, as [`read_walker_run`] reads it from the files `vrw simulate --model`
+/// writes for it, without files (a front that draws a walk it has just computed, such as the Python binding):
+/// `summary` (the fields of `summary.json`) goes through its JSON text, `trajectory` (the rows of
+/// `trajectory.csv`, its header first, each cell the text the file holds) is read as the file's cells are, so
+/// a drawing of it is the one of the directory, bit for bit. The paths named in errors are the bare file
+/// names.
+pub fn walker_run_from_walk<S: Serialize>(
+    summary: &S,
+    trajectory: &[Vec<String>],
+) -> Result<WalkerRun, ReadError> {
+    let path = PathBuf::from("summary.json");
+    let json = |source| ReadError::Json {
+        path: path.clone(),
+        source,
+    };
+    let text = serde_json::to_string(summary).map_err(json)?;
+    let info: WalkerRunInfo = serde_json::from_str(&text).map_err(json)?;
+    let empty = Vec::new();
+    let (header, cells) = trajectory.split_first().unwrap_or((&empty, &[]));
+    // The rows as the file's reader takes them: complete rows of numbers (a walk computed in memory has no
+    // other).
+    let rows = cells
+        .iter()
+        .map_while(|r| {
+            let values: Option<Vec<f64>> = r.iter().map(|v| v.parse::<f64>().ok()).collect();
+            values.filter(|v| v.len() == header.len())
+        })
+        .collect();
+    let table = (header.to_vec(), rows, Vec::new());
+    walker_run(Path::new(""), info, table, PathBuf::from("trajectory.csv"))
 }
 
 /// A CSV file's header, complete numeric rows, and warnings about the rows left out.

@@ -39,13 +39,16 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::read::RunData;
 use super::style::{png_bytes, require_font, save_png, PlotError};
 use draw::Renderer;
 pub use plan::{plan_frames, FrameTime, SlowMotion, MAX_ANIMATION_FRAMES};
-pub use stick::{write_walker_animation, write_walker_still};
+pub use stick::{
+    walker_still_png, write_walker_animation, write_walker_animation_to, write_walker_still,
+};
 
 /// Largest frame rate: GIF delays are whole hundredths of a second and viewers slow down delays below
 /// 0.02 s, so faster frame rates would not play at their speed.
@@ -314,11 +317,26 @@ fn still_rgb(
     time: f64,
     path: &Path,
 ) -> Result<Vec<u8>, AnimateError> {
+    let walk = (time, run.time_span(), run.path("trajectory.csv"));
+    frame_rgb(opts, walk, path, |root| {
+        let frame = FrameTime { time, slow: None };
+        Ok(Renderer::new(run, opts).draw(root, &frame, path)?)
+    })
+}
+
+/// The RGB bitmap of one frame, at `time` of a walk spanning `span` whose samples are `trajectory`, drawn by
+/// `draw` once the options and the time are checked: the wheel's stills and the walkers' (errors name `path`,
+/// the file being made; a time outside the walk names `trajectory`).
+pub(super) fn frame_rgb(
+    opts: &AnimateOptions,
+    (time, (start, end), trajectory): (f64, (f64, f64), PathBuf),
+    path: &Path,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), AnimateError>,
+) -> Result<Vec<u8>, AnimateError> {
     opts.validate()?;
-    let (start, end) = run.time_span();
     if !(start..=end).contains(&time) {
         return Err(AnimateError::EmptyWindow {
-            path: run.path("trajectory.csv"),
+            path: trajectory,
             from: time,
             to: time,
             start,
@@ -330,8 +348,7 @@ fn still_rgb(
     let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
-        let frame = FrameTime { time, slow: None };
-        Renderer::new(run, opts).draw(&root, &frame, path)?;
+        draw(&root)?;
     }
     Ok(rgb)
 }

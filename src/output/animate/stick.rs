@@ -1,11 +1,12 @@
 //! A walker's walk as an animated GIF or a still (`vrw animate` of a `vrw simulate --model NAME` run): the stick
 //! figure its `summary.json` declares ([`StickFigure`]), drawn from the points `trajectory.csv` holds: the legs
 //! as lines from the hip to the feet (each physical leg in its colour, blue and vermillion, as the wheel's Leg 1
-//! and Leg 2: the stance and swing legs exchange roles at every heel strike), the masses as dots, the feet as
-//! small circles (green on the ground), the ground along the slope. The camera follows the hip along the slope,
-//! as the wheel's does; frames are regular, `speed / fps` of the model's time apart, each interpolated
-//! linearly between the two samples around it (the points are continuous through a heel strike), and are
-//! encoded as the wheel's are (`encode.rs`: its palette holds every colour used here).
+//! and Leg 2: the stance and swing legs exchange roles at every heel strike), the springs (and dampers) of
+//! compliant legs as coils, the masses as dots, the feet as small circles over them (green on the ground), the
+//! ground along the slope. The camera follows the hip along the slope, as the wheel's does; frames are regular,
+//! `speed / fps` of the model's time apart, each interpolated linearly between the two samples around it (the
+//! points are continuous through a heel strike), and are encoded as the wheel's are (`encode.rs`: its palette
+//! holds every colour used here).
 
 use std::path::Path;
 
@@ -13,7 +14,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::super::style::{
-    font, require_font, save_png, PlotError, COLOR_BLUE, COLOR_GREEN, COLOR_VERMILLION,
+    font, png_bytes, require_font, save_png, PlotError, COLOR_BLUE, COLOR_GREEN, COLOR_VERMILLION,
 };
 use super::super::walker_run::WalkerRun;
 use super::draw::{GROUND, INK};
@@ -118,14 +119,15 @@ fn draw_frame<DB: DrawingBackend>(
             colour.stroke_width(2),
         ))?;
     }
+    for (k, &m) in figure.masses.iter().enumerate() {
+        let r = if k == 0 { 11 } else { 7 };
+        root.draw(&Circle::new(view.px(points[m]), r, INK.filled()))?;
+    }
+    // The feet over the masses: a foot that carries mass still shows whether it stands.
     for (k, &f) in figure.feet.iter().enumerate() {
         let fill = if k == 0 { COLOR_GREEN } else { WHITE };
         root.draw(&Circle::new(view.px(points[f]), 5, fill.filled()))?;
         root.draw(&Circle::new(view.px(points[f]), 5, INK.stroke_width(2)))?;
-    }
-    for (k, &m) in figure.masses.iter().enumerate() {
-        let r = if k == 0 { 11 } else { 7 };
-        root.draw(&Circle::new(view.px(points[m]), r, INK.filled()))?;
     }
     let text = size.1 / 20.0;
     root.draw(&Text::new(
@@ -231,14 +233,37 @@ pub fn write_walker_animation(
     opts: &AnimateOptions,
     path: &Path,
 ) -> Result<AnimationReport, AnimateError> {
-    let (window, frames) = frames(run, opts, path)?;
-    let height = hip_height(run);
+    let planned = frames(run, opts, path)?;
     let file = std::fs::File::create(path).map_err(|e| AnimateError::Write {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
+    encoded(run, opts, planned, std::io::BufWriter::new(file), path)
+}
+
+/// Writes the animation of the walker run `run` to `out`: the bytes [`write_walker_animation`] writes to a file
+/// (errors and the report name `name`), e.g. into a `Vec<u8>` for a front that shows the GIF without a file.
+pub fn write_walker_animation_to(
+    run: &WalkerRun,
+    opts: &AnimateOptions,
+    out: impl std::io::Write,
+    name: &Path,
+) -> Result<AnimationReport, AnimateError> {
+    let planned = frames(run, opts, name)?;
+    encoded(run, opts, planned, out, name)
+}
+
+/// Draws and encodes the planned frames of `run` into `out`.
+fn encoded(
+    run: &WalkerRun,
+    opts: &AnimateOptions,
+    (window, frames): ((f64, f64), Vec<FrameTime>),
+    out: impl std::io::Write,
+    path: &Path,
+) -> Result<AnimationReport, AnimateError> {
+    let height = hip_height(run);
     let bytes = encode::write_gif(
-        std::io::BufWriter::new(file),
+        out,
         path,
         (opts.width, opts.height),
         opts.fps,
@@ -266,25 +291,33 @@ pub fn write_walker_still(
     time: f64,
     path: &Path,
 ) -> Result<(), AnimateError> {
-    opts.validate()?;
-    let (start, end) = run.time_span();
-    if !(start..=end).contains(&time) {
-        return Err(AnimateError::EmptyWindow {
-            path: run.dir.join("trajectory.csv"),
-            from: time,
-            to: time,
-            start,
-            end,
-        });
-    }
-    require_font(path)?;
-    let size = (opts.width, opts.height);
-    let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+    let rgb = walker_still_rgb(run, opts, time, path)?;
+    Ok(save_png(path, &rgb, (opts.width, opts.height))?)
+}
+
+/// The frame at `time` of the walker run `run` as the bytes of a PNG: the file [`write_walker_still`] writes
+/// (errors name `name`).
+pub fn walker_still_png(
+    run: &WalkerRun,
+    opts: &AnimateOptions,
+    time: f64,
+    name: &Path,
+) -> Result<Vec<u8>, AnimateError> {
+    let rgb = walker_still_rgb(run, opts, time, name)?;
+    Ok(png_bytes(name, &rgb, (opts.width, opts.height))?)
+}
+
+/// The RGB bitmap of the frame at `time` of the walker run `run` (errors name `path`, the file being made).
+fn walker_still_rgb(
+    run: &WalkerRun,
+    opts: &AnimateOptions,
+    time: f64,
+    path: &Path,
+) -> Result<Vec<u8>, AnimateError> {
+    let walk = (time, run.time_span(), run.dir.join("trajectory.csv"));
+    super::frame_rgb(opts, walk, path, |root| {
         let fail = PlotError::draw_at(path);
-        draw_frame(&root, run, opts, (time, hip_height(run))).map_err(|e| fail(e.to_string()))?;
-        root.present().map_err(|e| fail(e.to_string()))?;
-    }
-    Ok(save_png(path, &rgb, size)?)
+        draw_frame(root, run, opts, (time, hip_height(run))).map_err(|e| fail(e.to_string()))?;
+        Ok(root.present().map_err(|e| fail(e.to_string()))?)
+    })
 }
