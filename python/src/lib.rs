@@ -1030,10 +1030,15 @@ fn continue_family<'py>(
             range,
             max_points,
             max_step,
-            wheel_only: initial.is_some()
-                || period.is_some()
-                || two_param.is_some()
-                || !extremum.is_empty(),
+            wheel_only: [
+                ("initial", initial.is_some()),
+                ("period", period.is_some()),
+                ("two_param", two_param.is_some()),
+                ("extremum", !extremum.is_empty()),
+            ]
+            .iter()
+            .find(|(_, given)| *given)
+            .map(|(o, _)| *o),
         };
         return walkers::continue_family(py, w, param, options);
     }

@@ -433,8 +433,9 @@ pub(crate) struct FamilyOptions {
     pub(crate) max_points: usize,
     /// Largest continuation step.
     pub(crate) max_step: f64,
-    /// The wheel's options a walker's continuation does not take (given: an error).
-    pub(crate) wheel_only: bool,
+    /// The first of the wheel's options a walker's continuation does not take (`initial`, `period`,
+    /// `two_param`, `extremum`) given: an error that names it.
+    pub(crate) wheel_only: Option<&'static str>,
 }
 
 /// `vrw.continue_family` of a walker: `vrw continue --model NAME --param KEY` without its files.
@@ -445,13 +446,13 @@ pub(crate) fn continue_family<'py>(
     options: FamilyOptions,
 ) -> PyResult<Bound<'py, PyDict>> {
     let walker = &params.walker;
-    if options.wheel_only {
+    if let Some(option) = options.wheel_only {
         let reason = format!(
-            "`two_param`, `initial` and `period` take the wheel's continuation; the model `{}` follows its \
-             start's family only so far (docs/model.md section 13)",
+            "is an option of the wheel's continuation; the model `{}` follows its start's family only so far \
+             (docs/model.md section 13)",
             params.name()
         );
-        return Err(option_error("model", reason));
+        return Err(option_error(option, reason));
     }
     let job = WalkerContinueJob {
         walker: walker.clone(),

@@ -179,10 +179,12 @@ def test_a_malformed_description_names_its_line(tmp_path):
         (lambda p: vrw.simulate(p, initial=[0.2]), "1 values given; the section of `simplest` has 2"),
         (lambda p: vrw.continue_family(p, "slope", range=(0.005, 0.017), two_param=("slope", 0, 1)),
          "`two_param`"),
+        (lambda p: vrw.continue_family(p, "slope", range=(0.005, 0.017), extremum=["speed"]),
+         "`extremum` is an option of the wheel's continuation"),
         (lambda p: vrw.orbit(p, "slope", range=(0.01, 0.011), points=2, part="coarse"), "`part`"),
     ],
     ids=["map key", "map axes", "curve_method", "second_route", "map rows", "basin coordinate", "basin rows",
-         "sweep key", "sweep value", "progress", "initial", "two_param", "part"],
+         "sweep key", "sweep value", "progress", "initial", "two_param", "extremum", "part"],
 )
 def test_a_job_a_walker_does_not_run_raises_config_error_naming_the_model(job, words):
     with pytest.raises(ValueError, match=words.replace("(", r"\(")) as raised:
