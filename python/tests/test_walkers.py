@@ -180,7 +180,7 @@ def test_a_malformed_description_names_its_line(tmp_path):
         (lambda p: vrw.continue_family(p, "slope", range=(0.005, 0.017), two_param=("slope", 0, 1)),
          "`two_param`"),
         (lambda p: vrw.continue_family(p, "slope", range=(0.005, 0.017), extremum=["speed"]),
-         "`extremum` is an option of the wheel's continuation"),
+         "invalid `extremum`: is an option of the wheel's continuation"),
         (lambda p: vrw.orbit(p, "slope", range=(0.01, 0.011), points=2, part="coarse"), "`part`"),
     ],
     ids=["map key", "map axes", "curve_method", "second_route", "map rows", "basin coordinate", "basin rows",
