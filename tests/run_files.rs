@@ -97,6 +97,8 @@ fn simulate_writes_a_running_summary_before_the_walk() {
     let (tmp, sim) = simulated("3");
     let m = manifest(&sim);
     assert_eq!(m["status"], "completed");
+    // The wheel's manifest names no model (a walker's does: tests/walkers.rs).
+    assert!(m.get("model").is_none(), "{m}");
     assert_eq!(
         m["files"],
         serde_json::json!(["steps.csv", "trajectory.csv", "summary.json"])

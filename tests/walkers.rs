@@ -74,6 +74,8 @@ fn simulate_plot_and_animate_each_walker() {
         );
         let manifest = json(&out.join("manifest.json"));
         assert_eq!(manifest["command"], "simulate");
+        // The manifest names the walker (the wheel's has no `model`: its files are as before).
+        assert_eq!(manifest["model"], model);
         ok(&vrw(&["plot", o], tmp.path()));
         ok(&vrw(&["animate", o, "--still", "1.0"], tmp.path()));
         ok(&vrw(

@@ -192,7 +192,17 @@ fn in_run<T>(
     command: &str,
     body: impl FnOnce(&mut RunDir) -> Result<(T, Option<String>), AppError>,
 ) -> Result<T, AppError> {
-    let mut run = RunDir::start(dir, command, overwrite)?;
+    in_run_on(dir, overwrite, (command, None), body)
+}
+
+/// [`in_run`] of a job on the walker `model` (`None`: the wheel), which the manifest names.
+fn in_run_on<T>(
+    dir: &std::path::Path,
+    overwrite: bool,
+    (command, model): (&str, Option<&str>),
+    body: impl FnOnce(&mut RunDir) -> Result<(T, Option<String>), AppError>,
+) -> Result<T, AppError> {
+    let mut run = RunDir::start_on(dir, command, model, overwrite)?;
     match body(&mut run) {
         Ok((value, None)) => {
             run.finish(RunStatus::Completed, None)?;

@@ -26,7 +26,7 @@ use super::walker_orbit::least_period;
 use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::FRESH_TRANSIENT;
 use super::walkers::{as_map, named, start_of, Walker};
-use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
+use super::{check_interrupted, check_phase_interrupted, in_run_on, AppError, NOTHING_WRITTEN};
 use crate::gait::periodicity::{MAX_PERIOD, RETURN_WINDOW};
 use crate::output;
 use crate::output::basin_plot::{write_basin_figure, BasinFigure};
@@ -353,24 +353,29 @@ pub fn run_walker_basin(
         output::manifest::check_out_dir(&job.out_dir, "basin", job.overwrite)?;
         Ok(())
     })?;
-    in_run(&job.out_dir, job.overwrite, "basin", |run| {
-        let grid = walker_basin_points(
-            &job.walker,
-            (&found.section, &axes),
-            (job.grid.max_steps, job.grid.tolerance),
-            progress,
-        );
-        write_rows(&run.path("basin.csv"), &basin_rows(&names, &grid))?;
-        run.add("basin.csv");
-        let total = axes[0].points * axes[1].points;
-        check_interrupted(grid.iter().map(Vec::len).sum(), total, "basin.csv")?;
-        let summary = summary(job, (model.name(), &names), &found, axes, &grid);
-        write_basin_figure(&figure(&summary, &found, &grid), &run.path("basin.png"))?;
-        run.add("basin.png");
-        output::write_json(&run.path("basin.json"), &summary)?;
-        run.add("basin.json");
-        Ok((summary, None))
-    })
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("basin", Some(&job.walker.name())),
+        |run| {
+            let grid = walker_basin_points(
+                &job.walker,
+                (&found.section, &axes),
+                (job.grid.max_steps, job.grid.tolerance),
+                progress,
+            );
+            write_rows(&run.path("basin.csv"), &basin_rows(&names, &grid))?;
+            run.add("basin.csv");
+            let total = axes[0].points * axes[1].points;
+            check_interrupted(grid.iter().map(Vec::len).sum(), total, "basin.csv")?;
+            let summary = summary(job, (model.name(), &names), &found, axes, &grid);
+            write_basin_figure(&figure(&summary, &found, &grid), &run.path("basin.png"))?;
+            run.add("basin.png");
+            output::write_json(&run.path("basin.json"), &summary)?;
+            run.add("basin.json");
+            Ok((summary, None))
+        },
+    )
 }
 
 /// The basin of [`run_walker_basin`] without its files and figure (the Python binding): `basin.json`'s fields

@@ -13,7 +13,7 @@ use super::legged::{legged_interruptible, search_legged_gait};
 use super::walker_model::{interruptible, search_gait};
 use super::walker_output::{write_rows, WalkerOutput};
 use super::walkers::{as_map, named, rigid_start, unreachable_walk, Walker};
-use super::{in_run, AppError};
+use super::{in_run_on, AppError};
 use crate::continuation::{
     continue_family, ContinuationOptions, FamilyEnd, FamilyMap, FamilyPoint, SpecialKind,
 };
@@ -92,15 +92,20 @@ pub struct WalkerSpecialPoint {
 pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinueSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "continue", job.overwrite)?;
     let WalkerOutput { summary, tables } = compute_walker_continuation(job)?;
-    in_run(&job.out_dir, job.overwrite, "continue", |run| {
-        for (name, rows) in &tables {
-            write_rows(&run.path(name), rows)?;
-            run.add(name);
-        }
-        output::write_json(&run.path("special_points.json"), &summary)?;
-        run.add("special_points.json");
-        Ok((summary, None))
-    })
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("continue", Some(&job.walker.name())),
+        |run| {
+            for (name, rows) in &tables {
+                write_rows(&run.path(name), rows)?;
+                run.add(name);
+            }
+            output::write_json(&run.path("special_points.json"), &summary)?;
+            run.add("special_points.json");
+            Ok((summary, None))
+        },
+    )
 }
 
 /// The family of [`run_walker_continuation`] without its files (the Python binding): `special_points.json`'s

@@ -28,7 +28,7 @@ use super::walker_sweep::{
     gait_at, sweep_rows, thresholds, walker_gaits, WalkerRange, WalkerSweepPoint, WalkerThreshold,
 };
 use super::walkers::{start_of, Walker};
-use super::{check_interrupted, check_phase_interrupted, in_run, AppError};
+use super::{check_interrupted, check_phase_interrupted, in_run_on, AppError};
 use crate::output;
 use crate::output::walker_map_plot::{write_walker_map_figure, MapCell, WalkerMapFigure};
 use crate::study::grid::{run_rows, Evaluated};
@@ -253,31 +253,36 @@ pub fn run_walker_map(
     let names = model.section_names();
     let model_name = model.name().to_string();
     output::manifest::check_out_dir(&job.out_dir, "map", job.overwrite)?;
-    in_run(&job.out_dir, job.overwrite, "map", |run| {
-        let map = walker_map_gaits(job, values, &start, progress)?;
-        write_rows(&run.path("map.csv"), &map_rows(job, &names, &map))?;
-        run.add("map.csv");
-        let done = map.rows.iter().map(Vec::len).sum();
-        check_interrupted(done, map.xs.len() * map.ys.len(), "map.csv")?;
-        let thresholds = match job.thresholds {
-            true => row_thresholds(job, &names, &map)?,
-            false => Vec::new(),
-        };
-        check_phase_interrupted(
-            None,
-            "while bisecting the thresholds",
-            "map.csv is complete; no threshold is kept",
-        )?;
-        let mut files = vec!["map.csv".to_string()];
-        let figure = map_figure(job, &model_name, &map, &thresholds);
-        write_walker_map_figure(&figure, &run.path("map.png"))?;
-        run.add("map.png");
-        files.extend(["map.png", "map.json"].map(String::from));
-        let summary = summary(job, &model_name, &map, thresholds, files);
-        output::write_json(&run.path("map.json"), &summary)?;
-        run.add("map.json");
-        Ok((summary, None))
-    })
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("map", Some(&job.walker.name())),
+        |run| {
+            let map = walker_map_gaits(job, values, &start, progress)?;
+            write_rows(&run.path("map.csv"), &map_rows(job, &names, &map))?;
+            run.add("map.csv");
+            let done = map.rows.iter().map(Vec::len).sum();
+            check_interrupted(done, map.xs.len() * map.ys.len(), "map.csv")?;
+            let thresholds = match job.thresholds {
+                true => row_thresholds(job, &names, &map)?,
+                false => Vec::new(),
+            };
+            check_phase_interrupted(
+                None,
+                "while bisecting the thresholds",
+                "map.csv is complete; no threshold is kept",
+            )?;
+            let mut files = vec!["map.csv".to_string()];
+            let figure = map_figure(job, &model_name, &map, &thresholds);
+            write_walker_map_figure(&figure, &run.path("map.png"))?;
+            run.add("map.png");
+            files.extend(["map.png", "map.json"].map(String::from));
+            let summary = summary(job, &model_name, &map, thresholds, files);
+            output::write_json(&run.path("map.json"), &summary)?;
+            run.add("map.json");
+            Ok((summary, None))
+        },
+    )
 }
 
 /// The map of [`run_walker_map`] without its files and figure (the Python binding): `map.json`'s fields (`files`

@@ -18,7 +18,7 @@ use super::walker_model::WalkerStep;
 use super::walker_output::{write_rows, WalkerOutput};
 use super::walker_sweep::{walker_gaits, WalkerRange, WalkerSweepPoint};
 use super::walkers::Walker;
-use super::{check_interrupted, check_phase_interrupted, in_run, AppError, NOTHING_WRITTEN};
+use super::{check_interrupted, check_phase_interrupted, in_run_on, AppError, NOTHING_WRITTEN};
 use crate::output;
 use crate::output::orbit_plot::{write_orbit_figure, BranchPoint, OrbitFigure, OrbitPanel};
 use crate::study::grid::{run_rows, Evaluated};
@@ -199,47 +199,52 @@ pub fn run_walker_orbit(job: &WalkerOrbitJob) -> Result<WalkerOrbitSummary, AppE
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     let names = model.section_names();
     output::manifest::check_out_dir(&job.out_dir, "orbit", job.overwrite)?;
-    in_run(&job.out_dir, job.overwrite, "orbit", |run| {
-        let columns = diagram(job, &values, &start);
-        write_rows(
-            &run.path("orbit.csv"),
-            &orbit_rows(&job.range.param, &names, &columns),
-        )?;
-        run.add("orbit.csv");
-        check_interrupted(columns.len(), values.len(), "orbit.csv")?;
-        let mut files = vec!["orbit.csv".to_string()];
-        let branch = match job.branch {
-            true => walker_gaits(&job.walker, &job.range.param, &values, &start),
-            false => Vec::new(),
-        };
-        if job.branch {
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("orbit", Some(&job.walker.name())),
+        |run| {
+            let columns = diagram(job, &values, &start);
             write_rows(
-                &run.path("branch.csv"),
-                &branch_rows(&job.range.param, &names, &branch),
+                &run.path("orbit.csv"),
+                &orbit_rows(&job.range.param, &names, &columns),
             )?;
-            run.add("branch.csv");
-            files.push("branch.csv".to_string());
-            check_interrupted(
-                branch.len(),
-                values.len(),
-                "branch.csv (and orbit.csv, complete)",
-            )?;
-        }
-        let figure = orbit_figure(job, (&names[0], model.name()), &columns, &branch);
-        match write_orbit_figure(&figure, &run.path("orbit.png")) {
-            Ok(()) => {
-                run.add("orbit.png");
-                files.push("orbit.png".to_string());
+            run.add("orbit.csv");
+            check_interrupted(columns.len(), values.len(), "orbit.csv")?;
+            let mut files = vec!["orbit.csv".to_string()];
+            let branch = match job.branch {
+                true => walker_gaits(&job.walker, &job.range.param, &values, &start),
+                false => Vec::new(),
+            };
+            if job.branch {
+                write_rows(
+                    &run.path("branch.csv"),
+                    &branch_rows(&job.range.param, &names, &branch),
+                )?;
+                run.add("branch.csv");
+                files.push("branch.csv".to_string());
+                check_interrupted(
+                    branch.len(),
+                    values.len(),
+                    "branch.csv (and orbit.csv, complete)",
+                )?;
             }
-            Err(crate::output::style::PlotError::Empty(_)) => {}
-            Err(e) => return Err(e.into()),
-        }
-        files.push("orbit.json".to_string());
-        let summary = summary(job, model.name(), &columns, &branch, files);
-        output::write_json(&run.path("orbit.json"), &summary)?;
-        run.add("orbit.json");
-        Ok((summary, None))
-    })
+            let figure = orbit_figure(job, (&names[0], model.name()), &columns, &branch);
+            match write_orbit_figure(&figure, &run.path("orbit.png")) {
+                Ok(()) => {
+                    run.add("orbit.png");
+                    files.push("orbit.png".to_string());
+                }
+                Err(crate::output::style::PlotError::Empty(_)) => {}
+                Err(e) => return Err(e.into()),
+            }
+            files.push("orbit.json".to_string());
+            let summary = summary(job, model.name(), &columns, &branch, files);
+            output::write_json(&run.path("orbit.json"), &summary)?;
+            run.add("orbit.json");
+            Ok((summary, None))
+        },
+    )
 }
 
 /// The orbit diagram of [`run_walker_orbit`] without its files and figure (the Python binding): `orbit.json`'s

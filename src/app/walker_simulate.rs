@@ -13,7 +13,7 @@ use serde::Serialize;
 use super::walker_model::{Sampling, WalkerModel, WalkerSample, WalkerStep};
 use super::walker_output::WalkerOutput;
 use super::walkers::{as_map, named, Walker};
-use super::{in_run, AppError, WalkEnded, MAX_SIMULATE_STEPS, SAMPLE_DT_RANGE};
+use super::{in_run_on, AppError, WalkEnded, MAX_SIMULATE_STEPS, SAMPLE_DT_RANGE};
 use crate::mechanism::legged::walk::StepAccount;
 use crate::output::walker_run::{
     legged_step_values, walker_steps_header, walker_trajectory_header, StickFigure,
@@ -193,48 +193,53 @@ pub fn run_walker_simulate(job: &WalkerSimulateJob) -> Result<WalkerSimulateSumm
     let model = job.walker.model()?;
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     output::manifest::check_out_dir(&job.out_dir, "simulate", job.overwrite)?;
-    in_run(&job.out_dir, job.overwrite, "simulate", |run| {
-        let mut files = vec!["steps.csv".to_string()];
-        if job.trajectory {
-            files.push("trajectory.csv".to_string());
-        }
-        files.push("summary.json".to_string());
-        let mut summary = WalkerSimulateSummary::start(job, model.as_ref(), &start);
-        summary.files.clone_from(&files);
-        output::write_json(&run.path("summary.json"), &summary)?;
-        let names: Vec<&str> = files.iter().map(String::as_str).collect();
-        run.add_streaming(&names)?;
-        let section = model.section_names();
-        let mut steps = CsvStream::create(
-            &run.path("steps.csv"),
-            walker_steps_header(&section, model.legged()),
-        )?;
-        let mut trajectory = match job.trajectory {
-            true => Some(CsvStream::create(
-                &run.path("trajectory.csv"),
-                walker_trajectory_header(&model.coordinates(), &model.figure()),
-            )?),
-            false => None,
-        };
-        let mut to_steps = |row| steps.write(row).map_err(AppError::from);
-        let mut to_trajectory = |row| match trajectory.as_mut() {
-            Some(csv) => csv.write(row).map_err(AppError::from),
-            None => Ok(()),
-        };
-        let sinks = RowSinks {
-            steps: &mut to_steps,
-            trajectory: job.trajectory.then_some(&mut to_trajectory),
-        };
-        walk(job, model.as_ref(), start, &mut summary, sinks)?;
-        output::write_json(&run.path("summary.json"), &summary)?;
-        let interrupted = (summary.status == WalkEnded::Interrupted).then(|| {
-            format!(
-                "interrupted (Ctrl-C) after {} of {} steps",
-                summary.steps_completed, summary.steps_requested
-            )
-        });
-        Ok((summary, interrupted))
-    })
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("simulate", Some(&job.walker.name())),
+        |run| {
+            let mut files = vec!["steps.csv".to_string()];
+            if job.trajectory {
+                files.push("trajectory.csv".to_string());
+            }
+            files.push("summary.json".to_string());
+            let mut summary = WalkerSimulateSummary::start(job, model.as_ref(), &start);
+            summary.files.clone_from(&files);
+            output::write_json(&run.path("summary.json"), &summary)?;
+            let names: Vec<&str> = files.iter().map(String::as_str).collect();
+            run.add_streaming(&names)?;
+            let section = model.section_names();
+            let mut steps = CsvStream::create(
+                &run.path("steps.csv"),
+                walker_steps_header(&section, model.legged()),
+            )?;
+            let mut trajectory = match job.trajectory {
+                true => Some(CsvStream::create(
+                    &run.path("trajectory.csv"),
+                    walker_trajectory_header(&model.coordinates(), &model.figure()),
+                )?),
+                false => None,
+            };
+            let mut to_steps = |row| steps.write(row).map_err(AppError::from);
+            let mut to_trajectory = |row| match trajectory.as_mut() {
+                Some(csv) => csv.write(row).map_err(AppError::from),
+                None => Ok(()),
+            };
+            let sinks = RowSinks {
+                steps: &mut to_steps,
+                trajectory: job.trajectory.then_some(&mut to_trajectory),
+            };
+            walk(job, model.as_ref(), start, &mut summary, sinks)?;
+            output::write_json(&run.path("summary.json"), &summary)?;
+            let interrupted = (summary.status == WalkEnded::Interrupted).then(|| {
+                format!(
+                    "interrupted (Ctrl-C) after {} of {} steps",
+                    summary.steps_completed, summary.steps_requested
+                )
+            });
+            Ok((summary, interrupted))
+        },
+    )
 }
 
 /// The walk of [`run_walker_simulate`] without its files (the Python binding): `summary.json`'s fields (`files`

@@ -13,7 +13,7 @@ use serde::Serialize;
 use super::walker_model::FoundGait;
 use super::walker_output::{write_rows, WalkerOutput};
 use super::walkers::{as_map, named, Walker};
-use super::{check_interrupted, in_run, AppError};
+use super::{check_interrupted, in_run_on, AppError};
 use crate::output;
 use crate::study::grid::{run_rows, Evaluated};
 
@@ -211,22 +211,27 @@ pub fn run_walker_sweep(job: &WalkerSweepJob) -> Result<WalkerSweepSummary, AppE
     let start = super::walkers::start_of(model.as_ref(), job.initial.as_deref())?;
     let names = model.section_names();
     output::manifest::check_out_dir(&job.out_dir, "sweep", job.overwrite)?;
-    in_run(&job.out_dir, job.overwrite, "sweep", |run| {
-        let points = walker_gaits(&job.walker, &job.range.param, &values, &start);
-        let rows = sweep_rows(&job.range.param, &names, &points);
-        write_rows(&run.path("sweep.csv"), &rows)?;
-        run.add("sweep.csv");
-        check_interrupted(points.len(), values.len(), "sweep.csv")?;
-        let summary = sweep_summary(
-            job,
-            (model.name(), &names),
-            &points,
-            "sweep.csv is complete",
-        )?;
-        output::write_json(&run.path("thresholds.json"), &summary)?;
-        run.add("thresholds.json");
-        Ok((summary, None))
-    })
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("sweep", Some(&job.walker.name())),
+        |run| {
+            let points = walker_gaits(&job.walker, &job.range.param, &values, &start);
+            let rows = sweep_rows(&job.range.param, &names, &points);
+            write_rows(&run.path("sweep.csv"), &rows)?;
+            run.add("sweep.csv");
+            check_interrupted(points.len(), values.len(), "sweep.csv")?;
+            let summary = sweep_summary(
+                job,
+                (model.name(), &names),
+                &points,
+                "sweep.csv is complete",
+            )?;
+            output::write_json(&run.path("thresholds.json"), &summary)?;
+            run.add("thresholds.json");
+            Ok((summary, None))
+        },
+    )
 }
 
 /// The sweep of [`run_walker_sweep`] at `values` (the range's, [`WalkerRange::values`], or others the caller

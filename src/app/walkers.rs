@@ -16,7 +16,7 @@ use super::walker_derivatives::{
 use super::walker_model::{
     found_rigid, search_gait, FoundGait, RigidModel, WalkerGaitError, WalkerModel,
 };
-use super::{in_run, AppError, SearchEnded};
+use super::{in_run_on, AppError, SearchEnded};
 use crate::mechanism::compass::Compass;
 use crate::mechanism::derivative_check::{DerivativeCheck, ParameterDerivative};
 use crate::mechanism::described::{self, AnyDescribed, Walk};
@@ -346,11 +346,16 @@ pub struct WalkerParamDerivative {
 pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppError> {
     crate::output::manifest::check_out_dir(&job.out_dir, "gait", job.overwrite)?;
     let summary = compute_walker_gait(job)?;
-    in_run(&job.out_dir, job.overwrite, "gait", |run| {
-        output::write_json(&run.path("gait.json"), &summary)?;
-        run.add("gait.json");
-        Ok((summary, None))
-    })
+    in_run_on(
+        &job.out_dir,
+        job.overwrite,
+        ("gait", Some(&job.walker.name())),
+        |run| {
+            output::write_json(&run.path("gait.json"), &summary)?;
+            run.add("gait.json");
+            Ok((summary, None))
+        },
+    )
 }
 
 /// The search of [`run_walker_gait`] without its file (the Python binding): `gait.json`'s fields (`job.out_dir`

@@ -118,6 +118,10 @@ pub struct Manifest {
     pub vrw_version: String,
     /// The job: `simulate`, `gait`, `sweep`, `map`, `orbit` or `basin`.
     pub command: String,
+    /// The walker the job ran on, for a walker other than the wheel (`--model`: `simplest`, `compass`,
+    /// `telescopic`, or a described walker's name); absent for the wheel, whose manifests are as before.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
     /// How the run ended.
     pub status: RunStatus,
     /// Why it was interrupted or failed.
@@ -195,6 +199,19 @@ impl RunDir {
     /// [`OutputError`] naming the directory (or the stale file) when it cannot be created, written or cleared,
     /// or when it holds files vrw did not write, or another command's run without `overwrite`.
     pub fn start(dir: &Path, command: &str, overwrite: bool) -> Result<RunDir, OutputError> {
+        RunDir::start_on(dir, command, None, overwrite)
+    }
+
+    /// [`RunDir::start`] of a job on the walker `model` (`None`: the wheel), which the manifest names.
+    ///
+    /// # Errors
+    /// As [`RunDir::start`].
+    pub fn start_on(
+        dir: &Path,
+        command: &str,
+        model: Option<&str>,
+        overwrite: bool,
+    ) -> Result<RunDir, OutputError> {
         let replaced = check_out_dir(dir, command, overwrite)?;
         clear(dir, replaced.as_ref())?;
         let run = RunDir {
@@ -202,6 +219,7 @@ impl RunDir {
             manifest: Manifest {
                 vrw_version: env!("CARGO_PKG_VERSION").to_string(),
                 command: command.to_string(),
+                model: model.map(str::to_string),
                 status: RunStatus::Running,
                 reason: None,
                 files: Vec::new(),
