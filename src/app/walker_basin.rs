@@ -356,7 +356,7 @@ pub fn run_walker_basin(
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("basin", Some(&job.walker.name())),
+        ("basin", Some(job.walker.name())),
         |run| {
             let grid = walker_basin_points(
                 &job.walker,

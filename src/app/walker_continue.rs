@@ -95,7 +95,7 @@ pub fn run_walker_continuation(job: &WalkerContinueJob) -> Result<WalkerContinue
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("continue", Some(&job.walker.name())),
+        ("continue", Some(job.walker.name())),
         |run| {
             for (name, rows) in &tables {
                 write_rows(&run.path(name), rows)?;

@@ -256,7 +256,7 @@ pub fn run_walker_map(
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("map", Some(&job.walker.name())),
+        ("map", Some(job.walker.name())),
         |run| {
             let map = walker_map_gaits(job, values, &start, progress)?;
             write_rows(&run.path("map.csv"), &map_rows(job, &names, &map))?;

@@ -202,7 +202,7 @@ pub fn run_walker_orbit(job: &WalkerOrbitJob) -> Result<WalkerOrbitSummary, AppE
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("orbit", Some(&job.walker.name())),
+        ("orbit", Some(job.walker.name())),
         |run| {
             let columns = diagram(job, &values, &start);
             write_rows(

@@ -196,7 +196,7 @@ pub fn run_walker_simulate(job: &WalkerSimulateJob) -> Result<WalkerSimulateSumm
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("simulate", Some(&job.walker.name())),
+        ("simulate", Some(job.walker.name())),
         |run| {
             let mut files = vec!["steps.csv".to_string()];
             if job.trajectory {

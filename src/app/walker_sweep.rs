@@ -214,7 +214,7 @@ pub fn run_walker_sweep(job: &WalkerSweepJob) -> Result<WalkerSweepSummary, AppE
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("sweep", Some(&job.walker.name())),
+        ("sweep", Some(job.walker.name())),
         |run| {
             let points = walker_gaits(&job.walker, &job.range.param, &values, &start);
             let rows = sweep_rows(&job.range.param, &names, &points);

@@ -349,7 +349,7 @@ pub fn run_walker_gait(job: &WalkerGaitJob) -> Result<WalkerGaitSummary, AppErro
     in_run_on(
         &job.out_dir,
         job.overwrite,
-        ("gait", Some(&job.walker.name())),
+        ("gait", Some(job.walker.name())),
         |run| {
             output::write_json(&run.path("gait.json"), &summary)?;
             run.add("gait.json");
