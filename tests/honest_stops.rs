@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_error, ok, simulated, stderr, vrw};
+use common::{assert_error, json, ok, simulated, stderr, vrw};
 
 use std::fs;
 use std::path::Path;
@@ -15,10 +15,6 @@ use serde_json::Value;
 
 fn manifest(dir: &Path) -> Value {
     serde_json::from_str(&fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap()
-}
-
-fn json(path: &Path) -> Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
 }
 
 fn spawn(args: &[&str], dir: &Path) -> Child {

@@ -5,24 +5,8 @@
 mod common;
 
 use std::fs;
-use std::path::Path;
 
-use common::{assert_error, ok, vrw};
-use serde_json::Value;
-
-/// The JSON file `path`.
-fn json(path: &Path) -> Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
-}
-
-/// The header and the rows of the CSV file `path` (no field holds a comma on these runs' rows that are read).
-fn table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = fs::read_to_string(path).unwrap();
-    let mut lines = text
-        .lines()
-        .map(|l| l.split(',').map(String::from).collect::<Vec<_>>());
-    (lines.next().unwrap(), lines.collect())
-}
+use common::{assert_error, json, ok, table, vrw};
 
 /// `vrw map --model compass` over (slope, leg_mass_offset): a row per point named by the model's section, the
 /// summary's counts adding up to the grid, the figure, the manifest.

@@ -10,22 +10,8 @@ use std::fs;
 use std::path::Path;
 use std::process::Command;
 
-use common::{assert_error, ok, vrw};
+use common::{assert_error, json, ok, table, vrw};
 use serde_json::Value;
-
-/// The JSON file `path`.
-fn json(path: &Path) -> Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
-}
-
-/// The header and the rows of the CSV file `path`.
-fn table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = fs::read_to_string(path).unwrap();
-    let mut lines = text
-        .lines()
-        .map(|l| l.split(',').map(String::from).collect::<Vec<_>>());
-    (lines.next().unwrap(), lines.collect())
-}
 
 /// `vrw simulate --model M` writes the walk named by the model's coordinates, and `vrw plot` and
 /// `vrw animate` draw it.

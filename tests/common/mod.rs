@@ -57,3 +57,19 @@ pub fn simulated(steps: &str) -> (TempDir, PathBuf) {
     ));
     (tmp, out)
 }
+
+/// The JSON file `path` (not every test binary reads one: hence the `allow`).
+#[allow(dead_code)]
+pub fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The header and the rows of the CSV file `path` (split at every comma: for files whose fields hold none).
+#[allow(dead_code)]
+pub fn table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect::<Vec<_>>());
+    (lines.next().unwrap(), lines.collect())
+}
