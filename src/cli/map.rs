@@ -189,19 +189,20 @@ fn map_job(args: &MapArgs) -> Result<MapJob> {
     })
 }
 
+/// The map's two axes as the first summary line names them: `X from A to B (NX) x Y from C to D (NY)`.
+fn axes(args: &MapArgs) -> String {
+    format!(
+        "{} from {} to {} ({}) x {} from {} to {} ({})",
+        args.x, args.x_from, args.x_to, args.nx, args.y, args.y_from, args.y_to, args.ny
+    )
+}
+
 /// The first summary line: the two axes, the gaits found and the time spent (`seconds` in all).
 fn print_totals(args: &MapArgs, summary: &MapSummary, seconds: f64) {
     println!(
-        "vrw map: {} from {} to {} ({}) x {} from {} to {} ({}): gait found at {} of {} points; {:.2} s \
-         (gaits {:.2} s, curves {:.2} s, of which continued {:.2} s)",
-        args.x,
-        args.x_from,
-        args.x_to,
-        args.nx,
-        args.y,
-        args.y_from,
-        args.y_to,
-        args.ny,
+        "vrw map: {}: gait found at {} of {} points; {:.2} s (gaits {:.2} s, curves {:.2} s, of which \
+         continued {:.2} s)",
+        axes(args),
         summary.gaits_found,
         summary.points,
         seconds,
@@ -337,16 +338,9 @@ fn run_walker(args: &MapArgs, walker: Walker) -> Result<()> {
     bar.finish_and_clear();
     let statuses: Vec<String> = s.statuses.iter().map(|(k, n)| format!("{k} {n}")).collect();
     println!(
-        "vrw map --model {}: {} from {} to {} ({}) x {} from {} to {} ({}): {}; {:.2} s",
+        "vrw map --model {}: {}: {}; {:.2} s",
         s.model,
-        args.x,
-        args.x_from,
-        args.x_to,
-        args.nx,
-        args.y,
-        args.y_from,
-        args.y_to,
-        args.ny,
+        axes(args),
         statuses.join(", "),
         started.elapsed().as_secs_f64()
     );
